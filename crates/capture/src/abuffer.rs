@@ -1,0 +1,297 @@
+//! The A-buffer scheme (ABS): FreePipe (Liu et al., I3D 2010) §4.2, after Carpenter 1984.
+//!
+//! **Algorithm.** Each pixel owns a counter (initially 0) and a run of slots. A fragment takes a
+//! slot with `k = atomicInc(&counter, …)` (here `fetch_add(1)`: CUDA's `atomicInc` is the same
+//! until it wraps at its bound) and writes itself into slot `k` with a plain store: two steps, two
+//! memory operations. A post pass, one pixel at a time, sorts each list by insertion sort or by a
+//! bitonic network (the paper names both); both give the canonical order.
+//!
+//! **Guarantee.** Fetch-and-add hands out distinct slot numbers under any interleaving, so no two
+//! fragments write one slot and no write is lost: every fragment is captured, exactly, as long as
+//! storage suffices. A fragment whose slot number is past the pixel's capacity is dropped and
+//! counted: the counter keeps counting, so `counter − capacity` is the pixel's overflow, read by
+//! the post pass and reported (never a write out of bounds). One geometry pass; memory: one
+//! counter per pixel plus the slots.
+//!
+//! **Storage.** Either a fixed capacity per pixel (the GPU's usual layout) or *exact*: sized from a
+//! counting pass's per-pixel depth complexity, as one flat array indexed by the prefix sum of the
+//! counts, with no padding.
+//!
+//! Unlike CUDA's `atomicInc(addr, bound)`, which wraps to 0 past `bound` and so would overwrite
+//! slot 0, the counter here never wraps: a pixel receives at most one fragment per triangle and a
+//! view has fewer than 2^32 triangles.
+
+use fragsim_raster::{Fragment, Viewport};
+
+use crate::capture::{Capture, Identity, Keeps};
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Layout, Scheme, Step, MEMORY_CAP_DEFAULT};
+
+/// The post pass's sort.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PostSort {
+    /// Insertion sort: quadratic, the best for the short lists of most pixels.
+    #[default]
+    Insertion,
+    /// A bitonic sorting network over the list padded to a power of two.
+    Bitonic,
+}
+
+/// The A-buffer scheme.
+#[derive(Clone, Debug)]
+pub struct ABuffer {
+    storage: Storage,
+    sort: PostSort,
+}
+
+/// Where each pixel's slots are.
+#[derive(Clone, Debug)]
+enum Storage {
+    /// `capacity` slots per pixel, pixel `p`'s starting at `p * capacity`.
+    Fixed { pixels: usize, capacity: usize },
+    /// `offsets[p]..offsets[p + 1]` are pixel `p`'s slots.
+    Exact { offsets: Vec<usize> },
+}
+
+/// A fragment's progress: take a slot, then write it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Claim {
+    /// Before the `fetch_add` on the pixel's counter.
+    Count {
+        /// The pixel.
+        pixel: u32,
+        /// The value to store.
+        value: u64,
+    },
+    /// Slot taken; the store is next.
+    Write {
+        /// The slot.
+        slot: usize,
+        /// The value to store.
+        value: u64,
+    },
+}
+
+impl ABuffer {
+    /// `capacity` slots for every pixel.
+    ///
+    /// # Errors
+    /// `capacity == 0`, or storage beyond `memory_cap` bytes.
+    pub fn fixed(
+        viewport: Viewport,
+        capacity: u32,
+        sort: PostSort,
+        memory_cap: u64,
+    ) -> Result<Self, CaptureError> {
+        if capacity == 0 {
+            return Err(CaptureError::BadParameter(
+                "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
+            ));
+        }
+        let needed = viewport.pixels() as u64 * (u64::from(capacity) * 8 + 4);
+        if needed > memory_cap {
+            return Err(CaptureError::TooMuchMemory {
+                scheme: "abuffer".into(),
+                needed,
+                cap: memory_cap,
+            });
+        }
+        Ok(Self {
+            storage: Storage::Fixed {
+                pixels: viewport.pixels(),
+                capacity: capacity as usize,
+            },
+            sort,
+        })
+    }
+
+    /// Exactly `counts[p]` slots for pixel `p` (the counts of a counting pass), in one flat array.
+    ///
+    /// # Errors
+    /// Storage beyond `memory_cap` bytes.
+    pub fn exact(counts: &[u32], sort: PostSort, memory_cap: u64) -> Result<Self, CaptureError> {
+        let mut offsets = Vec::with_capacity(counts.len() + 1);
+        let mut total = 0usize;
+        offsets.push(0);
+        for &c in counts {
+            total += c as usize;
+            offsets.push(total);
+        }
+        let scheme = Self {
+            storage: Storage::Exact { offsets },
+            sort,
+        };
+        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
+        Ok(scheme)
+    }
+
+    /// Like [`ABuffer::exact`] with insertion sort and the default cap.
+    ///
+    /// # Errors
+    /// As [`ABuffer::exact`].
+    pub fn exact_default(counts: &[u32]) -> Result<Self, CaptureError> {
+        Self::exact(counts, PostSort::Insertion, MEMORY_CAP_DEFAULT)
+    }
+
+    /// The first slot of `pixel` and how many it has.
+    fn slots(&self, pixel: usize) -> (usize, usize) {
+        match &self.storage {
+            Storage::Fixed { capacity, .. } => (pixel * capacity, *capacity),
+            Storage::Exact { offsets } => (offsets[pixel], offsets[pixel + 1] - offsets[pixel]),
+        }
+    }
+
+    fn pixels(&self) -> usize {
+        match &self.storage {
+            Storage::Fixed { pixels, .. } => *pixels,
+            Storage::Exact { offsets } => offsets.len() - 1,
+        }
+    }
+}
+
+impl Scheme for ABuffer {
+    type State = Claim;
+
+    fn name(&self) -> String {
+        let sort = match self.sort {
+            PostSort::Insertion => "",
+            PostSort::Bitonic => "-bitonic",
+        };
+        let storage = match self.storage {
+            Storage::Fixed { .. } => "-fixed",
+            Storage::Exact { .. } => "",
+        };
+        format!("abuffer{storage}{sort}")
+    }
+
+    fn layout(&self) -> Layout {
+        let (slots, table_bytes) = match &self.storage {
+            Storage::Fixed { pixels, capacity } => (pixels * capacity, 0),
+            // A GPU would keep 32-bit offsets: that is what is counted.
+            Storage::Exact { offsets } => (offsets[offsets.len() - 1], offsets.len() * 4),
+        };
+        Layout {
+            words32: self.pixels(),
+            init32: 0,
+            words64: slots,
+            init64: u64::MAX,
+            table_bytes,
+        }
+    }
+
+    fn begin(&self, fragment: Fragment) -> Claim {
+        Claim::Count {
+            pixel: fragment.pixel,
+            value: fragment.packed(),
+        }
+    }
+
+    fn step<M: Memory>(&self, claim: &mut Claim, memory: &M) -> Step {
+        match *claim {
+            Claim::Count { pixel, value } => {
+                let taken = WordMemory::<u32>::fetch_add(memory, pixel as usize, 1) as usize;
+                let (first, capacity) = self.slots(pixel as usize);
+                if taken < capacity {
+                    *claim = Claim::Write {
+                        slot: first + taken,
+                        value,
+                    };
+                    Step::Continue
+                } else {
+                    Step::Dropped
+                }
+            }
+            Claim::Write { slot, value } => {
+                WordMemory::<u64>::store(memory, slot, value);
+                Step::Stored
+            }
+        }
+    }
+
+    fn resolve<M: Memory>(&self, memory: &M) -> Capture {
+        let pixels = self.pixels();
+        let mut overflow = vec![0u32; pixels];
+        let mut capture = Capture::with_pixels(
+            pixels,
+            Identity::KeyAndPrim,
+            Keeps::All {
+                overflow: Vec::new(),
+            },
+        );
+        let mut list = Vec::new();
+        for (pixel, overflowed) in overflow.iter_mut().enumerate() {
+            let count = WordMemory::<u32>::load(memory, pixel) as usize;
+            let (first, capacity) = self.slots(pixel);
+            let stored = count.min(capacity);
+            *overflowed = (count - stored) as u32;
+            list.clear();
+            list.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
+            match self.sort {
+                PostSort::Insertion => insertion_sort(&mut list),
+                PostSort::Bitonic => bitonic_sort(&mut list),
+            }
+            capture.push_pixel(list.iter().copied());
+        }
+        capture.keeps = Keeps::All { overflow };
+        capture
+    }
+}
+
+/// Insertion sort, as a GPU thread sorts a short list in registers.
+pub fn insertion_sort(list: &mut [u64]) {
+    for i in 1..list.len() {
+        let value = list[i];
+        let mut j = i;
+        while j > 0 && list[j - 1] > value {
+            list[j] = list[j - 1];
+            j -= 1;
+        }
+        list[j] = value;
+    }
+}
+
+/// Bitonic sort: the list is padded with `u64::MAX` to a power of two and sorted by the network of
+/// Batcher (1968), compare-exchange stage by stage as a GPU thread (or warp) runs it.
+pub fn bitonic_sort(list: &mut Vec<u64>) {
+    let len = list.len();
+    let padded = len.next_power_of_two();
+    list.resize(padded, u64::MAX);
+    let mut size = 2;
+    while size <= padded {
+        let mut stride = size / 2;
+        while stride > 0 {
+            for i in 0..padded {
+                let partner = i ^ stride;
+                if partner > i {
+                    let ascending = i & size == 0;
+                    if (list[i] > list[partner]) == ascending {
+                        list.swap(i, partner);
+                    }
+                }
+            }
+            stride /= 2;
+        }
+        size *= 2;
+    }
+    list.truncate(len);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn both_sorts_sort() {
+        let mut rng = fragsim_raster::SplitMix64::new(7);
+        for len in 0..40 {
+            let list: Vec<u64> = (0..len).map(|_| rng.next_u64() % 50).collect();
+            let mut expected = list.clone();
+            expected.sort_unstable();
+            let (mut a, mut b) = (list.clone(), list);
+            insertion_sort(&mut a);
+            bitonic_sort(&mut b);
+            assert_eq!(a, expected);
+            assert_eq!(b, expected);
+        }
+    }
+}

@@ -1,0 +1,82 @@
+//! What a scheme hands back: per-pixel fragment lists, and what it was meant to keep.
+
+/// How much of a fragment a scheme's words identify.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Identity {
+    /// Depth key and primitive id (64-bit words): compared fragment for fragment.
+    KeyAndPrim,
+    /// Depth key only (32-bit words, as FreePipe's Table 1): compared by key.
+    KeyOnly,
+}
+
+/// Which of a pixel's fragments a scheme promises to keep.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Keeps {
+    /// The `K` nearest in canonical order (ascending MDTS).
+    Nearest(u32),
+    /// The `K` farthest (descending MDTS).
+    Farthest(u32),
+    /// Every fragment, except the per-pixel counts that overflowed fixed storage; which ones
+    /// overflow depends on arrival order.
+    All {
+        /// Per pixel, how many fragments found no free slot.
+        overflow: Vec<u32>,
+    },
+}
+
+/// Per-pixel lists of captured fragments in the order the scheme's post pass produced them.
+///
+/// Entries are packed `depth_key << 32 | prim` (see `Fragment::packed`); with
+/// [`Identity::KeyOnly`] the low half is zero.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Capture {
+    /// `offsets[p]..offsets[p + 1]` indexes pixel `p`'s entries.
+    pub offsets: Vec<usize>,
+    /// The entries of all pixels, pixel after pixel.
+    pub entries: Vec<u64>,
+    /// What the entries identify.
+    pub identity: Identity,
+    /// What the scheme promises to keep.
+    pub keeps: Keeps,
+}
+
+impl Capture {
+    /// An empty capture builder for `pixels` pixels.
+    #[must_use]
+    pub fn with_pixels(pixels: usize, identity: Identity, keeps: Keeps) -> Self {
+        let mut offsets = Vec::with_capacity(pixels + 1);
+        offsets.push(0);
+        Self {
+            offsets,
+            entries: Vec::new(),
+            identity,
+            keeps,
+        }
+    }
+
+    /// Appends the next pixel's list.
+    pub fn push_pixel(&mut self, entries: impl IntoIterator<Item = u64>) {
+        self.entries.extend(entries);
+        self.offsets.push(self.entries.len());
+    }
+
+    /// Number of pixels.
+    #[must_use]
+    pub fn pixels(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Pixel `p`'s entries.
+    #[must_use]
+    pub fn pixel(&self, p: usize) -> &[u64] {
+        &self.entries[self.offsets[p]..self.offsets[p + 1]]
+    }
+
+    /// The nearest depth key per pixel (`None` where nothing was captured), for images.
+    #[must_use]
+    pub fn nearest_keys(&self) -> Vec<Option<u32>> {
+        (0..self.pixels())
+            .map(|p| self.pixel(p).iter().map(|&e| (e >> 32) as u32).min())
+            .collect()
+    }
+}

@@ -1,0 +1,246 @@
+//! The multi-depth test scheme (MDTS): FreePipe (Liu et al., I3D 2010) §4.1.1 and Table 1.
+//!
+//! **Algorithm.** Each pixel owns `K` words initialised to the empty sentinel. A fragment walks
+//! them in order: `old = atomicMin(&A[i], new)`; if `old` is the sentinel the fragment has landed
+//! and stops; otherwise it carries `new = max(new, old)` to slot `i + 1`. Past slot `K − 1` the
+//! carried value is dropped. The descending variant (§4.1.1, last paragraph) uses `atomicMax`,
+//! the empty value 0 and carries `min(new, old)`.
+//!
+//! **Guarantee.** Under any interleaving of the fragments' steps, when all are done each pixel's
+//! array holds exactly the `K` smallest values in ascending order (the `K` largest, descending, for
+//! the descending variant), each value once: the proof is in `docs/proof.md`, loom checks it
+//! exhaustively for small cases (`tests/loom.rs`). Exact up to `K`; with `K` at least the depth
+//! complexity it is exact. Memory: `K` words per pixel. One geometry pass; at most `K` atomic
+//! operations per fragment.
+//!
+//! **Words.** With `u64` words a value is `depth_key << 32 | prim`, so every fragment is distinct
+//! and the result is comparable fragment for fragment with the oracle; with `u32` words (as in the
+//! paper) a value is the depth key alone and equal depths are all kept (no early exit on equality).
+//!
+//! Unlike the paper's Table 1, which initialises to `0xFFFFFFFF` but stops on `0x7FFFFFFF`, the
+//! sentinel tested is the one stored (`u32::MAX` / `u64::MAX`); no depth key reaches it, since the
+//! largest is `0x3F80_0000` (depth 1.0). Unlike the paper's descending variant, whose empty value 0
+//! is also the key of depth 0.0, values are stored plus one so that no fragment equals empty.
+
+use fragsim_raster::{Fragment, Viewport};
+
+use crate::capture::{Capture, Identity, Keeps};
+use crate::memory::{Memory, Word, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Layout, Scheme, Step, MEMORY_CAP_DEFAULT};
+
+/// Which way the array is sorted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// `atomicMin`, empty = all ones: keeps the `K` nearest.
+    Ascending,
+    /// `atomicMax`, empty = 0: keeps the `K` farthest.
+    Descending,
+}
+
+/// A word type MDTS can sort: `u32` (depth key) or `u64` (depth key and primitive id).
+pub trait MdtsWord: Word {
+    /// What the word identifies.
+    const IDENTITY: Identity;
+    /// The word for a fragment (before the descending variant's offset).
+    fn encode(fragment: Fragment) -> Self;
+    /// The packed `key << 32 | prim` form of a word made by [`MdtsWord::encode`].
+    fn decode(self) -> u64;
+    /// This word type's array in `memory`.
+    fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self>;
+}
+
+impl MdtsWord for u32 {
+    const IDENTITY: Identity = Identity::KeyOnly;
+    fn encode(fragment: Fragment) -> Self {
+        fragment.depth_key
+    }
+    fn decode(self) -> u64 {
+        u64::from(self) << 32
+    }
+    fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self> {
+        memory
+    }
+}
+
+impl MdtsWord for u64 {
+    const IDENTITY: Identity = Identity::KeyAndPrim;
+    fn encode(fragment: Fragment) -> Self {
+        fragment.packed()
+    }
+    fn decode(self) -> u64 {
+        self
+    }
+    fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self> {
+        memory
+    }
+}
+
+/// The multi-depth test scheme over words of type `W` (default: `u64`, fragment identity kept).
+#[derive(Clone, Debug)]
+pub struct Mdts<W: MdtsWord = u64> {
+    pixels: usize,
+    k: u32,
+    direction: Direction,
+    _word: std::marker::PhantomData<W>,
+}
+
+/// A fragment's walk: the slot it tests next and the value it carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Walk<W> {
+    /// First word of the pixel's array.
+    pub base: usize,
+    /// Slot tested next.
+    pub slot: u32,
+    /// The value carried onward.
+    pub carried: W,
+}
+
+impl<W: MdtsWord> Mdts<W> {
+    /// MDTS with `k` slots per pixel, sorted in `direction`, within `memory_cap` bytes.
+    ///
+    /// # Errors
+    /// `k == 0`, or storage beyond `memory_cap`.
+    pub fn new(
+        viewport: Viewport,
+        k: u32,
+        direction: Direction,
+        memory_cap: u64,
+    ) -> Result<Self, CaptureError> {
+        if k == 0 {
+            return Err(CaptureError::BadParameter(
+                "MDTS needs K ≥ 1 slots per pixel, got K = 0".into(),
+            ));
+        }
+        let scheme = Self {
+            pixels: viewport.pixels(),
+            k,
+            direction,
+            _word: std::marker::PhantomData,
+        };
+        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
+        Ok(scheme)
+    }
+
+    /// Ascending MDTS (the paper's main form) with the default memory cap.
+    ///
+    /// # Errors
+    /// As [`Mdts::new`].
+    pub fn ascending(viewport: Viewport, k: u32) -> Result<Self, CaptureError> {
+        Self::new(viewport, k, Direction::Ascending, MEMORY_CAP_DEFAULT)
+    }
+
+    /// Slots per pixel.
+    #[must_use]
+    pub fn k(&self) -> u32 {
+        self.k
+    }
+
+    /// The empty value of a slot.
+    fn empty(&self) -> W {
+        match self.direction {
+            Direction::Ascending => W::MAX,
+            Direction::Descending => W::ZERO,
+        }
+    }
+
+    /// The stored value of a fragment.
+    fn stored(&self, fragment: Fragment) -> W {
+        let word = W::encode(fragment);
+        match self.direction {
+            Direction::Ascending => word,
+            // Keys never reach the top of the word, so the offset cannot wrap.
+            Direction::Descending => word.wrapping_add(W::ONE),
+        }
+    }
+}
+
+impl<W: MdtsWord> Scheme for Mdts<W> {
+    type State = Walk<W>;
+
+    fn name(&self) -> String {
+        let word = if W::IDENTITY == Identity::KeyOnly {
+            "32"
+        } else {
+            "64"
+        };
+        match self.direction {
+            Direction::Ascending => format!("mdts{word}"),
+            Direction::Descending => format!("mdts{word}-desc"),
+        }
+        .replace("mdts64", "mdts")
+    }
+
+    fn layout(&self) -> Layout {
+        let words = self.pixels * self.k as usize;
+        let (bytes32, bytes64) = if W::IDENTITY == Identity::KeyOnly {
+            (words, 0)
+        } else {
+            (0, words)
+        };
+        let empty = self.empty().decode();
+        Layout {
+            words32: bytes32,
+            init32: (empty >> 32) as u32,
+            words64: bytes64,
+            init64: empty,
+            table_bytes: 0,
+        }
+    }
+
+    fn begin(&self, fragment: Fragment) -> Walk<W> {
+        Walk {
+            base: fragment.pixel as usize * self.k as usize,
+            slot: 0,
+            carried: self.stored(fragment),
+        }
+    }
+
+    fn step<M: Memory>(&self, walk: &mut Walk<W>, memory: &M) -> Step {
+        let words = W::words(memory);
+        let index = walk.base + walk.slot as usize;
+        let old = match self.direction {
+            Direction::Ascending => words.fetch_min(index, walk.carried),
+            Direction::Descending => words.fetch_max(index, walk.carried),
+        };
+        if old == self.empty() {
+            return Step::Stored;
+        }
+        walk.carried = match self.direction {
+            Direction::Ascending => walk.carried.max(old),
+            Direction::Descending => walk.carried.min(old),
+        };
+        walk.slot += 1;
+        if walk.slot == self.k {
+            Step::Dropped
+        } else {
+            Step::Continue
+        }
+    }
+
+    fn resolve<M: Memory>(&self, memory: &M) -> Capture {
+        let words = W::words(memory);
+        let keeps = match self.direction {
+            Direction::Ascending => Keeps::Nearest(self.k),
+            Direction::Descending => Keeps::Farthest(self.k),
+        };
+        let mut capture = Capture::with_pixels(self.pixels, W::IDENTITY, keeps);
+        let k = self.k as usize;
+        let mut list = Vec::with_capacity(k);
+        for pixel in 0..self.pixels {
+            list.clear();
+            list.extend(
+                (0..k)
+                    .map(|slot| words.load(pixel * k + slot))
+                    .take_while(|&w| w != self.empty()),
+            );
+            match self.direction {
+                Direction::Ascending => capture.push_pixel(list.iter().map(|w| w.decode())),
+                Direction::Descending => {
+                    // Undo the +1 offset and report nearest first, like every other scheme.
+                    capture.push_pixel(list.iter().rev().map(|w| w.wrapping_sub(W::ONE).decode()));
+                }
+            }
+        }
+        capture
+    }
+}

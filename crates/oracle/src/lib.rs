@@ -1,0 +1,286 @@
+//! The serial oracle: every fragment of every pixel in canonical order, and the per-pixel diff
+//! that says where a scheme's capture departs from it.
+//!
+//! The oracle shares nothing with the schemes but the rasterizer: it counts each pixel's fragments
+//! (the depth complexity), allocates one flat array by the prefix sum of the counts, fills it in
+//! submission order and sorts each pixel's list by `(depth key, primitive id)` with the standard
+//! library's sort.
+//!
+//! ```
+//! use fragsim_oracle::Oracle;
+//! use fragsim_raster::{OrbitCamera, Scene, Viewport};
+//! let scene = Scene::procedural("spheres:3").unwrap();
+//! let view = scene.view(Viewport::new(32, 32).unwrap(), &OrbitCamera::default()).unwrap();
+//! let oracle = Oracle::build(&view);
+//! assert_eq!(oracle.max_depth_complexity(), 6);
+//! ```
+
+use fragsim_capture::{Capture, Identity, Keeps};
+use fragsim_raster::View;
+
+/// The exact per-pixel fragment lists of a view.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Oracle {
+    offsets: Vec<usize>,
+    entries: Vec<u64>,
+}
+
+impl Oracle {
+    /// Rasterizes `view` twice (count, then fill) and sorts every pixel's list.
+    #[must_use]
+    pub fn build(view: &View<'_>) -> Self {
+        let pixels = view.viewport().pixels();
+        let mut counts = vec![0usize; pixels];
+        for prim in 0..view.triangle_count() {
+            view.rasterize(prim, &mut |f| counts[f.pixel as usize] += 1);
+        }
+        let mut offsets = Vec::with_capacity(pixels + 1);
+        offsets.push(0);
+        for &c in &counts {
+            offsets.push(offsets[offsets.len() - 1] + c);
+        }
+        let mut next = offsets[..pixels].to_vec();
+        let mut entries = vec![0u64; offsets[pixels]];
+        for prim in 0..view.triangle_count() {
+            view.rasterize(prim, &mut |f| {
+                let p = f.pixel as usize;
+                entries[next[p]] = f.packed();
+                next[p] += 1;
+            });
+        }
+        for p in 0..pixels {
+            entries[offsets[p]..offsets[p + 1]].sort_unstable();
+        }
+        Self { offsets, entries }
+    }
+
+    /// Number of pixels.
+    #[must_use]
+    pub fn pixels(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Pixel `p`'s fragments, packed `key << 32 | prim`, in canonical order.
+    #[must_use]
+    pub fn pixel(&self, p: usize) -> &[u64] {
+        &self.entries[self.offsets[p]..self.offsets[p + 1]]
+    }
+
+    /// Total fragments.
+    #[must_use]
+    pub fn fragments(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Per-pixel depth complexity (fragment count).
+    #[must_use]
+    pub fn depth_complexity(&self) -> Vec<u32> {
+        self.offsets
+            .windows(2)
+            .map(|w| (w[1] - w[0]) as u32)
+            .collect()
+    }
+
+    /// The largest depth complexity of any pixel.
+    #[must_use]
+    pub fn max_depth_complexity(&self) -> u32 {
+        self.offsets
+            .windows(2)
+            .map(|w| (w[1] - w[0]) as u32)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Compares a capture with this oracle, pixel by pixel, under the capture's promise.
+    ///
+    /// # Panics
+    /// If the capture covers a different number of pixels.
+    #[must_use]
+    pub fn diff(&self, capture: &Capture) -> Diff {
+        assert_eq!(
+            capture.pixels(),
+            self.pixels(),
+            "capture and oracle cover different viewports"
+        );
+        let mut diff = Diff::default();
+        let mask = match capture.identity {
+            Identity::KeyAndPrim => u64::MAX,
+            Identity::KeyOnly => u64::MAX << 32,
+        };
+        let mut expected = Vec::new();
+        let mut got_sorted = Vec::new();
+        for p in 0..self.pixels() {
+            let all = self.pixel(p);
+            let got = capture.pixel(p);
+            expected.clear();
+            let n = all.len();
+            let (allowed_missing, exact_list) = match &capture.keeps {
+                Keeps::Nearest(k) => {
+                    let kept = n.min(*k as usize);
+                    expected.extend(all[..kept].iter().map(|e| e & mask));
+                    (n - kept, true)
+                }
+                Keeps::Farthest(k) => {
+                    let kept = n.min(*k as usize);
+                    expected.extend(all[n - kept..].iter().map(|e| e & mask));
+                    (n - kept, true)
+                }
+                Keeps::All { overflow } => {
+                    expected.extend(all.iter().map(|e| e & mask));
+                    let o = overflow[p] as usize;
+                    (o, o == 0)
+                }
+            };
+            diff.overflowed += allowed_missing as u64;
+            let misordered = got.windows(2).any(|w| w[0] > w[1]);
+            got_sorted.clear();
+            got_sorted.extend_from_slice(got);
+            got_sorted.sort_unstable();
+            let (missing, extra) = multiset_difference(&expected, &got_sorted);
+            // Where overflow made the kept subset order-dependent, `allowed_missing` of the
+            // expected fragments may be absent; any more is a loss.
+            let lost = if exact_list {
+                missing
+            } else {
+                missing.saturating_sub(allowed_missing)
+            };
+            let unexplained_gap = !exact_list && missing < allowed_missing;
+            let differs = lost > 0 || extra > 0 || misordered || unexplained_gap;
+            diff.lost += lost as u64;
+            diff.extra += extra as u64;
+            if misordered {
+                diff.misordered_pixels += 1;
+            }
+            if differs {
+                diff.mismatched_pixels += 1;
+                if diff.first_mismatches.len() < Diff::EXAMPLES {
+                    diff.first_mismatches.push(PixelMismatch {
+                        pixel: p,
+                        expected: expected.clone(),
+                        got: got.to_vec(),
+                    });
+                }
+            }
+            diff.captured += got.len() as u64;
+        }
+        diff
+    }
+}
+
+/// `(|a − b|, |b − a|)` for sorted multisets.
+fn multiset_difference(a: &[u64], b: &[u64]) -> (usize, usize) {
+    let (mut i, mut j, mut only_a, mut only_b) = (0, 0, 0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Equal => {
+                i += 1;
+                j += 1;
+            }
+            std::cmp::Ordering::Less => {
+                only_a += 1;
+                i += 1;
+            }
+            std::cmp::Ordering::Greater => {
+                only_b += 1;
+                j += 1;
+            }
+        }
+    }
+    (only_a + a.len() - i, only_b + b.len() - j)
+}
+
+/// One pixel where a capture differs from the oracle.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PixelMismatch {
+    /// Row-major pixel index.
+    pub pixel: usize,
+    /// What the oracle says the scheme should hold (packed, masked to the capture's identity).
+    pub expected: Vec<u64>,
+    /// What the scheme holds.
+    pub got: Vec<u64>,
+}
+
+/// How a capture differs from the oracle.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Diff {
+    /// Fragments captured.
+    pub captured: u64,
+    /// Fragments the scheme was not meant to keep: beyond K, or overflowing fixed storage.
+    pub overflowed: u64,
+    /// Fragments the scheme should have kept but did not.
+    pub lost: u64,
+    /// Fragments captured that the oracle does not have where the scheme should have kept them
+    /// (duplicates, corrupted values).
+    pub extra: u64,
+    /// Pixels whose list is out of canonical order.
+    pub misordered_pixels: u64,
+    /// Pixels that differ in any way.
+    pub mismatched_pixels: u64,
+    /// The first few differing pixels.
+    pub first_mismatches: Vec<PixelMismatch>,
+}
+
+impl Diff {
+    /// How many differing pixels are kept as examples.
+    pub const EXAMPLES: usize = 8;
+
+    /// Whether the capture is exactly what its scheme promises.
+    #[must_use]
+    pub fn is_exact(&self) -> bool {
+        self.mismatched_pixels == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fragsim_capture::Capture;
+
+    fn oracle_of(lists: &[&[u64]]) -> Oracle {
+        let mut offsets = vec![0];
+        let mut entries = Vec::new();
+        for l in lists {
+            entries.extend_from_slice(l);
+            offsets.push(entries.len());
+        }
+        Oracle { offsets, entries }
+    }
+
+    fn capture_of(lists: &[&[u64]], keeps: Keeps) -> Capture {
+        let mut c = Capture::with_pixels(lists.len(), Identity::KeyAndPrim, keeps);
+        for l in lists {
+            c.push_pixel(l.iter().copied());
+        }
+        c
+    }
+
+    #[test]
+    fn diff_names_lost_extra_and_misordered() {
+        let oracle = oracle_of(&[&[1, 2, 3], &[4, 5]]);
+        let exact = oracle.diff(&capture_of(&[&[1, 2], &[4, 5]], Keeps::Nearest(2)));
+        assert!(exact.is_exact());
+        assert_eq!(exact.overflowed, 1);
+        let lost = oracle.diff(&capture_of(&[&[1], &[4, 5]], Keeps::Nearest(2)));
+        assert_eq!((lost.lost, lost.mismatched_pixels), (1, 1));
+        let wrong = oracle.diff(&capture_of(&[&[2, 1], &[4, 4]], Keeps::Nearest(2)));
+        assert_eq!(
+            (
+                wrong.misordered_pixels,
+                wrong.extra,
+                wrong.lost,
+                wrong.mismatched_pixels
+            ),
+            (1, 1, 1, 2)
+        );
+    }
+
+    #[test]
+    fn overflowing_abuffer_may_keep_any_subset_but_not_lose_more() {
+        let oracle = oracle_of(&[&[1, 2, 3]]);
+        let ok = oracle.diff(&capture_of(&[&[1, 3]], Keeps::All { overflow: vec![1] }));
+        assert!(ok.is_exact());
+        let bad = oracle.diff(&capture_of(&[&[3]], Keeps::All { overflow: vec![1] }));
+        assert_eq!(bad.lost, 1);
+        assert!(!bad.is_exact());
+    }
+}

@@ -1,0 +1,212 @@
+//! Triangle meshes and OBJ loading.
+
+use std::io::BufRead;
+use std::path::Path;
+
+/// Why a mesh could not be loaded or used.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    /// The file could not be opened or read.
+    #[error("cannot read mesh file {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The reason the OS gave.
+        source: std::io::Error,
+    },
+    /// The OBJ parser rejected the file.
+    #[error("malformed OBJ {path}: {reason}")]
+    Obj {
+        /// The file.
+        path: String,
+        /// What tobj reported.
+        reason: String,
+    },
+    /// The file parsed but holds no triangle.
+    #[error("mesh {path} has no triangles")]
+    Empty {
+        /// The file.
+        path: String,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("mesh {path}: vertex {vertex} has a non-finite coordinate {value}")]
+    NonFinite {
+        /// The file.
+        path: String,
+        /// Index of the vertex.
+        vertex: usize,
+        /// The coordinate.
+        value: f32,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    #[error(
+        "mesh {path}: triangle {triangle} refers to vertex {index}, but there are only {vertices}"
+    )]
+    BadIndex {
+        /// The file.
+        path: String,
+        /// Index of the triangle.
+        triangle: usize,
+        /// The bad vertex index.
+        index: u32,
+        /// How many vertices the mesh has.
+        vertices: usize,
+    },
+}
+
+/// An indexed triangle mesh. Triangle `i` has primitive id `i`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions in model space.
+    pub positions: Vec<[f32; 3]>,
+    /// Vertex indices, three per triangle, in the order the file gave them.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Checks that every coordinate is finite and every index in range.
+    ///
+    /// # Errors
+    /// The first problem found, naming `source` (a file name or a scene name).
+    pub fn validate(&self, source: &str) -> Result<(), MeshError> {
+        for (vertex, p) in self.positions.iter().enumerate() {
+            if let Some(&value) = p.iter().find(|c| !c.is_finite()) {
+                return Err(MeshError::NonFinite {
+                    path: source.into(),
+                    vertex,
+                    value,
+                });
+            }
+        }
+        for (triangle, tri) in self.triangles.iter().enumerate() {
+            if let Some(&index) = tri.iter().find(|&&i| i as usize >= self.positions.len()) {
+                return Err(MeshError::BadIndex {
+                    path: source.into(),
+                    triangle,
+                    index,
+                    vertices: self.positions.len(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Loads an OBJ file, triangulating polygons, all of its models merged into one mesh.
+    ///
+    /// # Errors
+    /// A missing or unreadable file, a file tobj rejects, a mesh with no triangle, a non-finite
+    /// coordinate or an out-of-range index: each names the file.
+    pub fn load_obj(path: &Path) -> Result<Self, MeshError> {
+        let name = path.display().to_string();
+        let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        Self::read_obj(&mut std::io::BufReader::new(file), &name)
+    }
+
+    /// Parses OBJ text from a reader; `name` is used in error messages.
+    ///
+    /// # Errors
+    /// As [`Mesh::load_obj`].
+    pub fn read_obj(reader: &mut impl BufRead, name: &str) -> Result<Self, MeshError> {
+        let options = tobj::LoadOptions {
+            triangulate: true,
+            single_index: false,
+            ..Default::default()
+        };
+        let (models, _materials) = tobj::load_obj_buf(reader, &options, |_| {
+            // Materials are irrelevant to depth; an absent .mtl must not fail the load.
+            Ok(Default::default())
+        })
+        .map_err(|e| MeshError::Obj {
+            path: name.into(),
+            reason: e.to_string(),
+        })?;
+        let mut mesh = Mesh::default();
+        for model in models {
+            let m = model.mesh;
+            if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
+                return Err(MeshError::Obj {
+                    path: name.into(),
+                    reason: "ragged position or index array".into(),
+                });
+            }
+            let base = u32::try_from(mesh.positions.len()).map_err(|_| MeshError::Obj {
+                path: name.into(),
+                reason: "more than 2^32 vertices".into(),
+            })?;
+            mesh.positions
+                .extend(m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
+            for t in m.indices.chunks_exact(3) {
+                let shifted = [t[0], t[1], t[2]].map(|i| i.checked_add(base).unwrap_or(u32::MAX));
+                mesh.triangles.push(shifted);
+            }
+        }
+        if mesh.triangles.is_empty() {
+            return Err(MeshError::Empty { path: name.into() });
+        }
+        mesh.validate(name)?;
+        Ok(mesh)
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the vertices that triangles use.
+    #[must_use]
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for tri in &self.triangles {
+            for &i in tri {
+                let p = self.positions[i as usize];
+                for axis in 0..3 {
+                    lo[axis] = lo[axis].min(f64::from(p[axis]));
+                    hi[axis] = hi[axis].max(f64::from(p[axis]));
+                }
+            }
+        }
+        if self.triangles.is_empty() {
+            return ([0.0; 3], [0.0; 3]);
+        }
+        (lo, hi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Mesh, MeshError> {
+        Mesh::read_obj(&mut text.as_bytes(), "test.obj")
+    }
+
+    #[test]
+    fn quads_are_triangulated() {
+        let mesh = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        assert_eq!(mesh.triangles.len(), 2);
+    }
+
+    #[test]
+    fn bad_index_is_an_error_naming_the_file() {
+        let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("test.obj"), "{err}");
+    }
+
+    #[test]
+    fn nan_coordinate_is_an_error() {
+        let err = parse("v nan 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n").unwrap_err();
+        assert!(
+            matches!(err, MeshError::NonFinite { .. } | MeshError::Obj { .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn empty_file_is_an_error() {
+        assert!(matches!(
+            parse(""),
+            Err(MeshError::Empty { .. }) | Err(MeshError::Obj { .. })
+        ));
+    }
+}

@@ -1,0 +1,400 @@
+//! The pipeline: vertex stage, clipping, snapping and the exact scan.
+//!
+//! The rules, in the order they apply (`docs/semantics.md` states them for backend authors):
+//! 1. Vertices are transformed once, in f64: `clip = view_projection * (x, y, z, 1)`.
+//! 2. A triangle whose vertices all lie outside one frustum plane (left, right, top, bottom,
+//!    near or far) is rejected whole.
+//! 3. A triangle with a vertex in front of the near plane (`z < 0`) or outside the guard band is
+//!    clipped in homogeneous space (Sutherland–Hodgman) against `z ≥ 0` and the guard-band
+//!    planes; the polygon is split into a fan `(v0, vi, vi+1)`; every piece keeps the primitive id.
+//!    Unlike FreePipe, which clips only the screen bounding box, this keeps triangles that cross
+//!    `w = 0` correct.
+//! 4. Each vertex is projected (`x/w`, `y/w`, `z/w`), mapped to the window (y down) and its x and y
+//!    snapped to [`SUBPIXEL_BITS`] fractional bits by rounding half away from zero.
+//! 5. The doubled signed area of the snapped triangle decides facing (exact, in i64); zero-area
+//!    triangles produce nothing; back faces are culled or, by default, reoriented.
+//! 6. Pixel `(i, j)` is sampled at its centre; it is covered when all three edge functions are
+//!    positive, or zero on a top or left edge (the top-left rule): a centre on an edge shared by two
+//!    triangles is covered exactly once.
+//! 7. Depth is interpolated linearly in screen space from the exact integer barycentrics, in f64,
+//!    rounded once to f32; depths outside `[0, 1]` are dropped.
+
+use glam::{DMat4, DVec4};
+
+use crate::camera::Camera;
+use crate::fragment::{depth_key, Fragment};
+use crate::mesh::Mesh;
+
+/// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
+pub const SUBPIXEL_BITS: u32 = 8;
+const ONE: i64 = 1 << SUBPIXEL_BITS;
+const HALF: i64 = ONE / 2;
+
+/// How far outside the viewport, in pixels, vertices may lie before they are clipped.
+///
+/// With viewports of at most [`Viewport::MAX_SIDE`] pixels, snapped coordinates stay below
+/// 2^24 in magnitude and the edge functions below 2^49: far from i64 overflow.
+pub const GUARD_BAND_PIXELS: f64 = 16384.0;
+
+/// The size of the render target in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Viewport {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+impl Viewport {
+    /// The largest side accepted (the guard band's fixed-point bound is sized for it).
+    pub const MAX_SIDE: u32 = 16384;
+
+    /// A viewport of `width × height` pixels.
+    ///
+    /// # Errors
+    /// A zero or larger than [`Viewport::MAX_SIDE`] side, named in the message.
+    pub fn new(width: u32, height: u32) -> Result<Self, String> {
+        for (name, side) in [("width", width), ("height", height)] {
+            if side == 0 || side > Self::MAX_SIDE {
+                return Err(format!(
+                    "viewport {name} must be between 1 and {}, got {side}",
+                    Self::MAX_SIDE
+                ));
+            }
+        }
+        Ok(Self { width, height })
+    }
+
+    /// Number of pixels.
+    #[must_use]
+    pub fn pixels(self) -> usize {
+        self.width as usize * self.height as usize
+    }
+}
+
+/// Which triangles are discarded by facing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CullMode {
+    /// Keep every triangle; back faces are reoriented (multi-fragment effects need all layers).
+    #[default]
+    None,
+    /// Discard triangles that are clockwise as the viewer sees them.
+    Back,
+    /// Discard triangles that are counter-clockwise as the viewer sees them.
+    Front,
+}
+
+/// A triangle after snapping: fixed-point window coordinates and f64 window depth, oriented so
+/// that its doubled signed area is positive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenTriangle {
+    /// Primitive id.
+    pub prim: u32,
+    /// x, y in 1/256 pixel, y down.
+    pub xy: [[i64; 2]; 3],
+    /// Window depth `z / w` of each vertex.
+    pub z: [f64; 3],
+}
+
+/// A mesh seen through a camera on a viewport: vertices transformed, ready to rasterize any
+/// triangle by primitive id. Immutable and `Sync`, so threads rasterize triangles independently.
+#[derive(Clone, Debug)]
+pub struct View<'mesh> {
+    mesh: &'mesh Mesh,
+    clip: Vec<DVec4>,
+    viewport: Viewport,
+    cull: CullMode,
+    guard: [f64; 2],
+}
+
+impl<'mesh> View<'mesh> {
+    /// Transforms every vertex of `mesh` once.
+    #[must_use]
+    pub fn new(mesh: &'mesh Mesh, camera: &Camera, viewport: Viewport, cull: CullMode) -> Self {
+        let m: DMat4 = camera.view_projection;
+        let clip = mesh
+            .positions
+            .iter()
+            .map(|p| m * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0))
+            .collect();
+        let guard = [
+            1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.width),
+            1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.height),
+        ];
+        Self {
+            mesh,
+            clip,
+            viewport,
+            cull,
+            guard,
+        }
+    }
+
+    /// The viewport.
+    #[must_use]
+    pub fn viewport(&self) -> Viewport {
+        self.viewport
+    }
+
+    /// The mesh.
+    #[must_use]
+    pub fn mesh(&self) -> &'mesh Mesh {
+        self.mesh
+    }
+
+    /// Number of triangles (primitive ids are `0..triangle_count()`).
+    #[must_use]
+    pub fn triangle_count(&self) -> u32 {
+        self.mesh.triangles.len() as u32
+    }
+
+    /// Rasterizes triangle `prim`, calling `emit` for each fragment in scan order (rows top to
+    /// bottom, pixels left to right, fan pieces in order).
+    pub fn rasterize(&self, prim: u32, emit: &mut impl FnMut(Fragment)) {
+        self.screen_triangles(prim, &mut |tri| self.scan(&tri, emit));
+    }
+
+    /// Calls `visit` with the snapped, clipped, oriented pieces of triangle `prim` (none when it
+    /// is rejected, culled or degenerate).
+    pub fn screen_triangles(&self, prim: u32, visit: &mut impl FnMut(ScreenTriangle)) {
+        let [a, b, c] = self.mesh.triangles[prim as usize].map(|i| self.clip[i as usize]);
+        let planes = self.planes();
+        // Trivial reject: all three vertices outside one plane.
+        if planes
+            .iter()
+            .any(|p| p.dot(a) < 0.0 && p.dot(b) < 0.0 && p.dot(c) < 0.0)
+        {
+            return;
+        }
+        let far = DVec4::new(0.0, 0.0, -1.0, 1.0);
+        if far.dot(a) < 0.0 && far.dot(b) < 0.0 && far.dot(c) < 0.0 {
+            return;
+        }
+        let needs_clip = [a, b, c]
+            .iter()
+            .any(|v| planes.iter().any(|p| p.dot(*v) < 0.0));
+        if needs_clip {
+            let mut polygon = vec![a, b, c];
+            for plane in planes {
+                polygon = clip_polygon(&polygon, plane);
+                if polygon.len() < 3 {
+                    return;
+                }
+            }
+            for i in 1..polygon.len() - 1 {
+                self.snap_and_orient(prim, [polygon[0], polygon[i], polygon[i + 1]], visit);
+            }
+        } else {
+            self.snap_and_orient(prim, [a, b, c], visit);
+        }
+    }
+
+    /// The clipping planes as `p · v ≥ 0`: near (`z ≥ 0`) then the four guard-band planes.
+    fn planes(&self) -> [DVec4; 5] {
+        let [gx, gy] = self.guard;
+        [
+            DVec4::new(0.0, 0.0, 1.0, 0.0),
+            DVec4::new(1.0, 0.0, 0.0, gx),
+            DVec4::new(-1.0, 0.0, 0.0, gx),
+            DVec4::new(0.0, 1.0, 0.0, gy),
+            DVec4::new(0.0, -1.0, 0.0, gy),
+        ]
+    }
+
+    fn snap_and_orient(&self, prim: u32, clip: [DVec4; 3], visit: &mut impl FnMut(ScreenTriangle)) {
+        if clip.iter().any(|v| !(v.w > 0.0)) {
+            // Only reachable with a projection whose near plane does not bound w away from 0.
+            return;
+        }
+        let (w, h) = (
+            f64::from(self.viewport.width),
+            f64::from(self.viewport.height),
+        );
+        let snap = |v: DVec4| -> ([i64; 2], f64) {
+            let x = (v.x / v.w * 0.5 + 0.5) * w;
+            let y = (0.5 - v.y / v.w * 0.5) * h;
+            (
+                [
+                    (x * ONE as f64).round() as i64,
+                    (y * ONE as f64).round() as i64,
+                ],
+                v.z / v.w,
+            )
+        };
+        let [(pa, za), (mut pb, mut zb), (mut pc, mut zc)] = clip.map(snap);
+        let area = edge(pa, pb, pc);
+        if area == 0 {
+            return;
+        }
+        // In a y-down window a negative area is counter-clockwise as the viewer sees it: a front
+        // face under the OpenGL/OBJ convention.
+        let front = area < 0;
+        match self.cull {
+            CullMode::Back if !front => return,
+            CullMode::Front if front => return,
+            _ => {}
+        }
+        if area < 0 {
+            std::mem::swap(&mut pb, &mut pc);
+            std::mem::swap(&mut zb, &mut zc);
+        }
+        visit(ScreenTriangle {
+            prim,
+            xy: [pa, pb, pc],
+            z: [za, zb, zc],
+        });
+    }
+
+    /// Scans an oriented snapped triangle: every covered pixel centre emits a fragment.
+    pub fn scan(&self, tri: &ScreenTriangle, emit: &mut impl FnMut(Fragment)) {
+        let [a, b, c] = tri.xy;
+        let area = edge(a, b, c);
+        debug_assert!(area > 0);
+        let (min_x, max_x) = (a[0].min(b[0]).min(c[0]), a[0].max(b[0]).max(c[0]));
+        let (min_y, max_y) = (a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]));
+        let first_px = |lo: i64| (lo - HALF + ONE - 1).div_euclid(ONE).max(0);
+        let last_px = |hi: i64, side: u32| (hi - HALF).div_euclid(ONE).min(i64::from(side) - 1);
+        let (x0, x1) = (first_px(min_x), last_px(max_x, self.viewport.width));
+        let (y0, y1) = (first_px(min_y), last_px(max_y, self.viewport.height));
+        if x0 > x1 || y0 > y1 {
+            return;
+        }
+        // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
+        let edges = [(b, c), (c, a), (a, b)];
+        let bias = edges.map(|(p, q)| if is_top_left(p, q) { 0 } else { -1 });
+        let step_x = edges.map(|(p, q)| -(q[1] - p[1]) * ONE);
+        let step_y = edges.map(|(p, q)| (q[0] - p[0]) * ONE);
+        let start = [x0 * ONE + HALF, y0 * ONE + HALF];
+        let mut row = edges.map(|(p, q)| edge(p, q, start));
+        let area_f = area as f64;
+        let width = i64::from(self.viewport.width);
+        for y in y0..=y1 {
+            let mut e = row;
+            for x in x0..=x1 {
+                if (0..3).all(|k| e[k] + bias[k] >= 0) {
+                    let z =
+                        (e[0] as f64 * tri.z[0] + e[1] as f64 * tri.z[1] + e[2] as f64 * tri.z[2])
+                            / area_f;
+                    if let Some(depth_key) = depth_key(z as f32) {
+                        emit(Fragment {
+                            pixel: (y * width + x) as u32,
+                            depth_key,
+                            prim: tri.prim,
+                        });
+                    }
+                }
+                for k in 0..3 {
+                    e[k] += step_x[k];
+                }
+            }
+            for k in 0..3 {
+                row[k] += step_y[k];
+            }
+        }
+    }
+}
+
+/// Twice the signed area of `(a, b, p)`: positive when `p` is on the interior side of `a → b` for
+/// a positively oriented triangle in the y-down window.
+fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
+    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+}
+
+/// Top edge: horizontal with the interior below; left edge: the interior to its right. For a
+/// positively oriented triangle that is `dy < 0`, or `dy == 0 && dx > 0`.
+fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    dy < 0 || (dy == 0 && dx > 0)
+}
+
+/// Sutherland–Hodgman against one plane `p · v ≥ 0`.
+fn clip_polygon(polygon: &[DVec4], plane: DVec4) -> Vec<DVec4> {
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for (i, &current) in polygon.iter().enumerate() {
+        let next = polygon[(i + 1) % polygon.len()];
+        let (dc, dn) = (plane.dot(current), plane.dot(next));
+        if dc >= 0.0 {
+            out.push(current);
+        }
+        if (dc >= 0.0) != (dn >= 0.0) {
+            let t = dc / (dc - dn);
+            out.push(current + (next - current) * t);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view_of(mesh: &Mesh, side: u32) -> View<'_> {
+        // Identity projection: model x, y in [-1, 1] map straight to the window, z is depth.
+        let camera = Camera {
+            view_projection: DMat4::IDENTITY,
+        };
+        View::new(
+            mesh,
+            &camera,
+            Viewport::new(side, side).unwrap(),
+            CullMode::None,
+        )
+    }
+
+    fn coverage(view: &View<'_>) -> Vec<u32> {
+        let mut counts = vec![0; view.viewport().pixels()];
+        for prim in 0..view.triangle_count() {
+            view.rasterize(prim, &mut |f| counts[f.pixel as usize] += 1);
+        }
+        counts
+    }
+
+    #[test]
+    fn two_triangles_sharing_a_diagonal_cover_each_centre_once() {
+        // A full-screen quad split along the diagonal, which passes through pixel centres.
+        let mesh = Mesh {
+            positions: vec![
+                [-1.0, -1.0, 0.5],
+                [1.0, -1.0, 0.5],
+                [1.0, 1.0, 0.5],
+                [-1.0, 1.0, 0.5],
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        };
+        assert!(coverage(&view_of(&mesh, 8)).iter().all(|&c| c == 1));
+    }
+
+    #[test]
+    fn depth_is_interpolated_and_keyed() {
+        let mesh = Mesh {
+            positions: vec![[-1.0, -1.0, 0.25], [3.0, -1.0, 0.25], [-1.0, 3.0, 0.25]],
+            triangles: vec![[0, 1, 2]],
+        };
+        let view = view_of(&mesh, 4);
+        let mut keys = Vec::new();
+        view.rasterize(0, &mut |f| keys.push(f.depth_key));
+        assert_eq!(keys.len(), 16);
+        assert!(keys.iter().all(|&k| k == 0.25f32.to_bits()));
+    }
+
+    #[test]
+    fn fragments_beyond_far_are_dropped() {
+        let mesh = Mesh {
+            positions: vec![[-1.0, -1.0, 1.5], [3.0, -1.0, 1.5], [-1.0, 3.0, 1.5]],
+            triangles: vec![[0, 1, 2]],
+        };
+        assert!(coverage(&view_of(&mesh, 4)).iter().all(|&c| c == 0));
+    }
+
+    #[test]
+    fn a_triangle_crossing_the_near_plane_is_clipped_not_lost() {
+        let mesh = Mesh {
+            positions: vec![[-1.0, -1.0, -0.5], [3.0, -1.0, 0.5], [-1.0, 3.0, 0.5]],
+            triangles: vec![[0, 1, 2]],
+        };
+        let counts = coverage(&view_of(&mesh, 8));
+        let covered = counts.iter().filter(|&&c| c == 1).count();
+        assert!(covered > 0 && covered < 64, "{covered}");
+        assert!(counts.iter().all(|&c| c <= 1));
+    }
+}

@@ -1,0 +1,250 @@
+//! Scenes: the embedded default mesh, meshes on disk and procedural scenes.
+
+use std::f64::consts::PI;
+use std::io::Read;
+use std::path::Path;
+
+use crate::camera::OrbitCamera;
+use crate::mesh::{Mesh, MeshError};
+use crate::pipeline::{CullMode, View, Viewport};
+use crate::rng::SplitMix64;
+
+/// The name of the embedded default scene.
+pub const DEFAULT_SCENE_NAME: &str = "bunny";
+
+/// The Stanford bunny (Turk & Levoy 1994; 35,947 vertices, 69,451 triangles), gzipped OBJ.
+/// Credit: Stanford Computer Graphics Laboratory, free for research use.
+const BUNNY_OBJ_GZ: &[u8] = include_bytes!("../assets/stanford-bunny.obj.gz");
+
+/// Why a scene could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The mesh could not be loaded.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The scene name or its parameters are not understood.
+    #[error("unknown scene {0:?}: expected bunny, spheres[:N], soup[:COUNT[:SEED]] or quads[:N]")]
+    Unknown(String),
+    /// A parameter is out of range.
+    #[error("scene {name}: {reason}")]
+    BadParameter {
+        /// The scene.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The viewport is invalid.
+    #[error("{0}")]
+    Viewport(String),
+}
+
+/// A named mesh: what the pipeline renders.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// A short description (file name or procedural parameters).
+    pub name: String,
+    /// The geometry.
+    pub mesh: Mesh,
+}
+
+impl Scene {
+    /// The embedded Stanford bunny.
+    ///
+    /// # Panics
+    /// Never in a correct build: the embedded asset is checked by a unit test.
+    #[must_use]
+    pub fn default_scene() -> Self {
+        let mut text = Vec::new();
+        flate2::read::GzDecoder::new(BUNNY_OBJ_GZ)
+            .read_to_end(&mut text)
+            .expect("the embedded bunny is valid gzip");
+        let mesh = Mesh::read_obj(&mut text.as_slice(), "embedded stanford-bunny.obj")
+            .expect("embedded bunny parses");
+        Self {
+            name: DEFAULT_SCENE_NAME.into(),
+            mesh,
+        }
+    }
+
+    /// A mesh from an OBJ file.
+    ///
+    /// # Errors
+    /// See [`Mesh::load_obj`].
+    pub fn from_obj(path: &Path) -> Result<Self, SceneError> {
+        let mesh = Mesh::load_obj(path)?;
+        Ok(Self {
+            name: path.display().to_string(),
+            mesh,
+        })
+    }
+
+    /// A scene by name: `bunny` (embedded), `spheres[:N]` (N nested closed spheres: depth
+    /// complexity 2N at the centre), `soup[:COUNT[:SEED]]` (random triangles in a cube) or
+    /// `quads[:N]` (N stacked parallel squares).
+    ///
+    /// # Errors
+    /// An unknown name or a parameter out of range.
+    pub fn procedural(spec: &str) -> Result<Self, SceneError> {
+        let mut parts = spec.split(':');
+        let kind = parts.next().unwrap_or_default();
+        let params: Vec<&str> = parts.collect();
+        let param = |i: usize, default: u64, max: u64| -> Result<u64, SceneError> {
+            let value = match params.get(i) {
+                None => default,
+                Some(text) => text.parse::<u64>().map_err(|_| SceneError::BadParameter {
+                    name: spec.into(),
+                    reason: format!(
+                        "parameter {} is not a non-negative integer: {text:?}",
+                        i + 1
+                    ),
+                })?,
+            };
+            if value == 0 && i == 0 || value > max {
+                return Err(SceneError::BadParameter {
+                    name: spec.into(),
+                    reason: format!(
+                        "parameter {} must be between 1 and {max}, got {value}",
+                        i + 1
+                    ),
+                });
+            }
+            Ok(value)
+        };
+        let mesh = match kind {
+            "bunny" if params.is_empty() => return Ok(Self::default_scene()),
+            "spheres" => nested_spheres(param(0, 4, 256)? as u32, 48, 24),
+            "soup" => triangle_soup(param(0, 2000, 10_000_000)? as u32, param(1, 1, u64::MAX)?),
+            "quads" => stacked_quads(param(0, 8, 1_000_000)? as u32),
+            _ => return Err(SceneError::Unknown(spec.into())),
+        };
+        Ok(Self {
+            name: spec.into(),
+            mesh,
+        })
+    }
+
+    /// This scene through an orbit camera on a viewport, all faces kept.
+    ///
+    /// # Errors
+    /// The scene has no triangles.
+    pub fn view(&self, viewport: Viewport, orbit: &OrbitCamera) -> Result<View<'_>, SceneError> {
+        if self.mesh.triangles.is_empty() {
+            return Err(SceneError::BadParameter {
+                name: self.name.clone(),
+                reason: "no triangles".into(),
+            });
+        }
+        let aspect = f64::from(viewport.width) / f64::from(viewport.height);
+        let camera = orbit.camera(self.mesh.bounds(), aspect);
+        Ok(View::new(&self.mesh, &camera, viewport, CullMode::None))
+    }
+}
+
+/// `count` closed UV spheres centred at the origin with radii `1/count, 2/count, …, 1`.
+#[must_use]
+pub fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
+    let mut mesh = Mesh::default();
+    for s in 1..=count {
+        let radius = f64::from(s) / f64::from(count);
+        let base = mesh.positions.len() as u32;
+        // Poles are single vertices so the sphere is closed (watertight).
+        mesh.positions.push([0.0, radius as f32, 0.0]);
+        for i in 1..stacks {
+            let theta = PI * f64::from(i) / f64::from(stacks);
+            for j in 0..slices {
+                let phi = 2.0 * PI * f64::from(j) / f64::from(slices);
+                let p = [
+                    radius * theta.sin() * phi.cos(),
+                    radius * theta.cos(),
+                    radius * theta.sin() * phi.sin(),
+                ];
+                mesh.positions.push(p.map(|c| c as f32));
+            }
+        }
+        mesh.positions.push([0.0, -radius as f32, 0.0]);
+        let ring = |i: u32, j: u32| base + 1 + (i - 1) * slices + (j % slices);
+        let south = base + 1 + (stacks - 1) * slices;
+        for j in 0..slices {
+            mesh.triangles.push([base, ring(1, j + 1), ring(1, j)]);
+            for i in 1..stacks - 1 {
+                mesh.triangles
+                    .push([ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)]);
+                mesh.triangles
+                    .push([ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)]);
+            }
+            mesh.triangles
+                .push([ring(stacks - 1, j), ring(stacks - 1, j + 1), south]);
+        }
+    }
+    mesh
+}
+
+/// `count` triangles with vertices uniform in the unit cube, from `seed`.
+#[must_use]
+pub fn triangle_soup(count: u32, seed: u64) -> Mesh {
+    let mut rng = SplitMix64::new(seed);
+    let mut mesh = Mesh::default();
+    for t in 0..count {
+        for _ in 0..3 {
+            mesh.positions
+                .push([rng.next_f64(), rng.next_f64(), rng.next_f64()].map(|c| c as f32));
+        }
+        mesh.triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
+    }
+    mesh
+}
+
+/// `count` unit squares parallel to the xy plane, stacked along z in `[0, 1]`.
+#[must_use]
+pub fn stacked_quads(count: u32) -> Mesh {
+    let mut mesh = Mesh::default();
+    for q in 0..count {
+        let z = if count == 1 {
+            0.0
+        } else {
+            q as f32 / (count - 1) as f32
+        };
+        let base = 4 * q;
+        mesh.positions.extend([
+            [-1.0, -1.0, z],
+            [1.0, -1.0, z],
+            [1.0, 1.0, z],
+            [-1.0, 1.0, z],
+        ]);
+        mesh.triangles.push([base, base + 1, base + 2]);
+        mesh.triangles.push([base, base + 2, base + 3]);
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_bunny_is_the_full_stanford_bunny() {
+        let scene = Scene::default_scene();
+        assert_eq!(scene.mesh.triangles.len(), 69_451);
+        // The file lists 35,947 vertices; tobj keeps the 34,834 that faces use.
+        assert_eq!(scene.mesh.positions.len(), 34_834);
+    }
+
+    #[test]
+    fn names_parse_and_bad_ones_fail() {
+        assert_eq!(
+            Scene::procedural("spheres:3").unwrap().mesh.triangles.len(),
+            3 * 48 * 2 * 23
+        );
+        assert_eq!(
+            Scene::procedural("quads:5").unwrap().mesh.triangles.len(),
+            10
+        );
+        assert_eq!(
+            Scene::procedural("soup:7:9").unwrap().mesh.triangles.len(),
+            7
+        );
+        assert!(Scene::procedural("spheres:0").is_err());
+        assert!(Scene::procedural("cubes").is_err());
+        assert!(Scene::procedural("soup:x").is_err());
+    }
+}

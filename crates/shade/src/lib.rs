@@ -1,0 +1,1 @@
+//! Images of captures: depth-complexity heat maps and nearest-layer depth, as PNG.

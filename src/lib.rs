@@ -1,0 +1,26 @@
+//! fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
+//!
+//! This facade re-exports the workspace's crates so that the integration tests in `tests/` and
+//! users see one library:
+//! - [`raster`]: scenes, camera and the exact rasterizer that produces fragments;
+//! - [`capture`]: the `Memory` seam, the schemes (MDTS, A-buffer) and the executors;
+//! - [`oracle`]: the serial reference lists and the per-pixel diff;
+//! - [`shade`]: images of the results.
+//!
+//! ```
+//! use fragsim::capture::{executor, mdts::Mdts};
+//! use fragsim::raster::{OrbitCamera, Scene, Viewport};
+//! use fragsim::oracle::Oracle;
+//!
+//! let scene = Scene::procedural("spheres:2").unwrap();
+//! let view = scene.view(Viewport::new(48, 48).unwrap(), &OrbitCamera::default()).unwrap();
+//! let oracle = Oracle::build(&view);
+//! let scheme = Mdts::ascending(view.viewport(), oracle.max_depth_complexity().max(1)).unwrap();
+//! let run = executor::run_parallel(&view, &scheme);
+//! assert!(oracle.diff(&run.capture).is_exact());
+//! ```
+
+pub use fragsim_capture as capture;
+pub use fragsim_oracle as oracle;
+pub use fragsim_raster as raster;
+pub use fragsim_shade as shade;
