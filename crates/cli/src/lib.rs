@@ -1,7 +1,55 @@
-//! The `fragsim` command line.
+//! The `fragsim` command line: `render` (the default) runs schemes on a scene, checks them
+//! against the serial oracle and writes a table, JSON and PNGs.
 
-/// Entry point.
+mod render;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub use render::{RenderArgs, RunSummary};
+
+/// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
+#[derive(Debug, Parser)]
+#[command(
+    name = "fragsim",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
+pub struct Cli {
+    /// What to do; without one, `render` runs with the options below.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Options of the default `render`.
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render a scene with capture schemes, check them against the oracle, write images.
+    Render(RenderArgs),
+}
+
+/// Parses the command line and runs it; errors go to stderr with a non-zero exit code.
 #[must_use]
-pub fn main() -> std::process::ExitCode {
-    std::process::ExitCode::SUCCESS
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let args = match cli.command {
+        Some(Command::Render(args)) => args,
+        None => cli.render,
+    };
+    match render::render(&args) {
+        Ok(summary) if summary.iter().all(|run| run.mismatches == 0) => ExitCode::SUCCESS,
+        Ok(_) => {
+            eprintln!("error: a scheme differs from the oracle (see the mismatches column)");
+            ExitCode::from(1)
+        }
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+    }
 }

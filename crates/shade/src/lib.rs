@@ -1,1 +1,91 @@
-//! Images of captures: depth-complexity heat maps and nearest-layer depth, as PNG.
+//! Images of captures: the depth-complexity heat map and the nearest-layer depth, as PNG.
+//!
+//! ```
+//! let counts = vec![0, 1, 2, 3];
+//! let image = fragsim_shade::heat_map(2, 2, &counts);
+//! assert_eq!(image.dimensions(), (2, 2));
+//! ```
+
+use std::path::Path;
+
+use image::{Rgb, RgbImage};
+
+/// Control points of the heat map's colour ramp (black → blue → red → yellow → white),
+/// interpolated linearly in sRGB: a perceptually ordered ramp that stays readable in greyscale.
+const RAMP: [[f32; 3]; 5] = [
+    [0.0, 0.0, 0.0],
+    [0.1, 0.1, 0.8],
+    [0.85, 0.1, 0.1],
+    [1.0, 0.85, 0.0],
+    [1.0, 1.0, 1.0],
+];
+
+/// Depth complexity per pixel as colour: 0 is black, the maximum is white.
+#[must_use]
+pub fn heat_map(width: u32, height: u32, counts: &[u32]) -> RgbImage {
+    let max = counts.iter().copied().max().unwrap_or(0).max(1);
+    RgbImage::from_fn(width, height, |x, y| {
+        let c = counts[(y * width + x) as usize];
+        ramp(c as f32 / max as f32)
+    })
+}
+
+fn ramp(t: f32) -> Rgb<u8> {
+    let scaled = t.clamp(0.0, 1.0) * (RAMP.len() - 1) as f32;
+    let i = (scaled.floor() as usize).min(RAMP.len() - 2);
+    let f = scaled - i as f32;
+    let c = [0, 1, 2].map(|ch| RAMP[i][ch] + (RAMP[i + 1][ch] - RAMP[i][ch]) * f);
+    Rgb(c.map(|v| (v * 255.0).round() as u8))
+}
+
+/// Nearest depth per pixel as grey, stretched over the depths present (near is white, far is
+/// dark); pixels with no fragment are black.
+#[must_use]
+pub fn nearest_depth(width: u32, height: u32, nearest: &[Option<f32>]) -> RgbImage {
+    let present = nearest.iter().flatten();
+    let lo = present.clone().copied().fold(f32::INFINITY, f32::min);
+    let hi = present.copied().fold(f32::NEG_INFINITY, f32::max);
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    RgbImage::from_fn(width, height, |x, y| {
+        match nearest[(y * width + x) as usize] {
+            None => Rgb([0, 0, 0]),
+            Some(d) => {
+                let v = (255.0 - 215.0 * (d - lo) / span).round() as u8;
+                Rgb([v, v, v])
+            }
+        }
+    })
+}
+
+/// Writes `image` as a PNG at `path`, creating parent directories.
+///
+/// # Errors
+/// The directory or file could not be written.
+pub fn save_png(image: &RgbImage, path: &Path) -> Result<(), String> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    image
+        .save(path)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ramp_ends_are_black_and_white() {
+        assert_eq!(ramp(0.0), Rgb([0, 0, 0]));
+        assert_eq!(ramp(1.0), Rgb([255, 255, 255]));
+    }
+
+    #[test]
+    fn nearest_is_brightest_and_empty_is_black() {
+        let img = nearest_depth(3, 1, &[Some(0.2), Some(0.8), None]);
+        assert_eq!(img.get_pixel(0, 0), &Rgb([255, 255, 255]));
+        assert_eq!(img.get_pixel(1, 0), &Rgb([40, 40, 40]));
+        assert_eq!(img.get_pixel(2, 0), &Rgb([0, 0, 0]));
+    }
+}
