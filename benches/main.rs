@@ -1,1 +1,134 @@
-fn main() {}
+//! Benchmarks of the core on the embedded default scene (the Stanford bunny, 512 × 512, view 30°).
+//!
+//! - `pass/*`: the executors end to end (storage initialisation, rasterization, capture, resolve),
+//!   serial against parallel.
+//! - `capture/*`: capture alone over the pre-rasterized fragment stream, the generic scheme code
+//!   (state machine behind the `Memory` seam) against a bare hand-written loop of `fetch_min` /
+//!   `fetch_add` on the same per-pixel arrays with the same fragment addresses: the speed limit of
+//!   the memory system for this work.
+//!
+//! Run: `cargo bench --bench main`; ratios are recorded in `docs/results.md`.
+
+#![allow(missing_docs, reason = "criterion_group! and criterion_main! generate undocumented items")]
+
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use fragsim::capture::abuffer::ABuffer;
+use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::mdts::Mdts;
+use fragsim::capture::{AtomicMemory, Scheme};
+use fragsim::oracle::Oracle;
+use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
+use rayon::prelude::*;
+
+/// Fragments per rayon work item when capturing a pre-rasterized stream.
+const FRAGMENTS_PER_TASK: usize = 4096;
+
+fn benches(c: &mut Criterion) {
+    let scene = Scene::default_scene();
+    let view = scene.view(Viewport::new(512, 512).unwrap(), &OrbitCamera::default().at_angle(30.0)).unwrap();
+    let oracle = Oracle::build(&view);
+    let k = oracle.max_depth_complexity();
+    let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
+    let abuffer = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
+
+    let mut pass = c.benchmark_group("pass");
+    pass.sample_size(20);
+    pass.bench_function("mdts/serial", |b| b.iter(|| run_serial(&view, &mdts)));
+    pass.bench_function("mdts/parallel", |b| b.iter(|| run_parallel(&view, &mdts)));
+    pass.bench_function("abuffer/serial", |b| b.iter(|| run_serial(&view, &abuffer)));
+    pass.bench_function("abuffer/parallel", |b| b.iter(|| run_parallel(&view, &abuffer)));
+    pass.finish();
+
+    let mut fragments: Vec<Fragment> = Vec::with_capacity(oracle.fragments());
+    for prim in 0..view.triangle_count() {
+        view.rasterize(prim, &mut |f| fragments.push(f));
+    }
+    let pixels = view.viewport().pixels();
+    let mut capture = c.benchmark_group("capture");
+    capture.sample_size(30);
+    capture.bench_function("mdts/generic", |b| {
+        b.iter_batched(
+            || mdts.layout().allocate::<AtomicMemory>(),
+            |memory| {
+                fragments.par_chunks(FRAGMENTS_PER_TASK).for_each(|chunk| {
+                    let mut steps = 0;
+                    for &f in chunk {
+                        mdts.insert(f, &memory, &mut steps);
+                    }
+                });
+                memory
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    capture.bench_function("mdts/bare-fetch_min", |b| {
+        b.iter_batched(
+            || (0..pixels * k as usize).map(|_| AtomicU64::new(u64::MAX)).collect::<Vec<_>>(),
+            |slots| {
+                fragments.par_chunks(FRAGMENTS_PER_TASK).for_each(|chunk| {
+                    for &f in chunk {
+                        let base = f.pixel as usize * k as usize;
+                        let mut carried = f.packed();
+                        for slot in &slots[base..base + k as usize] {
+                            let old = slot.fetch_min(carried, Relaxed);
+                            if old == u64::MAX {
+                                break;
+                            }
+                            carried = carried.max(old);
+                        }
+                    }
+                });
+                slots
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    capture.bench_function("abuffer/generic", |b| {
+        b.iter_batched(
+            || abuffer.layout().allocate::<AtomicMemory>(),
+            |memory| {
+                fragments.par_chunks(FRAGMENTS_PER_TASK).for_each(|chunk| {
+                    let mut steps = 0;
+                    for &f in chunk {
+                        abuffer.insert(f, &memory, &mut steps);
+                    }
+                });
+                memory
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    let counts = oracle.depth_complexity();
+    let mut offsets = vec![0usize; pixels + 1];
+    for p in 0..pixels {
+        offsets[p + 1] = offsets[p] + counts[p] as usize;
+    }
+    capture.bench_function("abuffer/bare-fetch_add", |b| {
+        b.iter_batched(
+            || {
+                let counters: Vec<AtomicU32> = (0..pixels).map(|_| AtomicU32::new(0)).collect();
+                let slots: Vec<AtomicU64> = (0..offsets[pixels]).map(|_| AtomicU64::new(u64::MAX)).collect();
+                (counters, slots)
+            },
+            |(counters, slots)| {
+                fragments.par_chunks(FRAGMENTS_PER_TASK).for_each(|chunk| {
+                    for &f in chunk {
+                        let p = f.pixel as usize;
+                        let taken = counters[p].fetch_add(1, Relaxed) as usize;
+                        if taken < offsets[p + 1] - offsets[p] {
+                            slots[offsets[p] + taken].store(f.packed(), Relaxed);
+                        }
+                    }
+                });
+                (counters, slots)
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    capture.finish();
+}
+
+criterion_group!(main_benches, benches);
+criterion_main!(main_benches);
