@@ -139,7 +139,7 @@ impl Mesh {
             mesh.positions
                 .extend(m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
             for t in m.indices.chunks_exact(3) {
-                let shifted = [t[0], t[1], t[2]].map(|i| i.checked_add(base).unwrap_or(u32::MAX));
+                let shifted = [t[0], t[1], t[2]].map(|i| i.saturating_add(base));
                 mesh.triangles.push(shifted);
             }
         }

@@ -202,7 +202,7 @@ impl<'mesh> View<'mesh> {
     }
 
     fn snap_and_orient(&self, prim: u32, clip: [DVec4; 3], visit: &mut impl FnMut(ScreenTriangle)) {
-        if clip.iter().any(|v| !(v.w > 0.0)) {
+        if clip.iter().any(|v| v.w.is_nan() || v.w <= 0.0) {
             // Only reachable with a projection whose near plane does not bound w away from 0.
             return;
         }
