@@ -23,9 +23,9 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capture, Identity, Keeps};
+use crate::capture::Identity;
 use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// The post pass's sort.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -141,7 +141,7 @@ impl ABuffer {
         }
     }
 
-    fn pixels(&self) -> usize {
+    fn pixel_count(&self) -> usize {
         match &self.storage {
             Storage::Fixed { pixels, .. } => *pixels,
             Storage::Exact { offsets } => offsets.len() - 1,
@@ -208,32 +208,30 @@ impl Scheme for ABuffer {
         }
     }
 
-    fn resolve<M: Memory>(&self, memory: &M) -> Capture {
-        let pixels = self.pixels();
-        let mut overflow = vec![0u32; pixels];
-        let mut capture = Capture::with_pixels(
-            pixels,
-            Identity::KeyAndPrim,
-            Keeps::All {
-                overflow: Vec::new(),
-            },
-        );
-        let mut list = Vec::new();
-        for (pixel, overflowed) in overflow.iter_mut().enumerate() {
-            let count = WordMemory::<u32>::load(memory, pixel) as usize;
-            let (first, capacity) = self.slots(pixel);
-            let stored = count.min(capacity);
-            *overflowed = (count - stored) as u32;
-            list.clear();
-            list.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
-            match self.sort {
-                PostSort::Insertion => insertion_sort(&mut list),
-                PostSort::Bitonic => bitonic_sort(&mut list),
-            }
-            capture.push_pixel(list.iter().copied());
+    fn identity(&self) -> Identity {
+        Identity::KeyAndPrim
+    }
+
+    fn promise(&self) -> Promise {
+        Promise::All
+    }
+
+    fn pixels(&self) -> usize {
+        self.pixel_count()
+    }
+
+    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+        let count = WordMemory::<u32>::load(memory, pixel) as usize;
+        let (first, capacity) = self.slots(pixel);
+        let stored = count.min(capacity);
+        let start = out.len();
+        out.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
+        let list = &mut out[start..];
+        match self.sort {
+            PostSort::Insertion => insertion_sort(list),
+            PostSort::Bitonic => bitonic_sort(list),
         }
-        capture.keeps = Keeps::All { overflow };
-        capture
+        (count - stored) as u32
     }
 }
 
@@ -252,10 +250,10 @@ pub fn insertion_sort(list: &mut [u64]) {
 
 /// Bitonic sort: the list is padded with `u64::MAX` to a power of two and sorted by the network of
 /// Batcher (1968), compare-exchange stage by stage as a GPU thread (or warp) runs it.
-pub fn bitonic_sort(list: &mut Vec<u64>) {
-    let len = list.len();
-    let padded = len.next_power_of_two();
-    list.resize(padded, u64::MAX);
+pub fn bitonic_sort(list: &mut [u64]) {
+    let padded = list.len().next_power_of_two();
+    let mut network = list.to_vec();
+    network.resize(padded, u64::MAX);
     let mut size = 2;
     while size <= padded {
         let mut stride = size / 2;
@@ -264,8 +262,8 @@ pub fn bitonic_sort(list: &mut Vec<u64>) {
                 let partner = i ^ stride;
                 if partner > i {
                     let ascending = i & size == 0;
-                    if (list[i] > list[partner]) == ascending {
-                        list.swap(i, partner);
+                    if (network[i] > network[partner]) == ascending {
+                        network.swap(i, partner);
                     }
                 }
             }
@@ -273,7 +271,8 @@ pub fn bitonic_sort(list: &mut Vec<u64>) {
         }
         size *= 2;
     }
-    list.truncate(len);
+    let len = list.len();
+    list.copy_from_slice(&network[..len]);
 }
 
 #[cfg(test)]

@@ -6,8 +6,11 @@
 //!   with std atomics ([`AtomicMemory`]). Fragments are inserted as they are rasterized, never
 //!   collected first. Triangles are handed to rayon in chunks, never a task per triangle.
 //!
-//! Both time the pass (storage initialisation, rasterization and capture) and the post pass
-//! (resolve) separately, and count fragments, steps (= memory operations) and drops.
+//! Multi-pass schemes run one geometry pass after another, with the scheme's between-pass kernel
+//! in between, until the scheme asks for no more. Both executors time the passes (storage
+//! initialisation, rasterization, capture) and the post pass (resolve) separately, and count
+//! fragments, steps (= memory operations), drops and passes. The parallel executor runs the post
+//! pass in parallel too (FreePipe's post-sort kernel: one GPU thread per pixel).
 
 use std::time::{Duration, Instant};
 
@@ -33,6 +36,8 @@ pub struct Counters {
     pub stored: u64,
     /// Walks that ended with a value dropped for lack of storage.
     pub dropped: u64,
+    /// Walks rejected by the scheme's own test (e.g. not in this peeling pass's layer).
+    pub discarded: u64,
 }
 
 impl Counters {
@@ -41,6 +46,7 @@ impl Counters {
         match end {
             Step::Stored => self.stored += 1,
             Step::Dropped => self.dropped += 1,
+            Step::Discarded => self.discarded += 1,
             Step::Continue => unreachable!("a walk ends with Stored or Dropped"),
         }
     }
@@ -51,6 +57,7 @@ impl Counters {
             steps: self.steps + other.steps,
             stored: self.stored + other.stored,
             dropped: self.dropped + other.dropped,
+            discarded: self.discarded + other.discarded,
         }
     }
 }
@@ -58,8 +65,10 @@ impl Counters {
 /// What a run measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RunStats {
-    /// Counts.
+    /// Counts, over all passes.
     pub counters: Counters,
+    /// Geometry passes.
+    pub passes: u32,
     /// Initialisation, rasterization and capture.
     pub pass_time: Duration,
     /// The post pass.
@@ -84,51 +93,111 @@ pub fn run_serial<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
     let start = Instant::now();
     let memory: SerialMemory = scheme.layout().allocate();
     let mut counters = Counters::default();
-    for prim in 0..view.triangle_count() {
-        view.rasterize(prim, &mut |fragment| {
-            let end = scheme.insert(fragment, &memory, &mut counters.steps);
-            counters.record(end);
-        });
+    let mut pass = 0;
+    loop {
+        for prim in 0..view.triangle_count() {
+            view.rasterize(prim, &mut |fragment| {
+                if let Some(state) = scheme.begin_pass(pass, fragment) {
+                    let end = scheme.insert_state(state, &memory, &mut counters.steps);
+                    counters.record(end);
+                }
+            });
+        }
+        pass += 1;
+        if !scheme.end_pass(pass - 1, &memory) {
+            break;
+        }
     }
-    finish(scheme, &memory, counters, start, 1)
+    let pass_time = start.elapsed();
+    let resolve_start = Instant::now();
+    let capture = scheme.resolve(&memory);
+    finish(scheme, capture, counters, pass, pass_time, resolve_start, 1)
 }
 
 /// Runs `scheme` over `view` on the current rayon pool, with std atomics.
 pub fn run_parallel<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
     let start = Instant::now();
     let memory: AtomicMemory = scheme.layout().allocate();
-    let counters = (0..view.triangle_count())
-        .into_par_iter()
-        .with_min_len(TRIANGLES_PER_TASK)
-        .fold(Counters::default, |mut counters, prim| {
-            view.rasterize(prim, &mut |fragment| {
-                let end = scheme.insert(fragment, &memory, &mut counters.steps);
-                counters.record(end);
-            });
-            counters
-        })
-        .reduce(Counters::default, Counters::merge);
+    let mut counters = Counters::default();
+    let mut pass = 0;
+    loop {
+        let this_pass = (0..view.triangle_count())
+            .into_par_iter()
+            .with_min_len(TRIANGLES_PER_TASK)
+            .fold(Counters::default, |mut counters, prim| {
+                view.rasterize(prim, &mut |fragment| {
+                    if let Some(state) = scheme.begin_pass(pass, fragment) {
+                        let end = scheme.insert_state(state, &memory, &mut counters.steps);
+                        counters.record(end);
+                    }
+                });
+                counters
+            })
+            .reduce(Counters::default, Counters::merge);
+        counters = counters.merge(this_pass);
+        pass += 1;
+        if !scheme.end_pass(pass - 1, &memory) {
+            break;
+        }
+    }
+    let pass_time = start.elapsed();
+    let resolve_start = Instant::now();
+    let capture = resolve_parallel(scheme, &memory);
     finish(
         scheme,
-        &memory,
+        capture,
         counters,
-        start,
+        pass,
+        pass_time,
+        resolve_start,
         rayon::current_num_threads(),
     )
 }
 
-fn finish<S: Scheme, M: Memory>(
+/// Pixels per rayon work item in the post pass.
+const PIXELS_PER_TASK: usize = 4096;
+
+/// The post pass on the rayon pool: pixel chunks resolved independently, then concatenated.
+fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capture {
+    let pixels = scheme.pixels();
+    let chunks: Vec<(Vec<u64>, Vec<usize>, Vec<u32>)> = (0..pixels.div_ceil(PIXELS_PER_TASK))
+        .into_par_iter()
+        .map(|chunk| {
+            let range = chunk * PIXELS_PER_TASK..((chunk + 1) * PIXELS_PER_TASK).min(pixels);
+            let mut entries = Vec::new();
+            let mut ends = Vec::with_capacity(range.len());
+            let mut overflow = Vec::with_capacity(range.len());
+            for pixel in range {
+                overflow.push(scheme.resolve_pixel(memory, pixel, &mut entries));
+                ends.push(entries.len());
+            }
+            (entries, ends, overflow)
+        })
+        .collect();
+    let mut capture = Capture::with_pixels(pixels, scheme.identity(), scheme.keeps(Vec::new()));
+    let mut all_overflow = Vec::with_capacity(pixels);
+    for (entries, ends, overflow) in chunks {
+        let base = capture.entries.len();
+        capture.offsets.extend(ends.iter().map(|end| base + end));
+        capture.entries.extend_from_slice(&entries);
+        all_overflow.extend_from_slice(&overflow);
+    }
+    capture.keeps = scheme.keeps(all_overflow);
+    capture
+}
+
+fn finish<S: Scheme>(
     scheme: &S,
-    memory: &M,
+    capture: Capture,
     counters: Counters,
-    start: Instant,
+    passes: u32,
+    pass_time: Duration,
+    resolve_start: Instant,
     threads: usize,
 ) -> Run {
-    let pass_time = start.elapsed();
-    let resolve_start = Instant::now();
-    let capture = scheme.resolve(memory);
     let stats = RunStats {
         counters,
+        passes,
         pass_time,
         resolve_time: resolve_start.elapsed(),
         memory_bytes: scheme.layout().bytes(),

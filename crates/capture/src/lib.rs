@@ -29,4 +29,4 @@ mod scheme;
 
 pub use capture::{Capture, Identity, Keeps};
 pub use memory::{AtomicMemory, Memory, SerialMemory, Word, WordMemory};
-pub use scheme::{CaptureError, Layout, Scheme, Step, MEMORY_CAP_DEFAULT};
+pub use scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};

@@ -24,9 +24,9 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capture, Identity, Keeps};
+use crate::capture::Identity;
 use crate::memory::{Memory, Word, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// Which way the array is sorted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -217,30 +217,36 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         }
     }
 
-    fn resolve<M: Memory>(&self, memory: &M) -> Capture {
+    fn identity(&self) -> Identity {
+        W::IDENTITY
+    }
+
+    fn promise(&self) -> Promise {
+        match self.direction {
+            Direction::Ascending => Promise::Nearest(self.k),
+            Direction::Descending => Promise::Farthest(self.k),
+        }
+    }
+
+    fn pixels(&self) -> usize {
+        self.pixels
+    }
+
+    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let words = W::words(memory);
-        let keeps = match self.direction {
-            Direction::Ascending => Keeps::Nearest(self.k),
-            Direction::Descending => Keeps::Farthest(self.k),
-        };
-        let mut capture = Capture::with_pixels(self.pixels, W::IDENTITY, keeps);
         let k = self.k as usize;
-        let mut list = Vec::with_capacity(k);
-        for pixel in 0..self.pixels {
-            list.clear();
-            list.extend(
-                (0..k)
-                    .map(|slot| words.load(pixel * k + slot))
-                    .take_while(|&w| w != self.empty()),
-            );
-            match self.direction {
-                Direction::Ascending => capture.push_pixel(list.iter().map(|w| w.decode())),
-                Direction::Descending => {
-                    // Undo the +1 offset and report nearest first, like every other scheme.
-                    capture.push_pixel(list.iter().rev().map(|w| w.wrapping_sub(W::ONE).decode()));
-                }
+        let stored = (0..k)
+            .take_while(|&slot| words.load(pixel * k + slot) != self.empty())
+            .count();
+        let slots = (0..stored).map(|slot| words.load(pixel * k + slot));
+        match self.direction {
+            Direction::Ascending => out.extend(slots.map(MdtsWord::decode)),
+            // Undo the +1 offset and report nearest first, like every other scheme.
+            Direction::Descending => {
+                out.extend(slots.rev().map(|w| w.wrapping_sub(W::ONE).decode()))
             }
         }
-        capture
+        // What fell off the end is not in memory: the executors count it from the walks.
+        0
     }
 }

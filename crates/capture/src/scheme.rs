@@ -4,7 +4,7 @@ use std::fmt::Debug;
 
 use fragsim_raster::Fragment;
 
-use crate::capture::Capture;
+use crate::capture::{Capture, Identity, Keeps};
 use crate::memory::Memory;
 
 /// Default cap on the per-pixel storage a scheme may allocate: 4 GiB.
@@ -48,6 +48,21 @@ pub enum Step {
     Stored,
     /// A value was dropped for lack of storage (counted, never hidden); the walk is over.
     Dropped,
+    /// The fragment was rejected by the scheme's own test, by design (a depth-peeling pass
+    /// ignores fragments that are not in its layer); the walk is over.
+    Discarded,
+}
+
+/// Which of a pixel's fragments a scheme promises to keep (see [`Keeps`], which adds the
+/// per-pixel overflow counts read back by the post pass).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Promise {
+    /// The `K` nearest in canonical order.
+    Nearest(u32),
+    /// The `K` farthest.
+    Farthest(u32),
+    /// Every fragment, except those counted as overflow.
+    All,
 }
 
 /// Why a scheme could not be set up.
@@ -85,18 +100,67 @@ pub trait Scheme: Sync {
     /// The storage the scheme needs.
     fn layout(&self) -> Layout;
 
-    /// The state of a fragment before its first step.
+    /// What the captured words identify.
+    fn identity(&self) -> Identity;
+
+    /// Which fragments the scheme promises to keep.
+    fn promise(&self) -> Promise;
+
+    /// The state of a fragment before its first step in the first geometry pass.
     fn begin(&self, fragment: Fragment) -> Self::State;
+
+    /// The state of a fragment before its first step in geometry pass `pass` (from 0), or `None`
+    /// when the pass ignores fragments. One-pass schemes need not override it.
+    fn begin_pass(&self, pass: u32, fragment: Fragment) -> Option<Self::State> {
+        (pass == 0).then(|| self.begin(fragment))
+    }
 
     /// One memory operation of the fragment's walk.
     fn step<M: Memory>(&self, state: &mut Self::State, memory: &M) -> Step;
 
-    /// The post pass, after every fragment is done: the per-pixel lists in canonical order.
-    fn resolve<M: Memory>(&self, memory: &M) -> Capture;
+    /// Work between geometry passes, after pass `pass` (a per-pixel kernel on the GPU); returns
+    /// whether another geometry pass is needed. One-pass schemes need not override it.
+    fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
+        let _ = (pass, memory);
+        false
+    }
+
+    /// The post pass for one pixel, after every pass is done: appends the pixel's list in
+    /// canonical order to `out` and returns how many of its fragments overflowed storage.
+    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32;
+
+    /// Number of pixels the scheme's storage covers.
+    fn pixels(&self) -> usize;
+
+    /// The post pass over every pixel, serially.
+    fn resolve<M: Memory>(&self, memory: &M) -> Capture {
+        let mut capture =
+            Capture::with_pixels(self.pixels(), self.identity(), self.keeps(Vec::new()));
+        let mut overflow = Vec::with_capacity(self.pixels());
+        for pixel in 0..self.pixels() {
+            overflow.push(self.resolve_pixel(memory, pixel, &mut capture.entries));
+            capture.offsets.push(capture.entries.len());
+        }
+        capture.keeps = self.keeps(overflow);
+        capture
+    }
+
+    /// The promise with the per-pixel overflow counts filled in.
+    fn keeps(&self, overflow: Vec<u32>) -> Keeps {
+        match self.promise() {
+            Promise::Nearest(k) => Keeps::Nearest(k),
+            Promise::Farthest(k) => Keeps::Farthest(k),
+            Promise::All => Keeps::All { overflow },
+        }
+    }
 
     /// Runs one fragment's walk to the end on `memory`, counting the steps into `steps`.
     fn insert<M: Memory>(&self, fragment: Fragment, memory: &M, steps: &mut u64) -> Step {
-        let mut state = self.begin(fragment);
+        self.insert_state(self.begin(fragment), memory, steps)
+    }
+
+    /// Runs a walk from `state` to the end on `memory`, counting the steps into `steps`.
+    fn insert_state<M: Memory>(&self, mut state: Self::State, memory: &M, steps: &mut u64) -> Step {
         loop {
             *steps += 1;
             match self.step(&mut state, memory) {

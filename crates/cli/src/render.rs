@@ -139,8 +139,10 @@ pub struct RunSummary {
     pub height: u32,
     /// Triangles in the scene.
     pub triangles: u32,
-    /// Fragments rasterized and inserted.
+    /// Fragments rasterized and inserted, over all passes.
     pub fragments: u64,
+    /// Geometry passes.
+    pub passes: u32,
     /// Largest per-pixel depth complexity.
     pub max_depth_complexity: u32,
     /// Memory operations (steps) performed.
@@ -236,6 +238,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 height: viewport.height,
                 triangles: view.triangle_count(),
                 fragments: run.stats.counters.fragments,
+                passes: run.stats.passes,
                 max_depth_complexity: max_dc,
                 memory_ops: run.stats.counters.steps,
                 captured: diff.captured,
@@ -407,37 +410,45 @@ fn print_table(
         oracle.max_depth_complexity(),
         oracle_ms
     );
-    println!(
-        "{:<16} {:<9} {:>3} {:>9} {:>10} {:>4} {:>10} {:>12} {:>9} {:>6} {:>10} {:>10}",
-        "scheme",
-        "executor",
-        "thr",
-        "triangles",
-        "fragments",
-        "maxdc",
-        "time ms",
-        "memory B",
-        "overflow",
-        "lost",
-        "mismatches",
-        "mem ops"
+    type Cell = fn(&RunSummary) -> String;
+    let columns: [(&str, usize, Cell); 13] = [
+        ("scheme", 16, |r| r.scheme.clone()),
+        ("executor", 9, |r| r.executor.clone()),
+        ("thr", 3, |r| r.threads.to_string()),
+        ("passes", 6, |r| r.passes.to_string()),
+        ("triangles", 9, |r| r.triangles.to_string()),
+        ("fragments", 10, |r| r.fragments.to_string()),
+        ("maxdc", 5, |r| r.max_depth_complexity.to_string()),
+        ("time ms", 9, |r| format!("{:.2}", r.time_ms)),
+        ("memory B", 11, |r| r.memory_bytes.to_string()),
+        ("overflow", 8, |r| r.overflowed.to_string()),
+        ("lost", 6, |r| r.lost.to_string()),
+        ("mismatches", 10, |r| r.mismatches.to_string()),
+        ("mem ops", 9, |r| r.memory_ops.to_string()),
+    ];
+    let line = |cells: Vec<String>| {
+        let padded: Vec<String> = cells
+            .iter()
+            .zip(&columns)
+            .enumerate()
+            .map(|(i, (cell, (_, width, _)))| {
+                if i < 2 {
+                    format!("{cell:<width$}")
+                } else {
+                    format!("{cell:>width$}")
+                }
+            })
+            .collect();
+        println!("{}", padded.join(" "));
+    };
+    line(
+        columns
+            .iter()
+            .map(|(header, _, _)| (*header).to_string())
+            .collect(),
     );
     for r in rows {
-        println!(
-            "{:<16} {:<9} {:>3} {:>9} {:>10} {:>4} {:>10.2} {:>12} {:>9} {:>6} {:>10} {:>10}",
-            r.scheme,
-            r.executor,
-            r.threads,
-            r.triangles,
-            r.fragments,
-            r.max_depth_complexity,
-            r.time_ms,
-            r.memory_bytes,
-            r.overflowed,
-            r.lost,
-            r.mismatches,
-            r.memory_ops
-        );
+        line(columns.iter().map(|(_, _, cell)| cell(r)).collect());
     }
     let pixels = viewport.pixels() as u64;
     let max_dc = u64::from(oracle.max_depth_complexity());
