@@ -21,11 +21,19 @@
 //! ```
 
 pub mod abuffer;
+pub mod bucket;
 mod capture;
+pub mod dual_peeling;
 pub mod executor;
+pub mod kbuffer;
+pub mod kbuffer_multipass;
 pub mod mdts;
+pub mod mdts_packed;
 mod memory;
+pub mod peeling;
 mod scheme;
+pub mod stencil_routed;
+pub mod zbuffer;
 
 pub use capture::{Capture, Identity, Keeps};
 pub use memory::{AtomicMemory, Memory, SerialMemory, Word, WordMemory};

@@ -106,7 +106,11 @@ impl Oracle {
         let mask = match capture.identity {
             Identity::KeyAndPrim => u64::MAX,
             Identity::KeyOnly => u64::MAX << 32,
+            Identity::PrimOnly => u64::from(u32::MAX),
         };
+        // Keys and packed words sort in depth order; bare primitive ids do not, so their order is
+        // checked against the oracle's sequence instead of by sortedness.
+        let sequence_order = capture.identity == Identity::PrimOnly;
         let mut expected = Vec::new();
         let mut got_sorted = Vec::new();
         for p in 0..self.pixels() {
@@ -132,11 +136,17 @@ impl Oracle {
                 }
             };
             diff.overflowed += allowed_missing as u64;
-            let misordered = got.windows(2).any(|w| w[0] > w[1]);
             got_sorted.clear();
             got_sorted.extend_from_slice(got);
             got_sorted.sort_unstable();
-            let (missing, extra) = multiset_difference(&expected, &got_sorted);
+            let mut expected_sorted = expected.clone();
+            expected_sorted.sort_unstable();
+            let (missing, extra) = multiset_difference(&expected_sorted, &got_sorted);
+            let misordered = if sequence_order {
+                missing == 0 && extra == 0 && got != expected.as_slice()
+            } else {
+                got.windows(2).any(|w| w[0] > w[1])
+            };
             // Where overflow made the kept subset order-dependent, `allowed_missing` of the
             // expected fragments may be absent; any more is a loss.
             let lost = if exact_list {
@@ -272,6 +282,19 @@ mod tests {
             ),
             (1, 1, 1, 2)
         );
+    }
+
+    #[test]
+    fn primitive_sequences_are_compared_in_depth_order() {
+        // Pixel 0: prim 9 is nearer (key 1) than prim 4 (key 2).
+        let oracle = oracle_of(&[&[(1 << 32) | 9, (2 << 32) | 4]]);
+        let mut right = Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
+        right.push_pixel([9, 4]);
+        assert!(oracle.diff(&right).is_exact());
+        let mut swapped = Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
+        swapped.push_pixel([4, 9]);
+        let diff = oracle.diff(&swapped);
+        assert_eq!((diff.misordered_pixels, diff.lost, diff.mismatched_pixels), (1, 0, 1));
     }
 
     #[test]

@@ -1,0 +1,1 @@
+//! Placeholder: filled in by the baselines work (issue 3).
