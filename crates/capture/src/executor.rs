@@ -41,7 +41,7 @@ pub struct Counters {
 }
 
 impl Counters {
-    fn record(&mut self, end: Step) {
+    pub(crate) fn record(&mut self, end: Step) {
         self.fragments += 1;
         match end {
             Step::Stored => self.stored += 1,

@@ -31,6 +31,7 @@ pub mod mdts;
 pub mod mdts_packed;
 mod memory;
 pub mod peeling;
+pub mod scheduled;
 mod scheme;
 pub mod stencil_routed;
 pub mod zbuffer;

@@ -1,0 +1,514 @@
+//! The scheduled executor: replayable GPU-like interleavings, with traces.
+//!
+//! Real threads on a 2-core CPU almost never interleave two fragments of one pixel, and when they
+//! do nobody can replay it; loom explores everything but only for a handful of fragments. This
+//! executor runs a whole scene on one thread under a simulated GPU scheduler:
+//!
+//! - `W` logical threads are in flight at once ([`Schedule::in_flight`]); a thread carries one
+//!   fragment's walk ([`Granularity::Fragment`]) or, as FreePipe's one CUDA thread per triangle,
+//!   every fragment of one triangle in scan order ([`Granularity::Triangle`]). When a thread
+//!   finishes, the next fragment or triangle of the stream takes its place.
+//! - Which thread's next step (one memory operation) runs is chosen by the [`Policy`]: uniformly
+//!   at random; round-robin over lockstep warps of 32 (a warp issues one step for each of its active
+//!   lanes, in lane order, so conflicting atomics on one word serialise in lane order and of plain
+//!   stores to one word the last lane wins); or PCT (Burckhardt et al., ASPLOS 2010: random thread
+//!   priorities, the highest-priority thread runs, with `depth − 1` random priority change points).
+//! - Everything is a pure function of (scene, scheme, policy, `W`, seed): the same [`Schedule`]
+//!   replays the same interleaving, step for step.
+//! - Every memory operation can be recorded as a [`TraceEvent`]; a trace can be filtered to one
+//!   pixel ([`Trace::pixel`]).
+//!
+//! Unlike a GPU, steps run one at a time: the schedule is a total order of memory operations. That
+//! is the model the schemes' proofs use (per-location atomicity); a GPU's lockstep warp is modelled
+//! by its lane order.
+
+use std::cell::{Cell, RefCell};
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use fragsim_raster::{Fragment, SplitMix64, View};
+
+use crate::executor::{Counters, Run, RunStats};
+use crate::memory::{Memory, SerialMemory, WordMemory};
+use crate::scheme::{Scheme, Step};
+
+/// Lanes of a warp in [`Policy::Warps`].
+pub const WARP_LANES: usize = 32;
+
+/// How the next step is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Policy {
+    /// Any in-flight thread, uniformly at random.
+    Random,
+    /// Warps of [`WARP_LANES`] threads in round-robin; a warp issues one step per active lane, in
+    /// lane order.
+    Warps,
+    /// Probabilistic concurrency testing with `depth − 1` priority change points.
+    Pct {
+        /// PCT's bug depth `d` (≥ 1).
+        depth: u32,
+    },
+}
+
+/// What one logical thread carries.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Granularity {
+    /// One fragment per thread.
+    #[default]
+    Fragment,
+    /// One triangle per thread, its fragments in scan order (FreePipe's model).
+    Triangle,
+}
+
+/// A complete description of an interleaving: replaying it gives the same run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Schedule {
+    /// The scheduling policy.
+    pub policy: Policy,
+    /// Threads in flight (`W` ≥ 1).
+    pub in_flight: usize,
+    /// What a thread carries.
+    pub granularity: Granularity,
+    /// The seed of every random choice.
+    pub seed: u64,
+}
+
+/// A memory operation, as recorded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// Plain load.
+    Load,
+    /// Plain store.
+    Store,
+    /// `atomicMin`.
+    FetchMin,
+    /// `atomicMax`.
+    FetchMax,
+    /// `atomicAdd`.
+    FetchAdd,
+    /// `atomicOr`.
+    FetchOr,
+}
+
+/// One recorded memory operation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceEvent {
+    /// Index of the step in the whole run.
+    pub step: u64,
+    /// The logical thread (slot) that ran it.
+    pub thread: u32,
+    /// Index of the fragment in the pass's stream.
+    pub fragment: u64,
+    /// The fragment's pixel.
+    pub pixel: u32,
+    /// Geometry pass.
+    pub pass: u32,
+    /// Word width in bits (32 or 64).
+    pub width: u8,
+    /// Word index in its array.
+    pub word: usize,
+    /// The operation.
+    pub op: Op,
+    /// The value passed in (0 for a load).
+    pub operand: u64,
+    /// The value returned (the old value of a read-modify-write, the value of a load; the value
+    /// overwritten, for a store).
+    pub returned: u64,
+}
+
+/// The recorded memory operations of a run, in execution order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Trace {
+    /// Events in execution order.
+    pub events: Vec<TraceEvent>,
+}
+
+impl Trace {
+    /// The events that touched `pixel`'s fragments.
+    #[must_use]
+    pub fn pixel(&self, pixel: u32) -> Trace {
+        Trace {
+            events: self
+                .events
+                .iter()
+                .filter(|e| e.pixel == pixel)
+                .copied()
+                .collect(),
+        }
+    }
+}
+
+/// A scheduled run: the usual result plus the trace, if one was asked for.
+#[derive(Clone, Debug)]
+pub struct ScheduledRun {
+    /// Capture and statistics.
+    pub run: Run,
+    /// The memory operations, when recording.
+    pub trace: Option<Trace>,
+}
+
+/// Storage that can record every operation: plain memory plus a log.
+struct RecordingMemory {
+    inner: SerialMemory,
+    log: Option<RefCell<Vec<TraceEvent>>>,
+    /// (step, thread, fragment, pixel, pass) of the step being run.
+    context: Cell<(u64, u32, u64, u32, u32)>,
+}
+
+impl RecordingMemory {
+    fn note(&self, width: u8, word: usize, op: Op, operand: u64, returned: u64) {
+        if let Some(log) = &self.log {
+            let (step, thread, fragment, pixel, pass) = self.context.get();
+            log.borrow_mut().push(TraceEvent {
+                step,
+                thread,
+                fragment,
+                pixel,
+                pass,
+                width,
+                word,
+                op,
+                operand,
+                returned,
+            });
+        }
+    }
+}
+
+/// Forwards each operation to the inner memory and records it.
+macro_rules! recording_words {
+    ($word:ty, $bits:expr) => {
+        impl WordMemory<$word> for RecordingMemory {
+            fn len(&self) -> usize {
+                WordMemory::<$word>::len(&self.inner)
+            }
+            fn load(&self, i: usize) -> $word {
+                let v = WordMemory::<$word>::load(&self.inner, i);
+                self.note($bits, i, Op::Load, 0, u64::from(v));
+                v
+            }
+            fn store(&self, i: usize, v: $word) {
+                let old = WordMemory::<$word>::load(&self.inner, i);
+                WordMemory::<$word>::store(&self.inner, i, v);
+                self.note($bits, i, Op::Store, u64::from(v), u64::from(old));
+            }
+            fn fetch_min(&self, i: usize, v: $word) -> $word {
+                let old = WordMemory::<$word>::fetch_min(&self.inner, i, v);
+                self.note($bits, i, Op::FetchMin, u64::from(v), u64::from(old));
+                old
+            }
+            fn fetch_max(&self, i: usize, v: $word) -> $word {
+                let old = WordMemory::<$word>::fetch_max(&self.inner, i, v);
+                self.note($bits, i, Op::FetchMax, u64::from(v), u64::from(old));
+                old
+            }
+            fn fetch_add(&self, i: usize, v: $word) -> $word {
+                let old = WordMemory::<$word>::fetch_add(&self.inner, i, v);
+                self.note($bits, i, Op::FetchAdd, u64::from(v), u64::from(old));
+                old
+            }
+            fn fetch_or(&self, i: usize, v: $word) -> $word {
+                let old = WordMemory::<$word>::fetch_or(&self.inner, i, v);
+                self.note($bits, i, Op::FetchOr, u64::from(v), u64::from(old));
+                old
+            }
+        }
+    };
+}
+
+recording_words!(u32, 32);
+recording_words!(u64, 64);
+
+impl Memory for RecordingMemory {
+    fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
+        Self {
+            inner: SerialMemory::new(len32, init32, len64, init64),
+            log: None,
+            context: Cell::new((0, 0, 0, 0, 0)),
+        }
+    }
+}
+
+/// One logical thread: its current walk and the fragments still queued for it.
+struct Thread<S> {
+    walk: Option<(S, Fragment, u64)>,
+    queue: VecDeque<(Fragment, u64)>,
+    priority: u64,
+}
+
+/// Chooses the next thread to step.
+struct Chooser {
+    policy: Policy,
+    rng: SplitMix64,
+    /// Warps: the warp being issued and the next lane to issue in it.
+    warp: usize,
+    lane: usize,
+    /// PCT: steps at which the running thread's priority drops, and the next low priority.
+    change_points: Vec<u64>,
+    next_low: u64,
+}
+
+impl Chooser {
+    fn new(schedule: &Schedule, expected_steps: u64) -> Self {
+        let mut rng = SplitMix64::new(schedule.seed);
+        let change_points = match schedule.policy {
+            Policy::Pct { depth } => {
+                let mut points: Vec<u64> = (1..depth.max(1))
+                    .map(|_| rng.next_u64() % expected_steps.max(1))
+                    .collect();
+                points.sort_unstable();
+                points
+            }
+            _ => Vec::new(),
+        };
+        Self {
+            policy: schedule.policy,
+            rng,
+            warp: 0,
+            lane: 0,
+            change_points,
+            next_low: u64::from(u32::MAX),
+        }
+    }
+
+    fn fresh_priority(&mut self) -> u64 {
+        // High priorities live above 2^32, lowered ones below, so a lowered thread yields to all.
+        (1 << 32) + (self.rng.next_u64() >> 32)
+    }
+
+    /// The next thread to step among `threads`, of which those with `walk.is_some()` are active.
+    fn choose<S>(&mut self, threads: &mut [Thread<S>], active: &[usize], step: u64) -> usize {
+        match self.policy {
+            Policy::Random => active[(self.rng.next_u64() % active.len() as u64) as usize],
+            Policy::Warps => {
+                let warps = threads.len().div_ceil(WARP_LANES);
+                loop {
+                    let base = self.warp * WARP_LANES;
+                    while self.lane < WARP_LANES && base + self.lane < threads.len() {
+                        let t = base + self.lane;
+                        self.lane += 1;
+                        if threads[t].walk.is_some() {
+                            return t;
+                        }
+                    }
+                    self.warp = (self.warp + 1) % warps;
+                    self.lane = 0;
+                }
+            }
+            Policy::Pct { .. } => {
+                let best = *active
+                    .iter()
+                    .max_by_key(|&&t| (threads[t].priority, std::cmp::Reverse(t)))
+                    .unwrap_or(&0);
+                while self.change_points.first().is_some_and(|&p| p <= step) {
+                    self.change_points.remove(0);
+                    threads[best].priority = self.next_low;
+                    self.next_low -= 1;
+                }
+                best
+            }
+        }
+    }
+}
+
+/// Runs `scheme` over `view` under `schedule` on one thread; records a trace when `record`.
+///
+/// # Panics
+/// If `schedule.in_flight` is 0.
+pub fn run_scheduled<S: Scheme>(
+    view: &View<'_>,
+    scheme: &S,
+    schedule: &Schedule,
+    record: bool,
+) -> ScheduledRun {
+    let fragments_of = |prim: u32| {
+        let mut list = Vec::new();
+        view.rasterize(prim, &mut |f| list.push(f));
+        list
+    };
+    run_stream(
+        scheme,
+        view.triangle_count(),
+        fragments_of,
+        schedule,
+        record,
+    )
+}
+
+/// Runs `scheme` on a hand-written fragment list (one "triangle" per fragment) under `schedule`.
+pub fn run_fragments<S: Scheme>(
+    scheme: &S,
+    fragments: &[Fragment],
+    schedule: &Schedule,
+    record: bool,
+) -> ScheduledRun {
+    run_stream(
+        scheme,
+        fragments.len() as u32,
+        |i| vec![fragments[i as usize]],
+        schedule,
+        record,
+    )
+}
+
+fn run_stream<S: Scheme>(
+    scheme: &S,
+    triangles: u32,
+    fragments_of: impl Fn(u32) -> Vec<Fragment>,
+    schedule: &Schedule,
+    record: bool,
+) -> ScheduledRun {
+    assert!(
+        schedule.in_flight > 0,
+        "the scheduled executor needs at least one thread in flight"
+    );
+    let start = Instant::now();
+    let mut memory: RecordingMemory = scheme.layout().allocate();
+    if record {
+        memory.log = Some(RefCell::new(Vec::new()));
+    }
+    let mut counters = Counters::default();
+    let mut pass = 0;
+    let mut chooser = Chooser::new(schedule, 4 * u64::from(triangles).max(1));
+    loop {
+        run_pass(
+            scheme,
+            &memory,
+            pass,
+            triangles,
+            &fragments_of,
+            schedule,
+            &mut chooser,
+            &mut counters,
+        );
+        pass += 1;
+        if !scheme.end_pass(pass - 1, &memory) {
+            break;
+        }
+    }
+    let pass_time = start.elapsed();
+    let resolve_start = Instant::now();
+    let capture = scheme.resolve(&memory.inner);
+    let stats = RunStats {
+        counters,
+        passes: pass,
+        pass_time,
+        resolve_time: resolve_start.elapsed(),
+        memory_bytes: scheme.layout().bytes(),
+        threads: 1,
+    };
+    let trace = memory.log.map(|log| Trace {
+        events: log.into_inner(),
+    });
+    ScheduledRun {
+        run: Run { capture, stats },
+        trace,
+    }
+}
+
+#[expect(
+    clippy::too_many_arguments,
+    reason = "one pass of the executor's loop, split out for reading"
+)]
+fn run_pass<S: Scheme>(
+    scheme: &S,
+    memory: &RecordingMemory,
+    pass: u32,
+    triangles: u32,
+    fragments_of: &impl Fn(u32) -> Vec<Fragment>,
+    schedule: &Schedule,
+    chooser: &mut Chooser,
+    counters: &mut Counters,
+) {
+    let mut next_triangle = 0u32;
+    let mut next_fragment_index = 0u64;
+    let mut pending: VecDeque<(Fragment, u64)> = VecDeque::new();
+    // Hands a thread its next unit of work: a fragment, or a whole triangle's fragments.
+    let mut refill = |queue: &mut VecDeque<(Fragment, u64)>| -> bool {
+        loop {
+            match schedule.granularity {
+                Granularity::Fragment => {
+                    if let Some(item) = pending.pop_front() {
+                        queue.push_back(item);
+                        return true;
+                    }
+                }
+                Granularity::Triangle => {}
+            }
+            if next_triangle == triangles {
+                return false;
+            }
+            let list = fragments_of(next_triangle);
+            next_triangle += 1;
+            let target = match schedule.granularity {
+                Granularity::Fragment => &mut pending,
+                Granularity::Triangle => &mut *queue,
+            };
+            for f in list {
+                target.push_back((f, next_fragment_index));
+                next_fragment_index += 1;
+            }
+            if schedule.granularity == Granularity::Triangle && !queue.is_empty() {
+                return true;
+            }
+        }
+    };
+    let mut threads: Vec<Thread<S::State>> = Vec::with_capacity(schedule.in_flight);
+    let mut active: Vec<usize> = Vec::with_capacity(schedule.in_flight);
+    for t in 0..schedule.in_flight {
+        let priority = chooser.fresh_priority();
+        threads.push(Thread {
+            walk: None,
+            queue: VecDeque::new(),
+            priority,
+        });
+        if start_next_walk(scheme, pass, &mut threads[t], &mut refill) {
+            active.push(t);
+        }
+    }
+    let mut step = counters.steps;
+    while !active.is_empty() {
+        let t = chooser.choose(&mut threads, &active, step);
+        let thread = &mut threads[t];
+        let (state, fragment, index) = thread.walk.as_mut().expect("chosen threads are active");
+        memory
+            .context
+            .set((step, t as u32, *index, fragment.pixel, pass));
+        step += 1;
+        counters.steps += 1;
+        let outcome = scheme.step(state, memory);
+        if outcome != Step::Continue {
+            counters.record(outcome);
+            thread.walk = None;
+            if !start_next_walk(scheme, pass, thread, &mut refill) {
+                // swap_remove is deterministic, so the choice stays a pure function of the seed.
+                let position = active
+                    .iter()
+                    .position(|&a| a == t)
+                    .expect("active thread is listed");
+                active.swap_remove(position);
+            } else if schedule.granularity == Granularity::Fragment {
+                thread.priority = chooser.fresh_priority();
+            }
+        }
+    }
+}
+
+/// Starts the thread's next walk that the pass does not ignore; false when it has no more work.
+fn start_next_walk<S: Scheme>(
+    scheme: &S,
+    pass: u32,
+    thread: &mut Thread<S::State>,
+    refill: &mut impl FnMut(&mut VecDeque<(Fragment, u64)>) -> bool,
+) -> bool {
+    loop {
+        if thread.queue.is_empty() && !refill(&mut thread.queue) {
+            return false;
+        }
+        let (fragment, index) = thread.queue.pop_front().expect("refilled");
+        if let Some(state) = scheme.begin_pass(pass, fragment) {
+            thread.walk = Some((state, fragment, index));
+            return true;
+        }
+    }
+}
