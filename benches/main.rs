@@ -7,16 +7,20 @@
 //!   `fetch_add` on the same per-pixel arrays with the same fragment addresses: the speed limit of
 //!   the memory system for this work.
 //!
+//! - `scheduled/*`: the scheduled executor on one core, in simulated memory operations per second
+//!   (criterion's throughput: one element = one step = one memory operation).
+//!
 //! Run: `cargo bench --bench main`; ratios are recorded in `docs/results.md`.
 
 #![allow(missing_docs, reason = "criterion_group! and criterion_main! generate undocumented items")]
 
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
-use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use fragsim::capture::abuffer::ABuffer;
 use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::mdts::Mdts;
+use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::{AtomicMemory, Scheme};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
@@ -128,6 +132,19 @@ fn benches(c: &mut Criterion) {
         );
     });
     capture.finish();
+
+    let mut scheduled = c.benchmark_group("scheduled");
+    scheduled.sample_size(10);
+    for (label, policy, granularity) in [
+        ("mdts/random-fragments-w1024", Policy::Random, Granularity::Fragment),
+        ("mdts/warps-triangles-w1024", Policy::Warps, Granularity::Triangle),
+    ] {
+        let schedule = Schedule { policy, in_flight: 1024, granularity, seed: 1 };
+        let steps = run_scheduled(&view, &mdts, &schedule, false).run.stats.counters.steps;
+        scheduled.throughput(Throughput::Elements(steps));
+        scheduled.bench_function(label, |b| b.iter(|| run_scheduled(&view, &mdts, &schedule, false)));
+    }
+    scheduled.finish();
 }
 
 criterion_group!(main_benches, benches);
