@@ -1,7 +1,8 @@
 //! Benchmarks of the core on the embedded default scene (the Stanford bunny, 512 × 512, view 30°).
 //!
-//! - `pass/*`: the executors end to end (storage initialisation, rasterization, capture, resolve),
-//!   serial against parallel.
+//! - `pass/*`: one frame of the executors end to end (storage re-initialisation, rasterization,
+//!   capture, resolve), serial against parallel; the executors keep their storage between frames
+//!   as a GPU application does.
 //! - `capture/*`: capture alone over the pre-rasterized fragment stream, the generic scheme code
 //!   (state machine behind the `Memory` seam) against a bare hand-written loop of `fetch_min` /
 //!   `fetch_add` on the same per-pixel arrays with the same fragment addresses: the speed limit of
@@ -12,13 +13,16 @@
 //!
 //! Run: `cargo bench --bench main`; ratios are recorded in `docs/results.md`.
 
-#![allow(missing_docs, reason = "criterion_group! and criterion_main! generate undocumented items")]
+#![allow(
+    missing_docs,
+    reason = "criterion_group! and criterion_main! generate undocumented items"
+)]
 
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use fragsim::capture::abuffer::ABuffer;
-use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::executor::{ParallelExecutor, SerialExecutor};
 use fragsim::capture::mdts::Mdts;
 use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::{AtomicMemory, Scheme};
@@ -31,7 +35,12 @@ const FRAGMENTS_PER_TASK: usize = 4096;
 
 fn benches(c: &mut Criterion) {
     let scene = Scene::default_scene();
-    let view = scene.view(Viewport::new(512, 512).unwrap(), &OrbitCamera::default().at_angle(30.0)).unwrap();
+    let view = scene
+        .view(
+            Viewport::new(512, 512).unwrap(),
+            &OrbitCamera::default().at_angle(30.0),
+        )
+        .unwrap();
     let oracle = Oracle::build(&view);
     let k = oracle.max_depth_complexity();
     let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
@@ -39,10 +48,13 @@ fn benches(c: &mut Criterion) {
 
     let mut pass = c.benchmark_group("pass");
     pass.sample_size(20);
-    pass.bench_function("mdts/serial", |b| b.iter(|| run_serial(&view, &mdts)));
-    pass.bench_function("mdts/parallel", |b| b.iter(|| run_parallel(&view, &mdts)));
-    pass.bench_function("abuffer/serial", |b| b.iter(|| run_serial(&view, &abuffer)));
-    pass.bench_function("abuffer/parallel", |b| b.iter(|| run_parallel(&view, &abuffer)));
+    let (mut serial, mut parallel) = (SerialExecutor::default(), ParallelExecutor::default());
+    pass.bench_function("mdts/serial", |b| b.iter(|| serial.run(&view, &mdts)));
+    pass.bench_function("mdts/parallel", |b| b.iter(|| parallel.run(&view, &mdts)));
+    pass.bench_function("abuffer/serial", |b| b.iter(|| serial.run(&view, &abuffer)));
+    pass.bench_function("abuffer/parallel", |b| {
+        b.iter(|| parallel.run(&view, &abuffer))
+    });
     pass.finish();
 
     let mut fragments: Vec<Fragment> = Vec::with_capacity(oracle.fragments());
@@ -69,7 +81,11 @@ fn benches(c: &mut Criterion) {
     });
     capture.bench_function("mdts/bare-fetch_min", |b| {
         b.iter_batched(
-            || (0..pixels * k as usize).map(|_| AtomicU64::new(u64::MAX)).collect::<Vec<_>>(),
+            || {
+                (0..pixels * k as usize)
+                    .map(|_| AtomicU64::new(u64::MAX))
+                    .collect::<Vec<_>>()
+            },
             |slots| {
                 fragments.par_chunks(FRAGMENTS_PER_TASK).for_each(|chunk| {
                     for &f in chunk {
@@ -113,7 +129,9 @@ fn benches(c: &mut Criterion) {
         b.iter_batched(
             || {
                 let counters: Vec<AtomicU32> = (0..pixels).map(|_| AtomicU32::new(0)).collect();
-                let slots: Vec<AtomicU64> = (0..offsets[pixels]).map(|_| AtomicU64::new(u64::MAX)).collect();
+                let slots: Vec<AtomicU64> = (0..offsets[pixels])
+                    .map(|_| AtomicU64::new(u64::MAX))
+                    .collect();
                 (counters, slots)
             },
             |(counters, slots)| {
@@ -136,13 +154,32 @@ fn benches(c: &mut Criterion) {
     let mut scheduled = c.benchmark_group("scheduled");
     scheduled.sample_size(10);
     for (label, policy, granularity) in [
-        ("mdts/random-fragments-w1024", Policy::Random, Granularity::Fragment),
-        ("mdts/warps-triangles-w1024", Policy::Warps, Granularity::Triangle),
+        (
+            "mdts/random-fragments-w1024",
+            Policy::Random,
+            Granularity::Fragment,
+        ),
+        (
+            "mdts/warps-triangles-w1024",
+            Policy::Warps,
+            Granularity::Triangle,
+        ),
     ] {
-        let schedule = Schedule { policy, in_flight: 1024, granularity, seed: 1 };
-        let steps = run_scheduled(&view, &mdts, &schedule, false).run.stats.counters.steps;
+        let schedule = Schedule {
+            policy,
+            in_flight: 1024,
+            granularity,
+            seed: 1,
+        };
+        let steps = run_scheduled(&view, &mdts, &schedule, false)
+            .run
+            .stats
+            .counters
+            .steps;
         scheduled.throughput(Throughput::Elements(steps));
-        scheduled.bench_function(label, |b| b.iter(|| run_scheduled(&view, &mdts, &schedule, false)));
+        scheduled.bench_function(label, |b| {
+            b.iter(|| run_scheduled(&view, &mdts, &schedule, false))
+        });
     }
     scheduled.finish();
 }

@@ -88,70 +88,135 @@ pub struct Run {
     pub stats: RunStats,
 }
 
-/// Runs `scheme` over `view` serially, in submission order.
+/// Runs `scheme` over `view` serially, in submission order, on fresh storage.
 pub fn run_serial<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
-    let start = Instant::now();
-    let memory: SerialMemory = scheme.layout().allocate();
-    let mut counters = Counters::default();
-    let mut pass = 0;
-    loop {
-        for prim in 0..view.triangle_count() {
-            view.rasterize(prim, &mut |fragment| {
-                if let Some(state) = scheme.begin_pass(pass, fragment) {
-                    let end = scheme.insert_state(state, &memory, &mut counters.steps);
-                    counters.record(end);
-                }
-            });
-        }
-        pass += 1;
-        if !scheme.end_pass(pass - 1, &memory) {
-            break;
-        }
-    }
-    let pass_time = start.elapsed();
-    let resolve_start = Instant::now();
-    let capture = scheme.resolve(&memory);
-    finish(scheme, capture, counters, pass, pass_time, resolve_start, 1)
+    SerialExecutor::default().run(view, scheme)
 }
 
-/// Runs `scheme` over `view` on the current rayon pool, with std atomics.
+/// Runs `scheme` over `view` on the current rayon pool, with std atomics, on fresh storage.
 pub fn run_parallel<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
-    let start = Instant::now();
-    let memory: AtomicMemory = scheme.layout().allocate();
+    ParallelExecutor::default().run(view, scheme)
+}
+
+/// The serial executor, keeping its storage between frames: like a GPU application it allocates
+/// once and re-initialises the words every frame (timed as part of the pass).
+#[derive(Debug, Default)]
+pub struct SerialExecutor {
+    memory: Option<SerialMemory>,
+}
+
+impl SerialExecutor {
+    /// Runs one frame of `scheme` over `view`.
+    pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
+        let start = Instant::now();
+        let layout = scheme.layout();
+        let memory = match self.memory.take() {
+            Some(mut memory) if memory.fits(&layout) => {
+                memory.reset(&layout);
+                memory
+            }
+            _ => layout.allocate(),
+        };
+        let memory = self.memory.insert(memory);
+        let (counters, passes) = run_passes(scheme, &*memory, |pass| {
+            let mut counters = Counters::default();
+            for prim in 0..view.triangle_count() {
+                rasterize_into(view, scheme, &*memory, pass, prim, &mut counters);
+            }
+            counters
+        });
+        let pass_time = start.elapsed();
+        let resolve_start = Instant::now();
+        let capture = scheme.resolve(&*memory);
+        finish(
+            scheme,
+            capture,
+            counters,
+            passes,
+            pass_time,
+            resolve_start,
+            1,
+        )
+    }
+}
+
+/// The parallel executor (rayon, std atomics), keeping its storage between frames.
+#[derive(Debug, Default)]
+pub struct ParallelExecutor {
+    memory: Option<AtomicMemory>,
+}
+
+impl ParallelExecutor {
+    /// Runs one frame of `scheme` over `view` on the current rayon pool.
+    pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
+        let start = Instant::now();
+        let layout = scheme.layout();
+        let memory = match self.memory.take() {
+            Some(mut memory) if memory.fits(&layout) => {
+                memory.reset(&layout);
+                memory
+            }
+            _ => layout.allocate(),
+        };
+        let memory = self.memory.insert(memory);
+        let (counters, passes) = run_passes(scheme, &*memory, |pass| {
+            (0..view.triangle_count())
+                .into_par_iter()
+                .with_min_len(TRIANGLES_PER_TASK)
+                .fold(Counters::default, |mut counters, prim| {
+                    rasterize_into(view, scheme, &*memory, pass, prim, &mut counters);
+                    counters
+                })
+                .reduce(Counters::default, Counters::merge)
+        });
+        let pass_time = start.elapsed();
+        let resolve_start = Instant::now();
+        let capture = resolve_parallel(scheme, &*memory);
+        finish(
+            scheme,
+            capture,
+            counters,
+            passes,
+            pass_time,
+            resolve_start,
+            rayon::current_num_threads(),
+        )
+    }
+}
+
+/// Rasterizes triangle `prim` and runs each fragment's walk of geometry pass `pass` to its end.
+fn rasterize_into<S: Scheme, M: Memory>(
+    view: &View<'_>,
+    scheme: &S,
+    memory: &M,
+    pass: u32,
+    prim: u32,
+    counters: &mut Counters,
+) {
+    view.rasterize(prim, &mut |fragment| {
+        if let Some(state) = scheme.begin_pass(pass, fragment) {
+            let end = scheme.insert_state(state, memory, &mut counters.steps);
+            counters.record(end);
+        }
+    });
+}
+
+/// Runs geometry passes until the scheme's between-pass kernel asks for no more; returns the
+/// summed counters and the number of passes.
+fn run_passes<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    mut geometry_pass: impl FnMut(u32) -> Counters,
+) -> (Counters, u32) {
     let mut counters = Counters::default();
     let mut pass = 0;
     loop {
-        let this_pass = (0..view.triangle_count())
-            .into_par_iter()
-            .with_min_len(TRIANGLES_PER_TASK)
-            .fold(Counters::default, |mut counters, prim| {
-                view.rasterize(prim, &mut |fragment| {
-                    if let Some(state) = scheme.begin_pass(pass, fragment) {
-                        let end = scheme.insert_state(state, &memory, &mut counters.steps);
-                        counters.record(end);
-                    }
-                });
-                counters
-            })
-            .reduce(Counters::default, Counters::merge);
-        counters = counters.merge(this_pass);
+        counters = counters.merge(geometry_pass(pass));
         pass += 1;
-        if !scheme.end_pass(pass - 1, &memory) {
-            break;
+        if !scheme.end_pass(pass - 1, memory) {
+            return (counters, pass);
         }
     }
-    let pass_time = start.elapsed();
-    let resolve_start = Instant::now();
-    let capture = resolve_parallel(scheme, &memory);
-    finish(
-        scheme,
-        capture,
-        counters,
-        pass,
-        pass_time,
-        resolve_start,
-        rayon::current_num_threads(),
-    )
 }
 
 /// Pixels per rayon work item in the post pass.

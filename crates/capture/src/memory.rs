@@ -12,6 +12,8 @@ use std::cell::Cell;
 use std::fmt::Debug;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
+use crate::scheme::Layout;
+
 /// A memory word: `u32` or `u64`.
 pub trait Word: Copy + Eq + Ord + Debug + Send + Sync + 'static {
     /// The all-zero word.
@@ -162,6 +164,44 @@ serial_words!(u32, words32);
 serial_words!(u64, words64);
 atomic_words!(u32, words32);
 atomic_words!(u64, words64);
+
+impl SerialMemory {
+    /// Whether this storage has exactly the words `layout` asks for.
+    #[must_use]
+    pub fn fits(&self, layout: &Layout) -> bool {
+        self.words32.len() == layout.words32 && self.words64.len() == layout.words64
+    }
+
+    /// Re-initialises every word to `layout`'s initial values.
+    pub fn reset(&mut self, layout: &Layout) {
+        self.words32
+            .iter_mut()
+            .for_each(|w| *w.get_mut() = layout.init32);
+        self.words64
+            .iter_mut()
+            .for_each(|w| *w.get_mut() = layout.init64);
+    }
+}
+
+impl AtomicMemory {
+    /// Whether this storage has exactly the words `layout` asks for.
+    #[must_use]
+    pub fn fits(&self, layout: &Layout) -> bool {
+        self.words32.len() == layout.words32 && self.words64.len() == layout.words64
+    }
+
+    /// Re-initialises every word to `layout`'s initial values, in parallel (FreePipe's
+    /// initialisation kernel: one GPU thread per word).
+    pub fn reset(&mut self, layout: &Layout) {
+        use rayon::prelude::*;
+        self.words32
+            .par_iter_mut()
+            .for_each(|w| *w.get_mut() = layout.init32);
+        self.words64
+            .par_iter_mut()
+            .for_each(|w| *w.get_mut() = layout.init64);
+    }
+}
 
 impl Memory for SerialMemory {
     fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
