@@ -101,33 +101,89 @@ pub struct ScreenTriangle {
 #[derive(Clone, Debug)]
 pub struct View<'mesh> {
     mesh: &'mesh Mesh,
-    clip: Vec<DVec4>,
+    vertices: Vec<VertexOut>,
     viewport: Viewport,
     cull: CullMode,
     guard: [f64; 2],
 }
+
+/// The vertex stage's output for one vertex, computed once and shared by every triangle using it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct VertexOut {
+    clip: DVec4,
+    /// Bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5: beyond far.
+    outcode: u8,
+    /// Snapped window position and depth; meaningful only when `outcode` has no clip bit set.
+    snapped: Snapped,
+}
+
+/// A snapped window position (1/256 pixel, y down) and the window depth `z / w`.
+type Snapped = ([i64; 2], f64);
+
+/// Outcode bits of the planes that force clipping (near and the guard band).
+const CLIP_BITS: u8 = 0b1_1111;
+/// Outcode bit of the far plane (rejects, never clips: fragments beyond it are dropped one by one).
+const FAR_BIT: u8 = 1 << 5;
 
 impl<'mesh> View<'mesh> {
     /// Transforms every vertex of `mesh` once.
     #[must_use]
     pub fn new(mesh: &'mesh Mesh, camera: &Camera, viewport: Viewport, cull: CullMode) -> Self {
         let m: DMat4 = camera.view_projection;
-        let clip = mesh
-            .positions
-            .iter()
-            .map(|p| m * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0))
-            .collect();
         let guard = [
             1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.width),
             1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.height),
         ];
-        Self {
+        let mut view = Self {
             mesh,
-            clip,
+            vertices: Vec::new(),
             viewport,
             cull,
             guard,
-        }
+        };
+        let planes = view.planes();
+        let far = DVec4::new(0.0, 0.0, -1.0, 1.0);
+        view.vertices = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let clip = m * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0);
+                let mut outcode = planes.iter().enumerate().fold(0u8, |code, (i, plane)| {
+                    code | (u8::from(plane.dot(clip) < 0.0) << i)
+                });
+                if far.dot(clip) < 0.0 {
+                    outcode |= FAR_BIT;
+                }
+                let snapped = if outcode & CLIP_BITS == 0 {
+                    view.snap(clip)
+                } else {
+                    ([0, 0], 0.0)
+                };
+                VertexOut {
+                    clip,
+                    outcode,
+                    snapped,
+                }
+            })
+            .collect();
+        view
+    }
+
+    /// Projects a clip-space vertex to the window and snaps x and y to the fixed-point grid.
+    fn snap(&self, v: DVec4) -> Snapped {
+        let (w, h) = (
+            f64::from(self.viewport.width),
+            f64::from(self.viewport.height),
+        );
+        let x = (v.x / v.w * 0.5 + 0.5) * w;
+        let y = (0.5 - v.y / v.w * 0.5) * h;
+        (
+            [
+                (x * ONE as f64).round() as i64,
+                (y * ONE as f64).round() as i64,
+            ],
+            v.z / v.w,
+        )
     }
 
     /// The viewport.
@@ -157,35 +213,30 @@ impl<'mesh> View<'mesh> {
     /// Calls `visit` with the snapped, clipped, oriented pieces of triangle `prim` (none when it
     /// is rejected, culled or degenerate).
     pub fn screen_triangles(&self, prim: u32, visit: &mut impl FnMut(ScreenTriangle)) {
-        let [a, b, c] = self.mesh.triangles[prim as usize].map(|i| self.clip[i as usize]);
-        let planes = self.planes();
+        let [a, b, c] = self.mesh.triangles[prim as usize].map(|i| self.vertices[i as usize]);
         // Trivial reject: all three vertices outside one plane.
-        if planes
-            .iter()
-            .any(|p| p.dot(a) < 0.0 && p.dot(b) < 0.0 && p.dot(c) < 0.0)
-        {
+        if a.outcode & b.outcode & c.outcode != 0 {
             return;
         }
-        let far = DVec4::new(0.0, 0.0, -1.0, 1.0);
-        if far.dot(a) < 0.0 && far.dot(b) < 0.0 && far.dot(c) < 0.0 {
+        if (a.outcode | b.outcode | c.outcode) & CLIP_BITS == 0 {
+            self.orient(
+                prim,
+                [a.snapped, b.snapped, c.snapped],
+                [a.clip.w, b.clip.w, c.clip.w],
+                visit,
+            );
             return;
         }
-        let needs_clip = [a, b, c]
-            .iter()
-            .any(|v| planes.iter().any(|p| p.dot(*v) < 0.0));
-        if needs_clip {
-            let mut polygon = vec![a, b, c];
-            for plane in planes {
-                polygon = clip_polygon(&polygon, plane);
-                if polygon.len() < 3 {
-                    return;
-                }
+        let mut polygon = vec![a.clip, b.clip, c.clip];
+        for plane in self.planes() {
+            polygon = clip_polygon(&polygon, plane);
+            if polygon.len() < 3 {
+                return;
             }
-            for i in 1..polygon.len() - 1 {
-                self.snap_and_orient(prim, [polygon[0], polygon[i], polygon[i + 1]], visit);
-            }
-        } else {
-            self.snap_and_orient(prim, [a, b, c], visit);
+        }
+        for i in 1..polygon.len() - 1 {
+            let piece = [polygon[0], polygon[i], polygon[i + 1]];
+            self.orient(prim, piece.map(|v| self.snap(v)), piece.map(|v| v.w), visit);
         }
     }
 
@@ -201,27 +252,19 @@ impl<'mesh> View<'mesh> {
         ]
     }
 
-    fn snap_and_orient(&self, prim: u32, clip: [DVec4; 3], visit: &mut impl FnMut(ScreenTriangle)) {
-        if clip.iter().any(|v| v.w.is_nan() || v.w <= 0.0) {
+    /// Culls or orients a snapped triangle and hands it to `visit`.
+    fn orient(
+        &self,
+        prim: u32,
+        snapped: [Snapped; 3],
+        w: [f64; 3],
+        visit: &mut impl FnMut(ScreenTriangle),
+    ) {
+        if w.iter().any(|w| w.is_nan() || *w <= 0.0) {
             // Only reachable with a projection whose near plane does not bound w away from 0.
             return;
         }
-        let (w, h) = (
-            f64::from(self.viewport.width),
-            f64::from(self.viewport.height),
-        );
-        let snap = |v: DVec4| -> ([i64; 2], f64) {
-            let x = (v.x / v.w * 0.5 + 0.5) * w;
-            let y = (0.5 - v.y / v.w * 0.5) * h;
-            (
-                [
-                    (x * ONE as f64).round() as i64,
-                    (y * ONE as f64).round() as i64,
-                ],
-                v.z / v.w,
-            )
-        };
-        let [(pa, za), (mut pb, mut zb), (mut pc, mut zc)] = clip.map(snap);
+        let [(pa, za), (mut pb, mut zb), (mut pc, mut zc)] = snapped;
         let area = edge(pa, pb, pc);
         if area == 0 {
             return;
