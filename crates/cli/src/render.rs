@@ -16,7 +16,7 @@ use serde::Serialize;
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
 pub struct RenderArgs {
-    /// An OBJ file to render instead of a named scene.
+    /// A mesh file (OBJ, or PLY: ASCII or binary, optionally gzipped) instead of a named scene.
     #[arg(long, value_name = "PATH", conflicts_with = "scene")]
     pub mesh: Option<PathBuf>,
     /// A named scene: bunny (embedded), spheres[:N], soup[:COUNT[:SEED]], quads[:N].
@@ -181,7 +181,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         .build()
         .map_err(|e| e.to_string())?;
     let scene = match &args.mesh {
-        Some(path) => Scene::from_obj(path),
+        Some(path) => Scene::from_file(path),
         None => Scene::procedural(&args.scene),
     }
     .map_err(|e| e.to_string())?;

@@ -22,6 +22,7 @@ mod camera;
 mod fragment;
 mod mesh;
 mod pipeline;
+mod ply;
 mod rng;
 mod scenes;
 

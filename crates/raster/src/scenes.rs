@@ -66,6 +66,23 @@ impl Scene {
         }
     }
 
+    /// A mesh from a file: PLY (`.ply`, `.ply.gz`: ASCII or binary) or OBJ (anything else).
+    ///
+    /// # Errors
+    /// See [`Mesh::load_obj`] and [`Mesh::load_ply`].
+    pub fn from_file(path: &Path) -> Result<Self, SceneError> {
+        let lower = path.to_string_lossy().to_ascii_lowercase();
+        let mesh = if lower.ends_with(".ply") || lower.ends_with(".ply.gz") {
+            Mesh::load_ply(path)?
+        } else {
+            Mesh::load_obj(path)?
+        };
+        Ok(Self {
+            name: path.display().to_string(),
+            mesh,
+        })
+    }
+
     /// A mesh from an OBJ file.
     ///
     /// # Errors
