@@ -1,4 +1,5 @@
-//! Images of captures: the depth-complexity heat map and the nearest-layer depth, as PNG.
+//! Images of captures: the depth-complexity heat map, the nearest-layer depth, and the
+//! multi-fragment effects ([`effects`]: transparency, translucency) with the error-pixel rate.
 //!
 //! ```
 //! let counts = vec![0, 1, 2, 3];
@@ -7,6 +8,8 @@
 //! ```
 
 use std::path::Path;
+
+pub mod effects;
 
 use image::{Rgb, RgbImage};
 
