@@ -1,13 +1,17 @@
 //! The `fragsim` command line: `render` (the default) runs schemes on a scene, checks them
 //! against the serial oracle and writes a table, JSON and PNGs.
 
+mod args;
 mod render;
+mod schemes;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use render::{RenderArgs, RunSummary};
+pub use schemes::SchemeName;
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
 #[derive(Debug, Parser)]

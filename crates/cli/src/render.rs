@@ -3,52 +3,27 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
-use fragsim_capture::abuffer::{ABuffer, PostSort};
-use fragsim_capture::executor::{run_parallel, run_serial, Run};
-use fragsim_capture::mdts::{Direction, Mdts};
-use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
+use clap::Args;
 use fragsim_oracle::Oracle;
-use fragsim_raster::{depth_from_key, OrbitCamera, Scene, View, Viewport, DEFAULT_SCENE_NAME};
+use fragsim_raster::{depth_from_key, Viewport};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
+
+use crate::args::{SceneArgs, SchemeArgs};
+use crate::schemes::{Executors, SchemeName, Sizing};
 
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
 pub struct RenderArgs {
-    /// A mesh file (OBJ, or PLY: ASCII or binary, optionally gzipped) instead of a named scene.
-    #[arg(long, value_name = "PATH", conflicts_with = "scene")]
-    pub mesh: Option<PathBuf>,
-    /// A named scene: bunny (embedded), spheres[:N], soup[:COUNT[:SEED]], quads[:N].
-    #[arg(long, value_name = "NAME", default_value = DEFAULT_SCENE_NAME)]
-    pub scene: String,
-    /// Viewport width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub width: u32,
-    /// Viewport height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub height: u32,
-    /// MDTS slots per pixel; `auto` sizes K to the scene's maximum depth complexity.
-    #[arg(long, default_value = "auto", value_parser = parse_count)]
-    pub k: Count,
-    /// A-buffer slots per pixel; `exact` sizes each pixel's list from a counting pass.
-    #[arg(long, default_value = "exact", value_parser = parse_count)]
-    pub capacity: Count,
+    /// The scene.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Scheme sizing and executors.
+    #[command(flatten)]
+    pub schemes: SchemeArgs,
     /// Schemes to run, comma-separated, or `all`.
     #[arg(long, value_delimiter = ',', default_value = "mdts,abuffer")]
     pub scheme: Vec<SchemeName>,
-    /// Executor: serial, parallel or all.
-    #[arg(long, default_value = "parallel")]
-    pub executor: ExecutorChoice,
-    /// Orbit angle of the camera around the model, in degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = finite)]
-    pub view: f64,
-    /// Camera elevation above the model's equator, in degrees.
-    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = finite)]
-    pub elevation: f64,
-    /// Threads of the parallel executor (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
     /// Directory for the PNG images.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -58,68 +33,6 @@ pub struct RenderArgs {
     /// Write no images.
     #[arg(long)]
     pub no_images: bool,
-    /// Refuse schemes whose per-pixel storage would exceed this many bytes.
-    #[arg(long, default_value_t = MEMORY_CAP_DEFAULT)]
-    pub memory_cap: u64,
-}
-
-/// A slot count: a number, or derived from the scene.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Count {
-    /// Sized from the scene's depth complexity.
-    Auto,
-    /// Exactly this many.
-    Fixed(u32),
-}
-
-fn parse_count(text: &str) -> Result<Count, String> {
-    match text {
-        "auto" | "exact" => Ok(Count::Auto),
-        _ => match text.parse::<u32>() {
-            Ok(0) => Err("must be at least 1 (a scheme with 0 slots stores nothing)".into()),
-            Ok(n) => Ok(Count::Fixed(n)),
-            Err(_) => Err(format!(
-                "expected a positive integer, `auto` or `exact`, got {text:?}"
-            )),
-        },
-    }
-}
-
-fn finite(text: &str) -> Result<f64, String> {
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(format!("expected a finite number of degrees, got {text:?}")),
-    }
-}
-
-/// The schemes `render` can run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SchemeName {
-    /// MDTS, 64-bit words (depth key and primitive id), ascending.
-    Mdts,
-    /// MDTS, 32-bit depth keys as in FreePipe's Table 1.
-    Mdts32,
-    /// MDTS with `atomicMax`, descending.
-    MdtsDesc,
-    /// A-buffer, storage sized exactly by a counting pass, insertion-sorted.
-    Abuffer,
-    /// A-buffer as above, bitonic-sorted.
-    AbufferBitonic,
-    /// A-buffer with a fixed capacity per pixel (`--capacity`, or the maximum depth complexity).
-    AbufferFixed,
-    /// Every scheme above.
-    All,
-}
-
-/// Which executors run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ExecutorChoice {
-    /// One thread, submission order.
-    Serial,
-    /// rayon, one logical thread per triangle, std atomics.
-    Parallel,
-    /// Both.
-    All,
 }
 
 /// One row of the summary.
@@ -173,31 +86,14 @@ pub struct RunSummary {
 /// A scene that cannot be loaded, bad parameters, storage beyond the memory cap, an image that
 /// cannot be written.
 pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
-    let threads = args
-        .threads
-        .map_or_else(rayon::current_num_threads, |t| t as usize);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
+    let pool = args.schemes.pool()?;
+    let scene = args.scene.scene()?;
+    let viewport = args.scene.viewport()?;
+    let view = scene
+        .view(viewport, &args.scene.orbit(args.scene.view))
         .map_err(|e| e.to_string())?;
-    let scene = match &args.mesh {
-        Some(path) => Scene::from_file(path),
-        None => Scene::procedural(&args.scene),
-    }
-    .map_err(|e| e.to_string())?;
-    let viewport = Viewport::new(args.width, args.height)?;
-    let orbit = OrbitCamera {
-        angle_degrees: args.view,
-        elevation_degrees: args.elevation,
-        ..OrbitCamera::default()
-    };
-    let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
-    let schemes = expand(&args.scheme);
-    let executors: &[&str] = match args.executor {
-        ExecutorChoice::Serial => &["serial"],
-        ExecutorChoice::Parallel => &["parallel"],
-        ExecutorChoice::All => &["serial", "parallel"],
-    };
+    let schemes = SchemeName::expand(&args.scheme);
+    let executors = args.schemes.executors();
     let progress = progress_bar(args.json, (schemes.len() * executors.len() + 1) as u64);
     progress.set_message("oracle (serial reference)");
     let oracle_start = Instant::now();
@@ -205,17 +101,22 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let oracle_ms = oracle_start.elapsed().as_secs_f64() * 1e3;
     progress.inc(1);
     let max_dc = oracle.max_depth_complexity();
-    let auto = |count: Count| match count {
-        Count::Auto => max_dc.max(1),
-        Count::Fixed(n) => n,
+    let depth_complexity = oracle.depth_complexity();
+    let sizing = Sizing {
+        k: args.schemes.k,
+        capacity: args.schemes.capacity,
+        depth_complexity: &depth_complexity,
+        max_depth_complexity: max_dc,
+        memory_cap: args.schemes.memory_cap,
     };
+    let mut runner = Executors::default();
     let mut rows = Vec::new();
     let mut nearest_written = false;
     for &name in &schemes {
         for &executor in executors {
             progress.set_message(format!("{name:?} on the {executor} executor"));
-            let (run, scheme_name, slots) =
-                pool.install(|| run_named(name, executor, &view, &oracle, args, auto))?;
+            let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            let run = named.run;
             let diff = oracle.diff(&run.capture);
             if !args.no_images && !nearest_written {
                 let nearest: Vec<Option<f32>> = run
@@ -230,7 +131,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             }
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
             rows.push(RunSummary {
-                scheme: scheme_name,
+                scheme: named.name,
                 executor: executor.into(),
                 threads: run.stats.threads,
                 scene: scene.name.clone(),
@@ -249,7 +150,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 pass_ms: ms(run.stats.pass_time),
                 resolve_ms: ms(run.stats.resolve_time),
                 memory_bytes: run.stats.memory_bytes,
-                slots_per_pixel: slots,
+                slots_per_pixel: named.slots,
             });
             progress.inc(1);
         }
@@ -269,115 +170,6 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         print_table(&rows, &scene.name, viewport, &oracle, oracle_ms, args);
     }
     Ok(rows)
-}
-
-fn expand(names: &[SchemeName]) -> Vec<SchemeName> {
-    use SchemeName::*;
-    if names.contains(&All) {
-        return vec![
-            Mdts,
-            Mdts32,
-            MdtsDesc,
-            Abuffer,
-            AbufferBitonic,
-            AbufferFixed,
-        ];
-    }
-    let mut unique = Vec::new();
-    for &n in names {
-        if !unique.contains(&n) {
-            unique.push(n);
-        }
-    }
-    unique
-}
-
-/// Builds the named scheme and runs it; returns the run, the scheme's name and its slots per pixel.
-fn run_named(
-    name: SchemeName,
-    executor: &str,
-    view: &View<'_>,
-    oracle: &Oracle,
-    args: &RenderArgs,
-    auto: impl Fn(Count) -> u32,
-) -> Result<(Run, String, Option<u32>), String> {
-    fn go<S: Scheme>(executor: &str, view: &View<'_>, scheme: &S) -> (Run, String) {
-        let run = if executor == "serial" {
-            run_serial(view, scheme)
-        } else {
-            run_parallel(view, scheme)
-        };
-        (run, scheme.name())
-    }
-    let viewport = view.viewport();
-    let cap = args.memory_cap;
-    let k = auto(args.k);
-    let err = |e: fragsim_capture::CaptureError| e.to_string();
-    let (run, slots) = match name {
-        SchemeName::Mdts => (
-            go(
-                executor,
-                view,
-                &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
-            ),
-            Some(k),
-        ),
-        SchemeName::Mdts32 => (
-            go(
-                executor,
-                view,
-                &Mdts::<u32>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
-            ),
-            Some(k),
-        ),
-        SchemeName::MdtsDesc => (
-            go(
-                executor,
-                view,
-                &Mdts::<u64>::new(viewport, k, Direction::Descending, cap).map_err(err)?,
-            ),
-            Some(k),
-        ),
-        SchemeName::Abuffer | SchemeName::AbufferBitonic => {
-            let sort = if name == SchemeName::Abuffer {
-                PostSort::Insertion
-            } else {
-                PostSort::Bitonic
-            };
-            match args.capacity {
-                Count::Auto => (
-                    go(
-                        executor,
-                        view,
-                        &ABuffer::exact(&oracle.depth_complexity(), sort, cap).map_err(err)?,
-                    ),
-                    None,
-                ),
-                Count::Fixed(c) => (
-                    go(
-                        executor,
-                        view,
-                        &ABuffer::fixed(viewport, c, sort, cap).map_err(err)?,
-                    ),
-                    Some(c),
-                ),
-            }
-        }
-        SchemeName::AbufferFixed => {
-            let c = auto(args.capacity);
-            (
-                go(
-                    executor,
-                    view,
-                    &ABuffer::fixed(viewport, c, PostSort::Insertion, cap).map_err(err)?,
-                ),
-                Some(c),
-            )
-        }
-        SchemeName::All => unreachable!("expanded before running"),
-    };
-    let (run, scheme_name) = run;
-    Ok((run, scheme_name, slots))
 }
 
 fn progress_bar(hidden: bool, len: u64) -> ProgressBar {

@@ -1,0 +1,159 @@
+//! Options shared by the subcommands: which scene, seen how, and how schemes are sized.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use fragsim_capture::MEMORY_CAP_DEFAULT;
+use fragsim_raster::{OrbitCamera, Scene, Viewport, DEFAULT_SCENE_NAME};
+
+/// The scene and the camera.
+#[derive(Debug, Clone, Args)]
+pub struct SceneArgs {
+    /// A mesh file (OBJ, or PLY: ASCII or binary, optionally gzipped) instead of a named scene.
+    #[arg(long, value_name = "PATH", conflicts_with = "scene")]
+    pub mesh: Option<PathBuf>,
+    /// A named scene: bunny (embedded), spheres[:N], soup[:COUNT[:SEED]], quads[:N].
+    #[arg(long, value_name = "NAME", default_value = DEFAULT_SCENE_NAME)]
+    pub scene: String,
+    /// Viewport width in pixels.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: u32,
+    /// Viewport height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: u32,
+    /// Orbit angle of the camera around the model, in degrees.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = finite)]
+    pub view: f64,
+    /// Camera elevation above the model's equator, in degrees.
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = finite)]
+    pub elevation: f64,
+}
+
+impl SceneArgs {
+    /// Loads the scene.
+    ///
+    /// # Errors
+    /// The mesh cannot be loaded or the scene name is unknown.
+    pub fn scene(&self) -> Result<Scene, String> {
+        match &self.mesh {
+            Some(path) => Scene::from_file(path),
+            None => Scene::procedural(&self.scene),
+        }
+        .map_err(|e| e.to_string())
+    }
+
+    /// The viewport.
+    ///
+    /// # Errors
+    /// A side out of range.
+    pub fn viewport(&self) -> Result<Viewport, String> {
+        Viewport::new(self.width, self.height)
+    }
+
+    /// The orbit camera at `angle` degrees (the `--view` angle unless overridden).
+    #[must_use]
+    pub fn orbit(&self, angle: f64) -> OrbitCamera {
+        OrbitCamera {
+            angle_degrees: angle,
+            elevation_degrees: self.elevation,
+            ..OrbitCamera::default()
+        }
+    }
+}
+
+/// How schemes are sized and run.
+#[derive(Debug, Clone, Args)]
+pub struct SchemeArgs {
+    /// MDTS (and k-buffer) slots per pixel; `auto` sizes K to the scene's maximum depth complexity.
+    #[arg(long, default_value = "auto", value_parser = parse_count)]
+    pub k: Count,
+    /// A-buffer slots per pixel; `exact` sizes each pixel's list from a counting pass.
+    #[arg(long, default_value = "exact", value_parser = parse_count)]
+    pub capacity: Count,
+    /// Executor: serial, parallel or all.
+    #[arg(long, default_value = "parallel")]
+    pub executor: ExecutorChoice,
+    /// Threads of the parallel executor (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Refuse schemes whose per-pixel storage would exceed this many bytes.
+    #[arg(long, default_value_t = MEMORY_CAP_DEFAULT)]
+    pub memory_cap: u64,
+}
+
+impl SchemeArgs {
+    /// The rayon pool of `--threads`.
+    ///
+    /// # Errors
+    /// The pool cannot be built.
+    pub fn pool(&self) -> Result<rayon::ThreadPool, String> {
+        let threads = self
+            .threads
+            .map_or_else(rayon::current_num_threads, |t| t as usize);
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| e.to_string())
+    }
+
+    /// The executors chosen.
+    #[must_use]
+    pub fn executors(&self) -> &'static [&'static str] {
+        match self.executor {
+            ExecutorChoice::Serial => &["serial"],
+            ExecutorChoice::Parallel => &["parallel"],
+            ExecutorChoice::All => &["serial", "parallel"],
+        }
+    }
+}
+
+/// A slot count: a number, or derived from the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Count {
+    /// Sized from the scene's depth complexity.
+    Auto,
+    /// Exactly this many.
+    Fixed(u32),
+}
+
+impl Count {
+    /// The count, with `Auto` resolved to `scene_max` (at least 1).
+    #[must_use]
+    pub fn resolve(self, scene_max: u32) -> u32 {
+        match self {
+            Count::Auto => scene_max.max(1),
+            Count::Fixed(n) => n,
+        }
+    }
+}
+
+fn parse_count(text: &str) -> Result<Count, String> {
+    match text {
+        "auto" | "exact" => Ok(Count::Auto),
+        _ => match text.parse::<u32>() {
+            Ok(0) => Err("must be at least 1 (a scheme with 0 slots stores nothing)".into()),
+            Ok(n) => Ok(Count::Fixed(n)),
+            Err(_) => Err(format!(
+                "expected a positive integer, `auto` or `exact`, got {text:?}"
+            )),
+        },
+    }
+}
+
+fn finite(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("expected a finite number of degrees, got {text:?}")),
+    }
+}
+
+/// Which executors run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ExecutorChoice {
+    /// One thread, submission order.
+    Serial,
+    /// rayon, one logical thread per triangle, std atomics.
+    Parallel,
+    /// Both.
+    All,
+}

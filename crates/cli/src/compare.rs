@@ -1,0 +1,486 @@
+//! `fragsim compare REFERENCE CANDIDATE`: a GPU backend's dump (or fragsim's own) against the
+//! oracle or another dump, pixel by pixel (`docs/dump-format.md`).
+//!
+//! Either side is a dump directory or the word `oracle`: fragsim's serial oracle on the scene
+//! the other side's header names. The candidate's lists are decoded by the scheme's own post pass
+//! and checked with `Oracle::diff` under the candidate's promise (the K nearest for MDTS, every
+//! fragment but the counted overflow for the A-buffer). Exit code 0 only when every pixel is
+//! equal.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use fragsim_capture::{Capture, Identity, Keeps};
+use fragsim_oracle::dump::{self, verdict, Comparison, Dump, Header, VerdictCounts};
+use fragsim_oracle::Oracle;
+use fragsim_raster::depth_from_key;
+use serde::Serialize;
+
+/// Options of `fragsim compare`.
+#[derive(Debug, Clone, Args)]
+pub struct CompareArgs {
+    /// The reference: a dump directory (or its dump.json), or `oracle`.
+    #[arg(value_name = "REFERENCE")]
+    pub reference: String,
+    /// The candidate: a dump directory (or its dump.json), or `oracle`.
+    #[arg(value_name = "CANDIDATE")]
+    pub candidate: String,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Accept a candidate depth key within N f32 ulps of the reference's (same primitive), for
+    /// backends that interpolate depth in f32.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub depth_ulps: u32,
+    /// How many differing pixels to show, both lists side by side.
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub show: usize,
+    /// The difference image (PNG).
+    #[arg(long, value_name = "PATH", default_value = "out/compare-diff.png")]
+    pub image: PathBuf,
+    /// Write no difference image.
+    #[arg(long)]
+    pub no_image: bool,
+}
+
+/// One side of a comparison.
+enum Side {
+    Oracle,
+    Dump(Box<Dump>, PathBuf),
+}
+
+impl Side {
+    fn open(text: &str) -> Result<Self, String> {
+        if text == "oracle" {
+            return Ok(Self::Oracle);
+        }
+        let path = PathBuf::from(text);
+        let dump = Dump::read(&path).map_err(|e| e.to_string())?;
+        Ok(Self::Dump(Box::new(dump), path))
+    }
+
+    fn header(&self) -> Option<&Header> {
+        match self {
+            Self::Oracle => None,
+            Self::Dump(dump, _) => Some(&dump.header),
+        }
+    }
+
+    fn describe(&self) -> SideReport {
+        match self {
+            Self::Oracle => SideReport {
+                source: "oracle".into(),
+                scheme: "oracle".into(),
+                producer: format!("fragsim {}", env!("CARGO_PKG_VERSION")),
+                k: None,
+                capacity: None,
+            },
+            Self::Dump(dump, path) => SideReport {
+                source: path.display().to_string(),
+                scheme: dump.header.scheme.clone(),
+                producer: dump.header.producer.clone(),
+                k: dump.header.k,
+                capacity: dump.header.capacity,
+            },
+        }
+    }
+}
+
+/// A side as the report names it.
+#[derive(Debug, Serialize)]
+struct SideReport {
+    source: String,
+    scheme: String,
+    producer: String,
+    k: Option<u32>,
+    capacity: Option<u32>,
+}
+
+/// A fragment as the report shows it.
+#[derive(Debug, Serialize)]
+struct Entry {
+    key: String,
+    depth: f32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    prim: Option<u32>,
+}
+
+/// One differing pixel, both lists.
+#[derive(Debug, Serialize)]
+struct Example {
+    pixel: usize,
+    x: u32,
+    y: u32,
+    verdict: Vec<&'static str>,
+    reference: Vec<Entry>,
+    candidate: Vec<Entry>,
+}
+
+/// Fragment totals.
+#[derive(Debug, Serialize)]
+struct Fragments {
+    reference: u64,
+    captured: u64,
+    lost: u64,
+    extra: u64,
+    overflowed: u64,
+}
+
+/// The whole report (`--json`).
+#[derive(Debug, Serialize)]
+struct Report {
+    equal: bool,
+    reference: SideReport,
+    candidate: SideReport,
+    scene: dump::SceneSpec,
+    width: u32,
+    height: u32,
+    compared: String,
+    depth_ulps: u32,
+    pixels: u64,
+    verdicts: VerdictCounts,
+    fragments: Fragments,
+    first_differences: Vec<Example>,
+    image: Option<String>,
+    notes: Vec<String>,
+}
+
+/// Runs `compare`; returns whether the sides are equal.
+///
+/// # Errors
+/// Unreadable or inconsistent dumps, a scene that cannot be rebuilt, an image that cannot be
+/// written.
+pub fn compare(args: &CompareArgs) -> Result<bool, String> {
+    let reference = Side::open(&args.reference)?;
+    let candidate = Side::open(&args.candidate)?;
+    let (header, beside) = match (&reference, &candidate) {
+        (Side::Dump(dump, path), _) | (Side::Oracle, Side::Dump(dump, path)) => {
+            (dump.header.clone(), dump_dir(path))
+        }
+        (Side::Oracle, Side::Oracle) => {
+            return Err("compare needs at least one dump: both sides are `oracle`".into())
+        }
+    };
+    let mut notes = Vec::new();
+    if let (Some(a), Some(b)) = (reference.header(), candidate.header()) {
+        if (a.width, a.height) != (b.width, b.height) {
+            return Err(format!(
+                "the dumps cover different viewports: {}x{} and {}x{}",
+                a.width, a.height, b.width, b.height
+            ));
+        }
+        if a.scene != b.scene {
+            notes.push(format!(
+                "the dumps name different scenes: {} and {}",
+                a.scene.describe(),
+                b.scene.describe()
+            ));
+        }
+    }
+    // The oracle is built only when a side asks for it (the scene may be a large mesh).
+    let needs_oracle = matches!(reference, Side::Oracle) || matches!(candidate, Side::Oracle);
+    let oracle = if needs_oracle {
+        let scene = header
+            .scene
+            .load(Some(&beside))
+            .map_err(|e| e.to_string())?;
+        let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
+        let view = scene
+            .view(viewport, &header.scene.orbit())
+            .map_err(|e| e.to_string())?;
+        Some(Oracle::build(&view))
+    } else {
+        None
+    };
+    let from_dump;
+    let (reference_oracle, reference_identity) = match (&reference, &oracle) {
+        (Side::Dump(dump, _), _) => {
+            let capture = dump.capture().map_err(|e| e.to_string())?;
+            notes.extend(reference_caveats(&capture));
+            from_dump = Oracle::from_capture(&capture);
+            (&from_dump, capture.identity)
+        }
+        (Side::Oracle, Some(oracle)) => (oracle, Identity::KeyAndPrim),
+        (Side::Oracle, None) => unreachable!("the oracle is built when a side names it"),
+    };
+    let mut candidate_capture = match (&candidate, &oracle) {
+        (Side::Dump(dump, _), _) => dump.capture().map_err(|e| e.to_string())?,
+        (Side::Oracle, Some(oracle)) => oracle_capture(oracle),
+        (Side::Oracle, None) => unreachable!("the oracle is built when a side names it"),
+    };
+    if reference_identity == Identity::KeyOnly && candidate_capture.identity != Identity::KeyOnly {
+        notes.push("the reference holds depth keys only: primitive ids are not compared".into());
+        candidate_capture = dump::with_identity(&candidate_capture, Identity::KeyOnly);
+    }
+    if candidate_capture.pixels() != reference_oracle.pixels() {
+        return Err(format!(
+            "the candidate covers {} pixels, the reference {}",
+            candidate_capture.pixels(),
+            reference_oracle.pixels()
+        ));
+    }
+    let comparison = dump::compare(
+        reference_oracle,
+        &candidate_capture,
+        args.depth_ulps,
+        args.show,
+    );
+    let image = if args.no_image {
+        None
+    } else {
+        write_image(
+            &comparison,
+            header.width,
+            header.height,
+            reference_oracle,
+            &args.image,
+        )?;
+        Some(args.image.display().to_string())
+    };
+    let report = Report {
+        equal: comparison.is_equal(),
+        reference: reference.describe(),
+        candidate: candidate.describe(),
+        scene: header.scene.clone(),
+        width: header.width,
+        height: header.height,
+        compared: what_is_compared(&candidate_capture, args.depth_ulps),
+        depth_ulps: args.depth_ulps,
+        pixels: comparison.verdicts.len() as u64,
+        verdicts: comparison.counts,
+        fragments: Fragments {
+            reference: reference_oracle.fragments() as u64,
+            captured: comparison.diff.captured,
+            lost: comparison.diff.lost,
+            extra: comparison.diff.extra,
+            overflowed: comparison.diff.overflowed,
+        },
+        first_differences: examples(&comparison, header.width, candidate_capture.identity),
+        image,
+        notes,
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        print_report(&report);
+    }
+    Ok(report.equal)
+}
+
+fn dump_dir(path: &Path) -> PathBuf {
+    if path.is_dir() {
+        path.to_path_buf()
+    } else {
+        path.parent().unwrap_or(Path::new(".")).to_path_buf()
+    }
+}
+
+/// The oracle's lists as a capture that promises every fragment.
+fn oracle_capture(oracle: &Oracle) -> Capture {
+    let pixels = oracle.pixels();
+    let mut capture = Capture::with_pixels(
+        pixels,
+        Identity::KeyAndPrim,
+        Keeps::All {
+            overflow: vec![0; pixels],
+        },
+    );
+    for p in 0..pixels {
+        capture.push_pixel(oracle.pixel(p).iter().copied());
+    }
+    capture
+}
+
+/// Why a dump used as the reference may not be the whole truth.
+fn reference_caveats(capture: &Capture) -> Vec<String> {
+    match &capture.keeps {
+        Keeps::Nearest(k) | Keeps::Farthest(k) => vec![format!(
+            "the reference is an MDTS dump keeping {k} fragments per pixel: where it is full, \
+             fragments beyond them are unknown to it"
+        )],
+        Keeps::All { overflow } => {
+            let lost: u64 = overflow.iter().map(|&o| u64::from(o)).sum();
+            if lost > 0 {
+                vec![format!(
+                    "the reference A-buffer overflowed: {lost} fragments are unknown to it"
+                )]
+            } else {
+                Vec::new()
+            }
+        }
+    }
+}
+
+fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
+    let words = match candidate.identity {
+        Identity::KeyAndPrim => "depth key (f32 bits) and primitive id of every fragment",
+        Identity::KeyOnly => "depth keys (f32 bits) of every fragment",
+        Identity::PrimOnly => "primitive ids in depth order",
+    };
+    let promise = match &candidate.keeps {
+        Keeps::Nearest(k) => format!("the {k} nearest per pixel"),
+        Keeps::Farthest(k) => format!("the {k} farthest per pixel"),
+        Keeps::All { .. } => "all per pixel, less the counted overflow".into(),
+    };
+    let tolerance = if ulps == 0 {
+        "bit for bit".to_string()
+    } else {
+        format!("depth keys within {ulps} ulps")
+    };
+    format!("{words}, {promise}, in stored order, {tolerance}")
+}
+
+fn verdict_names(flags: u8) -> Vec<&'static str> {
+    [
+        (verdict::MISSING, "missing"),
+        (verdict::EXTRA, "extra"),
+        (verdict::MISORDERED, "misordered"),
+        (verdict::OVERFLOWED, "overflowed"),
+        (verdict::MISCOUNTED, "overflow-miscounted"),
+    ]
+    .into_iter()
+    .filter(|(flag, _)| flags & flag != 0)
+    .map(|(_, name)| name)
+    .collect()
+}
+
+fn entry(word: u64, identity: Identity) -> Entry {
+    let key = (word >> 32) as u32;
+    Entry {
+        key: format!("{key:08x}"),
+        depth: depth_from_key(key),
+        prim: (identity != Identity::KeyOnly).then_some(word as u32),
+    }
+}
+
+fn examples(comparison: &Comparison, width: u32, identity: Identity) -> Vec<Example> {
+    comparison
+        .diff
+        .first_mismatches
+        .iter()
+        .map(|m| Example {
+            pixel: m.pixel,
+            x: (m.pixel % width as usize) as u32,
+            y: (m.pixel / width as usize) as u32,
+            verdict: verdict_names(comparison.verdicts[m.pixel]),
+            reference: m.expected.iter().map(|&w| entry(w, identity)).collect(),
+            candidate: m.got.iter().map(|&w| entry(w, identity)).collect(),
+        })
+        .collect()
+}
+
+/// Colour of a pixel's verdict in the difference image.
+fn colour(flags: u8, fragments: usize) -> [u8; 3] {
+    let wrong = flags & (verdict::MISSING | verdict::EXTRA);
+    match () {
+        () if wrong == verdict::MISSING | verdict::EXTRA => [220, 50, 220],
+        () if wrong == verdict::MISSING => [230, 40, 40],
+        () if wrong == verdict::EXTRA => [60, 90, 255],
+        () if flags & verdict::MISORDERED != 0 => [250, 220, 0],
+        () if flags & verdict::MISCOUNTED != 0 => [255, 140, 0],
+        () if flags & verdict::OVERFLOWED != 0 => [0, 90, 90],
+        () if fragments > 0 => [70, 70, 70],
+        () => [0, 0, 0],
+    }
+}
+
+fn write_image(
+    comparison: &Comparison,
+    width: u32,
+    height: u32,
+    reference: &Oracle,
+    path: &Path,
+) -> Result<(), String> {
+    // A black image of the right size from fragsim-shade (whose `image` types this crate does not
+    // name), recoloured through its RGB bytes.
+    let mut image = fragsim_shade::heat_map(width, height, &vec![0; comparison.verdicts.len()]);
+    for (p, (rgb, &flags)) in image
+        .chunks_exact_mut(3)
+        .zip(&comparison.verdicts)
+        .enumerate()
+    {
+        rgb.copy_from_slice(&colour(flags, reference.pixel(p).len()));
+    }
+    fragsim_shade::save_png(&image, path)
+}
+
+fn print_report(r: &Report) {
+    let side = |s: &SideReport| {
+        let size = match (s.k, s.capacity) {
+            (Some(k), _) => format!(" K={k}"),
+            (None, Some(c)) => format!(" capacity={c}"),
+            _ => String::new(),
+        };
+        if s.source == "oracle" {
+            "fragsim oracle".to_string()
+        } else {
+            format!("{} ({}{size}, by {})", s.source, s.scheme, s.producer)
+        }
+    };
+    println!(
+        "reference {}\ncandidate {}\nscene {} at {}x{}",
+        side(&r.reference),
+        side(&r.candidate),
+        r.scene.describe(),
+        r.width,
+        r.height
+    );
+    println!("compared: {}", r.compared);
+    let v = &r.verdicts;
+    println!(
+        "pixels {}: equal {}, missing {}, extra {}, misordered {}, overflowed {}, overflow-miscounted {}",
+        r.pixels, v.equal, v.missing, v.extra, v.misordered, v.overflowed, v.miscounted
+    );
+    let f = &r.fragments;
+    println!(
+        "fragments: reference {}, captured {}, lost {}, extra {}, overflowed by design {}",
+        f.reference, f.captured, f.lost, f.extra, f.overflowed
+    );
+    for note in &r.notes {
+        println!("note: {note}");
+    }
+    for e in &r.first_differences {
+        println!(
+            "pixel {} (x {}, y {}): {}",
+            e.pixel,
+            e.x,
+            e.y,
+            e.verdict.join(", ")
+        );
+        println!("  {:<36} {:<36}", "reference", "candidate");
+        let show = |e: Option<&Entry>| {
+            e.map_or(String::new(), |e| match e.prim {
+                Some(prim) => format!("{:.9} [{}] prim {prim}", e.depth, e.key),
+                None => format!("{:.9} [{}]", e.depth, e.key),
+            })
+        };
+        for i in 0..e.reference.len().max(e.candidate.len()) {
+            let (a, b) = (e.reference.get(i), e.candidate.get(i));
+            let same = matches!((a, b), (Some(a), Some(b)) if a.key == b.key && a.prim == b.prim);
+            println!(
+                "{} {:<36} {:<36}",
+                if same { ' ' } else { '*' },
+                show(a),
+                show(b)
+            );
+        }
+    }
+    if let Some(image) = &r.image {
+        println!("difference image: {image}");
+    }
+    println!(
+        "verdict: {}",
+        if r.equal {
+            if r.compared.ends_with("bit for bit") {
+                "EQUAL (bit-identical)"
+            } else {
+                "EQUAL (within tolerance)"
+            }
+        } else {
+            "DIFFERENT"
+        }
+    );
+}
