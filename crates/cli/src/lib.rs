@@ -2,6 +2,7 @@
 //! against the serial oracle and writes a table, JSON and PNGs.
 
 mod args;
+mod bench;
 mod render;
 mod schemes;
 
@@ -10,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
+pub use bench::{BenchArgs, BenchReport, BenchRow};
 pub use render::{RenderArgs, RunSummary};
 pub use schemes::SchemeName;
 
@@ -35,6 +37,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene with capture schemes, check them against the oracle, write images.
     Render(RenderArgs),
+    /// Measure every scheme's speed and accuracy (passes, memory, loss, error pixels, time).
+    Bench(BenchArgs),
 }
 
 /// Parses the command line and runs it; errors go to stderr with a non-zero exit code.
@@ -43,6 +47,15 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let args = match cli.command {
         Some(Command::Render(args)) => args,
+        Some(Command::Bench(args)) => {
+            return match bench::bench(&args) {
+                Ok(_) => ExitCode::SUCCESS,
+                Err(message) => {
+                    eprintln!("error: {message}");
+                    ExitCode::from(2)
+                }
+            }
+        }
         None => cli.render,
     };
     match render::render(&args) {

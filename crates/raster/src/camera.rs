@@ -50,6 +50,22 @@ impl OrbitCamera {
     /// The camera for a model with the given bounds and a viewport aspect ratio (width / height).
     #[must_use]
     pub fn camera(&self, bounds: ([f64; 3], [f64; 3]), aspect: f64) -> Camera {
+        let frame = self.frame(bounds, aspect);
+        let projection = DMat4::perspective_rh(frame.fov_y, aspect, frame.near, frame.far);
+        Camera {
+            view_projection: projection * frame.view,
+        }
+    }
+
+    /// The eye-space distance of a window depth `z ∈ [0, 1]` under [`OrbitCamera::camera`]:
+    /// the inverse of the D3D perspective depth mapping, `near · far / (far − z (far − near))`.
+    #[must_use]
+    pub fn eye_distance(&self, bounds: ([f64; 3], [f64; 3]), aspect: f64, z: f32) -> f64 {
+        let Frame { near, far, .. } = self.frame(bounds, aspect);
+        near * far / (far - f64::from(z) * (far - near))
+    }
+
+    fn frame(&self, bounds: ([f64; 3], [f64; 3]), aspect: f64) -> Frame {
         let (lo, hi) = bounds;
         let lo = DVec3::from(lo);
         let hi = DVec3::from(hi);
@@ -67,14 +83,43 @@ impl OrbitCamera {
             yaw.cos() * pitch.cos(),
         );
         let eye = centre + direction * distance;
-        let view = DMat4::look_at_rh(eye, centre, DVec3::Y);
         // The sphere lies between distance − radius and distance + radius; the margins keep
         // depths strictly inside (0, 1) and the near plane in front of the eye.
         let far = distance + radius * 1.01;
         let near = (distance - radius * 1.01).max(far * 1e-4);
-        let projection = DMat4::perspective_rh(half_fov * 2.0, aspect, near, far);
-        Camera {
-            view_projection: projection * view,
+        Frame {
+            view: DMat4::look_at_rh(eye, centre, DVec3::Y),
+            near,
+            far,
+            fov_y: half_fov * 2.0,
+        }
+    }
+}
+
+/// What the orbit derives from the model's bounds.
+struct Frame {
+    view: DMat4,
+    near: f64,
+    far: f64,
+    fov_y: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec4;
+
+    #[test]
+    fn eye_distance_inverts_the_projection() {
+        let bounds = ([-1.0, -2.0, -0.5], [1.0, 2.0, 0.5]);
+        let orbit = OrbitCamera::default().at_angle(40.0);
+        let camera = orbit.camera(bounds, 1.5);
+        for p in [[0.0, 0.0, 0.0], [0.9, 1.9, 0.4], [-1.0, -2.0, -0.5]] {
+            let clip = camera.view_projection * DVec4::new(p[0], p[1], p[2], 1.0);
+            let z = (clip.z / clip.w) as f32;
+            // w is the distance along the view axis: what the inverse mapping must give back.
+            let d = orbit.eye_distance(bounds, 1.5, z);
+            assert!((d - clip.w).abs() < 1e-5 * clip.w, "{d} vs {}", clip.w);
         }
     }
 }

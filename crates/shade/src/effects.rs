@@ -4,7 +4,8 @@
 //!   `C += T · α · c_i`, `T *= 1 − α`, then `C += T · background`.
 //! - **Translucency**: Beer–Lambert absorption through the thickness between successive entering
 //!   and leaving layers, `(d1 − d0) + (d3 − d2) + …` in eye-space distance (bucket depth peeling
-//!   §4): `T = exp(−σ · thickness)`, `C = T · background + (1 − T) · colour`.
+//!   §4): `T = exp(−σ · thickness)`, `C = T · background + (1 − T) · colour`; the caller's
+//!   `distance` fixes the unit (the bench uses the model's bounding radius).
 //!
 //! Colours are linear; each pixel is encoded to sRGB once, at the end ([`encode_srgb`]).
 
@@ -31,15 +32,18 @@ pub struct Material {
     /// Linear colour of fragments whose primitive is unknown (key-only captures), and the
     /// absorbing medium's colour.
     pub base: [f32; 3],
+    /// Number of primitives of the mesh (spreads [`primitive_colour`] over the wheel).
+    pub primitives: u32,
 }
 
 impl Default for Material {
     fn default() -> Self {
         Self {
-            opacity: 0.3,
-            sigma: 4.0,
-            background: [1.0, 1.0, 1.0],
+            opacity: 0.35,
+            sigma: 1.5,
+            background: [0.02, 0.02, 0.03],
             base: [0.9, 0.5, 0.1],
+            primitives: 1,
         }
     }
 }
@@ -55,10 +59,12 @@ pub enum Entries {
     PrimOnly,
 }
 
-/// A per-triangle colour: a hue from the primitive id by the golden ratio, in linear RGB.
+/// A per-triangle colour in linear RGB: the hue runs once round the colour wheel over the mesh's
+/// primitive ids, so that neighbouring triangles (which scanned meshes number close together)
+/// get close colours and a misordered or lost fragment still changes the pixel.
 #[must_use]
-pub fn primitive_colour(prim: u32) -> [f32; 3] {
-    let hue = (f64::from(prim) * 0.618_033_988_749_895).fract();
+pub fn primitive_colour(prim: u32, primitives: u32) -> [f32; 3] {
+    let hue = f64::from(prim) / f64::from(primitives.max(1));
     let channel = |offset: f64| {
         let h = (hue + offset).fract() * 6.0;
         let v = (h - 3.0).abs() - 1.0;
@@ -90,7 +96,7 @@ pub fn shade_pixel(
     distance: &dyn Fn(f32) -> f64,
 ) -> Option<[f32; 3]> {
     let colour_of = |entry: u64| match entries {
-        Entries::KeyAndPrim | Entries::PrimOnly => primitive_colour(entry as u32),
+        Entries::KeyAndPrim | Entries::PrimOnly => primitive_colour(entry as u32, material.primitives),
         Entries::KeyOnly => material.base,
     };
     match effect {
@@ -190,7 +196,7 @@ mod tests {
 
     #[test]
     fn an_empty_pixel_is_the_background_and_order_matters() {
-        let m = Material::default();
+        let m = Material { primitives: 4, ..Material::default() };
         assert_eq!(
             shade_pixel(Effect::Transparency, &m, Entries::KeyAndPrim, &[], &flat),
             Some(m.background)
@@ -236,9 +242,10 @@ mod tests {
             &linear,
         )
         .unwrap();
-        // More material absorbs more of the white background's blue: closer to the base colour.
-        assert!(thick[2] < thin[2]);
-        assert!((thick[0] - m.base[0]).abs() < (thin[0] - m.base[0]).abs());
+        // More material hides more of the background: closer to the medium's colour everywhere.
+        for ch in 0..3 {
+            assert!((thick[ch] - m.base[ch]).abs() < (thin[ch] - m.base[ch]).abs());
+        }
         assert_eq!(
             shade_pixel(Effect::Translucency, &m, Entries::PrimOnly, &[1], &linear),
             None

@@ -1,0 +1,400 @@
+//! `fragsim bench`: the speed/accuracy trade of every scheme on one scene, measured the way the
+//! papers do (FreePipe Tables 2–3, bucket depth peeling Table 2): passes, memory, fragments
+//! captured and lost, error-pixel rate of an effect against the oracle's image, and time per
+//! frame (median, min, max over `--frames`), with the split between vertex stage, rasterization
+//! and capture.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use clap::{Args, ValueEnum};
+use fragsim_capture::Identity;
+use fragsim_oracle::Oracle;
+use fragsim_raster::View;
+use fragsim_shade::effects::{self, Effect, Entries, Material};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::args::{SceneArgs, SchemeArgs};
+use crate::schemes::{Executors, SchemeName, Sizing};
+
+/// Options of `fragsim bench`.
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// The scene.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Scheme sizing and executors.
+    #[command(flatten)]
+    pub schemes: SchemeArgs,
+    /// Schemes to run, comma-separated, or `all`.
+    #[arg(long, value_delimiter = ',', default_value = "all")]
+    pub scheme: Vec<SchemeName>,
+    /// Frames timed per scheme and executor (the median, min and max are reported).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: u32,
+    /// The effect whose image is compared with the oracle's.
+    #[arg(long, default_value = "transparency")]
+    pub effect: EffectName,
+    /// Directory for bench.json, bench.md and the images.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Print the rows as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Effects `bench` can compare.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum EffectName {
+    /// Front-to-back transparency.
+    Transparency,
+    /// Beer–Lambert translucency.
+    Translucency,
+}
+
+/// One row of the bench.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchRow {
+    /// Scheme name.
+    pub scheme: String,
+    /// `serial` or `parallel`.
+    pub executor: String,
+    /// Threads.
+    pub threads: usize,
+    /// Geometry passes per frame.
+    pub passes: u32,
+    /// Bytes of per-pixel storage.
+    pub memory_bytes: u64,
+    /// Bytes per pixel.
+    pub bytes_per_pixel: f64,
+    /// Fragments rasterized per frame, over all passes.
+    pub fragments: u64,
+    /// Fragments captured.
+    pub captured: u64,
+    /// Fragments the scheme had no room for (counted by design).
+    pub overflowed: u64,
+    /// Fragments it should have kept but did not.
+    pub lost: u64,
+    /// Pixels that differ from the oracle's lists.
+    pub mismatched_pixels: u64,
+    /// Pixels whose 8-bit colour differs from the oracle's image for the effect (`None` when the
+    /// scheme's words cannot resolve the effect).
+    pub error_pixels: Option<u64>,
+    /// `error_pixels` over the pixels the oracle covers.
+    pub error_pixel_rate: Option<f64>,
+    /// Memory operations per fragment.
+    pub ops_per_fragment: f64,
+    /// Median frame time in milliseconds (passes plus post pass).
+    pub median_ms: f64,
+    /// Fastest frame.
+    pub min_ms: f64,
+    /// Slowest frame.
+    pub max_ms: f64,
+    /// Frames per second at the median.
+    pub fps: f64,
+    /// Triangles per second at the median (per geometry pass).
+    pub triangles_per_second: f64,
+    /// Fragments per second at the median.
+    pub fragments_per_second: f64,
+    /// Median time of the post pass.
+    pub resolve_ms: f64,
+    /// Depth peeling's median time over this one, when depth peeling ran.
+    pub speedup_vs_depth_peeling: Option<f64>,
+}
+
+/// What the whole bench measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchReport {
+    /// Scene name.
+    pub scene: String,
+    /// Triangles.
+    pub triangles: u32,
+    /// Viewport.
+    pub width: u32,
+    /// Viewport.
+    pub height: u32,
+    /// Oracle fragments.
+    pub fragments: usize,
+    /// Largest depth complexity.
+    pub max_depth_complexity: u32,
+    /// Pixels with at least one fragment.
+    pub covered_pixels: usize,
+    /// Median vertex stage (transform, outcodes, snapping of every vertex), ms.
+    pub vertex_stage_ms: f64,
+    /// Median rasterization alone (every triangle set up and scanned, fragments discarded) on the
+    /// pool, ms: what every scheme pays per geometry pass before its first memory operation.
+    pub raster_ms: f64,
+    /// The effect compared.
+    pub effect: String,
+    /// Frames per row.
+    pub frames: u32,
+    /// One row per scheme and executor.
+    pub rows: Vec<BenchRow>,
+}
+
+fn median(times: &mut [Duration]) -> Duration {
+    times.sort_unstable();
+    times[times.len() / 2]
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// Runs `bench`.
+///
+/// # Errors
+/// Scene, parameter or output errors.
+pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
+    let pool = args.schemes.pool()?;
+    let scene = args.scene.scene()?;
+    let viewport = args.scene.viewport()?;
+    let orbit = args.scene.orbit(args.scene.view);
+    let frames = args.frames as usize;
+    let mut vertex_times = Vec::with_capacity(frames);
+    for _ in 0..frames {
+        let start = Instant::now();
+        let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+        vertex_times.push(start.elapsed());
+        drop(view);
+    }
+    let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+    let raster_times: Vec<Duration> = (0..frames)
+        .map(|_| pool.install(|| time_raster_alone(&view)))
+        .collect();
+    let oracle = Oracle::build(&view);
+    let depth_complexity = oracle.depth_complexity();
+    let covered = depth_complexity.iter().filter(|&&c| c > 0).count();
+    let effect = match args.effect {
+        EffectName::Transparency => Effect::Transparency,
+        EffectName::Translucency => Effect::Translucency,
+    };
+    let aspect = f64::from(viewport.width) / f64::from(viewport.height);
+    let bounds = scene.mesh.bounds();
+    let (lo, hi) = bounds;
+    let radius = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt() * 0.5;
+    // Thickness in units of the model's bounding radius, so σ means the same on every mesh.
+    let distance = |z: f32| orbit.eye_distance(bounds, aspect, z) / radius.max(1e-12);
+    let material = Material { primitives: view.triangle_count(), ..Material::default() };
+    let size = (viewport.width, viewport.height);
+    // The oracle's image shaded from what each kind of capture can know: a key-only capture is
+    // compared with the oracle's fragments coloured by key only, so that the error-pixel rate
+    // measures lost and misordered fragments, not the attribute the scheme never stored.
+    let references: Vec<(Entries, Option<image::RgbImage>)> =
+        [Entries::KeyAndPrim, Entries::KeyOnly, Entries::PrimOnly]
+            .into_iter()
+            .map(|entries| {
+                let list = |p: usize| oracle.pixel(p);
+                (
+                    entries,
+                    effects::render(effect, &material, entries, size, list, &distance),
+                )
+            })
+            .collect();
+    if let Some((_, Some(image))) = references.first() {
+        let name = format!("bench-oracle-{}.png", effect_name(effect));
+        fragsim_shade::save_png(image, &args.out.join(name))?;
+    }
+    let sizing = Sizing {
+        k: args.schemes.k,
+        capacity: args.schemes.capacity,
+        depth_complexity: &depth_complexity,
+        max_depth_complexity: oracle.max_depth_complexity(),
+        memory_cap: args.schemes.memory_cap,
+    };
+    let mut rows = Vec::new();
+    for name in SchemeName::expand(&args.scheme) {
+        for &executor in args.schemes.executors() {
+            let mut runner = Executors::default();
+            let mut times = Vec::with_capacity(frames);
+            let mut resolve_times = Vec::with_capacity(frames);
+            let mut first = None;
+            for _ in 0..frames {
+                let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+                times.push(named.run.stats.pass_time + named.run.stats.resolve_time);
+                resolve_times.push(named.run.stats.resolve_time);
+                first.get_or_insert(named);
+            }
+            let named = first.expect("at least one frame");
+            let diff = oracle.diff(&named.run.capture);
+            let entries = entries_of(named.run.capture.identity);
+            let list = |p: usize| named.run.capture.pixel(p);
+            let image = effects::render(effect, &material, entries, size, list, &distance);
+            let reference = references
+                .iter()
+                .find(|(e, _)| *e == entries)
+                .and_then(|(_, r)| r.as_ref());
+            let compared = image.as_ref().zip(reference);
+            let error_pixels =
+                compared.map(|(image, reference)| effects::error_pixels(reference, image) as u64);
+            if let Some((image, reference)) = compared {
+                let stem = format!("bench-{}-{executor}", named.name);
+                fragsim_shade::save_png(image, &args.out.join(format!("{stem}.png")))?;
+                let difference = effects::difference_image(reference, image);
+                fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
+            }
+            let median_time = median(&mut times);
+            let stats = &named.run.stats;
+            let seconds = median_time.as_secs_f64().max(1e-12);
+            rows.push(BenchRow {
+                scheme: named.name.clone(),
+                executor: executor.into(),
+                threads: stats.threads,
+                passes: stats.passes,
+                memory_bytes: stats.memory_bytes,
+                bytes_per_pixel: stats.memory_bytes as f64 / viewport.pixels() as f64,
+                fragments: stats.counters.fragments,
+                captured: diff.captured,
+                overflowed: diff.overflowed,
+                lost: diff.lost,
+                mismatched_pixels: diff.mismatched_pixels,
+                error_pixels,
+                error_pixel_rate: error_pixels.map(|e| e as f64 / covered.max(1) as f64),
+                ops_per_fragment: stats.counters.steps as f64
+                    / stats.counters.fragments.max(1) as f64,
+                median_ms: ms(median_time),
+                min_ms: ms(times[0]),
+                max_ms: ms(times[times.len() - 1]),
+                fps: 1.0 / seconds,
+                triangles_per_second: f64::from(view.triangle_count()) * f64::from(stats.passes)
+                    / seconds,
+                fragments_per_second: stats.counters.fragments as f64 / seconds,
+                resolve_ms: ms(median(&mut resolve_times)),
+                speedup_vs_depth_peeling: None,
+            });
+        }
+    }
+    set_speedups(&mut rows);
+    let report = BenchReport {
+        scene: scene.name.clone(),
+        triangles: view.triangle_count(),
+        width: viewport.width,
+        height: viewport.height,
+        fragments: oracle.fragments(),
+        max_depth_complexity: oracle.max_depth_complexity(),
+        covered_pixels: covered,
+        vertex_stage_ms: ms(median(&mut vertex_times)),
+        raster_ms: ms(median(&mut raster_times.clone())),
+        effect: effect_name(effect).into(),
+        frames: args.frames,
+        rows,
+    };
+    write_outputs(&report, args)?;
+    Ok(report)
+}
+
+/// Rasterizes every triangle on the current pool and discards the fragments.
+fn time_raster_alone(view: &View<'_>) -> Duration {
+    let start = Instant::now();
+    let fragments: u64 = (0..view.triangle_count())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|prim| {
+            let mut count = 0u64;
+            view.rasterize(prim, &mut |_| count += 1);
+            count
+        })
+        .sum();
+    std::hint::black_box(fragments);
+    start.elapsed()
+}
+
+fn entries_of(identity: Identity) -> Entries {
+    match identity {
+        Identity::KeyAndPrim => Entries::KeyAndPrim,
+        Identity::KeyOnly => Entries::KeyOnly,
+        Identity::PrimOnly => Entries::PrimOnly,
+    }
+}
+
+fn effect_name(effect: Effect) -> &'static str {
+    match effect {
+        Effect::Transparency => "transparency",
+        Effect::Translucency => "translucency",
+    }
+}
+
+/// Depth peeling is the papers' baseline: every row gets the ratio of its time to it.
+fn set_speedups(rows: &mut [BenchRow]) {
+    let baselines: Vec<(String, f64)> = rows
+        .iter()
+        .filter(|r| r.scheme.starts_with("peeling") || r.scheme == "dp")
+        .map(|r| (r.executor.clone(), r.median_ms))
+        .collect();
+    for row in rows.iter_mut() {
+        if let Some((_, base)) = baselines
+            .iter()
+            .find(|(executor, _)| *executor == row.executor)
+        {
+            row.speedup_vs_depth_peeling = Some(base / row.median_ms.max(1e-9));
+        }
+    }
+}
+
+fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
+    let json_path = args.out.join("bench.json");
+    std::fs::write(&json_path, &json)
+        .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
+    let markdown = markdown(report);
+    let md_path = args.out.join("bench.md");
+    std::fs::write(&md_path, &markdown)
+        .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
+    if args.json {
+        println!("{json}");
+    } else {
+        print!("{markdown}");
+    }
+    Ok(())
+}
+
+fn markdown(report: &BenchReport) -> String {
+    let mut text = format!(
+        "scene {}: {} triangles, {}x{}, {} fragments, max depth complexity {}, {} covered pixels; \
+         vertex stage {:.2} ms, rasterization alone {:.2} ms (medians of {} frames); effect {}\n\n",
+        report.scene,
+        report.triangles,
+        report.width,
+        report.height,
+        report.fragments,
+        report.max_depth_complexity,
+        report.covered_pixels,
+        report.vertex_stage_ms,
+        report.raster_ms,
+        report.frames,
+        report.effect
+    );
+    text.push_str(
+        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR | ops/frag | median ms | min | max | fps | vs DP |\n",
+    );
+    text.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let option = |v: Option<f64>, digits: usize| {
+        v.map_or_else(|| "n/a".to_string(), |v| format!("{v:.digits$}"))
+    };
+    for r in &report.rows {
+        text.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {} |\n",
+            r.scheme,
+            r.executor,
+            r.threads,
+            r.passes,
+            r.memory_bytes,
+            r.bytes_per_pixel,
+            r.captured,
+            r.overflowed,
+            r.lost,
+            r.mismatched_pixels,
+            r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}%", e * 100.0)),
+            r.ops_per_fragment,
+            r.median_ms,
+            r.min_ms,
+            r.max_ms,
+            r.fps,
+            option(r.speedup_vs_depth_peeling, 2),
+        ));
+    }
+    text
+}
