@@ -15,7 +15,7 @@
 //! let scene = Scene::procedural("spheres:2").unwrap();
 //! let view = scene.view(Viewport::new(48, 48).unwrap(), &OrbitCamera::default()).unwrap();
 //! let oracle = Oracle::build(&view);
-//! let scheme = Mdts::ascending(view.viewport(), oracle.max_depth_complexity().max(1)).unwrap();
+//! let scheme = Mdts::<u64>::ascending(view.viewport(), oracle.max_depth_complexity().max(1)).unwrap();
 //! let run = executor::run_parallel(&view, &scheme);
 //! assert!(oracle.diff(&run.capture).is_exact());
 //! ```

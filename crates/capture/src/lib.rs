@@ -15,7 +15,7 @@
 //!
 //! let scene = Scene::procedural("quads:3").unwrap();
 //! let view = scene.view(Viewport::new(16, 16).unwrap(), &OrbitCamera::default()).unwrap();
-//! let scheme = Mdts::ascending(view.viewport(), 4).unwrap();
+//! let scheme = Mdts::<u64>::ascending(view.viewport(), 4).unwrap();
 //! let run = executor::run_serial(&view, &scheme);
 //! assert_eq!(run.stats.counters.dropped, 0);
 //! ```

@@ -16,10 +16,13 @@ pub struct SceneArgs {
     #[arg(long, value_name = "NAME", default_value = DEFAULT_SCENE_NAME)]
     pub scene: String,
     /// Viewport width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    // Negative values reach the range check (and its message) instead of being taken for a flag.
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true,
+          value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
     /// Viewport height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true,
+          value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
     /// Orbit angle of the camera around the model, in degrees.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = finite)]
@@ -65,19 +68,20 @@ impl SceneArgs {
 #[derive(Debug, Clone, Args)]
 pub struct SchemeArgs {
     /// MDTS (and k-buffer) slots per pixel; `auto` sizes K to the scene's maximum depth complexity.
-    #[arg(long, default_value = "auto", value_parser = parse_count)]
+    #[arg(long, default_value = "auto", allow_negative_numbers = true, value_parser = parse_count)]
     pub k: Count,
     /// A-buffer slots per pixel; `exact` sizes each pixel's list from a counting pass.
-    #[arg(long, default_value = "exact", value_parser = parse_count)]
+    #[arg(long, default_value = "exact", allow_negative_numbers = true, value_parser = parse_count)]
     pub capacity: Count,
     /// Executor: serial, parallel or all.
     #[arg(long, default_value = "parallel")]
     pub executor: ExecutorChoice,
     /// Threads of the parallel executor (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Refuse schemes whose per-pixel storage would exceed this many bytes.
-    #[arg(long, default_value_t = MEMORY_CAP_DEFAULT)]
+    #[arg(long, default_value_t = MEMORY_CAP_DEFAULT, allow_negative_numbers = true,
+          value_parser = parse_bytes)]
     pub memory_cap: u64,
 }
 
@@ -138,6 +142,13 @@ fn parse_count(text: &str) -> Result<Count, String> {
             )),
         },
     }
+}
+
+fn parse_bytes(text: &str) -> Result<u64, String> {
+    text.parse::<u64>().map_err(|_| match text.parse::<i128>() {
+        Ok(n) if n < 0 => format!("a number of bytes cannot be negative, got {n}"),
+        _ => format!("expected a number of bytes, got {text:?}"),
+    })
 }
 
 fn finite(text: &str) -> Result<f64, String> {

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::schemes::{Executors, SchemeName, Sizing};
+use crate::schemes::{check_memory_cap_early, Executors, SchemeName, Sizing};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -58,6 +58,8 @@ pub enum EffectName {
 pub struct BenchRow {
     /// Scheme name.
     pub scheme: String,
+    /// `exact`, `exact-distinct-depths` or `approximate`.
+    pub guarantee: &'static str,
     /// `serial` or `parallel`.
     pub executor: String,
     /// Threads.
@@ -160,6 +162,13 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         drop(view);
     }
     let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+    check_memory_cap_early(
+        &args.scheme,
+        viewport,
+        args.schemes.k,
+        args.schemes.capacity,
+        args.schemes.memory_cap,
+    )?;
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
@@ -239,6 +248,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let seconds = median_time.as_secs_f64().max(1e-12);
             rows.push(BenchRow {
                 scheme: named.name.clone(),
+                guarantee: name.guarantee(),
                 executor: executor.into(),
                 threads: stats.threads,
                 passes: stats.passes,

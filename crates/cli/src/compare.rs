@@ -297,10 +297,19 @@ fn oracle_capture(oracle: &Oracle) -> Capture {
 /// Why a dump used as the reference may not be the whole truth.
 fn reference_caveats(capture: &Capture) -> Vec<String> {
     match &capture.keeps {
-        Keeps::Nearest(k) | Keeps::Farthest(k) => vec![format!(
-            "the reference is an MDTS dump keeping {k} fragments per pixel: where it is full, \
-             fragments beyond them are unknown to it"
-        )],
+        Keeps::Nearest(k) | Keeps::Farthest(k) => {
+            let full = (0..capture.pixels())
+                .filter(|&p| capture.pixel(p).len() >= *k as usize)
+                .count();
+            if full > 0 {
+                vec![format!(
+                    "the reference is an MDTS dump keeping {k} fragments per pixel and {full} \
+                     pixels are full: fragments beyond K there are unknown to it"
+                )]
+            } else {
+                Vec::new()
+            }
+        }
         Keeps::All { overflow } => {
             let lost: u64 = overflow.iter().map(|&o| u64::from(o)).sum();
             if lost > 0 {
@@ -394,16 +403,10 @@ fn write_image(
     reference: &Oracle,
     path: &Path,
 ) -> Result<(), String> {
-    // A black image of the right size from fragsim-shade (whose `image` types this crate does not
-    // name), recoloured through its RGB bytes.
-    let mut image = fragsim_shade::heat_map(width, height, &vec![0; comparison.verdicts.len()]);
-    for (p, (rgb, &flags)) in image
-        .chunks_exact_mut(3)
-        .zip(&comparison.verdicts)
-        .enumerate()
-    {
-        rgb.copy_from_slice(&colour(flags, reference.pixel(p).len()));
-    }
+    let image = image::RgbImage::from_fn(width, height, |x, y| {
+        let p = (y * width + x) as usize;
+        image::Rgb(colour(comparison.verdicts[p], reference.pixel(p).len()))
+    });
     fragsim_shade::save_png(&image, path)
 }
 

@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::schemes::{Executors, SchemeName, Sizing};
+use crate::schemes::{check_memory_cap_early, Executors, SchemeName, Sizing};
 
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
@@ -33,6 +33,9 @@ pub struct RenderArgs {
     /// Write no images.
     #[arg(long)]
     pub no_images: bool,
+    /// Also write each scheme's per-pixel words as a dump in DIR/<scheme>/ (docs/dump-format.md).
+    #[arg(long, value_name = "DIR")]
+    pub dump: Option<PathBuf>,
 }
 
 /// One row of the summary.
@@ -40,6 +43,8 @@ pub struct RenderArgs {
 pub struct RunSummary {
     /// Scheme name.
     pub scheme: String,
+    /// `exact`, `exact-distinct-depths` or `approximate` (see `SchemeName::guarantee`).
+    pub guarantee: &'static str,
     /// `serial` or `parallel`.
     pub executor: String,
     /// Threads that ran it.
@@ -93,6 +98,13 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         .view(viewport, &args.scene.orbit(args.scene.view))
         .map_err(|e| e.to_string())?;
     let schemes = SchemeName::expand(&args.scheme);
+    check_memory_cap_early(
+        &schemes,
+        viewport,
+        args.schemes.k,
+        args.schemes.capacity,
+        args.schemes.memory_cap,
+    )?;
     let executors = args.schemes.executors();
     let progress = progress_bar(args.json, (schemes.len() * executors.len() + 1) as u64);
     progress.set_message("oracle (serial reference)");
@@ -132,6 +144,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
             rows.push(RunSummary {
                 scheme: named.name,
+                guarantee: name.guarantee(),
                 executor: executor.into(),
                 threads: run.stats.threads,
                 scene: scene.name.clone(),
@@ -153,6 +166,9 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 slots_per_pixel: named.slots,
             });
             progress.inc(1);
+        }
+        if let Some(dir) = &args.dump {
+            crate::export::write_dump(dir, name, &view, &sizing, &args.scene)?;
         }
     }
     progress.finish_and_clear();
@@ -203,8 +219,9 @@ fn print_table(
         oracle_ms
     );
     type Cell = fn(&RunSummary) -> String;
-    let columns: [(&str, usize, Cell); 13] = [
+    let columns: [(&str, usize, Cell); 14] = [
         ("scheme", 16, |r| r.scheme.clone()),
+        ("guarantee", 21, |r| r.guarantee.to_string()),
         ("executor", 9, |r| r.executor.clone()),
         ("thr", 3, |r| r.threads.to_string()),
         ("passes", 6, |r| r.passes.to_string()),
@@ -224,7 +241,7 @@ fn print_table(
             .zip(&columns)
             .enumerate()
             .map(|(i, (cell, (_, width, _)))| {
-                if i < 2 {
+                if i < 3 {
                     format!("{cell:<width$}")
                 } else {
                     format!("{cell:>width$}")

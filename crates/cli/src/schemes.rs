@@ -2,10 +2,14 @@
 
 use clap::ValueEnum;
 use fragsim_capture::abuffer::{ABuffer, PostSort};
+use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
+use fragsim_capture::dual_peeling::DualDepthPeeling;
 use fragsim_capture::executor::{ParallelExecutor, Run, SerialExecutor};
 use fragsim_capture::mdts::{Direction, Mdts};
+use fragsim_capture::peeling::DepthPeeling;
+use fragsim_capture::zbuffer::ZBuffer;
 use fragsim_capture::{CaptureError, Scheme};
-use fragsim_raster::View;
+use fragsim_raster::{View, Viewport};
 
 use crate::args::Count;
 
@@ -24,20 +28,61 @@ pub enum SchemeName {
     AbufferBitonic,
     /// A-buffer with a fixed capacity per pixel (`--capacity`, or the maximum depth complexity).
     AbufferFixed,
+    /// Classical depth peeling, 64-bit words (ties ordered by primitive id): one pass per layer.
+    Peeling,
+    /// Classical depth peeling on 32-bit depth keys: equal depths merge.
+    Peeling32,
+    /// Dual depth peeling (nearest and farthest layer per pass), 64-bit words.
+    DualPeeling,
+    /// Dual depth peeling on 32-bit depth keys.
+    DualPeeling32,
+    /// The opaque z-buffer via `atomicMin`: the nearest fragment only.
+    Zbuffer,
+    /// Bucket depth peeling, one pass, 16 bucket pairs (HPG 2009 §3.2).
+    Bdp,
+    /// Bucket depth peeling, 32 single-value buckets.
+    BdpSingle,
+    /// Two-pass bucket depth peeling (§3.2).
+    Bdp2,
+    /// Adaptive bucket depth peeling (§3.3).
+    Adp,
     /// Every scheme above.
     All,
 }
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 6] = [
+    pub const EVERY: [SchemeName; 15] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
         SchemeName::Abuffer,
         SchemeName::AbufferBitonic,
         SchemeName::AbufferFixed,
+        SchemeName::Peeling,
+        SchemeName::Peeling32,
+        SchemeName::DualPeeling,
+        SchemeName::DualPeeling32,
+        SchemeName::Zbuffer,
+        SchemeName::Bdp,
+        SchemeName::BdpSingle,
+        SchemeName::Bdp2,
+        SchemeName::Adp,
     ];
+
+    /// What the scheme promises against the oracle: `exact` (fragment for fragment, up to K where
+    /// it has K slots), `exact-distinct-depths` (32-bit depth peeling merges equal depths), or
+    /// `approximate` (loses fragments in situations its paper describes, and reports them).
+    #[must_use]
+    pub fn guarantee(self) -> &'static str {
+        match self {
+            SchemeName::Peeling32 | SchemeName::DualPeeling32 => "exact-distinct-depths",
+            SchemeName::Bdp | SchemeName::BdpSingle | SchemeName::Bdp2 | SchemeName::Adp => {
+                "approximate"
+            }
+            _ => "exact",
+        }
+    }
 
     /// `names` with `all` expanded and duplicates removed, in the order given.
     #[must_use]
@@ -109,6 +154,8 @@ impl Executors {
         let viewport = view.viewport();
         let cap = sizing.memory_cap;
         let k = sizing.k.resolve(sizing.max_depth_complexity);
+        // Multi-pass schemes store every layer: sized to the scene, as the A-buffer's storage.
+        let layers = sizing.max_depth_complexity.max(1);
         let err = |e: CaptureError| e.to_string();
         let exact_or_fixed =
             |sort: PostSort, capacity: Count| -> Result<(ABuffer, Option<u32>), String> {
@@ -149,9 +196,114 @@ impl Executors {
                 let (scheme, slots) = exact_or_fixed(PostSort::Insertion, capacity)?;
                 go(&scheme, slots)
             }
+            SchemeName::Peeling => go(
+                &DepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
+                None,
+            ),
+            SchemeName::Peeling32 => go(
+                &DepthPeeling::<u32>::new(viewport, layers, cap).map_err(err)?,
+                None,
+            ),
+            SchemeName::DualPeeling => go(
+                &DualDepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
+                None,
+            ),
+            SchemeName::DualPeeling32 => go(
+                &DualDepthPeeling::<u32>::new(viewport, layers, cap).map_err(err)?,
+                None,
+            ),
+            SchemeName::Zbuffer => go(&ZBuffer::new(viewport, cap).map_err(err)?, Some(1)),
+            SchemeName::Bdp => go(
+                &Bdp::<u32>::new(viewport, Buckets::Pairs(16), cap).map_err(err)?,
+                Some(32),
+            ),
+            SchemeName::BdpSingle => go(
+                &Bdp::<u32>::new(viewport, Buckets::Singles(32), cap).map_err(err)?,
+                Some(32),
+            ),
+            SchemeName::Bdp2 => go(&Bdp2::<u32>::new(viewport, 16, cap).map_err(err)?, Some(64)),
+            SchemeName::Adp => go(
+                &Adp::<u32>::new(viewport, layers, cap).map_err(err)?,
+                Some(layers),
+            ),
             SchemeName::All => return Err("`all` names a list of schemes, not one".into()),
         })
     }
+}
+
+/// Refuses, before the oracle's counting pass, any scheme of `names` whose storage on `viewport`
+/// would exceed `memory_cap` even at its smallest.
+///
+/// With `--k auto` or `--capacity exact` storage is sized from the scene's depth complexity, known
+/// only after the counting pass, and that pass alone needs 24 bytes a pixel (6 GiB at
+/// 16384 × 16384): a refusal must not wait for it. The smallest storage is one slot per pixel for
+/// MDTS and the fixed A-buffer, and for the exact A-buffer its counters and offsets with no
+/// fragment (4 + 4 bytes a pixel, as `ABuffer::exact` counts them). Schemes not listed here are
+/// checked when they are built, after the count.
+///
+/// # Errors
+/// The first scheme refused, with the bytes it would need at least.
+pub fn check_memory_cap_early(
+    names: &[SchemeName],
+    viewport: Viewport,
+    k: Count,
+    capacity: Count,
+    memory_cap: u64,
+) -> Result<(), String> {
+    let smallest = |count: Count| match count {
+        Count::Auto => 1,
+        Count::Fixed(n) => n,
+    };
+    let (k_least, capacity_least) = (smallest(k), smallest(capacity));
+    for name in SchemeName::expand(names) {
+        let result = match name {
+            SchemeName::Mdts => {
+                Mdts::<u64>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
+            }
+            SchemeName::Mdts32 => {
+                Mdts::<u32>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
+            }
+            SchemeName::MdtsDesc => {
+                Mdts::<u64>::new(viewport, k_least, Direction::Descending, memory_cap).map(drop)
+            }
+            SchemeName::Abuffer | SchemeName::AbufferBitonic if capacity == Count::Auto => {
+                let pixels = viewport.pixels() as u64;
+                let needed = pixels * 4 + (pixels + 1) * 4;
+                if needed > memory_cap {
+                    Err(CaptureError::TooMuchMemory {
+                        scheme: if name == SchemeName::Abuffer {
+                            "abuffer"
+                        } else {
+                            "abuffer-bitonic"
+                        }
+                        .into(),
+                        needed,
+                        cap: memory_cap,
+                    })
+                } else {
+                    Ok(())
+                }
+            }
+            SchemeName::Abuffer | SchemeName::AbufferBitonic | SchemeName::AbufferFixed => {
+                ABuffer::fixed(viewport, capacity_least, PostSort::Insertion, memory_cap).map(drop)
+            }
+            _ => Ok(()),
+        };
+        if let Err(error) = result {
+            let sized_by_scene = match name {
+                SchemeName::Mdts | SchemeName::Mdts32 | SchemeName::MdtsDesc => k == Count::Auto,
+                _ => capacity == Count::Auto,
+            };
+            return Err(if sized_by_scene {
+                format!(
+                    "{error} (at least: sized to the scene, it needs one slot per pixel or more)"
+                )
+            } else {
+                error.to_string()
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A scheme behind a vtable, so the registry needs one call site per executor rather than one

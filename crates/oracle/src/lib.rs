@@ -15,6 +15,8 @@
 //! assert_eq!(oracle.max_depth_complexity(), 6);
 //! ```
 
+pub mod dump;
+
 use fragsim_capture::{Capture, Identity, Keeps};
 use fragsim_raster::View;
 

@@ -94,8 +94,9 @@ impl Mesh {
     /// Loads an OBJ file, triangulating polygons, all of its models merged into one mesh.
     ///
     /// # Errors
-    /// A missing or unreadable file, a file tobj rejects, a mesh with no triangle, a non-finite
-    /// coordinate or an out-of-range index: each names the file.
+    /// A missing or unreadable file, a file tobj rejects, a face of fewer than 3 vertices or one
+    /// referring to texture coordinates or normals the file lacks, a mesh with no triangle, a
+    /// non-finite coordinate or an out-of-range index: each names the file.
     pub fn load_obj(path: &Path) -> Result<Self, MeshError> {
         let name = path.display().to_string();
         let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
@@ -115,7 +116,19 @@ impl Mesh {
             single_index: false,
             ..Default::default()
         };
-        let (models, _materials) = tobj::load_obj_buf(reader, &options, |_| {
+        // Read once, parse twice: the face checks tobj leaves out, then tobj.
+        let mut text = Vec::new();
+        reader
+            .read_to_end(&mut text)
+            .map_err(|source| MeshError::Io {
+                path: name.into(),
+                source,
+            })?;
+        check_faces(&String::from_utf8_lossy(&text)).map_err(|reason| MeshError::Obj {
+            path: name.into(),
+            reason,
+        })?;
+        let (models, _materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |_| {
             // Materials are irrelevant to depth; an absent .mtl must not fail the load.
             Ok(Default::default())
         })
@@ -171,6 +184,68 @@ impl Mesh {
     }
 }
 
+/// Face checks made before tobj parses: a face of fewer than 3 vertices (tobj makes it a
+/// degenerate triangle), and every vertex, texture-coordinate and normal index of a face or line
+/// element in range. tobj drops references to attributes the file has none of, and its index
+/// arithmetic overflows on a relative index reaching before the first element (a panic where
+/// overflow checks are on, as in `cargo test`), so indices are bounded here first: positive ones
+/// by the file's total, negative (relative) ones by the elements defined before the line, as tobj
+/// resolves them. Parts that are not integers are left for tobj to reject.
+fn check_faces(text: &str) -> Result<(), String> {
+    const KINDS: [(&str, &str); 3] = [
+        ("v", "vertex"),
+        ("vt", "texture coordinate"),
+        ("vn", "normal"),
+    ];
+    let kind_of = |tag: &str| KINDS.iter().position(|&(t, _)| t == tag);
+    let mut totals = [0usize; 3];
+    for line in text.lines() {
+        if let Some(k) = line.split_whitespace().next().and_then(kind_of) {
+            totals[k] += 1;
+        }
+    }
+    let mut before = [0usize; 3];
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(tag) = words.next() else { continue };
+        if let Some(k) = kind_of(tag) {
+            before[k] += 1;
+            continue;
+        }
+        if tag != "f" && tag != "l" {
+            continue;
+        }
+        let corners: Vec<&str> = words.collect();
+        if tag == "f" && corners.len() < 3 {
+            return Err(format!(
+                "line {}: a face needs at least 3 vertices, got {}",
+                number + 1,
+                corners.len()
+            ));
+        }
+        for corner in corners {
+            for (k, part) in corner.split('/').take(3).enumerate() {
+                let Ok(index) = part.parse::<i64>() else {
+                    continue;
+                };
+                let kind = KINDS[k].1;
+                let (available, whence) = if index < 0 {
+                    (before[k], " before it")
+                } else {
+                    (totals[k], "")
+                };
+                if index == 0 || index.unsigned_abs() > available as u64 {
+                    return Err(format!(
+                        "line {}: {tag} refers to {kind} {index}, but {available} {kind}s are defined{whence}",
+                        number + 1
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,6 +275,41 @@ mod tests {
             matches!(err, MeshError::NonFinite { .. } | MeshError::Obj { .. }),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_face_referring_to_a_normal_in_a_file_without_normals_is_an_error() {
+        let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1//5 2//5 3//5\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("line 4") && err.contains("normal 5"), "{err}");
+        let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/2 2/2 3/2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("texture coordinate 2"), "{err}");
+    }
+
+    #[test]
+    fn a_relative_index_before_the_first_element_is_an_error_not_an_overflow() {
+        // Found by the obj_load fuzz target: tobj computed `vt * 2 + 1` on the wrapped index.
+        let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nf 1/-11 2/-1 3/-1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("texture coordinate -11, but 2 texture coordinates are defined before it"),
+            "{err}"
+        );
+        for face in ["f -4 1 2", "f 0 1 2", "f 1 2 4", "l 1 9"] {
+            let err = parse(&format!("v 0 0 0\nv 1 0 0\nv 1 1 0\n{face}\n")).unwrap_err();
+            assert!(err.to_string().contains("line 4"), "{face}: {err}");
+        }
+        assert!(parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf -3 -2 -1\n").is_ok());
+    }
+
+    #[test]
+    fn a_face_with_two_vertices_is_an_error_not_a_degenerate_triangle() {
+        let err = parse("v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap_err().to_string();
+        assert!(err.contains("at least 3 vertices, got 2"), "{err}");
     }
 
     #[test]

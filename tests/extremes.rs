@@ -1,0 +1,919 @@
+//! Numerical stability at the extremes (issue 5): the ends of the depth range, the sentinels, hostile
+//! geometry and extreme sizes. Each test names the extreme and asserts the expected result;
+//! `docs/extremes.md` lists them with the numbers measured here.
+
+#[path = "fuzz_support/camera.rs"]
+mod camera;
+
+use std::time::Instant;
+
+use assert_cmd::Command;
+use camera::{camera_from_columns, identity_camera};
+use fragsim::capture::abuffer::{ABuffer, PostSort};
+use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::{
+    CaptureError, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT,
+};
+use fragsim::oracle::Oracle;
+use fragsim::raster::{
+    depth_from_key, depth_key, Camera, CullMode, Fragment, Mesh, MeshError, OrbitCamera, Scene,
+    View, Viewport, EMPTY_KEY,
+};
+use proptest::prelude::*;
+
+/// The key of depth 1.0: the largest a fragment can carry.
+const MAX_KEY: u32 = 0x3F80_0000;
+
+fn viewport(width: u32, height: u32) -> Viewport {
+    Viewport::new(width, height).expect("a valid viewport")
+}
+
+/// D3D/Vulkan `perspective_rh` with a 90° field of view and aspect 1 (so `x` and `y` pass
+/// unscaled), as `glam::DMat4::perspective_rh` builds it: `w = −z_eye`, depth 0 at `near`, 1 at
+/// `far`. The model space is the eye space.
+fn perspective(near: f64, far: f64) -> Camera {
+    let r = far / (near - far);
+    camera_from_columns([
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, r, -1.0],
+        [0.0, 0.0, r * near, 0.0],
+    ])
+}
+
+/// A mesh of unshared triangles, primitive id = position in `triangles`.
+fn soup(triangles: &[[[f32; 3]; 3]]) -> Mesh {
+    Mesh {
+        positions: triangles.iter().flatten().copied().collect(),
+        triangles: (0..triangles.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect(),
+    }
+}
+
+/// The square `[-s, s]²` at depth (or eye-space z) `z`, as two triangles sharing a diagonal.
+fn square(s: f32, z: f32) -> [[[f32; 3]; 3]; 2] {
+    [
+        [[-s, -s, z], [s, -s, z], [s, s, z]],
+        [[-s, -s, z], [s, s, z], [-s, s, z]],
+    ]
+}
+
+fn all_fragments(view: &View<'_>) -> Vec<Fragment> {
+    let mut fragments = Vec::new();
+    for prim in 0..view.triangle_count() {
+        view.rasterize(prim, &mut |f| fragments.push(f));
+    }
+    fragments
+}
+
+/// Fragments per pixel.
+fn coverage(view: &View<'_>) -> Vec<u32> {
+    let mut counts = vec![0; view.viewport().pixels()];
+    for f in all_fragments(view) {
+        counts[f.pixel as usize] += 1;
+    }
+    counts
+}
+
+fn identity_view(mesh: &Mesh, width: u32, height: u32) -> View<'_> {
+    View::new(
+        mesh,
+        &identity_camera(),
+        viewport(width, height),
+        CullMode::None,
+    )
+}
+
+/// Checks that `scheme` run serially and in parallel on `view` is exactly what it promises, with
+/// the counted drops equal to the oracle's overflow; returns that overflow.
+fn assert_exact<S: Scheme>(view: &View<'_>, oracle: &Oracle, scheme: &S) -> u64 {
+    let overflow = [run_serial(view, scheme), run_parallel(view, scheme)].map(|run| {
+        let diff = oracle.diff(&run.capture);
+        assert!(diff.is_exact(), "{}: {diff:?}", scheme.name());
+        assert_eq!(
+            diff.overflowed,
+            run.stats.counters.dropped,
+            "{}",
+            scheme.name()
+        );
+        diff.overflowed
+    });
+    assert_eq!(overflow[0], overflow[1], "{}", scheme.name());
+    overflow[0]
+}
+
+// ---------------------------------------------------------------------------------------------
+// Depth encoding
+
+#[test]
+fn depth_zero_has_key_zero() {
+    assert_eq!(depth_key(0.0), Some(0));
+}
+
+#[test]
+fn negative_zero_has_the_key_of_positive_zero_not_0x80000000() {
+    assert_eq!(depth_key(-0.0), Some(0));
+    // Unmapped, its bit pattern would sort after every depth up to 1.0 in an unsigned atomicMin.
+    assert_eq!((-0.0f32).to_bits(), 0x8000_0000);
+    assert!((-0.0f32).to_bits() > MAX_KEY);
+}
+
+#[test]
+fn the_smallest_subnormal_depth_has_key_one() {
+    let smallest = f32::from_bits(1);
+    assert!(smallest > 0.0 && !smallest.is_normal());
+    assert_eq!(depth_key(smallest), Some(1));
+}
+
+#[test]
+fn the_largest_depth_below_one_has_key_0x3f7fffff() {
+    let below_one = 1.0 - f32::EPSILON / 2.0;
+    assert_eq!(below_one.to_bits(), 0x3F7F_FFFF);
+    assert_eq!(depth_key(below_one), Some(0x3F7F_FFFF));
+    assert!(depth_key(below_one) < depth_key(1.0));
+}
+
+#[test]
+fn depth_one_has_the_largest_key_0x3f800000() {
+    assert_eq!(depth_key(1.0), Some(MAX_KEY));
+    assert_eq!(depth_from_key(MAX_KEY), 1.0);
+}
+
+#[test]
+fn depths_just_outside_the_unit_interval_have_no_key() {
+    let above_one = f32::from_bits(0x3F80_0001);
+    assert!(above_one > 1.0);
+    for depth in [above_one, -f32::from_bits(1), -1e-30, 1.5, -1.0] {
+        assert_eq!(depth_key(depth), None, "{depth:e}");
+    }
+}
+
+#[test]
+fn infinities_and_nan_have_no_key() {
+    for depth in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN, -f32::NAN] {
+        assert_eq!(depth_key(depth), None, "{depth}");
+    }
+}
+
+#[test]
+fn non_finite_vertices_are_stopped_by_mesh_validation_and_by_the_pipeline() {
+    // At load: every OBJ mesh is validated finite.
+    for text in ["v inf 0 0\n", "v nan 0 0\n", "v 0 -inf 0\n", "v 0 0 1e39\n"] {
+        let obj = format!("{text}v 1 0 0\nv 1 1 0\nf 1 2 3\n");
+        let err = Mesh::read_obj(&mut obj.as_bytes(), "hostile.obj").unwrap_err();
+        assert!(
+            matches!(err, MeshError::NonFinite { .. }),
+            "{text:?}: {err}"
+        );
+    }
+    // A hand-built mesh that skips validation: the pipeline emits nothing and does not panic
+    // (a NaN or infinite w fails the `w > 0` test before any fixed-point arithmetic).
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let mesh = soup(&[[[bad, -1.0, 0.5], [3.0, -1.0, 0.5], [-1.0, 3.0, 0.5]]]);
+        assert!(mesh.validate("hand-built").is_err());
+        let view = identity_view(&mesh, 8, 8);
+        assert!(all_fragments(&view).is_empty(), "{bad}");
+        let view = View::new(
+            &mesh,
+            &perspective(0.1, 10.0),
+            viewport(8, 8),
+            CullMode::None,
+        );
+        assert!(all_fragments(&view).is_empty(), "{bad}");
+    }
+}
+
+#[test]
+fn fragments_interpolated_just_beyond_depth_one_are_dropped_one_by_one() {
+    // Depth 1.0 at one corner, one ulp above 1.0 at the others: pixels near the first corner
+    // round to exactly 1.0 and are kept; the rest are beyond the far plane and dropped.
+    let above_one = f32::from_bits(0x3F80_0001);
+    let mesh = soup(&[[
+        [-1.0, 1.0, 1.0],
+        [3.0, 1.0, above_one],
+        [-1.0, -3.0, above_one],
+    ]]);
+    let view = identity_view(&mesh, 16, 16);
+    let kept = all_fragments(&view);
+    assert!(
+        !kept.is_empty() && kept.len() < 256,
+        "kept {} of 256",
+        kept.len()
+    );
+    assert!(kept.iter().all(|f| f.depth_key == MAX_KEY));
+    // The same triangle at depth 0.5 covers all 256 pixels.
+    let flat = soup(&[[[-1.0, 1.0, 0.5], [3.0, 1.0, 0.5], [-1.0, -3.0, 0.5]]]);
+    assert_eq!(all_fragments(&identity_view(&flat, 16, 16)).len(), 256);
+}
+
+#[test]
+fn a_triangle_touching_depth_zero_from_below_is_clipped_away() {
+    let below_zero = -f32::from_bits(1);
+    let mesh = soup(&[[
+        [-1.0, 1.0, 0.0],
+        [3.0, 1.0, below_zero],
+        [-1.0, -3.0, below_zero],
+    ]]);
+    assert!(all_fragments(&identity_view(&mesh, 16, 16)).is_empty());
+}
+
+proptest! {
+    #[test]
+    fn key_order_equals_float_order_for_all_non_negative_floats(
+        a in 0u32..=0x7F80_0000,
+        b in 0u32..=0x7F80_0000,
+    ) {
+        // Every non-negative float, +inf included: the bit pattern orders as the float.
+        let (x, y) = (f32::from_bits(a), f32::from_bits(b));
+        prop_assert_eq!(x.partial_cmp(&y), Some(a.cmp(&b)));
+    }
+
+    #[test]
+    fn depth_key_order_equals_depth_order_on_the_unit_interval(
+        a in prop_oneof![0u32..=MAX_KEY, Just(0x8000_0000u32)],
+        b in prop_oneof![0u32..=MAX_KEY, Just(0x8000_0000u32)],
+    ) {
+        // Including -0.0, which equals +0.0 as a float and as a key.
+        let (x, y) = (f32::from_bits(a), f32::from_bits(b));
+        let (kx, ky) = (depth_key(x).unwrap(), depth_key(y).unwrap());
+        prop_assert_eq!(x.partial_cmp(&y), Some(kx.cmp(&ky)));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sentinels
+
+#[test]
+fn no_float_has_a_depth_key_above_0x3f800000_so_neither_sentinel_collides() {
+    // Exhaustive over all 2^32 bit patterns, on the rayon pool.
+    use rayon::prelude::*;
+    let max = (0..=u16::MAX)
+        .into_par_iter()
+        .map(|high| {
+            let base = u32::from(high) << 16;
+            (0..=u16::MAX)
+                .filter_map(|low| depth_key(f32::from_bits(base | u32::from(low))))
+                .max()
+                .unwrap_or(0)
+        })
+        .max();
+    assert_eq!(max, Some(MAX_KEY));
+    // The only bit patterns equal to the sentinels are NaNs, which have no key.
+    for sentinel in [0x7FFF_FFFFu32, 0xFFFF_FFFF] {
+        assert!(f32::from_bits(sentinel).is_nan());
+        assert_eq!(depth_key(f32::from_bits(sentinel)), None);
+    }
+    assert_eq!(EMPTY_KEY, u32::MAX);
+    // With 64-bit words the empty value u64::MAX would need key 0xFFFFFFFF.
+    let largest_word = Fragment {
+        pixel: 0,
+        depth_key: MAX_KEY,
+        prim: u32::MAX,
+    }
+    .packed();
+    assert!(largest_word < u64::MAX);
+}
+
+/// How an `atomicMin` against an empty slot treats a value: `true` when the value replaces the
+/// sentinel (it sorts below it).
+fn sorts_below(value: u32, sentinel: u32, signed: bool) -> bool {
+    if signed {
+        (value as i32) < (sentinel as i32)
+    } else {
+        value < sentinel
+    }
+}
+
+#[test]
+fn which_values_sort_below_each_sentinel_signed_and_unsigned() {
+    let depths = [0.0f32, f32::from_bits(1), 0.5, 1.0].map(|d| depth_key(d).unwrap());
+    for key in depths {
+        // Every depth key sorts below 0x7FFFFFFF either way, and below 0xFFFFFFFF unsigned...
+        assert!(sorts_below(key, 0x7FFF_FFFF, false));
+        assert!(sorts_below(key, 0x7FFF_FFFF, true));
+        assert!(sorts_below(key, 0xFFFF_FFFF, false));
+        // ...but a signed atomicMin sees 0xFFFFFFFF as −1, below every depth: nothing is stored.
+        assert!(!sorts_below(key, 0xFFFF_FFFF, true));
+    }
+    // Bit patterns that are not depth keys: unmapped −0.0 and −1.0 sort above 0x7FFFFFFF
+    // unsigned (they would be taken for "beyond empty") and below everything signed; +inf sorts
+    // below both sentinels.
+    for negative in [(-0.0f32).to_bits(), (-1.0f32).to_bits()] {
+        assert!(!sorts_below(negative, 0x7FFF_FFFF, false));
+        assert!(sorts_below(negative, 0x7FFF_FFFF, true));
+    }
+    let inf = f32::INFINITY.to_bits();
+    assert!(sorts_below(inf, 0x7FFF_FFFF, false) && sorts_below(inf, 0xFFFF_FFFF, false));
+}
+
+/// FreePipe's Table 1 as printed: slots initialised to `0xFFFFFFFF` (the text, §4.1.1) but the
+/// loop stops when `atomicMin` returns `MAX_INTEGER` (`0x7FFFFFFF`, line 13). The returned value
+/// is never `0x7FFFFFFF`, so every walk runs to the end of the array.
+struct Table1Mdts {
+    pixels: usize,
+    k: u32,
+}
+
+/// The slot the walk tests next and the value it carries.
+#[derive(Clone, Copy, Debug)]
+struct Table1Walk {
+    base: usize,
+    slot: u32,
+    carried: u32,
+}
+
+impl Scheme for Table1Mdts {
+    type State = Table1Walk;
+
+    fn name(&self) -> String {
+        "mdts32-table1".into()
+    }
+
+    fn layout(&self) -> Layout {
+        Layout {
+            words32: self.pixels * self.k as usize,
+            init32: 0xFFFF_FFFF,
+            words64: 0,
+            init64: 0,
+            table_bytes: 0,
+        }
+    }
+
+    fn identity(&self) -> Identity {
+        Identity::KeyOnly
+    }
+
+    fn promise(&self) -> Promise {
+        Promise::Nearest(self.k)
+    }
+
+    fn begin(&self, fragment: Fragment) -> Table1Walk {
+        Table1Walk {
+            base: fragment.pixel as usize * self.k as usize,
+            slot: 0,
+            carried: fragment.depth_key,
+        }
+    }
+
+    fn step<M: Memory>(&self, walk: &mut Table1Walk, memory: &M) -> Step {
+        let old =
+            WordMemory::<u32>::fetch_min(memory, walk.base + walk.slot as usize, walk.carried);
+        if old == 0x7FFF_FFFF {
+            return Step::Stored;
+        }
+        walk.carried = walk.carried.max(old);
+        walk.slot += 1;
+        if walk.slot == self.k {
+            // What falls off the end is usually the sentinel itself, yet it reads as a drop.
+            Step::Dropped
+        } else {
+            Step::Continue
+        }
+    }
+
+    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+        let k = self.k as usize;
+        out.extend(
+            (0..k)
+                .map(|slot| WordMemory::<u32>::load(memory, pixel * k + slot))
+                .take_while(|&w| w != 0xFFFF_FFFF)
+                .map(MdtsWord::decode),
+        );
+        0
+    }
+
+    fn pixels(&self) -> usize {
+        self.pixels
+    }
+}
+
+#[test]
+fn freepipe_table1_mixed_sentinels_are_correct_but_never_exit_early() {
+    let scene = Scene::procedural("spheres:4").unwrap();
+    let view = scene
+        .view(viewport(64, 64), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    let k = oracle.max_depth_complexity();
+    assert_eq!(k, 8);
+    let table1 = Table1Mdts {
+        pixels: view.viewport().pixels(),
+        k,
+    };
+    let mdts =
+        Mdts::<u32>::new(view.viewport(), k, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
+    let (mixed, ours) = (run_serial(&view, &table1), run_serial(&view, &mdts));
+    // Correct: the same sorted lists as MDTS with one sentinel, exactly the oracle's.
+    assert_eq!(mixed.capture.entries, ours.capture.entries);
+    assert_eq!(mixed.capture.offsets, ours.capture.offsets);
+    assert!(oracle.diff(&mixed.capture).is_exact());
+    // Never exits early: every fragment walks all K slots, and every walk ends as a "drop".
+    let fragments = oracle.fragments() as u64;
+    assert_eq!(mixed.stats.counters.steps, fragments * u64::from(k));
+    assert_eq!(mixed.stats.counters.dropped, fragments);
+    assert_eq!(ours.stats.counters.dropped, 0);
+    let extra = mixed.stats.counters.steps - ours.stats.counters.steps;
+    eprintln!(
+        "spheres:4 64x64 K={k}: {fragments} fragments, Table 1 as printed {} steps, one sentinel {} steps, {extra} extra ({:.2}x)",
+        mixed.stats.counters.steps,
+        ours.stats.counters.steps,
+        mixed.stats.counters.steps as f64 / ours.stats.counters.steps as f64
+    );
+    assert!(extra > 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry
+
+#[test]
+fn degenerate_triangles_produce_no_fragments() {
+    let tiny = 1.0 / 4096.0; // 1/256 of a pixel on a 16-pixel side: below the snapping grid
+    let mesh = soup(&[
+        // collinear
+        [[-1.0, -1.0, 0.5], [0.0, 0.0, 0.5], [1.0, 1.0, 0.5]],
+        // a repeated vertex
+        [[-1.0, -1.0, 0.5], [1.0, 0.0, 0.5], [1.0, 0.0, 0.5]],
+        // one point
+        [[0.3, 0.3, 0.5], [0.3, 0.3, 0.5], [0.3, 0.3, 0.5]],
+        // smaller than the snapping grid, at a pixel centre
+        [
+            [1.0 / 16.0, 1.0 / 16.0, 0.5],
+            [1.0 / 16.0 + tiny, 1.0 / 16.0, 0.5],
+            [1.0 / 16.0, 1.0 / 16.0 + tiny, 0.5],
+        ],
+    ]);
+    let view = identity_view(&mesh, 16, 16);
+    for prim in 0..view.triangle_count() {
+        let mut n = 0;
+        view.rasterize(prim, &mut |_| n += 1);
+        assert_eq!(n, 0, "triangle {prim}");
+    }
+}
+
+#[test]
+fn sliver_triangles_tile_the_screen_without_cracks_or_overlaps() {
+    // A fan of 1,000 slivers from the top-left corner to the bottom edge, plus the triangle that
+    // completes the square, and a sliver one grid step thick along the right edge.
+    let n = 1000;
+    let mut triangles: Vec<[[f32; 3]; 3]> = (0..n)
+        .map(|i| {
+            let x = |i: usize| -1.0 + 2.0 * i as f32 / n as f32;
+            [[-1.0, 1.0, 0.5], [x(i), -1.0, 0.5], [x(i + 1), -1.0, 0.5]]
+        })
+        .collect();
+    let thin = 1.0 - 1.0 / 8192.0;
+    triangles.push([[-1.0, 1.0, 0.5], [1.0, -1.0, 0.5], [thin, 1.0, 0.5]]);
+    triangles.push([[thin, 1.0, 0.5], [1.0, -1.0, 0.5], [1.0, 1.0, 0.5]]);
+    let mesh = soup(&triangles);
+    let counts = coverage(&identity_view(&mesh, 64, 64));
+    assert!(counts.iter().all(|&c| c == 1), "{counts:?}");
+}
+
+#[test]
+fn vertices_at_1e7_are_clipped_to_the_guard_band_and_cover_the_screen_once() {
+    // Identity camera: x = 1e7 is 3·10^8 pixels off screen, far beyond the guard band.
+    let mesh = soup(&square(1e7, 0.5));
+    for (width, height) in [(64, 48), (1, 1)] {
+        let view = identity_view(&mesh, width, height);
+        let fragments = all_fragments(&view);
+        assert_eq!(fragments.len(), (width * height) as usize);
+        assert!(coverage(&view).iter().all(|&c| c == 1));
+        assert!(fragments
+            .iter()
+            .all(|f| f.depth_key == depth_key(0.5).unwrap()));
+    }
+    let mesh = soup(&[[[-1e7, -1e7, 0.25], [3e7, -1e7, 0.25], [-1e7, 3e7, 0.25]]]);
+    assert!(coverage(&identity_view(&mesh, 33, 17))
+        .iter()
+        .all(|&c| c == 1));
+}
+
+#[test]
+fn vertices_at_1e_minus_7_snap_to_one_point_and_produce_nothing() {
+    // 1e-7 in clip space is 3·10^-6 pixels on a 64-pixel side: far below the 1/256 grid.
+    let centre = 1.0 / 64.0; // the centre of pixel (32, 31)
+    let mesh = soup(&[[
+        [centre, centre, 0.5],
+        [centre + 1e-7, centre, 0.5],
+        [centre, centre + 1e-7, 0.5],
+    ]]);
+    assert!(all_fragments(&identity_view(&mesh, 64, 64)).is_empty());
+}
+
+#[test]
+fn a_model_scaled_by_1e7_or_1e_minus_7_renders_like_the_original() {
+    let original = Scene::procedural("spheres:3").unwrap();
+    let fragments_at = |scale: f32| {
+        let mut scene = original.clone();
+        for p in &mut scene.mesh.positions {
+            *p = p.map(|c| c * scale);
+        }
+        let view = scene
+            .view(viewport(64, 64), &OrbitCamera::default())
+            .unwrap();
+        let oracle = Oracle::build(&view);
+        let k = oracle.max_depth_complexity();
+        assert_eq!(k, 6, "scale {scale:e}");
+        let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
+        assert!(oracle.diff(&run_serial(&view, &mdts).capture).is_exact());
+        oracle.depth_complexity()
+    };
+    let reference = fragments_at(1.0);
+    for scale in [1e7, 1e-7] {
+        let scaled = fragments_at(scale);
+        let differing = reference
+            .iter()
+            .zip(&scaled)
+            .filter(|(a, b)| a != b)
+            .count();
+        // Scaling is not exact in binary: a few vertices may snap one grid step apart.
+        assert!(
+            differing <= reference.len() / 100,
+            "scale {scale:e}: {differing} pixels differ"
+        );
+    }
+}
+
+/// The eye-space triangle A, B, C clipped by hand at `z = −near` (exactly representable here),
+/// as a mesh: what the pipeline's homogeneous clipping must reproduce.
+fn coverage_clipped_by_hand(pieces: &[[[f32; 3]; 3]], camera: &Camera) -> Vec<u32> {
+    let mesh = soup(pieces);
+    coverage(&View::new(&mesh, camera, viewport(32, 32), CullMode::None))
+}
+
+#[test]
+fn a_triangle_crossing_the_near_plane_is_clipped_and_keeps_its_primitive_id() {
+    let camera = perspective(1.0, 100.0);
+    // C lies between the eye and the near plane (z = −0.5); A and B beyond it (z = −1.5).
+    let (a, b, c) = ([-1.5, -1.5, -1.5], [1.5, -1.5, -1.5], [0.0, 0.5, -0.5]);
+    let hidden = [[-1.0, -1.0, -50.0], [1.0, -1.0, -50.0], [0.0, 1.0, -50.0]];
+    let mesh = soup(&[hidden, hidden, [a, b, c]]);
+    let view = View::new(&mesh, &camera, viewport(32, 32), CullMode::None);
+    let mut clipped = Vec::new();
+    view.rasterize(2, &mut |f| clipped.push(f));
+    assert!(!clipped.is_empty());
+    assert!(clipped
+        .iter()
+        .all(|f| f.prim == 2 && f.depth_key <= MAX_KEY));
+    let mut counts = vec![0; 32 * 32];
+    for f in &clipped {
+        counts[f.pixel as usize] += 1;
+    }
+    // The near plane cuts CA and CB at their midpoints (z = −1).
+    let (ca, cb) = ([-0.75, -0.5, -1.0], [0.75, -0.5, -1.0]);
+    let by_hand = coverage_clipped_by_hand(&[[a, b, cb], [a, cb, ca]], &camera);
+    assert_eq!(counts, by_hand);
+}
+
+#[test]
+fn a_triangle_crossing_the_eye_plane_w_0_is_clipped_not_inverted() {
+    let camera = perspective(1.0, 100.0);
+    // C is behind the eye (z = +1, so w = −1); the near plane cuts CA and CB at z = −1.
+    let (a, b, c) = ([-1.0, -1.0, -3.0], [1.0, -1.0, -3.0], [0.0, 1.0, 1.0]);
+    let mesh = soup(&[[a, b, c]]);
+    let counts = coverage(&View::new(&mesh, &camera, viewport(32, 32), CullMode::None));
+    let (ca, cb) = ([-0.5, 0.0, -1.0], [0.5, 0.0, -1.0]);
+    let by_hand = coverage_clipped_by_hand(&[[a, b, cb], [a, cb, ca]], &camera);
+    assert!(by_hand.iter().sum::<u32>() > 0);
+    assert_eq!(counts, by_hand);
+    // FreePipe's bounding-box-only approach divides by w < 0: C lands at the bottom of the
+    // screen instead of beyond the top, and the triangle drawn is a different, inverted one.
+    let project = |[x, y, z]: [f32; 3]| {
+        let w = -z;
+        [x / w, y / w, 0.5]
+    };
+    let naive = soup(&[[project(a), project(b), project(c)]]);
+    let naive_counts = coverage(&identity_view(&naive, 32, 32));
+    assert_ne!(naive_counts, counts);
+}
+
+#[test]
+fn a_piece_with_a_vertex_at_w_0_is_dropped_as_documented() {
+    // A projection with w = z does not keep w away from 0 at the near plane (z ≥ 0 ⇔ w ≥ 0): a
+    // triangle reaching w < 0 is clipped to a piece with a vertex at w = 0, which is dropped.
+    let camera = camera_from_columns([
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 1.0],
+        [0.0, 0.0, 0.0, 0.0],
+    ]);
+    let crossing = soup(&[[[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, -1.0]]]);
+    let view = View::new(&crossing, &camera, viewport(16, 16), CullMode::None);
+    assert!(all_fragments(&view).is_empty());
+    // In front of w = 0 the same projection draws (depth z / w = 1 everywhere).
+    let in_front = soup(&[[[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, 1.0]]]);
+    let view = View::new(&in_front, &camera, viewport(16, 16), CullMode::None);
+    let fragments = all_fragments(&view);
+    assert!(!fragments.is_empty());
+    assert!(fragments.iter().all(|f| f.depth_key == MAX_KEY));
+}
+
+/// The depth keys of full-screen squares at these eye-space distances, under `camera`.
+fn keys_of_layers(camera: &Camera, distances: &[f32]) -> (Vec<u32>, Mesh) {
+    let triangles: Vec<[[f32; 3]; 3]> = distances
+        .iter()
+        .flat_map(|&d| square(2.0 * d, -d))
+        .collect();
+    let mesh = soup(&triangles);
+    let view = View::new(&mesh, camera, viewport(1, 1), CullMode::None);
+    let keys = (0..distances.len() as u32)
+        .map(|layer| {
+            let mut key = None;
+            for prim in [2 * layer, 2 * layer + 1] {
+                view.rasterize(prim, &mut |f| key = Some(f.depth_key));
+            }
+            key.expect("each layer covers the pixel")
+        })
+        .collect();
+    (keys, mesh)
+}
+
+#[test]
+fn a_near_far_ratio_of_1e_minus_7_merges_distinct_layers_ordered_by_primitive() {
+    let distances: Vec<f32> = (1..=10).map(|i| i as f32 / 10.0).collect();
+    let (keys, _) = keys_of_layers(&perspective(1e-7, 1.0), &distances);
+    let mut distinct = keys.clone();
+    distinct.dedup();
+    // Depth ≈ 1 − 1e-7 / d: ten layers from 0.1 to 1.0 get only a handful of keys just below 1.0.
+    assert!(keys.iter().all(|&k| k > depth_key(0.999_998).unwrap()));
+    assert!(distinct.len() < distances.len(), "{keys:x?}");
+    eprintln!(
+        "near/far 1e-7: layers at 0.1..1.0 get {} distinct keys: {keys:x?}",
+        distinct.len()
+    );
+    // With near/far = 1e-2 they are all distinct.
+    let (keys, _) = keys_of_layers(&perspective(1e-2, 1.0), &distances);
+    let mut distinct = keys.clone();
+    distinct.dedup();
+    assert_eq!(distinct.len(), distances.len());
+    // Merged layers are still captured exactly: equal keys in primitive order, as the oracle.
+    let camera = perspective(1e-7, 1.0);
+    let (_, mesh) = keys_of_layers(&camera, &[0.9, 0.8, 0.7, 0.6, 0.5]);
+    let view = View::new(&mesh, &camera, viewport(8, 8), CullMode::None);
+    let oracle = Oracle::build(&view);
+    let mdts = Mdts::<u64>::ascending(view.viewport(), oracle.max_depth_complexity()).unwrap();
+    assert_exact(&view, &oracle, &mdts);
+}
+
+#[test]
+fn two_layers_closer_than_one_ulp_keep_both_in_primitive_order() {
+    let camera = perspective(1.0, 100.0);
+    // Eye-space distances one f32 ulp apart; the farther layer has the lower primitive ids.
+    let far = 50.0f32;
+    let near = f32::from_bits(far.to_bits() - 1);
+    let (keys, mesh) = keys_of_layers(&camera, &[far, near]);
+    assert_eq!(keys[0], keys[1], "one depth key for both layers");
+    let view = View::new(&mesh, &camera, viewport(4, 4), CullMode::None);
+    let oracle = Oracle::build(&view);
+    let mdts = Mdts::<u64>::ascending(view.viewport(), 2).unwrap();
+    let run = run_serial(&view, &mdts);
+    assert!(oracle.diff(&run.capture).is_exact());
+    for p in 0..view.viewport().pixels() {
+        let list = run.capture.pixel(p);
+        assert_eq!(list.len(), 2, "pixel {p}");
+        assert_eq!(list[0] >> 32, list[1] >> 32);
+        assert!(
+            (list[0] as u32) < 2 && (list[1] as u32) >= 2,
+            "pixel {p}: {list:x?}"
+        );
+    }
+    let keys_only =
+        Mdts::<u32>::new(view.viewport(), 2, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
+    let capture = run_serial(&view, &keys_only).capture;
+    assert!(oracle.diff(&capture).is_exact());
+    assert!((0..capture.pixels()).all(|p| capture.pixel(p).len() == 2));
+}
+
+#[test]
+fn ten_thousand_coincident_triangles_on_one_pixel_are_ordered_by_primitive_id() {
+    let n = 10_000u32;
+    let mesh = Mesh {
+        positions: vec![[-1.0, -1.0, 0.5], [3.0, -1.0, 0.5], [-1.0, 3.0, 0.5]],
+        triangles: vec![[0, 1, 2]; n as usize],
+    };
+    let view = identity_view(&mesh, 1, 1);
+    let oracle = Oracle::build(&view);
+    let key = u64::from(depth_key(0.5).unwrap()) << 32;
+    let expected: Vec<u64> = (0..n).map(|prim| key | u64::from(prim)).collect();
+    assert_eq!(oracle.pixel(0), expected.as_slice());
+    let mdts = Mdts::<u64>::ascending(view.viewport(), n).unwrap();
+    for run in [run_serial(&view, &mdts), run_parallel(&view, &mdts)] {
+        assert_eq!(run.capture.pixel(0), expected.as_slice());
+    }
+    // Serially, fragment i walks past the i equal-key fragments before it: n (n + 1) / 2 steps.
+    let steps = run_serial(&view, &mdts).stats.counters.steps;
+    assert_eq!(steps, u64::from(n) * u64::from(n + 1) / 2);
+    let abuffer = ABuffer::exact(
+        &oracle.depth_complexity(),
+        PostSort::Insertion,
+        MEMORY_CAP_DEFAULT,
+    )
+    .unwrap();
+    assert_exact(&view, &oracle, &abuffer);
+    let bitonic = ABuffer::exact(
+        &oracle.depth_complexity(),
+        PostSort::Bitonic,
+        MEMORY_CAP_DEFAULT,
+    )
+    .unwrap();
+    assert_exact(&view, &oracle, &bitonic);
+    let keys_only =
+        Mdts::<u32>::new(view.viewport(), n, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
+    let capture = run_serial(&view, &keys_only).capture;
+    assert_eq!(capture.pixel(0), vec![key; n as usize].as_slice());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sizes
+
+#[test]
+fn a_1x1_viewport_is_captured_exactly() {
+    let scene = Scene::procedural("spheres:3").unwrap();
+    let view = scene.view(viewport(1, 1), &OrbitCamera::default()).unwrap();
+    let oracle = Oracle::build(&view);
+    assert_eq!(oracle.max_depth_complexity(), 6);
+    assert_exact(
+        &view,
+        &oracle,
+        &Mdts::<u64>::ascending(view.viewport(), 6).unwrap(),
+    );
+    let abuffer = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
+    assert_exact(&view, &oracle, &abuffer);
+}
+
+#[test]
+fn a_16384_square_viewport_beyond_the_memory_cap_is_refused_naming_the_bytes() {
+    let side = Viewport::MAX_SIDE;
+    assert_eq!(side, 16384);
+    let huge = viewport(side, side);
+    let cap = 1_000_000;
+    let pixels = u64::from(side) * u64::from(side);
+    let refused = |result: Result<(), CaptureError>, needed: u64| {
+        let err = result.unwrap_err();
+        assert_eq!(
+            err,
+            CaptureError::TooMuchMemory {
+                scheme: match &err {
+                    CaptureError::TooMuchMemory { scheme, .. } => scheme.clone(),
+                    other => panic!("{other}"),
+                },
+                needed,
+                cap,
+            }
+        );
+        let message = err.to_string();
+        assert!(message.contains(&needed.to_string()), "{message}");
+    };
+    refused(
+        Mdts::<u64>::new(huge, 1, Direction::Ascending, cap).map(drop),
+        pixels * 8,
+    );
+    refused(
+        Mdts::<u32>::new(huge, 1, Direction::Ascending, cap).map(drop),
+        pixels * 4,
+    );
+    refused(
+        ABuffer::fixed(huge, 1, PostSort::Insertion, cap).map(drop),
+        pixels * 12,
+    );
+    assert_eq!(pixels * 8, 2_147_483_648);
+    // One more pixel per side is refused by the viewport itself.
+    let err = Viewport::new(side + 1, 1).unwrap_err();
+    assert!(err.contains("16384"), "{err}");
+}
+
+#[test]
+fn the_binary_refuses_a_16384_square_viewport_beyond_the_memory_cap_before_the_oracle() {
+    let start = Instant::now();
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args([
+            "--width",
+            "16384",
+            "--height",
+            "16384",
+            "--memory-cap",
+            "1000000",
+            "--no-images",
+        ])
+        .output()
+        .unwrap();
+    let elapsed = start.elapsed();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    // MDTS with 64-bit words needs at least K = 1 word per pixel: 16384² × 8 bytes.
+    assert!(
+        stderr.contains("2147483648") && stderr.contains("1000000"),
+        "{stderr}"
+    );
+    // Refused before the oracle's counting pass (which took 20 s and 5.4 GB here before the fix).
+    assert!(elapsed.as_secs() < 10, "took {elapsed:?}");
+}
+
+#[test]
+fn k_1_keeps_exactly_the_nearest_layer_and_counts_the_rest() {
+    let scene = Scene::procedural("spheres:3").unwrap();
+    let view = scene
+        .view(viewport(48, 48), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    let mdts = Mdts::<u64>::ascending(view.viewport(), 1).unwrap();
+    assert_exact(&view, &oracle, &mdts);
+    let run = run_serial(&view, &mdts);
+    let covered = oracle.depth_complexity().iter().filter(|&&c| c > 0).count() as u64;
+    assert_eq!(run.capture.entries.len() as u64, covered);
+    assert_eq!(
+        run.stats.counters.dropped,
+        oracle.fragments() as u64 - covered
+    );
+    for p in 0..oracle.pixels() {
+        assert_eq!(
+            run.capture.pixel(p),
+            &oracle.pixel(p)[..oracle.pixel(p).len().min(1)]
+        );
+    }
+}
+
+#[test]
+fn k_1024_costs_memory_but_no_extra_steps() {
+    let scene = Scene::procedural("spheres:3").unwrap();
+    let view = scene
+        .view(viewport(32, 32), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    let full = oracle.max_depth_complexity();
+    let wide = Mdts::<u64>::ascending(view.viewport(), 1024).unwrap();
+    let tight = Mdts::<u64>::ascending(view.viewport(), full).unwrap();
+    assert_exact(&view, &oracle, &wide);
+    let (w, t) = (run_serial(&view, &wide), run_serial(&view, &tight));
+    assert_eq!(w.capture, t.capture);
+    // A walk stops at the first empty slot: slots beyond the depth complexity are never touched.
+    assert_eq!(w.stats.counters.steps, t.stats.counters.steps);
+    assert_eq!(w.stats.memory_bytes, 32 * 32 * 1024 * 8);
+    assert_eq!(t.stats.memory_bytes, 32 * 32 * u64::from(full) * 8);
+}
+
+#[test]
+fn a_scene_with_zero_triangles_is_a_clear_error() {
+    let empty = Scene {
+        name: "nothing".into(),
+        mesh: Mesh {
+            positions: vec![[0.0; 3]; 3],
+            triangles: Vec::new(),
+        },
+    };
+    let err = empty
+        .view(viewport(8, 8), &OrbitCamera::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("nothing") && err.contains("no triangles"),
+        "{err}"
+    );
+    let err =
+        Mesh::read_obj(&mut "v 0 0 0\nv 1 0 0\nv 1 1 0\n".as_bytes(), "points.obj").unwrap_err();
+    assert!(matches!(err, MeshError::Empty { .. }), "{err}");
+    assert!(err.to_string().contains("points.obj has no triangles"));
+}
+
+#[test]
+fn one_triangle_covering_the_whole_screen_covers_every_pixel_once() {
+    let mesh = soup(&[[[-1.0, -1.0, 0.75], [3.0, -1.0, 0.75], [-1.0, 3.0, 0.75]]]);
+    for (width, height) in [(64, 48), (1, 1), (1, 64)] {
+        let view = identity_view(&mesh, width, height);
+        assert!(coverage(&view).iter().all(|&c| c == 1), "{width}x{height}");
+        let oracle = Oracle::build(&view);
+        let mdts = Mdts::<u64>::ascending(view.viewport(), 1).unwrap();
+        assert_exact(&view, &oracle, &mdts);
+        assert_eq!(run_serial(&view, &mdts).stats.counters.dropped, 0);
+    }
+}
+
+#[test]
+fn depth_complexity_above_k_is_counted_as_overflow_equal_to_drops() {
+    let scene = Scene::procedural("spheres:4").unwrap();
+    let view = scene
+        .view(viewport(48, 48), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    assert_eq!(oracle.max_depth_complexity(), 8);
+    let k = 3;
+    let beyond_k: u64 = oracle
+        .depth_complexity()
+        .iter()
+        .map(|&c| u64::from(c.saturating_sub(k)))
+        .sum();
+    assert!(beyond_k > 0);
+    let vp = view.viewport();
+    let asc = Mdts::<u64>::ascending(vp, k).unwrap();
+    assert_eq!(assert_exact(&view, &oracle, &asc), beyond_k);
+    let desc = Mdts::<u64>::new(vp, k, Direction::Descending, MEMORY_CAP_DEFAULT).unwrap();
+    assert_eq!(assert_exact(&view, &oracle, &desc), beyond_k);
+    let keys = Mdts::<u32>::new(vp, k, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
+    assert_eq!(assert_exact(&view, &oracle, &keys), beyond_k);
+    let fixed = ABuffer::fixed(vp, k, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
+    assert_eq!(assert_exact(&view, &oracle, &fixed), beyond_k);
+}
