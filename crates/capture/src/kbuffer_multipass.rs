@@ -186,7 +186,7 @@ impl Scheme for KBufferMultipass {
                 WordMemory::<u64>::store(memory, pixel * k + slot, EMPTY);
             }
             // Packed fragments stop at key 0x3F80_0000, so `last + 1` cannot reach COMPLETE.
-            let next = if last == EMPTY { COMPLETE } else { last };
+            let next = if last == EMPTY { COMPLETE } else { last + 1 };
             WordMemory::<u64>::store(memory, boundary, next);
             more |= next != COMPLETE;
         }
