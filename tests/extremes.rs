@@ -245,21 +245,34 @@ proptest! {
 // ---------------------------------------------------------------------------------------------
 // Sentinels
 
+/// What `depth_key` must return for a bit pattern: the pattern itself for `+0.0 ..= 1.0` (bits
+/// `0 ..= 0x3F80_0000`), 0 for `−0.0`, nothing for the rest (negative, above 1, infinite, NaN).
+fn expected_key(bits: u32) -> Option<u32> {
+    match bits {
+        0..=MAX_KEY => Some(bits),
+        0x8000_0000 => Some(0),
+        _ => None,
+    }
+}
+
 #[test]
-fn no_float_has_a_depth_key_above_0x3f800000_so_neither_sentinel_collides() {
-    // Exhaustive over all 2^32 bit patterns, on the rayon pool.
-    use rayon::prelude::*;
-    let max = (0..=u16::MAX)
-        .into_par_iter()
-        .map(|high| {
-            let base = u32::from(high) << 16;
-            (0..=u16::MAX)
-                .filter_map(|low| depth_key(f32::from_bits(base | u32::from(low))))
-                .max()
-                .unwrap_or(0)
-        })
-        .max();
-    assert_eq!(max, Some(MAX_KEY));
+fn depth_keys_exist_only_up_to_0x3f800000_so_neither_sentinel_collides() {
+    // Both signs, every exponent, the 4,096 smallest and largest mantissas of each: every
+    // boundary of the float format (0, subnormals, 1.0, infinity, the NaNs) is covered exactly;
+    // the proptest below samples the rest.
+    for sign in [0, 0x8000_0000u32] {
+        for exponent in 0..256u32 {
+            let base = sign | exponent << 23;
+            for mantissa in (0..4096).chain((1 << 23) - 4096..1 << 23) {
+                let bits = base | mantissa;
+                assert_eq!(
+                    depth_key(f32::from_bits(bits)),
+                    expected_key(bits),
+                    "{bits:#x}"
+                );
+            }
+        }
+    }
     // The only bit patterns equal to the sentinels are NaNs, which have no key.
     for sentinel in [0x7FFF_FFFFu32, 0xFFFF_FFFF] {
         assert!(f32::from_bits(sentinel).is_nan());
@@ -274,6 +287,17 @@ fn no_float_has_a_depth_key_above_0x3f800000_so_neither_sentinel_collides() {
     }
     .packed();
     assert!(largest_word < u64::MAX);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 10_000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn depth_key_of_any_bit_pattern_is_the_pattern_on_the_unit_interval_else_none(
+        bits in any::<u32>(),
+    ) {
+        prop_assert_eq!(depth_key(f32::from_bits(bits)), expected_key(bits));
+    }
 }
 
 /// How an `atomicMin` against an empty slot treats a value: `true` when the value replaces the
@@ -502,27 +526,29 @@ fn vertices_at_1e_minus_7_snap_to_one_point_and_produce_nothing() {
     assert!(all_fragments(&identity_view(&mesh, 64, 64)).is_empty());
 }
 
+/// Per-pixel depth complexity of `spheres:3` scaled by `scale`, seen by the orbit camera at
+/// 64 × 64, after checking MDTS captures it exactly.
+fn scaled_spheres(scale: f32) -> Vec<u32> {
+    let mut scene = Scene::procedural("spheres:3").unwrap();
+    for p in &mut scene.mesh.positions {
+        *p = p.map(|c| c * scale);
+    }
+    let view = scene
+        .view(viewport(64, 64), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    let k = oracle.max_depth_complexity();
+    assert_eq!(k, 6, "scale {scale:e}");
+    let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
+    assert!(oracle.diff(&run_serial(&view, &mdts).capture).is_exact());
+    oracle.depth_complexity()
+}
+
 #[test]
-fn a_model_scaled_by_1e7_or_1e_minus_7_renders_like_the_original() {
-    let original = Scene::procedural("spheres:3").unwrap();
-    let fragments_at = |scale: f32| {
-        let mut scene = original.clone();
-        for p in &mut scene.mesh.positions {
-            *p = p.map(|c| c * scale);
-        }
-        let view = scene
-            .view(viewport(64, 64), &OrbitCamera::default())
-            .unwrap();
-        let oracle = Oracle::build(&view);
-        let k = oracle.max_depth_complexity();
-        assert_eq!(k, 6, "scale {scale:e}");
-        let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
-        assert!(oracle.diff(&run_serial(&view, &mdts).capture).is_exact());
-        oracle.depth_complexity()
-    };
-    let reference = fragments_at(1.0);
-    for scale in [1e7, 1e-7] {
-        let scaled = fragments_at(scale);
+fn a_model_scaled_by_1e7_or_1e_minus_5_renders_like_the_original() {
+    let reference = scaled_spheres(1.0);
+    for scale in [1e7, 1e-5] {
+        let scaled = scaled_spheres(scale);
         let differing = reference
             .iter()
             .zip(&scaled)
@@ -534,6 +560,19 @@ fn a_model_scaled_by_1e7_or_1e_minus_7_renders_like_the_original() {
             "scale {scale:e}: {differing} pixels differ"
         );
     }
+}
+
+#[test]
+fn a_model_below_2e_minus_6_across_is_framed_as_if_it_were_2e_minus_6() {
+    // `OrbitCamera` clamps the bounding radius to at least 1e-6 (to survive a one-point mesh):
+    // spheres of radius 1e-7 are still captured exactly, but drawn about ten times smaller.
+    let covered = |counts: Vec<u32>| counts.iter().filter(|&&c| c > 0).count();
+    let reference = covered(scaled_spheres(1.0));
+    let tiny = covered(scaled_spheres(1e-7));
+    assert!(
+        tiny > 0 && tiny * 20 < reference,
+        "{tiny} vs {reference} pixels"
+    );
 }
 
 /// The eye-space triangle A, B, C clipped by hand at `z = −near` (exactly representable here),
@@ -849,7 +888,8 @@ fn k_1024_costs_memory_but_no_extra_steps() {
     let tight = Mdts::<u64>::ascending(view.viewport(), full).unwrap();
     assert_exact(&view, &oracle, &wide);
     let (w, t) = (run_serial(&view, &wide), run_serial(&view, &tight));
-    assert_eq!(w.capture, t.capture);
+    assert_eq!(w.capture.entries, t.capture.entries);
+    assert_eq!(w.capture.offsets, t.capture.offsets);
     // A walk stops at the first empty slot: slots beyond the depth complexity are never touched.
     assert_eq!(w.stats.counters.steps, t.stats.counters.steps);
     assert_eq!(w.stats.memory_bytes, 32 * 32 * 1024 * 8);

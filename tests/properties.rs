@@ -19,9 +19,9 @@ use fragsim::raster::{
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use support::strategies::{
-    closed_mesh, depth_plane, identity_camera, is_closed, k_choice, orbit_camera,
+    closed_mesh, depth_plane, hinge, identity_camera, is_closed, k_choice, orbit_camera,
     orbit_camera_outside, scene_spec, small_capacity, unit_depth_pair, viewport,
-    viewport_and_tiling, DepthPlane, KChoice, PlanarTiling, SceneSpec,
+    viewport_and_tiling, KChoice, PlanarTiling, SceneSpec,
 };
 
 /// A config with `cases` cases (or `PROPTEST_CASES` when set, for a longer run) and no failure
@@ -54,7 +54,13 @@ fn check_mdts_parallel<W: MdtsWord>(
     let diff = oracle.diff(&run.capture);
     let name = scheme.name();
     prop_assert!(diff.is_exact(), "{name} K={k}: {diff:?}");
-    prop_assert_eq!(diff.overflowed, run.stats.counters.dropped, "{} K={}", name, k);
+    prop_assert_eq!(
+        diff.overflowed,
+        run.stats.counters.dropped,
+        "{} K={}",
+        name,
+        k
+    );
     prop_assert_eq!(
         diff.captured + diff.overflowed,
         oracle.fragments() as u64,
@@ -129,7 +135,7 @@ fn check_tiling(viewport: Viewport, tiling: &PlanarTiling) -> Result<(), TestCas
 }
 
 proptest! {
-    #![proptest_config(config(40))]
+    #![proptest_config(config(384))]
 
     /// Property 1: parallel MDTS (64-bit words ascending and descending, 32-bit depth-key words
     /// ascending and descending) equals the oracle exactly on random scenes, cameras (near-plane
@@ -196,7 +202,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(32))]
+    #![proptest_config(config(192))]
 
     /// Property 3: the serial and the parallel executor produce equal captures for MDTS (64-bit
     /// ascending, 32-bit descending, random `K`) and for the exact A-buffer, and the same
@@ -252,7 +258,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(48))]
+    #![proptest_config(config(192))]
 
     /// Property 4: fragments are conserved: the oracle's fragment count equals the sum of its
     /// per-pixel depth complexities, the number of fragments the rasterizer emits, and the
@@ -293,7 +299,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(48))]
+    #![proptest_config(config(512))]
 
     /// Property 5a: crack-free coverage of closed meshes: nested spheres
     /// (`Scene::procedural("spheres:N")`) seen from outside (distance scale ≥ 1.05: no near
@@ -343,17 +349,15 @@ proptest! {
     }
 }
 
-/// Checks that a planar tiling put on a depth plane crossing the near plane covers no pixel centre
-/// twice, every centre clearly inside its visible part once and every centre clearly outside not
-/// at all.
-fn check_near_clipped_tiling(
+/// Checks that `mesh`, seen through the identity camera, covers no pixel centre twice and every
+/// centre as `expected` says where it says something.
+fn check_robust_coverage(
     viewport: Viewport,
-    tiling: &PlanarTiling,
-    plane: DepthPlane,
+    mesh: &Mesh,
+    expected: &[Option<u32>],
 ) -> Result<(), TestCaseError> {
-    let view = View::new(&tiling.mesh, &identity_camera(), viewport, CullMode::None);
+    let view = View::new(mesh, &identity_camera(), viewport, CullMode::None);
     let got = coverage(&view);
-    let expected = tiling.robust_expectation(viewport, plane);
     let wrong: Vec<(u32, u32, Option<u32>, u32)> = (0..got.len())
         .filter(|&p| got[p] > 1 || expected[p].is_some_and(|e| e != got[p]))
         .map(|p| {
@@ -371,7 +375,7 @@ fn check_near_clipped_tiling(
 }
 
 proptest! {
-    #![proptest_config(config(256))]
+    #![proptest_config(config(1024))]
 
     /// Property 5d: near-plane clipping keeps a tiling watertight: a planar tiling (as in 5c, its
     /// vertices also on dyadic NDC coordinates) on a depth plane that crosses the near plane, seen
@@ -382,12 +386,30 @@ proptest! {
         (viewport, tiling) in viewport_and_tiling(),
         plane in depth_plane(),
     ) {
-        check_near_clipped_tiling(viewport, &tiling.on_plane(plane), plane)?;
+        let tiling = tiling.on_plane(plane);
+        check_robust_coverage(viewport, &tiling.mesh, &tiling.robust_expectation(viewport, plane))?;
     }
 }
 
 proptest! {
-    #![proptest_config(config(4096))]
+    #![proptest_config(config(20_000))]
+
+    /// Property 5e: near-plane clipping keeps a shared edge watertight: two triangles sharing an
+    /// edge that crosses the near plane (a `Hinge`, vertices on dyadic coordinates), seen through
+    /// the identity camera on a random viewport, cover no pixel centre twice and every centre
+    /// clearly inside the visible part of their union exactly once.
+    ///
+    /// Fails about once in 4,000 cases (see the regression tests below), hence the many cases and
+    /// the `ignore` until the clipper is fixed; then 1,024 cases will do.
+    #[test]
+    #[ignore = "bug: near-plane clipping is not watertight (see regression_near_clipped_shared_edge_*)"]
+    fn near_clipped_shared_edges_are_watertight(hinge in hinge(), viewport in viewport()) {
+        check_robust_coverage(viewport, &hinge.mesh, &hinge.robust_expectation(viewport))?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(10_000))]
 
     /// Property 6: the depth key is order-preserving: for any two depths `a`, `b` in `[0, 1]`
     /// (subnormals, neighbours one ulp apart and `-0.0` included) `a < b` exactly when
@@ -443,4 +465,76 @@ fn closed_scenes_are_in_view() {
     let counts = coverage(&cube.view(viewport, &OrbitCamera::default()).unwrap());
     assert_eq!(counts.iter().max(), Some(&2));
     assert!(odd_pixels(&counts).is_empty());
+}
+
+/// Coverage of `mesh` through the identity camera: per pixel, how many of its triangles cover
+/// the centre, and the viewport width.
+fn identity_coverage(mesh: &Mesh, width: u32, height: u32) -> (Vec<u32>, u32) {
+    let viewport = Viewport::new(width, height).unwrap();
+    let view = View::new(mesh, &identity_camera(), viewport, CullMode::None);
+    (coverage(&view), width)
+}
+
+/// Regression, found by `near_clipped_shared_edges_are_watertight` (minimised by proptest): a
+/// hole along an edge shared by two triangles, where the near plane clips it.
+///
+/// Triangles `[a, b, c1]` and `[b, a, c2]` share `a b`; `a` is behind the near plane (z < 0), `b`
+/// in front. `View::screen_triangles` clips each with `clip_polygon`, which computes the
+/// intersection as `current + (next − current) · t` in the polygon's own order: from `a` to `b`
+/// in the first triangle, from `b` to `a` in the second. The two f64 results differ in the last
+/// bit, and as the exact point lies halfway between two points of the 1/256-pixel grid (x = 676.5
+/// here), they snap to x = 677 and x = 676: the clipped pieces share the vertex `b` but not the
+/// clipped one, and the centre of pixel (4, 26), strictly between the lines from `b` (1391, 8733)
+/// to (677, 2906) and to (676, 2906), is covered by neither (its depth is about 0.35, well inside
+/// the view volume). A fix: compute an intersection in a canonical direction (e.g. always from
+/// the vertex inside the plane to the one outside), so both triangles get the same point. The
+/// guard-band planes go through the same function.
+#[test]
+#[ignore = "bug: near-plane clipping computes a shared edge's clipped vertex from each triangle's own end, so the two can snap 1/256 px apart and leave a hole"]
+fn regression_near_clipped_shared_edge_leaves_a_hole() {
+    let mesh = Mesh {
+        positions: vec![
+            [-0.667_968_75, 0.886_718_75, -0.218_75],
+            [0.207_031_25, -0.949_218_75, 0.531_25],
+            [-0.488_671_9, 0.746_875, 0.015_625],
+            [-0.672_265_65, 0.659_375, 0.015_625],
+        ],
+        triangles: vec![[0, 1, 2], [1, 0, 3]],
+    };
+    let (counts, width) = identity_coverage(&mesh, 9, 35);
+    let at = |x: u32, y: u32| counts[(y * width + x) as usize];
+    assert_eq!(
+        at(4, 26),
+        1,
+        "pixel (4, 26) lies inside the union of the two triangles"
+    );
+    assert!(counts.iter().all(|&c| c <= 1));
+}
+
+/// Regression, the same bug the other way round: where the two clipped vertices snap 1/256 pixel
+/// apart towards each other's triangle, a pixel centre in the sliver between them is covered by
+/// both triangles. Here the clipped vertex of the shared edge snaps to (6638, 6697) in the first
+/// triangle and (6638, 6698) in the second on a 45 × 45 viewport, and pixel (23, 22) gets two
+/// fragments (the A-buffer and MDTS then capture both, and the oracle agrees, so only the coverage
+/// properties see it).
+#[test]
+#[ignore = "bug: near-plane clipping computes a shared edge's clipped vertex from each triangle's own end, so the two can snap 1/256 px apart and cover a pixel twice"]
+fn regression_near_clipped_shared_edge_covers_a_pixel_twice() {
+    let mesh = Mesh {
+        positions: vec![
+            [0.5625, -0.781_25, -0.078_125],
+            [-0.421_875, 0.703_125, 0.109_375],
+            [-1.414_062_5, -1.023_437_5, 0.5],
+            [1.554_687_5, 0.945_312_5, 0.5],
+        ],
+        triangles: vec![[0, 1, 2], [1, 0, 3]],
+    };
+    let (counts, width) = identity_coverage(&mesh, 45, 45);
+    let at = |x: u32, y: u32| counts[(y * width + x) as usize];
+    assert_eq!(
+        at(23, 22),
+        1,
+        "pixel (23, 22) must be covered once, not by both triangles"
+    );
+    assert!(counts.iter().all(|&c| c <= 1));
 }

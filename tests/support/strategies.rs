@@ -14,6 +14,7 @@
 //! | [`closed_mesh`] | a watertight mesh (perturbed icosphere or subdivided cube) |
 //! | [`planar_tiling`], [`viewport_and_tiling`] | a [`PlanarTiling`]: triangles tiling a rectangle |
 //! | [`depth_plane`] | a [`DepthPlane`] to put a tiling on, crossing the near plane |
+//! | [`hinge`] | a [`Hinge`]: two triangles sharing an edge that crosses the near plane |
 //! | [`k_choice`] | a [`KChoice`]: a `K` (or capacity) relative to the depth complexity |
 //! | [`unit_depth`], [`unit_depth_pair`] | depths in `[0, 1]` for the depth-key order |
 //!
@@ -243,54 +244,50 @@ fn piece() -> impl Strategy<Value = Piece> {
 /// Triangle `i` is primitive `i`; every index is valid.
 pub fn random_mesh(max_triangles: usize) -> impl Strategy<Value = Mesh> {
     let max_triangles = max_triangles.max(1);
-    (
-        [point(), point(), point()],
-        vec(piece(), 0..max_triangles),
-    )
-        .prop_map(|(first, pieces)| {
-            let mut mesh = Mesh::default();
-            let push = |mesh: &mut Mesh, points: [[f32; 3]; 3]| {
-                let base = mesh.positions.len() as u32;
-                mesh.positions.extend(points);
-                mesh.triangles.push([base, base + 1, base + 2]);
-            };
-            push(&mut mesh, first);
-            for piece in pieces {
-                match piece {
-                    Piece::Free(points) => push(&mut mesh, points),
-                    Piece::Sliver { a, b, t, offset } => {
-                        let c = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]) + offset[i]);
-                        push(&mut mesh, [a, b, c]);
+    ([point(), point(), point()], vec(piece(), 0..max_triangles)).prop_map(|(first, pieces)| {
+        let mut mesh = Mesh::default();
+        let push = |mesh: &mut Mesh, points: [[f32; 3]; 3]| {
+            let base = mesh.positions.len() as u32;
+            mesh.positions.extend(points);
+            mesh.triangles.push([base, base + 1, base + 2]);
+        };
+        push(&mut mesh, first);
+        for piece in pieces {
+            match piece {
+                Piece::Free(points) => push(&mut mesh, points),
+                Piece::Sliver { a, b, t, offset } => {
+                    let c = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]) + offset[i]);
+                    push(&mut mesh, [a, b, c]);
+                }
+                Piece::Collapsed { a, b } => push(&mut mesh, [a, a, b]),
+                Piece::Coincident {
+                    of,
+                    shared,
+                    reversed,
+                } => {
+                    let mut tri = mesh.triangles[of % mesh.triangles.len()];
+                    if reversed {
+                        tri.swap(1, 2);
                     }
-                    Piece::Collapsed { a, b } => push(&mut mesh, [a, a, b]),
-                    Piece::Coincident {
-                        of,
-                        shared,
-                        reversed,
-                    } => {
-                        let mut tri = mesh.triangles[of % mesh.triangles.len()];
-                        if reversed {
-                            tri.swap(1, 2);
-                        }
-                        if shared {
-                            mesh.triangles.push(tri);
-                        } else {
-                            let points = tri.map(|i| mesh.positions[i as usize]);
-                            push(&mut mesh, points);
-                        }
-                    }
-                    Piece::SharedEdge { of, edge, apex } => {
-                        let tri = mesh.triangles[of % mesh.triangles.len()];
-                        let (i, j) = (tri[edge % 3], tri[(edge + 1) % 3]);
-                        let k = mesh.positions.len() as u32;
-                        mesh.positions.push(apex);
-                        // The opposite winding along the shared edge, as in a consistent mesh.
-                        mesh.triangles.push([j, i, k]);
+                    if shared {
+                        mesh.triangles.push(tri);
+                    } else {
+                        let points = tri.map(|i| mesh.positions[i as usize]);
+                        push(&mut mesh, points);
                     }
                 }
+                Piece::SharedEdge { of, edge, apex } => {
+                    let tri = mesh.triangles[of % mesh.triangles.len()];
+                    let (i, j) = (tri[edge % 3], tri[(edge + 1) % 3]);
+                    let k = mesh.positions.len() as u32;
+                    mesh.positions.push(apex);
+                    // The opposite winding along the shared edge, as in a consistent mesh.
+                    mesh.triangles.push([j, i, k]);
+                }
             }
-            mesh
-        })
+        }
+        mesh
+    })
 }
 
 /// A [`random_mesh`] scaled by 0.01, 1, 100 or 3000 and moved by up to 10 times its scale, so that
@@ -561,9 +558,15 @@ impl PlanarTiling {
     /// applied to the union), zero elsewhere.
     pub fn expected_coverage(&self, viewport: Viewport) -> Vec<u32> {
         let [x0, y0, x1, y1] = self.rect;
-        let (left, right) = (snap_ndc_x(x0, viewport.width), snap_ndc_x(x1, viewport.width));
+        let (left, right) = (
+            snap_ndc_x(x0, viewport.width),
+            snap_ndc_x(x1, viewport.width),
+        );
         // y is flipped: the top of the window is NDC y1.
-        let (top, bottom) = (snap_ndc_y(y1, viewport.height), snap_ndc_y(y0, viewport.height));
+        let (top, bottom) = (
+            snap_ndc_y(y1, viewport.height),
+            snap_ndc_y(y0, viewport.height),
+        );
         let one = 1i64 << SUBPIXEL_BITS;
         let mut expected = Vec::with_capacity(viewport.pixels());
         for j in 0..i64::from(viewport.height) {
@@ -657,9 +660,15 @@ pub fn depth_plane() -> impl Strategy<Value = DepthPlane> {
 /// past the far edge of the window.
 fn window_interval(side: u32) -> impl Strategy<Value = (f64, f64)> {
     let length = f64::from(side);
-    (-4.0..length * 0.7, 3.0..length + 8.0, quantize(), quantize()).prop_map(
-        move |(lo, length, q_lo, q_hi)| (q_lo.apply(lo, side), q_hi.apply(lo + length, side)),
+    (
+        -4.0..length * 0.7,
+        3.0..length + 8.0,
+        quantize(),
+        quantize(),
     )
+        .prop_map(move |(lo, length, q_lo, q_hi)| {
+            (q_lo.apply(lo, side), q_hi.apply(lo + length, side))
+        })
 }
 
 /// How far a jittered grid vertex may move, as a fraction of the cell: below 1/6 every quad stays
@@ -672,7 +681,12 @@ const JITTER: f64 = 0.12;
 /// diagonal.
 pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
     let (w, h) = (viewport.width, viewport.height);
-    (window_interval(w), window_interval(h), 1usize..=6, 1usize..=6)
+    (
+        window_interval(w),
+        window_interval(h),
+        1usize..=6,
+        1usize..=6,
+    )
         .prop_flat_map(|(bx, by, nx, ny)| {
             let vertices = (nx + 1) * (ny + 1);
             (
@@ -685,51 +699,58 @@ pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
                 vec(0.1f32..0.9, vertices),
             )
         })
-        .prop_map(move |(((x_lo, x_hi), (y_lo, y_hi), nx, ny), jitter, diagonals, z)| {
-            let rect = [ndc_x(x_lo, w), ndc_y(y_hi, h), ndc_x(x_hi, w), ndc_y(y_lo, h)];
-            let (cell_x, cell_y) = ((x_hi - x_lo) / nx as f64, (y_hi - y_lo) / ny as f64);
-            // One axis of a grid vertex: fixed on the boundary, jittered (and maybe quantized)
-            // inside.
-            let axis = |i: usize, lo: f64, cell: f64, jitter: f64, q: Quantize, side: u32| {
-                let base = lo + i as f64 * cell;
-                let moved = base + jitter * cell;
-                let quantized = q.apply(moved, side);
-                if (quantized - base).abs() <= JITTER * cell {
-                    quantized
-                } else {
-                    moved
-                }
-            };
-            let mut mesh = Mesh::default();
-            for j in 0..=ny {
-                for i in 0..=nx {
-                    let (jx, jy, qx, qy) = jitter[j * (nx + 1) + i];
-                    let x = match i {
-                        0 => rect[0],
-                        _ if i == nx => rect[2],
-                        _ => ndc_x(axis(i, x_lo, cell_x, jx, qx, w), w),
-                    };
-                    let y = match j {
-                        0 => rect[3],
-                        _ if j == ny => rect[1],
-                        _ => ndc_y(axis(j, y_lo, cell_y, jy, qy, h), h),
-                    };
-                    mesh.positions.push([x, y, z[j * (nx + 1) + i]]);
-                }
-            }
-            let at = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-            for j in 0..ny {
-                for i in 0..nx {
-                    let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-                    if diagonals[j * nx + i] {
-                        mesh.triangles.extend([[a, b, d], [b, c, d]]);
+        .prop_map(
+            move |(((x_lo, x_hi), (y_lo, y_hi), nx, ny), jitter, diagonals, z)| {
+                let rect = [
+                    ndc_x(x_lo, w),
+                    ndc_y(y_hi, h),
+                    ndc_x(x_hi, w),
+                    ndc_y(y_lo, h),
+                ];
+                let (cell_x, cell_y) = ((x_hi - x_lo) / nx as f64, (y_hi - y_lo) / ny as f64);
+                // One axis of a grid vertex: fixed on the boundary, jittered (and maybe quantized)
+                // inside.
+                let axis = |i: usize, lo: f64, cell: f64, jitter: f64, q: Quantize, side: u32| {
+                    let base = lo + i as f64 * cell;
+                    let moved = base + jitter * cell;
+                    let quantized = q.apply(moved, side);
+                    if (quantized - base).abs() <= JITTER * cell {
+                        quantized
                     } else {
-                        mesh.triangles.extend([[a, b, c], [a, c, d]]);
+                        moved
+                    }
+                };
+                let mut mesh = Mesh::default();
+                for j in 0..=ny {
+                    for i in 0..=nx {
+                        let (jx, jy, qx, qy) = jitter[j * (nx + 1) + i];
+                        let x = match i {
+                            0 => rect[0],
+                            _ if i == nx => rect[2],
+                            _ => ndc_x(axis(i, x_lo, cell_x, jx, qx, w), w),
+                        };
+                        let y = match j {
+                            0 => rect[3],
+                            _ if j == ny => rect[1],
+                            _ => ndc_y(axis(j, y_lo, cell_y, jy, qy, h), h),
+                        };
+                        mesh.positions.push([x, y, z[j * (nx + 1) + i]]);
                     }
                 }
-            }
-            PlanarTiling { mesh, rect }
-        })
+                let at = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                        if diagonals[j * nx + i] {
+                            mesh.triangles.extend([[a, b, d], [b, c, d]]);
+                        } else {
+                            mesh.triangles.extend([[a, b, c], [a, c, d]]);
+                        }
+                    }
+                }
+                PlanarTiling { mesh, rect }
+            },
+        )
 }
 
 /// A fan: a centre vertex anywhere strictly inside a random rectangle (sometimes within 1e-4 of a
@@ -752,7 +773,12 @@ pub fn fan(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
         vec(0.1f32..0.9, 21),
     )
         .prop_map(move |((x_lo, x_hi), (y_lo, y_hi), sides, (u, v, q), z)| {
-            let rect = [ndc_x(x_lo, w), ndc_y(y_hi, h), ndc_x(x_hi, w), ndc_y(y_lo, h)];
+            let rect = [
+                ndc_x(x_lo, w),
+                ndc_y(y_hi, h),
+                ndc_x(x_hi, w),
+                ndc_y(y_lo, h),
+            ];
             // Points along [lo, hi], quantized but kept inside and in order.
             let along = |lo: f64, hi: f64, points: &[(f64, Quantize)], side: u32| -> Vec<f64> {
                 let mut out: Vec<f64> = points
@@ -766,16 +792,30 @@ pub fn fan(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
             // side downwards, bottom side right to left, left side upwards; corners included.
             let mut boundary: Vec<[f32; 2]> = Vec::new();
             boundary.push([rect[0], rect[3]]);
-            boundary.extend(along(x_lo, x_hi, &sides[0], w).iter().map(|&x| [ndc_x(x, w), rect[3]]));
+            boundary.extend(
+                along(x_lo, x_hi, &sides[0], w)
+                    .iter()
+                    .map(|&x| [ndc_x(x, w), rect[3]]),
+            );
             boundary.push([rect[2], rect[3]]);
-            boundary.extend(along(y_lo, y_hi, &sides[1], h).iter().map(|&y| [rect[2], ndc_y(y, h)]));
+            boundary.extend(
+                along(y_lo, y_hi, &sides[1], h)
+                    .iter()
+                    .map(|&y| [rect[2], ndc_y(y, h)]),
+            );
             boundary.push([rect[2], rect[1]]);
             boundary.extend(
-                along(x_lo, x_hi, &sides[2], w).iter().rev().map(|&x| [ndc_x(x, w), rect[1]]),
+                along(x_lo, x_hi, &sides[2], w)
+                    .iter()
+                    .rev()
+                    .map(|&x| [ndc_x(x, w), rect[1]]),
             );
             boundary.push([rect[0], rect[1]]);
             boundary.extend(
-                along(y_lo, y_hi, &sides[3], h).iter().rev().map(|&y| [rect[0], ndc_y(y, h)]),
+                along(y_lo, y_hi, &sides[3], h)
+                    .iter()
+                    .rev()
+                    .map(|&y| [rect[0], ndc_y(y, h)]),
             );
             let inside = |lo: f64, hi: f64, t: f64, side: u32| {
                 let c = lo + t * (hi - lo);
@@ -811,6 +851,115 @@ pub fn planar_tiling(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
 /// A [`viewport`] and a [`planar_tiling`] for it.
 pub fn viewport_and_tiling() -> impl Strategy<Value = (Viewport, PlanarTiling)> {
     viewport().prop_flat_map(|viewport| (Just(viewport), planar_tiling(viewport)))
+}
+
+/// Two triangles sharing the edge `a b` that crosses the near plane of the identity camera (`a`
+/// behind it, `b` in front), one on each side: vertices `[a, b, c1, c2]`, triangles `[a, b, c1]`
+/// and `[b, a, c2]` (consistent orientation, so the clipper meets the shared edge once from each
+/// end). Their union is the convex quadrilateral `a c1 b c2`.
+#[derive(Clone, Debug)]
+pub struct Hinge {
+    /// The two triangles.
+    pub mesh: Mesh,
+}
+
+/// A [`Hinge`]: `a` and `b` with NDC x and y on multiples of 1/256 and z on multiples of 1/64
+/// (`a` behind the near plane, `b` in front), `c1` and `c2` anywhere in front on either side.
+/// With a viewport side that is not a power of two such coordinates put the clipped vertex of
+/// `a b` exactly halfway between two points of the fixed-point grid now and then.
+pub fn hinge() -> impl Strategy<Value = Hinge> {
+    let dyadic = || (-256i32..=256).prop_map(|k| k as f32 / 256.0);
+    let wing = || (0.1f32..0.9, 0.05f32..1.5, 1i32..=63);
+    (
+        [dyadic(), dyadic()],
+        -64i32..=-1,
+        [dyadic(), dyadic()],
+        1i32..=64,
+        wing(),
+        wing(),
+    )
+        .prop_filter("a and b must differ in x or y", |(a, _, b, _, _, _)| a != b)
+        .prop_map(|(a, za, b, zb, (t1, s1, z1), (t2, s2, z2))| {
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let side = |t: f32, s: f32, z: i32, sign: f32| {
+                [
+                    a[0] + d[0] * t - sign * d[1] * s,
+                    a[1] + d[1] * t + sign * d[0] * s,
+                    z as f32 / 64.0,
+                ]
+            };
+            Hinge {
+                mesh: Mesh {
+                    positions: vec![
+                        [a[0], a[1], za as f32 / 64.0],
+                        [b[0], b[1], zb as f32 / 64.0],
+                        side(t1, s1, z1, 1.0),
+                        side(t2, s2, z2, -1.0),
+                    ],
+                    triangles: vec![[0, 1, 2], [1, 0, 3]],
+                },
+            }
+        })
+}
+
+impl Hinge {
+    /// What each pixel centre must hold under the identity camera, where that is certain whatever
+    /// the rounding: `Some(1)` for centres clearly (by 1/64 pixel) inside the quadrilateral where
+    /// both triangles' planes give a depth clearly inside `(0, 1)` (near the shared edge the two
+    /// planes agree), `Some(0)` for centres clearly outside it or where both planes are clearly in
+    /// front of the near plane (or both beyond depth 1), `None` (at most once) elsewhere.
+    pub fn robust_expectation(&self, viewport: Viewport) -> Vec<Option<u32>> {
+        let (w, h) = (f64::from(viewport.width), f64::from(viewport.height));
+        let window = |p: [f32; 3]| {
+            [
+                (f64::from(p[0]) * 0.5 + 0.5) * w,
+                (0.5 - f64::from(p[1]) * 0.5) * h,
+                f64::from(p[2]),
+            ]
+        };
+        let [a, b, c1, c2] = [0, 1, 2, 3].map(|i| window(self.mesh.positions[i]));
+        let cross = |o: [f64; 3], p: [f64; 3], q: [f64; 2]| {
+            (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
+        };
+        // Depth planes over window coordinates, as z = gx·X + gy·Y + z0.
+        let plane = |p: [f64; 3], q: [f64; 3], r: [f64; 3]| {
+            let area = cross(p, q, [r[0], r[1]]);
+            let gx = ((q[2] - p[2]) * (r[1] - p[1]) - (r[2] - p[2]) * (q[1] - p[1])) / area;
+            let gy = ((r[2] - p[2]) * (q[0] - p[0]) - (q[2] - p[2]) * (r[0] - p[0])) / area;
+            (gx, gy, p[2] - gx * p[0] - gy * p[1])
+        };
+        let planes = [plane(a, b, c1), plane(b, a, c2)];
+        let m = 1.0 / 64.0;
+        let mz = planes
+            .iter()
+            .map(|(gx, gy, _)| (gx.abs() + gy.abs()) * m)
+            .fold(0.0, f64::max)
+            + 1e-6;
+        let quad = [a, c1, b, c2];
+        let orientation = cross(a, c1, [b[0], b[1]]).signum();
+        let mut expected = Vec::with_capacity(viewport.pixels());
+        for j in 0..viewport.height {
+            for i in 0..viewport.width {
+                let p = [f64::from(i) + 0.5, f64::from(j) + 0.5];
+                let distances = (0..4).map(|e| {
+                    let (u, v) = (quad[e], quad[(e + 1) % 4]);
+                    orientation * cross(u, v, p) / (v[0] - u[0]).hypot(v[1] - u[1])
+                });
+                let inside = distances.clone().all(|d| d > m);
+                let outside = distances.clone().any(|d| d < -m);
+                let z = planes.map(|(gx, gy, z0)| gx * p[0] + gy * p[1] + z0);
+                let (lo, hi) = (z[0].min(z[1]), z[0].max(z[1]));
+                expected.push(if outside || hi < -mz || lo > 1.0 + mz {
+                    Some(0)
+                } else if inside && lo > mz && hi < 1.0 - mz {
+                    Some(1)
+                } else {
+                    None
+                });
+            }
+        }
+        expected
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -221,7 +221,7 @@ fn print_table(
     type Cell = fn(&RunSummary) -> String;
     let columns: [(&str, usize, Cell); 14] = [
         ("scheme", 16, |r| r.scheme.clone()),
-        ("guarantee", 21, |r| r.guarantee.to_string()),
+        ("guarantee", 22, |r| r.guarantee.to_string()),
         ("executor", 9, |r| r.executor.clone()),
         ("thr", 3, |r| r.threads.to_string()),
         ("passes", 6, |r| r.passes.to_string()),

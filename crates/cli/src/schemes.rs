@@ -5,8 +5,11 @@ use fragsim_capture::abuffer::{ABuffer, PostSort};
 use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
 use fragsim_capture::dual_peeling::DualDepthPeeling;
 use fragsim_capture::executor::{ParallelExecutor, Run, SerialExecutor};
+use fragsim_capture::kbuffer::KBuffer;
+use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::mdts::{Direction, Mdts};
 use fragsim_capture::peeling::DepthPeeling;
+use fragsim_capture::stencil_routed::StencilRouted;
 use fragsim_capture::zbuffer::ZBuffer;
 use fragsim_capture::{CaptureError, Scheme};
 use fragsim_raster::{View, Viewport};
@@ -46,13 +49,19 @@ pub enum SchemeName {
     Bdp2,
     /// Adaptive bucket depth peeling (§3.3).
     Adp,
+    /// The k-buffer: read–insert–write of K slots, exact only without concurrent hazards.
+    Kbuffer,
+    /// The multi-pass k-buffer: k-buffer passes beyond the last captured depth until complete.
+    KbufferMultipass,
+    /// The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.
+    Srab,
     /// Every scheme above.
     All,
 }
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 15] = [
+    pub const EVERY: [SchemeName; 18] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
@@ -68,11 +77,16 @@ impl SchemeName {
         SchemeName::BdpSingle,
         SchemeName::Bdp2,
         SchemeName::Adp,
+        SchemeName::Kbuffer,
+        SchemeName::KbufferMultipass,
+        SchemeName::Srab,
     ];
 
     /// What the scheme promises against the oracle: `exact` (fragment for fragment, up to K where
-    /// it has K slots), `exact-distinct-depths` (32-bit depth peeling merges equal depths), or
-    /// `approximate` (loses fragments in situations its paper describes, and reports them).
+    /// it has K slots), `exact-distinct-depths` (32-bit depth peeling merges equal depths),
+    /// `exact-without-hazards` (read–modify–write schemes: exact serially), `exact-in-arrival-order`
+    /// (multi-pass routing), or `approximate` (loses fragments in situations its paper describes,
+    /// and reports them). Only `exact` schemes fail `render` when they differ from the oracle.
     #[must_use]
     pub fn guarantee(self) -> &'static str {
         match self {
@@ -80,6 +94,11 @@ impl SchemeName {
             SchemeName::Bdp | SchemeName::BdpSingle | SchemeName::Bdp2 | SchemeName::Adp => {
                 "approximate"
             }
+            // Exact on the serial executor; concurrent read–modify–write hazards lose fragments.
+            SchemeName::Kbuffer | SchemeName::KbufferMultipass => "exact-without-hazards",
+            // Exact up to 8 samples per pass (the rest counted as overflow); its passes must see
+            // one arrival order, which the parallel executor does not promise.
+            SchemeName::Srab => "exact-in-arrival-order",
             _ => "exact",
         }
     }
@@ -225,6 +244,15 @@ impl Executors {
             SchemeName::Adp => go(
                 &Adp::<u32>::new(viewport, layers, cap).map_err(err)?,
                 Some(layers),
+            ),
+            SchemeName::Kbuffer => go(&KBuffer::new(viewport, k, cap).map_err(err)?, Some(k)),
+            SchemeName::KbufferMultipass => go(
+                &KBufferMultipass::new(viewport, k, layers, cap).map_err(err)?,
+                Some(k),
+            ),
+            SchemeName::Srab => go(
+                &StencilRouted::new(viewport, 2, cap).map_err(err)?,
+                Some(16),
             ),
             SchemeName::All => return Err("`all` names a list of schemes, not one".into()),
         })

@@ -192,12 +192,12 @@ impl Mesh {
 /// by the file's total, negative (relative) ones by the elements defined before the line, as tobj
 /// resolves them. Parts that are not integers are left for tobj to reject.
 fn check_faces(text: &str) -> Result<(), String> {
-    const KINDS: [(&str, &str); 3] = [
-        ("v", "vertex"),
-        ("vt", "texture coordinate"),
-        ("vn", "normal"),
+    const KINDS: [(&str, &str, &str); 3] = [
+        ("v", "vertex", "vertices"),
+        ("vt", "texture coordinate", "texture coordinates"),
+        ("vn", "normal", "normals"),
     ];
-    let kind_of = |tag: &str| KINDS.iter().position(|&(t, _)| t == tag);
+    let kind_of = |tag: &str| KINDS.iter().position(|&(t, _, _)| t == tag);
     let mut totals = [0usize; 3];
     for line in text.lines() {
         if let Some(k) = line.split_whitespace().next().and_then(kind_of) {
@@ -228,15 +228,17 @@ fn check_faces(text: &str) -> Result<(), String> {
                 let Ok(index) = part.parse::<i64>() else {
                     continue;
                 };
-                let kind = KINDS[k].1;
+                let (_, kind, kinds) = KINDS[k];
                 let (available, whence) = if index < 0 {
                     (before[k], " before it")
                 } else {
                     (totals[k], "")
                 };
                 if index == 0 || index.unsigned_abs() > available as u64 {
+                    let element = if tag == "f" { "a face" } else { "a line" };
                     return Err(format!(
-                        "line {}: {tag} refers to {kind} {index}, but {available} {kind}s are defined{whence}",
+                        "line {}: {element} refers to {kind} {index}, \
+                         but {available} {kinds} are defined{whence}",
                         number + 1
                     ));
                 }

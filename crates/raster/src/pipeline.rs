@@ -227,17 +227,36 @@ impl<'mesh> View<'mesh> {
             );
             return;
         }
-        let mut polygon = vec![a.clip, b.clip, c.clip];
-        for plane in self.planes() {
-            polygon = clip_polygon(&polygon, plane);
-            if polygon.len() < 3 {
-                return;
-            }
+        let polygon = self.clip([a.clip, b.clip, c.clip]);
+        if polygon.len() < 3 {
+            return;
         }
         for i in 1..polygon.len() - 1 {
             let piece = [polygon[0], polygon[i], polygon[i + 1]];
             self.orient(prim, piece.map(|v| self.snap(v)), piece.map(|v| v.w), visit);
         }
+    }
+
+    /// Clips a triangle in homogeneous space against the near plane and the guard band (rule 3);
+    /// fewer than 3 vertices when nothing is left.
+    fn clip(&self, triangle: [DVec4; 3]) -> Vec<DVec4> {
+        let mut polygon = triangle.to_vec();
+        for plane in self.planes() {
+            polygon = clip_polygon(&polygon, plane);
+            if polygon.len() < 3 {
+                return polygon;
+            }
+        }
+        // An intersection between vertices far apart (|x| near 1e38, say) cancels catastrophically
+        // and may land far outside the band it was clipped to; clamping restores the bound that
+        // keeps fixed-point coordinates and edge functions from overflowing (rule 3). It moves
+        // nothing that the clipping left inside.
+        let [gx, gy] = self.guard;
+        for v in &mut polygon {
+            v.x = v.x.max(-gx * v.w).min(gx * v.w);
+            v.y = v.y.max(-gy * v.w).min(gy * v.w);
+        }
+        polygon
     }
 
     /// The clipping planes as `p · v ≥ 0`: near (`z ≥ 0`) then the four guard-band planes.
@@ -427,6 +446,29 @@ mod tests {
             triangles: vec![[0, 1, 2]],
         };
         assert!(coverage(&view_of(&mesh, 4)).iter().all(|&c| c == 0));
+    }
+
+    #[test]
+    fn a_clipped_vertex_lost_to_cancellation_is_clamped_into_the_guard_band() {
+        // Found by the rasterize fuzz target: clipping the edge from x = 1.9e38 to x = −2.55e38
+        // against x ≥ −513 w cancelled to x ≈ −3.8e22, which snapped to i64::MIN and overflowed
+        // the edge function (a panic with overflow checks, garbage without).
+        let mesh = Mesh {
+            positions: vec![
+                [-2.552_080_4e38, -2.046_936_3, 0.012],
+                [1.900_796_2e38, 0.0, 0.004],
+            ],
+            triangles: vec![[0, 1, 1]],
+        };
+        let view = view_of(&mesh, 64);
+        let [a, b] = [0, 1].map(|i| view.vertices[i].clip);
+        let polygon = view.clip([a, b, b]);
+        assert!(polygon.len() >= 3);
+        let [gx, gy] = view.guard;
+        for v in &polygon {
+            assert!(v.x.abs() <= gx * v.w && v.y.abs() <= gy * v.w, "{v:?}");
+        }
+        assert!(coverage(&view).iter().all(|&c| c == 0));
     }
 
     #[test]
