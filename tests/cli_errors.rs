@@ -6,14 +6,16 @@ use std::process::Output;
 
 use assert_cmd::Command;
 
-/// A small, fast render of whatever the arguments name.
+/// A small, fast render of whatever the arguments name (16 × 16 unless they give a size).
 fn fragsim(args: &[&str]) -> Output {
-    Command::cargo_bin("fragsim")
-        .unwrap()
-        .args(["--width", "16", "--height", "16", "--no-images"])
-        .args(args)
-        .output()
-        .unwrap()
+    let mut command = Command::cargo_bin("fragsim").unwrap();
+    command.arg("--no-images");
+    for side in ["--width", "--height"] {
+        if !args.iter().any(|a| a.starts_with(side)) {
+            command.args([side, "16"]);
+        }
+    }
+    command.args(args).output().unwrap()
 }
 
 /// Asserts that `fragsim args` fails with status 2 and an error containing every one of

@@ -399,10 +399,9 @@ proptest! {
     /// the identity camera on a random viewport, cover no pixel centre twice and every centre
     /// clearly inside the visible part of their union exactly once.
     ///
-    /// Fails about once in 4,000 cases (see the regression tests below), hence the many cases and
-    /// the `ignore` until the clipper is fixed; then 1,024 cases will do.
+    /// Failed about once in 4,000 cases (see the regression tests below) until the clipper
+    /// computed each intersection from the edge's inside end; the many cases keep it watched.
     #[test]
-    #[ignore = "bug: near-plane clipping is not watertight (see regression_near_clipped_shared_edge_*)"]
     fn near_clipped_shared_edges_are_watertight(hinge in hinge(), viewport in viewport()) {
         check_robust_coverage(viewport, &hinge.mesh, &hinge.robust_expectation(viewport))?;
     }
@@ -490,7 +489,6 @@ fn identity_coverage(mesh: &Mesh, width: u32, height: u32) -> (Vec<u32>, u32) {
 /// the vertex inside the plane to the one outside), so both triangles get the same point. The
 /// guard-band planes go through the same function.
 #[test]
-#[ignore = "bug: near-plane clipping computes a shared edge's clipped vertex from each triangle's own end, so the two can snap 1/256 px apart and leave a hole"]
 fn regression_near_clipped_shared_edge_leaves_a_hole() {
     let mesh = Mesh {
         positions: vec![
@@ -518,7 +516,6 @@ fn regression_near_clipped_shared_edge_leaves_a_hole() {
 /// fragments (the A-buffer and MDTS then capture both, and the oracle agrees, so only the coverage
 /// properties see it).
 #[test]
-#[ignore = "bug: near-plane clipping computes a shared edge's clipped vertex from each triangle's own end, so the two can snap 1/256 px apart and cover a pixel twice"]
 fn regression_near_clipped_shared_edge_covers_a_pixel_twice() {
     let mesh = Mesh {
         positions: vec![

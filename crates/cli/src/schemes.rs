@@ -8,6 +8,7 @@ use fragsim_capture::executor::{ParallelExecutor, Run, SerialExecutor};
 use fragsim_capture::kbuffer::KBuffer;
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::mdts::{Direction, Mdts};
+use fragsim_capture::mdts_packed::{Colours, MdtsPacked};
 use fragsim_capture::peeling::DepthPeeling;
 use fragsim_capture::stencil_routed::StencilRouted;
 use fragsim_capture::zbuffer::ZBuffer;
@@ -55,13 +56,15 @@ pub enum SchemeName {
     KbufferMultipass,
     /// The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.
     Srab,
+    /// MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).
+    MdtsPacked,
     /// Every scheme above.
     All,
 }
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 18] = [
+    pub const EVERY: [SchemeName; 19] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
@@ -80,6 +83,7 @@ impl SchemeName {
         SchemeName::Kbuffer,
         SchemeName::KbufferMultipass,
         SchemeName::Srab,
+        SchemeName::MdtsPacked,
     ];
 
     /// What the scheme promises against the oracle: `exact` (fragment for fragment, up to K where
@@ -99,6 +103,8 @@ impl SchemeName {
             // Exact up to 8 samples per pass (the rest counted as overflow); its passes must see
             // one arrival order, which the parallel executor does not promise.
             SchemeName::Srab => "exact-in-arrival-order",
+            // 20 bits of depth: fragments closer than 2^-20 may swap colours.
+            SchemeName::MdtsPacked => "approximate",
             _ => "exact",
         }
     }
@@ -253,6 +259,10 @@ impl Executors {
             SchemeName::Srab => go(
                 &StencilRouted::new(viewport, 2, cap).map_err(err)?,
                 Some(16),
+            ),
+            SchemeName::MdtsPacked => go(
+                &MdtsPacked::new(viewport, k, Colours::Prim, cap).map_err(err)?,
+                Some(k),
             ),
             SchemeName::All => return Err("`all` names a list of schemes, not one".into()),
         })

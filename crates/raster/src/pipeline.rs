@@ -379,8 +379,16 @@ fn clip_polygon(polygon: &[DVec4], plane: DVec4) -> Vec<DVec4> {
             out.push(current);
         }
         if (dc >= 0.0) != (dn >= 0.0) {
-            let t = dc / (dc - dn);
-            out.push(current + (next - current) * t);
+            // From the inside end toward the outside end, whichever way this polygon walks the
+            // edge: two triangles sharing the edge then compute the very same f64 point, snap it
+            // to the same grid point, and the shared clipped edge stays watertight.
+            let (inside, d_in, outside, d_out) = if dc >= 0.0 {
+                (current, dc, next, dn)
+            } else {
+                (next, dn, current, dc)
+            };
+            let t = d_in / (d_in - d_out);
+            out.push(inside + (outside - inside) * t);
         }
     }
     out
