@@ -7,15 +7,15 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use clap::{Args, ValueEnum};
-use fragsim_capture::Identity;
+use clap::Args;
 use fragsim_oracle::Oracle;
 use fragsim_raster::View;
-use fragsim_shade::effects::{self, Effect, Entries, Material};
+use fragsim_shade::effects;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
+use crate::judge::{EffectName, Judge};
 use crate::schemes::{check_memory_cap_early, Executors, SchemeName, Sizing};
 
 /// Options of `fragsim bench`.
@@ -42,15 +42,6 @@ pub struct BenchArgs {
     /// Print the rows as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Effects `bench` can compare.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum EffectName {
-    /// Front-to-back transparency.
-    Transparency,
-    /// Beer–Lambert translucency.
-    Translucency,
 }
 
 /// One row of the bench.
@@ -174,35 +165,10 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .collect();
     let oracle = Oracle::build(&view);
     let depth_complexity = oracle.depth_complexity();
-    let covered = depth_complexity.iter().filter(|&&c| c > 0).count();
-    let effect = match args.effect {
-        EffectName::Transparency => Effect::Transparency,
-        EffectName::Translucency => Effect::Translucency,
-    };
-    let aspect = f64::from(viewport.width) / f64::from(viewport.height);
-    let bounds = scene.mesh.bounds();
-    let (lo, hi) = bounds;
-    let radius = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt() * 0.5;
-    // Thickness in units of the model's bounding radius, so σ means the same on every mesh.
-    let distance = |z: f32| orbit.eye_distance(bounds, aspect, z) / radius.max(1e-12);
-    let material = Material { primitives: view.triangle_count(), ..Material::default() };
-    let size = (viewport.width, viewport.height);
-    // The oracle's image shaded from what each kind of capture can know: a key-only capture is
-    // compared with the oracle's fragments coloured by key only, so that the error-pixel rate
-    // measures lost and misordered fragments, not the attribute the scheme never stored.
-    let references: Vec<(Entries, Option<image::RgbImage>)> =
-        [Entries::KeyAndPrim, Entries::KeyOnly, Entries::PrimOnly]
-            .into_iter()
-            .map(|entries| {
-                let list = |p: usize| oracle.pixel(p);
-                (
-                    entries,
-                    effects::render(effect, &material, entries, size, list, &distance),
-                )
-            })
-            .collect();
-    if let Some((_, Some(image))) = references.first() {
-        let name = format!("bench-oracle-{}.png", effect_name(effect));
+    let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+    let covered = judge.covered;
+    if let Some(image) = judge.reference() {
+        let name = format!("bench-oracle-{}.png", args.effect.label());
         fragsim_shade::save_png(image, &args.out.join(name))?;
     }
     let sizing = Sizing {
@@ -227,17 +193,9 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             }
             let named = first.expect("at least one frame");
             let diff = oracle.diff(&named.run.capture);
-            let entries = entries_of(named.run.capture.identity);
-            let list = |p: usize| named.run.capture.pixel(p);
-            let image = effects::render(effect, &material, entries, size, list, &distance);
-            let reference = references
-                .iter()
-                .find(|(e, _)| *e == entries)
-                .and_then(|(_, r)| r.as_ref());
-            let compared = image.as_ref().zip(reference);
-            let error_pixels =
-                compared.map(|(image, reference)| effects::error_pixels(reference, image) as u64);
-            if let Some((image, reference)) = compared {
+            let judged = judge.judge(&named.run.capture);
+            let error_pixels = judged.as_ref().map(|(_, _, errors)| *errors);
+            if let Some((image, reference, _)) = &judged {
                 let stem = format!("bench-{}-{executor}", named.name);
                 fragsim_shade::save_png(image, &args.out.join(format!("{stem}.png")))?;
                 let difference = effects::difference_image(reference, image);
@@ -286,7 +244,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         covered_pixels: covered,
         vertex_stage_ms: ms(median(&mut vertex_times)),
         raster_ms: ms(median(&mut raster_times.clone())),
-        effect: effect_name(effect).into(),
+        effect: args.effect.label().into(),
         frames: args.frames,
         rows,
     };
@@ -308,21 +266,6 @@ fn time_raster_alone(view: &View<'_>) -> Duration {
         .sum();
     std::hint::black_box(fragments);
     start.elapsed()
-}
-
-fn entries_of(identity: Identity) -> Entries {
-    match identity {
-        Identity::KeyAndPrim => Entries::KeyAndPrim,
-        Identity::KeyOnly => Entries::KeyOnly,
-        Identity::PrimOnly => Entries::PrimOnly,
-    }
-}
-
-fn effect_name(effect: Effect) -> &'static str {
-    match effect {
-        Effect::Transparency => "transparency",
-        Effect::Translucency => "translucency",
-    }
 }
 
 /// Depth peeling is the papers' baseline: every row gets the ratio of its time to it.

@@ -5,8 +5,10 @@ mod args;
 mod bench;
 mod compare;
 mod export;
+mod judge;
 mod render;
 mod schemes;
+mod sweep;
 
 use std::process::ExitCode;
 
@@ -14,10 +16,12 @@ use clap::{Parser, Subcommand};
 
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
+pub use judge::EffectName;
 pub use compare::CompareArgs;
 pub use export::ExportArgs;
 pub use render::{RenderArgs, RunSummary};
 pub use schemes::SchemeName;
+pub use sweep::{SweepArgs, SweepSeries};
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
 #[derive(Debug, Parser)]
@@ -43,6 +47,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Measure every scheme's speed and accuracy (passes, memory, loss, error pixels, time).
     Bench(BenchArgs),
+    /// Error-pixel rate per view angle around the model, and the speed/accuracy scatter.
+    Sweep(SweepArgs),
     /// Compare a dump (docs/dump-format.md) with fragsim's oracle or another dump, pixel by pixel.
     Compare(CompareArgs),
     /// Write a view's screen triangles (snapped, clipped, oriented) for a GPU backend.
@@ -55,6 +61,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let args = match cli.command {
         Some(Command::Render(args)) => args,
+        Some(Command::Sweep(args)) => return exit_code(sweep::sweep(&args).map(|_| true), ""),
         Some(Command::Bench(args)) => return exit_code(bench::bench(&args).map(|_| true), ""),
         Some(Command::Compare(args)) => {
             return exit_code(

@@ -10,6 +10,7 @@
 use std::path::Path;
 
 pub mod effects;
+pub mod plot;
 
 use image::{Rgb, RgbImage};
 

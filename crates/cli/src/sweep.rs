@@ -1,0 +1,182 @@
+//! `fragsim sweep`: the error-pixel rate of each scheme at many view angles around the model
+//! (the bucket depth peeling paper's Figure 6), and the speed-versus-accuracy scatter.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use fragsim_oracle::Oracle;
+use serde::Serialize;
+
+use crate::args::{SceneArgs, SchemeArgs};
+use crate::judge::{EffectName, Judge};
+use crate::schemes::{Executors, SchemeName, Sizing};
+
+/// Options of `fragsim sweep`.
+#[derive(Debug, Clone, Args)]
+pub struct SweepArgs {
+    /// The scene (`--view` is ignored: the sweep sets the angle).
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Scheme sizing and executors (the first executor chosen runs).
+    #[command(flatten)]
+    pub schemes: SchemeArgs,
+    /// Schemes to sweep, comma-separated, or `all`.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "bdp,bdp-single,bdp2,adp,mdts-packed,mdts"
+    )]
+    pub scheme: Vec<SchemeName>,
+    /// View angles, evenly spaced over a full turn.
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=3600))]
+    pub angles: u32,
+    /// The effect whose image is compared with the oracle's.
+    #[arg(long, default_value = "transparency")]
+    pub effect: EffectName,
+    /// Directory for sweep.json and the SVG charts.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+}
+
+/// One scheme's measurements over the sweep.
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepSeries {
+    /// Scheme name.
+    pub scheme: String,
+    /// Error-pixel rate (over covered pixels) per angle; `None` where the effect is unresolvable.
+    pub error_pixel_rate: Vec<Option<f64>>,
+    /// Frame time per angle, ms.
+    pub time_ms: Vec<f64>,
+}
+
+/// Runs `sweep`.
+///
+/// # Errors
+/// Scene, parameter or output errors.
+pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
+    let pool = args.schemes.pool()?;
+    let scene = args.scene.scene()?;
+    let viewport = args.scene.viewport()?;
+    let executor = args.schemes.executors()[0];
+    let schemes = SchemeName::expand(&args.scheme);
+    let mut series: Vec<SweepSeries> = Vec::new();
+    let mut angles = Vec::new();
+    for step in 0..args.angles {
+        let angle = 360.0 * f64::from(step) / f64::from(args.angles);
+        angles.push(angle);
+        let orbit = args.scene.orbit(angle);
+        let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+        let oracle = Oracle::build(&view);
+        let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+        let depth_complexity = oracle.depth_complexity();
+        let sizing = Sizing {
+            k: args.schemes.k,
+            capacity: args.schemes.capacity,
+            depth_complexity: &depth_complexity,
+            max_depth_complexity: oracle.max_depth_complexity(),
+            memory_cap: args.schemes.memory_cap,
+        };
+        let mut runner = Executors::default();
+        for (i, &name) in schemes.iter().enumerate() {
+            let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            if series.len() <= i {
+                series.push(SweepSeries {
+                    scheme: named.name.clone(),
+                    error_pixel_rate: Vec::new(),
+                    time_ms: Vec::new(),
+                });
+            }
+            let rate = judge
+                .judge(&named.run.capture)
+                .map(|(_, _, errors)| errors as f64 / judge.covered.max(1) as f64);
+            series[i].error_pixel_rate.push(rate);
+            series[i].time_ms.push(
+                (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,
+            );
+        }
+    }
+    write_outputs(args, &angles, &series)?;
+    Ok(series)
+}
+
+fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Result<(), String> {
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let json =
+        serde_json::json!({ "effect": args.effect.label(), "angles": angles, "series": series });
+    let path = args.out.join("sweep.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
+    )
+    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let per_angle: Vec<fragsim_shade::plot::Series> = series
+        .iter()
+        .map(|s| {
+            let points = angles
+                .iter()
+                .zip(&s.error_pixel_rate)
+                .filter_map(|(&a, r)| r.map(|r| (a, r * 100.0)))
+                .collect();
+            (s.scheme.clone(), points)
+        })
+        .collect();
+    let title = format!("error pixels of {} per view angle", args.effect.label());
+    fragsim_shade::plot::chart(
+        &args.out.join("sweep-epr.svg"),
+        &title,
+        "view angle (degrees)",
+        "EPR (% of covered pixels)",
+        &per_angle,
+        false,
+    )?;
+    let mean = |v: &mut dyn Iterator<Item = f64>| {
+        let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+        (n > 0).then(|| sum / n as f64)
+    };
+    let scatter: Vec<fragsim_shade::plot::Series> = series
+        .iter()
+        .filter_map(|s| {
+            let time = mean(&mut s.time_ms.iter().copied())?;
+            let rate = mean(&mut s.error_pixel_rate.iter().flatten().copied())?;
+            Some((s.scheme.clone(), vec![(time, rate * 100.0)]))
+        })
+        .collect();
+    fragsim_shade::plot::chart(
+        &args.out.join("sweep-speed-accuracy.svg"),
+        "speed against accuracy (means over the sweep)",
+        "frame time (ms)",
+        "EPR (% of covered pixels)",
+        &scatter,
+        true,
+    )?;
+    println!(
+        "{:<20} {:>12} {:>12} {:>12}",
+        "scheme", "mean EPR %", "max EPR %", "mean ms"
+    );
+    for s in series {
+        let rates: Vec<f64> = s
+            .error_pixel_rate
+            .iter()
+            .flatten()
+            .map(|r| r * 100.0)
+            .collect();
+        let mean_rate =
+            mean(&mut rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
+        let max_rate = rates
+            .iter()
+            .copied()
+            .reduce(f64::max)
+            .map_or("n/a".into(), |r| format!("{r:.4}"));
+        let mean_ms = mean(&mut s.time_ms.iter().copied()).unwrap_or(0.0);
+        println!(
+            "{:<20} {:>12} {:>12} {:>12.2}",
+            s.scheme, mean_rate, max_rate, mean_ms
+        );
+    }
+    println!(
+        "wrote {}/sweep.json, sweep-epr.svg, sweep-speed-accuracy.svg",
+        args.out.display()
+    );
+    Ok(())
+}
