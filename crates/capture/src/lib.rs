@@ -6,8 +6,16 @@
 //! atomics (the model-checking suite in `tests/loom.rs`), and whether a scheme is safe under
 //! concurrency is a question of where its steps are cut.
 //!
-//! Schemes: [`mdts`] (FreePipe's multi-depth test scheme) and [`abuffer`] (FreePipe's A-buffer
-//! scheme).
+//! Schemes, one module each, every one stating its algorithm, guarantee, passes and memory:
+//! - FreePipe (Liu et al., I3D 2010): [`mdts`] (the multi-depth test scheme, §4.1.1),
+//!   [`mdts_packed`] (depth and colour packed in 32-bit words, §4.1.2), [`abuffer`] (§4.2);
+//! - the baselines the papers measure: [`zbuffer`] (opaque), [`peeling`] (Everitt 2001),
+//!   [`dual_peeling`] (Bavoil & Myers 2008), [`kbuffer`] (Bavoil et al. 2007),
+//!   [`kbuffer_multipass`] (Liu et al. 2006), [`stencil_routed`] (Myers & Bavoil 2007) and
+//!   [`bucket`] (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive).
+//!
+//! Executors: [`executor`] (serial and parallel, storage kept between frames) and [`scheduled`]
+//! (replayable GPU-like interleavings with traces).
 //!
 //! ```
 //! use fragsim_capture::{executor, mdts::Mdts};

@@ -166,21 +166,29 @@ impl Mesh {
     /// Axis-aligned bounds `(min, max)` of the vertices that triangles use.
     #[must_use]
     pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for tri in &self.triangles {
-            for &i in tri {
-                let p = self.positions[i as usize];
-                for axis in 0..3 {
-                    lo[axis] = lo[axis].min(f64::from(p[axis]));
-                    hi[axis] = hi[axis].max(f64::from(p[axis]));
-                }
-            }
-        }
+        use rayon::prelude::*;
         if self.triangles.is_empty() {
             return ([0.0; 3], [0.0; 3]);
         }
-        (lo, hi)
+        let empty = || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let merge = |(lo, hi): ([f64; 3], [f64; 3]), (lo2, hi2): ([f64; 3], [f64; 3])| {
+            (
+                [0, 1, 2].map(|axis| lo[axis].min(lo2[axis])),
+                [0, 1, 2].map(|axis| hi[axis].max(hi2[axis])),
+            )
+        };
+        // A reduction over triangles (not positions: unused vertices must not widen the view),
+        // in parallel because the full dragon's 2.6 M random reads dominate the vertex stage.
+        self.triangles
+            .par_iter()
+            .with_min_len(4096)
+            .fold(empty, |bounds, tri| {
+                tri.iter().fold(bounds, |bounds, &i| {
+                    let p = self.positions[i as usize].map(f64::from);
+                    merge(bounds, (p, p))
+                })
+            })
+            .reduce(empty, merge)
     }
 }
 

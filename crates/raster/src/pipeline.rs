@@ -20,6 +20,7 @@
 //!    rounded once to f32; depths outside `[0, 1]` are dropped.
 
 use glam::{DMat4, DVec4};
+use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::fragment::{depth_key, Fragment};
@@ -143,9 +144,11 @@ impl<'mesh> View<'mesh> {
         };
         let planes = view.planes();
         let far = DVec4::new(0.0, 0.0, -1.0, 1.0);
+        // One vertex per work item of rayon's adaptive splitting: every vertex is independent.
         view.vertices = mesh
             .positions
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|p| {
                 let clip = m * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0);
                 let mut outcode = planes.iter().enumerate().fold(0u8, |code, (i, plane)| {
