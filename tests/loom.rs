@@ -14,11 +14,11 @@
 //! `loom::sync::Arc`, whose reference counts loom would model too (that multiplies the state space
 //! by about 225).
 //!
-//! The last tests are controls, schemes written here and run through the same checker that
-//! passes MDTS: a non-atomic read–insert–write k-buffer must lose a fragment in some interleaving
-//! (so the harness is not vacuous), an MDTS variant that stops on an equal slot must lose a
-//! duplicate depth, and FreePipe's Table 1 read literally (mismatched sentinels) must stay correct
-//! while never exiting early. The proofs these tests check are in `docs/proof.md`, with the
+//! The last tests are controls run through the same checker that passes MDTS: the library's
+//! k-buffer, whose read–insert–write is not atomic, must lose a fragment in some interleaving
+//! (so the harness is not vacuous); and two schemes written here: an MDTS variant that stops on an
+//! equal slot must lose a duplicate depth, and FreePipe's Table 1 read literally (mismatched
+//! sentinels) must stay correct while never exiting early. The proofs these tests check are in `docs/proof.md`, with the
 //! interleaving counts and the suite's wall time.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -27,6 +27,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use fragsim::capture::abuffer::{ABuffer, PostSort};
+use fragsim::capture::kbuffer::KBuffer;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
     Identity, Keeps, Layout, Memory, Promise, Scheme, SerialMemory, Step, WordMemory,
@@ -631,117 +632,11 @@ fn abuffer_exact_4_threads_capacity_2() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The negative control: a non-atomic read–insert–write k-buffer.
+// The negative control: the library's k-buffer, whose read–insert–write is not atomic.
 
-/// A k-buffer whose read–modify–write is not atomic (the fixed-function k-buffer's hazard): a
-/// fragment loads the pixel's `K` slots one step at a time, inserts itself into the sorted list
-/// in registers (dropping the largest when full), then stores the `K` slots back one step at a
-/// time. Correct alone; under concurrency another fragment's steps fall between the reads and
-/// the writes.
-#[derive(Clone, Debug)]
-struct RmwKBuffer {
-    k: usize,
-}
-
-/// A read–insert–write walk: the slots read so far, then the list being written back.
-#[derive(Clone, Debug)]
-enum Rmw {
-    Read {
-        value: u64,
-        seen: Vec<u64>,
-    },
-    Write {
-        list: Vec<u64>,
-        next: usize,
-        dropped: bool,
-    },
-}
-
-impl Scheme for RmwKBuffer {
-    type State = Rmw;
-
-    fn name(&self) -> String {
-        "rmw-kbuffer".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: 0,
-            init32: 0,
-            words64: self.k,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k as u32)
-    }
-
-    fn begin(&self, fragment: Fragment) -> Rmw {
-        Rmw::Read {
-            value: fragment.packed(),
-            seen: Vec::with_capacity(self.k),
-        }
-    }
-
-    fn step<M: Memory>(&self, state: &mut Rmw, memory: &M) -> Step {
-        match state {
-            Rmw::Read { value, seen } => {
-                seen.push(WordMemory::<u64>::load(memory, seen.len()));
-                if seen.len() == self.k {
-                    let mut list: Vec<u64> =
-                        seen.iter().copied().filter(|&w| w != u64::MAX).collect();
-                    list.push(*value);
-                    list.sort_unstable();
-                    let dropped = list.len() > self.k;
-                    list.truncate(self.k);
-                    *state = Rmw::Write {
-                        list,
-                        next: 0,
-                        dropped,
-                    };
-                }
-                Step::Continue
-            }
-            Rmw::Write {
-                list,
-                next,
-                dropped,
-            } => {
-                let word = list.get(*next).copied().unwrap_or(u64::MAX);
-                WordMemory::<u64>::store(memory, *next, word);
-                *next += 1;
-                match (*next == self.k, *dropped) {
-                    (false, _) => Step::Continue,
-                    (true, false) => Step::Stored,
-                    (true, true) => Step::Dropped,
-                }
-            }
-        }
-    }
-
-    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        let first = pixel * self.k;
-        out.extend(
-            (first..first + self.k)
-                .map(|i| WordMemory::<u64>::load(memory, i))
-                .take_while(|&w| w != u64::MAX),
-        );
-        0
-    }
-
-    fn pixels(&self) -> usize {
-        1
-    }
-}
-
-/// The negative control (2 threads, K = 3, exhaustive): the non-atomic k-buffer is correct when
-/// its two walks run one after the other, but loom finds interleavings that lose a fragment, and
+/// The negative control (2 threads, K = 3, exhaustive): the library's k-buffer
+/// (`crates/capture/src/kbuffer.rs`: `K` loads, an insertion in registers, `K` stores, one memory
+/// operation per step) is correct when its two walks run one after the other, but loom finds interleavings that lose a fragment, and
 /// the very checker that passes MDTS (`check_k_best`) panics on them. Also counts how many of the
 /// interleavings lose one.
 #[test]
@@ -749,7 +644,8 @@ fn negative_control_rmw_kbuffer_2_threads_k3_loses_a_fragment() {
     const K: u32 = 3;
     let list = fragments(&DISTINCT[..2]);
     let values: Vec<u64> = list.iter().map(|f| f.packed()).collect();
-    let scheme: &'static RmwKBuffer = Box::leak(Box::new(RmwKBuffer { k: K as usize }));
+    let scheme: &'static KBuffer =
+        Box::leak(Box::new(KBuffer::with_k(one_pixel(), K).expect("K = 3 fits")));
 
     // Alone, one walk after the other, the control is a correct k-buffer.
     let serial: SerialMemory = scheme.layout().allocate();

@@ -16,7 +16,8 @@
 //! - Everything is a pure function of (scene, scheme, policy, `W`, seed): the same [`Schedule`]
 //!   replays the same interleaving, step for step.
 //! - Every memory operation can be recorded as a [`TraceEvent`]; a trace can be filtered to one
-//!   pixel ([`Trace::pixel`]).
+//!   pixel ([`Trace::pixel`]); an explicit interleaving of a fragment list can be replayed
+//!   ([`run_fragments_in_order`]: `fragsim explain` shrinks interleavings with it).
 //!
 //! Unlike a GPU, steps run one at a time: the schedule is a total order of memory operations. That
 //! is the model the schemes' proofs use (per-location atomicity); a GPU's lockstep warp is modelled
@@ -246,6 +247,8 @@ struct Chooser {
     /// PCT: steps at which the running thread's priority drops, and the next low priority.
     change_points: Vec<u64>,
     next_low: u64,
+    /// Replay: the threads to step, in order, and the next entry to use.
+    order: Option<(Vec<u32>, usize)>,
 }
 
 impl Chooser {
@@ -268,6 +271,7 @@ impl Chooser {
             lane: 0,
             change_points,
             next_low: u64::from(u32::MAX),
+            order: None,
         }
     }
 
@@ -278,6 +282,20 @@ impl Chooser {
 
     /// The next thread to step among `threads`, of which those with `walk.is_some()` are active.
     fn choose<S>(&mut self, threads: &mut [Thread<S>], active: &[usize], step: u64) -> usize {
+        if let Some((order, next)) = &mut self.order {
+            // Entries naming a finished thread are skipped, so every order is a valid schedule
+            // (what shrinking needs); past the end, the lowest-numbered thread runs.
+            while let Some(&t) = order.get(*next) {
+                *next += 1;
+                if active.contains(&(t as usize)) {
+                    return t as usize;
+                }
+            }
+            return *active
+                .iter()
+                .min()
+                .expect("choose is called with an active thread");
+        }
         match self.policy {
             Policy::Random => active[(self.rng.next_u64() % active.len() as u64) as usize],
             Policy::Warps => {
@@ -331,6 +349,7 @@ pub fn run_scheduled<S: Scheme>(
         view.triangle_count(),
         fragments_of,
         schedule,
+        None,
         record,
     )
 }
@@ -347,6 +366,34 @@ pub fn run_fragments<S: Scheme>(
         fragments.len() as u32,
         |i| vec![fragments[i as usize]],
         schedule,
+        None,
+        record,
+    )
+}
+
+/// Replays an explicit interleaving of a hand-written fragment list: thread `t` carries
+/// `fragments[t]` (one thread per fragment), and step `i` runs thread `order[i]`. Entries naming a
+/// thread that has finished are skipped; when `order` runs out, the remaining steps run the
+/// lowest-numbered unfinished thread first. So every `order` is a valid schedule, and
+/// `order` = the `thread` column of a recorded trace replays that trace exactly.
+pub fn run_fragments_in_order<S: Scheme>(
+    scheme: &S,
+    fragments: &[Fragment],
+    order: &[u32],
+    record: bool,
+) -> ScheduledRun {
+    let schedule = Schedule {
+        policy: Policy::Random,
+        in_flight: fragments.len().max(1),
+        granularity: Granularity::Fragment,
+        seed: 0,
+    };
+    run_stream(
+        scheme,
+        fragments.len() as u32,
+        |i| vec![fragments[i as usize]],
+        &schedule,
+        Some(order),
         record,
     )
 }
@@ -356,6 +403,7 @@ fn run_stream<S: Scheme>(
     triangles: u32,
     fragments_of: impl Fn(u32) -> Vec<Fragment>,
     schedule: &Schedule,
+    order: Option<&[u32]>,
     record: bool,
 ) -> ScheduledRun {
     assert!(
@@ -370,6 +418,7 @@ fn run_stream<S: Scheme>(
     let mut counters = Counters::default();
     let mut pass = 0;
     let mut chooser = Chooser::new(schedule, 4 * u64::from(triangles).max(1));
+    chooser.order = order.map(|order| (order.to_vec(), 0));
     loop {
         run_pass(
             scheme,

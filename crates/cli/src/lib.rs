@@ -4,7 +4,9 @@
 mod args;
 mod bench;
 mod compare;
+mod explain;
 mod export;
+mod hazard;
 mod judge;
 mod render;
 mod schemes;
@@ -18,7 +20,9 @@ pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
 pub use judge::EffectName;
 pub use compare::CompareArgs;
+pub use explain::{ExplainArgs, ExplainScheme};
 pub use export::ExportArgs;
+pub use hazard::{HazardArgs, HazardReport, HazardRow};
 pub use render::{RenderArgs, RunSummary};
 pub use schemes::SchemeName;
 pub use sweep::{SweepArgs, SweepSeries};
@@ -53,6 +57,10 @@ pub enum Command {
     Compare(CompareArgs),
     /// Write a view's screen triangles (snapped, clipped, oriented) for a GPU backend.
     ExportScene(ExportArgs),
+    /// Find, shrink and print a step-by-step interleaving (k-buffer hazard, MDTS invariant).
+    Explain(ExplainArgs),
+    /// The k-buffer's hazard rate vs threads in flight and depth complexity (scheduled executor).
+    Hazard(HazardArgs),
 }
 
 /// Parses the command line and runs it; errors go to stderr with a non-zero exit code.
@@ -62,6 +70,10 @@ pub fn main() -> ExitCode {
     let args = match cli.command {
         Some(Command::Render(args)) => args,
         Some(Command::Sweep(args)) => return exit_code(sweep::sweep(&args).map(|_| true), ""),
+        Some(Command::Explain(args)) => {
+            return exit_code(explain::explain(&args), "no interleaving showed the property")
+        }
+        Some(Command::Hazard(args)) => return exit_code(hazard::hazard(&args).map(|_| true), ""),
         Some(Command::Bench(args)) => return exit_code(bench::bench(&args).map(|_| true), ""),
         Some(Command::Compare(args)) => {
             return exit_code(
