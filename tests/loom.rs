@@ -644,8 +644,9 @@ fn negative_control_rmw_kbuffer_2_threads_k3_loses_a_fragment() {
     const K: u32 = 3;
     let list = fragments(&DISTINCT[..2]);
     let values: Vec<u64> = list.iter().map(|f| f.packed()).collect();
-    let scheme: &'static KBuffer =
-        Box::leak(Box::new(KBuffer::with_k(one_pixel(), K).expect("K = 3 fits")));
+    let scheme: &'static KBuffer = Box::leak(Box::new(
+        KBuffer::with_k(one_pixel(), K).expect("K = 3 fits"),
+    ));
 
     // Alone, one walk after the other, the control is a correct k-buffer.
     let serial: SerialMemory = scheme.layout().allocate();
