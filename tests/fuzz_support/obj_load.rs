@@ -18,7 +18,10 @@ pub fn check(data: &[u8]) {
         Ok(mesh) => mesh,
         Err(error) => {
             let message = error.to_string();
-            assert!(message.contains(NAME), "error does not name the file: {message}");
+            assert!(
+                message.contains(NAME),
+                "error does not name the file: {message}"
+            );
             return;
         }
     };

@@ -4,9 +4,7 @@
 //! a triangle that needs no clipping, coverage equals [`reference_coverage`] pixel for pixel and
 //! every depth lies between the vertices' depths.
 
-use fragsim::raster::{
-    CullMode, Fragment, Mesh, View, Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS,
-};
+use fragsim::raster::{CullMode, Fragment, Mesh, View, Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS};
 
 use super::camera::{camera_from_columns, identity_camera};
 use super::input::Input;
@@ -22,7 +20,10 @@ pub fn check_fragments(view: &View<'_>, prim: u32) -> Vec<Fragment> {
     for f in &fragments {
         assert!((f.pixel as usize) < pixels, "{f:?} outside {pixels} pixels");
         assert!(f.depth_key <= MAX_KEY, "{f:?}: key above depth 1.0");
-        assert!((0.0..=1.0).contains(&f.depth()), "{f:?}: depth outside [0, 1]");
+        assert!(
+            (0.0..=1.0).contains(&f.depth()),
+            "{f:?}: depth outside [0, 1]"
+        );
         assert_eq!(f.prim, prim, "{f:?} carries the wrong primitive id");
     }
     fragments
@@ -83,7 +84,8 @@ pub fn check(data: &[u8]) {
         positions,
         triangles,
     };
-    mesh.validate("fuzz").expect("decoded meshes are finite and in range");
+    mesh.validate("fuzz")
+        .expect("decoded meshes are finite and in range");
     let view = View::new(&mesh, &camera, viewport, cull);
     for prim in 0..view.triangle_count() {
         let fragments = check_fragments(&view, prim);
@@ -96,7 +98,10 @@ pub fn check(data: &[u8]) {
         };
         let mut got: Vec<u32> = fragments.iter().map(|f| f.pixel).collect();
         got.sort_unstable();
-        assert_eq!(got, expected, "coverage of {corners:?} on {viewport:?}, {cull:?}");
+        assert_eq!(
+            got, expected,
+            "coverage of {corners:?} on {viewport:?}, {cull:?}"
+        );
         let (lo, hi) = corners
             .iter()
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), c| {
@@ -132,9 +137,7 @@ pub fn reference_coverage(
         1.0 + 2.0 * GUARD_BAND_PIXELS / height,
     ];
     let unclipped = corners.iter().all(|&[x, y, z]| {
-        (0.0..=1.0).contains(&z)
-            && f64::from(x).abs() <= guard[0]
-            && f64::from(y).abs() <= guard[1]
+        (0.0..=1.0).contains(&z) && f64::from(x).abs() <= guard[0] && f64::from(y).abs() <= guard[1]
     });
     if !unclipped {
         return None;
@@ -159,7 +162,10 @@ pub fn reference_coverage(
     }
     // In the y-down window a negative area is counter-clockwise as seen: a front face.
     let front = area < 0;
-    if matches!((cull, front), (CullMode::Back, false) | (CullMode::Front, true)) {
+    if matches!(
+        (cull, front),
+        (CullMode::Back, false) | (CullMode::Front, true)
+    ) {
         return Some(Vec::new());
     }
     // Each edge with the vertex opposite it.

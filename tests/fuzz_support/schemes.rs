@@ -124,17 +124,19 @@ pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped:
                 // Which ones overflow depends on arrival order; the kept ones are real.
                 let mut rest = all.clone();
                 for e in got {
-                    let i = rest
-                        .iter()
-                        .position(|r| r == e)
-                        .unwrap_or_else(|| panic!("{name}: pixel {p} holds {e:#x}, not a fragment of it"));
+                    let i = rest.iter().position(|r| r == e).unwrap_or_else(|| {
+                        panic!("{name}: pixel {p} holds {e:#x}, not a fragment of it")
+                    });
                     rest.remove(i);
                 }
             }
         }
         missing += (n - got.len()) as u64;
     }
-    assert_eq!(dropped, missing, "{name}: counted drops vs fragments missing");
+    assert_eq!(
+        dropped, missing,
+        "{name}: counted drops vs fragments missing"
+    );
 }
 
 /// Runs `scheme` both ways over the case and checks both captures.
@@ -149,7 +151,12 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>]) {
             other => panic!("{name}: a one-pass walk ended with {other:?}"),
         }
     }
-    check_capture(&format!("{name} serial"), lists, &scheme.resolve(&memory), dropped);
+    check_capture(
+        &format!("{name} serial"),
+        lists,
+        &scheme.resolve(&memory),
+        dropped,
+    );
     let Run { capture, stats } = run_fragments(scheme, &case.fragments, &case.schedule, false).run;
     assert_eq!(stats.counters.fragments, case.fragments.len() as u64);
     check_capture(

@@ -18,11 +18,11 @@ use clap::{Parser, Subcommand};
 
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
-pub use judge::EffectName;
 pub use compare::CompareArgs;
 pub use explain::{ExplainArgs, ExplainScheme};
 pub use export::ExportArgs;
 pub use hazard::{HazardArgs, HazardReport, HazardRow};
+pub use judge::EffectName;
 pub use render::{RenderArgs, RunSummary};
 pub use schemes::SchemeName;
 pub use sweep::{SweepArgs, SweepSeries};
@@ -71,7 +71,10 @@ pub fn main() -> ExitCode {
         Some(Command::Render(args)) => args,
         Some(Command::Sweep(args)) => return exit_code(sweep::sweep(&args).map(|_| true), ""),
         Some(Command::Explain(args)) => {
-            return exit_code(explain::explain(&args), "no interleaving showed the property")
+            return exit_code(
+                explain::explain(&args),
+                "no interleaving showed the property",
+            )
         }
         Some(Command::Hazard(args)) => return exit_code(hazard::hazard(&args).map(|_| true), ""),
         Some(Command::Bench(args)) => return exit_code(bench::bench(&args).map(|_| true), ""),
@@ -87,7 +90,11 @@ pub fn main() -> ExitCode {
         None => cli.render,
     };
     match render::render(&args) {
-        Ok(summary) if summary.iter().all(|run| run.guarantee != "exact" || run.mismatches == 0) => {
+        Ok(summary)
+            if summary
+                .iter()
+                .all(|run| run.guarantee != "exact" || run.mismatches == 0) =>
+        {
             ExitCode::SUCCESS
         }
         Ok(_) => {

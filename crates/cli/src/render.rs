@@ -33,7 +33,7 @@ pub struct RenderArgs {
     /// Write no images.
     #[arg(long)]
     pub no_images: bool,
-    /// Also write each scheme's per-pixel words as a dump in DIR/<scheme>/ (docs/dump-format.md).
+    /// Also write each scheme's per-pixel words as a dump in `DIR/<scheme>/` (docs/dump-format.md).
     #[arg(long, value_name = "DIR")]
     pub dump: Option<PathBuf>,
 }

@@ -290,13 +290,18 @@ mod tests {
     fn primitive_sequences_are_compared_in_depth_order() {
         // Pixel 0: prim 9 is nearer (key 1) than prim 4 (key 2).
         let oracle = oracle_of(&[&[(1 << 32) | 9, (2 << 32) | 4]]);
-        let mut right = Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
+        let mut right =
+            Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
         right.push_pixel([9, 4]);
         assert!(oracle.diff(&right).is_exact());
-        let mut swapped = Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
+        let mut swapped =
+            Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
         swapped.push_pixel([4, 9]);
         let diff = oracle.diff(&swapped);
-        assert_eq!((diff.misordered_pixels, diff.lost, diff.mismatched_pixels), (1, 0, 1));
+        assert_eq!(
+            (diff.misordered_pixels, diff.lost, diff.mismatched_pixels),
+            (1, 0, 1)
+        );
     }
 
     #[test]

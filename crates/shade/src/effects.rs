@@ -96,7 +96,9 @@ pub fn shade_pixel(
     distance: &dyn Fn(f32) -> f64,
 ) -> Option<[f32; 3]> {
     let colour_of = |entry: u64| match entries {
-        Entries::KeyAndPrim | Entries::PrimOnly => primitive_colour(entry as u32, material.primitives),
+        Entries::KeyAndPrim | Entries::PrimOnly => {
+            primitive_colour(entry as u32, material.primitives)
+        }
         Entries::KeyOnly => material.base,
     };
     match effect {
@@ -196,7 +198,10 @@ mod tests {
 
     #[test]
     fn an_empty_pixel_is_the_background_and_order_matters() {
-        let m = Material { primitives: 4, ..Material::default() };
+        let m = Material {
+            primitives: 4,
+            ..Material::default()
+        };
         assert_eq!(
             shade_pixel(Effect::Transparency, &m, Entries::KeyAndPrim, &[], &flat),
             Some(m.background)
