@@ -1,11 +1,19 @@
 //! The real scanned meshes of `../shared/meshes/` (beside the project's root): each loads, and
-//! both FreePipe schemes on the parallel executor equal the oracle fragment for fragment.
+//! every exact scheme equals the oracle fragment for fragment: the atomic ones on the parallel
+//! executor, the read–modify–write and arrival-order ones (exact only without hazards) serially.
 
 use std::path::PathBuf;
 
 use fragsim::capture::abuffer::ABuffer;
-use fragsim::capture::executor::run_parallel;
-use fragsim::capture::mdts::Mdts;
+use fragsim::capture::dual_peeling::DualDepthPeeling;
+use fragsim::capture::executor::{run_parallel, run_serial, Run};
+use fragsim::capture::kbuffer::KBuffer;
+use fragsim::capture::kbuffer_multipass::KBufferMultipass;
+use fragsim::capture::mdts::{Direction, Mdts};
+use fragsim::capture::peeling::DepthPeeling;
+use fragsim::capture::stencil_routed::StencilRouted;
+use fragsim::capture::zbuffer::ZBuffer;
+use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
 
@@ -45,11 +53,55 @@ fn every_shared_mesh_loads_and_both_schemes_equal_the_oracle() {
             "{file}: {} fragments",
             oracle.fragments()
         );
-        let mdts = Mdts::<u64>::ascending(view.viewport(), oracle.max_depth_complexity()).unwrap();
-        let abuffer = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
-        let diff = oracle.diff(&run_parallel(&view, &mdts).capture);
-        assert!(diff.is_exact(), "{file} mdts: {diff:?}");
-        let diff = oracle.diff(&run_parallel(&view, &abuffer).capture);
-        assert!(diff.is_exact(), "{file} abuffer: {diff:?}");
+        let (viewport, depth) = (view.viewport(), oracle.max_depth_complexity());
+        let cap = MEMORY_CAP_DEFAULT;
+        let check = |scheme: &str, run: Run| {
+            let diff = oracle.diff(&run.capture);
+            assert!(diff.is_exact(), "{file} {scheme}: {diff:?}");
+        };
+        check(
+            "mdts",
+            run_parallel(&view, &Mdts::<u64>::ascending(viewport, depth).unwrap()),
+        );
+        let descending = Mdts::<u64>::new(viewport, depth, Direction::Descending, cap).unwrap();
+        check("mdts-desc", run_parallel(&view, &descending));
+        check(
+            "abuffer",
+            run_parallel(
+                &view,
+                &ABuffer::exact_default(&oracle.depth_complexity()).unwrap(),
+            ),
+        );
+        check(
+            "zbuffer",
+            run_parallel(&view, &ZBuffer::for_viewport(viewport).unwrap()),
+        );
+        check(
+            "peeling",
+            run_parallel(
+                &view,
+                &DepthPeeling::<u64>::with_layers(viewport, depth).unwrap(),
+            ),
+        );
+        check(
+            "dual-peeling",
+            run_parallel(
+                &view,
+                &DualDepthPeeling::<u64>::with_layers(viewport, depth).unwrap(),
+            ),
+        );
+        check(
+            "kbuffer",
+            run_serial(&view, &KBuffer::with_k(viewport, depth).unwrap()),
+        );
+        let multipass = KBufferMultipass::new(viewport, 4, depth, cap).unwrap();
+        check("kbuffer-multipass", run_serial(&view, &multipass));
+        check(
+            "srab",
+            run_serial(
+                &view,
+                &StencilRouted::new(viewport, depth.div_ceil(8), cap).unwrap(),
+            ),
+        );
     }
 }

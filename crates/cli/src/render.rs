@@ -219,7 +219,7 @@ fn print_table(
         oracle_ms
     );
     type Cell = fn(&RunSummary) -> String;
-    let columns: [(&str, usize, Cell); 14] = [
+    let columns: [(&str, usize, Cell); 15] = [
         ("scheme", 16, |r| r.scheme.clone()),
         ("guarantee", 22, |r| r.guarantee.to_string()),
         ("executor", 9, |r| r.executor.clone()),
@@ -230,6 +230,7 @@ fn print_table(
         ("maxdc", 5, |r| r.max_depth_complexity.to_string()),
         ("time ms", 9, |r| format!("{:.2}", r.time_ms)),
         ("memory B", 11, |r| r.memory_bytes.to_string()),
+        ("captured", 9, |r| r.captured.to_string()),
         ("overflow", 8, |r| r.overflowed.to_string()),
         ("lost", 6, |r| r.lost.to_string()),
         ("mismatches", 10, |r| r.mismatches.to_string()),
