@@ -102,20 +102,27 @@ pub struct ScreenTriangle {
 #[derive(Clone, Debug)]
 pub struct View<'mesh> {
     mesh: &'mesh Mesh,
-    vertices: Vec<VertexOut>,
+    view_projection: DMat4,
+    /// Per vertex: bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5:
+    /// beyond far; bit 6: not in front of the eye (`w ≤ 0` or NaN).
+    outcodes: Vec<u8>,
+    /// Per vertex: the snapped window position and depth; meaningful only when the vertex's
+    /// outcode has no clip bit set.
+    screen: Vec<ScreenVertex>,
     viewport: Viewport,
     cull: CullMode,
     guard: [f64; 2],
 }
 
-/// The vertex stage's output for one vertex, computed once and shared by every triangle using it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct VertexOut {
-    clip: DVec4,
-    /// Bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5: beyond far.
-    outcode: u8,
-    /// Snapped window position and depth; meaningful only when `outcode` has no clip bit set.
-    snapped: Snapped,
+/// The vertex stage's output that the triangle loop reads: 16 bytes, a quarter of the clip-space
+/// vertex, because the loop over a large mesh is bound by fetching its three vertices. Clip
+/// coordinates are recomputed, bit for bit, only for the few triangles that need clipping.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ScreenVertex {
+    /// x, y in 1/256 pixel, y down; inside the guard band they fit an `i32` (|x| < 2^23).
+    xy: [i32; 2],
+    /// Window depth `z / w`.
+    z: f64,
 }
 
 /// A snapped window position (1/256 pixel, y down) and the window depth `z / w`.
@@ -125,68 +132,71 @@ type Snapped = ([i64; 2], f64);
 const CLIP_BITS: u8 = 0b1_1111;
 /// Outcode bit of the far plane (rejects, never clips: fragments beyond it are dropped one by one).
 const FAR_BIT: u8 = 1 << 5;
+/// Outcode bit of a vertex with `w ≤ 0` (or NaN) that no plane clips: possible only with a
+/// projection whose near plane does not bound `w` away from 0; its triangles are dropped.
+const NOT_IN_FRONT_BIT: u8 = 1 << 6;
+
+/// Vertices per rayon work item of the vertex stage.
+const VERTICES_PER_TASK: usize = 4096;
 
 impl<'mesh> View<'mesh> {
     /// Transforms every vertex of `mesh` once.
     #[must_use]
     pub fn new(mesh: &'mesh Mesh, camera: &Camera, viewport: Viewport, cull: CullMode) -> Self {
-        let m: DMat4 = camera.view_projection;
         let guard = [
             1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.width),
             1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.height),
         ];
         let mut view = Self {
             mesh,
-            vertices: Vec::new(),
+            view_projection: camera.view_projection,
+            outcodes: Vec::new(),
+            screen: Vec::new(),
             viewport,
             cull,
             guard,
         };
-        let planes = view.planes();
-        let far = DVec4::new(0.0, 0.0, -1.0, 1.0);
-        // One vertex per work item of rayon's adaptive splitting: every vertex is independent.
-        view.vertices = mesh
-            .positions
-            .par_iter()
-            .with_min_len(4096)
-            .map(|p| {
-                let clip = m * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0);
-                let mut outcode = planes.iter().enumerate().fold(0u8, |code, (i, plane)| {
-                    code | (u8::from(plane.dot(clip) < 0.0) << i)
-                });
-                if far.dot(clip) < 0.0 {
-                    outcode |= FAR_BIT;
-                }
-                let snapped = if outcode & CLIP_BITS == 0 {
-                    view.snap(clip)
-                } else {
-                    ([0, 0], 0.0)
-                };
-                VertexOut {
-                    clip,
-                    outcode,
-                    snapped,
-                }
-            })
-            .collect();
+        view.set_camera(camera);
         view
     }
 
-    /// Projects a clip-space vertex to the window and snaps x and y to the fixed-point grid.
-    fn snap(&self, v: DVec4) -> Snapped {
-        let (w, h) = (
-            f64::from(self.viewport.width),
-            f64::from(self.viewport.height),
-        );
-        let x = (v.x / v.w * 0.5 + 0.5) * w;
-        let y = (0.5 - v.y / v.w * 0.5) * h;
-        (
-            [
-                (x * ONE as f64).round() as i64,
-                (y * ONE as f64).round() as i64,
-            ],
-            v.z / v.w,
-        )
+    /// Runs the vertex stage again for another camera, reusing this view's buffers (a frame loop
+    /// allocates nothing).
+    pub fn set_camera(&mut self, camera: &Camera) {
+        self.view_projection = camera.view_projection;
+        let count = self.mesh.positions.len();
+        self.outcodes.resize(count, 0);
+        self.screen.resize(count, ScreenVertex::default());
+        let stage = VertexStage {
+            view_projection: self.view_projection,
+            planes: self.planes(),
+        };
+        // Every vertex is independent: chunks of the three arrays go to the pool side by side.
+        self.mesh
+            .positions
+            .par_chunks(VERTICES_PER_TASK)
+            .zip(self.outcodes.par_chunks_mut(VERTICES_PER_TASK))
+            .zip(self.screen.par_chunks_mut(VERTICES_PER_TASK))
+            .for_each(|((positions, outcodes), screen)| {
+                for ((p, outcode), out) in positions.iter().zip(outcodes).zip(screen) {
+                    let clip = stage.clip(*p);
+                    *outcode = stage.outcode(clip);
+                    if *outcode & CLIP_BITS == 0 {
+                        let ([x, y], z) = snap(self.viewport, clip);
+                        // Inside the guard band |x|, |y| < (MAX_SIDE + 2 · GUARD_BAND) · 256
+                        // = 2^23: the narrowing is lossless.
+                        *out = ScreenVertex {
+                            xy: [x as i32, y as i32],
+                            z,
+                        };
+                    }
+                }
+            });
+    }
+
+    /// The clip-space position of vertex `index`, exactly as the vertex stage computed it.
+    fn clip_position(&self, index: u32) -> DVec4 {
+        transform(self.view_projection, self.mesh.positions[index as usize])
     }
 
     /// The viewport.
@@ -210,33 +220,62 @@ impl<'mesh> View<'mesh> {
     /// Rasterizes triangle `prim`, calling `emit` for each fragment in scan order (rows top to
     /// bottom, pixels left to right, fan pieces in order).
     pub fn rasterize(&self, prim: u32, emit: &mut impl FnMut(Fragment)) {
-        self.screen_triangles(prim, &mut |tri| self.scan(&tri, emit));
+        let indices = self.mesh.triangles[prim as usize];
+        let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
+        if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS != 0 {
+            self.screen_triangles(prim, &mut |tri| self.scan(&tri, emit));
+            return;
+        }
+        // The common case, inlined: no clipping, and most triangles of a dense mesh cover no
+        // pixel centre, which their bounding box tells before any edge function is set up.
+        if (ca | cb | cc) & NOT_IN_FRONT_BIT != 0 {
+            return;
+        }
+        let vertices = indices.map(|i| self.screen[i as usize]);
+        let [a, b, c] = vertices.map(|v| v.xy);
+        let span = |axis: usize, side: u32| {
+            pixel_span(
+                a[axis].min(b[axis]).min(c[axis]).into(),
+                a[axis].max(b[axis]).max(c[axis]).into(),
+                side,
+            )
+        };
+        if span(0, self.viewport.width).is_none() || span(1, self.viewport.height).is_none() {
+            return;
+        }
+        let snapped = vertices.map(|v| (v.xy.map(i64::from), v.z));
+        self.orient(prim, snapped, &mut |tri| self.scan(&tri, emit));
     }
 
     /// Calls `visit` with the snapped, clipped, oriented pieces of triangle `prim` (none when it
     /// is rejected, culled or degenerate).
     pub fn screen_triangles(&self, prim: u32, visit: &mut impl FnMut(ScreenTriangle)) {
-        let [a, b, c] = self.mesh.triangles[prim as usize].map(|i| self.vertices[i as usize]);
+        let indices = self.mesh.triangles[prim as usize];
+        let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
         // Trivial reject: all three vertices outside one plane.
-        if a.outcode & b.outcode & c.outcode != 0 {
+        if ca & cb & cc != 0 {
             return;
         }
-        if (a.outcode | b.outcode | c.outcode) & CLIP_BITS == 0 {
-            self.orient(
-                prim,
-                [a.snapped, b.snapped, c.snapped],
-                [a.clip.w, b.clip.w, c.clip.w],
-                visit,
-            );
+        if (ca | cb | cc) & CLIP_BITS == 0 {
+            if (ca | cb | cc) & NOT_IN_FRONT_BIT == 0 {
+                let snapped = indices.map(|i| {
+                    let v = self.screen[i as usize];
+                    (v.xy.map(i64::from), v.z)
+                });
+                self.orient(prim, snapped, visit);
+            }
             return;
         }
-        let polygon = self.clip([a.clip, b.clip, c.clip]);
+        let polygon = self.clip(indices.map(|i| self.clip_position(i)));
         if polygon.len() < 3 {
             return;
         }
         for i in 1..polygon.len() - 1 {
             let piece = [polygon[0], polygon[i], polygon[i + 1]];
-            self.orient(prim, piece.map(|v| self.snap(v)), piece.map(|v| v.w), visit);
+            if piece.iter().any(|v| !in_front(*v)) {
+                continue;
+            }
+            self.orient(prim, piece.map(|v| snap(self.viewport, v)), visit);
         }
     }
 
@@ -275,17 +314,7 @@ impl<'mesh> View<'mesh> {
     }
 
     /// Culls or orients a snapped triangle and hands it to `visit`.
-    fn orient(
-        &self,
-        prim: u32,
-        snapped: [Snapped; 3],
-        w: [f64; 3],
-        visit: &mut impl FnMut(ScreenTriangle),
-    ) {
-        if w.iter().any(|w| w.is_nan() || *w <= 0.0) {
-            // Only reachable with a projection whose near plane does not bound w away from 0.
-            return;
-        }
+    fn orient(&self, prim: u32, snapped: [Snapped; 3], visit: &mut impl FnMut(ScreenTriangle)) {
         let [(pa, za), (mut pb, mut zb), (mut pc, mut zc)] = snapped;
         let area = edge(pa, pb, pc);
         if area == 0 {
@@ -315,15 +344,20 @@ impl<'mesh> View<'mesh> {
         let [a, b, c] = tri.xy;
         let area = edge(a, b, c);
         debug_assert!(area > 0);
-        let (min_x, max_x) = (a[0].min(b[0]).min(c[0]), a[0].max(b[0]).max(c[0]));
-        let (min_y, max_y) = (a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]));
-        let first_px = |lo: i64| (lo - HALF + ONE - 1).div_euclid(ONE).max(0);
-        let last_px = |hi: i64, side: u32| (hi - HALF).div_euclid(ONE).min(i64::from(side) - 1);
-        let (x0, x1) = (first_px(min_x), last_px(max_x, self.viewport.width));
-        let (y0, y1) = (first_px(min_y), last_px(max_y, self.viewport.height));
-        if x0 > x1 || y0 > y1 {
+        let Some((x0, x1)) = pixel_span(
+            a[0].min(b[0]).min(c[0]),
+            a[0].max(b[0]).max(c[0]),
+            self.viewport.width,
+        ) else {
             return;
-        }
+        };
+        let Some((y0, y1)) = pixel_span(
+            a[1].min(b[1]).min(c[1]),
+            a[1].max(b[1]).max(c[1]),
+            self.viewport.height,
+        ) else {
+            return;
+        };
         // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
         let edges = [(b, c), (c, a), (a, b)];
         let bias = edges.map(|(p, q)| if is_top_left(p, q) { 0 } else { -1 });
@@ -357,6 +391,67 @@ impl<'mesh> View<'mesh> {
             }
         }
     }
+}
+
+/// The first and last pixel whose centre lies in `[lo, hi]` (1/256 pixel) and on a viewport side
+/// of `side` pixels; `None` when there is none.
+fn pixel_span(lo: i64, hi: i64, side: u32) -> Option<(i64, i64)> {
+    let first = (lo - HALF + ONE - 1).div_euclid(ONE).max(0);
+    let last = (hi - HALF).div_euclid(ONE).min(i64::from(side) - 1);
+    (first <= last).then_some((first, last))
+}
+
+/// What the vertex stage needs, copied out of the view so that it can fill the view's buffers.
+struct VertexStage {
+    view_projection: DMat4,
+    planes: [DVec4; 5],
+}
+
+impl VertexStage {
+    fn clip(&self, position: [f32; 3]) -> DVec4 {
+        transform(self.view_projection, position)
+    }
+
+    fn outcode(&self, clip: DVec4) -> u8 {
+        let mut outcode = self
+            .planes
+            .iter()
+            .enumerate()
+            .fold(0u8, |code, (i, plane)| {
+                code | (u8::from(plane.dot(clip) < 0.0) << i)
+            });
+        if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
+            outcode |= FAR_BIT;
+        }
+        if !in_front(clip) {
+            outcode |= NOT_IN_FRONT_BIT;
+        }
+        outcode
+    }
+}
+
+/// Rule 1: model space to clip space, in f64.
+fn transform(view_projection: DMat4, p: [f32; 3]) -> DVec4 {
+    view_projection * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0)
+}
+
+/// Whether a clip-space vertex has `w > 0` (false for NaN).
+fn in_front(clip: DVec4) -> bool {
+    clip.w > 0.0
+}
+
+/// Rule 4: projects a clip-space vertex to the window and snaps x and y to the fixed-point grid.
+fn snap(viewport: Viewport, v: DVec4) -> Snapped {
+    let (w, h) = (f64::from(viewport.width), f64::from(viewport.height));
+    let x = (v.x / v.w * 0.5 + 0.5) * w;
+    let y = (0.5 - v.y / v.w * 0.5) * h;
+    (
+        [
+            (x * ONE as f64).round() as i64,
+            (y * ONE as f64).round() as i64,
+        ],
+        v.z / v.w,
+    )
 }
 
 /// Twice the signed area of `(a, b, p)`: positive when `p` is on the interior side of `a → b` for
@@ -472,7 +567,7 @@ mod tests {
             triangles: vec![[0, 1, 1]],
         };
         let view = view_of(&mesh, 64);
-        let [a, b] = [0, 1].map(|i| view.vertices[i].clip);
+        let [a, b] = [0, 1].map(|i| view.clip_position(i));
         let polygon = view.clip([a, b, b]);
         assert!(polygon.len() >= 3);
         let [gx, gy] = view.guard;
@@ -480,6 +575,38 @@ mod tests {
             assert!(v.x.abs() <= gx * v.w && v.y.abs() <= gy * v.w, "{v:?}");
         }
         assert!(coverage(&view).iter().all(|&c| c == 0));
+    }
+
+    #[test]
+    fn the_inlined_fast_path_emits_what_the_general_path_emits() {
+        // `rasterize` skips `screen_triangles` for unclipped triangles; both must agree, on
+        // soups seen from far (tiny triangles), near (clipped ones) and inside (w ≤ 0).
+        let mesh = crate::scenes::triangle_soup(3000, 7);
+        for distance_scale in [40.0, 1.0, 0.3, 0.01] {
+            let orbit = crate::OrbitCamera {
+                distance_scale,
+                ..crate::OrbitCamera::default()
+            };
+            let camera = orbit.camera(mesh.bounds(), 1.0);
+            let view = View::new(
+                &mesh,
+                &camera,
+                Viewport::new(97, 61).unwrap(),
+                CullMode::None,
+            );
+            let mut fragments = 0;
+            for prim in 0..view.triangle_count() {
+                let (mut fast, mut general) = (Vec::new(), Vec::new());
+                view.rasterize(prim, &mut |f| fast.push(f));
+                view.screen_triangles(prim, &mut |t| view.scan(&t, &mut |f| general.push(f)));
+                assert_eq!(
+                    fast, general,
+                    "triangle {prim} at distance {distance_scale}"
+                );
+                fragments += fast.len();
+            }
+            assert!(fragments > 0, "distance {distance_scale} drew nothing");
+        }
     }
 
     #[test]
