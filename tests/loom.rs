@@ -221,13 +221,46 @@ fn mdts_model<W: MdtsWord>(
     fragments: &[Fragment],
     preemption_bound: Option<usize>,
 ) -> usize {
+    let scheme =
+        Mdts::<W>::new(one_pixel(), k, direction, MEMORY_CAP_DEFAULT).expect("a valid MDTS");
+    mdts_scheme_model(name, scheme, direction, fragments, preemption_bound)
+}
+
+/// [`mdts_model`] for the probing walk (a load, then `atomicMin` only where it changes the
+/// slot): every check but the walk lengths, which count the loads too.
+fn mdts_probe_model<W: MdtsWord>(
+    name: &str,
+    direction: Direction,
+    k: u32,
+    fragments: &[Fragment],
+    preemption_bound: Option<usize>,
+) -> usize {
+    let scheme =
+        Mdts::<W>::new(one_pixel(), k, direction, MEMORY_CAP_DEFAULT).expect("a valid MDTS");
+    mdts_scheme_model(
+        name,
+        scheme.probing(),
+        direction,
+        fragments,
+        preemption_bound,
+    )
+}
+
+/// The body of [`mdts_model`] and [`mdts_probe_model`].
+fn mdts_scheme_model<W: MdtsWord>(
+    name: &str,
+    scheme: Mdts<W>,
+    direction: Direction,
+    fragments: &[Fragment],
+    preemption_bound: Option<usize>,
+) -> usize {
     assert!(
         fragments.len() <= 4,
         "loom allows 4 threads besides the main one"
     );
-    let scheme: &'static Mdts<W> = Box::leak(Box::new(
-        Mdts::new(one_pixel(), k, direction, MEMORY_CAP_DEFAULT).expect("a valid MDTS"),
-    ));
+    let k = scheme.k();
+    let probing = scheme.name().ends_with("-probe");
+    let scheme: &'static Mdts<W> = Box::leak(Box::new(scheme));
     let fragments = fragments.to_vec();
     let values: Vec<u64> = fragments.iter().map(|&f| W::encode(f).decode()).collect();
     let empty = match direction {
@@ -242,6 +275,9 @@ fn mdts_model<W: MdtsWord>(
         let m = fragments.len().min(k as usize);
         for slot in m..k as usize {
             assert_eq!(words.load(slot), empty, "slot {slot} past the kept values");
+        }
+        if probing {
+            return;
         }
         let mut lengths = steps.clone();
         lengths.sort_unstable();
@@ -474,6 +510,65 @@ fn mdts64_4_threads_equal_depths_k3_preemption_bound_3() {
         3,
         &fragments(&[(0.3, 0), (0.1, 1), (0.5, 2), (0.1, 3)]),
         Some(3),
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// MDTS with the probing walk: a plain load first, `atomicMin` only where it would change the slot.
+// The load of a slot at or below the carried value stands for an `atomicMin` at that instant
+// (slots only decrease), so every check of the plain walk must hold.
+
+/// Probing MDTS (u64, ascending), 3 threads, K = 1, 2, 3, 4: the K nearest, sorted, the rest
+/// dropped, slots past them empty. Exhaustive.
+#[test]
+fn mdts64_probe_3_threads_k1_to_k4() {
+    for k in 1..=4 {
+        let name = format!("mdts64_probe_3_threads_k{k}");
+        let n = mdts_probe_model::<u64>(
+            &name,
+            Direction::Ascending,
+            k,
+            &fragments(&DISTINCT[..3]),
+            None,
+        );
+        assert!(n >= 6);
+    }
+}
+
+/// Probing MDTS (u64, ascending), 4 threads, K = 2. Preemption bound 2 (bound 3 over K = 2 and 4
+/// took 246 s here, too long for CI).
+#[test]
+fn mdts64_probe_4_threads_k2_preemption_bound_2() {
+    mdts_probe_model::<u64>(
+        "mdts64_probe_4_threads_k2_preemption_bound_2",
+        Direction::Ascending,
+        2,
+        &fragments(&DISTINCT),
+        Some(2),
+    );
+}
+
+/// Probing MDTS (u32, ascending), 3 threads, depths [0.1, 0.1, 0.3], K = 1 to 4: a slot equal to
+/// the carried key is passed by a load (an `atomicMin` there changes nothing) and both copies
+/// are still kept. Exhaustive.
+#[test]
+fn mdts32_probe_3_threads_equal_depths_k1_to_k4() {
+    let list = fragments(&[(0.3, 0), (0.1, 1), (0.1, 2)]);
+    for k in 1..=4 {
+        let name = format!("mdts32_probe_3_threads_equal_depths_k{k}");
+        mdts_probe_model::<u32>(&name, Direction::Ascending, k, &list, None);
+    }
+}
+
+/// Probing MDTS (u64, descending), 3 threads, K = 2: the two farthest kept. Exhaustive.
+#[test]
+fn mdts64_desc_probe_3_threads_k2() {
+    mdts_probe_model::<u64>(
+        "mdts64_desc_probe_3_threads_k2",
+        Direction::Descending,
+        2,
+        &fragments(&DISTINCT[..3]),
+        None,
     );
 }
 

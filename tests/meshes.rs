@@ -63,6 +63,13 @@ fn every_shared_mesh_loads_and_both_schemes_equal_the_oracle() {
             "mdts",
             run_parallel(&view, &Mdts::<u64>::ascending(viewport, depth).unwrap()),
         );
+        check(
+            "mdts-probe",
+            run_parallel(
+                &view,
+                &Mdts::<u64>::ascending(viewport, depth).unwrap().probing(),
+            ),
+        );
         let descending = Mdts::<u64>::new(viewport, depth, Direction::Descending, cap).unwrap();
         check("mdts-desc", run_parallel(&view, &descending));
         check(

@@ -49,25 +49,28 @@ fn check_mdts_parallel<W: MdtsWord>(
     k: u32,
     direction: Direction,
 ) -> Result<(), TestCaseError> {
-    let scheme = Mdts::<W>::new(view.viewport(), k, direction, MEMORY_CAP_DEFAULT).unwrap();
-    let run = run_parallel(view, &scheme);
-    let diff = oracle.diff(&run.capture);
-    let name = scheme.name();
-    prop_assert!(diff.is_exact(), "{name} K={k}: {diff:?}");
-    prop_assert_eq!(
-        diff.overflowed,
-        run.stats.counters.dropped,
-        "{} K={}",
-        name,
-        k
-    );
-    prop_assert_eq!(
-        diff.captured + diff.overflowed,
-        oracle.fragments() as u64,
-        "{} K={}",
-        name,
-        k
-    );
+    let plain = Mdts::<W>::new(view.viewport(), k, direction, MEMORY_CAP_DEFAULT).unwrap();
+    // The probing walk must give the very same lists.
+    for scheme in [plain.clone(), plain.probing()] {
+        let run = run_parallel(view, &scheme);
+        let diff = oracle.diff(&run.capture);
+        let name = scheme.name();
+        prop_assert!(diff.is_exact(), "{name} K={k}: {diff:?}");
+        prop_assert_eq!(
+            diff.overflowed,
+            run.stats.counters.dropped,
+            "{} K={}",
+            name,
+            k
+        );
+        prop_assert_eq!(
+            diff.captured + diff.overflowed,
+            oracle.fragments() as u64,
+            "{} K={}",
+            name,
+            k
+        );
+    }
     Ok(())
 }
 

@@ -53,6 +53,9 @@ proptest! {
             check(&run_scheduled(&view, &m32, &schedule, false).run.capture)?;
             let desc = Mdts::<u64>::new(view.viewport(), k, Direction::Descending, MEMORY_CAP_DEFAULT).unwrap();
             check(&run_scheduled(&view, &desc, &schedule, false).run.capture)?;
+            let probing = Mdts::<u64>::ascending(view.viewport(), k).unwrap().probing();
+            check(&run_scheduled(&view, &probing, &schedule, false).run.capture)?;
+            check(&run_scheduled(&view, &desc.probing(), &schedule, false).run.capture)?;
         }
         let abuffer = ABuffer::exact(&oracle.depth_complexity(), PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
         check(&run_scheduled(&view, &abuffer, &schedule, false).run.capture)?;

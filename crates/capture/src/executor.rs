@@ -18,6 +18,7 @@ use fragsim_raster::View;
 use rayon::prelude::*;
 
 use crate::capture::Capture;
+use crate::counting::CountingMemory;
 use crate::memory::{AtomicMemory, Memory, SerialMemory};
 use crate::scheme::{Scheme, Step};
 
@@ -77,6 +78,8 @@ pub struct RunStats {
     pub memory_bytes: u64,
     /// Threads that ran the pass.
     pub threads: usize,
+    /// Read-modify-write (locked) operations, when the run counted them ([`count_locked_ops`]).
+    pub locked_ops: Option<u64>,
 }
 
 /// A run's result.
@@ -118,13 +121,7 @@ impl SerialExecutor {
             _ => layout.allocate(),
         };
         let memory = self.memory.insert(memory);
-        let (counters, passes) = run_passes(scheme, &*memory, |pass| {
-            let mut counters = Counters::default();
-            for prim in 0..view.triangle_count() {
-                rasterize_into(view, scheme, &*memory, pass, prim, &mut counters);
-            }
-            counters
-        });
+        let (counters, passes) = serial_passes(view, scheme, &*memory);
         let pass_time = start.elapsed();
         let resolve_start = Instant::now();
         let capture = scheme.resolve(&*memory);
@@ -159,16 +156,7 @@ impl ParallelExecutor {
             _ => layout.allocate(),
         };
         let memory = self.memory.insert(memory);
-        let (counters, passes) = run_passes(scheme, &*memory, |pass| {
-            (0..view.triangle_count())
-                .into_par_iter()
-                .with_min_len(TRIANGLES_PER_TASK)
-                .fold(Counters::default, |mut counters, prim| {
-                    rasterize_into(view, scheme, &*memory, pass, prim, &mut counters);
-                    counters
-                })
-                .reduce(Counters::default, Counters::merge)
-        });
+        let (counters, passes) = parallel_passes(view, scheme, &*memory);
         let pass_time = start.elapsed();
         let resolve_start = Instant::now();
         let capture = resolve_parallel(scheme, &*memory);
@@ -182,6 +170,83 @@ impl ParallelExecutor {
             rayon::current_num_threads(),
         )
     }
+}
+
+/// Runs one frame of `scheme` over `view` on fresh storage that counts its read-modify-write
+/// operations (on the current rayon pool when `parallel`, else serially): an untimed frame that
+/// reports [`RunStats::locked_ops`]. Its lists are those of an ordinary run.
+pub fn count_locked_ops<S: Scheme>(view: &View<'_>, scheme: &S, parallel: bool) -> Run {
+    let start = Instant::now();
+    let (run, locked_ops) = if parallel {
+        let memory: CountingMemory<AtomicMemory> = scheme.layout().allocate();
+        let (counters, passes) = parallel_passes(view, scheme, &memory);
+        let pass_time = start.elapsed();
+        let resolve_start = Instant::now();
+        let capture = resolve_parallel(scheme, &memory);
+        let threads = rayon::current_num_threads();
+        let run = finish(
+            scheme,
+            capture,
+            counters,
+            passes,
+            pass_time,
+            resolve_start,
+            threads,
+        );
+        (run, memory.read_modify_writes())
+    } else {
+        let memory: CountingMemory<SerialMemory> = scheme.layout().allocate();
+        let (counters, passes) = serial_passes(view, scheme, &memory);
+        let pass_time = start.elapsed();
+        let resolve_start = Instant::now();
+        let capture = scheme.resolve(&memory);
+        let run = finish(
+            scheme,
+            capture,
+            counters,
+            passes,
+            pass_time,
+            resolve_start,
+            1,
+        );
+        (run, memory.read_modify_writes())
+    };
+    Run {
+        stats: RunStats {
+            locked_ops: Some(locked_ops),
+            ..run.stats
+        },
+        ..run
+    }
+}
+
+/// Every geometry pass of a frame, triangles in submission order on this thread.
+fn serial_passes<S: Scheme, M: Memory>(view: &View<'_>, scheme: &S, memory: &M) -> (Counters, u32) {
+    run_passes(scheme, memory, |pass| {
+        let mut counters = Counters::default();
+        for prim in 0..view.triangle_count() {
+            rasterize_into(view, scheme, memory, pass, prim, &mut counters);
+        }
+        counters
+    })
+}
+
+/// Every geometry pass of a frame, triangles in chunks on the current rayon pool.
+fn parallel_passes<S: Scheme, M: Memory + Sync>(
+    view: &View<'_>,
+    scheme: &S,
+    memory: &M,
+) -> (Counters, u32) {
+    run_passes(scheme, memory, |pass| {
+        (0..view.triangle_count())
+            .into_par_iter()
+            .with_min_len(TRIANGLES_PER_TASK)
+            .fold(Counters::default, |mut counters, prim| {
+                rasterize_into(view, scheme, memory, pass, prim, &mut counters);
+                counters
+            })
+            .reduce(Counters::default, Counters::merge)
+    })
 }
 
 /// Rasterizes triangle `prim` and runs each fragment's walk of geometry pass `pass` to its end.
@@ -222,7 +287,9 @@ fn run_passes<S: Scheme, M: Memory>(
 /// Pixels per rayon work item in the post pass.
 const PIXELS_PER_TASK: usize = 4096;
 
-/// The post pass on the rayon pool: pixel chunks resolved independently, then concatenated.
+/// The post pass on the rayon pool: pixel chunks resolved independently, then copied into the
+/// capture in parallel (a serial concatenation of a megapixel's offsets would cost as much as the
+/// resolve itself on many threads).
 fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capture {
     let pixels = scheme.pixels();
     let chunks: Vec<(Vec<u64>, Vec<usize>, Vec<u32>)> = (0..pixels.div_ceil(PIXELS_PER_TASK))
@@ -240,13 +307,33 @@ fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capt
         })
         .collect();
     let mut capture = Capture::with_pixels(pixels, scheme.identity(), scheme.keeps(Vec::new()));
-    let mut all_overflow = Vec::with_capacity(pixels);
-    for (entries, ends, overflow) in chunks {
-        let base = capture.entries.len();
-        capture.offsets.extend(ends.iter().map(|end| base + end));
-        capture.entries.extend_from_slice(&entries);
-        all_overflow.extend_from_slice(&overflow);
+    let total: usize = chunks.iter().map(|(entries, _, _)| entries.len()).sum();
+    capture.entries.resize(total, 0);
+    capture.offsets.resize(pixels + 1, 0);
+    let mut all_overflow = vec![0; pixels];
+    // Each chunk's share of the entries, cut in order; offsets and overflow cut evenly.
+    let mut entry_slices = Vec::with_capacity(chunks.len());
+    let (mut rest, mut base) = (capture.entries.as_mut_slice(), 0);
+    for (entries, _, _) in &chunks {
+        let (slice, tail) = rest.split_at_mut(entries.len());
+        entry_slices.push((slice, base));
+        base += entries.len();
+        rest = tail;
     }
+    chunks
+        .into_par_iter()
+        .zip(entry_slices)
+        .zip(capture.offsets[1..].par_chunks_mut(PIXELS_PER_TASK))
+        .zip(all_overflow.par_chunks_mut(PIXELS_PER_TASK))
+        .for_each(
+            |((((entries, ends, overflow), (entry_slice, base)), offsets), overflow_out)| {
+                entry_slice.copy_from_slice(&entries);
+                for (offset, end) in offsets.iter_mut().zip(ends) {
+                    *offset = base + end;
+                }
+                overflow_out.copy_from_slice(&overflow);
+            },
+        );
     capture.keeps = scheme.keeps(all_overflow);
     capture
 }
@@ -267,6 +354,7 @@ fn finish<S: Scheme>(
         resolve_time: resolve_start.elapsed(),
         memory_bytes: scheme.layout().bytes(),
         threads,
+        locked_ops: None,
     };
     Run { capture, stats }
 }

@@ -31,6 +31,7 @@
 pub mod abuffer;
 pub mod bucket;
 mod capture;
+mod counting;
 pub mod dual_peeling;
 pub mod executor;
 pub mod kbuffer;
@@ -45,5 +46,6 @@ pub mod stencil_routed;
 pub mod zbuffer;
 
 pub use capture::{Capture, Identity, Keeps};
+pub use counting::CountingMemory;
 pub use memory::{AtomicMemory, Memory, SerialMemory, Word, WordMemory};
 pub use scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};

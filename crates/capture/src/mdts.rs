@@ -17,6 +17,14 @@
 //! and the result is comparable fragment for fragment with the oracle; with `u32` words (as in the
 //! paper) a value is the depth key alone and equal depths are all kept (no early exit on equality).
 //!
+//! **The probing walk** ([`Mdts::probing`], a CPU optimisation, not in the paper): a step first
+//! *loads* the slot, and only when the slot holds a larger value (or is empty) does the next step
+//! run the `atomicMin`. A slot only ever decreases, so a slot seen at or below the carried value
+//! would have made the `atomicMin` a no-op returning that value: the load *is* that `atomicMin`,
+//! linearised at the load. The lists are therefore those of the plain walk under some
+//! interleaving (proof in `docs/proof.md`; loom checks it in `tests/loom.rs`), with fewer locked
+//! instructions (`fetch_min` is a `lock cmpxchg` loop on x86): `fragsim bench` reports both.
+//!
 //! Unlike the paper's Table 1, which initialises to `0xFFFFFFFF` but stops on `0x7FFFFFFF`, the
 //! sentinel tested is the one stored (`u32::MAX` / `u64::MAX`); no depth key reaches it, since the
 //! largest is `0x3F80_0000` (depth 1.0). Unlike the paper's descending variant, whose empty value 0
@@ -81,6 +89,7 @@ pub struct Mdts<W: MdtsWord = u64> {
     pixels: usize,
     k: u32,
     direction: Direction,
+    probe: bool,
     _word: std::marker::PhantomData<W>,
 }
 
@@ -93,6 +102,9 @@ pub struct Walk<W> {
     pub slot: u32,
     /// The value carried onward.
     pub carried: W,
+    /// The probing walk loaded this slot and found it larger than `carried`: the next step is
+    /// the `atomicMin`.
+    pub probed: bool,
 }
 
 impl<W: MdtsWord> Mdts<W> {
@@ -115,6 +127,7 @@ impl<W: MdtsWord> Mdts<W> {
             pixels: viewport.pixels(),
             k,
             direction,
+            probe: false,
             _word: std::marker::PhantomData,
         };
         check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
@@ -127,6 +140,15 @@ impl<W: MdtsWord> Mdts<W> {
     /// As [`Mdts::new`].
     pub fn ascending(viewport: Viewport, k: u32) -> Result<Self, CaptureError> {
         Self::new(viewport, k, Direction::Ascending, MEMORY_CAP_DEFAULT)
+    }
+
+    /// The same scheme with the probing walk (see the module documentation).
+    #[must_use]
+    pub fn probing(self) -> Self {
+        Self {
+            probe: true,
+            ..self
+        }
     }
 
     /// Slots per pixel.
@@ -154,6 +176,18 @@ impl<W: MdtsWord> Mdts<W> {
     }
 }
 
+impl<W: MdtsWord> Mdts<W> {
+    /// Moves a walk on to its next slot, dropping the carried value past the last.
+    fn next_slot(&self, walk: &mut Walk<W>) -> Step {
+        walk.slot += 1;
+        if walk.slot == self.k {
+            Step::Dropped
+        } else {
+            Step::Continue
+        }
+    }
+}
+
 impl<W: MdtsWord> Scheme for Mdts<W> {
     type State = Walk<W>;
 
@@ -163,9 +197,10 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         } else {
             "64"
         };
+        let probe = if self.probe { "-probe" } else { "" };
         match self.direction {
-            Direction::Ascending => format!("mdts{word}"),
-            Direction::Descending => format!("mdts{word}-desc"),
+            Direction::Ascending => format!("mdts{word}{probe}"),
+            Direction::Descending => format!("mdts{word}-desc{probe}"),
         }
         .replace("mdts64", "mdts")
     }
@@ -192,12 +227,27 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
             base: fragment.pixel as usize * self.k as usize,
             slot: 0,
             carried: self.stored(fragment),
+            probed: false,
         }
     }
 
     fn step<M: Memory>(&self, walk: &mut Walk<W>, memory: &M) -> Step {
         let words = W::words(memory);
         let index = walk.base + walk.slot as usize;
+        if self.probe && !walk.probed {
+            let seen = words.load(index);
+            // `carried` is never empty, so a slot at or past it in sort order holds a value.
+            let no_op = match self.direction {
+                Direction::Ascending => seen <= walk.carried,
+                Direction::Descending => seen >= walk.carried,
+            };
+            if !no_op {
+                walk.probed = true;
+                return Step::Continue;
+            }
+            return self.next_slot(walk);
+        }
+        walk.probed = false;
         let old = match self.direction {
             Direction::Ascending => words.fetch_min(index, walk.carried),
             Direction::Descending => words.fetch_max(index, walk.carried),
@@ -209,12 +259,7 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
             Direction::Ascending => walk.carried.max(old),
             Direction::Descending => walk.carried.min(old),
         };
-        walk.slot += 1;
-        if walk.slot == self.k {
-            Step::Dropped
-        } else {
-            Step::Continue
-        }
+        self.next_slot(walk)
     }
 
     fn identity(&self) -> Identity {

@@ -269,6 +269,7 @@ impl Scheme for MdtsPacked {
                     base: state.walk.base + self.array_words(),
                     slot: 0,
                     carried: lo,
+                    probed: false,
                 };
                 Step::Continue
             }

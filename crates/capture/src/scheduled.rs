@@ -445,6 +445,7 @@ fn run_stream<S: Scheme>(
         resolve_time: resolve_start.elapsed(),
         memory_bytes: scheme.layout().bytes(),
         threads: 1,
+        locked_ops: None,
     };
     let trace = memory.log.map(|log| Trace {
         events: log.into_inner(),

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use fragsim_oracle::Oracle;
-use fragsim_raster::{CullMode, View};
+use fragsim_raster::View;
 use fragsim_shade::effects;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -78,7 +78,10 @@ pub struct BenchRow {
     pub error_pixel_rate: Option<f64>,
     /// Memory operations per fragment.
     pub ops_per_fragment: f64,
-    /// Median frame time in milliseconds (passes plus post pass).
+    /// Read-modify-write operations (`lock`-prefixed instructions on x86) per fragment, counted
+    /// in one extra, untimed frame.
+    pub locked_ops_per_fragment: f64,
+    /// Median frame time in milliseconds: vertex stage, geometry passes and post pass.
     pub median_ms: f64,
     /// Fastest frame.
     pub min_ms: f64,
@@ -90,6 +93,10 @@ pub struct BenchRow {
     pub triangles_per_second: f64,
     /// Fragments per second at the median.
     pub fragments_per_second: f64,
+    /// Median time of the vertex stage (transform, outcodes, snapping of every vertex).
+    pub vertex_ms: f64,
+    /// Median time of the geometry passes: storage initialisation, rasterization and capture.
+    pub passes_ms: f64,
     /// Median time of the post pass.
     pub resolve_ms: f64,
     /// Depth peeling's median time over this one, when depth peeling ran.
@@ -113,8 +120,6 @@ pub struct BenchReport {
     pub max_depth_complexity: u32,
     /// Pixels with at least one fragment.
     pub covered_pixels: usize,
-    /// Median vertex stage (transform, outcodes, snapping of every vertex), ms.
-    pub vertex_stage_ms: f64,
     /// Median rasterization alone (every triangle set up and scanned, fragments discarded) on the
     /// pool, ms: what every scheme pays per geometry pass before its first memory operation.
     pub raster_ms: f64,
@@ -149,18 +154,11 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     // it at load); the vertex stage proper is timed per frame, on the pool.
     let aspect = f64::from(viewport.width) / f64::from(viewport.height);
     let camera = orbit.camera(scene.mesh.bounds(), aspect);
-    let vertex_times: Vec<Duration> = (0..frames)
-        .map(|_| {
-            pool.install(|| {
-                let start = Instant::now();
-                let view = View::new(&scene.mesh, &camera, viewport, CullMode::None);
-                let elapsed = start.elapsed();
-                drop(view);
-                elapsed
-            })
-        })
-        .collect();
-    let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+    let serial_pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let mut view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
     check_memory_cap_early(
         &args.scheme,
         viewport,
@@ -190,15 +188,33 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     for name in SchemeName::expand(&args.scheme) {
         for &executor in args.schemes.executors() {
             let mut runner = Executors::default();
+            // A frame is the vertex stage, the geometry passes and the post pass; the serial
+            // executor's vertex stage runs on one thread too.
+            let frame_pool = if executor == "serial" {
+                &serial_pool
+            } else {
+                &pool
+            };
             let mut times = Vec::with_capacity(frames);
+            let mut vertex_times = Vec::with_capacity(frames);
+            let mut pass_times = Vec::with_capacity(frames);
             let mut resolve_times = Vec::with_capacity(frames);
             let mut first = None;
             for _ in 0..frames {
+                let start = Instant::now();
+                frame_pool.install(|| view.set_camera(&camera));
+                let vertex_time = start.elapsed();
                 let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
-                times.push(named.run.stats.pass_time + named.run.stats.resolve_time);
-                resolve_times.push(named.run.stats.resolve_time);
+                let stats = &named.run.stats;
+                times.push(vertex_time + stats.pass_time + stats.resolve_time);
+                vertex_times.push(vertex_time);
+                pass_times.push(stats.pass_time);
+                resolve_times.push(stats.resolve_time);
                 first.get_or_insert(named);
             }
+            runner.count_locked_ops = true;
+            let counted = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
             let named = first.expect("at least one frame");
             let diff = oracle.diff(&named.run.capture);
             let judged = judge.judge(&named.run.capture);
@@ -229,6 +245,8 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 error_pixel_rate: error_pixels.map(|e| e as f64 / covered.max(1) as f64),
                 ops_per_fragment: stats.counters.steps as f64
                     / stats.counters.fragments.max(1) as f64,
+                locked_ops_per_fragment: locked_ops as f64
+                    / counted.run.stats.counters.fragments.max(1) as f64,
                 median_ms: ms(median_time),
                 min_ms: ms(times[0]),
                 max_ms: ms(times[times.len() - 1]),
@@ -236,6 +254,8 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 triangles_per_second: f64::from(view.triangle_count()) * f64::from(stats.passes)
                     / seconds,
                 fragments_per_second: stats.counters.fragments as f64 / seconds,
+                vertex_ms: ms(median(&mut vertex_times)),
+                passes_ms: ms(median(&mut pass_times)),
                 resolve_ms: ms(median(&mut resolve_times)),
                 speedup_vs_depth_peeling: None,
             });
@@ -250,7 +270,6 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         fragments: oracle.fragments(),
         max_depth_complexity: oracle.max_depth_complexity(),
         covered_pixels: covered,
-        vertex_stage_ms: ms(median(&mut vertex_times.clone())),
         raster_ms: ms(median(&mut raster_times.clone())),
         effect: args.effect.label().into(),
         frames: args.frames,
@@ -315,7 +334,7 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
 fn markdown(report: &BenchReport) -> String {
     let mut text = format!(
         "scene {}: {} triangles, {}x{}, {} fragments, max depth complexity {}, {} covered pixels; \
-         vertex stage {:.2} ms, rasterization alone {:.2} ms (medians of {} frames); effect {}\n\n",
+         rasterization alone {:.2} ms (median of {} frames); effect {}\n\n",
         report.scene,
         report.triangles,
         report.width,
@@ -323,21 +342,22 @@ fn markdown(report: &BenchReport) -> String {
         report.fragments,
         report.max_depth_complexity,
         report.covered_pixels,
-        report.vertex_stage_ms,
         report.raster_ms,
         report.frames,
         report.effect
     );
     text.push_str(
-        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR | ops/frag | median ms | min | max | fps | vs DP |\n",
+        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
     );
-    text.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    text.push_str(
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
     let option = |v: Option<f64>, digits: usize| {
         v.map_or_else(|| "n/a".to_string(), |v| format!("{v:.digits$}"))
     };
     for r in &report.rows {
         text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {:.1} | {:.1} | {} |\n",
             r.scheme,
             r.executor,
             r.threads,
@@ -350,10 +370,16 @@ fn markdown(report: &BenchReport) -> String {
             r.mismatched_pixels,
             r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}%", e * 100.0)),
             r.ops_per_fragment,
+            r.locked_ops_per_fragment,
+            r.vertex_ms,
+            r.passes_ms,
+            r.resolve_ms,
             r.median_ms,
             r.min_ms,
             r.max_ms,
             r.fps,
+            r.triangles_per_second / 1e6,
+            r.fragments_per_second / 1e6,
             option(r.speedup_vs_depth_peeling, 2),
         ));
     }

@@ -4,7 +4,7 @@ use clap::ValueEnum;
 use fragsim_capture::abuffer::{ABuffer, PostSort};
 use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
 use fragsim_capture::dual_peeling::DualDepthPeeling;
-use fragsim_capture::executor::{ParallelExecutor, Run, SerialExecutor};
+use fragsim_capture::executor::{self, ParallelExecutor, Run, SerialExecutor};
 use fragsim_capture::kbuffer::KBuffer;
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::mdts::{Direction, Mdts};
@@ -26,6 +26,9 @@ pub enum SchemeName {
     Mdts32,
     /// MDTS with `atomicMax`, descending.
     MdtsDesc,
+    /// MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would
+    /// change the slot (same lists, fewer locked operations).
+    MdtsProbe,
     /// A-buffer, storage sized exactly by a counting pass, insertion-sorted.
     Abuffer,
     /// A-buffer as above, bitonic-sorted.
@@ -64,10 +67,11 @@ pub enum SchemeName {
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 19] = [
+    pub const EVERY: [SchemeName; 20] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
+        SchemeName::MdtsProbe,
         SchemeName::Abuffer,
         SchemeName::AbufferBitonic,
         SchemeName::AbufferFixed,
@@ -156,6 +160,9 @@ pub struct NamedRun {
 pub struct Executors {
     serial: SerialExecutor,
     parallel: ParallelExecutor,
+    /// Run the next frames on fresh storage that counts read-modify-write operations
+    /// ([`RunStats::locked_ops`](fragsim_capture::executor::RunStats)), untimed.
+    pub count_locked_ops: bool,
 }
 
 impl Executors {
@@ -202,6 +209,12 @@ impl Executors {
             ),
             SchemeName::Mdts32 => go(
                 &Mdts::<u32>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
+                Some(k),
+            ),
+            SchemeName::MdtsProbe => go(
+                &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap)
+                    .map_err(err)?
+                    .probing(),
                 Some(k),
             ),
             SchemeName::MdtsDesc => go(
@@ -295,7 +308,7 @@ pub fn check_memory_cap_early(
     let (k_least, capacity_least) = (smallest(k), smallest(capacity));
     for name in SchemeName::expand(names) {
         let result = match name {
-            SchemeName::Mdts => {
+            SchemeName::Mdts | SchemeName::MdtsProbe => {
                 Mdts::<u64>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
             }
             SchemeName::Mdts32 => {
@@ -329,7 +342,10 @@ pub fn check_memory_cap_early(
         };
         if let Err(error) = result {
             let sized_by_scene = match name {
-                SchemeName::Mdts | SchemeName::Mdts32 | SchemeName::MdtsDesc => k == Count::Auto,
+                SchemeName::Mdts
+                | SchemeName::Mdts32
+                | SchemeName::MdtsDesc
+                | SchemeName::MdtsProbe => k == Count::Auto,
                 _ => capacity == Count::Auto,
             };
             return Err(if sized_by_scene {
@@ -357,7 +373,9 @@ impl<S: Scheme> ErasedScheme for S {
     }
 
     fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run {
-        if executor == "serial" {
+        if executors.count_locked_ops {
+            executor::count_locked_ops(view, self, executor != "serial")
+        } else if executor == "serial" {
             executors.serial.run(view, self)
         } else {
             executors.parallel.run(view, self)

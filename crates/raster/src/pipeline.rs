@@ -106,23 +106,17 @@ pub struct View<'mesh> {
     /// Per vertex: bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5:
     /// beyond far; bit 6: not in front of the eye (`w ≤ 0` or NaN).
     outcodes: Vec<u8>,
-    /// Per vertex: the snapped window position and depth; meaningful only when the vertex's
-    /// outcode has no clip bit set.
-    screen: Vec<ScreenVertex>,
+    /// Per vertex: the snapped window position, x and y in 1/256 pixel, y down; meaningful only
+    /// when the vertex's outcode has no clip bit set. Inside the guard band they fit an `i32`
+    /// (|x| < 2^23). Kept apart from the depth: the triangle loop over a large mesh is bound by
+    /// fetching its vertices, and most triangles of a dense mesh are rejected by their bounding
+    /// box alone, before the depth is needed.
+    window_xy: Vec<[i32; 2]>,
+    /// Per vertex: the window depth `z / w`, under the same condition.
+    window_z: Vec<f64>,
     viewport: Viewport,
     cull: CullMode,
     guard: [f64; 2],
-}
-
-/// The vertex stage's output that the triangle loop reads: 16 bytes, a quarter of the clip-space
-/// vertex, because the loop over a large mesh is bound by fetching its three vertices. Clip
-/// coordinates are recomputed, bit for bit, only for the few triangles that need clipping.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct ScreenVertex {
-    /// x, y in 1/256 pixel, y down; inside the guard band they fit an `i32` (|x| < 2^23).
-    xy: [i32; 2],
-    /// Window depth `z / w`.
-    z: f64,
 }
 
 /// A snapped window position (1/256 pixel, y down) and the window depth `z / w`.
@@ -151,7 +145,8 @@ impl<'mesh> View<'mesh> {
             mesh,
             view_projection: camera.view_projection,
             outcodes: Vec::new(),
-            screen: Vec::new(),
+            window_xy: Vec::new(),
+            window_z: Vec::new(),
             viewport,
             cull,
             guard,
@@ -166,32 +161,38 @@ impl<'mesh> View<'mesh> {
         self.view_projection = camera.view_projection;
         let count = self.mesh.positions.len();
         self.outcodes.resize(count, 0);
-        self.screen.resize(count, ScreenVertex::default());
+        self.window_xy.resize(count, [0, 0]);
+        self.window_z.resize(count, 0.0);
         let stage = VertexStage {
             view_projection: self.view_projection,
             planes: self.planes(),
         };
-        // Every vertex is independent: chunks of the three arrays go to the pool side by side.
+        // Every vertex is independent: chunks of the arrays go to the pool side by side.
         self.mesh
             .positions
             .par_chunks(VERTICES_PER_TASK)
             .zip(self.outcodes.par_chunks_mut(VERTICES_PER_TASK))
-            .zip(self.screen.par_chunks_mut(VERTICES_PER_TASK))
-            .for_each(|((positions, outcodes), screen)| {
-                for ((p, outcode), out) in positions.iter().zip(outcodes).zip(screen) {
+            .zip(self.window_xy.par_chunks_mut(VERTICES_PER_TASK))
+            .zip(self.window_z.par_chunks_mut(VERTICES_PER_TASK))
+            .for_each(|(((positions, outcodes), window_xy), window_z)| {
+                let outputs = outcodes.iter_mut().zip(window_xy).zip(window_z);
+                for (p, ((outcode, xy), z)) in positions.iter().zip(outputs) {
                     let clip = stage.clip(*p);
                     *outcode = stage.outcode(clip);
                     if *outcode & CLIP_BITS == 0 {
-                        let ([x, y], z) = snap(self.viewport, clip);
-                        // Inside the guard band |x|, |y| < (MAX_SIDE + 2 · GUARD_BAND) · 256
-                        // = 2^23: the narrowing is lossless.
-                        *out = ScreenVertex {
-                            xy: [x as i32, y as i32],
-                            z,
-                        };
+                        let ([x, y], depth) = snap(self.viewport, clip);
+                        // Inside the guard band: lossless (see `window_xy`).
+                        *xy = [x as i32, y as i32];
+                        *z = depth;
                     }
                 }
             });
+    }
+
+    /// The vertex stage's snapped position and depth of vertex `index` (no clip bit set).
+    fn snapped(&self, index: u32) -> Snapped {
+        let [x, y] = self.window_xy[index as usize];
+        ([x.into(), y.into()], self.window_z[index as usize])
     }
 
     /// The clip-space position of vertex `index`, exactly as the vertex stage computed it.
@@ -231,8 +232,7 @@ impl<'mesh> View<'mesh> {
         if (ca | cb | cc) & NOT_IN_FRONT_BIT != 0 {
             return;
         }
-        let vertices = indices.map(|i| self.screen[i as usize]);
-        let [a, b, c] = vertices.map(|v| v.xy);
+        let [a, b, c] = indices.map(|i| self.window_xy[i as usize]);
         let span = |axis: usize, side: u32| {
             pixel_span(
                 a[axis].min(b[axis]).min(c[axis]).into(),
@@ -243,7 +243,7 @@ impl<'mesh> View<'mesh> {
         if span(0, self.viewport.width).is_none() || span(1, self.viewport.height).is_none() {
             return;
         }
-        let snapped = vertices.map(|v| (v.xy.map(i64::from), v.z));
+        let snapped = indices.map(|i| self.snapped(i));
         self.orient(prim, snapped, &mut |tri| self.scan(&tri, emit));
     }
 
@@ -258,10 +258,7 @@ impl<'mesh> View<'mesh> {
         }
         if (ca | cb | cc) & CLIP_BITS == 0 {
             if (ca | cb | cc) & NOT_IN_FRONT_BIT == 0 {
-                let snapped = indices.map(|i| {
-                    let v = self.screen[i as usize];
-                    (v.xy.map(i64::from), v.z)
-                });
+                let snapped = indices.map(|i| self.snapped(i));
                 self.orient(prim, snapped, visit);
             }
             return;
@@ -393,6 +390,7 @@ impl<'mesh> View<'mesh> {
     }
 }
 
+#[inline]
 /// The first and last pixel whose centre lies in `[lo, hi]` (1/256 pixel) and on a viewport side
 /// of `side` pixels; `None` when there is none.
 fn pixel_span(lo: i64, hi: i64, side: u32) -> Option<(i64, i64)> {
@@ -447,11 +445,27 @@ fn snap(viewport: Viewport, v: DVec4) -> Snapped {
     let y = (0.5 - v.y / v.w * 0.5) * h;
     (
         [
-            (x * ONE as f64).round() as i64,
-            (y * ONE as f64).round() as i64,
+            round_half_away(x * ONE as f64),
+            round_half_away(y * ONE as f64),
         ],
         v.z / v.w,
     )
+}
+
+/// `value.round() as i64` (half away from zero, saturating, NaN to 0) without a libm call:
+/// baseline x86-64 has no rounding instruction, only the truncating conversion. The fraction
+/// `value − trunc(value)` is exact for every f64, so the comparison with one half decides exactly
+/// as `round` does.
+fn round_half_away(value: f64) -> i64 {
+    let truncated = value as i64;
+    let fraction = value - truncated as f64;
+    if fraction >= 0.5 {
+        truncated.saturating_add(1)
+    } else if fraction <= -0.5 {
+        truncated.saturating_sub(1)
+    } else {
+        truncated
+    }
 }
 
 /// Twice the signed area of `(a, b, p)`: positive when `p` is on the interior side of `a → b` for
@@ -575,6 +589,45 @@ mod tests {
             assert!(v.x.abs() <= gx * v.w && v.y.abs() <= gy * v.w, "{v:?}");
         }
         assert!(coverage(&view).iter().all(|&c| c == 0));
+    }
+
+    #[test]
+    fn rounding_without_libm_equals_f64_round() {
+        let mut values = vec![
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            4_503_599_627_370_495.5,
+            4_503_599_627_370_497.0,
+            1e30,
+            -1e30,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+        ];
+        // Halves and their neighbours over the snapped range, and a deterministic spread.
+        for i in -3000i32..3000 {
+            let half = f64::from(i) + 0.5;
+            values.extend([half, half.next_up(), half.next_down()]);
+        }
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            values.push(f64::from_bits(x));
+        }
+        for v in values {
+            assert_eq!(round_half_away(v), v.round() as i64, "{v:e}");
+        }
     }
 
     #[test]
