@@ -14,7 +14,8 @@
 //!   [`kbuffer_multipass`] (Liu et al. 2006), [`stencil_routed`] (Myers & Bavoil 2007) and
 //!   [`bucket`] (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive).
 //!
-//! Executors: [`executor`] (serial and parallel, storage kept between frames) and [`scheduled`]
+//! Executors: [`executor`] (serial and parallel, storage kept between frames), [`tiled`]
+//! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`]
 //! (replayable GPU-like interleavings with traces).
 //!
 //! ```
@@ -43,6 +44,7 @@ pub mod peeling;
 pub mod scheduled;
 mod scheme;
 pub mod stencil_routed;
+pub mod tiled;
 pub mod zbuffer;
 
 pub use capture::{Capture, Identity, Keeps};

@@ -73,7 +73,7 @@ pub struct SchemeArgs {
     /// A-buffer slots per pixel; `exact` sizes each pixel's list from a counting pass.
     #[arg(long, default_value = "exact", allow_negative_numbers = true, value_parser = parse_count)]
     pub capacity: Count,
-    /// Executor: serial, parallel or all.
+    /// Executor: serial, parallel, tiled or all.
     #[arg(long, default_value = "parallel")]
     pub executor: ExecutorChoice,
     /// Threads of the parallel executor (default: one per core).
@@ -106,7 +106,8 @@ impl SchemeArgs {
         match self.executor {
             ExecutorChoice::Serial => &["serial"],
             ExecutorChoice::Parallel => &["parallel"],
-            ExecutorChoice::All => &["serial", "parallel"],
+            ExecutorChoice::Tiled => &["tiled"],
+            ExecutorChoice::All => &["serial", "parallel", "tiled"],
         }
     }
 }
@@ -165,6 +166,8 @@ pub enum ExecutorChoice {
     Serial,
     /// rayon, one logical thread per triangle, std atomics.
     Parallel,
-    /// Both.
+    /// rayon, triangles binned into 32 × 32 pixel tiles, one thread per tile at a time.
+    Tiled,
+    /// All three.
     All,
 }

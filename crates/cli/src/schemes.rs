@@ -11,6 +11,7 @@ use fragsim_capture::mdts::{Direction, Mdts};
 use fragsim_capture::mdts_packed::{Colours, MdtsPacked};
 use fragsim_capture::peeling::DepthPeeling;
 use fragsim_capture::stencil_routed::StencilRouted;
+use fragsim_capture::tiled::TiledExecutor;
 use fragsim_capture::zbuffer::ZBuffer;
 use fragsim_capture::{CaptureError, Scheme};
 use fragsim_raster::{View, Viewport};
@@ -160,6 +161,7 @@ pub struct NamedRun {
 pub struct Executors {
     serial: SerialExecutor,
     parallel: ParallelExecutor,
+    tiled: TiledExecutor,
     /// Run the next frames on fresh storage that counts read-modify-write operations
     /// ([`RunStats::locked_ops`](fragsim_capture::executor::RunStats)), untimed.
     pub count_locked_ops: bool,
@@ -167,7 +169,7 @@ pub struct Executors {
 
 impl Executors {
     /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor`
-    /// (`serial` or `parallel`, on the current rayon pool).
+    /// (`serial`, or `parallel` or `tiled` on the current rayon pool).
     ///
     /// # Errors
     /// A parameter the scheme rejects, or storage beyond the memory cap.
@@ -375,10 +377,12 @@ impl<S: Scheme> ErasedScheme for S {
     fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run {
         if executors.count_locked_ops {
             executor::count_locked_ops(view, self, executor != "serial")
-        } else if executor == "serial" {
-            executors.serial.run(view, self)
         } else {
-            executors.parallel.run(view, self)
+            match executor {
+                "serial" => executors.serial.run(view, self),
+                "tiled" => executors.tiled.run(view, self),
+                _ => executors.parallel.run(view, self),
+            }
         }
     }
 }
