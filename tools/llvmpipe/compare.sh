@@ -43,14 +43,14 @@ echo "== $ROUNDS rounds x $FRAMES frames; fragsim --threads $THREADS --scheme $S
 
 echo "== building"
 cargo build --release --quiet
-cargo build --release --quiet --manifest-path "$here/prep/Cargo.toml" --target-dir "$WORK/prep-target"
+cargo build --release --quiet --manifest-path "$here/prep/Cargo.toml"
 if ! cc -O2 -Wall -o "$WORK/draw" "$here/draw.c" -lEGL -lOpenGL; then
     echo "draw.c did not build: install the packages (README.md):" >&2
     echo "  apt-get install -y gcc libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri" >&2
     exit 2
 fi
 fragsim="$root/target/release/fragsim"
-prep="$WORK/prep-target/release/fragsim-llvmpipe-prep"
+prep="$here/prep/target/release/fragsim-llvmpipe-prep"
 
 echo "== fragsim's vertex stage and depth complexity (prep)"
 "$prep" "$MESH" "$WIDTH" "$HEIGHT" "$VIEW" "$ELEVATION" "$MODE" "$WORK/scene.bin" "$WORK/fragsim.u32" \
