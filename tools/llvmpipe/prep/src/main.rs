@@ -164,7 +164,9 @@ fn run() -> Result<(), String> {
         }
     }
     if max_err != 0.0 {
-        return Err(format!("clip coordinates not exact in f32 (error {max_err:e})"));
+        return Err(format!(
+            "clip coordinates not exact in f32 (error {max_err:e})"
+        ));
     }
     for tri in &mesh.triangles {
         for i in tri {
