@@ -9,6 +9,7 @@
 #   FRAMES [30]      timed frames per run (each side reports its median)
 #   SCHEMES [mdts,abuffer]   fragsim schemes (`fragsim bench --scheme`)
 #   THREADS [cores]  fragsim's --threads
+#   EXECUTOR [parallel]      fragsim's --executor (comma-separated, or `all`)
 #   LP_THREADS [default]     llvmpipe thread settings to run each round, space-separated:
 #                    `default` leaves LP_NUM_THREADS unset (llvmpipe: one thread per CPU), a
 #                    number sets it (0: rasterize on the calling thread)
@@ -32,6 +33,7 @@ ROUNDS=${ROUNDS:-5}
 FRAMES=${FRAMES:-30}
 SCHEMES=${SCHEMES:-mdts,abuffer}
 THREADS=${THREADS:-$(nproc)}
+EXECUTOR=${EXECUTOR:-parallel}
 LP_THREADS=${LP_THREADS:-default}
 MODE=${MODE:-exact}
 WORK=${WORK:-$root/target/llvmpipe}
@@ -39,7 +41,7 @@ mkdir -p "$WORK"
 
 echo "== $(date -u '+%Y-%m-%d %H:%M:%S UTC'), $(nproc) cores, $(uname -sr), load: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "== mesh $MESH, ${WIDTH}x${HEIGHT}, view $VIEW, elevation $ELEVATION, mode $MODE"
-echo "== $ROUNDS rounds x $FRAMES frames; fragsim --threads $THREADS --scheme $SCHEMES; llvmpipe: $LP_THREADS"
+echo "== $ROUNDS rounds x $FRAMES frames; fragsim --threads $THREADS --scheme $SCHEMES --executor $EXECUTOR; llvmpipe: $LP_THREADS"
 
 echo "== building"
 cargo build --release --quiet
@@ -67,7 +69,7 @@ run_llvmpipe() { # $1: round, $2: thread setting
 }
 run_fragsim() { # $1: round
     "$fragsim" bench --mesh "$MESH" --width "$WIDTH" --height "$HEIGHT" --view "$VIEW" \
-        --elevation "$ELEVATION" --scheme "$SCHEMES" --frames "$FRAMES" --threads "$THREADS" \
+        --elevation "$ELEVATION" --scheme "$SCHEMES" --executor "$EXECUTOR" --frames "$FRAMES" --threads "$THREADS" \
         --json --out "$WORK/fragsim-r$1" > /dev/null
 }
 
@@ -90,21 +92,22 @@ fs = {r: json.load(open(f"{work}/fragsim-r{r}/bench.json")) for r in range(1, ro
 lp = {(r, t): json.load(open(f"{work}/llvmpipe-r{r}-t{t}.json"))
       for r in range(1, rounds + 1) for t in lp_threads}
 schemes = [(row["scheme"], row["executor"], row["threads"]) for row in fs[1]["rows"]]
+def row(r, s, e):
+    return next(x for x in fs[r]["rows"] if x["scheme"] == s and x["executor"] == e)
 first = next(iter(lp.values()))
 print(f"llvmpipe: {first['renderer']}; fragsim: {fs[1]['scene']}, {fs[1]['triangles']} triangles")
 print("ms per frame (each the median of its run's frames; fragsim's includes the vertex stage)")
 head = ["round"] + [f"llvmpipe[{t}]" for t in lp_threads] + [f"{s}/{e}x{n}" for s, e, n in schemes]
-head += [f"ratio {t}/{s}" for t in lp_threads for s, _, _ in schemes]
+head += [f"ratio {t}/{s}/{e}" for t in lp_threads for s, e, _ in schemes]
 print(" | ".join(head))
-ratios = {(t, s): [] for t in lp_threads for s, _, _ in schemes}
+ratios = {(t, s, e): [] for t in lp_threads for s, e, _ in schemes}
 for r in range(1, rounds + 1):
-    rows = {row["scheme"]: row for row in fs[r]["rows"]}
     cells = [str(r)] + [f"{lp[(r, t)]['median_ms']:.1f}" for t in lp_threads]
-    cells += [f"{rows[s]['median_ms']:.1f}" for s, _, _ in schemes]
+    cells += [f"{row(r, s, e)['median_ms']:.1f}" for s, e, _ in schemes]
     for t in lp_threads:
-        for s, _, _ in schemes:
-            q = lp[(r, t)]["median_ms"] / rows[s]["median_ms"]
-            ratios[(t, s)].append(q)
+        for s, e, _ in schemes:
+            q = lp[(r, t)]["median_ms"] / row(r, s, e)["median_ms"]
+            ratios[(t, s, e)].append(q)
             cells.append(f"{q:.2f}")
     print(" | ".join(cells))
 print("median over rounds:")
@@ -112,25 +115,23 @@ for t in lp_threads:
     lp_ms = statistics.median(lp[(r, t)]["median_ms"] for r in range(1, rounds + 1))
     print(f"  llvmpipe[{t}] {lp_ms:.1f} ms")
 for s, e, n in schemes:
-    ms = statistics.median(next(x for x in fs[r]["rows"] if x["scheme"] == s)["median_ms"]
-                           for r in range(1, rounds + 1))
-    row = next(x for x in fs[1]["rows"] if x["scheme"] == s)
-    print(f"  fragsim {s} ({e}, {n} threads) {ms:.1f} ms, of which vertex stage "
-          f"{row['vertex_ms']:.1f} ms in round 1; mismatched pixels {row['mismatched_pixels']}")
-for (t, s), q in ratios.items():
-    print(f"  ratio llvmpipe[{t}] / fragsim {s}: median {statistics.median(q):.2f} "
+    ms = statistics.median(row(r, s, e)["median_ms"] for r in range(1, rounds + 1))
+    vertex = statistics.median(row(r, s, e)["vertex_ms"] for r in range(1, rounds + 1))
+    bad = max(row(r, s, e)["mismatched_pixels"] for r in range(1, rounds + 1))
+    print(f"  fragsim {s} ({e}, {n} threads) {ms:.1f} ms, of which vertex stage {vertex:.1f} ms; "
+          f"mismatched pixels {bad}")
+for (t, s, e), q in ratios.items():
+    print(f"  ratio llvmpipe[{t}] / fragsim {s} ({e}): median {statistics.median(q):.2f} "
           f"(min {min(q):.2f}, max {max(q):.2f})")
 # Load from other processes only adds time: each run's fastest frame is the least disturbed.
 print("fastest frames (min over each run's frames), ratio of the fastest per round, median:")
 for t in lp_threads:
-    for s, _, _ in schemes:
-        q = [lp[(r, t)]["min_ms"] / next(x for x in fs[r]["rows"] if x["scheme"] == s)["min_ms"]
-             for r in range(1, rounds + 1)]
+    for s, e, _ in schemes:
+        q = [lp[(r, t)]["min_ms"] / row(r, s, e)["min_ms"] for r in range(1, rounds + 1)]
         lp_min = min(lp[(r, t)]["min_ms"] for r in range(1, rounds + 1))
-        fs_min = min(next(x for x in fs[r]["rows"] if x["scheme"] == s)["min_ms"]
-                     for r in range(1, rounds + 1))
-        print(f"  llvmpipe[{t}] {lp_min:.1f} ms / fragsim {s} {fs_min:.1f} ms (fastest of all "
-              f"rounds); per-round ratio median {statistics.median(q):.2f} "
+        fs_min = min(row(r, s, e)["min_ms"] for r in range(1, rounds + 1))
+        print(f"  llvmpipe[{t}] {lp_min:.1f} ms / fragsim {s} ({e}) {fs_min:.1f} ms (fastest of "
+              f"all rounds); per-round ratio median {statistics.median(q):.2f} "
               f"(min {min(q):.2f}, max {max(q):.2f})")
 
 # The pictures: llvmpipe's per-pixel counts against fragsim's depth complexity.
