@@ -104,6 +104,7 @@ impl PixelRect {
 
     /// The pixel centres that a bounding box `[lo, hi]` (x and y in 1/256 pixel) holds inside
     /// this rectangle; `None` when there is none.
+    #[inline]
     fn centres_within(self, lo: [i64; 2], hi: [i64; 2]) -> Option<Self> {
         let x = pixel_span(lo[0], hi[0], self.x)?;
         let y = pixel_span(lo[1], hi[1], self.y)?;
@@ -487,15 +488,20 @@ impl VertexStage {
         transform(self.view_projection, position)
     }
 
+    /// The outcode of [`View::planes`] and the far plane, each plane written out rather than as a
+    /// dot product with mostly zero coefficients: for finite coordinates (always: positions are
+    /// finite f32 and the matrix finite f64) the zero terms add only signed zeros, so each sum is
+    /// rounded exactly as the dot product's and every comparison decides the same.
     fn outcode(&self, clip: DVec4) -> u8 {
-        let mut outcode = self
-            .planes
-            .iter()
-            .enumerate()
-            .fold(0u8, |code, (i, plane)| {
-                code | (u8::from(plane.dot(clip) < 0.0) << i)
-            });
-        if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
+        let [_, right, _, bottom, _] = self.planes;
+        let (gx, gy) = (right.w, bottom.w);
+        let DVec4 { x, y, z, w } = clip;
+        let mut outcode = u8::from(z < 0.0)
+            | u8::from(x + gx * w < 0.0) << 1
+            | u8::from(-x + gx * w < 0.0) << 2
+            | u8::from(y + gy * w < 0.0) << 3
+            | u8::from(-y + gy * w < 0.0) << 4;
+        if -z + w < 0.0 {
             outcode |= FAR_BIT;
         }
         if !in_front(clip) {
@@ -666,6 +672,57 @@ mod tests {
             assert!(v.x.abs() <= gx * v.w && v.y.abs() <= gy * v.w, "{v:?}");
         }
         assert!(coverage(&view).iter().all(|&c| c == 0));
+    }
+
+    #[test]
+    fn the_written_out_outcode_equals_the_plane_dot_products() {
+        let mesh = Mesh {
+            positions: vec![],
+            triangles: vec![],
+        };
+        let view = view_of(&mesh, 37);
+        let stage = VertexStage {
+            view_projection: DMat4::IDENTITY,
+            planes: view.planes(),
+        };
+        let by_dot_products = |clip: DVec4| {
+            let mut code = stage
+                .planes
+                .iter()
+                .enumerate()
+                .fold(0u8, |code, (i, plane)| {
+                    code | (u8::from(plane.dot(clip) < 0.0) << i)
+                });
+            if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
+                code |= FAR_BIT;
+            }
+            if !in_front(clip) {
+                code |= NOT_IN_FRONT_BIT;
+            }
+            code
+        };
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let specials = [0.0, -0.0, 1.0, -1.0, 1e-300, 3.4e38, -3.4e38, 1e300];
+        for _ in 0..200_000 {
+            let mut coordinate = || {
+                let bits = next();
+                match bits % 4 {
+                    0 => specials[(bits >> 8) as usize % specials.len()],
+                    1 => (bits >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0,
+                    _ => f64::from_bits(bits).clamp(-1e300, 1e300),
+                }
+            };
+            let clip = DVec4::new(coordinate(), coordinate(), coordinate(), coordinate());
+            if clip.is_finite() {
+                assert_eq!(stage.outcode(clip), by_dot_products(clip), "{clip:?}");
+            }
+        }
     }
 
     #[test]
