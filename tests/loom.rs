@@ -70,6 +70,9 @@ macro_rules! loom_words {
             fn fetch_or(&self, i: usize, v: $word) -> $word {
                 self.$field[i].fetch_or(v, Relaxed)
             }
+            fn swap(&self, i: usize, v: $word) -> $word {
+                self.$field[i].swap(v, Relaxed)
+            }
         }
     };
 }
