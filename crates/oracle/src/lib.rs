@@ -18,7 +18,7 @@
 pub mod dump;
 
 use fragsim_capture::{Capture, Identity, Keeps};
-use fragsim_raster::View;
+use fragsim_raster::{Fragment, View};
 
 /// How the oracle orders (or merges) fragments of one pixel at one depth key: the tie policies
 /// that shipping GPU code differs on.
@@ -74,11 +74,24 @@ impl Oracle {
     /// Rasterizes `view` twice (count, then fill) and sorts every pixel's list.
     #[must_use]
     pub fn build(view: &View<'_>) -> Self {
-        let pixels = view.viewport().pixels();
+        Self::from_stream(view.viewport().pixels(), |emit| {
+            for prim in 0..view.triangle_count() {
+                view.rasterize(prim, &mut |f| emit(f));
+            }
+        })
+    }
+
+    /// The oracle of a hand-written fragment stream over `pixels` pixels (every fragment's pixel
+    /// must be below `pixels`): what the property suites check schemes against.
+    #[must_use]
+    pub fn from_fragments(pixels: usize, fragments: &[Fragment]) -> Self {
+        Self::from_stream(pixels, |emit| fragments.iter().for_each(|&f| emit(f)))
+    }
+
+    /// Runs `stream` twice (count, then fill) and sorts every pixel's list.
+    fn from_stream(pixels: usize, stream: impl Fn(&mut dyn FnMut(Fragment))) -> Self {
         let mut counts = vec![0usize; pixels];
-        for prim in 0..view.triangle_count() {
-            view.rasterize(prim, &mut |f| counts[f.pixel as usize] += 1);
-        }
+        stream(&mut |f| counts[f.pixel as usize] += 1);
         let mut offsets = Vec::with_capacity(pixels + 1);
         offsets.push(0);
         for &c in &counts {
@@ -86,13 +99,11 @@ impl Oracle {
         }
         let mut next = offsets[..pixels].to_vec();
         let mut entries = vec![0u64; offsets[pixels]];
-        for prim in 0..view.triangle_count() {
-            view.rasterize(prim, &mut |f| {
-                let p = f.pixel as usize;
-                entries[next[p]] = f.packed();
-                next[p] += 1;
-            });
-        }
+        stream(&mut |f| {
+            let p = f.pixel as usize;
+            entries[next[p]] = f.packed();
+            next[p] += 1;
+        });
         for p in 0..pixels {
             entries[offsets[p]..offsets[p + 1]].sort_unstable();
         }
