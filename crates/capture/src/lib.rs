@@ -17,7 +17,8 @@
 //!   depths merge), [`layer_counter`] (Bevy 0.15) and [`linked_list`] (per-pixel linked lists,
 //!   Yang et al. 2010, with the resolve policies the samples ship).
 //!
-//! Executors: [`executor`] (serial and parallel, storage kept between frames) and [`scheduled`]
+//! Executors: [`executor`] (serial and parallel, storage kept between frames), [`tiled`]
+//! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`]
 //! (replayable GPU-like interleavings with traces).
 //!
 //! ```
@@ -49,6 +50,7 @@ pub mod peeling;
 pub mod scheduled;
 mod scheme;
 pub mod stencil_routed;
+pub mod tiled;
 pub mod zbuffer;
 
 pub use capture::{Capture, Identity, Keeps};

@@ -75,8 +75,8 @@ pub struct SchemeArgs {
     /// list (the linked lists' pool) from a counting pass.
     #[arg(long, default_value = "exact", allow_negative_numbers = true, value_parser = parse_count)]
     pub capacity: Count,
-    /// Executor: serial, parallel, scheduled (replayable GPU-like interleaving) or all (serial
-    /// and parallel).
+    /// Executor: serial, parallel, tiled, scheduled (a replayable GPU-like interleaving) or all
+    /// (serial, parallel and tiled).
     #[arg(long, default_value = "parallel")]
     pub executor: ExecutorChoice,
     /// Threads of the parallel executor (default: one per core).
@@ -109,8 +109,9 @@ impl SchemeArgs {
         match self.executor {
             ExecutorChoice::Serial => &["serial"],
             ExecutorChoice::Parallel => &["parallel"],
+            ExecutorChoice::Tiled => &["tiled"],
             ExecutorChoice::Scheduled => &["scheduled"],
-            ExecutorChoice::All => &["serial", "parallel"],
+            ExecutorChoice::All => &["serial", "parallel", "tiled"],
         }
     }
 }
@@ -169,8 +170,10 @@ pub enum ExecutorChoice {
     Serial,
     /// rayon, one logical thread per triangle, std atomics.
     Parallel,
+    /// rayon, triangles binned into 32 × 32 pixel tiles, one thread per tile at a time.
+    Tiled,
     /// One thread, the scheduled executor's random interleaving of 256 fragments in flight.
     Scheduled,
-    /// Serial and parallel.
+    /// Serial, parallel and tiled.
     All,
 }

@@ -15,6 +15,7 @@ use fragsim_capture::mdts_packed::{Colours, MdtsPacked};
 use fragsim_capture::peeling::DepthPeeling;
 use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim_capture::stencil_routed::StencilRouted;
+use fragsim_capture::tiled::TiledExecutor;
 use fragsim_capture::zbuffer::ZBuffer;
 use fragsim_capture::{CaptureError, Scheme};
 use fragsim_raster::{View, Viewport};
@@ -187,6 +188,7 @@ pub struct NamedRun {
 pub struct Executors {
     serial: SerialExecutor,
     parallel: ParallelExecutor,
+    tiled: TiledExecutor,
     /// Run the next frames on fresh storage that counts read-modify-write operations
     /// ([`RunStats::locked_ops`](fragsim_capture::executor::RunStats)), untimed.
     pub count_locked_ops: bool,
@@ -194,7 +196,7 @@ pub struct Executors {
 
 impl Executors {
     /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor`
-    /// (`serial` or `parallel`, on the current rayon pool).
+    /// (`serial`, or `parallel` or `tiled` on the current rayon pool).
     ///
     /// # Errors
     /// A parameter the scheme rejects, or storage beyond the memory cap.
@@ -435,12 +437,13 @@ impl<S: Scheme> ErasedScheme for S {
     fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run {
         if executors.count_locked_ops {
             executor::count_locked_ops(view, self, executor != "serial")
-        } else if executor == "scheduled" {
-            run_scheduled(view, self, &SCHEDULE, false).run
-        } else if executor == "serial" {
-            executors.serial.run(view, self)
         } else {
-            executors.parallel.run(view, self)
+            match executor {
+                "serial" => executors.serial.run(view, self),
+                "tiled" => executors.tiled.run(view, self),
+                "scheduled" => run_scheduled(view, self, &SCHEDULE, false).run,
+                _ => executors.parallel.run(view, self),
+            }
         }
     }
 }
