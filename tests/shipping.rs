@@ -24,6 +24,7 @@ use fragsim::capture::mdts::Mdts;
 use fragsim::capture::scheduled::{
     run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
 };
+use fragsim::capture::tiled::run_tiled;
 use fragsim::capture::{Capture, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
@@ -306,7 +307,8 @@ fn linked_list_keep_first_loses_the_nearest_arriving_first() {
     assert_eq!(nearest.pixel(0), &oracle.pixel(0)[..2]);
 }
 
-/// Every shipping scheme on the serial, parallel and scheduled executors on the spheres scene:
+/// Every shipping scheme on the serial, parallel, tiled and scheduled executors on the spheres
+/// scene:
 /// the departures are those the properties pin down.
 #[test]
 fn shipping_schemes_on_every_executor() {
@@ -347,7 +349,8 @@ fn shipping_schemes_on_every_executor() {
         MEMORY_CAP_DEFAULT,
     )
     .unwrap();
-    let captures = |f: &dyn Fn(&str) -> Capture| ["serial", "parallel", "scheduled"].map(f);
+    let captures =
+        |f: &dyn Fn(&str) -> Capture| ["serial", "parallel", "tiled", "scheduled"].map(f);
     for got in captures(&|e| on(e, &view, &counter, &schedule)) {
         assert_eq!(oracle.diff(&got).lost, excess);
     }
@@ -367,6 +370,7 @@ fn on<S: Scheme>(executor: &str, view: &View<'_>, scheme: &S, schedule: &Schedul
     match executor {
         "serial" => run_serial(view, scheme).capture,
         "parallel" => run_parallel(view, scheme).capture,
+        "tiled" => run_tiled(view, scheme).capture,
         _ => run_scheduled(view, scheme, schedule, false).run.capture,
     }
 }
