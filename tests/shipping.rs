@@ -24,6 +24,7 @@ use fragsim::capture::mdts::Mdts;
 use fragsim::capture::scheduled::{
     run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
 };
+use fragsim::capture::tiled::run_tiled;
 use fragsim::capture::{Capture, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
@@ -306,7 +307,8 @@ fn linked_list_keep_first_loses_the_nearest_arriving_first() {
     assert_eq!(nearest.pixel(0), &oracle.pixel(0)[..2]);
 }
 
-/// Every shipping scheme on the serial, parallel and scheduled executors on the spheres scene:
+/// Every shipping scheme on the serial, parallel, tiled and scheduled executors on the spheres
+/// scene:
 /// the departures are those the properties pin down.
 #[test]
 fn shipping_schemes_on_every_executor() {
@@ -347,7 +349,8 @@ fn shipping_schemes_on_every_executor() {
         MEMORY_CAP_DEFAULT,
     )
     .unwrap();
-    let captures = |f: &dyn Fn(&str) -> Capture| ["serial", "parallel", "scheduled"].map(f);
+    let captures =
+        |f: &dyn Fn(&str) -> Capture| ["serial", "parallel", "tiled", "scheduled"].map(f);
     for got in captures(&|e| on(e, &view, &counter, &schedule)) {
         assert_eq!(oracle.diff(&got).lost, excess);
     }
@@ -367,6 +370,107 @@ fn on<S: Scheme>(executor: &str, view: &View<'_>, scheme: &S, schedule: &Schedul
     match executor {
         "serial" => run_serial(view, scheme).capture,
         "parallel" => run_parallel(view, scheme).capture,
+        "tiled" => run_tiled(view, scheme).capture,
         _ => run_scheduled(view, scheme, schedule, false).run.capture,
     }
+}
+
+/// `fragsim render` on `args` (no images): per row, (scheme, executor, lost, mismatches).
+fn render_rows(args: &[&str]) -> Vec<(String, String, u64, u64)> {
+    let output = assert_cmd::Command::cargo_bin("fragsim")
+        .unwrap()
+        .arg("--no-images")
+        .args(args)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(0), "{args:?}: {stdout}");
+    stdout
+        .lines()
+        .skip(2)
+        .filter(|line| !line.starts_with("memory sized"))
+        .map(|line| {
+            let cells: Vec<&str> = line.split_whitespace().collect();
+            let number = |i: usize| cells[i].parse::<u64>().unwrap();
+            (cells[0].into(), cells[2].into(), number(12), number(13))
+        })
+        .collect()
+}
+
+/// The smallest scenes' commands of `docs/baselines/shipping.md` print what the docs say, on
+/// every executor they name.
+#[test]
+fn smallest_scenes_through_the_command_line() {
+    let tie = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/docs/baselines/shipping-tie.obj"
+    );
+    let one_pixel = ["--width", "1", "--height", "1", "--elevation", "0"];
+    let run = |extra: &[&str]| render_rows(&[&one_pixel[..], extra].concat());
+    for (scheme, executor, lost, mismatches) in run(&[
+        "--mesh",
+        tie,
+        "--view",
+        "0",
+        "--k",
+        "3",
+        "--scheme",
+        "mdts,loop32",
+        "--executor",
+        "all",
+    ]) {
+        let expected = if scheme == "loop32" { 1 } else { 0 };
+        assert_eq!(
+            (lost, mismatches),
+            (expected, expected),
+            "{scheme} {executor}"
+        );
+    }
+    let merged = run(&[
+        "--mesh",
+        tie,
+        "--view",
+        "0",
+        "--k",
+        "3",
+        "--scheme",
+        "loop32",
+        "--executor",
+        "scheduled",
+        "--ties",
+        "merge-equal-depths",
+    ]);
+    assert_eq!(merged, [("loop32".into(), "scheduled".into(), 0, 0)]);
+    let counter = run(&[
+        "--scene",
+        "quads:3",
+        "--view",
+        "0",
+        "--k",
+        "2",
+        "--scheme",
+        "layer-counter",
+        "--executor",
+        "serial",
+    ]);
+    assert_eq!(counter, [("layer-counter".into(), "serial".into(), 1, 1)]);
+    let lists = run(&[
+        "--scene",
+        "quads:3",
+        "--view",
+        "180",
+        "--k",
+        "2",
+        "--scheme",
+        "linked-list,linked-list-nearest",
+        "--executor",
+        "serial",
+    ]);
+    assert_eq!(
+        lists,
+        [
+            ("linked-list".into(), "serial".into(), 1, 1),
+            ("linked-list-nearest".into(), "serial".into(), 0, 0)
+        ]
+    );
 }

@@ -75,7 +75,7 @@ pub struct SchemeArgs {
     /// list (the linked lists' pool) from a counting pass.
     #[arg(long, default_value = "exact", allow_negative_numbers = true, value_parser = parse_count)]
     pub capacity: Count,
-    /// Executor: serial, parallel, tiled, scheduled (replayable GPU-like interleaving) or all
+    /// Executor: serial, parallel, tiled, scheduled (a replayable GPU-like interleaving) or all
     /// (serial, parallel and tiled).
     #[arg(long, default_value = "parallel")]
     pub executor: ExecutorChoice,

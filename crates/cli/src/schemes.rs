@@ -437,12 +437,11 @@ impl<S: Scheme> ErasedScheme for S {
     fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run {
         if executors.count_locked_ops {
             executor::count_locked_ops(view, self, executor != "serial")
-        } else if executor == "scheduled" {
-            run_scheduled(view, self, &SCHEDULE, false).run
         } else {
             match executor {
                 "serial" => executors.serial.run(view, self),
                 "tiled" => executors.tiled.run(view, self),
+                "scheduled" => run_scheduled(view, self, &SCHEDULE, false).run,
                 _ => executors.parallel.run(view, self),
             }
         }
