@@ -538,3 +538,86 @@ fn the_binary_exports_the_triangles_of_the_view_it_names() {
     let read = TriangleExport::read(&file).unwrap();
     with_view(|view, _| assert_eq!(read, TriangleExport::from_view(view, spec())));
 }
+
+/// A 2 × 2 MDTS dump header (K = 2) whose `slots` array has this file name and shape (JSON).
+fn mdts_header(file: &str, shape: &str) -> String {
+    format!(
+        r#"{{"format": "fragsim-dump", "version": 1, "scene": {{"name": "quads:2",
+            "view_degrees": 30.0, "elevation_degrees": 15.0}}, "width": 2, "height": 2,
+            "scheme": "mdts", "k": 2,
+            "arrays": {{"slots": {{"file": {file:?}, "dtype": "u64", "shape": {shape}}}}}}}"#
+    )
+}
+
+/// Parses `header` from memory with a reader that records every file name it is asked for and
+/// returns eight empty slots.
+fn parse_recording(header: &str) -> (Result<Dump, String>, Vec<String>) {
+    let mut asked = Vec::new();
+    let parsed = Dump::parse("dump.json", header.as_bytes(), |file| {
+        asked.push(file.to_string());
+        Ok(vec![0xFF; 8 * 8])
+    });
+    (parsed.map_err(|e| e.to_string()), asked)
+}
+
+#[test]
+fn dump_parse_reads_a_dump_from_memory_as_read_does_from_files() {
+    let (parsed, asked) = parse_recording(&mdts_header("slots.u64", "[4, 2]"));
+    let dump = parsed.unwrap();
+    assert_eq!(asked, ["slots.u64"]);
+    let capture = dump.capture().unwrap();
+    assert_eq!(capture.pixels(), 4);
+    assert!(
+        (0..4).all(|p| capture.pixel(p).is_empty()),
+        "every slot empty"
+    );
+    let (text, files) = dump.encode().unwrap();
+    let dir = scratch("parse-vs-read");
+    std::fs::write(dir.join("dump.json"), text).unwrap();
+    for (file, bytes) in files {
+        std::fs::write(dir.join(file), bytes).unwrap();
+    }
+    assert_eq!(Dump::read(&dir).unwrap(), dump);
+}
+
+#[test]
+fn regression_dump_parse_refuses_array_file_names_that_leave_the_dump_directory() {
+    for file in [
+        "../slots.u64",
+        "/etc/passwd",
+        "sub/slots.u64",
+        "..",
+        ".",
+        "",
+        "C:slots",
+        "a\\b",
+    ] {
+        let header = mdts_header(file, "[4, 2]");
+        let (parsed, asked) = parse_recording(&header);
+        let error = parsed.expect_err(file);
+        assert!(
+            error.contains("must be a plain file name"),
+            "{file:?}: {error}"
+        );
+        assert!(
+            asked.is_empty(),
+            "{file:?}: the reader was asked for {asked:?}"
+        );
+        let dir = scratch("bad-file-name");
+        std::fs::write(dir.join("dump.json"), header).unwrap();
+        let error = Dump::read(&dir).unwrap_err().to_string();
+        assert!(
+            error.contains("must be a plain file name"),
+            "{file:?}: {error}"
+        );
+    }
+}
+
+#[test]
+fn regression_dump_parse_refuses_a_shape_whose_element_count_overflows() {
+    let header = mdts_header("slots.u64", "[4294967296, 4294967296, 2]");
+    let (parsed, asked) = parse_recording(&header);
+    let error = parsed.unwrap_err();
+    assert!(error.contains("more than 2^64 elements"), "{error}");
+    assert!(asked.is_empty(), "the reader was asked for {asked:?}");
+}

@@ -54,6 +54,11 @@ fn schemes_vs_oracle_corpus_equals_the_sorting_oracle() {
     replay("schemes_vs_oracle", fuzz_support::schemes::check);
 }
 
+#[test]
+fn dump_parse_corpus_parses_round_trips_or_fails_cleanly() {
+    replay("dump_parse", fuzz_support::dump::check);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 
@@ -62,5 +67,6 @@ proptest! {
         fuzz_support::obj_load::check(&data);
         fuzz_support::raster::check(&data);
         fuzz_support::schemes::check(&data);
+        fuzz_support::dump::check(&data);
     }
 }

@@ -4,6 +4,7 @@
 //! libFuzzer and to the replay.
 
 pub mod camera;
+pub mod dump;
 pub mod input;
 pub mod obj_load;
 pub mod raster;

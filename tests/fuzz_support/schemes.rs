@@ -1,15 +1,24 @@
 //! The `schemes_vs_oracle` target: an arbitrary fragment stream on a viewport of fewer than 16
 //! pixels (depth keys from arbitrary f32 in `[0, 1]`, primitive ids distinct per pixel) through
-//! every exact scheme — MDTS with u64 words ascending and descending, with u32 words, and the
-//! A-buffer with exact and fixed storage — run by `Scheme::insert` on `SerialMemory` and by the
-//! scheduled executor under a schedule decoded from the input. Each capture must be what the
-//! scheme promises of an oracle computed here by sorting, and the counted drops must equal what
-//! the capture is missing.
+//! every exact scheme — MDTS with u64 words ascending, probing and descending, with u32 words, the
+//! A-buffer with exact and fixed storage, insertion and bitonic post-sort, the z-buffer, depth
+//! peeling and dual depth peeling on u64 words, and serially the k-buffer, the multi-pass
+//! k-buffer and stencil routing — run serially (every pass, submission order) and, the atomic
+//! ones, by the scheduled executor under a schedule decoded from the input (multi-pass schemes on
+//! cases of depth complexity up to 24, where they cost a pass per layer). Each capture must be
+//! what the scheme promises of an oracle computed here by sorting, and for one-pass schemes the
+//! counted drops must equal what the capture is missing.
 
 use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::executor::Run;
+use fragsim::capture::dual_peeling::DualDepthPeeling;
+use fragsim::capture::executor::{Counters, Run};
+use fragsim::capture::kbuffer::KBuffer;
+use fragsim::capture::kbuffer_multipass::KBufferMultipass;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::peeling::DepthPeeling;
 use fragsim::capture::scheduled::{run_fragments, Granularity, Policy, Schedule};
+use fragsim::capture::stencil_routed::StencilRouted;
+use fragsim::capture::zbuffer::ZBuffer;
 use fragsim::capture::{Capture, Identity, Keeps, Scheme, SerialMemory, Step, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{depth_key, Fragment, Viewport};
 
@@ -17,6 +26,9 @@ use super::input::Input;
 
 /// At most this many fragments are decoded (libFuzzer's inputs are short anyway).
 const MAX_FRAGMENTS: usize = 512;
+
+/// Multi-pass schemes are checked on cases of at most this depth complexity.
+const MAX_MULTIPASS_LAYERS: u32 = 24;
 
 /// The decoded case.
 struct Case {
@@ -91,9 +103,11 @@ pub fn sorted_lists(pixels: u32, fragments: &[Fragment]) -> Vec<Vec<u64>> {
     lists
 }
 
-/// Checks `capture` against `lists` under the capture's promise; `dropped` is the count of walks
-/// that ended in [`Step::Dropped`], which must equal the fragments missing from the capture.
-pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped: u64) {
+/// Checks `capture` against `lists` under the capture's promise; `dropped`, where given, is the
+/// count of walks that ended in [`Step::Dropped`], which must equal the fragments missing from the
+/// capture (multi-pass schemes count overflow per pass and the z-buffer overwrites uncounted,
+/// so they give none).
+pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped: Option<u64>) {
     assert_eq!(capture.pixels(), lists.len(), "{name}: pixel count");
     let mask = match capture.identity {
         Identity::KeyAndPrim => u64::MAX,
@@ -133,38 +147,88 @@ pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped:
         }
         missing += (n - got.len()) as u64;
     }
-    assert_eq!(
-        dropped, missing,
-        "{name}: counted drops vs fragments missing"
-    );
+    if let Some(dropped) = dropped {
+        assert_eq!(
+            dropped, missing,
+            "{name}: counted drops vs fragments missing"
+        );
+    }
 }
 
-/// Runs `scheme` both ways over the case and checks both captures.
-fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>]) {
+/// How a scheme is checked: every one serially (in submission order, every pass), and the
+/// atomic ones also under the case's schedule. Read–modify–write schemes (the k-buffers) are
+/// exact only without concurrent hazards, and stencil routing only in one arrival order, so they
+/// are checked serially alone.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Runs {
+    SerialAndScheduled,
+    SerialOnly,
+}
+
+/// Whether every fragment a one-pass scheme does not keep ends its own walk as
+/// [`Step::Dropped`] (MDTS carries the evicted value to the end of the array; the A-buffer drops
+/// past its capacity), so that the counted drops must equal the fragments missing. A z-buffer's
+/// `atomicMin` overwrites the farther value without a walk to count it: `Uncounted`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Drops {
+    Counted,
+    Uncounted,
+}
+
+/// Runs `scheme` over the case and checks each capture: serially (every pass, fragments in
+/// submission order, each walk to its end), and for `Runs::SerialAndScheduled` under the case's
+/// schedule too. For one-pass schemes of [`Drops::Counted`] the counted drops must equal the
+/// fragments missing.
+fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Runs, drops: Drops) {
     let name = scheme.name();
     let memory: SerialMemory = scheme.layout().allocate();
-    let (mut steps, mut dropped) = (0, 0);
-    for &f in &case.fragments {
-        match scheme.insert(f, &memory, &mut steps) {
-            Step::Dropped => dropped += 1,
-            Step::Stored => {}
-            other => panic!("{name}: a one-pass walk ended with {other:?}"),
+    let mut counters = Counters::default();
+    let mut pass = 0;
+    loop {
+        for &f in &case.fragments {
+            if let Some(state) = scheme.begin_pass(pass, f) {
+                let mut steps = 0;
+                let end = scheme.insert_state(state, &memory, &mut steps);
+                counters.steps += steps;
+                counters.fragments += 1;
+                match end {
+                    Step::Stored => counters.stored += 1,
+                    Step::Dropped => counters.dropped += 1,
+                    Step::Discarded => counters.discarded += 1,
+                    Step::Continue => panic!("{name}: a walk ended with Continue"),
+                }
+            }
         }
+        if !scheme.end_pass(pass, &memory) {
+            break;
+        }
+        pass += 1;
     }
-    check_capture(
-        &format!("{name} serial"),
-        lists,
-        &scheme.resolve(&memory),
-        dropped,
-    );
+    // A scheme whose second pass would take no fragment is a one-pass scheme; multi-pass schemes
+    // count overflow per pass.
+    let one_pass = drops == Drops::Counted
+        && case
+            .fragments
+            .first()
+            .is_none_or(|&f| scheme.begin_pass(1, f).is_none());
+    let capture = scheme.resolve(&memory);
+    let dropped = counted_drops(one_pass, &counters);
+    check_capture(&format!("{name} serial"), lists, &capture, dropped);
+    if runs == Runs::SerialOnly {
+        return;
+    }
     let Run { capture, stats } = run_fragments(scheme, &case.fragments, &case.schedule, false).run;
-    assert_eq!(stats.counters.fragments, case.fragments.len() as u64);
-    check_capture(
-        &format!("{name} under {:?}", case.schedule),
-        lists,
-        &capture,
-        stats.counters.dropped,
-    );
+    if one_pass {
+        assert_eq!(stats.counters.fragments, case.fragments.len() as u64);
+    }
+    let dropped = counted_drops(one_pass, &stats.counters);
+    let name = format!("{name} under {:?}", case.schedule);
+    check_capture(&name, lists, &capture, dropped);
+}
+
+/// The drops that must equal the fragments missing: those of a one-pass scheme of counted drops.
+fn counted_drops(one_pass: bool, counters: &Counters) -> Option<u64> {
+    one_pass.then_some(counters.dropped)
 }
 
 fn check_mdts<W: MdtsWord>(case: &Case, lists: &[Vec<u64>], k: u32) {
@@ -172,26 +236,67 @@ fn check_mdts<W: MdtsWord>(case: &Case, lists: &[Vec<u64>], k: u32) {
     for direction in [Direction::Ascending, Direction::Descending] {
         let scheme = Mdts::<W>::new(viewport, k, direction, MEMORY_CAP_DEFAULT)
             .expect("K ≥ 1 on a few pixels");
-        check_scheme(&scheme, case, lists);
+        check_scheme(
+            &scheme,
+            case,
+            lists,
+            Runs::SerialAndScheduled,
+            Drops::Counted,
+        );
+        if direction == Direction::Ascending {
+            check_scheme(
+                &scheme.probing(),
+                case,
+                lists,
+                Runs::SerialAndScheduled,
+                Drops::Counted,
+            );
+        }
     }
 }
 
-/// Decodes a fragment stream and checks every exact scheme on it.
+/// Decodes a fragment stream and checks every exact scheme on it (those `fragsim` lists as
+/// `exact`, and the `exact-without-hazards` and `exact-in-arrival-order` ones serially), with
+/// storage for the deepest pixel and with the case's smaller `k`; multi-pass schemes on cases of
+/// depth complexity up to [`MAX_MULTIPASS_LAYERS`].
 pub fn check(data: &[u8]) {
     let case = decode(data);
     let lists = sorted_lists(case.pixels, &case.fragments);
     let counts: Vec<u32> = lists.iter().map(|l| l.len() as u32).collect();
     let full = counts.iter().copied().max().unwrap_or(0).max(1);
+    let viewport = Viewport::new(case.pixels, 1).expect("1..=15 pixels");
+    let cap = MEMORY_CAP_DEFAULT;
+    let both = Runs::SerialAndScheduled;
     for k in [case.k, full] {
         check_mdts::<u64>(&case, &lists, k);
         check_mdts::<u32>(&case, &lists, k);
+        // A multi-pass scheme costs a pass per layer over every fragment: deep cases run the
+        // one-pass schemes only, so that the fuzzer keeps its pace.
+        if full > MAX_MULTIPASS_LAYERS {
+            continue;
+        }
+        let peeling = DepthPeeling::<u64>::new(viewport, k, cap).expect("layers ≥ 1");
+        check_scheme(&peeling, &case, &lists, both, Drops::Counted);
+        let dual = DualDepthPeeling::<u64>::new(viewport, k, cap).expect("layers ≥ 1");
+        check_scheme(&dual, &case, &lists, both, Drops::Counted);
+        let kbuffer = KBuffer::new(viewport, k, cap).expect("K ≥ 1");
+        check_scheme(&kbuffer, &case, &lists, Runs::SerialOnly, Drops::Counted);
+        let multipass = KBufferMultipass::new(viewport, case.k, k, cap).expect("K ≥ 1");
+        check_scheme(&multipass, &case, &lists, Runs::SerialOnly, Drops::Counted);
+        let srab = StencilRouted::new(viewport, k.div_ceil(8), cap).expect("passes ≥ 1");
+        check_scheme(&srab, &case, &lists, Runs::SerialOnly, Drops::Counted);
     }
-    let viewport = Viewport::new(case.pixels, 1).expect("1..=15 pixels");
+    check_scheme(
+        &ZBuffer::new(viewport, cap).expect("one word a pixel"),
+        &case,
+        &lists,
+        both,
+        Drops::Uncounted,
+    );
     for sort in [PostSort::Insertion, PostSort::Bitonic] {
-        let exact = ABuffer::exact(&counts, sort, MEMORY_CAP_DEFAULT).expect("tiny storage");
-        check_scheme(&exact, &case, &lists);
-        let fixed =
-            ABuffer::fixed(viewport, case.k, sort, MEMORY_CAP_DEFAULT).expect("tiny storage");
-        check_scheme(&fixed, &case, &lists);
+        let exact = ABuffer::exact(&counts, sort, cap).expect("tiny storage");
+        check_scheme(&exact, &case, &lists, both, Drops::Counted);
+        let fixed = ABuffer::fixed(viewport, case.k, sort, cap).expect("tiny storage");
+        check_scheme(&fixed, &case, &lists, both, Drops::Counted);
     }
 }

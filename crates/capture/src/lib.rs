@@ -8,7 +8,9 @@
 //!
 //! Schemes, one module each, every one stating its algorithm, guarantee, passes and memory:
 //! - FreePipe (Liu et al., I3D 2010): [`mdts`] (the multi-depth test scheme, §4.1.1),
-//!   [`mdts_packed`] (depth and colour packed in 32-bit words, §4.1.2), [`abuffer`] (§4.2);
+//!   [`mdts_packed`] (depth and colour packed in 32-bit words, §4.1.2), [`abuffer`] (§4.2), and
+//!   [`abuffer_atomic_inc`] (its counter as CUDA's wrapping `atomicInc`: a model of the silent
+//!   overwrite on overflow, not a scheme to use);
 //! - the baselines the papers measure: [`zbuffer`] (opaque), [`peeling`] (Everitt 2001),
 //!   [`dual_peeling`] (Bavoil & Myers 2008), [`kbuffer`] (Bavoil et al. 2007),
 //!   [`kbuffer_multipass`] (Liu et al. 2006), [`stencil_routed`] (Myers & Bavoil 2007) and
@@ -33,6 +35,7 @@
 //! ```
 
 pub mod abuffer;
+pub mod abuffer_atomic_inc;
 pub mod bucket;
 mod capture;
 mod counting;

@@ -625,25 +625,40 @@ impl Dump {
         })
     }
 
-    /// Writes `dump.json` and the array files into `dir`, creating it.
+    /// The header as `dump.json` text and each array file's bytes, by file name: what
+    /// [`Dump::write`] puts in a directory, and [`Dump::parse`] reads back.
     ///
     /// # Errors
-    /// I/O failures, or arrays that disagree with the header.
-    pub fn write(&self, dir: &Path) -> Result<(), DumpError> {
-        std::fs::create_dir_all(dir).map_err(|e| io_err("create", dir, e))?;
+    /// Arrays that disagree with the header, or a file name that is not a plain name.
+    pub fn encode(&self) -> Result<(String, BTreeMap<String, Vec<u8>>), DumpError> {
+        let mut files = BTreeMap::new();
         for (name, spec) in &self.header.arrays {
+            check_file_name(name, &spec.file)?;
             let words = self
                 .arrays
                 .get(name)
                 .ok_or_else(|| DumpError(format!("the header names array {name:?}, absent")))?;
             check_array(name, spec, words.dtype(), words.len() as u64)?;
-            let path = dir.join(&spec.file);
-            std::fs::write(&path, words.to_le_bytes()).map_err(|e| io_err("write", &path, e))?;
+            files.insert(spec.file.clone(), words.to_le_bytes());
         }
         let text = serde_json::to_string_pretty(&self.header)
             .map_err(|e| DumpError(format!("cannot encode the header: {e}")))?;
+        Ok((text + "\n", files))
+    }
+
+    /// Writes `dump.json` and the array files into `dir`, creating it.
+    ///
+    /// # Errors
+    /// I/O failures, or arrays that disagree with the header.
+    pub fn write(&self, dir: &Path) -> Result<(), DumpError> {
+        let (text, files) = self.encode()?;
+        std::fs::create_dir_all(dir).map_err(|e| io_err("create", dir, e))?;
+        for (file, bytes) in files {
+            let path = dir.join(file);
+            std::fs::write(&path, bytes).map_err(|e| io_err("write", &path, e))?;
+        }
         let path = dir.join(HEADER_FILE);
-        std::fs::write(&path, text + "\n").map_err(|e| io_err("write", &path, e))
+        std::fs::write(&path, text).map_err(|e| io_err("write", &path, e))
     }
 
     /// Reads a dump from its directory (or from the path of its `dump.json`).
@@ -660,29 +675,51 @@ impl Dump {
                 path.to_path_buf(),
             )
         };
-        let text =
-            std::fs::read_to_string(&header_path).map_err(|e| io_err("read", &header_path, e))?;
-        let header: Header = serde_json::from_str(&text)
-            .map_err(|e| DumpError(format!("{}: {e}", header_path.display())))?;
+        let text = std::fs::read(&header_path).map_err(|e| io_err("read", &header_path, e))?;
+        Self::parse(&header_path.display().to_string(), &text, |file| {
+            let path = dir.join(file);
+            std::fs::read(&path).map_err(|e| io_err("read", &path, e))
+        })
+    }
+
+    /// Decodes a dump from its header's bytes (`dump.json`, named `header_name` in errors) and
+    /// `read_file`, which returns an array file's bytes by its name in the header. Never touches
+    /// the file system itself: [`Dump::read`] passes a reader of the dump's directory, the
+    /// `dump_parse` fuzz target one over its input.
+    ///
+    /// Array file names must be plain names (no directory part, not `.` or `..`), so that a
+    /// header cannot make the reader open a file outside the dump's directory; shapes whose
+    /// element count overflows 64 bits are refused before anything is read.
+    ///
+    /// # Errors
+    /// A malformed header, another format or version, a bad viewport, an array file name that is
+    /// not plain, a shape that overflows, `read_file`'s own errors, or array files whose size
+    /// disagrees with their shape.
+    pub fn parse(
+        header_name: &str,
+        header_bytes: &[u8],
+        mut read_file: impl FnMut(&str) -> Result<Vec<u8>, DumpError>,
+    ) -> Result<Self, DumpError> {
+        let header: Header = serde_json::from_slice(header_bytes)
+            .map_err(|e| DumpError(format!("{header_name}: {e}")))?;
         if header.format != FORMAT {
             return err(format!(
-                "{}: format {:?}, expected {FORMAT:?}",
-                header_path.display(),
+                "{header_name}: format {:?}, expected {FORMAT:?}",
                 header.format
             ));
         }
         if header.version != VERSION {
             return err(format!(
-                "{}: dump format version {}, this fragsim reads version {VERSION}",
-                header_path.display(),
+                "{header_name}: dump format version {}, this fragsim reads version {VERSION}",
                 header.version
             ));
         }
         Viewport::new(header.width, header.height).map_err(DumpError)?;
         let mut arrays = BTreeMap::new();
         for (name, spec) in &header.arrays {
-            let file = dir.join(&spec.file);
-            let bytes = std::fs::read(&file).map_err(|e| io_err("read", &file, e))?;
+            check_file_name(name, &spec.file)?;
+            elements(name, &spec.shape)?;
+            let bytes = read_file(&spec.file)?;
             let width = match spec.dtype {
                 Dtype::U32 => 4,
                 Dtype::U64 => 8,
@@ -690,7 +727,7 @@ impl Dump {
             if bytes.len() % width != 0 {
                 return err(format!(
                     "{}: {} bytes is not a whole number of {width}-byte words",
-                    file.display(),
+                    spec.file,
                     bytes.len()
                 ));
             }
@@ -819,8 +856,34 @@ fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme: &DumpSche
     }
 }
 
+/// Refuses an array file name with a directory part (`/`, `\\`, a drive's `:`), `.`, `..` or
+/// nothing: a dump's arrays lie in its own directory.
+fn check_file_name(name: &str, file: &str) -> Result<(), DumpError> {
+    let plain =
+        !file.is_empty() && file != "." && file != ".." && !file.contains(['/', '\\', ':', '\0']);
+    if plain {
+        Ok(())
+    } else {
+        err(format!(
+            "array {name:?}: file {file:?} must be a plain file name in the dump's directory"
+        ))
+    }
+}
+
+/// The element count of a shape, refused when it overflows 64 bits.
+fn elements(name: &str, shape: &[u64]) -> Result<u64, DumpError> {
+    shape
+        .iter()
+        .try_fold(1u64, |n, &d| n.checked_mul(d))
+        .ok_or_else(|| {
+            DumpError(format!(
+                "array {name:?}: shape {shape:?} has more than 2^64 elements"
+            ))
+        })
+}
+
 fn check_array(name: &str, spec: &ArraySpec, dtype: Dtype, len: u64) -> Result<(), DumpError> {
-    let expected: u64 = spec.shape.iter().product();
+    let expected = elements(name, &spec.shape)?;
     if spec.dtype != dtype {
         return err(format!("array {name:?}: dtype {:?} expected", spec.dtype));
     }
