@@ -33,7 +33,7 @@ pub struct SweepArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for sweep.json and the SVG charts.
+    /// Directory for sweep.json and the PNG charts.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
 }
@@ -123,7 +123,7 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
         .collect();
     let title = format!("error pixels of {} per view angle", args.effect.label());
     fragsim_shade::plot::chart(
-        &args.out.join("sweep-epr.svg"),
+        &args.out.join("sweep-epr.png"),
         &title,
         "view angle (degrees)",
         "EPR (% of covered pixels)",
@@ -143,7 +143,7 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
         })
         .collect();
     fragsim_shade::plot::chart(
-        &args.out.join("sweep-speed-accuracy.svg"),
+        &args.out.join("sweep-speed-accuracy.png"),
         "speed against accuracy (means over the sweep)",
         "frame time (ms)",
         "EPR (% of covered pixels)",
@@ -175,7 +175,7 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
         );
     }
     println!(
-        "wrote {}/sweep.json, sweep-epr.svg, sweep-speed-accuracy.svg",
+        "wrote {}/sweep.json, sweep-epr.png, sweep-speed-accuracy.png",
         args.out.display()
     );
     Ok(())
