@@ -128,9 +128,8 @@ fn fresnel_of_one_fragment_is_schlicks_transmittance() {
             )
             .unwrap();
             let ft = 1.0 - (1.0 - cos).powi(5);
-            for ch in 0..3 {
-                let expected = ft * f64::from(material.base[ch]);
-                assert!((f64::from(colour[ch]) - expected).abs() < 1e-6);
+            for (got, base) in colour.iter().zip(material.base) {
+                assert!((f64::from(*got) - ft * f64::from(base)).abs() < 1e-6);
             }
             // The centre pixel looks straight at the square: Ft = 1.
             if f.pixel == 16 * 33 + 16 {

@@ -332,8 +332,8 @@ mod tests {
         )
         .unwrap();
         let ft = 1.0 - 0.5f64.powi(5);
-        for ch in 0..3 {
-            assert!((f64::from(two[ch]) - ft * ft * f64::from(m.base[ch])).abs() < 1e-6);
+        for (got, base) in two.iter().zip(m.base) {
+            assert!((f64::from(*got) - ft * ft * f64::from(base)).abs() < 1e-6);
         }
         assert_eq!(
             shade_pixel(Effect::Fresnel, &m, Entries::KeyOnly, 0, &[0], geometry),
