@@ -208,22 +208,22 @@ mod tests {
             .view(Viewport::new(48, 40).unwrap(), &OrbitCamera::default())
             .unwrap();
         let attributes = Attributes::new(&view);
-        let mut checked = 0;
+        let (mut checked, mut close) = (0, 0);
         for prim in (0..view.triangle_count()).step_by(7) {
             view.rasterize(prim, &mut |f| {
                 let p = attributes.point(f.prim, f.pixel).unwrap();
                 let clip = view.view_projection() * DVec3::from(p).extend(1.0);
-                let z = clip.z / clip.w;
-                assert!(
-                    (z - f64::from(f.depth())).abs() < 1e-4,
-                    "{z} vs {}",
-                    f.depth()
-                );
+                let error = (clip.z / clip.w - f64::from(f.depth())).abs();
+                // The rasterizer interpolates from snapped positions (1/256 pixel): on triangles
+                // seen nearly edge-on the depth changes fast enough across that to show.
+                assert!(error < 1e-3, "{error} at pixel {}", f.pixel);
+                close += usize::from(error < 2e-4);
                 let b = attributes.barycentrics(f.prim, f.pixel).unwrap();
                 assert!(b.iter().all(|&w| w > -1e-2), "{b:?}");
                 checked += 1;
             });
         }
         assert!(checked > 50);
+        assert!(close * 10 > checked * 9, "{close} of {checked} within 2e-4");
     }
 }
