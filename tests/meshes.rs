@@ -1,6 +1,7 @@
 //! The real scanned meshes of `../shared/meshes/` (beside the project's root): each loads, and
-//! every exact scheme equals the oracle fragment for fragment: the atomic ones on the parallel
-//! executor, the read–modify–write and arrival-order ones (exact only without hazards) serially.
+//! every exact scheme equals the oracle fragment for fragment: the atomic ones on the parallel and
+//! the tiled executors, the read–modify–write and arrival-order ones (exact only without hazards)
+//! serially and tiled (one thread per pixel, primitive order).
 
 use std::path::PathBuf;
 
@@ -12,7 +13,9 @@ use fragsim::capture::kbuffer_multipass::KBufferMultipass;
 use fragsim::capture::mdts::{Direction, Mdts};
 use fragsim::capture::peeling::DepthPeeling;
 use fragsim::capture::stencil_routed::StencilRouted;
+use fragsim::capture::tiled::run_tiled;
 use fragsim::capture::zbuffer::ZBuffer;
+use fragsim::capture::Scheme;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
@@ -55,60 +58,84 @@ fn every_shared_mesh_loads_and_both_schemes_equal_the_oracle() {
         );
         let (viewport, depth) = (view.viewport(), oracle.max_depth_complexity());
         let cap = MEMORY_CAP_DEFAULT;
-        let check = |scheme: &str, run: Run| {
-            let diff = oracle.diff(&run.capture);
-            assert!(diff.is_exact(), "{file} {scheme}: {diff:?}");
+        let check = |scheme: &str, runs: [(&str, Run); 2]| {
+            for (executor, run) in runs {
+                let diff = oracle.diff(&run.capture);
+                assert!(diff.is_exact(), "{file} {scheme} {executor}: {diff:?}");
+            }
         };
         check(
             "mdts",
-            run_parallel(&view, &Mdts::<u64>::ascending(viewport, depth).unwrap()),
+            concurrently(&view, &Mdts::<u64>::ascending(viewport, depth).unwrap()),
         );
         check(
             "mdts-probe",
-            run_parallel(
+            concurrently(
                 &view,
                 &Mdts::<u64>::ascending(viewport, depth).unwrap().probing(),
             ),
         );
         let descending = Mdts::<u64>::new(viewport, depth, Direction::Descending, cap).unwrap();
-        check("mdts-desc", run_parallel(&view, &descending));
+        check("mdts-desc", concurrently(&view, &descending));
         check(
             "abuffer",
-            run_parallel(
+            concurrently(
                 &view,
                 &ABuffer::exact_default(&oracle.depth_complexity()).unwrap(),
             ),
         );
         check(
             "zbuffer",
-            run_parallel(&view, &ZBuffer::for_viewport(viewport).unwrap()),
+            concurrently(&view, &ZBuffer::for_viewport(viewport).unwrap()),
         );
         check(
             "peeling",
-            run_parallel(
+            concurrently(
                 &view,
                 &DepthPeeling::<u64>::with_layers(viewport, depth).unwrap(),
             ),
         );
         check(
             "dual-peeling",
-            run_parallel(
+            concurrently(
                 &view,
                 &DualDepthPeeling::<u64>::with_layers(viewport, depth).unwrap(),
             ),
         );
         check(
             "kbuffer",
-            run_serial(&view, &KBuffer::with_k(viewport, depth).unwrap()),
+            one_writer_per_pixel(&view, &KBuffer::with_k(viewport, depth).unwrap()),
         );
         let multipass = KBufferMultipass::new(viewport, 4, depth, cap).unwrap();
-        check("kbuffer-multipass", run_serial(&view, &multipass));
+        check("kbuffer-multipass", one_writer_per_pixel(&view, &multipass));
         check(
             "srab",
-            run_serial(
+            one_writer_per_pixel(
                 &view,
                 &StencilRouted::new(viewport, depth.div_ceil(8), cap).unwrap(),
             ),
         );
     }
+}
+
+/// An atomic scheme's runs on the two concurrent executors.
+fn concurrently<S: Scheme>(
+    view: &fragsim::raster::View<'_>,
+    scheme: &S,
+) -> [(&'static str, Run); 2] {
+    [
+        ("parallel", run_parallel(view, scheme)),
+        ("tiled", run_tiled(view, scheme)),
+    ]
+}
+
+/// A hazard-prone scheme's runs where each pixel has one writer: serial, and tiled.
+fn one_writer_per_pixel<S: Scheme>(
+    view: &fragsim::raster::View<'_>,
+    scheme: &S,
+) -> [(&'static str, Run); 2] {
+    [
+        ("serial", run_serial(view, scheme)),
+        ("tiled", run_tiled(view, scheme)),
+    ]
 }

@@ -1,5 +1,5 @@
 //! Property tests of the whole system on random scenes, cameras, viewports and `K`: the FreePipe
-//! schemes against the serial oracle on the parallel executor, serial against parallel, fragment
+//! schemes against the serial oracle on the parallel executor, serial against parallel and tiled, fragment
 //! counts, crack-free coverage of closed meshes and planar tilings, and the depth-key order.
 //!
 //! The strategies live in `tests/support/strategies.rs` for other suites to reuse. Case counts are
@@ -10,7 +10,9 @@ mod support;
 
 use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::executor::{run_parallel, run_serial, Run};
+use fragsim::capture::kbuffer::KBuffer;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::tiled::run_tiled;
 use fragsim::capture::{Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{
@@ -200,6 +202,51 @@ proptest! {
                 prop_assert_eq!(diff.captured + beyond, oracle.fragments() as u64, "{}", name);
             }
             Ok(())
+        })?;
+    }
+}
+
+/// Asserts that the tiled executor gave `scheme` exactly the serial executor's run: the capture
+/// and the fragment, step, stored and dropped counts.
+fn check_tiled_equals_serial<S: Scheme>(view: &View<'_>, scheme: &S) -> Result<(), TestCaseError> {
+    let (serial, tiled) = (run_serial(view, scheme), run_tiled(view, scheme));
+    prop_assert!(serial.capture == tiled.capture, "{}", scheme.name());
+    prop_assert_eq!(
+        serial.stats.counters,
+        tiled.stats.counters,
+        "{}",
+        scheme.name()
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(96))]
+
+    /// Property 3b: the tiled executor gives every pixel its fragments in primitive order, from
+    /// one thread, so every scheme's run equals the serial executor's, counts included: the
+    /// atomic schemes, the fixed A-buffer past its capacity (the same subset kept) and the
+    /// k-buffer, whose read–modify–write hazard needs two writers on one pixel.
+    #[test]
+    fn the_tiled_executor_equals_the_serial_one_for_every_scheme(
+        spec in scene_spec(),
+        camera in orbit_camera(),
+        viewport in viewport(),
+        k in k_choice(),
+        capacity in small_capacity(),
+    ) {
+        with_view(&spec, viewport, &camera, |view, oracle| {
+            let max = oracle.max_depth_complexity();
+            let k = k.resolve(max);
+            check_tiled_equals_serial(view, &Mdts::<u64>::ascending(viewport, k).unwrap())?;
+            check_tiled_equals_serial(view, &Mdts::<u64>::ascending(viewport, k).unwrap().probing())?;
+            let exact = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
+            check_tiled_equals_serial(view, &exact)?;
+            let capacity = capacity.resolve(max);
+            let fixed =
+                ABuffer::fixed(viewport, capacity, PostSort::Bitonic, MEMORY_CAP_DEFAULT).unwrap();
+            check_tiled_equals_serial(view, &fixed)?;
+            check_tiled_equals_serial(view, &KBuffer::with_k(viewport, k).unwrap())
         })?;
     }
 }

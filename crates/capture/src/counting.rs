@@ -50,6 +50,10 @@ impl<W: Word, M: WordMemory<W>> WordMemory<W> for CountingMemory<M> {
     fn fetch_or(&self, index: usize, value: W) -> W {
         self.counted().fetch_or(index, value)
     }
+    fn swap(&self, index: usize, value: W) -> W {
+        // `atomicExch` is a locked instruction too (`xchg` with memory is implicitly locked).
+        self.counted().swap(index, value)
+    }
 }
 
 impl<M: Memory> Memory for CountingMemory<M> {

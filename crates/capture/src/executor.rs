@@ -1,5 +1,7 @@
 //! Executors: who runs which fragment's next step, and when.
 //!
+//! The third, [`crate::tiled`], bins triangles into screen tiles first.
+//!
 //! - [`run_serial`]: triangles in submission order on one thread, each fragment's walk run to the
 //!   end before the next fragment starts, on [`SerialMemory`]: the reference behaviour of a scheme.
 //! - [`run_parallel`]: FreePipe's model, one logical thread per triangle, on the current rayon pool
@@ -14,13 +16,13 @@
 
 use std::time::{Duration, Instant};
 
-use fragsim_raster::View;
+use fragsim_raster::{PixelRect, View};
 use rayon::prelude::*;
 
 use crate::capture::Capture;
 use crate::counting::CountingMemory;
 use crate::memory::{AtomicMemory, Memory, SerialMemory};
-use crate::scheme::{Scheme, Step};
+use crate::scheme::{Layout, Scheme, Step};
 
 /// Triangles per rayon work item: large enough to amortise scheduling (~100 ns a task), small
 /// enough to balance the uneven cost of triangles.
@@ -52,7 +54,7 @@ impl Counters {
         }
     }
 
-    fn merge(self, other: Self) -> Self {
+    pub(crate) fn merge(self, other: Self) -> Self {
         Self {
             fragments: self.fragments + other.fragments,
             steps: self.steps + other.steps,
@@ -112,15 +114,7 @@ impl SerialExecutor {
     /// Runs one frame of `scheme` over `view`.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
-        let layout = scheme.layout();
-        let memory = match self.memory.take() {
-            Some(mut memory) if memory.fits(&layout) => {
-                memory.reset(&layout);
-                memory
-            }
-            _ => layout.allocate(),
-        };
-        let memory = self.memory.insert(memory);
+        let memory = reuse_storage(&mut self.memory, scheme);
         let (counters, passes) = serial_passes(view, scheme, &*memory);
         let pass_time = start.elapsed();
         let resolve_start = Instant::now();
@@ -147,15 +141,7 @@ impl ParallelExecutor {
     /// Runs one frame of `scheme` over `view` on the current rayon pool.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
-        let layout = scheme.layout();
-        let memory = match self.memory.take() {
-            Some(mut memory) if memory.fits(&layout) => {
-                memory.reset(&layout);
-                memory
-            }
-            _ => layout.allocate(),
-        };
-        let memory = self.memory.insert(memory);
+        let memory = reuse_storage(&mut self.memory, scheme);
         let (counters, passes) = parallel_passes(view, scheme, &*memory);
         let pass_time = start.elapsed();
         let resolve_start = Instant::now();
@@ -170,6 +156,49 @@ impl ParallelExecutor {
             rayon::current_num_threads(),
         )
     }
+}
+
+/// Storage that a frame loop re-initialises rather than allocates again.
+pub(crate) trait ReusableStorage: Memory + Sized {
+    /// Whether this storage has exactly the words `layout` asks for.
+    fn fits(&self, layout: &Layout) -> bool;
+    /// Re-initialises every word to `layout`'s initial values.
+    fn reset(&mut self, layout: &Layout);
+}
+
+impl ReusableStorage for SerialMemory {
+    fn fits(&self, layout: &Layout) -> bool {
+        SerialMemory::fits(self, layout)
+    }
+    fn reset(&mut self, layout: &Layout) {
+        SerialMemory::reset(self, layout);
+    }
+}
+
+impl ReusableStorage for AtomicMemory {
+    fn fits(&self, layout: &Layout) -> bool {
+        AtomicMemory::fits(self, layout)
+    }
+    fn reset(&mut self, layout: &Layout) {
+        AtomicMemory::reset(self, layout);
+    }
+}
+
+/// The storage of `scheme`'s frame: `kept` re-initialised when it fits the scheme's layout, else
+/// newly allocated; kept again for the next frame.
+pub(crate) fn reuse_storage<'a, S: Scheme, M: ReusableStorage>(
+    kept: &'a mut Option<M>,
+    scheme: &S,
+) -> &'a mut M {
+    let layout = scheme.layout();
+    let memory = match kept.take() {
+        Some(mut memory) if memory.fits(&layout) => {
+            memory.reset(&layout);
+            memory
+        }
+        _ => layout.allocate(),
+    };
+    kept.insert(memory)
 }
 
 /// Runs one frame of `scheme` over `view` on fresh storage that counts its read-modify-write
@@ -224,8 +253,9 @@ pub fn count_locked_ops<S: Scheme>(view: &View<'_>, scheme: &S, parallel: bool) 
 fn serial_passes<S: Scheme, M: Memory>(view: &View<'_>, scheme: &S, memory: &M) -> (Counters, u32) {
     run_passes(scheme, memory, |pass| {
         let mut counters = Counters::default();
+        let rect = view.viewport().rect();
         for prim in 0..view.triangle_count() {
-            rasterize_into(view, scheme, memory, pass, prim, &mut counters);
+            rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
         }
         counters
     })
@@ -242,23 +272,26 @@ fn parallel_passes<S: Scheme, M: Memory + Sync>(
             .into_par_iter()
             .with_min_len(TRIANGLES_PER_TASK)
             .fold(Counters::default, |mut counters, prim| {
-                rasterize_into(view, scheme, memory, pass, prim, &mut counters);
+                let rect = view.viewport().rect();
+                rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
                 counters
             })
             .reduce(Counters::default, Counters::merge)
     })
 }
 
-/// Rasterizes triangle `prim` and runs each fragment's walk of geometry pass `pass` to its end.
-fn rasterize_into<S: Scheme, M: Memory>(
+/// Rasterizes the pixels of `rect` that triangle `prim` covers and runs each fragment's walk of
+/// geometry pass `pass` to its end.
+pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
     view: &View<'_>,
     scheme: &S,
     memory: &M,
     pass: u32,
     prim: u32,
+    rect: PixelRect,
     counters: &mut Counters,
 ) {
-    view.rasterize(prim, &mut |fragment| {
+    view.rasterize_in(prim, rect, &mut |fragment| {
         if let Some(state) = scheme.begin_pass(pass, fragment) {
             let end = scheme.insert_state(state, memory, &mut counters.steps);
             counters.record(end);
@@ -268,7 +301,7 @@ fn rasterize_into<S: Scheme, M: Memory>(
 
 /// Runs geometry passes until the scheme's between-pass kernel asks for no more; returns the
 /// summed counters and the number of passes.
-fn run_passes<S: Scheme, M: Memory>(
+pub(crate) fn run_passes<S: Scheme, M: Memory>(
     scheme: &S,
     memory: &M,
     mut geometry_pass: impl FnMut(u32) -> Counters,
@@ -290,7 +323,7 @@ const PIXELS_PER_TASK: usize = 4096;
 /// The post pass on the rayon pool: pixel chunks resolved independently, then copied into the
 /// capture in parallel (a serial concatenation of a megapixel's offsets would cost as much as the
 /// resolve itself on many threads).
-fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capture {
+pub(crate) fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capture {
     let pixels = scheme.pixels();
     let chunks: Vec<(Vec<u64>, Vec<usize>, Vec<u32>)> = (0..pixels.div_ceil(PIXELS_PER_TASK))
         .into_par_iter()
@@ -338,7 +371,8 @@ fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capt
     capture
 }
 
-fn finish<S: Scheme>(
+/// The run's statistics around its capture.
+pub(crate) fn finish<S: Scheme>(
     scheme: &S,
     capture: Capture,
     counters: Counters,

@@ -12,9 +12,13 @@
 //! - the baselines the papers measure: [`zbuffer`] (opaque), [`peeling`] (Everitt 2001),
 //!   [`dual_peeling`] (Bavoil & Myers 2008), [`kbuffer`] (Bavoil et al. 2007),
 //!   [`kbuffer_multipass`] (Liu et al. 2006), [`stencil_routed`] (Myers & Bavoil 2007) and
-//!   [`bucket`] (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive).
+//!   [`bucket`] (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive);
+//! - shipping OIT backends (`docs/baselines/shipping.md`): [`loop32`] (nvpro-samples, equal
+//!   depths merge), [`layer_counter`] (Bevy 0.15) and [`linked_list`] (per-pixel linked lists,
+//!   Yang et al. 2010, with the resolve policies the samples ship).
 //!
-//! Executors: [`executor`] (serial and parallel, storage kept between frames) and [`scheduled`]
+//! Executors: [`executor`] (serial and parallel, storage kept between frames), [`tiled`]
+//! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`]
 //! (replayable GPU-like interleavings with traces).
 //!
 //! ```
@@ -36,6 +40,9 @@ pub mod dual_peeling;
 pub mod executor;
 pub mod kbuffer;
 pub mod kbuffer_multipass;
+pub mod layer_counter;
+pub mod linked_list;
+pub mod loop32;
 pub mod mdts;
 pub mod mdts_packed;
 mod memory;
@@ -43,6 +50,7 @@ pub mod peeling;
 pub mod scheduled;
 mod scheme;
 pub mod stencil_routed;
+pub mod tiled;
 pub mod zbuffer;
 
 pub use capture::{Capture, Identity, Keeps};

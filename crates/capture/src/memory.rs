@@ -1,8 +1,9 @@
 //! The memory seam: the only place that knows which atomic type is underneath.
 //!
 //! Schemes see per-pixel storage as two flat arrays of words, one of `u32` and one of `u64`,
-//! through [`WordMemory`]'s six operations: the atomics CUDA offers on global memory (`atomicMin`,
-//! `atomicMax`, `atomicAdd`, `atomicOr`) plus plain loads and stores. Every operation is one step.
+//! through [`WordMemory`]'s seven operations: the atomics CUDA offers on global memory (`atomicMin`,
+//! `atomicMax`, `atomicAdd`, `atomicOr`, `atomicExch`) plus plain loads and stores. Every
+//! operation is one step.
 //!
 //! Unlike the GPU, the atomic implementation uses `Relaxed` ordering: the schemes' guarantees need
 //! only per-location atomicity (a total order of the read-modify-writes on each word), and the end
@@ -72,6 +73,8 @@ pub trait WordMemory<W: Word> {
     fn fetch_add(&self, index: usize, value: W) -> W;
     /// `atomicOr`.
     fn fetch_or(&self, index: usize, value: W) -> W;
+    /// `atomicExch` (`imageAtomicExchange`): stores `value`, returns the old value.
+    fn swap(&self, index: usize, value: W) -> W;
 }
 
 /// Per-pixel storage: a `u32` array and a `u64` array.
@@ -128,6 +131,9 @@ macro_rules! serial_words {
                 self.$field[i].set(old | v);
                 old
             }
+            fn swap(&self, i: usize, v: $word) -> $word {
+                self.$field[i].replace(v)
+            }
         }
     };
 }
@@ -155,6 +161,9 @@ macro_rules! atomic_words {
             }
             fn fetch_or(&self, i: usize, v: $word) -> $word {
                 self.$field[i].fetch_or(v, Relaxed)
+            }
+            fn swap(&self, i: usize, v: $word) -> $word {
+                self.$field[i].swap(v, Relaxed)
             }
         }
     };

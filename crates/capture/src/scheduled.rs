@@ -89,6 +89,8 @@ pub enum Op {
     FetchAdd,
     /// `atomicOr`.
     FetchOr,
+    /// `atomicExch`.
+    Swap,
 }
 
 /// One recorded memory operation.
@@ -211,6 +213,11 @@ macro_rules! recording_words {
             fn fetch_or(&self, i: usize, v: $word) -> $word {
                 let old = WordMemory::<$word>::fetch_or(&self.inner, i, v);
                 self.note($bits, i, Op::FetchOr, u64::from(v), u64::from(old));
+                old
+            }
+            fn swap(&self, i: usize, v: $word) -> $word {
+                let old = WordMemory::<$word>::swap(&self.inner, i, v);
+                self.note($bits, i, Op::Swap, u64::from(v), u64::from(old));
                 old
             }
         }

@@ -67,13 +67,16 @@ impl SceneArgs {
 /// How schemes are sized and run.
 #[derive(Debug, Clone, Args)]
 pub struct SchemeArgs {
-    /// MDTS (and k-buffer) slots per pixel; `auto` sizes K to the scene's maximum depth complexity.
+    /// MDTS (and k-buffer, loop32, layer-counter, linked-list resolve) slots per pixel; `auto`
+    /// sizes K to the scene's maximum depth complexity.
     #[arg(long, default_value = "auto", allow_negative_numbers = true, value_parser = parse_count)]
     pub k: Count,
-    /// A-buffer slots per pixel; `exact` sizes each pixel's list from a counting pass.
+    /// A-buffer slots per pixel (linked lists: pool nodes per pixel); `exact` sizes each pixel's
+    /// list (the linked lists' pool) from a counting pass.
     #[arg(long, default_value = "exact", allow_negative_numbers = true, value_parser = parse_count)]
     pub capacity: Count,
-    /// Executor: serial, parallel or all.
+    /// Executor: serial, parallel, tiled, scheduled (a replayable GPU-like interleaving) or all
+    /// (serial, parallel and tiled).
     #[arg(long, default_value = "parallel")]
     pub executor: ExecutorChoice,
     /// Threads of the parallel executor (default: one per core).
@@ -106,7 +109,9 @@ impl SchemeArgs {
         match self.executor {
             ExecutorChoice::Serial => &["serial"],
             ExecutorChoice::Parallel => &["parallel"],
-            ExecutorChoice::All => &["serial", "parallel"],
+            ExecutorChoice::Tiled => &["tiled"],
+            ExecutorChoice::Scheduled => &["scheduled"],
+            ExecutorChoice::All => &["serial", "parallel", "tiled"],
         }
     }
 }
@@ -165,6 +170,10 @@ pub enum ExecutorChoice {
     Serial,
     /// rayon, one logical thread per triangle, std atomics.
     Parallel,
-    /// Both.
+    /// rayon, triangles binned into 32 × 32 pixel tiles, one thread per tile at a time.
+    Tiled,
+    /// One thread, the scheduled executor's random interleaving of 256 fragments in flight.
+    Scheduled,
+    /// Serial, parallel and tiled.
     All,
 }

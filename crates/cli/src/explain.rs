@@ -145,7 +145,7 @@ fn memory_after(trace: &Trace, k: u32, init: u64) -> Vec<Vec<u64>> {
         .map(|e| {
             words[e.word] = match e.op {
                 Op::Load => e.returned,
-                Op::Store => e.operand,
+                Op::Store | Op::Swap => e.operand,
                 Op::FetchMin => e.returned.min(e.operand),
                 Op::FetchMax => e.returned.max(e.operand),
                 Op::FetchAdd => e.returned.wrapping_add(e.operand),
@@ -452,6 +452,7 @@ fn cell(e: &TraceEvent) -> String {
                 Op::FetchMin => "fetch_min",
                 Op::FetchMax => "fetch_max",
                 Op::FetchAdd => "fetch_add",
+                Op::Swap => "swap",
                 _ => "fetch_or",
             };
             format!("{name} w{w} ← {} → {}", value(e.operand), value(e.returned))

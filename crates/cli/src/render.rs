@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::Args;
-use fragsim_oracle::Oracle;
+use clap::{Args, ValueEnum};
+use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::{depth_from_key, Viewport};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -36,6 +36,32 @@ pub struct RenderArgs {
     /// Also write each scheme's per-pixel words as a dump in `DIR/<scheme>/` (docs/dump-format.md).
     #[arg(long, value_name = "DIR")]
     pub dump: Option<PathBuf>,
+    /// The oracle's tie policy for fragments of one pixel at one depth: `by-primitive` (the
+    /// canonical order), `keep-duplicates` (compared by depth key) or `merge-equal-depths`
+    /// (compared by distinct depth key, as loop32 and 32-bit peeling keep them).
+    #[arg(long, default_value = "by-primitive")]
+    pub ties: TieChoice,
+}
+
+/// `--ties`: [`Ties`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TieChoice {
+    /// Ties ordered by primitive id (fragsim's canonical order).
+    ByPrimitive,
+    /// Every fragment kept, compared by depth key (FreePipe's MDTS on 32-bit keys).
+    KeepDuplicates,
+    /// Equal depths merged, compared by distinct depth key (nvpro-samples' loop32).
+    MergeEqualDepths,
+}
+
+impl From<TieChoice> for Ties {
+    fn from(choice: TieChoice) -> Self {
+        match choice {
+            TieChoice::ByPrimitive => Ties::ByPrimitive,
+            TieChoice::KeepDuplicates => Ties::KeepDuplicates,
+            TieChoice::MergeEqualDepths => Ties::MergeEqualDepths,
+        }
+    }
 }
 
 /// One row of the summary.
@@ -129,7 +155,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             progress.set_message(format!("{name:?} on the {executor} executor"));
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             let run = named.run;
-            let diff = oracle.diff(&run.capture);
+            let diff = oracle.diff_with(&run.capture, args.ties.into());
             if !args.no_images && !nearest_written {
                 let nearest: Vec<Option<f32>> = run
                     .capture
@@ -220,7 +246,7 @@ fn print_table(
     );
     type Cell = fn(&RunSummary) -> String;
     let columns: [(&str, usize, Cell); 15] = [
-        ("scheme", 16, |r| r.scheme.clone()),
+        ("scheme", 19, |r| r.scheme.clone()),
         ("guarantee", 22, |r| r.guarantee.to_string()),
         ("executor", 9, |r| r.executor.clone()),
         ("thr", 3, |r| r.threads.to_string()),

@@ -7,10 +7,15 @@ use fragsim_capture::dual_peeling::DualDepthPeeling;
 use fragsim_capture::executor::{self, ParallelExecutor, Run, SerialExecutor};
 use fragsim_capture::kbuffer::KBuffer;
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
+use fragsim_capture::layer_counter::LayerCounter;
+use fragsim_capture::linked_list::{LinkedList, Resolve};
+use fragsim_capture::loop32::Loop32;
 use fragsim_capture::mdts::{Direction, Mdts};
 use fragsim_capture::mdts_packed::{Colours, MdtsPacked};
 use fragsim_capture::peeling::DepthPeeling;
+use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim_capture::stencil_routed::StencilRouted;
+use fragsim_capture::tiled::TiledExecutor;
 use fragsim_capture::zbuffer::ZBuffer;
 use fragsim_capture::{CaptureError, Scheme};
 use fragsim_raster::{View, Viewport};
@@ -61,13 +66,24 @@ pub enum SchemeName {
     Srab,
     /// MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).
     MdtsPacked,
+    /// nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths
+    /// merge), then a colour pass; K = `--k`.
+    Loop32,
+    /// Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.
+    LayerCounter,
+    /// Per-pixel linked lists (node counter, head exchange), the resolve keeping the first `--k`
+    /// nodes (the most recent: Vulkan-Samples); node pool `--capacity` per pixel, `exact` = the
+    /// scene's fragments.
+    LinkedList,
+    /// Per-pixel linked lists, the resolve keeping the `--k` nearest (nvpro-samples).
+    LinkedListNearest,
     /// Every scheme above.
     All,
 }
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 20] = [
+    pub const EVERY: [SchemeName; 24] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
@@ -88,13 +104,18 @@ impl SchemeName {
         SchemeName::KbufferMultipass,
         SchemeName::Srab,
         SchemeName::MdtsPacked,
+        SchemeName::Loop32,
+        SchemeName::LayerCounter,
+        SchemeName::LinkedList,
+        SchemeName::LinkedListNearest,
     ];
 
     /// What the scheme promises against the oracle: `exact` (fragment for fragment, up to K where
     /// it has K slots), `exact-distinct-depths` (32-bit depth peeling merges equal depths),
     /// `exact-without-hazards` (read–modify–write schemes: exact serially), `exact-in-arrival-order`
-    /// (multi-pass routing), or `approximate` (loses fragments in situations its paper describes,
-    /// and reports them). Only `exact` schemes fail `render` when they differ from the oracle.
+    /// (multi-pass routing), `exact-within-capacity` (shipping OIT storage: exact while the scene
+    /// fits it, silently lossy beyond), or `approximate` (loses fragments in situations its paper
+    /// describes, and reports them). Only `exact` schemes fail `render` when they differ from the oracle.
     #[must_use]
     pub fn guarantee(self) -> &'static str {
         match self {
@@ -109,6 +130,13 @@ impl SchemeName {
             SchemeName::Srab => "exact-in-arrival-order",
             // 20 bits of depth: fragments closer than 2^-20 may swap colours.
             SchemeName::MdtsPacked => "approximate",
+            // Equal depths merge into one slot (docs/baselines/shipping.md).
+            SchemeName::Loop32 => "exact-distinct-depths",
+            // Exact while every pixel's fragments fit its layers (or its list fits `--k` and the
+            // node pool); past that, fragments are lost silently.
+            SchemeName::LayerCounter | SchemeName::LinkedList | SchemeName::LinkedListNearest => {
+                "exact-within-capacity"
+            }
             _ => "exact",
         }
     }
@@ -160,6 +188,7 @@ pub struct NamedRun {
 pub struct Executors {
     serial: SerialExecutor,
     parallel: ParallelExecutor,
+    tiled: TiledExecutor,
     /// Run the next frames on fresh storage that counts read-modify-write operations
     /// ([`RunStats::locked_ops`](fragsim_capture::executor::RunStats)), untimed.
     pub count_locked_ops: bool,
@@ -167,7 +196,7 @@ pub struct Executors {
 
 impl Executors {
     /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor`
-    /// (`serial` or `parallel`, on the current rayon pool).
+    /// (`serial`, or `parallel` or `tiled` on the current rayon pool).
     ///
     /// # Errors
     /// A parameter the scheme rejects, or storage beyond the memory cap.
@@ -277,6 +306,30 @@ impl Executors {
                 &MdtsPacked::new(viewport, k, Colours::Prim, cap).map_err(err)?,
                 Some(k),
             ),
+            SchemeName::Loop32 => go(&Loop32::new(viewport, k, cap).map_err(err)?, Some(k)),
+            SchemeName::LayerCounter => {
+                go(&LayerCounter::new(viewport, k, cap).map_err(err)?, Some(k))
+            }
+            SchemeName::LinkedList | SchemeName::LinkedListNearest => {
+                let pool = match sizing.capacity {
+                    Count::Auto => sizing
+                        .depth_complexity
+                        .iter()
+                        .map(|&c| c as usize)
+                        .sum::<usize>()
+                        .max(1),
+                    Count::Fixed(c) => viewport.pixels() * c as usize,
+                };
+                let resolve = if name == SchemeName::LinkedList {
+                    Resolve::KeepFirst
+                } else {
+                    Resolve::KeepNearest
+                };
+                go(
+                    &LinkedList::new(viewport, pool, k, resolve, cap).map_err(err)?,
+                    Some(k),
+                )
+            }
             SchemeName::All => return Err("`all` names a list of schemes, not one".into()),
         })
     }
@@ -360,6 +413,15 @@ pub fn check_memory_cap_early(
     Ok(())
 }
 
+/// The interleaving `--executor scheduled` runs: the scheduled executor's random policy with 256
+/// fragments in flight, seed 0 (replayable; `fragsim explain` and `fragsim hazard` search seeds).
+const SCHEDULE: Schedule = Schedule {
+    policy: Policy::Random,
+    in_flight: 256,
+    granularity: Granularity::Fragment,
+    seed: 0,
+};
+
 /// A scheme behind a vtable, so the registry needs one call site per executor rather than one
 /// per (scheme, executor) pair. The per-step code stays statically dispatched inside `run`.
 trait ErasedScheme {
@@ -375,10 +437,13 @@ impl<S: Scheme> ErasedScheme for S {
     fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run {
         if executors.count_locked_ops {
             executor::count_locked_ops(view, self, executor != "serial")
-        } else if executor == "serial" {
-            executors.serial.run(view, self)
         } else {
-            executors.parallel.run(view, self)
+            match executor {
+                "serial" => executors.serial.run(view, self),
+                "tiled" => executors.tiled.run(view, self),
+                "scheduled" => run_scheduled(view, self, &SCHEDULE, false).run,
+                _ => executors.parallel.run(view, self),
+            }
         }
     }
 }

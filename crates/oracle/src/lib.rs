@@ -18,7 +18,50 @@
 pub mod dump;
 
 use fragsim_capture::{Capture, Identity, Keeps};
-use fragsim_raster::View;
+use fragsim_raster::{Fragment, View};
+
+/// How the oracle orders (or merges) fragments of one pixel at one depth key: the tie policies
+/// that shipping GPU code differs on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Ties {
+    /// Order ties by primitive id: fragsim's canonical order, compared fragment for fragment.
+    #[default]
+    ByPrimitive,
+    /// Keep every fragment at an equal depth, in no particular order among themselves (FreePipe's
+    /// MDTS on 32-bit keys): compared by depth key, duplicates counted.
+    KeepDuplicates,
+    /// Merge fragments at an equal depth into one (nvpro-samples' loop32, 32-bit depth peeling):
+    /// compared by distinct depth key.
+    MergeEqualDepths,
+}
+
+impl Ties {
+    /// The mask that keeps what this policy compares of a packed entry, for a capture of
+    /// `identity`.
+    fn mask(self, identity: Identity) -> u64 {
+        match (self, identity) {
+            (_, Identity::PrimOnly) => u64::from(u32::MAX),
+            (Ties::ByPrimitive, Identity::KeyAndPrim) => u64::MAX,
+            _ => u64::MAX << 32,
+        }
+    }
+
+    /// `list` (canonical order) as this policy expects it, masked by `mask`: appended to `out`.
+    fn expected(self, list: &[u64], mask: u64, out: &mut Vec<u64>) {
+        let start = out.len();
+        out.extend(list.iter().map(|e| e & mask));
+        if self == Ties::MergeEqualDepths {
+            let mut kept = start;
+            for i in start..out.len() {
+                if i == start || out[i] != out[kept - 1] {
+                    out[kept] = out[i];
+                    kept += 1;
+                }
+            }
+            out.truncate(kept);
+        }
+    }
+}
 
 /// The exact per-pixel fragment lists of a view.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -31,11 +74,24 @@ impl Oracle {
     /// Rasterizes `view` twice (count, then fill) and sorts every pixel's list.
     #[must_use]
     pub fn build(view: &View<'_>) -> Self {
-        let pixels = view.viewport().pixels();
+        Self::from_stream(view.viewport().pixels(), |emit| {
+            for prim in 0..view.triangle_count() {
+                view.rasterize(prim, &mut |f| emit(f));
+            }
+        })
+    }
+
+    /// The oracle of a hand-written fragment stream over `pixels` pixels (every fragment's pixel
+    /// must be below `pixels`): what the property suites check schemes against.
+    #[must_use]
+    pub fn from_fragments(pixels: usize, fragments: &[Fragment]) -> Self {
+        Self::from_stream(pixels, |emit| fragments.iter().for_each(|&f| emit(f)))
+    }
+
+    /// Runs `stream` twice (count, then fill) and sorts every pixel's list.
+    fn from_stream(pixels: usize, stream: impl Fn(&mut dyn FnMut(Fragment))) -> Self {
         let mut counts = vec![0usize; pixels];
-        for prim in 0..view.triangle_count() {
-            view.rasterize(prim, &mut |f| counts[f.pixel as usize] += 1);
-        }
+        stream(&mut |f| counts[f.pixel as usize] += 1);
         let mut offsets = Vec::with_capacity(pixels + 1);
         offsets.push(0);
         for &c in &counts {
@@ -43,13 +99,11 @@ impl Oracle {
         }
         let mut next = offsets[..pixels].to_vec();
         let mut entries = vec![0u64; offsets[pixels]];
-        for prim in 0..view.triangle_count() {
-            view.rasterize(prim, &mut |f| {
-                let p = f.pixel as usize;
-                entries[next[p]] = f.packed();
-                next[p] += 1;
-            });
-        }
+        stream(&mut |f| {
+            let p = f.pixel as usize;
+            entries[next[p]] = f.packed();
+            next[p] += 1;
+        });
         for p in 0..pixels {
             entries[offsets[p]..offsets[p + 1]].sort_unstable();
         }
@@ -93,51 +147,86 @@ impl Oracle {
             .unwrap_or(0)
     }
 
-    /// Compares a capture with this oracle, pixel by pixel, under the capture's promise.
+    /// Pixel `p`'s list as `ties` expects it: canonical (`ByPrimitive`), depth keys only with
+    /// duplicates (`KeepDuplicates`), or distinct depth keys (`MergeEqualDepths`); keys are
+    /// packed `key << 32`.
+    #[must_use]
+    pub fn expected(&self, p: usize, ties: Ties) -> Vec<u64> {
+        let mut out = Vec::new();
+        ties.expected(self.pixel(p), ties.mask(Identity::KeyAndPrim), &mut out);
+        out
+    }
+
+    /// Compares a capture with this oracle, pixel by pixel, under the capture's promise, with
+    /// ties ordered by primitive id ([`Ties::ByPrimitive`]).
     ///
     /// # Panics
     /// If the capture covers a different number of pixels.
     #[must_use]
     pub fn diff(&self, capture: &Capture) -> Diff {
+        self.diff_with(capture, Ties::ByPrimitive)
+    }
+
+    /// Compares a capture with this oracle under the tie policy `ties`: the oracle's list is
+    /// first made what `ties` expects ([`Oracle::expected`]), then cut to the capture's promise
+    /// (its `K` nearest entries), and the capture's entries are compared under the same mask.
+    /// A [`Identity::PrimOnly`] capture is always compared by primitive sequence, ties by
+    /// primitive id.
+    ///
+    /// # Panics
+    /// If the capture covers a different number of pixels.
+    #[must_use]
+    pub fn diff_with(&self, capture: &Capture, ties: Ties) -> Diff {
         assert_eq!(
             capture.pixels(),
             self.pixels(),
             "capture and oracle cover different viewports"
         );
         let mut diff = Diff::default();
-        let mask = match capture.identity {
-            Identity::KeyAndPrim => u64::MAX,
-            Identity::KeyOnly => u64::MAX << 32,
-            Identity::PrimOnly => u64::from(u32::MAX),
-        };
+        let mask = ties.mask(capture.identity);
+        let masks_captured = mask != u64::MAX && capture.identity == Identity::KeyAndPrim;
+        let mut all = Vec::new();
         // Keys and packed words sort in depth order; bare primitive ids do not, so their order is
         // checked against the oracle's sequence instead of by sortedness.
         let sequence_order = capture.identity == Identity::PrimOnly;
         let mut expected = Vec::new();
         let mut got_sorted = Vec::new();
         for p in 0..self.pixels() {
-            let all = self.pixel(p);
+            all.clear();
+            let ties = if capture.identity == Identity::PrimOnly {
+                Ties::ByPrimitive
+            } else {
+                ties
+            };
+            ties.expected(self.pixel(p), mask, &mut all);
             let got = capture.pixel(p);
             expected.clear();
             let n = all.len();
             let (allowed_missing, exact_list) = match &capture.keeps {
                 Keeps::Nearest(k) => {
                     let kept = n.min(*k as usize);
-                    expected.extend(all[..kept].iter().map(|e| e & mask));
+                    expected.extend_from_slice(&all[..kept]);
                     (n - kept, true)
                 }
                 Keeps::Farthest(k) => {
                     let kept = n.min(*k as usize);
-                    expected.extend(all[n - kept..].iter().map(|e| e & mask));
+                    expected.extend_from_slice(&all[n - kept..]);
                     (n - kept, true)
                 }
                 Keeps::All { overflow } => {
-                    expected.extend(all.iter().map(|e| e & mask));
+                    expected.extend_from_slice(&all);
                     let o = overflow[p] as usize;
                     (o, o == 0)
                 }
             };
             diff.overflowed += allowed_missing as u64;
+            let masked: Vec<u64>;
+            let got = if masks_captured {
+                masked = got.iter().map(|e| e & mask).collect();
+                masked.as_slice()
+            } else {
+                got
+            };
             got_sorted.clear();
             got_sorted.extend_from_slice(got);
             got_sorted.sort_unstable();
@@ -302,6 +391,31 @@ mod tests {
             (diff.misordered_pixels, diff.lost, diff.mismatched_pixels),
             (1, 0, 1)
         );
+    }
+
+    #[test]
+    fn tie_policies_change_what_is_expected() {
+        let e = |key: u64, prim: u64| key << 32 | prim;
+        let oracle = oracle_of(&[&[e(10, 1), e(10, 2), e(30, 3)]]);
+        assert_eq!(oracle.expected(0, Ties::ByPrimitive), oracle.pixel(0));
+        assert_eq!(
+            oracle.expected(0, Ties::KeepDuplicates),
+            vec![e(10, 0), e(10, 0), e(30, 0)]
+        );
+        assert_eq!(
+            oracle.expected(0, Ties::MergeEqualDepths),
+            vec![e(10, 0), e(30, 0)]
+        );
+        // Equal depths merged into one, the later primitive's colour kept (loop32).
+        let merged = capture_of(&[&[e(10, 2), e(30, 3)]], Keeps::Nearest(2));
+        let canonical = oracle.diff(&merged);
+        assert_eq!((canonical.lost, canonical.extra), (1, 1));
+        assert_eq!(oracle.diff_with(&merged, Ties::KeepDuplicates).lost, 1);
+        assert!(oracle.diff_with(&merged, Ties::MergeEqualDepths).is_exact());
+        // Both kept, tie in the other order: misordered canonically, fine by key.
+        let swapped = capture_of(&[&[e(10, 2), e(10, 1)]], Keeps::Nearest(2));
+        assert_eq!(oracle.diff(&swapped).misordered_pixels, 1);
+        assert!(oracle.diff_with(&swapped, Ties::KeepDuplicates).is_exact());
     }
 
     #[test]

@@ -30,6 +30,8 @@ mod scenes;
 pub use camera::{Camera, OrbitCamera};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError};
-pub use pipeline::{CullMode, ScreenTriangle, View, Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS};
+pub use pipeline::{
+    CullMode, PixelRect, ScreenTriangle, View, Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS,
+};
 pub use rng::SplitMix64;
 pub use scenes::{Scene, SceneError, DEFAULT_SCENE_NAME};

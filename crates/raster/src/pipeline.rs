@@ -71,6 +71,45 @@ impl Viewport {
     pub fn pixels(self) -> usize {
         self.width as usize * self.height as usize
     }
+
+    /// Every pixel of the viewport.
+    #[must_use]
+    pub fn rect(self) -> PixelRect {
+        PixelRect {
+            x: (0, self.width - 1),
+            y: (0, self.height - 1),
+        }
+    }
+}
+
+/// A rectangle of whole pixels, bounds inclusive: the pixels a scan may visit (a screen tile, or
+/// the pixels whose centres a triangle's bounding box holds).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    /// First and last column.
+    pub x: (u32, u32),
+    /// First and last row.
+    pub y: (u32, u32),
+}
+
+impl PixelRect {
+    /// The smallest rectangle holding both.
+    #[must_use]
+    pub fn union(self, other: Self) -> Self {
+        Self {
+            x: (self.x.0.min(other.x.0), self.x.1.max(other.x.1)),
+            y: (self.y.0.min(other.y.0), self.y.1.max(other.y.1)),
+        }
+    }
+
+    /// The pixel centres that a bounding box `[lo, hi]` (x and y in 1/256 pixel) holds inside
+    /// this rectangle; `None` when there is none.
+    #[inline]
+    fn centres_within(self, lo: [i64; 2], hi: [i64; 2]) -> Option<Self> {
+        let x = pixel_span(lo[0], hi[0], self.x)?;
+        let y = pixel_span(lo[1], hi[1], self.y)?;
+        Some(Self { x, y })
+    }
 }
 
 /// Which triangles are discarded by facing.
@@ -227,10 +266,16 @@ impl<'mesh> View<'mesh> {
     /// Rasterizes triangle `prim`, calling `emit` for each fragment in scan order (rows top to
     /// bottom, pixels left to right, fan pieces in order).
     pub fn rasterize(&self, prim: u32, emit: &mut impl FnMut(Fragment)) {
+        self.rasterize_in(prim, self.viewport.rect(), emit);
+    }
+
+    /// [`View::rasterize`] restricted to the pixels of `rect` (a screen tile): exactly the
+    /// fragments of the whole triangle that fall in `rect`, in the same order.
+    pub fn rasterize_in(&self, prim: u32, rect: PixelRect, emit: &mut impl FnMut(Fragment)) {
         let indices = self.mesh.triangles[prim as usize];
         let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
         if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS != 0 {
-            self.screen_triangles(prim, &mut |tri| self.scan(&tri, emit));
+            self.screen_triangles(prim, &mut |tri| self.scan_in(&tri, rect, emit));
             return;
         }
         // The common case, inlined: no clipping, and most triangles of a dense mesh cover no
@@ -238,19 +283,38 @@ impl<'mesh> View<'mesh> {
         if (ca | cb | cc) & NOT_IN_FRONT_BIT != 0 {
             return;
         }
-        let [a, b, c] = indices.map(|i| self.window_xy[i as usize]);
-        let span = |axis: usize, side: u32| {
-            pixel_span(
-                a[axis].min(b[axis]).min(c[axis]).into(),
-                a[axis].max(b[axis]).max(c[axis]).into(),
-                side,
-            )
-        };
-        if span(0, self.viewport.width).is_none() || span(1, self.viewport.height).is_none() {
+        let [lo, hi] = bounding_box(indices.map(|i| self.window_xy[i as usize]));
+        if rect.centres_within(lo, hi).is_none() {
             return;
         }
         let snapped = indices.map(|i| self.snapped(i));
-        self.orient(prim, snapped, &mut |tri| self.scan(&tri, emit));
+        self.orient(prim, snapped, &mut |tri| self.scan_in(&tri, rect, emit));
+    }
+
+    /// The pixels whose centres the bounding boxes of triangle `prim`'s pieces hold: every
+    /// fragment of the triangle lies inside. `None` when the triangle is rejected or its boxes
+    /// hold no pixel centre, as for most triangles of a dense mesh (culling and zero area are
+    /// left to the scan).
+    #[must_use]
+    pub fn pixel_bounds(&self, prim: u32) -> Option<PixelRect> {
+        let indices = self.mesh.triangles[prim as usize];
+        let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
+        let full = self.viewport.rect();
+        if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS != 0 {
+            let mut bounds: Option<PixelRect> = None;
+            self.screen_triangles(prim, &mut |tri| {
+                let [lo, hi] = bounding_box(tri.xy);
+                if let Some(piece) = full.centres_within(lo, hi) {
+                    bounds = Some(bounds.map_or(piece, |b| b.union(piece)));
+                }
+            });
+            return bounds;
+        }
+        if (ca | cb | cc) & NOT_IN_FRONT_BIT != 0 {
+            return None;
+        }
+        let [lo, hi] = bounding_box(indices.map(|i| self.window_xy[i as usize]));
+        full.centres_within(lo, hi)
     }
 
     /// Calls `visit` with the snapped, clipped, oriented pieces of triangle `prim` (none when it
@@ -344,23 +408,23 @@ impl<'mesh> View<'mesh> {
 
     /// Scans an oriented snapped triangle: every covered pixel centre emits a fragment.
     pub fn scan(&self, tri: &ScreenTriangle, emit: &mut impl FnMut(Fragment)) {
+        self.scan_in(tri, self.viewport.rect(), emit);
+    }
+
+    /// [`View::scan`] restricted to the pixels of `rect`.
+    pub fn scan_in(&self, tri: &ScreenTriangle, rect: PixelRect, emit: &mut impl FnMut(Fragment)) {
         let [a, b, c] = tri.xy;
         let area = edge(a, b, c);
         debug_assert!(area > 0);
-        let Some((x0, x1)) = pixel_span(
-            a[0].min(b[0]).min(c[0]),
-            a[0].max(b[0]).max(c[0]),
-            self.viewport.width,
-        ) else {
+        let [lo, hi] = bounding_box(tri.xy);
+        let Some(PixelRect {
+            x: (x0, x1),
+            y: (y0, y1),
+        }) = rect.centres_within(lo, hi)
+        else {
             return;
         };
-        let Some((y0, y1)) = pixel_span(
-            a[1].min(b[1]).min(c[1]),
-            a[1].max(b[1]).max(c[1]),
-            self.viewport.height,
-        ) else {
-            return;
-        };
+        let [x0, x1, y0, y1] = [x0, x1, y0, y1].map(i64::from);
         // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
         let edges = [(b, c), (c, a), (a, b)];
         let bias = edges.map(|(p, q)| if is_top_left(p, q) { 0 } else { -1 });
@@ -396,13 +460,27 @@ impl<'mesh> View<'mesh> {
     }
 }
 
+/// The bounding box of three window positions: its lowest and highest corner.
 #[inline]
-/// The first and last pixel whose centre lies in `[lo, hi]` (1/256 pixel) and on a viewport side
-/// of `side` pixels; `None` when there is none.
-fn pixel_span(lo: i64, hi: i64, side: u32) -> Option<(i64, i64)> {
-    let first = (lo - HALF + ONE - 1).div_euclid(ONE).max(0);
-    let last = (hi - HALF).div_euclid(ONE).min(i64::from(side) - 1);
-    (first <= last).then_some((first, last))
+fn bounding_box<T: Copy + Ord + Into<i64>>([a, b, c]: [[T; 2]; 3]) -> [[i64; 2]; 2] {
+    let axis = |i: usize| {
+        (
+            a[i].min(b[i]).min(c[i]).into(),
+            a[i].max(b[i]).max(c[i]).into(),
+        )
+    };
+    let ((x_lo, x_hi), (y_lo, y_hi)) = (axis(0), axis(1));
+    [[x_lo, y_lo], [x_hi, y_hi]]
+}
+
+/// The first and last pixel whose centre lies in `[lo, hi]` (1/256 pixel) and in the pixel range
+/// `[first, last]`; `None` when there is none.
+#[inline]
+fn pixel_span(lo: i64, hi: i64, (first, last): (u32, u32)) -> Option<(u32, u32)> {
+    let from = (lo - HALF + ONE - 1).div_euclid(ONE).max(first.into());
+    let to = (hi - HALF).div_euclid(ONE).min(last.into());
+    // Both lie in [first, last] when they are ordered, so the conversions are lossless.
+    (from <= to).then_some((from as u32, to as u32))
 }
 
 /// What the vertex stage needs, copied out of the view so that it can fill the view's buffers.
@@ -416,15 +494,20 @@ impl VertexStage {
         transform(self.view_projection, position)
     }
 
+    /// The outcode of [`View::planes`] and the far plane, each plane written out rather than as a
+    /// dot product with mostly zero coefficients: for finite coordinates (always: positions are
+    /// finite f32 and the matrix finite f64) the zero terms add only signed zeros, so each sum is
+    /// rounded exactly as the dot product's and every comparison decides the same.
     fn outcode(&self, clip: DVec4) -> u8 {
-        let mut outcode = self
-            .planes
-            .iter()
-            .enumerate()
-            .fold(0u8, |code, (i, plane)| {
-                code | (u8::from(plane.dot(clip) < 0.0) << i)
-            });
-        if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
+        let [_, right, _, bottom, _] = self.planes;
+        let (gx, gy) = (right.w, bottom.w);
+        let DVec4 { x, y, z, w } = clip;
+        let mut outcode = u8::from(z < 0.0)
+            | u8::from(x + gx * w < 0.0) << 1
+            | u8::from(-x + gx * w < 0.0) << 2
+            | u8::from(y + gy * w < 0.0) << 3
+            | u8::from(-y + gy * w < 0.0) << 4;
+        if -z + w < 0.0 {
             outcode |= FAR_BIT;
         }
         if !in_front(clip) {
@@ -598,6 +681,57 @@ mod tests {
     }
 
     #[test]
+    fn the_written_out_outcode_equals_the_plane_dot_products() {
+        let mesh = Mesh {
+            positions: vec![],
+            triangles: vec![],
+        };
+        let view = view_of(&mesh, 37);
+        let stage = VertexStage {
+            view_projection: DMat4::IDENTITY,
+            planes: view.planes(),
+        };
+        let by_dot_products = |clip: DVec4| {
+            let mut code = stage
+                .planes
+                .iter()
+                .enumerate()
+                .fold(0u8, |code, (i, plane)| {
+                    code | (u8::from(plane.dot(clip) < 0.0) << i)
+                });
+            if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
+                code |= FAR_BIT;
+            }
+            if !in_front(clip) {
+                code |= NOT_IN_FRONT_BIT;
+            }
+            code
+        };
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let specials = [0.0, -0.0, 1.0, -1.0, 1e-300, 3.4e38, -3.4e38, 1e300];
+        for _ in 0..200_000 {
+            let mut coordinate = || {
+                let bits = next();
+                match bits % 4 {
+                    0 => specials[(bits >> 8) as usize % specials.len()],
+                    1 => (bits >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0,
+                    _ => f64::from_bits(bits).clamp(-1e300, 1e300),
+                }
+            };
+            let clip = DVec4::new(coordinate(), coordinate(), coordinate(), coordinate());
+            if clip.is_finite() {
+                assert_eq!(stage.outcode(clip), by_dot_products(clip), "{clip:?}");
+            }
+        }
+    }
+
+    #[test]
     fn rounding_without_libm_equals_f64_round() {
         let mut values = vec![
             0.5,
@@ -636,23 +770,28 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_inlined_fast_path_emits_what_the_general_path_emits() {
-        // `rasterize` skips `screen_triangles` for unclipped triangles; both must agree, on
-        // soups seen from far (tiny triangles), near (clipped ones) and inside (w ≤ 0).
-        let mesh = crate::scenes::triangle_soup(3000, 7);
-        for distance_scale in [40.0, 1.0, 0.3, 0.01] {
+    /// Views of a triangle soup seen from far (tiny triangles), near (clipped ones) and inside
+    /// (w ≤ 0), on a viewport of odd sides.
+    fn soup_views(mesh: &Mesh) -> impl Iterator<Item = (f64, View<'_>)> {
+        [40.0, 1.0, 0.3, 0.01].into_iter().map(|distance_scale| {
             let orbit = crate::OrbitCamera {
                 distance_scale,
                 ..crate::OrbitCamera::default()
             };
             let camera = orbit.camera(mesh.bounds(), 1.0);
-            let view = View::new(
-                &mesh,
-                &camera,
-                Viewport::new(97, 61).unwrap(),
-                CullMode::None,
-            );
+            let viewport = Viewport::new(97, 61).unwrap();
+            (
+                distance_scale,
+                View::new(mesh, &camera, viewport, CullMode::None),
+            )
+        })
+    }
+
+    #[test]
+    fn the_inlined_fast_path_emits_what_the_general_path_emits() {
+        // `rasterize` skips `screen_triangles` for unclipped triangles; both must agree.
+        let mesh = crate::scenes::triangle_soup(3000, 7);
+        for (distance_scale, view) in soup_views(&mesh) {
             let mut fragments = 0;
             for prim in 0..view.triangle_count() {
                 let (mut fast, mut general) = (Vec::new(), Vec::new());
@@ -665,6 +804,46 @@ mod tests {
                 fragments += fast.len();
             }
             assert!(fragments > 0, "distance {distance_scale} drew nothing");
+        }
+    }
+
+    #[test]
+    fn tiles_split_a_triangle_s_fragments_exactly_and_its_bounds_hold_them() {
+        // Tiles of 13 × 8 pixels, misaligned with the 97 × 61 viewport's sides on purpose.
+        let mesh = crate::scenes::triangle_soup(3000, 11);
+        for (distance_scale, view) in soup_views(&mesh) {
+            let Viewport { width, height } = view.viewport();
+            let tiles: Vec<PixelRect> = (0..height.div_ceil(8))
+                .flat_map(|row| {
+                    (0..width.div_ceil(13)).map(move |column| PixelRect {
+                        x: (column * 13, (column * 13 + 12).min(width - 1)),
+                        y: (row * 8, (row * 8 + 7).min(height - 1)),
+                    })
+                })
+                .collect();
+            for prim in 0..view.triangle_count() {
+                let mut whole = Vec::new();
+                view.rasterize(prim, &mut |f| whole.push(f));
+                let bounds = view.pixel_bounds(prim);
+                let inside = |rect: &PixelRect, pixel: u32| {
+                    let (x, y) = (pixel % width, pixel / width);
+                    (rect.x.0..=rect.x.1).contains(&x) && (rect.y.0..=rect.y.1).contains(&y)
+                };
+                match bounds {
+                    None => assert!(whole.is_empty(), "triangle {prim} at {distance_scale}"),
+                    Some(rect) => assert!(whole.iter().all(|f| inside(&rect, f.pixel))),
+                }
+                for tile in &tiles {
+                    let mut part = Vec::new();
+                    view.rasterize_in(prim, *tile, &mut |f| part.push(f));
+                    let expected: Vec<Fragment> = whole
+                        .iter()
+                        .copied()
+                        .filter(|f| inside(tile, f.pixel))
+                        .collect();
+                    assert_eq!(part, expected, "triangle {prim} at {distance_scale}");
+                }
+            }
         }
     }
 
