@@ -95,11 +95,20 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
             );
         }
     }
-    write_outputs(args, &angles, &series)?;
+    write_outputs(args, &scene.name, &angles, &series)?;
     Ok(series)
 }
 
-fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Result<(), String> {
+fn write_outputs(
+    args: &SweepArgs,
+    scene: &str,
+    angles: &[f64],
+    series: &[SweepSeries],
+) -> Result<(), String> {
+    // A mesh path is named by its file.
+    let scene = std::path::Path::new(scene)
+        .file_name()
+        .map_or(scene.into(), |f| f.to_string_lossy());
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let json =
@@ -121,7 +130,10 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
             (s.scheme.clone(), points)
         })
         .collect();
-    let title = format!("error pixels of {} per view angle", args.effect.label());
+    let title = format!(
+        "{scene}: error pixels of {} per view angle",
+        args.effect.label()
+    );
     fragsim_shade::plot::chart(
         &args.out.join("sweep-epr.png"),
         &title,
@@ -144,7 +156,7 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
         .collect();
     fragsim_shade::plot::chart(
         &args.out.join("sweep-speed-accuracy.png"),
-        "speed against accuracy (means over the sweep)",
+        &format!("{scene}: speed against accuracy (means over the sweep)"),
         "frame time (ms)",
         "EPR (% of covered pixels)",
         &scatter,

@@ -107,13 +107,20 @@ fn draw<DB: DrawingBackend>(
     let points = || series.iter().flat_map(|(_, p)| p.iter().copied());
     let (x0, x1) = range(points().map(|p| p.0));
     let (y0, y1) = range(points().map(|p| p.1));
+    // Rates and times are never negative: the axis starts at 0 (and spans 1 when all are 0).
+    let y_start = if points().all(|p| p.1 >= 0.0) {
+        0.0
+    } else {
+        y0.min(0.0)
+    };
+    let y_end = if y1 > y_start { y1 } else { y_start + 1.0 };
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(44)
         .y_label_area_size(72)
-        .build_cartesian_2d(x0.min(if scatter { 0.0 } else { x0 })..x1, y0.min(0.0)..y1)?;
+        .build_cartesian_2d(x0.min(if scatter { 0.0 } else { x0 })..x1, y_start..y_end)?;
     chart
         .configure_mesh()
         .x_desc(x_label)
