@@ -12,7 +12,7 @@ pub struct SceneArgs {
     /// A mesh file (OBJ, or PLY: ASCII or binary, optionally gzipped) instead of a named scene.
     #[arg(long, value_name = "PATH", conflicts_with = "scene")]
     pub mesh: Option<PathBuf>,
-    /// A named scene: `bunny` (embedded), `spheres:N`, `soup:COUNT:SEED`, `quads:N` (parameters optional).
+    /// A named scene: `bunny` (embedded), `bunny-spheres:N:SEED`, `spheres:N`, `soup:COUNT:SEED`, `quads:N` (parameters optional).
     #[arg(long, value_name = "NAME", default_value = DEFAULT_SCENE_NAME)]
     pub scene: String,
     /// Viewport width in pixels.

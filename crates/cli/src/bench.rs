@@ -36,7 +36,7 @@ pub struct BenchArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for bench.json, bench.md and the images.
+    /// Directory for bench.json, bench.md, the images and the speed/accuracy chart.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Print the rows as JSON instead of a table.
@@ -323,6 +323,29 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
     let md_path = args.out.join("bench.md");
     std::fs::write(&md_path, &markdown)
         .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
+    // One point per scheme and executor: the bench's own speed/accuracy scatter.
+    let points: Vec<fragsim_shade::plot::Series> = report
+        .rows
+        .iter()
+        .filter_map(|r| {
+            let rate = r.error_pixel_rate?;
+            Some((
+                format!("{} ({})", r.scheme, r.executor),
+                vec![(r.median_ms, rate * 100.0)],
+            ))
+        })
+        .collect();
+    fragsim_shade::plot::chart(
+        &args.out.join("bench-speed-accuracy.png"),
+        &format!(
+            "{}: speed against accuracy ({})",
+            report.scene, report.effect
+        ),
+        "median frame time (ms)",
+        "EPR (% of covered pixels)",
+        &points,
+        true,
+    )?;
     if args.json {
         println!("{json}");
     } else {

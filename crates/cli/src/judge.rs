@@ -1,12 +1,30 @@
 //! The error-pixel judge shared by `bench` and `sweep`: shades an effect from a capture and
 //! counts the pixels whose 8-bit colour differs from the oracle's image (the papers' EPR).
+//!
+//! Every scheme is shaded for every effect. A capture whose words hold only depth keys (32-bit
+//! schemes) or only primitive ids (FreePipe's packed MDTS) first goes through a **deferred
+//! attribute pass**, as a GPU application renders attributes in a second geometry pass: the
+//! scene's fragments of each pixel, in canonical order (the oracle's lists: what rasterizing
+//! again gives), supply the missing half. A key takes the primitive of the next fragment with
+//! that key not yet taken (equal keys in canonical order); a primitive id takes the depth key of
+//! its fragment at the pixel. An entry that matches no fragment (a scheme that invented one)
+//! keeps an unknown half ([`UNKNOWN_PRIM`] or depth 1). Then normals, colours and depths come
+//! from full identities, and every capture is compared with the one full reference image: the
+//! error-pixel rate measures lost, merged and misordered fragments, whatever the words stored.
+
+use std::borrow::Cow;
 
 use clap::ValueEnum;
 use fragsim_capture::{Capture, Identity};
 use fragsim_oracle::Oracle;
+use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
-use fragsim_shade::effects::{self, Effect, Entries, Material};
+use fragsim_shade::effects::{self, Effect, Entries, Geometry, Material};
 use image::RgbImage;
+use rayon::prelude::*;
+
+/// The primitive id the deferred pass gives a key that matches no fragment of its pixel.
+pub const UNKNOWN_PRIM: u32 = u32::MAX;
 
 /// Effects whose images are compared.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -15,6 +33,8 @@ pub enum EffectName {
     Transparency,
     /// Beer–Lambert translucency.
     Translucency,
+    /// Schlick's Fresnel transmittance along the list (needs normals: computed only for it).
+    Fresnel,
 }
 
 impl EffectName {
@@ -24,6 +44,7 @@ impl EffectName {
         match self {
             EffectName::Transparency => Effect::Transparency,
             EffectName::Translucency => Effect::Translucency,
+            EffectName::Fresnel => Effect::Fresnel,
         }
     }
 
@@ -33,20 +54,23 @@ impl EffectName {
         match self {
             EffectName::Transparency => "transparency",
             EffectName::Translucency => "translucency",
+            EffectName::Fresnel => "fresnel",
         }
     }
 }
+
+type Distance<'a> = Box<dyn Fn(f32) -> f64 + Sync + 'a>;
 
 /// Shades captures and compares them with the oracle's image.
 pub(crate) struct Judge<'a> {
     effect: Effect,
     material: Material,
     size: (u32, u32),
-    distance: Box<dyn Fn(f32) -> f64 + 'a>,
-    /// The oracle's image shaded from what each kind of capture can know: a key-only capture is
-    /// compared with the oracle's fragments coloured by key only, so that the error-pixel rate
-    /// measures lost and misordered fragments, not the attribute the scheme never stored.
-    references: Vec<(Entries, Option<RgbImage>)>,
+    distance: Distance<'a>,
+    /// The deferred attribute pass of the view: only when the effect needs normals.
+    attributes: Option<Attributes<'a>>,
+    oracle: &'a Oracle,
+    reference: RgbImage,
     /// Pixels the oracle covers: the rate's denominator.
     pub covered: usize,
 }
@@ -56,9 +80,9 @@ impl<'a> Judge<'a> {
     pub fn new(
         effect: EffectName,
         scene: &Scene,
-        view: &View<'_>,
+        view: &View<'a>,
         orbit: OrbitCamera,
-        oracle: &Oracle,
+        oracle: &'a Oracle,
     ) -> Self {
         let viewport = view.viewport();
         let aspect = f64::from(viewport.width) / f64::from(viewport.height);
@@ -66,65 +90,148 @@ impl<'a> Judge<'a> {
         let (lo, hi) = bounds;
         let radius = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt() * 0.5;
         // Thickness in units of the model's bounding radius, so σ means the same on every mesh.
-        let distance: Box<dyn Fn(f32) -> f64 + 'a> =
+        let distance: Distance<'a> =
             Box::new(move |z: f32| orbit.eye_distance(bounds, aspect, z) / radius.max(1e-12));
         let material = Material {
             primitives: view.triangle_count(),
             ..Material::default()
         };
-        let size = (viewport.width, viewport.height);
         let effect = effect.effect();
-        let references = [Entries::KeyAndPrim, Entries::KeyOnly, Entries::PrimOnly]
-            .into_iter()
-            .map(|entries| {
-                let list = |p: usize| oracle.pixel(p);
-                (
-                    entries,
-                    effects::render(effect, &material, entries, size, list, &*distance),
-                )
-            })
-            .collect();
+        let attributes = (effect == Effect::Fresnel).then(|| Attributes::new(view));
         let covered = oracle.depth_complexity().iter().filter(|&&c| c > 0).count();
-        Self {
+        let mut judge = Self {
             effect,
             material,
-            size,
+            size: (viewport.width, viewport.height),
             distance,
-            references,
+            attributes,
+            oracle,
+            reference: RgbImage::new(0, 0),
             covered,
-        }
-    }
-
-    /// The oracle's full-identity image.
-    pub fn reference(&self) -> Option<&RgbImage> {
-        self.references
-            .first()
-            .and_then(|(_, image)| image.as_ref())
-    }
-
-    /// The capture's image, the reference it is compared with, and the error pixels; `None`
-    /// when the capture's words cannot resolve the effect.
-    pub fn judge(&self, capture: &Capture) -> Option<(RgbImage, &RgbImage, u64)> {
-        let entries = match capture.identity {
-            Identity::KeyAndPrim => Entries::KeyAndPrim,
-            Identity::KeyOnly => Entries::KeyOnly,
-            Identity::PrimOnly => Entries::PrimOnly,
         };
-        let image = effects::render(
+        judge.reference = judge.shade(|p| oracle.pixel(p));
+        judge
+    }
+
+    /// The oracle's image.
+    pub fn reference(&self) -> Option<&RgbImage> {
+        Some(&self.reference)
+    }
+
+    fn shade<'l>(&self, list: impl Fn(usize) -> &'l [u64] + Sync) -> RgbImage {
+        let cosine = |p: usize, entry: u64| {
+            self.attributes
+                .as_ref()
+                .and_then(|a| a.cosine(entry as u32, p as u32))
+                .unwrap_or(1.0)
+        };
+        let geometry = Geometry {
+            distance: &*self.distance,
+            cosine: &cosine,
+        };
+        effects::render(
             self.effect,
             &self.material,
-            entries,
+            Entries::KeyAndPrim,
             self.size,
-            |p| capture.pixel(p),
-            &*self.distance,
-        )?;
-        let reference = self
-            .references
-            .iter()
-            .find(|(e, _)| *e == entries)?
-            .1
-            .as_ref()?;
-        let errors = effects::error_pixels(reference, &image) as u64;
-        Some((image, reference, errors))
+            list,
+            geometry,
+        )
+        .expect("full identities resolve every effect")
+    }
+
+    /// The capture's image, the reference it is compared with, and the error pixels.
+    pub fn judge(&self, capture: &Capture) -> Option<(RgbImage, &RgbImage, u64)> {
+        let full = deferred_attributes(capture, self.oracle);
+        let image = self.shade(|p| full.pixel(p));
+        let errors = effects::error_pixels(&self.reference, &image) as u64;
+        Some((image, &self.reference, errors))
+    }
+}
+
+/// The deferred attribute pass (see the module's documentation): the capture with full
+/// `depth_key << 32 | prim` entries, in the capture's order.
+#[must_use]
+pub fn deferred_attributes<'c>(capture: &'c Capture, oracle: &Oracle) -> Cow<'c, Capture> {
+    let resolve: fn(&[u64], &[u64]) -> Vec<u64> = match capture.identity {
+        Identity::KeyAndPrim => return Cow::Borrowed(capture),
+        Identity::KeyOnly => prims_of_keys,
+        Identity::PrimOnly => keys_of_prims,
+    };
+    let entries = (0..capture.pixels())
+        .into_par_iter()
+        .with_min_len(256)
+        .flat_map_iter(|p| resolve(capture.pixel(p), oracle.pixel(p)))
+        .collect();
+    Cow::Owned(Capture {
+        offsets: capture.offsets.clone(),
+        entries,
+        identity: Identity::KeyAndPrim,
+        keeps: capture.keeps.clone(),
+    })
+}
+
+/// Key-only entries to full ones: the i-th occurrence of a key takes the primitive of the i-th
+/// fragment with that key in canonical order.
+fn prims_of_keys(list: &[u64], fragments: &[u64]) -> Vec<u64> {
+    let mut order: Vec<usize> = (0..list.len()).collect();
+    order.sort_by_key(|&i| list[i] >> 32);
+    let mut out = vec![0u64; list.len()];
+    let mut previous: Option<(u64, usize)> = None;
+    for i in order {
+        let key = list[i] >> 32;
+        let occurrence = match previous {
+            Some((k, n)) if k == key => n + 1,
+            _ => 0,
+        };
+        previous = Some((key, occurrence));
+        let first = fragments.partition_point(|&f| f >> 32 < key);
+        let prim = fragments
+            .get(first + occurrence)
+            .filter(|&&f| f >> 32 == key)
+            .map_or(UNKNOWN_PRIM, |&f| f as u32);
+        out[i] = (key << 32) | u64::from(prim);
+    }
+    out
+}
+
+/// Primitive-only entries to full ones: each takes its fragment's depth key at the pixel.
+fn keys_of_prims(list: &[u64], fragments: &[u64]) -> Vec<u64> {
+    const FAR: u64 = 0x3F80_0000; // the key of depth 1.0
+    list.iter()
+        .map(|&e| {
+            let prim = e as u32;
+            let key = fragments
+                .iter()
+                .find(|&&f| f as u32 == prim)
+                .map_or(FAR, |&f| f >> 32);
+            (key << 32) | u64::from(prim)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn equal_keys_take_their_primitives_in_canonical_order() {
+        let fragments = [(5 << 32) | 2, (5 << 32) | 7, (9 << 32) | 1];
+        // A capture that kept both fives (in any order) and the nine, and one invented key.
+        assert_eq!(
+            prims_of_keys(&[9 << 32, 5 << 32, 5 << 32, 6 << 32], &fragments),
+            vec![
+                (9 << 32) | 1,
+                (5 << 32) | 2,
+                (5 << 32) | 7,
+                (6 << 32) | u64::from(UNKNOWN_PRIM)
+            ]
+        );
+        // A merging scheme that kept one five gets the first.
+        assert_eq!(prims_of_keys(&[5 << 32], &fragments), vec![(5 << 32) | 2]);
+        assert_eq!(
+            keys_of_prims(&[1, 7], &fragments),
+            vec![(9 << 32) | 1, (5 << 32) | 7]
+        );
     }
 }

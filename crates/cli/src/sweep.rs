@@ -33,7 +33,7 @@ pub struct SweepArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for sweep.json and the SVG charts.
+    /// Directory for sweep.json and the PNG charts.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
 }
@@ -95,11 +95,20 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
             );
         }
     }
-    write_outputs(args, &angles, &series)?;
+    write_outputs(args, &scene.name, &angles, &series)?;
     Ok(series)
 }
 
-fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Result<(), String> {
+fn write_outputs(
+    args: &SweepArgs,
+    scene: &str,
+    angles: &[f64],
+    series: &[SweepSeries],
+) -> Result<(), String> {
+    // A mesh path is named by its file.
+    let scene = std::path::Path::new(scene)
+        .file_name()
+        .map_or(scene.into(), |f| f.to_string_lossy());
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let json =
@@ -121,9 +130,12 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
             (s.scheme.clone(), points)
         })
         .collect();
-    let title = format!("error pixels of {} per view angle", args.effect.label());
+    let title = format!(
+        "{scene}: error pixels of {} per view angle",
+        args.effect.label()
+    );
     fragsim_shade::plot::chart(
-        &args.out.join("sweep-epr.svg"),
+        &args.out.join("sweep-epr.png"),
         &title,
         "view angle (degrees)",
         "EPR (% of covered pixels)",
@@ -143,8 +155,8 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
         })
         .collect();
     fragsim_shade::plot::chart(
-        &args.out.join("sweep-speed-accuracy.svg"),
-        "speed against accuracy (means over the sweep)",
+        &args.out.join("sweep-speed-accuracy.png"),
+        &format!("{scene}: speed against accuracy (means over the sweep)"),
         "frame time (ms)",
         "EPR (% of covered pixels)",
         &scatter,
@@ -175,7 +187,7 @@ fn write_outputs(args: &SweepArgs, angles: &[f64], series: &[SweepSeries]) -> Re
         );
     }
     println!(
-        "wrote {}/sweep.json, sweep-epr.svg, sweep-speed-accuracy.svg",
+        "wrote {}/sweep.json, sweep-epr.png, sweep-speed-accuracy.png",
         args.out.display()
     );
     Ok(())

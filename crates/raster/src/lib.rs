@@ -18,6 +18,7 @@
 //! assert!(fragments > 0);
 //! ```
 
+pub mod attributes;
 mod camera;
 mod fragment;
 mod mesh;

@@ -245,6 +245,12 @@ impl<'mesh> View<'mesh> {
         self.viewport
     }
 
+    /// The model-to-clip-space matrix of the current camera.
+    #[must_use]
+    pub fn view_projection(&self) -> DMat4 {
+        self.view_projection
+    }
+
     /// The mesh.
     #[must_use]
     pub fn mesh(&self) -> &'mesh Mesh {

@@ -5,11 +5,17 @@
 //! - **Translucency**: Beer–Lambert absorption through the thickness between successive entering
 //!   and leaving layers, `(d1 − d0) + (d3 − d2) + …` in eye-space distance (bucket depth peeling
 //!   §4): `T = exp(−σ · thickness)`, `C = T · background + (1 − T) · colour`; the caller's
-//!   `distance` fixes the unit (the bench uses the model's bounding radius).
+//!   [`Geometry::distance`] fixes the unit (the bench uses the model's bounding radius).
+//! - **Fresnel**: Schlick's transmittance `Ft = 1 − (1 − cos θ)^5` of every fragment, from its
+//!   interpolated normal and the view ray ([`Geometry::cosine`]), multiplied along the list and
+//!   applied to the Beer–Lambert ambient term, as the bucket sort chapter's Listing 1.3:
+//!   `C = (Π Ft) · exp(−σ · thickness) · colour`; an empty pixel is the background.
 //!
-//! Colours are linear; each pixel is encoded to sRGB once, at the end ([`encode_srgb`]).
+//! Colours are linear; each pixel is encoded to sRGB once, at the end ([`encode_srgb`]). Pixels
+//! are shaded in parallel, a row per rayon task.
 
 use image::{Rgb, RgbImage};
+use rayon::prelude::*;
 
 /// The effect to resolve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,6 +24,43 @@ pub enum Effect {
     Transparency,
     /// Beer–Lambert translucency.
     Translucency,
+    /// Schlick's Fresnel transmittance along the list, over Beer–Lambert absorption.
+    Fresnel,
+}
+
+impl Effect {
+    /// Whether a list of these entries holds what the effect needs: translucency needs depths,
+    /// Fresnel depths and primitives (for the normal).
+    #[must_use]
+    pub fn resolvable_from(self, entries: Entries) -> bool {
+        match self {
+            Effect::Transparency => true,
+            Effect::Translucency => entries != Entries::PrimOnly,
+            Effect::Fresnel => entries == Entries::KeyAndPrim,
+        }
+    }
+}
+
+/// What shading needs to know of the geometry beyond the entries.
+#[derive(Clone, Copy)]
+pub struct Geometry<'a> {
+    /// Eye-space distance of a window depth (translucency's thickness), in the caller's unit.
+    pub distance: &'a (dyn Fn(f32) -> f64 + Sync),
+    /// `|cos θ|` between the normal of the entry's fragment at pixel `p` and the view ray
+    /// (`(p, entry)`); called for Fresnel only.
+    pub cosine: &'a (dyn Fn(usize, u64) -> f64 + Sync),
+}
+
+impl std::fmt::Debug for Geometry<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Geometry")
+    }
+}
+
+/// Schlick's approximation of the Fresnel transmittance, `1 − (1 − cos θ)^5`.
+#[must_use]
+pub fn schlick_transmittance(cos_theta: f64) -> f64 {
+    1.0 - (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5)
 }
 
 /// Material and scene constants of the effects.
@@ -85,23 +128,35 @@ pub fn encode_srgb(linear: f32) -> u8 {
     (s * 255.0).round() as u8
 }
 
-/// Resolves one pixel's list (nearest first) to a linear colour. `distance` maps a window depth
-/// to eye-space distance (translucency). `None` when the effect needs what the entries lack.
+/// Resolves pixel `pixel`'s list (nearest first) to a linear colour; `None` when the effect
+/// needs what the entries lack ([`Effect::resolvable_from`]).
 #[must_use]
 pub fn shade_pixel(
     effect: Effect,
     material: &Material,
     entries: Entries,
+    pixel: usize,
     list: &[u64],
-    distance: &dyn Fn(f32) -> f64,
+    geometry: Geometry<'_>,
 ) -> Option<[f32; 3]> {
+    if !effect.resolvable_from(entries) {
+        return None;
+    }
     let colour_of = |entry: u64| match entries {
         Entries::KeyAndPrim | Entries::PrimOnly => {
             primitive_colour(entry as u32, material.primitives)
         }
         Entries::KeyOnly => material.base,
     };
-    match effect {
+    let absorption = || {
+        let depths: Vec<f64> = list
+            .iter()
+            .map(|&e| (geometry.distance)(f32::from_bits((e >> 32) as u32)))
+            .collect();
+        let thickness: f64 = depths.chunks_exact(2).map(|pair| pair[1] - pair[0]).sum();
+        (-material.sigma * thickness).exp() as f32
+    };
+    Some(match effect {
         Effect::Transparency => {
             let (mut colour, mut transmittance) = ([0.0f32; 3], 1.0f32);
             for &entry in list {
@@ -111,40 +166,54 @@ pub fn shade_pixel(
                 }
                 transmittance *= 1.0 - material.opacity;
             }
-            Some([0, 1, 2].map(|ch| colour[ch] + transmittance * material.background[ch]))
+            [0, 1, 2].map(|ch| colour[ch] + transmittance * material.background[ch])
         }
         Effect::Translucency => {
-            if entries == Entries::PrimOnly {
-                return None;
-            }
-            let depths: Vec<f64> = list
-                .iter()
-                .map(|&e| distance(f32::from_bits((e >> 32) as u32)))
-                .collect();
-            let thickness: f64 = depths.chunks_exact(2).map(|pair| pair[1] - pair[0]).sum();
-            let t = (-material.sigma * thickness).exp() as f32;
-            Some([0, 1, 2].map(|ch| t * material.background[ch] + (1.0 - t) * material.base[ch]))
+            let t = absorption();
+            [0, 1, 2].map(|ch| t * material.background[ch] + (1.0 - t) * material.base[ch])
         }
-    }
+        Effect::Fresnel => {
+            if list.is_empty() {
+                return Some(material.background);
+            }
+            let fresnel: f64 = list
+                .iter()
+                .map(|&e| schlick_transmittance((geometry.cosine)(pixel, e)))
+                .product();
+            let t = absorption() * fresnel as f32;
+            material.base.map(|c| t * c)
+        }
+    })
 }
 
-/// Resolves every pixel; `list(p)` gives pixel `p`'s entries. `None` when the effect cannot be
-/// resolved from these entries.
+/// Resolves every pixel, rows in parallel; `list(p)` gives pixel `p`'s entries. `None` when the
+/// effect cannot be resolved from these entries.
 #[must_use]
 pub fn render<'a>(
     effect: Effect,
     material: &Material,
     entries: Entries,
     (width, height): (u32, u32),
-    list: impl Fn(usize) -> &'a [u64],
-    distance: &dyn Fn(f32) -> f64,
+    list: impl Fn(usize) -> &'a [u64] + Sync,
+    geometry: Geometry<'_>,
 ) -> Option<RgbImage> {
-    let mut image = RgbImage::new(width, height);
-    for (p, pixel) in image.pixels_mut().enumerate() {
-        let colour = shade_pixel(effect, material, entries, list(p), distance)?;
-        *pixel = Rgb(colour.map(encode_srgb));
+    if !effect.resolvable_from(entries) {
+        return None;
     }
-    Some(image)
+    let row = width as usize * 3;
+    let mut bytes = vec![0u8; row * height as usize];
+    bytes
+        .par_chunks_mut(row.max(1))
+        .enumerate()
+        .for_each(|(y, out)| {
+            for (x, rgb) in out.chunks_exact_mut(3).enumerate() {
+                let p = y * width as usize + x;
+                let colour = shade_pixel(effect, material, entries, p, list(p), geometry)
+                    .expect("resolvable entries shade every pixel");
+                rgb.copy_from_slice(&colour.map(encode_srgb));
+            }
+        });
+    RgbImage::from_raw(width, height, bytes)
 }
 
 /// The paper's error-pixel count: pixels whose 8-bit colour differs.
@@ -187,6 +256,15 @@ mod tests {
         0.0
     }
 
+    fn facing(_: usize, _: u64) -> f64 {
+        1.0
+    }
+
+    const FLAT: Geometry<'static> = Geometry {
+        distance: &flat,
+        cosine: &facing,
+    };
+
     #[test]
     fn srgb_encoding_ends_and_midpoint() {
         assert_eq!(encode_srgb(0.0), 0);
@@ -202,25 +280,14 @@ mod tests {
             primitives: 4,
             ..Material::default()
         };
-        assert_eq!(
-            shade_pixel(Effect::Transparency, &m, Entries::KeyAndPrim, &[], &flat),
-            Some(m.background)
+        let shade = |list: &[u64]| {
+            shade_pixel(Effect::Transparency, &m, Entries::KeyAndPrim, 0, list, FLAT)
+        };
+        assert_eq!(shade(&[]), Some(m.background));
+        assert_ne!(
+            shade(&[1 << 32, (2 << 32) | 1]),
+            shade(&[(2 << 32) | 1, 1 << 32])
         );
-        let near_first = shade_pixel(
-            Effect::Transparency,
-            &m,
-            Entries::KeyAndPrim,
-            &[1 << 32, (2 << 32) | 1],
-            &flat,
-        );
-        let swapped = shade_pixel(
-            Effect::Transparency,
-            &m,
-            Entries::KeyAndPrim,
-            &[(2 << 32) | 1, 1 << 32],
-            &flat,
-        );
-        assert_ne!(near_first, swapped);
     }
 
     #[test]
@@ -230,29 +297,46 @@ mod tests {
             ..Material::default()
         };
         let linear = |z: f32| f64::from(z) * 10.0;
+        let geometry = Geometry {
+            distance: &linear,
+            cosine: &facing,
+        };
         let key = |d: f32| u64::from(d.to_bits()) << 32;
-        let thin = shade_pixel(
-            Effect::Translucency,
-            &m,
-            Entries::KeyOnly,
-            &[key(0.1), key(0.2)],
-            &linear,
-        )
-        .unwrap();
-        let thick = shade_pixel(
-            Effect::Translucency,
-            &m,
-            Entries::KeyOnly,
-            &[key(0.1), key(0.5)],
-            &linear,
-        )
-        .unwrap();
+        let shade = |list: &[u64], entries| {
+            shade_pixel(Effect::Translucency, &m, entries, 0, list, geometry)
+        };
+        let thin = shade(&[key(0.1), key(0.2)], Entries::KeyOnly).unwrap();
+        let thick = shade(&[key(0.1), key(0.5)], Entries::KeyOnly).unwrap();
         // More material hides more of the background: closer to the medium's colour everywhere.
         for ch in 0..3 {
             assert!((thick[ch] - m.base[ch]).abs() < (thin[ch] - m.base[ch]).abs());
         }
+        assert_eq!(shade(&[1], Entries::PrimOnly), None);
+    }
+
+    #[test]
+    fn fresnel_multiplies_schlick_along_the_list() {
+        let m = Material::default();
+        let half = |_: usize, _: u64| 0.5;
+        let geometry = Geometry {
+            distance: &flat,
+            cosine: &half,
+        };
+        let two = shade_pixel(
+            Effect::Fresnel,
+            &m,
+            Entries::KeyAndPrim,
+            0,
+            &[0, 1],
+            geometry,
+        )
+        .unwrap();
+        let ft = 1.0 - 0.5f64.powi(5);
+        for (got, base) in two.iter().zip(m.base) {
+            assert!((f64::from(*got) - ft * ft * f64::from(base)).abs() < 1e-6);
+        }
         assert_eq!(
-            shade_pixel(Effect::Translucency, &m, Entries::PrimOnly, &[1], &linear),
+            shade_pixel(Effect::Fresnel, &m, Entries::KeyOnly, 0, &[0], geometry),
             None
         );
     }
