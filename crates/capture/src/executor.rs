@@ -115,19 +115,8 @@ impl SerialExecutor {
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
         let memory = reuse_storage(&mut self.memory, scheme);
-        let (counters, passes) = serial_passes(view, scheme, &*memory);
-        let pass_time = start.elapsed();
-        let resolve_start = Instant::now();
-        let capture = scheme.resolve(&*memory);
-        finish(
-            scheme,
-            capture,
-            counters,
-            passes,
-            pass_time,
-            resolve_start,
-            1,
-        )
+        let passes = serial_passes(view, scheme, &*memory);
+        finish(scheme, start, passes, 1, || scheme.resolve(&*memory))
     }
 }
 
@@ -142,19 +131,10 @@ impl ParallelExecutor {
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
         let memory = reuse_storage(&mut self.memory, scheme);
-        let (counters, passes) = parallel_passes(view, scheme, &*memory);
-        let pass_time = start.elapsed();
-        let resolve_start = Instant::now();
-        let capture = resolve_parallel(scheme, &*memory);
-        finish(
-            scheme,
-            capture,
-            counters,
-            passes,
-            pass_time,
-            resolve_start,
-            rayon::current_num_threads(),
-        )
+        let passes = parallel_passes(view, scheme, &*memory);
+        finish(scheme, start, passes, rayon::current_num_threads(), || {
+            resolve_parallel(scheme, &*memory)
+        })
     }
 }
 
@@ -208,36 +188,15 @@ pub fn count_locked_ops<S: Scheme>(view: &View<'_>, scheme: &S, parallel: bool) 
     let start = Instant::now();
     let (run, locked_ops) = if parallel {
         let memory: CountingMemory<AtomicMemory> = scheme.layout().allocate();
-        let (counters, passes) = parallel_passes(view, scheme, &memory);
-        let pass_time = start.elapsed();
-        let resolve_start = Instant::now();
-        let capture = resolve_parallel(scheme, &memory);
-        let threads = rayon::current_num_threads();
-        let run = finish(
-            scheme,
-            capture,
-            counters,
-            passes,
-            pass_time,
-            resolve_start,
-            threads,
-        );
+        let passes = parallel_passes(view, scheme, &memory);
+        let run = finish(scheme, start, passes, rayon::current_num_threads(), || {
+            resolve_parallel(scheme, &memory)
+        });
         (run, memory.read_modify_writes())
     } else {
         let memory: CountingMemory<SerialMemory> = scheme.layout().allocate();
-        let (counters, passes) = serial_passes(view, scheme, &memory);
-        let pass_time = start.elapsed();
-        let resolve_start = Instant::now();
-        let capture = scheme.resolve(&memory);
-        let run = finish(
-            scheme,
-            capture,
-            counters,
-            passes,
-            pass_time,
-            resolve_start,
-            1,
-        );
+        let passes = serial_passes(view, scheme, &memory);
+        let run = finish(scheme, start, passes, 1, || scheme.resolve(&memory));
         (run, memory.read_modify_writes())
     };
     Run {
@@ -371,16 +330,18 @@ pub(crate) fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: 
     capture
 }
 
-/// The run's statistics around its capture.
+/// Ends a frame whose geometry passes ran since `start` and returned `(counters, passes)`: runs
+/// the post pass `resolve`, timing the two apart.
 pub(crate) fn finish<S: Scheme>(
     scheme: &S,
-    capture: Capture,
-    counters: Counters,
-    passes: u32,
-    pass_time: Duration,
-    resolve_start: Instant,
+    start: Instant,
+    (counters, passes): (Counters, u32),
     threads: usize,
+    resolve: impl FnOnce() -> Capture,
 ) -> Run {
+    let pass_time = start.elapsed();
+    let resolve_start = Instant::now();
+    let capture = resolve();
     let stats = RunStats {
         counters,
         passes,

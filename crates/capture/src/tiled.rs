@@ -156,7 +156,7 @@ impl TiledExecutor {
             });
         let chunks = &self.chunks;
         let memory = &*memory;
-        let (counters, passes) = run_passes(scheme, memory, |pass| {
+        let passes = run_passes(scheme, memory, |pass| {
             (0..tiles.count())
                 .into_par_iter()
                 .map(|tile| {
@@ -169,18 +169,9 @@ impl TiledExecutor {
                 })
                 .reduce(Counters::default, Counters::merge)
         });
-        let pass_time = start.elapsed();
-        let resolve_start = Instant::now();
-        let capture = resolve_parallel(scheme, memory);
-        finish(
-            scheme,
-            capture,
-            counters,
-            passes,
-            pass_time,
-            resolve_start,
-            rayon::current_num_threads(),
-        )
+        finish(scheme, start, passes, rayon::current_num_threads(), || {
+            resolve_parallel(scheme, memory)
+        })
     }
 }
 
