@@ -171,11 +171,8 @@ impl Scheme for ABuffer {
             Storage::Exact { offsets } => (offsets[offsets.len() - 1], offsets.len() * 4),
         };
         Layout {
-            words32: self.pixels(),
-            init32: 0,
-            words64: slots,
-            init64: u64::MAX,
             table_bytes,
+            ..Layout::counters_and_slots(self.pixels(), slots)
         }
     }
 

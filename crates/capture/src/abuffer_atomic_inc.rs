@@ -93,13 +93,7 @@ impl Scheme for ABufferAtomicInc {
     }
 
     fn layout(&self) -> Layout {
-        Layout {
-            words32: self.pixels,
-            init32: 0,
-            words64: self.pixels * self.capacity,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
+        Layout::counters_and_slots(self.pixels, self.pixels * self.capacity)
     }
 
     fn identity(&self) -> Identity {

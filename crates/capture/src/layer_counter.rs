@@ -100,13 +100,7 @@ impl Scheme for LayerCounter {
     }
 
     fn layout(&self) -> Layout {
-        Layout {
-            words32: self.pixels,
-            init32: 0,
-            words64: self.pixels * self.layer_count as usize,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
+        Layout::counters_and_slots(self.pixels, self.pixels * self.layer_count as usize)
     }
 
     fn identity(&self) -> Identity {

@@ -155,14 +155,8 @@ impl Scheme for LinkedList {
     }
 
     fn layout(&self) -> Layout {
-        Layout {
-            // Heads, the counter, then the `next` of nodes 1..=pool.
-            words32: self.pixels + 1 + self.pool,
-            init32: 0,
-            words64: self.pool,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
+        // Heads, the counter, then the `next` of nodes 1..=pool.
+        Layout::counters_and_slots(self.pixels + 1 + self.pool, self.pool)
     }
 
     fn identity(&self) -> Identity {

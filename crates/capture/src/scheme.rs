@@ -26,6 +26,19 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The layout of the counting schemes: `counters` `u32` words starting at 0 beside `slots`
+    /// `u64` slots starting empty (`u64::MAX`), no tables.
+    #[must_use]
+    pub fn counters_and_slots(counters: usize, slots: usize) -> Self {
+        Self {
+            words32: counters,
+            init32: 0,
+            words64: slots,
+            init64: u64::MAX,
+            table_bytes: 0,
+        }
+    }
+
     /// Total bytes: words and tables.
     #[must_use]
     pub fn bytes(&self) -> u64 {

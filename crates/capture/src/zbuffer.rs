@@ -68,13 +68,7 @@ impl Scheme for ZBuffer {
     }
 
     fn layout(&self) -> Layout {
-        Layout {
-            words32: 0,
-            init32: 0,
-            words64: self.pixels,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
+        Layout::counters_and_slots(0, self.pixels)
     }
 
     fn identity(&self) -> Identity {
