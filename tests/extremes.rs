@@ -14,7 +14,8 @@ use fragsim::capture::abuffer_atomic_inc::ABufferAtomicInc;
 use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
-    CaptureError, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT,
+    CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory,
+    MEMORY_CAP_DEFAULT,
 };
 use fragsim::oracle::Oracle;
 use fragsim::raster::{
@@ -372,6 +373,11 @@ impl Scheme for Table1Mdts {
 
     fn promise(&self) -> Promise {
         Promise::Nearest(self.k)
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        // What the paper claims for it; the tests show where the literal reading breaks it.
+        Guarantee::Exact
     }
 
     fn begin(&self, fragment: Fragment) -> Table1Walk {

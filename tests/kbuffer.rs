@@ -386,7 +386,7 @@ fn srab_reports_exactly_the_ninth_fragment_as_overflow() {
         assert_eq!(diff.overflowed, nine);
         assert_eq!(run.stats.counters.dropped, nine);
         assert_eq!(run.stats.passes, 1);
-        let Keeps::All { overflow } = &run.capture.keeps else {
+        let Keeps::All { overflow, .. } = &run.capture.keeps else {
             panic!("the stencil-routed A-buffer promises all fragments but the overflow");
         };
         for (p, &n) in complexity.iter().enumerate() {

@@ -33,8 +33,8 @@ use fragsim::capture::linked_list::{LinkedList, Resolve};
 use fragsim::capture::loop32::Loop32;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
-    Identity, Keeps, Layout, Memory, Promise, Scheme, SerialMemory, Step, WordMemory,
-    MEMORY_CAP_DEFAULT,
+    Capacity, Guarantee, Identity, Keeps, Layout, Memory, Promise, Scheme, SerialMemory, Step,
+    WordMemory, MEMORY_CAP_DEFAULT,
 };
 use fragsim::raster::{depth_key, Fragment, Viewport};
 use loom::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
@@ -355,6 +355,7 @@ fn abuffer_model(
         assert_eq!(
             capture.keeps,
             Keeps::All {
+                capacity: Capacity::PerPixel(capacity as u32),
                 overflow: vec![(n - fit) as u32]
             },
             "overflow reported"
@@ -986,6 +987,11 @@ impl Scheme for Table1 {
 
     fn promise(&self) -> Promise {
         Promise::Nearest(self.k)
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        // What the paper claims for it; the tests show where the literal reading breaks it.
+        Guarantee::Exact
     }
 
     fn begin(&self, fragment: Fragment) -> (u32, u32) {

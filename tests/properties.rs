@@ -79,7 +79,7 @@ fn check_mdts_parallel<W: MdtsWord>(
 /// The sum of a fixed A-buffer's per-pixel overflow counts.
 fn total_overflow(run: &Run) -> u64 {
     match &run.capture.keeps {
-        Keeps::All { overflow } => overflow.iter().map(|&o| u64::from(o)).sum(),
+        Keeps::All { overflow, .. } => overflow.iter().map(|&o| u64::from(o)).sum(),
         other => panic!("the A-buffer promises all fragments, got {other:?}"),
     }
 }

@@ -51,7 +51,7 @@ pub fn check(data: &[u8]) {
     };
     let pixels = dump.viewport().expect("parse checked it").pixels();
     assert_eq!(capture.pixels(), pixels, "one list per pixel");
-    if let Keeps::All { overflow } = &capture.keeps {
+    if let Keeps::All { overflow, .. } = &capture.keeps {
         assert_eq!(overflow.len(), pixels, "one overflow count per pixel");
     }
     // A capture whose lists are in canonical order, with no overflow, is what it promises of
@@ -59,7 +59,7 @@ pub fn check(data: &[u8]) {
     let reference = Oracle::from_capture(&capture);
     let comparison = dump::compare(&reference, &capture, 0, 4);
     let no_overflow = match &capture.keeps {
-        Keeps::All { overflow } => overflow.iter().all(|&o| o == 0),
+        Keeps::All { overflow, .. } => overflow.iter().all(|&o| o == 0),
         _ => true,
     };
     let in_order =

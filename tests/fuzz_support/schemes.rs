@@ -128,9 +128,18 @@ pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped:
                 let kept = n.min(*k as usize);
                 assert_eq!(got, &all[n - kept..], "{name}: pixel {p}, the farthest {k}");
             }
-            Keeps::All { overflow } => {
-                let o = overflow[p] as usize;
-                assert_eq!(got.len() + o, n, "{name}: pixel {p}, kept + overflow");
+            Keeps::All { capacity, overflow } => {
+                // The overflow is predicted from the capacity, never taken from the scheme.
+                assert_eq!(
+                    overflow[p] as usize,
+                    capacity.reported_overflow(n),
+                    "{name}: pixel {p}, counted overflow"
+                );
+                assert_eq!(
+                    got.len() + capacity.overflow(n),
+                    n,
+                    "{name}: pixel {p}, kept + overflow"
+                );
                 assert!(
                     got.windows(2).all(|w| w[0] <= w[1]),
                     "{name}: pixel {p} out of order: {got:?}"

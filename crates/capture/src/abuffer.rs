@@ -13,9 +13,12 @@
 //! the post pass and reported (never a write out of bounds). One geometry pass; memory: one
 //! counter per pixel plus the slots.
 //!
-//! **Storage.** Either a fixed capacity per pixel (the GPU's usual layout) or *exact*: sized from a
-//! counting pass's per-pixel depth complexity, as one flat array indexed by the prefix sum of the
-//! counts, with no padding.
+//! **Storage.** Either a fixed capacity per pixel (`abuffer`: FreePipe's layout, "a fixed size
+//! struct array per pixel", §4.2, 20 slots in Table 3; guarantee
+//! [`Guarantee::ExactWithinCapacity`]) or *exact* (`abuffer-exact`): sized by the scheme's own
+//! counting pass ([`crate::depth_count`], one `fetch_add` per fragment) into one flat array indexed
+//! by the prefix sum of the counts, with no padding. The exact variant is two geometry passes, and
+//! its rows say so; FreePipe's scheme is one.
 //!
 //! Unlike CUDA's `atomicInc(addr, bound)`, which wraps to 0 past `bound` and so would overwrite
 //! slot 0, the counter here never wraps: a pixel receives at most one fragment per triangle and a
@@ -23,7 +26,8 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
@@ -157,9 +161,10 @@ impl Scheme for ABuffer {
             PostSort::Insertion => "",
             PostSort::Bitonic => "-bitonic",
         };
+        // FreePipe's A-buffer is the fixed-array one; exact storage is the variant.
         let storage = match self.storage {
-            Storage::Fixed { .. } => "-fixed",
-            Storage::Exact { .. } => "",
+            Storage::Fixed { .. } => "",
+            Storage::Exact { .. } => "-exact",
         };
         format!("abuffer{storage}{sort}")
     }
@@ -209,8 +214,18 @@ impl Scheme for ABuffer {
         Identity::KeyAndPrim
     }
 
+    fn guarantee(&self) -> Guarantee {
+        match self.storage {
+            Storage::Fixed { capacity, .. } => Guarantee::ExactWithinCapacity(capacity as u32),
+            Storage::Exact { .. } => Guarantee::Exact,
+        }
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(match self.storage {
+            Storage::Fixed { capacity, .. } => Capacity::PerPixel(capacity as u32),
+            Storage::Exact { .. } => Capacity::Unbounded,
+        })
     }
 
     fn pixels(&self) -> usize {

@@ -27,7 +27,8 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::abuffer::{insertion_sort, Claim};
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
 
@@ -100,8 +101,12 @@ impl Scheme for ABufferAtomicInc {
         Identity::KeyAndPrim
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactWithinCapacity(self.capacity as u32)
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixel(self.capacity as u32))
     }
 
     fn begin(&self, fragment: Fragment) -> Claim {
@@ -173,7 +178,7 @@ mod tests {
             }
         }
         let capture = scheme.resolve(&memory);
-        let Keeps::All { overflow } = &capture.keeps else {
+        let Keeps::All { overflow, .. } = &capture.keeps else {
             unreachable!("both promise every fragment")
         };
         (capture.pixel(0).to_vec(), overflow[0], dropped)

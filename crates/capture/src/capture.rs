@@ -23,9 +23,51 @@ pub enum Keeps {
     /// Every fragment, except the per-pixel counts that overflowed fixed storage; which ones
     /// overflow depends on arrival order.
     All {
-        /// Per pixel, how many fragments found no free slot.
+        /// The storage the fragments had: what lets the oracle predict each pixel's overflow
+        /// instead of trusting the scheme's count.
+        capacity: Capacity,
+        /// Per pixel, how many fragments found no free slot, as the scheme counted them.
         overflow: Vec<u32>,
     },
+}
+
+/// How many fragments of a pixel a scheme's storage holds: with a pixel's fragment count `n` from
+/// the oracle, the overflow the scheme must report is known exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Capacity {
+    /// Storage sized to hold every fragment (from a counting pass, or unbounded by design):
+    /// nothing may overflow.
+    Unbounded,
+    /// `C` slots per pixel: a pixel of `n` fragments overflows by exactly `max(0, n − C)`, and
+    /// the scheme counts it.
+    PerPixel(u32),
+    /// `C` slots per pixel, the overflow discarded without a count (Bevy's clamped layer
+    /// counter, a linked list resolve that stops at `C` nodes): the oracle's `max(0, n − C)` is
+    /// the only count there is, and the scheme must report 0.
+    PerPixelUncounted(u32),
+}
+
+impl Capacity {
+    /// The overflow a pixel of `fragments` fragments must report.
+    #[must_use]
+    pub fn overflow(self, fragments: usize) -> usize {
+        match self {
+            Capacity::Unbounded => 0,
+            Capacity::PerPixel(c) | Capacity::PerPixelUncounted(c) => {
+                fragments.saturating_sub(c as usize)
+            }
+        }
+    }
+
+    /// The overflow a pixel of `fragments` fragments must report itself: 0 where the scheme
+    /// cannot count it.
+    #[must_use]
+    pub fn reported_overflow(self, fragments: usize) -> usize {
+        match self {
+            Capacity::PerPixelUncounted(_) => 0,
+            _ => self.overflow(fragments),
+        }
+    }
 }
 
 /// Per-pixel lists of captured fragments in the order the scheme's post pass produced them.

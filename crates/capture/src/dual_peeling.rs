@@ -56,7 +56,8 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::mdts::MdtsWord;
 use crate::memory::{Memory, Word, WordMemory};
 use crate::peeling::LayerStorage;
@@ -164,8 +165,16 @@ impl<W: MdtsWord> Scheme for DualDepthPeeling<W> {
         W::IDENTITY
     }
 
+    fn guarantee(&self) -> Guarantee {
+        // 32-bit depth keys merge equal depths into one layer; 64-bit words are all distinct.
+        match W::IDENTITY {
+            Identity::KeyOnly => Guarantee::ExactDistinctDepths,
+            _ => Guarantee::Exact,
+        }
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixel(self.storage.layers() as u32))
     }
 
     fn begin(&self, fragment: Fragment) -> DualPeel<W> {

@@ -24,9 +24,58 @@ use crate::counting::CountingMemory;
 use crate::memory::{AtomicMemory, Memory, SerialMemory};
 use crate::scheme::{Layout, Scheme, Step};
 
-/// Triangles per rayon work item: large enough to amortise scheduling (~100 ns a task), small
-/// enough to balance the uneven cost of triangles.
-const TRIANGLES_PER_TASK: usize = 1024;
+/// Triangles per rayon work item by default: large enough to amortise scheduling (~100 ns a
+/// task), small enough to balance the uneven cost of triangles. Scenes of fewer triangles than two
+/// tasks run on one thread, so tests that want concurrency on small scenes set a smaller size
+/// ([`ParallelExecutor::with_task_size`]).
+pub const TRIANGLES_PER_TASK: usize = 1024;
+
+/// The executors, by name: what the command line, the catalog and the tests iterate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Executor {
+    /// Submission order on one thread: the reference behaviour.
+    Serial,
+    /// FreePipe's model: triangles in chunks on rayon, std atomics.
+    Parallel,
+    /// Triangles binned into screen tiles, one thread per tile at a time.
+    Tiled,
+    /// A replayable GPU-like interleaving on one thread ([`crate::scheduled`]).
+    Scheduled,
+}
+
+impl Executor {
+    /// Every executor.
+    pub const EVERY: [Executor; 4] = [
+        Executor::Serial,
+        Executor::Parallel,
+        Executor::Tiled,
+        Executor::Scheduled,
+    ];
+
+    /// The name used on the command line and in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Executor::Serial => "serial",
+            Executor::Parallel => "parallel",
+            Executor::Tiled => "tiled",
+            Executor::Scheduled => "scheduled",
+        }
+    }
+
+    /// Whether each pixel sees its fragments one walk at a time, in primitive order: then no
+    /// read–modify–write hazard can happen, and the guarantees that exclude hazards are owed.
+    #[must_use]
+    pub fn serialises_pixels(self) -> bool {
+        matches!(self, Executor::Serial | Executor::Tiled)
+    }
+}
+
+impl std::fmt::Display for Executor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Counts of what a pass did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -82,6 +131,9 @@ pub struct RunStats {
     pub threads: usize,
     /// Read-modify-write (locked) operations, when the run counted them ([`count_locked_ops`]).
     pub locked_ops: Option<u64>,
+    /// The counting pass that sized the storage, when one ran (its time is in `pass_time` and
+    /// its geometry pass in `passes` too): see [`Run::after_count_pass`].
+    pub count_pass_time: Option<Duration>,
 }
 
 /// A run's result.
@@ -91,6 +143,32 @@ pub struct Run {
     pub capture: Capture,
     /// What was measured.
     pub stats: RunStats,
+}
+
+impl Run {
+    /// This run as the second half of a frame whose storage `count` sized: the counting pass's
+    /// geometry pass, counters and time (its pass and its read-back) are added in, and the
+    /// memory is the larger of the two (the counters are freed, or reused as the A-buffer's,
+    /// before the sized storage is allocated).
+    #[must_use]
+    pub fn after_count_pass(self, count: &Run) -> Run {
+        let counted = count.stats.pass_time + count.stats.resolve_time;
+        Run {
+            stats: RunStats {
+                counters: count.stats.counters.merge(self.stats.counters),
+                passes: count.stats.passes + self.stats.passes,
+                pass_time: counted + self.stats.pass_time,
+                memory_bytes: count.stats.memory_bytes.max(self.stats.memory_bytes),
+                locked_ops: self
+                    .stats
+                    .locked_ops
+                    .map(|ops| ops + count.stats.locked_ops.unwrap_or(0)),
+                count_pass_time: Some(counted),
+                ..self.stats
+            },
+            capture: self.capture,
+        }
+    }
 }
 
 /// Runs `scheme` over `view` serially, in submission order, on fresh storage.
@@ -121,17 +199,34 @@ impl SerialExecutor {
 }
 
 /// The parallel executor (rayon, std atomics), keeping its storage between frames.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct ParallelExecutor {
     memory: Option<AtomicMemory>,
+    triangles_per_task: usize,
+}
+
+impl Default for ParallelExecutor {
+    fn default() -> Self {
+        Self::with_task_size(TRIANGLES_PER_TASK)
+    }
 }
 
 impl ParallelExecutor {
+    /// The executor handing rayon `triangles_per_task` triangles per work item (at least 1):
+    /// small sizes make small scenes run on every thread, so their fragments really interleave.
+    #[must_use]
+    pub fn with_task_size(triangles_per_task: usize) -> Self {
+        Self {
+            memory: None,
+            triangles_per_task: triangles_per_task.max(1),
+        }
+    }
+
     /// Runs one frame of `scheme` over `view` on the current rayon pool.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
         let memory = reuse_storage(&mut self.memory, scheme);
-        let passes = parallel_passes(view, scheme, &*memory);
+        let passes = parallel_passes(view, scheme, &*memory, self.triangles_per_task);
         finish(scheme, start, passes, rayon::current_num_threads(), || {
             resolve_parallel(scheme, &*memory)
         })
@@ -188,7 +283,7 @@ pub fn count_locked_ops<S: Scheme>(view: &View<'_>, scheme: &S, parallel: bool) 
     let start = Instant::now();
     let (run, locked_ops) = if parallel {
         let memory: CountingMemory<AtomicMemory> = scheme.layout().allocate();
-        let passes = parallel_passes(view, scheme, &memory);
+        let passes = parallel_passes(view, scheme, &memory, TRIANGLES_PER_TASK);
         let run = finish(scheme, start, passes, rayon::current_num_threads(), || {
             resolve_parallel(scheme, &memory)
         });
@@ -225,11 +320,12 @@ fn parallel_passes<S: Scheme, M: Memory + Sync>(
     view: &View<'_>,
     scheme: &S,
     memory: &M,
+    triangles_per_task: usize,
 ) -> (Counters, u32) {
     run_passes(scheme, memory, |pass| {
         (0..view.triangle_count())
             .into_par_iter()
-            .with_min_len(TRIANGLES_PER_TASK)
+            .with_min_len(triangles_per_task)
             .fold(Counters::default, |mut counters, prim| {
                 let rect = view.viewport().rect();
                 rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
@@ -350,6 +446,7 @@ pub(crate) fn finish<S: Scheme>(
         memory_bytes: scheme.layout().bytes(),
         threads,
         locked_ops: None,
+        count_pass_time: None,
     };
     Run { capture, stats }
 }

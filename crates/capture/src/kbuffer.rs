@@ -33,6 +33,7 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
@@ -219,6 +220,10 @@ impl Scheme for KBuffer {
 
     fn identity(&self) -> Identity {
         Identity::KeyAndPrim
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactWithoutHazards
     }
 
     fn promise(&self) -> Promise {

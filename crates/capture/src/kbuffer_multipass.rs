@@ -39,7 +39,8 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::kbuffer::{Insert, Outcome, Slots, EMPTY};
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
@@ -125,8 +126,12 @@ impl Scheme for KBufferMultipass {
         Identity::KeyAndPrim
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactWithoutHazards
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixel(self.capacity))
     }
 
     fn begin(&self, fragment: Fragment) -> Peel {

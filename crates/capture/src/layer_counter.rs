@@ -15,8 +15,9 @@
 //! lost. Under any interleaving a pixel of depth complexity `n` loses exactly
 //! `max(0, n − layer_count)` fragments (fetch-and-add hands out distinct layer ids, and the clamp
 //! only ever stores `layer_count` over a counter already at or past it). The promise is therefore
-//! [`Promise::All`] with no overflow known: every discarded fragment is counted as lost by the
-//! oracle's diff, which is exactly Bevy's image error. One geometry pass; memory: one counter and
+//! [`Promise::All`] over [`Capacity::PerPixelUncounted`]: the scheme reports no overflow, and
+//! the oracle supplies the count it cannot keep (`max(0, n − layer_count)` per pixel) and checks
+//! that exactly that many are missing. One geometry pass; memory: one counter and
 //! `layer_count` 64-bit layers per pixel; two memory operations per kept fragment, two per
 //! discarded one.
 //!
@@ -27,7 +28,8 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::abuffer::insertion_sort;
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
 
@@ -107,8 +109,12 @@ impl Scheme for LayerCounter {
         Identity::KeyAndPrim
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactWithinCapacity(self.layer_count)
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixelUncounted(self.layer_count))
     }
 
     fn begin(&self, fragment: Fragment) -> LayerStep {

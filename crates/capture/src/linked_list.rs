@@ -21,8 +21,9 @@
 //! **Guarantee.** The exchange makes list construction safe under any interleaving: every
 //! fragment that gets a node is in its pixel's list exactly once (loom checks it in
 //! `tests/loom.rs`). With a pool that suffices, `KeepNearest` is exact up to `N`
-//! ([`Promise::Nearest`]); `KeepFirst` is exact when every list has at most `N` nodes and departs
-//! otherwise. A fragment past the pool is lost silently (no per-pixel count survives), and the
+//! ([`Promise::Nearest`]); `KeepFirst` is exact when every list has at most `N` nodes and
+//! otherwise keeps `N` of them, uncounted ([`Capacity::PerPixelUncounted`]: the oracle supplies
+//! the count and checks it). A fragment past the pool is lost silently (no per-pixel count survives), and the
 //! oracle's diff counts it. One geometry pass; memory: one 32-bit head per pixel, the counter, and
 //! per node a 64-bit fragment and a 32-bit `next`.
 //!
@@ -32,7 +33,8 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
 
@@ -163,8 +165,16 @@ impl Scheme for LinkedList {
         Identity::KeyAndPrim
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactWithinCapacity(self.sorted_max)
+    }
+
     fn promise(&self) -> Promise {
-        Promise::Nearest(self.sorted_max)
+        match self.resolve {
+            // The resolve stops after N nodes and never learns the list's length.
+            Resolve::KeepFirst => Promise::All(Capacity::PerPixelUncounted(self.sorted_max)),
+            Resolve::KeepNearest => Promise::Nearest(self.sorted_max),
+        }
     }
 
     fn begin(&self, fragment: Fragment) -> Node {

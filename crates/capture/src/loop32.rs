@@ -34,6 +34,7 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
 
@@ -182,6 +183,10 @@ impl Scheme for Loop32 {
 
     fn identity(&self) -> Identity {
         Identity::KeyAndPrim
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactDistinctDepths
     }
 
     fn promise(&self) -> Promise {

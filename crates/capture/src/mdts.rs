@@ -33,6 +33,7 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, Word, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
@@ -264,6 +265,10 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
 
     fn identity(&self) -> Identity {
         W::IDENTITY
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Exact
     }
 
     fn promise(&self) -> Promise {

@@ -56,6 +56,7 @@
 use fragsim_raster::{depth_from_key, Fragment, Viewport};
 
 use crate::capture::Identity;
+use crate::guarantee::Guarantee;
 use crate::mdts::{Direction, Mdts, MdtsWord, Walk};
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
@@ -240,6 +241,10 @@ impl Scheme for MdtsPacked {
 
     fn identity(&self) -> Identity {
         Identity::PrimOnly
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Approximate
     }
 
     fn promise(&self) -> Promise {

@@ -46,7 +46,8 @@ use std::marker::PhantomData;
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::mdts::MdtsWord;
 use crate::memory::{Memory, Word, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
@@ -251,8 +252,16 @@ impl<W: MdtsWord> Scheme for DepthPeeling<W> {
         W::IDENTITY
     }
 
+    fn guarantee(&self) -> Guarantee {
+        // 32-bit depth keys merge equal depths into one layer; 64-bit words are all distinct.
+        match W::IDENTITY {
+            Identity::KeyOnly => Guarantee::ExactDistinctDepths,
+            _ => Guarantee::Exact,
+        }
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixel(self.max_layers()))
     }
 
     fn begin(&self, fragment: Fragment) -> Peel<W> {

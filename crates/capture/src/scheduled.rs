@@ -453,6 +453,7 @@ fn run_stream<S: Scheme>(
         memory_bytes: scheme.layout().bytes(),
         threads: 1,
         locked_ops: None,
+        count_pass_time: None,
     };
     let trace = memory.log.map(|log| Trace {
         events: log.into_inner(),

@@ -4,7 +4,8 @@ use std::fmt::Debug;
 
 use fragsim_raster::Fragment;
 
-use crate::capture::{Capture, Identity, Keeps};
+use crate::capture::{Capacity, Capture, Identity, Keeps};
+use crate::guarantee::Guarantee;
 use crate::memory::Memory;
 
 /// Default cap on the per-pixel storage a scheme may allocate: 4 GiB.
@@ -74,8 +75,9 @@ pub enum Promise {
     Nearest(u32),
     /// The `K` farthest.
     Farthest(u32),
-    /// Every fragment, except those counted as overflow.
-    All,
+    /// Every fragment that fits the storage; what overflows it is counted by the scheme and
+    /// checked against what the capacity predicts.
+    All(Capacity),
 }
 
 /// Why a scheme could not be set up.
@@ -118,6 +120,9 @@ pub trait Scheme: Sync {
 
     /// Which fragments the scheme promises to keep.
     fn promise(&self) -> Promise;
+
+    /// What the scheme guarantees against the oracle (each module's header says why).
+    fn guarantee(&self) -> Guarantee;
 
     /// The state of a fragment before its first step in the first geometry pass.
     fn begin(&self, fragment: Fragment) -> Self::State;
@@ -163,7 +168,7 @@ pub trait Scheme: Sync {
         match self.promise() {
             Promise::Nearest(k) => Keeps::Nearest(k),
             Promise::Farthest(k) => Keeps::Farthest(k),
-            Promise::All => Keeps::All { overflow },
+            Promise::All(capacity) => Keeps::All { capacity, overflow },
         }
     }
 

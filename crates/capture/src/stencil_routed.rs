@@ -40,7 +40,8 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::abuffer::bitonic_sort;
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
@@ -128,8 +129,12 @@ impl Scheme for StencilRouted {
         Identity::KeyAndPrim
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::ExactInArrivalOrder
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixel(self.capacity()))
     }
 
     fn begin(&self, fragment: Fragment) -> Route {

@@ -19,6 +19,7 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
+use crate::guarantee::Guarantee;
 use crate::memory::{Memory, WordMemory};
 use crate::peeling::depth_test;
 use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
@@ -73,6 +74,10 @@ impl Scheme for ZBuffer {
 
     fn identity(&self) -> Identity {
         Identity::KeyAndPrim
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Exact
     }
 
     fn promise(&self) -> Promise {

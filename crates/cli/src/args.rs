@@ -3,8 +3,11 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
+use fragsim_capture::executor::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::{OrbitCamera, Scene, Viewport, DEFAULT_SCENE_NAME};
+
+use crate::schemes::Sizing;
 
 /// The scene and the camera.
 #[derive(Debug, Clone, Args)]
@@ -67,13 +70,15 @@ impl SceneArgs {
 /// How schemes are sized and run.
 #[derive(Debug, Clone, Args)]
 pub struct SchemeArgs {
-    /// MDTS (and k-buffer, loop32, layer-counter, linked-list resolve) slots per pixel; `auto`
-    /// sizes K to the scene's maximum depth complexity.
-    #[arg(long, default_value = "auto", allow_negative_numbers = true, value_parser = parse_count)]
+    /// MDTS (and k-buffer, loop32, layer-counter, linked-list resolve) slots per pixel: FreePipe
+    /// allocates 20 (Table 3); `auto` sizes K to the scene's maximum depth complexity by a
+    /// counting pass that the scheme's row reports (one more geometry pass, timed).
+    #[arg(long, default_value = "20", allow_negative_numbers = true, value_parser = parse_count)]
     pub k: Count,
-    /// A-buffer slots per pixel (linked lists: pool nodes per pixel); `exact` sizes each pixel's
-    /// list (the linked lists' pool) from a counting pass.
-    #[arg(long, default_value = "exact", allow_negative_numbers = true, value_parser = parse_count)]
+    /// A-buffer slots per pixel (linked lists: pool nodes per pixel); `auto` (or `exact`) sizes
+    /// them to the scene's maximum depth complexity (the linked lists' pool to its fragments) by
+    /// a counting pass that the row reports. `abuffer-exact` always sizes each pixel exactly.
+    #[arg(long, default_value = "20", allow_negative_numbers = true, value_parser = parse_count)]
     pub capacity: Count,
     /// Executor: serial, parallel, tiled, scheduled (a replayable GPU-like interleaving) or all
     /// (serial, parallel and tiled).
@@ -105,13 +110,23 @@ impl SchemeArgs {
 
     /// The executors chosen.
     #[must_use]
-    pub fn executors(&self) -> &'static [&'static str] {
+    pub fn executors(&self) -> &'static [Executor] {
         match self.executor {
-            ExecutorChoice::Serial => &["serial"],
-            ExecutorChoice::Parallel => &["parallel"],
-            ExecutorChoice::Tiled => &["tiled"],
-            ExecutorChoice::Scheduled => &["scheduled"],
-            ExecutorChoice::All => &["serial", "parallel", "tiled"],
+            ExecutorChoice::Serial => &[Executor::Serial],
+            ExecutorChoice::Parallel => &[Executor::Parallel],
+            ExecutorChoice::Tiled => &[Executor::Tiled],
+            ExecutorChoice::Scheduled => &[Executor::Scheduled],
+            ExecutorChoice::All => &[Executor::Serial, Executor::Parallel, Executor::Tiled],
+        }
+    }
+
+    /// The sizes chosen.
+    #[must_use]
+    pub fn sizing(&self) -> Sizing {
+        Sizing {
+            k: self.k,
+            capacity: self.capacity,
+            memory_cap: self.memory_cap,
         }
     }
 }
@@ -119,21 +134,10 @@ impl SchemeArgs {
 /// A slot count: a number, or derived from the scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Count {
-    /// Sized from the scene's depth complexity.
+    /// Sized to the scene's depth complexity by a counting pass of the scheme's own.
     Auto,
     /// Exactly this many.
     Fixed(u32),
-}
-
-impl Count {
-    /// The count, with `Auto` resolved to `scene_max` (at least 1).
-    #[must_use]
-    pub fn resolve(self, scene_max: u32) -> u32 {
-        match self {
-            Count::Auto => scene_max.max(1),
-            Count::Fixed(n) => n,
-        }
-    }
 }
 
 fn parse_count(text: &str) -> Result<Count, String> {

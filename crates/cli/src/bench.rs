@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use clap::Args;
+use fragsim_capture::executor::Executor;
 use fragsim_oracle::Oracle;
 use fragsim_raster::View;
 use fragsim_shade::effects;
@@ -16,7 +17,7 @@ use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{EffectName, Judge};
-use crate::schemes::{check_memory_cap_early, Executors, SchemeName, Sizing};
+use crate::schemes::{check_memory_cap_early, Executors, SchemeName};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -50,13 +51,17 @@ pub struct BenchRow {
     /// Scheme name.
     pub scheme: String,
     /// `exact`, `exact-distinct-depths` or `approximate`.
-    pub guarantee: &'static str,
+    pub guarantee: String,
+    /// Whether the first frame kept the guarantee (judged by the oracle, on this executor).
+    pub keeps_guarantee: bool,
     /// `serial` or `parallel`.
     pub executor: String,
     /// Threads.
     pub threads: usize,
     /// Geometry passes per frame.
     pub passes: u32,
+    /// The counting pass that sized the storage (inside `passes_ms`), where one ran.
+    pub count_pass_ms: Option<f64>,
     /// Bytes of per-pixel storage.
     pub memory_bytes: u64,
     /// Bytes per pixel.
@@ -159,38 +164,25 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .build()
         .map_err(|e| e.to_string())?;
     let mut view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
-    check_memory_cap_early(
-        &args.scheme,
-        viewport,
-        args.schemes.k,
-        args.schemes.capacity,
-        args.schemes.memory_cap,
-    )?;
+    let sizing = args.schemes.sizing();
+    check_memory_cap_early(&args.scheme, viewport, &sizing)?;
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
     let oracle = Oracle::build(&view);
-    let depth_complexity = oracle.depth_complexity();
     let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
     let covered = judge.covered;
     if let Some(image) = judge.reference() {
         let name = format!("bench-oracle-{}.png", args.effect.label());
         fragsim_shade::save_png(image, &args.out.join(name))?;
     }
-    let sizing = Sizing {
-        k: args.schemes.k,
-        capacity: args.schemes.capacity,
-        depth_complexity: &depth_complexity,
-        max_depth_complexity: oracle.max_depth_complexity(),
-        memory_cap: args.schemes.memory_cap,
-    };
     let mut rows = Vec::new();
     for name in SchemeName::expand(&args.scheme) {
         for &executor in args.schemes.executors() {
             let mut runner = Executors::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial
             // executor's vertex stage runs on one thread too.
-            let frame_pool = if executor == "serial" {
+            let frame_pool = if executor == Executor::Serial {
                 &serial_pool
             } else {
                 &pool
@@ -230,10 +222,16 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let seconds = median_time.as_secs_f64().max(1e-12);
             rows.push(BenchRow {
                 scheme: named.name.clone(),
-                guarantee: name.guarantee(),
-                executor: executor.into(),
+                guarantee: named.guarantee.to_string(),
+                keeps_guarantee: oracle.keeps_guarantee(
+                    &named.run.capture,
+                    named.guarantee,
+                    executor.serialises_pixels(),
+                ),
+                executor: executor.name().into(),
                 threads: stats.threads,
                 passes: stats.passes,
+                count_pass_ms: stats.count_pass_time.map(ms),
                 memory_bytes: stats.memory_bytes,
                 bytes_per_pixel: stats.memory_bytes as f64 / viewport.pixels() as f64,
                 fragments: stats.counters.fragments,

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_capture::{Capture, Identity, Keeps};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_oracle::dump::{self, verdict, Comparison, Dump, Header, VerdictCounts};
 use fragsim_oracle::Oracle;
 use fragsim_raster::depth_from_key;
@@ -285,6 +285,7 @@ fn oracle_capture(oracle: &Oracle) -> Capture {
         pixels,
         Identity::KeyAndPrim,
         Keeps::All {
+            capacity: Capacity::Unbounded,
             overflow: vec![0; pixels],
         },
     );
@@ -310,7 +311,7 @@ fn reference_caveats(capture: &Capture) -> Vec<String> {
                 Vec::new()
             }
         }
-        Keeps::All { overflow } => {
+        Keeps::All { overflow, .. } => {
             let lost: u64 = overflow.iter().map(|&o| u64::from(o)).sum();
             if lost > 0 {
                 vec![format!(

@@ -8,8 +8,8 @@ use fragsim_capture::mdts::Direction;
 use fragsim_oracle::dump::{Dump, DumpScheme, SceneSpec, TriangleExport};
 use fragsim_raster::View;
 
-use crate::args::{Count, SceneArgs};
-use crate::schemes::{SchemeName, Sizing};
+use crate::args::SceneArgs;
+use crate::schemes::{NamedRun, SchemeName};
 
 /// Options of `fragsim export-scene`.
 #[derive(Debug, Clone, Args)]
@@ -54,31 +54,28 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The dump layout of a `render` scheme, with K and capacity resolved as `render` resolves them.
-fn dump_scheme(name: SchemeName, sizing: &Sizing<'_>) -> Result<DumpScheme, String> {
-    let k = sizing.k.resolve(sizing.max_depth_complexity);
+/// The dump layout of a `render` scheme, with K and capacity as its run had them.
+fn dump_scheme(name: SchemeName, run: &NamedRun) -> Result<DumpScheme, String> {
+    let slots = run.slots.unwrap_or(1);
     Ok(match name {
         SchemeName::Mdts => DumpScheme::Mdts {
-            k,
+            k: slots,
             direction: Direction::Ascending,
         },
         SchemeName::MdtsDesc => DumpScheme::Mdts {
-            k,
+            k: slots,
             direction: Direction::Descending,
         },
-        SchemeName::Mdts32 => DumpScheme::Mdts32 { k },
-        SchemeName::Abuffer | SchemeName::AbufferBitonic => match sizing.capacity {
-            Count::Auto => DumpScheme::ABufferExact {
-                counts: sizing.depth_complexity.to_vec(),
-                sorted: false,
-            },
-            Count::Fixed(capacity) => DumpScheme::ABufferFixed {
-                capacity,
-                sorted: false,
-            },
+        SchemeName::Mdts32 => DumpScheme::Mdts32 { k: slots },
+        SchemeName::Abuffer | SchemeName::AbufferBitonic => DumpScheme::ABufferFixed {
+            capacity: slots,
+            sorted: false,
         },
-        SchemeName::AbufferFixed => DumpScheme::ABufferFixed {
-            capacity: sizing.capacity.resolve(sizing.max_depth_complexity),
+        SchemeName::AbufferExact => DumpScheme::ABufferExact {
+            counts: run
+                .counts
+                .clone()
+                .ok_or("abuffer-exact ran without its counting pass")?,
             sorted: false,
         },
         #[allow(unreachable_patterns)]
@@ -86,7 +83,7 @@ fn dump_scheme(name: SchemeName, sizing: &Sizing<'_>) -> Result<DumpScheme, Stri
     })
 }
 
-/// Writes scheme `name`'s memory, after a serial run, as a dump in `dir/<scheme>/`; returns
+/// Writes scheme `name`'s memory, sized as `run` was, after a serial run, as a dump in `dir/<scheme>/`; returns
 /// that directory.
 ///
 /// # Errors
@@ -94,11 +91,11 @@ fn dump_scheme(name: SchemeName, sizing: &Sizing<'_>) -> Result<DumpScheme, Stri
 pub(crate) fn write_dump(
     dir: &Path,
     name: SchemeName,
+    run: &NamedRun,
     view: &View<'_>,
-    sizing: &Sizing<'_>,
     scene: &SceneArgs,
 ) -> Result<PathBuf, String> {
-    let scheme = dump_scheme(name, sizing)?;
+    let scheme = dump_scheme(name, run)?;
     let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
     let dump =
         Dump::record(view, scene_spec(scene), &scheme, &producer).map_err(|e| e.to_string())?;

@@ -24,7 +24,7 @@ pub use export::ExportArgs;
 pub use hazard::{HazardArgs, HazardReport, HazardRow};
 pub use judge::EffectName;
 pub use render::{RenderArgs, RunSummary, TieChoice};
-pub use schemes::SchemeName;
+pub use schemes::{Fault, SchemeName, Sizing};
 pub use sweep::{SweepArgs, SweepSeries};
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
@@ -90,15 +90,18 @@ pub fn main() -> ExitCode {
         None => cli.render,
     };
     match render::render(&args) {
-        Ok(summary)
-            if summary
-                .iter()
-                .all(|run| run.guarantee != "exact" || run.mismatches == 0) =>
-        {
-            ExitCode::SUCCESS
-        }
-        Ok(_) => {
-            eprintln!("error: an exact scheme differs from the oracle (see the mismatches column)");
+        Ok(summary) if summary.iter().all(|run| run.keeps_guarantee) => ExitCode::SUCCESS,
+        Ok(summary) => {
+            for run in summary.iter().filter(|run| !run.keeps_guarantee) {
+                eprintln!(
+                    "error: {} on the {} executor breaks its guarantee `{}` ({} mismatched pixels, {} with a miscounted overflow)",
+                    run.scheme,
+                    run.executor,
+                    run.guarantee,
+                    run.mismatches,
+                    run.overflow_miscounted_pixels
+                );
+            }
             ExitCode::from(1)
         }
         Err(message) => {

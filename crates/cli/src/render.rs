@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::schemes::{check_memory_cap_early, Executors, SchemeName, Sizing};
+use crate::schemes::{check_memory_cap_early, Executors, Fault, SchemeName};
 
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
@@ -41,6 +41,9 @@ pub struct RenderArgs {
     /// (compared by distinct depth key, as loop32 and 32-bit peeling keep them).
     #[arg(long, default_value = "by-primitive")]
     pub ties: TieChoice,
+    /// Inject a fault into every scheme (to show that a verdict can fail; tests only).
+    #[arg(long, hide = true)]
+    pub inject_fault: Option<Fault>,
 }
 
 /// `--ties`: [`Ties`] on the command line.
@@ -69,9 +72,12 @@ impl From<TieChoice> for Ties {
 pub struct RunSummary {
     /// Scheme name.
     pub scheme: String,
-    /// `exact`, `exact-distinct-depths` or `approximate` (see `SchemeName::guarantee`).
-    pub guarantee: &'static str,
-    /// `serial` or `parallel`.
+    /// What the scheme guarantees (`exact`, `exact-within-capacity(C)`, `exact-distinct-depths`,
+    /// `exact-without-hazards`, `exact-in-arrival-order` or `approximate`).
+    pub guarantee: String,
+    /// Whether this run kept its guarantee (judged by the oracle, on this executor).
+    pub keeps_guarantee: bool,
+    /// `serial`, `parallel`, `tiled` or `scheduled`.
     pub executor: String,
     /// Threads that ran it.
     pub threads: usize,
@@ -85,23 +91,30 @@ pub struct RunSummary {
     pub triangles: u32,
     /// Fragments rasterized and inserted, over all passes.
     pub fragments: u64,
-    /// Geometry passes.
+    /// Geometry passes, the counting pass included where one sized the storage.
     pub passes: u32,
+    /// The counting pass that sized the storage (its time is inside `pass_ms`), where one ran.
+    pub count_pass_ms: Option<f64>,
     /// Largest per-pixel depth complexity.
     pub max_depth_complexity: u32,
     /// Memory operations (steps) performed.
     pub memory_ops: u64,
     /// Fragments captured.
     pub captured: u64,
-    /// Fragments the scheme had no room for (beyond K, or past a fixed capacity), counted.
+    /// Fragments the scheme had no room for (beyond K, or past a fixed capacity), as the oracle
+    /// predicts from each pixel's fragment count.
     pub overflowed: u64,
+    /// The overflow the scheme counted itself.
+    pub reported_overflow: u64,
+    /// Pixels whose counted overflow differs from the oracle's prediction.
+    pub overflow_miscounted_pixels: u64,
     /// Fragments the scheme should have kept but did not.
     pub lost: u64,
     /// Pixels that differ from the oracle.
     pub mismatches: u64,
     /// Pass plus post pass, in milliseconds.
     pub time_ms: f64,
-    /// The pass (storage initialisation, rasterization, capture), in milliseconds.
+    /// The passes (storage initialisation, rasterization, capture), in milliseconds.
     pub pass_ms: f64,
     /// The post pass (resolve, sort), in milliseconds.
     pub resolve_ms: f64,
@@ -124,13 +137,8 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         .view(viewport, &args.scene.orbit(args.scene.view))
         .map_err(|e| e.to_string())?;
     let schemes = SchemeName::expand(&args.scheme);
-    check_memory_cap_early(
-        &schemes,
-        viewport,
-        args.schemes.k,
-        args.schemes.capacity,
-        args.schemes.memory_cap,
-    )?;
+    let sizing = args.schemes.sizing();
+    check_memory_cap_early(&schemes, viewport, &sizing)?;
     let executors = args.schemes.executors();
     let progress = progress_bar(args.json, (schemes.len() * executors.len() + 1) as u64);
     progress.set_message("oracle (serial reference)");
@@ -139,23 +147,19 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let oracle_ms = oracle_start.elapsed().as_secs_f64() * 1e3;
     progress.inc(1);
     let max_dc = oracle.max_depth_complexity();
-    let depth_complexity = oracle.depth_complexity();
-    let sizing = Sizing {
-        k: args.schemes.k,
-        capacity: args.schemes.capacity,
-        depth_complexity: &depth_complexity,
-        max_depth_complexity: max_dc,
-        memory_cap: args.schemes.memory_cap,
-    };
     let mut runner = Executors::default();
+    runner.fault = args.inject_fault;
     let mut rows = Vec::new();
     let mut nearest_written = false;
     for &name in &schemes {
+        let mut last = None;
         for &executor in executors {
             progress.set_message(format!("{name:?} on the {executor} executor"));
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
-            let run = named.run;
+            let run = &named.run;
             let diff = oracle.diff_with(&run.capture, args.ties.into());
+            let keeps_guarantee =
+                oracle.keeps_guarantee(&run.capture, named.guarantee, executor.serialises_pixels());
             if !args.no_images && !nearest_written {
                 let nearest: Vec<Option<f32>> = run
                     .capture
@@ -169,9 +173,10 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             }
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
             rows.push(RunSummary {
-                scheme: named.name,
-                guarantee: name.guarantee(),
-                executor: executor.into(),
+                scheme: named.name.clone(),
+                guarantee: named.guarantee.to_string(),
+                keeps_guarantee,
+                executor: executor.name().into(),
                 threads: run.stats.threads,
                 scene: scene.name.clone(),
                 width: viewport.width,
@@ -179,10 +184,13 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 triangles: view.triangle_count(),
                 fragments: run.stats.counters.fragments,
                 passes: run.stats.passes,
+                count_pass_ms: run.stats.count_pass_time.map(ms),
                 max_depth_complexity: max_dc,
                 memory_ops: run.stats.counters.steps,
                 captured: diff.captured,
                 overflowed: diff.overflowed,
+                reported_overflow: diff.reported_overflow,
+                overflow_miscounted_pixels: diff.overflow_miscounted_pixels,
                 lost: diff.lost,
                 mismatches: diff.mismatched_pixels,
                 time_ms: ms(run.stats.pass_time + run.stats.resolve_time),
@@ -192,9 +200,10 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 slots_per_pixel: named.slots,
             });
             progress.inc(1);
+            last = Some(named);
         }
-        if let Some(dir) = &args.dump {
-            crate::export::write_dump(dir, name, &view, &sizing, &args.scene)?;
+        if let (Some(dir), Some(run)) = (&args.dump, &last) {
+            crate::export::write_dump(dir, name, run, &view, &args.scene)?;
         }
     }
     progress.finish_and_clear();
@@ -245,12 +254,16 @@ fn print_table(
         oracle_ms
     );
     type Cell = fn(&RunSummary) -> String;
-    let columns: [(&str, usize, Cell); 15] = [
+    let columns: [(&str, usize, Cell); 16] = [
         ("scheme", 19, |r| r.scheme.clone()),
-        ("guarantee", 22, |r| r.guarantee.to_string()),
+        ("guarantee", 26, |r| r.guarantee.clone()),
         ("executor", 9, |r| r.executor.clone()),
         ("thr", 3, |r| r.threads.to_string()),
-        ("passes", 6, |r| r.passes.to_string()),
+        ("passes", 6, |r| {
+            // A counting pass that sized the storage is marked: `2c` = one capture pass after it.
+            let counted = if r.count_pass_ms.is_some() { "c" } else { "" };
+            format!("{}{counted}", r.passes)
+        }),
         ("triangles", 9, |r| r.triangles.to_string()),
         ("fragments", 10, |r| r.fragments.to_string()),
         ("maxdc", 5, |r| r.max_depth_complexity.to_string()),
@@ -260,6 +273,9 @@ fn print_table(
         ("overflow", 8, |r| r.overflowed.to_string()),
         ("lost", 6, |r| r.lost.to_string()),
         ("mismatches", 10, |r| r.mismatches.to_string()),
+        ("verdict", 7, |r| {
+            if r.keeps_guarantee { "kept" } else { "BROKEN" }.to_string()
+        }),
         ("mem ops", 9, |r| r.memory_ops.to_string()),
     ];
     let line = |cells: Vec<String>| {
@@ -286,16 +302,9 @@ fn print_table(
     for r in rows {
         line(columns.iter().map(|(_, _, cell)| cell(r)).collect());
     }
-    let pixels = viewport.pixels() as u64;
-    let max_dc = u64::from(oracle.max_depth_complexity());
-    let exact = pixels * 4 + oracle.fragments() as u64 * 8 + (pixels + 1) * 4;
-    let fixed = pixels * (4 + max_dc * 8);
-    println!(
-        "memory sized to the scene: A-buffer exact {exact} B ({:.1} B/pixel) vs fixed capacity {max_dc} {fixed} B ({:.1} B/pixel); MDTS K={max_dc}: {} B",
-        exact as f64 / pixels as f64,
-        fixed as f64 / pixels as f64,
-        pixels * max_dc * 8
-    );
+    if rows.iter().any(|r| r.count_pass_ms.is_some()) {
+        println!("passes marked c include the scheme's own counting pass, which sized its storage");
+    }
     if !args.no_images {
         println!(
             "images: {}/depth-complexity.png, {}/nearest-depth.png",

@@ -3,8 +3,9 @@
 use clap::ValueEnum;
 use fragsim_capture::abuffer::{ABuffer, PostSort};
 use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
+use fragsim_capture::depth_count::{DepthCount, DepthCounts};
 use fragsim_capture::dual_peeling::DualDepthPeeling;
-use fragsim_capture::executor::{self, ParallelExecutor, Run, SerialExecutor};
+use fragsim_capture::executor::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use fragsim_capture::kbuffer::KBuffer;
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::layer_counter::LayerCounter;
@@ -17,8 +18,8 @@ use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim_capture::stencil_routed::StencilRouted;
 use fragsim_capture::tiled::TiledExecutor;
 use fragsim_capture::zbuffer::ZBuffer;
-use fragsim_capture::{CaptureError, Scheme};
-use fragsim_raster::{View, Viewport};
+use fragsim_capture::{CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step};
+use fragsim_raster::{Fragment, View, Viewport};
 
 use crate::args::Count;
 
@@ -34,12 +35,14 @@ pub enum SchemeName {
     /// MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would
     /// change the slot (same lists, fewer locked operations).
     MdtsProbe,
-    /// A-buffer, storage sized exactly by a counting pass, insertion-sorted.
+    /// FreePipe's A-buffer: `--capacity` slots per pixel (fixed arrays, FreePipe §4.2), overflow
+    /// counted; insertion-sorted.
     Abuffer,
-    /// A-buffer as above, bitonic-sorted.
+    /// The A-buffer as above, bitonic-sorted.
     AbufferBitonic,
-    /// A-buffer with a fixed capacity per pixel (`--capacity`, or the maximum depth complexity).
-    AbufferFixed,
+    /// The A-buffer with storage sized exactly by its own counting pass (`fetch_add` per
+    /// fragment, then a prefix sum): two geometry passes.
+    AbufferExact,
     /// Classical depth peeling, 64-bit words (ties ordered by primitive id): one pass per layer.
     Peeling,
     /// Classical depth peeling on 32-bit depth keys: equal depths merge.
@@ -90,7 +93,7 @@ impl SchemeName {
         SchemeName::MdtsProbe,
         SchemeName::Abuffer,
         SchemeName::AbufferBitonic,
-        SchemeName::AbufferFixed,
+        SchemeName::AbufferExact,
         SchemeName::Peeling,
         SchemeName::Peeling32,
         SchemeName::DualPeeling,
@@ -110,37 +113,6 @@ impl SchemeName {
         SchemeName::LinkedListNearest,
     ];
 
-    /// What the scheme promises against the oracle: `exact` (fragment for fragment, up to K where
-    /// it has K slots), `exact-distinct-depths` (32-bit depth peeling merges equal depths),
-    /// `exact-without-hazards` (read–modify–write schemes: exact serially), `exact-in-arrival-order`
-    /// (multi-pass routing), `exact-within-capacity` (shipping OIT storage: exact while the scene
-    /// fits it, silently lossy beyond), or `approximate` (loses fragments in situations its paper
-    /// describes, and reports them). Only `exact` schemes fail `render` when they differ from the oracle.
-    #[must_use]
-    pub fn guarantee(self) -> &'static str {
-        match self {
-            SchemeName::Peeling32 | SchemeName::DualPeeling32 => "exact-distinct-depths",
-            SchemeName::Bdp | SchemeName::BdpSingle | SchemeName::Bdp2 | SchemeName::Adp => {
-                "approximate"
-            }
-            // Exact on the serial executor; concurrent read–modify–write hazards lose fragments.
-            SchemeName::Kbuffer | SchemeName::KbufferMultipass => "exact-without-hazards",
-            // Exact up to 8 samples per pass (the rest counted as overflow); its passes must see
-            // one arrival order, which the parallel executor does not promise.
-            SchemeName::Srab => "exact-in-arrival-order",
-            // 20 bits of depth: fragments closer than 2^-20 may swap colours.
-            SchemeName::MdtsPacked => "approximate",
-            // Equal depths merge into one slot (docs/baselines/shipping.md).
-            SchemeName::Loop32 => "exact-distinct-depths",
-            // Exact while every pixel's fragments fit its layers (or its list fits `--k` and the
-            // node pool); past that, fragments are lost silently.
-            SchemeName::LayerCounter | SchemeName::LinkedList | SchemeName::LinkedListNearest => {
-                "exact-within-capacity"
-            }
-            _ => "exact",
-        }
-    }
-
     /// `names` with `all` expanded and duplicates removed, in the order given.
     #[must_use]
     pub fn expand(names: &[SchemeName]) -> Vec<SchemeName> {
@@ -157,30 +129,75 @@ impl SchemeName {
     }
 }
 
-/// What sizing a scheme may need from the scene and the user.
+/// How the user sized the schemes. Nothing here comes from the oracle: where a size is `auto`
+/// (or a scheme's storage is sized to the scene by design), the scheme runs its own counting pass
+/// first ([`fragsim_capture::depth_count`]), and its row reports that pass.
 #[derive(Debug, Clone, Copy)]
-pub struct Sizing<'a> {
+pub struct Sizing {
     /// `--k`.
     pub k: Count,
     /// `--capacity`.
     pub capacity: Count,
-    /// The scene's per-pixel depth complexity (from the oracle's counting pass).
-    pub depth_complexity: &'a [u32],
-    /// Its maximum.
-    pub max_depth_complexity: u32,
     /// `--memory-cap`.
     pub memory_cap: u64,
+}
+
+impl SchemeName {
+    /// Whether the scheme, sized by `sizing`, needs the scene's per-pixel depth complexity, and
+    /// so a counting pass before its capture.
+    #[must_use]
+    pub fn needs_count_pass(self, sizing: &Sizing) -> bool {
+        let k_auto = sizing.k == Count::Auto;
+        let capacity_auto = sizing.capacity == Count::Auto;
+        match self {
+            SchemeName::Mdts
+            | SchemeName::Mdts32
+            | SchemeName::MdtsDesc
+            | SchemeName::MdtsProbe
+            | SchemeName::MdtsPacked
+            | SchemeName::Kbuffer
+            | SchemeName::Loop32
+            | SchemeName::LayerCounter => k_auto,
+            SchemeName::Abuffer | SchemeName::AbufferBitonic => capacity_auto,
+            SchemeName::LinkedList | SchemeName::LinkedListNearest => k_auto || capacity_auto,
+            // Storage for every fragment, or a record of every layer: sized to the scene.
+            SchemeName::AbufferExact
+            | SchemeName::Peeling
+            | SchemeName::Peeling32
+            | SchemeName::DualPeeling
+            | SchemeName::DualPeeling32
+            | SchemeName::Adp
+            | SchemeName::KbufferMultipass => true,
+            SchemeName::Zbuffer
+            | SchemeName::Bdp
+            | SchemeName::BdpSingle
+            | SchemeName::Bdp2
+            | SchemeName::Srab
+            | SchemeName::All => false,
+        }
+    }
 }
 
 /// A finished run of a named scheme.
 #[derive(Debug, Clone)]
 pub struct NamedRun {
-    /// The run.
+    /// The run (with its counting pass folded in, where one ran).
     pub run: Run,
     /// The scheme's own name (`Scheme::name`).
     pub name: String,
+    /// What the scheme guarantees (`Scheme::guarantee`).
+    pub guarantee: Guarantee,
     /// Slots per pixel, where the scheme has a fixed number.
     pub slots: Option<u32>,
+    /// The per-pixel counts of the scheme's own counting pass, where one sized its storage.
+    pub counts: Option<Vec<u32>>,
+}
+
+/// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Fault {
+    /// Every scheme that counts its own overflow reports one fragment more at pixel 0.
+    MiscountOverflow,
 }
 
 /// Executors that keep their storage between frames of the same scheme.
@@ -192,46 +209,46 @@ pub struct Executors {
     /// Run the next frames on fresh storage that counts read-modify-write operations
     /// ([`RunStats::locked_ops`](fragsim_capture::executor::RunStats)), untimed.
     pub count_locked_ops: bool,
+    /// A fault injected into every scheme run (tests only).
+    pub fault: Option<Fault>,
 }
 
 impl Executors {
-    /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor`
-    /// (`serial`, or `parallel` or `tiled` on the current rayon pool).
+    /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor` (on the
+    /// current rayon pool where it is parallel): first its counting pass where it needs one,
+    /// then its own passes.
     ///
     /// # Errors
     /// A parameter the scheme rejects, or storage beyond the memory cap.
     pub fn run(
         &mut self,
         name: SchemeName,
-        executor: &str,
+        executor: Executor,
         view: &View<'_>,
-        sizing: &Sizing<'_>,
+        sizing: &Sizing,
     ) -> Result<NamedRun, String> {
+        let viewport = view.viewport();
+        let counted = name
+            .needs_count_pass(sizing)
+            .then(|| DepthCounts::from_run(DepthCount::new(viewport).run(self, executor, view)));
+        // What `auto` sizes resolve to: the count pass's maximum depth complexity (at least 1).
+        let scene_max = counted.as_ref().map_or(1, |c| c.max().max(1));
+        let resolve = |count: Count| match count {
+            Count::Auto => scene_max,
+            Count::Fixed(n) => n,
+        };
+        let (k, capacity) = (resolve(sizing.k), resolve(sizing.capacity));
+        let layers = scene_max;
+        let cap = sizing.memory_cap;
+        let err = |e: CaptureError| e.to_string();
         let mut go = |scheme: &dyn ErasedScheme, slots: Option<u32>| NamedRun {
             run: scheme.run(self, executor, view),
             name: scheme.name(),
+            guarantee: scheme.guarantee(),
             slots,
+            counts: None,
         };
-        let viewport = view.viewport();
-        let cap = sizing.memory_cap;
-        let k = sizing.k.resolve(sizing.max_depth_complexity);
-        // Multi-pass schemes store every layer: sized to the scene, as the A-buffer's storage.
-        let layers = sizing.max_depth_complexity.max(1);
-        let err = |e: CaptureError| e.to_string();
-        let exact_or_fixed =
-            |sort: PostSort, capacity: Count| -> Result<(ABuffer, Option<u32>), String> {
-                Ok(match capacity {
-                    Count::Auto => (
-                        ABuffer::exact(sizing.depth_complexity, sort, cap).map_err(err)?,
-                        None,
-                    ),
-                    Count::Fixed(c) => (
-                        ABuffer::fixed(viewport, c, sort, cap).map_err(err)?,
-                        Some(c),
-                    ),
-                })
-            };
-        Ok(match name {
+        let mut named = match name {
             SchemeName::Mdts => go(
                 &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
                 Some(k),
@@ -250,18 +267,20 @@ impl Executors {
                 &Mdts::<u64>::new(viewport, k, Direction::Descending, cap).map_err(err)?,
                 Some(k),
             ),
-            SchemeName::Abuffer => {
-                let (scheme, slots) = exact_or_fixed(PostSort::Insertion, sizing.capacity)?;
-                go(&scheme, slots)
-            }
-            SchemeName::AbufferBitonic => {
-                let (scheme, slots) = exact_or_fixed(PostSort::Bitonic, sizing.capacity)?;
-                go(&scheme, slots)
-            }
-            SchemeName::AbufferFixed => {
-                let capacity = Count::Fixed(sizing.capacity.resolve(sizing.max_depth_complexity));
-                let (scheme, slots) = exact_or_fixed(PostSort::Insertion, capacity)?;
-                go(&scheme, slots)
+            SchemeName::Abuffer => go(
+                &ABuffer::fixed(viewport, capacity, PostSort::Insertion, cap).map_err(err)?,
+                Some(capacity),
+            ),
+            SchemeName::AbufferBitonic => go(
+                &ABuffer::fixed(viewport, capacity, PostSort::Bitonic, cap).map_err(err)?,
+                Some(capacity),
+            ),
+            SchemeName::AbufferExact => {
+                let counts = &counted.as_ref().expect("sized by its count pass").counts;
+                go(
+                    &ABuffer::exact(counts, PostSort::Insertion, cap).map_err(err)?,
+                    None,
+                )
             }
             SchemeName::Peeling => go(
                 &DepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
@@ -311,14 +330,9 @@ impl Executors {
                 go(&LayerCounter::new(viewport, k, cap).map_err(err)?, Some(k))
             }
             SchemeName::LinkedList | SchemeName::LinkedListNearest => {
-                let pool = match sizing.capacity {
-                    Count::Auto => sizing
-                        .depth_complexity
-                        .iter()
-                        .map(|&c| c as usize)
-                        .sum::<usize>()
-                        .max(1),
-                    Count::Fixed(c) => viewport.pixels() * c as usize,
+                let pool = match (sizing.capacity, &counted) {
+                    (Count::Auto, Some(counted)) => counted.total().max(1),
+                    _ => viewport.pixels() * capacity as usize,
                 };
                 let resolve = if name == SchemeName::LinkedList {
                     Resolve::KeepFirst
@@ -331,34 +345,38 @@ impl Executors {
                 )
             }
             SchemeName::All => return Err("`all` names a list of schemes, not one".into()),
-        })
+        };
+        if let Some(counted) = counted {
+            named.run = named.run.after_count_pass(&counted.run);
+            named.counts = Some(counted.counts);
+        }
+        Ok(named)
     }
 }
 
-/// Refuses, before the oracle's counting pass, any scheme of `names` whose storage on `viewport`
-/// would exceed `memory_cap` even at its smallest.
+/// Refuses, before the oracle and any counting pass, any scheme of `names` whose storage on
+/// `viewport` would exceed `memory_cap` even at its smallest.
 ///
-/// With `--k auto` or `--capacity exact` storage is sized from the scene's depth complexity, known
-/// only after the counting pass, and that pass alone needs 24 bytes a pixel (6 GiB at
-/// 16384 × 16384): a refusal must not wait for it. The smallest storage is one slot per pixel for
-/// MDTS and the fixed A-buffer, and for the exact A-buffer its counters and offsets with no
-/// fragment (4 + 4 bytes a pixel, as `ABuffer::exact` counts them). Schemes not listed here are
-/// checked when they are built, after the count.
+/// With `--k auto`, `--capacity auto` or a scheme sized to the scene, storage is known only after
+/// a counting pass, and the oracle alone needs 24 bytes a pixel (6 GiB at 16384 × 16384): a
+/// refusal must not wait for them. The smallest storage is one slot per pixel for MDTS and the
+/// fixed A-buffer, and for the exact A-buffer its counters and offsets with no fragment (4 + 4
+/// bytes a pixel, as `ABuffer::exact` counts them). Schemes not listed here are checked when they
+/// are built.
 ///
 /// # Errors
 /// The first scheme refused, with the bytes it would need at least.
 pub fn check_memory_cap_early(
     names: &[SchemeName],
     viewport: Viewport,
-    k: Count,
-    capacity: Count,
-    memory_cap: u64,
+    sizing: &Sizing,
 ) -> Result<(), String> {
     let smallest = |count: Count| match count {
         Count::Auto => 1,
         Count::Fixed(n) => n,
     };
-    let (k_least, capacity_least) = (smallest(k), smallest(capacity));
+    let (k_least, capacity_least) = (smallest(sizing.k), smallest(sizing.capacity));
+    let memory_cap = sizing.memory_cap;
     for name in SchemeName::expand(names) {
         let result = match name {
             SchemeName::Mdts | SchemeName::MdtsProbe => {
@@ -370,38 +388,17 @@ pub fn check_memory_cap_early(
             SchemeName::MdtsDesc => {
                 Mdts::<u64>::new(viewport, k_least, Direction::Descending, memory_cap).map(drop)
             }
-            SchemeName::Abuffer | SchemeName::AbufferBitonic if capacity == Count::Auto => {
-                let pixels = viewport.pixels() as u64;
-                let needed = pixels * 4 + (pixels + 1) * 4;
-                if needed > memory_cap {
-                    Err(CaptureError::TooMuchMemory {
-                        scheme: if name == SchemeName::Abuffer {
-                            "abuffer"
-                        } else {
-                            "abuffer-bitonic"
-                        }
-                        .into(),
-                        needed,
-                        cap: memory_cap,
-                    })
-                } else {
-                    Ok(())
-                }
+            SchemeName::AbufferExact => {
+                ABuffer::exact(&vec![0; viewport.pixels()], PostSort::Insertion, memory_cap)
+                    .map(drop)
             }
-            SchemeName::Abuffer | SchemeName::AbufferBitonic | SchemeName::AbufferFixed => {
+            SchemeName::Abuffer | SchemeName::AbufferBitonic => {
                 ABuffer::fixed(viewport, capacity_least, PostSort::Insertion, memory_cap).map(drop)
             }
             _ => Ok(()),
         };
         if let Err(error) = result {
-            let sized_by_scene = match name {
-                SchemeName::Mdts
-                | SchemeName::Mdts32
-                | SchemeName::MdtsDesc
-                | SchemeName::MdtsProbe => k == Count::Auto,
-                _ => capacity == Count::Auto,
-            };
-            return Err(if sized_by_scene {
+            return Err(if name.needs_count_pass(sizing) {
                 format!(
                     "{error} (at least: sized to the scene, it needs one slot per pixel or more)"
                 )
@@ -426,7 +423,8 @@ const SCHEDULE: Schedule = Schedule {
 /// per (scheme, executor) pair. The per-step code stays statically dispatched inside `run`.
 trait ErasedScheme {
     fn name(&self) -> String;
-    fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run;
+    fn guarantee(&self) -> Guarantee;
+    fn run(&self, executors: &mut Executors, executor: Executor, view: &View<'_>) -> Run;
 }
 
 impl<S: Scheme> ErasedScheme for S {
@@ -434,16 +432,76 @@ impl<S: Scheme> ErasedScheme for S {
         Scheme::name(self)
     }
 
-    fn run(&self, executors: &mut Executors, executor: &str, view: &View<'_>) -> Run {
-        if executors.count_locked_ops {
-            executor::count_locked_ops(view, self, executor != "serial")
-        } else {
-            match executor {
-                "serial" => executors.serial.run(view, self),
-                "tiled" => executors.tiled.run(view, self),
-                "scheduled" => run_scheduled(view, self, &SCHEDULE, false).run,
-                _ => executors.parallel.run(view, self),
+    fn guarantee(&self) -> Guarantee {
+        Scheme::guarantee(self)
+    }
+
+    fn run(&self, executors: &mut Executors, executor: Executor, view: &View<'_>) -> Run {
+        match executors.fault {
+            Some(Fault::MiscountOverflow) => {
+                run_on(&MiscountOverflow(self), executors, executor, view)
             }
+            None => run_on(self, executors, executor, view),
         }
+    }
+}
+
+/// One frame of `scheme` on `executor`.
+fn run_on<S: Scheme>(
+    scheme: &S,
+    executors: &mut Executors,
+    executor: Executor,
+    view: &View<'_>,
+) -> Run {
+    if executors.count_locked_ops {
+        return executor::count_locked_ops(view, scheme, executor != Executor::Serial);
+    }
+    match executor {
+        Executor::Serial => executors.serial.run(view, scheme),
+        Executor::Parallel => executors.parallel.run(view, scheme),
+        Executor::Tiled => executors.tiled.run(view, scheme),
+        Executor::Scheduled => run_scheduled(view, scheme, &SCHEDULE, false).run,
+    }
+}
+
+/// [`Fault::MiscountOverflow`]: the scheme, reporting one overflowing fragment more at pixel 0
+/// than it counted.
+struct MiscountOverflow<'a, S>(&'a S);
+
+impl<S: Scheme> Scheme for MiscountOverflow<'_, S> {
+    type State = S::State;
+
+    fn name(&self) -> String {
+        self.0.name()
+    }
+    fn layout(&self) -> Layout {
+        self.0.layout()
+    }
+    fn identity(&self) -> Identity {
+        self.0.identity()
+    }
+    fn promise(&self) -> Promise {
+        self.0.promise()
+    }
+    fn guarantee(&self) -> Guarantee {
+        self.0.guarantee()
+    }
+    fn begin(&self, fragment: Fragment) -> S::State {
+        self.0.begin(fragment)
+    }
+    fn begin_pass(&self, pass: u32, fragment: Fragment) -> Option<S::State> {
+        self.0.begin_pass(pass, fragment)
+    }
+    fn step<M: Memory>(&self, state: &mut S::State, memory: &M) -> Step {
+        self.0.step(state, memory)
+    }
+    fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
+        self.0.end_pass(pass, memory)
+    }
+    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+        self.0.resolve_pixel(memory, pixel, out) + u32::from(pixel == 0)
+    }
+    fn pixels(&self) -> usize {
+        self.0.pixels()
     }
 }

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{EffectName, Judge};
-use crate::schemes::{Executors, SchemeName, Sizing};
+use crate::schemes::{Executors, SchemeName};
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -68,14 +68,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
-        let depth_complexity = oracle.depth_complexity();
-        let sizing = Sizing {
-            k: args.schemes.k,
-            capacity: args.schemes.capacity,
-            depth_complexity: &depth_complexity,
-            max_depth_complexity: oracle.max_depth_complexity(),
-            memory_cap: args.schemes.memory_cap,
-        };
+        let sizing = args.schemes.sizing();
         let mut runner = Executors::default();
         for (i, &name) in schemes.iter().enumerate() {
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;

@@ -39,7 +39,7 @@ use std::path::{Path, PathBuf};
 
 use fragsim_capture::abuffer::{ABuffer, PostSort};
 use fragsim_capture::mdts::{Direction, Mdts};
-use fragsim_capture::{Capture, CaptureError, Identity, Keeps, Scheme, SerialMemory};
+use fragsim_capture::{Capacity, Capture, CaptureError, Identity, Keeps, Scheme, SerialMemory};
 use fragsim_capture::{Step, WordMemory};
 use fragsim_raster::{OrbitCamera, Scene, ScreenTriangle, View, Viewport, SUBPIXEL_BITS};
 use serde::{Deserialize, Serialize};
@@ -823,11 +823,16 @@ fn abuffer_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
 /// A-buffer lists as the GPU's sort kernel left them: `min(counter, capacity)` slots, unsorted.
 fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture {
     let at = abuffer_slots(scheme);
+    let capacity = match scheme {
+        DumpScheme::ABufferFixed { capacity, .. } => Capacity::PerPixel(*capacity),
+        _ => Capacity::Unbounded,
+    };
     let mut overflow = Vec::with_capacity(counters.len());
     let mut capture = Capture::with_pixels(
         counters.len(),
         Identity::KeyAndPrim,
         Keeps::All {
+            capacity,
             overflow: Vec::new(),
         },
     );
@@ -837,7 +842,7 @@ fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture
         capture.push_pixel(slots[first..first + stored].iter().copied());
         overflow.push(count - stored as u32);
     }
-    capture.keeps = Keeps::All { overflow };
+    capture.keeps = Keeps::All { capacity, overflow };
     capture
 }
 
@@ -1007,7 +1012,7 @@ pub fn compare(
         offsets: vec![0, 0],
         entries: Vec::new(),
     };
-    let mut one = Capture::with_pixels(1, candidate.identity, Keeps::All { overflow: vec![0] });
+    let mut one = Capture::with_pixels(1, candidate.identity, Keeps::Nearest(0));
     one.offsets.push(0);
     for p in 0..candidate.pixels() {
         let all = reference.pixel(p);
@@ -1021,7 +1026,8 @@ pub fn compare(
         }
         one.offsets[1] = one.entries.len();
         one.keeps = match &candidate.keeps {
-            Keeps::All { overflow } => Keeps::All {
+            Keeps::All { capacity, overflow } => Keeps::All {
+                capacity: *capacity,
                 overflow: vec![overflow[p]],
             },
             keeps => keeps.clone(),

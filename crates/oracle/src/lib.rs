@@ -17,7 +17,7 @@
 
 pub mod dump;
 
-use fragsim_capture::{Capture, Identity, Keeps};
+use fragsim_capture::{Capture, Guarantee, Identity, Keeps};
 use fragsim_raster::{Fragment, View};
 
 /// How the oracle orders (or merges) fragments of one pixel at one depth key: the tie policies
@@ -157,6 +157,31 @@ impl Oracle {
         out
     }
 
+    /// Whether `capture` keeps `guarantee` on an executor that serialises each pixel's fragments
+    /// (`pixels_serialised`: serial, tiled) or not. Judged by the guarantee's own tie policy,
+    /// whatever policy a report uses: equal depths merged for
+    /// [`Guarantee::ExactDistinctDepths`], the canonical order otherwise.
+    ///
+    /// # Panics
+    /// If the capture covers a different number of pixels.
+    #[must_use]
+    pub fn keeps_guarantee(
+        &self,
+        capture: &Capture,
+        guarantee: Guarantee,
+        pixels_serialised: bool,
+    ) -> bool {
+        if !guarantee.owes_exactness(pixels_serialised) {
+            return true;
+        }
+        let ties = if guarantee.merges_equal_depths() {
+            Ties::MergeEqualDepths
+        } else {
+            Ties::ByPrimitive
+        };
+        self.diff_with(capture, ties).is_exact()
+    }
+
     /// Compares a capture with this oracle, pixel by pixel, under the capture's promise, with
     /// ties ordered by primitive id ([`Ties::ByPrimitive`]).
     ///
@@ -201,6 +226,7 @@ impl Oracle {
             ties.expected(self.pixel(p), mask, &mut all);
             let got = capture.pixel(p);
             expected.clear();
+            let mut overflow_miscounted = false;
             let n = all.len();
             let (allowed_missing, exact_list) = match &capture.keeps {
                 Keeps::Nearest(k) => {
@@ -213,10 +239,15 @@ impl Oracle {
                     expected.extend_from_slice(&all[n - kept..]);
                     (n - kept, true)
                 }
-                Keeps::All { overflow } => {
+                Keeps::All { capacity, overflow } => {
                     expected.extend_from_slice(&all);
-                    let o = overflow[p] as usize;
-                    (o, o == 0)
+                    // The capacity counts fragments as they arrive, before any tie merging.
+                    let arrived = self.pixel(p).len();
+                    let predicted = capacity.overflow(arrived);
+                    let reported = overflow[p] as usize;
+                    diff.reported_overflow += reported as u64;
+                    overflow_miscounted = reported != capacity.reported_overflow(arrived);
+                    (predicted, predicted == 0)
                 }
             };
             diff.overflowed += allowed_missing as u64;
@@ -246,7 +277,11 @@ impl Oracle {
                 missing.saturating_sub(allowed_missing)
             };
             let unexplained_gap = !exact_list && missing < allowed_missing;
-            let differs = lost > 0 || extra > 0 || misordered || unexplained_gap;
+            let differs =
+                lost > 0 || extra > 0 || misordered || unexplained_gap || overflow_miscounted;
+            if overflow_miscounted {
+                diff.overflow_miscounted_pixels += 1;
+            }
             diff.lost += lost as u64;
             diff.extra += extra as u64;
             if misordered {
@@ -306,8 +341,13 @@ pub struct PixelMismatch {
 pub struct Diff {
     /// Fragments captured.
     pub captured: u64,
-    /// Fragments the scheme was not meant to keep: beyond K, or overflowing fixed storage.
+    /// Fragments the scheme was not meant to keep: beyond K, or overflowing fixed storage, as
+    /// the oracle predicts them from each pixel's fragment count and the scheme's capacity.
     pub overflowed: u64,
+    /// The overflow the scheme itself counted (schemes that keep every fragment that fits).
+    pub reported_overflow: u64,
+    /// Pixels whose counted overflow differs from the oracle's prediction.
+    pub overflow_miscounted_pixels: u64,
     /// Fragments the scheme should have kept but did not.
     pub lost: u64,
     /// Fragments captured that the oracle does not have where the scheme should have kept them
@@ -335,7 +375,7 @@ impl Diff {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fragsim_capture::Capture;
+    use fragsim_capture::{Capacity, Capture};
 
     fn oracle_of(lists: &[&[u64]]) -> Oracle {
         let mut offsets = vec![0];
@@ -379,12 +419,24 @@ mod tests {
     fn primitive_sequences_are_compared_in_depth_order() {
         // Pixel 0: prim 9 is nearer (key 1) than prim 4 (key 2).
         let oracle = oracle_of(&[&[(1 << 32) | 9, (2 << 32) | 4]]);
-        let mut right =
-            Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
+        let mut right = Capture::with_pixels(
+            1,
+            Identity::PrimOnly,
+            Keeps::All {
+                capacity: Capacity::Unbounded,
+                overflow: vec![0],
+            },
+        );
         right.push_pixel([9, 4]);
         assert!(oracle.diff(&right).is_exact());
-        let mut swapped =
-            Capture::with_pixels(1, Identity::PrimOnly, Keeps::All { overflow: vec![0] });
+        let mut swapped = Capture::with_pixels(
+            1,
+            Identity::PrimOnly,
+            Keeps::All {
+                capacity: Capacity::Unbounded,
+                overflow: vec![0],
+            },
+        );
         swapped.push_pixel([4, 9]);
         let diff = oracle.diff(&swapped);
         assert_eq!(
@@ -421,10 +473,58 @@ mod tests {
     #[test]
     fn overflowing_abuffer_may_keep_any_subset_but_not_lose_more() {
         let oracle = oracle_of(&[&[1, 2, 3]]);
-        let ok = oracle.diff(&capture_of(&[&[1, 3]], Keeps::All { overflow: vec![1] }));
+        let two_slots = |overflow: u32| Keeps::All {
+            capacity: Capacity::PerPixel(2),
+            overflow: vec![overflow],
+        };
+        let ok = oracle.diff(&capture_of(&[&[1, 3]], two_slots(1)));
         assert!(ok.is_exact());
-        let bad = oracle.diff(&capture_of(&[&[3]], Keeps::All { overflow: vec![1] }));
+        assert_eq!(ok.overflowed, 1);
+        let bad = oracle.diff(&capture_of(&[&[3]], two_slots(1)));
         assert_eq!(bad.lost, 1);
         assert!(!bad.is_exact());
+    }
+
+    #[test]
+    fn overflow_counted_wrong_by_one_either_way_is_a_mismatch() {
+        let oracle = oracle_of(&[&[1, 2, 3], &[4]]);
+        let two_slots = |overflow: Vec<u32>| Keeps::All {
+            capacity: Capacity::PerPixel(2),
+            overflow,
+        };
+        for miscount in [vec![0, 0], vec![2, 0], vec![1, 1]] {
+            let diff = oracle.diff(&capture_of(&[&[1, 2], &[4]], two_slots(miscount.clone())));
+            assert_eq!(diff.overflow_miscounted_pixels, 1, "{miscount:?}");
+            assert!(!diff.is_exact());
+            // The overflow shown is the oracle's, not the scheme's.
+            assert_eq!(diff.overflowed, 1);
+        }
+        // A scheme that cannot count its overflow must report none; the oracle supplies it.
+        let silent = |overflow: Vec<u32>| Keeps::All {
+            capacity: Capacity::PerPixelUncounted(2),
+            overflow,
+        };
+        assert!(oracle
+            .diff(&capture_of(&[&[2, 3], &[4]], silent(vec![0, 0])))
+            .is_exact());
+        assert!(!oracle
+            .diff(&capture_of(&[&[2, 3], &[4]], silent(vec![1, 0])))
+            .is_exact());
+        // Missing fewer than the capacity predicts is a mismatch too (storage beyond capacity).
+        assert!(!oracle
+            .diff(&capture_of(&[&[1, 2, 3], &[4]], two_slots(vec![1, 0])))
+            .is_exact());
+    }
+
+    #[test]
+    fn guarantees_are_judged_where_they_are_owed() {
+        let e = |key: u64, prim: u64| key << 32 | prim;
+        let oracle = oracle_of(&[&[e(10, 1), e(10, 2)]]);
+        let merged = capture_of(&[&[e(10, 2)]], Keeps::Nearest(2));
+        assert!(oracle.keeps_guarantee(&merged, Guarantee::ExactDistinctDepths, false));
+        assert!(!oracle.keeps_guarantee(&merged, Guarantee::Exact, false));
+        assert!(!oracle.keeps_guarantee(&merged, Guarantee::ExactWithoutHazards, true));
+        assert!(oracle.keeps_guarantee(&merged, Guarantee::ExactWithoutHazards, false));
+        assert!(oracle.keeps_guarantee(&merged, Guarantee::Approximate, true));
     }
 }

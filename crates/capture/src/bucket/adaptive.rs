@@ -58,7 +58,8 @@ use std::marker::PhantomData;
 use fragsim_raster::{Fragment, Viewport};
 
 use super::{positive, read_single, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS};
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::mdts::MdtsWord;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
@@ -236,8 +237,12 @@ impl<W: MdtsWord> Scheme for Adp<W> {
         W::IDENTITY
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Approximate
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::PerPixel(self.slots))
     }
 
     fn begin(&self, fragment: Fragment) -> Self::State {

@@ -33,7 +33,8 @@ use fragsim_raster::{Fragment, Viewport};
 use super::{
     positive, push_distinct, read_pair, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS,
 };
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::mdts::MdtsWord;
 use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
@@ -130,8 +131,12 @@ impl<W: MdtsWord> Scheme for Bdp2<W> {
         W::IDENTITY
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Approximate
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::Unbounded)
     }
 
     fn begin(&self, fragment: Fragment) -> Self::State {

@@ -37,7 +37,8 @@ use super::{
     positive, push_distinct, read_pair, read_single, word_suffix, Blend, Plan, Stage, Walk,
     RANGE_WORDS,
 };
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::mdts::MdtsWord;
 use crate::memory::Memory;
 use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
@@ -152,8 +153,12 @@ impl<W: MdtsWord> Scheme for Bdp<W> {
         W::IDENTITY
     }
 
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Approximate
+    }
+
     fn promise(&self) -> Promise {
-        Promise::All
+        Promise::All(Capacity::Unbounded)
     }
 
     fn begin(&self, fragment: Fragment) -> Self::State {

@@ -1,0 +1,123 @@
+//! The counting pass: the first geometry pass of every scheme whose storage is sized to the scene.
+//!
+//! **Algorithm.** One `u32` counter per pixel, initially 0; every fragment does
+//! `atomicAdd(&count[p], 1)` (one step) and is done. The post pass reads each counter back: the
+//! pixel's depth complexity. This is what an exact-storage A-buffer runs before its capture pass
+//! (a count, a prefix sum of the counts into offsets, then the fill), and what sizes MDTS's `K` to
+//! the scene (`--k auto`), adaptive bucket peeling's slots and the layer records of the multi-pass
+//! schemes.
+//!
+//! **Guarantee.** Fetch-and-add loses no increment under any interleaving: each counter ends at
+//! its pixel's exact fragment count. A scheme sized by this pass reports it: one more geometry
+//! pass, its time and its counters (`Run::after_count_pass`).
+//!
+//! The counts come from the scheme's own pass over the scene, never from the oracle: the oracle
+//! is what the result is checked against, and a scheme that read it would be sized by the answer.
+//!
+//! ```
+//! use fragsim_capture::{depth_count::{DepthCount, DepthCounts}, executor};
+//! use fragsim_raster::{OrbitCamera, Scene, Viewport};
+//! let scene = Scene::procedural("spheres:3").unwrap();
+//! let view = scene.view(Viewport::new(32, 32).unwrap(), &OrbitCamera::default()).unwrap();
+//! let counts = DepthCounts::from_run(executor::run_serial(&view, &DepthCount::new(view.viewport())));
+//! assert_eq!(counts.max(), 6);
+//! ```
+
+use fragsim_raster::{Fragment, Viewport};
+
+use crate::capture::{Capacity, Identity};
+use crate::executor::Run;
+use crate::guarantee::Guarantee;
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{Layout, Promise, Scheme, Step};
+
+/// The counting pass as a scheme: its capture holds one entry per pixel, the pixel's count.
+#[derive(Clone, Copy, Debug)]
+pub struct DepthCount {
+    pixels: usize,
+}
+
+impl DepthCount {
+    /// A counter for every pixel of `viewport`.
+    #[must_use]
+    pub fn new(viewport: Viewport) -> Self {
+        Self {
+            pixels: viewport.pixels(),
+        }
+    }
+}
+
+impl Scheme for DepthCount {
+    /// The pixel whose counter the fragment increments.
+    type State = u32;
+
+    fn name(&self) -> String {
+        "count".into()
+    }
+
+    fn layout(&self) -> Layout {
+        Layout::counters_and_slots(self.pixels, 0)
+    }
+
+    fn identity(&self) -> Identity {
+        Identity::KeyAndPrim
+    }
+
+    fn promise(&self) -> Promise {
+        Promise::All(Capacity::Unbounded)
+    }
+
+    fn guarantee(&self) -> Guarantee {
+        Guarantee::Exact
+    }
+
+    fn begin(&self, fragment: Fragment) -> u32 {
+        fragment.pixel
+    }
+
+    fn step<M: Memory>(&self, pixel: &mut u32, memory: &M) -> Step {
+        WordMemory::<u32>::fetch_add(memory, *pixel as usize, 1);
+        Step::Stored
+    }
+
+    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+        out.push(u64::from(WordMemory::<u32>::load(memory, pixel)));
+        0
+    }
+
+    fn pixels(&self) -> usize {
+        self.pixels
+    }
+}
+
+/// What a counting pass found, and what it cost.
+#[derive(Clone, Debug)]
+pub struct DepthCounts {
+    /// Per pixel, its fragment count.
+    pub counts: Vec<u32>,
+    /// The pass's run (its capture emptied: the counts are above).
+    pub run: Run,
+}
+
+impl DepthCounts {
+    /// The counts of a finished run of [`DepthCount`].
+    #[must_use]
+    pub fn from_run(mut run: Run) -> Self {
+        let counts = run.capture.entries.iter().map(|&c| c as u32).collect();
+        run.capture.entries = Vec::new();
+        run.capture.offsets = Vec::new();
+        Self { counts, run }
+    }
+
+    /// The largest count: the scene's maximum depth complexity.
+    #[must_use]
+    pub fn max(&self) -> u32 {
+        self.counts.iter().copied().max().unwrap_or(0)
+    }
+
+    /// The sum of the counts: the scene's fragments.
+    #[must_use]
+    pub fn total(&self) -> usize {
+        self.counts.iter().map(|&c| c as usize).sum()
+    }
+}
