@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
-use fragsim::raster::attributes::Attributes;
 use fragsim::oracle::Oracle;
+use fragsim::raster::attributes::Attributes;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
 use fragsim::shade::effects::{
     encode_srgb, schlick_transmittance, shade_pixel, Effect, Entries, Geometry, Material,
@@ -64,7 +64,10 @@ fn exact_schemes_have_no_error_pixels_in_any_effect_whatever_their_words_hold() 
             assert_eq!(rate(row), 0.0, "{effect}: {row}");
             // Fresnel recomputes normals; only the key-only capture is completed.
             let pass = &row["attribute_pass"];
-            assert_eq!(pass.is_null(), effect != "fresnel" && row["scheme"] != "mdts32");
+            assert_eq!(
+                pass.is_null(),
+                effect != "fresnel" && row["scheme"] != "mdts32"
+            );
             let completed = !pass.is_null() && !pass["completed_from_oracle"].is_null();
             assert_eq!(completed, row["scheme"] == "mdts32", "{row}");
         }
