@@ -14,7 +14,8 @@ use fragsim::capture::abuffer_atomic_inc::ABufferAtomicInc;
 use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
-    CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory,
+    CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, SerialMemory, Step,
+    WordMemory,
     MEMORY_CAP_DEFAULT,
 };
 use fragsim::oracle::Oracle;
@@ -117,9 +118,14 @@ fn depth_zero_has_key_zero() {
 #[test]
 fn negative_zero_has_the_key_of_positive_zero_not_0x80000000() {
     assert_eq!(depth_key(-0.0), Some(0));
-    // Unmapped, its bit pattern would sort after every depth up to 1.0 in an unsigned atomicMin.
-    assert_eq!((-0.0f32).to_bits(), 0x8000_0000);
-    assert!((-0.0f32).to_bits() > MAX_KEY);
+    // Unmapped, its bit pattern would sort after every depth up to 1.0: the library's MDTS,
+    // handed the raw bits, keeps the nearest depth there is behind depth 1.0.
+    let raw = (-0.0f32).to_bits();
+    assert_eq!(
+        mdts32_run::<SerialMemory>(&[raw, MAX_KEY]).0,
+        [MAX_KEY, raw]
+    );
+    assert_eq!(mdts32_run::<SerialMemory>(&[0, MAX_KEY]).0, [0, MAX_KEY]);
 }
 
 #[test]
@@ -223,16 +229,6 @@ fn a_triangle_touching_depth_zero_from_below_is_clipped_away() {
 
 proptest! {
     #[test]
-    fn key_order_equals_float_order_for_all_non_negative_floats(
-        a in 0u32..=0x7F80_0000,
-        b in 0u32..=0x7F80_0000,
-    ) {
-        // Every non-negative float, +inf included: the bit pattern orders as the float.
-        let (x, y) = (f32::from_bits(a), f32::from_bits(b));
-        prop_assert_eq!(x.partial_cmp(&y), Some(a.cmp(&b)));
-    }
-
-    #[test]
     fn depth_key_order_equals_depth_order_on_the_unit_interval(
         a in prop_oneof![0u32..=MAX_KEY, Just(0x8000_0000u32)],
         b in prop_oneof![0u32..=MAX_KEY, Just(0x8000_0000u32)],
@@ -241,6 +237,10 @@ proptest! {
         let (x, y) = (f32::from_bits(a), f32::from_bits(b));
         let (kx, ky) = (depth_key(x).unwrap(), depth_key(y).unwrap());
         prop_assert_eq!(x.partial_cmp(&y), Some(kx.cmp(&ky)));
+        // And the library's 32-bit MDTS, which compares keys as integers, keeps them in depth
+        // order: the nearer first (f32 order computed here, not by the library).
+        let (near, far) = if x <= y { (kx, ky) } else { (ky, kx) };
+        prop_assert_eq!(mdts32_run::<SerialMemory>(&[kx, ky]).0, vec![near, far]);
     }
 }
 
@@ -302,36 +302,142 @@ proptest! {
     }
 }
 
-/// How an `atomicMin` against an empty slot treats a value: `true` when the value replaces the
-/// sentinel (it sorts below it).
-fn sorts_below(value: u32, sentinel: u32, signed: bool) -> bool {
-    if signed {
-        (value as i32) < (sentinel as i32)
-    } else {
-        value < sentinel
+/// Memory whose 32-bit `atomicMin` compares as signed `int` (CUDA's `atomicMin(int*, int)`);
+/// everything else is the library's serial memory.
+struct SignedMin(SerialMemory);
+
+impl WordMemory<u32> for SignedMin {
+    fn len(&self) -> usize {
+        WordMemory::<u32>::len(&self.0)
+    }
+    fn load(&self, i: usize) -> u32 {
+        WordMemory::<u32>::load(&self.0, i)
+    }
+    fn store(&self, i: usize, v: u32) {
+        WordMemory::<u32>::store(&self.0, i, v);
+    }
+    fn fetch_min(&self, i: usize, v: u32) -> u32 {
+        let old = WordMemory::<u32>::load(&self.0, i);
+        if (v as i32) < (old as i32) {
+            WordMemory::<u32>::store(&self.0, i, v);
+        }
+        old
+    }
+    fn fetch_max(&self, i: usize, v: u32) -> u32 {
+        WordMemory::<u32>::fetch_max(&self.0, i, v)
+    }
+    fn fetch_add(&self, i: usize, v: u32) -> u32 {
+        WordMemory::<u32>::fetch_add(&self.0, i, v)
+    }
+    fn fetch_or(&self, i: usize, v: u32) -> u32 {
+        WordMemory::<u32>::fetch_or(&self.0, i, v)
+    }
+    fn swap(&self, i: usize, v: u32) -> u32 {
+        WordMemory::<u32>::swap(&self.0, i, v)
     }
 }
 
+impl WordMemory<u64> for SignedMin {
+    fn len(&self) -> usize {
+        WordMemory::<u64>::len(&self.0)
+    }
+    fn load(&self, i: usize) -> u64 {
+        WordMemory::<u64>::load(&self.0, i)
+    }
+    fn store(&self, i: usize, v: u64) {
+        WordMemory::<u64>::store(&self.0, i, v);
+    }
+    fn fetch_min(&self, i: usize, v: u64) -> u64 {
+        WordMemory::<u64>::fetch_min(&self.0, i, v)
+    }
+    fn fetch_max(&self, i: usize, v: u64) -> u64 {
+        WordMemory::<u64>::fetch_max(&self.0, i, v)
+    }
+    fn fetch_add(&self, i: usize, v: u64) -> u64 {
+        WordMemory::<u64>::fetch_add(&self.0, i, v)
+    }
+    fn fetch_or(&self, i: usize, v: u64) -> u64 {
+        WordMemory::<u64>::fetch_or(&self.0, i, v)
+    }
+    fn swap(&self, i: usize, v: u64) -> u64 {
+        WordMemory::<u64>::swap(&self.0, i, v)
+    }
+}
+
+impl Memory for SignedMin {
+    fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
+        Self(SerialMemory::new(len32, init32, len64, init64))
+    }
+}
+
+/// The library's 32-bit MDTS (`K = 4`, one pixel) after inserting `keys` one after another on
+/// memory `M`: the kept keys, nearest first, and how each walk ended.
+fn mdts32_run<M: Memory>(keys: &[u32]) -> (Vec<u32>, Vec<Step>) {
+    let mdts = Mdts::<u32>::new(viewport(1, 1), 4, Direction::Ascending, MEMORY_CAP_DEFAULT)
+        .expect("a valid MDTS");
+    let memory: M = mdts.layout().allocate();
+    let mut steps = 0;
+    let outcomes = keys
+        .iter()
+        .map(|&depth_key| {
+            let fragment = Fragment {
+                pixel: 0,
+                depth_key,
+                prim: 0,
+            };
+            mdts.insert(fragment, &memory, &mut steps)
+        })
+        .collect();
+    let kept = mdts
+        .resolve(&memory)
+        .pixel(0)
+        .iter()
+        .map(|&e| (e >> 32) as u32)
+        .collect();
+    (kept, outcomes)
+}
+
+/// The library's sentinel against the integer semantics of `atomicMin`: with its own unsigned
+/// `atomicMin`, every depth key from 0 to 1.0 is stored (the keys, sorted, as the depths sort);
+/// a signed `int` `atomicMin` reads the same empty value `0xFFFFFFFF` as −1, below every key, so
+/// it stores nothing, and every walk, handed back the empty value, takes itself for stored.
 #[test]
-fn which_values_sort_below_each_sentinel_signed_and_unsigned() {
-    let depths = [0.0f32, f32::from_bits(1), 0.5, 1.0].map(|d| depth_key(d).unwrap());
-    for key in depths {
-        // Every depth key sorts below 0x7FFFFFFF either way, and below 0xFFFFFFFF unsigned...
-        assert!(sorts_below(key, 0x7FFF_FFFF, false));
-        assert!(sorts_below(key, 0x7FFF_FFFF, true));
-        assert!(sorts_below(key, 0xFFFF_FFFF, false));
-        // ...but a signed atomicMin sees 0xFFFFFFFF as −1, below every depth: nothing is stored.
-        assert!(!sorts_below(key, 0xFFFF_FFFF, true));
-    }
-    // Bit patterns that are not depth keys: unmapped −0.0 and −1.0 sort above 0x7FFFFFFF
-    // unsigned (they would be taken for "beyond empty") and below everything signed; +inf sorts
-    // below both sentinels.
-    for negative in [(-0.0f32).to_bits(), (-1.0f32).to_bits()] {
-        assert!(!sorts_below(negative, 0x7FFF_FFFF, false));
-        assert!(sorts_below(negative, 0x7FFF_FFFF, true));
-    }
-    let inf = f32::INFINITY.to_bits();
-    assert!(sorts_below(inf, 0x7FFF_FFFF, false) && sorts_below(inf, 0xFFFF_FFFF, false));
+fn a_signed_atomic_min_sees_the_librarys_empty_value_as_minus_one_and_keeps_nothing() {
+    let depths = [0.5f32, 1.0, 0.0, f32::from_bits(1)];
+    let keys: Vec<u32> = depths.iter().map(|&d| depth_key(d).unwrap()).collect();
+    let (kept, outcomes) = mdts32_run::<SerialMemory>(&keys);
+    let mut sorted = depths.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let sorted: Vec<u32> = sorted.iter().map(|d| d.to_bits()).collect();
+    assert_eq!(kept, sorted);
+    assert!(outcomes.iter().all(|&o| o == Step::Stored));
+    let (kept, outcomes) = mdts32_run::<SignedMin>(&keys);
+    assert_eq!(kept, [] as [u32; 0]);
+    assert_eq!(outcomes, [Step::Stored; 4], "no walk notices");
+}
+
+/// `proof.md`'s cast to integer: with a unorm conversion, `round(d · (2^32 − 1))`, depth 1.0
+/// becomes `0xFFFFFFFF`, the library's empty value. Its walk finds the empty slot, changes nothing,
+/// reports itself stored, and the fragment is gone; the next fragment takes the slot. The bit
+/// reinterpretation the library uses (`depth_key`) keeps depth 1.0 at `0x3F800000`.
+#[test]
+fn a_unorm_depth_one_equals_the_empty_value_and_vanishes_from_the_librarys_mdts() {
+    let unorm = |d: f64| (d * f64::from(u32::MAX)).round() as u32;
+    let empty = Mdts::<u32>::new(viewport(1, 1), 4, Direction::Ascending, MEMORY_CAP_DEFAULT)
+        .unwrap()
+        .layout()
+        .init32;
+    assert_eq!(unorm(1.0), empty);
+    let (kept, outcomes) = mdts32_run::<SerialMemory>(&[unorm(1.0), unorm(0.25)]);
+    assert_eq!(kept, [unorm(0.25)], "depth 1.0 vanished");
+    assert_eq!(
+        outcomes,
+        [Step::Stored, Step::Stored],
+        "and no drop was counted"
+    );
+    let bits = [depth_key(1.0).unwrap(), depth_key(0.25).unwrap()];
+    assert_eq!(bits[0], MAX_KEY);
+    assert_eq!(mdts32_run::<SerialMemory>(&bits).0, [bits[1], bits[0]]);
 }
 
 /// FreePipe's Table 1 as printed: slots initialised to `0xFFFFFFFF` (the text, §4.1.1) but the
@@ -902,7 +1008,6 @@ fn a_16384_square_viewport_beyond_the_memory_cap_is_refused_naming_the_bytes() {
         ABuffer::fixed(huge, 1, PostSort::Insertion, cap).map(drop),
         pixels * 12,
     );
-    assert_eq!(pixels * 8, 2_147_483_648);
     // One more pixel per side is refused by the viewport itself.
     let err = Viewport::new(side + 1, 1).unwrap_err();
     assert!(err.contains("16384"), "{err}");
@@ -945,14 +1050,14 @@ fn k_1_keeps_exactly_the_nearest_layer_and_counts_the_rest() {
         .unwrap();
     let oracle = Oracle::build(&view);
     let mdts = Mdts::<u64>::ascending(view.viewport(), 1).unwrap();
-    assert_exact(&view, &oracle, &mdts);
-    let run = run_serial(&view, &mdts);
+    // The overflow, counted here from the depth complexity alone: every fragment but one per
+    // covered pixel; the scheme's own drops must equal it (`assert_exact`).
     let covered = oracle.depth_complexity().iter().filter(|&&c| c > 0).count() as u64;
-    assert_eq!(run.capture.entries.len() as u64, covered);
     assert_eq!(
-        run.stats.counters.dropped,
+        assert_exact(&view, &oracle, &mdts),
         oracle.fragments() as u64 - covered
     );
+    let run = run_serial(&view, &mdts);
     for p in 0..oracle.pixels() {
         assert_eq!(
             run.capture.pixel(p),

@@ -7,9 +7,10 @@ pub enum Identity {
     KeyAndPrim,
     /// Depth key only (32-bit words, as FreePipe's Table 1): compared by key.
     KeyOnly,
-    /// Primitive id only, in the order the scheme resolved them (the high half is zero): for
-    /// schemes that keep a lossy depth beside an attribute (FreePipe §4.1.2), compared with the
-    /// oracle's primitive sequence in canonical depth order.
+    /// Primitive id only, in the order the scheme resolved them: for schemes that keep a lossy
+    /// depth beside an attribute (FreePipe §4.1.2), compared with the oracle's primitive
+    /// sequence in canonical depth order. The high half is the lossy depth key the scheme holds
+    /// (what the image judge shades), never compared.
     PrimOnly,
 }
 

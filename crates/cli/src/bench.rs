@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::judge::{EffectName, Judge};
+use crate::judge::{AttributePass, EffectName, Judge, Judged};
 use crate::schemes::{check_memory_cap_early, Executors, SchemeName};
 
 /// Options of `fragsim bench`.
@@ -81,6 +81,9 @@ pub struct BenchRow {
     pub error_pixels: Option<u64>,
     /// `error_pixels` over the pixels the oracle covers.
     pub error_pixel_rate: Option<f64>,
+    /// What the image judge completed from the oracle or recomputed (the deferred attribute
+    /// pass), with its count and time; `None` when the image is the scheme's words alone.
+    pub attribute_pass: Option<AttributePass>,
     /// Memory operations per fragment.
     pub ops_per_fragment: f64,
     /// Read-modify-write operations (`lock`-prefixed instructions on x86) per fragment, counted
@@ -210,8 +213,11 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let named = first.expect("at least one frame");
             let diff = oracle.diff(&named.run.capture);
             let judged = judge.judge(&named.run.capture);
-            let error_pixels = judged.as_ref().map(|(_, _, errors)| *errors);
-            if let Some((image, reference, _)) = &judged {
+            let error_pixels = judged.as_ref().map(|j| j.errors);
+            if let Some(Judged {
+                image, reference, ..
+            }) = &judged
+            {
                 let stem = format!("bench-{}-{executor}", named.name);
                 fragsim_shade::save_png(image, &args.out.join(format!("{stem}.png")))?;
                 let difference = effects::difference_image(reference, image);
@@ -241,6 +247,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 mismatched_pixels: diff.mismatched_pixels,
                 error_pixels,
                 error_pixel_rate: error_pixels.map(|e| e as f64 / covered.max(1) as f64),
+                attribute_pass: judged.and_then(|j| j.pass),
                 ops_per_fragment: stats.counters.steps as f64
                     / stats.counters.fragments.max(1) as f64,
                 locked_ops_per_fragment: locked_ops as f64

@@ -1,18 +1,26 @@
 //! The error-pixel judge shared by `bench` and `sweep`: shades an effect from a capture and
 //! counts the pixels whose 8-bit colour differs from the oracle's image (the papers' EPR).
 //!
-//! Every scheme is shaded for every effect. A capture whose words hold only depth keys (32-bit
-//! schemes) or only primitive ids (FreePipe's packed MDTS) first goes through a **deferred
-//! attribute pass**, as a GPU application renders attributes in a second geometry pass: the
-//! scene's fragments of each pixel, in canonical order (the oracle's lists: what rasterizing
-//! again gives), supply the missing half. A key takes the primitive of the next fragment with
-//! that key not yet taken (equal keys in canonical order); a primitive id takes the depth key of
-//! its fragment at the pixel. An entry that matches no fragment (a scheme that invented one)
-//! keeps an unknown half ([`UNKNOWN_PRIM`] or depth 1). Then normals, colours and depths come
-//! from full identities, and every capture is compared with the one full reference image: the
-//! error-pixel rate measures lost, merged and misordered fragments, whatever the words stored.
+//! **The judge shades what the scheme holds.** Entries with a depth key and a primitive id are
+//! shaded as they are. FreePipe's packed MDTS ([`Identity::PrimOnly`]) is shaded from its own
+//! words: the primitive ids its colours decode to, in its own slot order, at the depths its 20
+//! bits hold (the entries' high half, `mdts_packed::held_depth`), so its precision loss (FreePipe
+//! §5) shows in every effect. Nothing of it comes from the oracle.
+//!
+//! Two things are not in the words, and each is reported ([`AttributePass`]):
+//! - **Normals** (Fresnel only): the **deferred attribute pass** recomputes each captured entry's
+//!   interpolated normal from its pixel and primitive id (`raster::attributes`), as a GPU
+//!   application shades from a visibility buffer. Counted (entries) and timed.
+//! - **Primitive ids of key-only captures** (32-bit MDTS, peeling and bucket schemes): a depth
+//!   key names no colour, so these captures are **completed from the oracle's lists** (what
+//!   rasterizing again gives): the i-th occurrence of a key takes the primitive of the i-th
+//!   fragment with that key in canonical order; a key that matches no fragment (a scheme that
+//!   invented one) keeps [`UNKNOWN_PRIM`]. The row names what was completed.
+//!
+//! Every capture is then compared with the one reference image, shaded from the oracle's lists.
 
 use std::borrow::Cow;
+use std::time::Instant;
 
 use clap::ValueEnum;
 use fragsim_capture::{Capture, Identity};
@@ -22,6 +30,7 @@ use fragsim_raster::{OrbitCamera, Scene, View};
 use fragsim_shade::effects::{self, Effect, Entries, Geometry, Material};
 use image::RgbImage;
 use rayon::prelude::*;
+use serde::Serialize;
 
 /// The primitive id the deferred pass gives a key that matches no fragment of its pixel.
 pub const UNKNOWN_PRIM: u32 = u32::MAX;
@@ -60,6 +69,68 @@ impl EffectName {
 }
 
 type Distance<'a> = Box<dyn Fn(f32) -> f64 + Sync + 'a>;
+
+/// What the judge had to do to a capture beyond reading its entries (`None` in a row: nothing).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AttributePass {
+    /// What the judge took from the oracle's lists because the scheme's words do not hold it
+    /// (`None`: the image is shaded from the scheme's own words alone).
+    pub completed_from_oracle: Option<&'static str>,
+    /// Entries whose attributes (the interpolated normal) were recomputed from pixel and
+    /// primitive id: the deferred attribute pass, run for Fresnel.
+    pub recomputed_entries: u64,
+    /// Time of the completion and the recomputation on this machine, in milliseconds (for a
+    /// completed capture, a GPU would pay a second geometry pass instead).
+    pub ms: f64,
+}
+
+/// A capture's image against the oracle's.
+pub(crate) struct Judged<'j> {
+    /// The capture's image.
+    pub image: RgbImage,
+    /// The oracle's image.
+    pub reference: &'j RgbImage,
+    /// Pixels whose 8-bit colour differs.
+    pub errors: u64,
+    /// What was completed or recomputed, if anything.
+    pub pass: Option<AttributePass>,
+}
+
+/// One value per entry of per-pixel lists: `values[offsets[p] + i]` belongs to entry `i` of
+/// pixel `p`.
+struct PerEntry {
+    offsets: Vec<usize>,
+    values: Vec<f64>,
+}
+
+impl PerEntry {
+    /// `value(p, entry)` of every entry of `lists`, pixels in parallel.
+    fn of<'l>(
+        pixels: usize,
+        lists: impl Fn(usize) -> &'l [u64] + Sync,
+        value: impl Fn(usize, u64) -> f64 + Sync,
+    ) -> Self {
+        let mut offsets = Vec::with_capacity(pixels + 1);
+        offsets.push(0);
+        for p in 0..pixels {
+            offsets.push(offsets[p] + lists(p).len());
+        }
+        let values = (0..pixels)
+            .into_par_iter()
+            .with_min_len(256)
+            .flat_map_iter(|p| lists(p).iter().map(move |&e| (p, e)))
+            .map(|(p, e)| value(p, e))
+            .collect();
+        Self { offsets, values }
+    }
+
+    /// The value of `entry` in pixel `p`'s list (the first equal entry: equal entries are the
+    /// same fragment, with the same value).
+    fn get(&self, list: &[u64], p: usize, entry: u64) -> f64 {
+        let i = list.iter().position(|&e| e == entry).unwrap_or(0);
+        self.values[self.offsets[p] + i]
+    }
+}
 
 /// Shades captures and compares them with the oracle's image.
 pub(crate) struct Judge<'a> {
@@ -109,7 +180,8 @@ impl<'a> Judge<'a> {
             reference: RgbImage::new(0, 0),
             covered,
         };
-        judge.reference = judge.shade(|p| oracle.pixel(p));
+        let cosines = judge.recompute(|p| oracle.pixel(p));
+        judge.reference = judge.shade(|p| oracle.pixel(p), cosines.as_ref());
         judge
     }
 
@@ -118,13 +190,26 @@ impl<'a> Judge<'a> {
         Some(&self.reference)
     }
 
-    fn shade<'l>(&self, list: impl Fn(usize) -> &'l [u64] + Sync) -> RgbImage {
-        let cosine = |p: usize, entry: u64| {
-            self.attributes
-                .as_ref()
-                .and_then(|a| a.cosine(entry as u32, p as u32))
-                .unwrap_or(1.0)
-        };
+    fn pixels(&self) -> usize {
+        self.size.0 as usize * self.size.1 as usize
+    }
+
+    /// The deferred attribute pass over `lists`: `|cos θ|` of every entry, from its pixel and
+    /// primitive id (1 where the primitive does not cover the pixel: an entry no fragment has);
+    /// `None` when the effect needs no normals.
+    fn recompute<'l>(&self, lists: impl Fn(usize) -> &'l [u64] + Sync) -> Option<PerEntry> {
+        let attributes = self.attributes.as_ref()?;
+        Some(PerEntry::of(self.pixels(), lists, |p, entry| {
+            attributes.cosine(entry as u32, p as u32).unwrap_or(1.0)
+        }))
+    }
+
+    fn shade<'l>(
+        &self,
+        list: impl Fn(usize) -> &'l [u64] + Sync,
+        cosines: Option<&PerEntry>,
+    ) -> RgbImage {
+        let cosine = |p: usize, entry: u64| cosines.map_or(1.0, |c| c.get(list(p), p, entry));
         let geometry = Geometry {
             distance: &*self.distance,
             cosine: &cosine,
@@ -134,41 +219,63 @@ impl<'a> Judge<'a> {
             &self.material,
             Entries::KeyAndPrim,
             self.size,
-            list,
+            &list,
             geometry,
         )
         .expect("full identities resolve every effect")
     }
 
-    /// The capture's image, the reference it is compared with, and the error pixels.
-    pub fn judge(&self, capture: &Capture) -> Option<(RgbImage, &RgbImage, u64)> {
-        let full = deferred_attributes(capture, self.oracle);
-        let image = self.shade(|p| full.pixel(p));
+    /// The capture's image, compared with the oracle's.
+    pub fn judge(&self, capture: &Capture) -> Option<Judged<'_>> {
+        let start = Instant::now();
+        let (full, completed) = complete(capture, self.oracle);
+        let cosines = self.recompute(|p| full.pixel(p));
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        let recomputed_entries = cosines.as_ref().map_or(0, |c| c.values.len() as u64);
+        let pass = (completed.is_some() || cosines.is_some()).then_some(AttributePass {
+            completed_from_oracle: completed,
+            recomputed_entries,
+            ms,
+        });
+        let image = self.shade(|p| full.pixel(p), cosines.as_ref());
         let errors = effects::error_pixels(&self.reference, &image) as u64;
-        Some((image, &self.reference, errors))
+        Some(Judged {
+            image,
+            reference: &self.reference,
+            errors,
+            pass,
+        })
     }
 }
 
-/// The deferred attribute pass (see the module's documentation): the capture with full
-/// `depth_key << 32 | prim` entries, in the capture's order.
+/// The capture with a depth key and a primitive id in every entry, in the capture's order, and
+/// what had to be taken from the oracle for it (see the module's documentation).
 #[must_use]
-pub fn deferred_attributes<'c>(capture: &'c Capture, oracle: &Oracle) -> Cow<'c, Capture> {
-    let resolve: fn(&[u64], &[u64]) -> Vec<u64> = match capture.identity {
-        Identity::KeyAndPrim => return Cow::Borrowed(capture),
-        Identity::KeyOnly => prims_of_keys,
-        Identity::PrimOnly => keys_of_prims,
-    };
-    let entries = (0..capture.pixels())
-        .into_par_iter()
-        .with_min_len(256)
-        .flat_map_iter(|p| resolve(capture.pixel(p), oracle.pixel(p)))
-        .collect();
-    Cow::Owned(Capture {
-        offsets: capture.offsets.clone(),
-        entries,
-        identity: Identity::KeyAndPrim,
-        keeps: capture.keeps.clone(),
-    })
+pub fn complete<'c>(
+    capture: &'c Capture,
+    oracle: &Oracle,
+) -> (Cow<'c, Capture>, Option<&'static str>) {
+    match capture.identity {
+        // Packed MDTS carries its own (lossy) depth in the high half: shaded as it is.
+        Identity::KeyAndPrim | Identity::PrimOnly => (Cow::Borrowed(capture), None),
+        Identity::KeyOnly => {
+            let entries = (0..capture.pixels())
+                .into_par_iter()
+                .with_min_len(256)
+                .flat_map_iter(|p| prims_of_keys(capture.pixel(p), oracle.pixel(p)))
+                .collect();
+            let full = Capture {
+                offsets: capture.offsets.clone(),
+                entries,
+                identity: Identity::KeyAndPrim,
+                keeps: capture.keeps.clone(),
+            };
+            (
+                Cow::Owned(full),
+                Some("primitive ids (matched by depth key)"),
+            )
+        }
+    }
 }
 
 /// Key-only entries to full ones: the i-th occurrence of a key takes the primitive of the i-th
@@ -195,24 +302,10 @@ fn prims_of_keys(list: &[u64], fragments: &[u64]) -> Vec<u64> {
     out
 }
 
-/// Primitive-only entries to full ones: each takes its fragment's depth key at the pixel.
-fn keys_of_prims(list: &[u64], fragments: &[u64]) -> Vec<u64> {
-    const FAR: u64 = 0x3F80_0000; // the key of depth 1.0
-    list.iter()
-        .map(|&e| {
-            let prim = e as u32;
-            let key = fragments
-                .iter()
-                .find(|&&f| f as u32 == prim)
-                .map_or(FAR, |&f| f >> 32);
-            (key << 32) | u64::from(prim)
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fragsim_capture::Keeps;
 
     #[test]
     fn equal_keys_take_their_primitives_in_canonical_order() {
@@ -229,9 +322,89 @@ mod tests {
         );
         // A merging scheme that kept one five gets the first.
         assert_eq!(prims_of_keys(&[5 << 32], &fragments), vec![(5 << 32) | 2]);
+    }
+
+    /// Two stacked squares: every covered pixel has a near and a far layer.
+    fn two_layers() -> (Scene, OrbitCamera) {
+        (
+            Scene::procedural("quads:2").unwrap(),
+            OrbitCamera::default(),
+        )
+    }
+
+    /// The oracle's lists as a capture of `identity`, each entry passed through `entry(i, e)`
+    /// (`i`: its position in the pixel's list).
+    fn capture_of(
+        oracle: &Oracle,
+        identity: Identity,
+        entry: impl Fn(usize, u64) -> u64,
+    ) -> Capture {
+        let mut capture = Capture::with_pixels(oracle.pixels(), identity, Keeps::Nearest(2));
+        for p in 0..oracle.pixels() {
+            capture.push_pixel(
+                oracle
+                    .pixel(p)
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &e)| entry(i, e)),
+            );
+        }
+        capture
+    }
+
+    #[test]
+    fn a_prim_only_capture_is_shaded_at_the_depths_it_holds_not_the_oracles() {
+        let (scene, orbit) = two_layers();
+        let view = scene
+            .view(fragsim_raster::Viewport::new(24, 24).unwrap(), &orbit)
+            .unwrap();
+        let oracle = Oracle::build(&view);
+        let two = oracle
+            .depth_complexity()
+            .iter()
+            .filter(|&&n| n == 2)
+            .count() as u64;
+        assert!(two > 100, "{two}");
+        let judge = Judge::new(EffectName::Translucency, &scene, &view, orbit, &oracle);
+        // Held depths equal to the true ones: nothing to see, nothing taken from the oracle.
+        let held = capture_of(&oracle, Identity::PrimOnly, |_, e| e);
+        let judged = judge.judge(&held).unwrap();
+        assert_eq!((judged.errors, judged.pass), (0, None));
+        // A scheme that holds its far layer at 0.0 has no thickness there: every two-layer
+        // pixel changes colour. Filling the depth in from the oracle would hide it.
+        let flat = capture_of(&oracle, Identity::PrimOnly, |i, e| {
+            if i == 1 {
+                e & u64::from(u32::MAX)
+            } else {
+                e
+            }
+        });
+        let judged = judge.judge(&flat).unwrap();
+        assert_eq!(judged.errors, two);
+        assert_eq!(judged.pass, None);
+    }
+
+    #[test]
+    fn a_key_only_capture_is_completed_from_the_oracle_and_its_row_says_so() {
+        let (scene, orbit) = two_layers();
+        let view = scene
+            .view(fragsim_raster::Viewport::new(24, 24).unwrap(), &orbit)
+            .unwrap();
+        let oracle = Oracle::build(&view);
+        let keys = capture_of(&oracle, Identity::KeyOnly, |_, e| e >> 32 << 32);
+        let judge = Judge::new(EffectName::Fresnel, &scene, &view, orbit, &oracle);
+        let judged = judge.judge(&keys).unwrap();
+        assert_eq!(judged.errors, 0);
+        let pass = judged.pass.expect("completed and recomputed");
         assert_eq!(
-            keys_of_prims(&[1, 7], &fragments),
-            vec![(9 << 32) | 1, (5 << 32) | 7]
+            pass.completed_from_oracle,
+            Some("primitive ids (matched by depth key)")
         );
+        // Fresnel recomputes the normal of every captured entry, once each.
+        assert_eq!(pass.recomputed_entries, oracle.fragments() as u64);
+        let full = capture_of(&oracle, Identity::KeyAndPrim, |_, e| e);
+        let pass = judge.judge(&full).unwrap().pass.expect("recomputed");
+        assert_eq!(pass.completed_from_oracle, None);
+        assert_eq!(pass.recomputed_entries, oracle.fragments() as u64);
     }
 }

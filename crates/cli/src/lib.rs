@@ -22,7 +22,7 @@ pub use compare::CompareArgs;
 pub use explain::{ExplainArgs, ExplainScheme};
 pub use export::ExportArgs;
 pub use hazard::{HazardArgs, HazardReport, HazardRow};
-pub use judge::EffectName;
+pub use judge::{AttributePass, EffectName};
 pub use render::{RenderArgs, RunSummary, TieChoice};
 pub use schemes::{Fault, SchemeName, Sizing};
 pub use sweep::{SweepArgs, SweepSeries};

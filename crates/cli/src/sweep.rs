@@ -81,7 +81,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
             }
             let rate = judge
                 .judge(&named.run.capture)
-                .map(|(_, _, errors)| errors as f64 / judge.covered.max(1) as f64);
+                .map(|judged| judged.errors as f64 / judge.covered.max(1) as f64);
             series[i].error_pixel_rate.push(rate);
             series[i].time_ms.push(
                 (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,

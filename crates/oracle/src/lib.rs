@@ -209,7 +209,7 @@ impl Oracle {
         );
         let mut diff = Diff::default();
         let mask = ties.mask(capture.identity);
-        let masks_captured = mask != u64::MAX && capture.identity == Identity::KeyAndPrim;
+        let masks_captured = mask != u64::MAX && capture.identity != Identity::KeyOnly;
         let mut all = Vec::new();
         // Keys and packed words sort in depth order; bare primitive ids do not, so their order is
         // checked against the oracle's sequence instead of by sortedness.
