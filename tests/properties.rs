@@ -9,7 +9,8 @@
 mod support;
 
 use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::executor::{run_parallel, run_serial, Run};
+use fragsim::capture::depth_count::{DepthCount, DepthCounts};
+use fragsim::capture::executor::{run_parallel, run_serial, ParallelExecutor, Run};
 use fragsim::capture::kbuffer::KBuffer;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::tiled::run_tiled;
@@ -21,7 +22,7 @@ use fragsim::raster::{
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use support::strategies::{
-    closed_mesh, depth_plane, hinge, identity_camera, is_closed, k_choice, orbit_camera,
+    closed_mesh, concurrency, Concurrency, depth_plane, hinge, identity_camera, is_closed, k_choice, orbit_camera,
     orbit_camera_outside, scene_spec, small_capacity, unit_depth_pair, viewport,
     viewport_and_tiling, KChoice, PlanarTiling, SceneSpec,
 };
@@ -42,36 +43,31 @@ fn config(cases: u32) -> ProptestConfig {
     }
 }
 
-/// Runs MDTS over words `W` in `direction` with `k` slots on the parallel executor and checks it
-/// against the oracle: exactly the promised `K` nearest (farthest) fragments in canonical order,
-/// and the fragments beyond `K` are exactly the ones the executor counted as dropped.
-fn check_mdts_parallel<W: MdtsWord>(
+/// Runs MDTS over words `W` in `direction` with `k` slots under `concurrency` (the parallel
+/// executor with small tasks, the scheduled executor) and checks it against the oracle: exactly
+/// the promised `K` nearest (farthest) fragments in canonical order, and the fragments beyond `K`
+/// are exactly the ones the executor counted as dropped.
+fn check_mdts_concurrent<W: MdtsWord>(
     view: &View<'_>,
     oracle: &Oracle,
     k: u32,
     direction: Direction,
+    concurrency: &Concurrency,
 ) -> Result<(), TestCaseError> {
     let plain = Mdts::<W>::new(view.viewport(), k, direction, MEMORY_CAP_DEFAULT).unwrap();
+    let beyond: u64 = oracle
+        .depth_complexity()
+        .iter()
+        .map(|&n| u64::from(n.saturating_sub(k)))
+        .sum();
     // The probing walk must give the very same lists.
     for scheme in [plain.clone(), plain.probing()] {
-        let run = run_parallel(view, &scheme);
-        let diff = oracle.diff(&run.capture);
-        let name = scheme.name();
-        prop_assert!(diff.is_exact(), "{name} K={k}: {diff:?}");
-        prop_assert_eq!(
-            diff.overflowed,
-            run.stats.counters.dropped,
-            "{} K={}",
-            name,
-            k
-        );
-        prop_assert_eq!(
-            diff.captured + diff.overflowed,
-            oracle.fragments() as u64,
-            "{} K={}",
-            name,
-            k
-        );
+        for (how, run) in concurrency.runs(view, &scheme) {
+            let diff = oracle.diff(&run.capture);
+            let name = scheme.name();
+            prop_assert!(diff.is_exact(), "{name} K={k} {how}: {diff:?}");
+            prop_assert_eq!(run.stats.counters.dropped, beyond, "{} K={} {}", name, k, how);
+        }
     }
     Ok(())
 }
@@ -82,6 +78,14 @@ fn total_overflow(run: &Run) -> u64 {
         Keeps::All { overflow, .. } => overflow.iter().map(|&o| u64::from(o)).sum(),
         other => panic!("the A-buffer promises all fragments, got {other:?}"),
     }
+}
+
+/// The per-pixel counts of the scheme's own counting pass, run under `concurrency`'s parallel
+/// executor (what sizes an exact A-buffer; never the oracle's counts).
+fn counted(view: &View<'_>, concurrency: &Concurrency) -> Vec<u32> {
+    let count = DepthCount::new(view.viewport());
+    DepthCounts::from_run(ParallelExecutor::with_task_size(concurrency.task_size).run(view, &count))
+        .counts
 }
 
 /// Builds the scene of `spec` and its oracle, and calls `check` with the view.
@@ -142,41 +146,47 @@ fn check_tiling(viewport: Viewport, tiling: &PlanarTiling) -> Result<(), TestCas
 proptest! {
     #![proptest_config(config(384))]
 
-    /// Property 1: parallel MDTS (64-bit words ascending and descending, 32-bit depth-key words
-    /// ascending and descending) equals the oracle exactly on random scenes, cameras (near-plane
-    /// clipping included), viewports and `K`, including `K` below the maximum depth complexity;
-    /// then the oracle's count of fragments beyond `K` equals the executor's dropped count.
+    /// Property 1: concurrent MDTS (64-bit words ascending and descending, 32-bit depth-key
+    /// words ascending and descending; the parallel executor with 1 to 8 triangles a task and the
+    /// scheduled executor under a random policy and seed) equals the oracle exactly on random
+    /// scenes, cameras (near-plane clipping included), viewports and `K`, including `K` below the
+    /// maximum depth complexity; the fragments beyond `K`, counted from the oracle's per-pixel
+    /// counts, are the executor's dropped walks.
     #[test]
-    fn mdts_parallel_equals_the_oracle(
+    fn mdts_concurrent_equals_the_oracle(
         spec in scene_spec(),
         camera in orbit_camera(),
         viewport in viewport(),
         k in k_choice(),
+        concurrency in concurrency(),
     ) {
         with_view(&spec, viewport, &camera, |view, oracle| {
             let k = k.resolve(oracle.max_depth_complexity());
             for direction in [Direction::Ascending, Direction::Descending] {
-                check_mdts_parallel::<u64>(view, oracle, k, direction)?;
-                check_mdts_parallel::<u32>(view, oracle, k, direction)?;
+                check_mdts_concurrent::<u64>(view, oracle, k, direction, &concurrency)?;
+                check_mdts_concurrent::<u32>(view, oracle, k, direction, &concurrency)?;
             }
             Ok(())
         })?;
     }
 
-    /// Property 2: the parallel A-buffer sized exactly from the oracle's depth complexity equals
-    /// the oracle (insertion and bitonic post sort) and drops nothing; with a small fixed capacity
-    /// it keeps a subset of exactly `min(n, capacity)` fragments per pixel in canonical order (the
-    /// diff is exact under its subset semantics) and the overflow it reports equals the
-    /// executor's dropped count and the oracle's count of fragments beyond the capacity.
+    /// Property 2: the concurrent A-buffer (as in property 1) sized exactly by its own counting
+    /// pass equals the oracle (insertion and bitonic post sort) and drops nothing; with a small
+    /// fixed capacity it keeps a subset of exactly `min(n, capacity)` fragments per pixel in
+    /// canonical order (the diff checks the overflow it counts against the capacity), and the
+    /// overflow it reports equals the executor's dropped count and the count of fragments beyond
+    /// the capacity computed here from the oracle's per-pixel counts.
     #[test]
-    fn abuffer_parallel_equals_the_oracle(
+    fn abuffer_concurrent_equals_the_oracle(
         spec in scene_spec(),
         camera in orbit_camera(),
         viewport in viewport(),
         capacity in small_capacity(),
+        concurrency in concurrency(),
     ) {
         with_view(&spec, viewport, &camera, |view, oracle| {
-            let counts = oracle.depth_complexity();
+            let counts = counted(view, &concurrency);
+            prop_assert_eq!(&counts, &oracle.depth_complexity(), "the counting pass");
             let capacity = capacity.resolve(oracle.max_depth_complexity());
             let beyond: u64 = counts
                 .iter()
@@ -184,22 +194,20 @@ proptest! {
                 .sum();
             for sort in [PostSort::Insertion, PostSort::Bitonic] {
                 let exact = ABuffer::exact(&counts, sort, MEMORY_CAP_DEFAULT).unwrap();
-                let run = run_parallel(view, &exact);
-                let diff = oracle.diff(&run.capture);
-                prop_assert!(diff.is_exact(), "{}: {:?}", exact.name(), diff);
-                prop_assert_eq!(diff.captured, oracle.fragments() as u64);
-                prop_assert_eq!(run.stats.counters.dropped, 0);
-
                 let fixed =
                     ABuffer::fixed(viewport, capacity, sort, MEMORY_CAP_DEFAULT).unwrap();
-                let run = run_parallel(view, &fixed);
-                let diff = oracle.diff(&run.capture);
-                let name = fixed.name();
-                prop_assert!(diff.is_exact(), "{} capacity {}: {:?}", name, capacity, diff);
-                prop_assert_eq!(total_overflow(&run), run.stats.counters.dropped, "{}", name);
-                prop_assert_eq!(run.stats.counters.dropped, beyond, "{}", name);
-                prop_assert_eq!(diff.overflowed, beyond, "{}", name);
-                prop_assert_eq!(diff.captured + beyond, oracle.fragments() as u64, "{}", name);
+                for (how, run) in concurrency.runs(view, &exact) {
+                    let diff = oracle.diff(&run.capture);
+                    prop_assert!(diff.is_exact(), "{} {}: {:?}", exact.name(), how, diff);
+                    prop_assert_eq!(run.stats.counters.dropped, 0);
+                }
+                for (how, run) in concurrency.runs(view, &fixed) {
+                    let diff = oracle.diff(&run.capture);
+                    let name = fixed.name();
+                    prop_assert!(diff.is_exact(), "{} capacity {} {}: {:?}", name, capacity, how, diff);
+                    prop_assert_eq!(total_overflow(&run), beyond, "{} {}", name, how);
+                    prop_assert_eq!(run.stats.counters.dropped, beyond, "{} {}", name, how);
+                }
             }
             Ok(())
         })?;
@@ -240,7 +248,9 @@ proptest! {
             let k = k.resolve(max);
             check_tiled_equals_serial(view, &Mdts::<u64>::ascending(viewport, k).unwrap())?;
             check_tiled_equals_serial(view, &Mdts::<u64>::ascending(viewport, k).unwrap().probing())?;
-            let exact = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
+            let count = DepthCount::new(viewport);
+            check_tiled_equals_serial(view, &count)?;
+            let exact = ABuffer::exact_default(&DepthCounts::from_run(run_serial(view, &count)).counts).unwrap();
             check_tiled_equals_serial(view, &exact)?;
             let capacity = capacity.resolve(max);
             let fixed =
@@ -254,18 +264,19 @@ proptest! {
 proptest! {
     #![proptest_config(config(192))]
 
-    /// Property 3: the serial and the parallel executor produce equal captures for MDTS (64-bit
-    /// ascending, 32-bit descending, random `K`) and for the exact A-buffer, and the same
-    /// fragment, stored and dropped counts. For a fixed A-buffer, whose kept subset may depend on
-    /// arrival order once a pixel overflows, the per-pixel overflow counts and list lengths agree,
-    /// and the whole capture does when nothing overflows.
+    /// Property 3: the serial executor and each concurrent one (as in property 1) produce equal
+    /// captures for MDTS (64-bit ascending, 32-bit descending, random `K`) and for the exact
+    /// A-buffer, and the same fragment, stored and dropped counts. For a fixed A-buffer, whose
+    /// kept subset may depend on arrival order once a pixel overflows, the per-pixel overflow
+    /// counts and list lengths agree, and the whole capture does when nothing overflows.
     #[test]
-    fn serial_and_parallel_executors_agree(
+    fn serial_and_concurrent_executors_agree(
         spec in scene_spec(),
         camera in orbit_camera(),
         viewport in viewport(),
         k in k_choice(),
         capacity in small_capacity(),
+        concurrency in concurrency(),
     ) {
         with_view(&spec, viewport, &camera, |view, oracle| {
             let max = oracle.max_depth_complexity();
@@ -276,31 +287,36 @@ proptest! {
             };
 
             let mdts = Mdts::<u64>::ascending(viewport, k).unwrap();
-            let (serial, parallel) = (run_serial(view, &mdts), run_parallel(view, &mdts));
-            prop_assert!(serial.capture == parallel.capture, "mdts K={}", k);
-            prop_assert!(same_counts(&serial, &parallel), "mdts K={}: {:?} vs {:?}",
-                k, serial.stats.counters, parallel.stats.counters);
-
             let mdts32 =
                 Mdts::<u32>::new(viewport, k, Direction::Descending, MEMORY_CAP_DEFAULT).unwrap();
-            let (serial, parallel) = (run_serial(view, &mdts32), run_parallel(view, &mdts32));
-            prop_assert!(serial.capture == parallel.capture, "mdts32-desc K={}", k);
-            prop_assert!(same_counts(&serial, &parallel), "mdts32-desc K={}", k);
-
-            let exact = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
-            let (serial, parallel) = (run_serial(view, &exact), run_parallel(view, &exact));
-            prop_assert!(serial.capture == parallel.capture, "abuffer exact");
-            prop_assert!(same_counts(&serial, &parallel), "abuffer exact");
-
+            let exact = ABuffer::exact_default(&counted(view, &concurrency)).unwrap();
             let capacity = capacity.resolve(max);
             let fixed =
                 ABuffer::fixed(viewport, capacity, PostSort::Bitonic, MEMORY_CAP_DEFAULT).unwrap();
-            let (serial, parallel) = (run_serial(view, &fixed), run_parallel(view, &fixed));
-            prop_assert_eq!(&serial.capture.keeps, &parallel.capture.keeps);
-            prop_assert_eq!(&serial.capture.offsets, &parallel.capture.offsets);
-            prop_assert!(same_counts(&serial, &parallel), "abuffer fixed {}", capacity);
-            if capacity >= max {
-                prop_assert!(serial.capture == parallel.capture, "abuffer fixed {}", capacity);
+            let serial_mdts = run_serial(view, &mdts);
+            let serial_mdts32 = run_serial(view, &mdts32);
+            let serial_exact = run_serial(view, &exact);
+            let serial_fixed = run_serial(view, &fixed);
+            for (how, run) in concurrency.runs(view, &mdts) {
+                prop_assert!(serial_mdts.capture == run.capture, "mdts K={} {}", k, how);
+                prop_assert!(same_counts(&serial_mdts, &run), "mdts K={} {}: {:?} vs {:?}",
+                    k, how, serial_mdts.stats.counters, run.stats.counters);
+            }
+            for (how, run) in concurrency.runs(view, &mdts32) {
+                prop_assert!(serial_mdts32.capture == run.capture, "mdts32-desc K={} {}", k, how);
+                prop_assert!(same_counts(&serial_mdts32, &run), "mdts32-desc K={} {}", k, how);
+            }
+            for (how, run) in concurrency.runs(view, &exact) {
+                prop_assert!(serial_exact.capture == run.capture, "abuffer-exact {}", how);
+                prop_assert!(same_counts(&serial_exact, &run), "abuffer-exact {}", how);
+            }
+            for (how, run) in concurrency.runs(view, &fixed) {
+                prop_assert_eq!(&serial_fixed.capture.keeps, &run.capture.keeps, "{}", how);
+                prop_assert_eq!(&serial_fixed.capture.offsets, &run.capture.offsets, "{}", how);
+                prop_assert!(same_counts(&serial_fixed, &run), "abuffer {} {}", capacity, how);
+                if capacity >= max {
+                    prop_assert!(serial_fixed.capture == run.capture, "abuffer {} {}", capacity, how);
+                }
             }
             Ok(())
         })?;
@@ -332,7 +348,10 @@ proptest! {
             }
             let mdts = Mdts::<u64>::ascending(viewport, k.resolve(oracle.max_depth_complexity()))
                 .unwrap();
-            let abuffer = ABuffer::exact_default(&complexity).unwrap();
+            let count = DepthCount::new(viewport);
+            let counted = DepthCounts::from_run(run_parallel(view, &count)).counts;
+            prop_assert_eq!(&counted, &complexity, "the counting pass");
+            let abuffer = ABuffer::exact_default(&counted).unwrap();
             for run in [
                 run_serial(view, &mdts),
                 run_parallel(view, &mdts),
@@ -472,6 +491,39 @@ proptest! {
         prop_assert!(depth_from_key(ka) == a && depth_from_key(kb) == b);
         prop_assert!(ka <= depth_key(1.0).unwrap() && kb < EMPTY_KEY);
     }
+}
+
+/// The control: the concurrency settings the properties above run under really interleave. The
+/// k-buffer's read–modify–write is exact serially and loses fragments under interleaving; drawn
+/// from the very strategy the properties use (ten settings from a fixed seed), on a small scene
+/// of the kind they generate, it must break in at least one. If it did not, the "concurrent"
+/// properties would be serial ones in disguise.
+#[test]
+fn the_concurrency_settings_make_the_kbuffer_lose_fragments() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let scene = Scene::procedural("quads:6").unwrap();
+    let viewport = Viewport::new(16, 16).unwrap();
+    let view = scene.view(viewport, &OrbitCamera::default()).unwrap();
+    let oracle = Oracle::build(&view);
+    let kbuffer = KBuffer::with_k(viewport, 4).unwrap();
+    assert!(
+        oracle.diff(&run_serial(&view, &kbuffer).capture).is_exact(),
+        "the k-buffer is exact serially"
+    );
+    let mut runner = TestRunner::deterministic();
+    let mut broken = Vec::new();
+    for _ in 0..10 {
+        let setting = concurrency().new_tree(&mut runner).unwrap().current();
+        for (how, run) in setting.runs(&view, &kbuffer) {
+            let diff = oracle.diff(&run.capture);
+            if !diff.is_exact() {
+                broken.push(format!("{how}: {} lost, {} extra", diff.lost, diff.extra));
+            }
+        }
+    }
+    eprintln!("k-buffer broken in {} of 20 runs: {broken:#?}", broken.len());
+    assert!(!broken.is_empty(), "no setting interleaved the k-buffer");
 }
 
 /// The strategies' building blocks are what they claim: closed meshes are closed, and `K`

@@ -17,6 +17,7 @@
 //! | [`hinge`] | a [`Hinge`]: two triangles sharing an edge that crosses the near plane |
 //! | [`k_choice`] | a [`KChoice`]: a `K` (or capacity) relative to the depth complexity |
 //! | [`unit_depth`], [`unit_depth_pair`] | depths in `[0, 1]` for the depth-key order |
+//! | [`concurrency`] | a [`Concurrency`]: how a run interleaves (task size, schedule) |
 //!
 //! Scenes are generated as a [`SceneSpec`] rather than as a [`Scene`] so that a failing case
 //! prints a short procedural name rather than thousands of vertices.
@@ -24,7 +25,10 @@
 use std::collections::HashMap;
 use std::ops::{Range, RangeInclusive};
 
-use fragsim::raster::{Camera, Mesh, OrbitCamera, Scene, Viewport, SUBPIXEL_BITS};
+use fragsim::capture::executor::{ParallelExecutor, Run};
+use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::Scheme;
+use fragsim::raster::{Camera, Mesh, OrbitCamera, Scene, View, Viewport, SUBPIXEL_BITS};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::select;
@@ -1053,4 +1057,69 @@ pub fn unit_depth_pair() -> impl Strategy<Value = (f32, f32)> {
             f32::from_bits((bits + ulps).min(ONE_BITS))
         )),
     ]
+}
+
+// ---------------------------------------------------------------------------------------------
+// Concurrency
+// ---------------------------------------------------------------------------------------------
+
+/// How a property's concurrent runs interleave: the parallel executor with a small task size
+/// (1 to 8 triangles a rayon task, so that even a scene of a dozen triangles runs on every
+/// thread), and the scheduled executor under a random policy, width, granularity and seed (a
+/// replayable interleaving, so that a failure shrinks and reproduces).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Concurrency {
+    /// Triangles per rayon task of the parallel executor.
+    pub task_size: usize,
+    /// The scheduled executor's interleaving.
+    pub schedule: Schedule,
+}
+
+impl Concurrency {
+    /// `scheme`'s runs under this concurrency: the parallel executor's and the scheduled one's,
+    /// each labelled for failure messages.
+    pub fn runs<S: Scheme>(&self, view: &View<'_>, scheme: &S) -> [(String, Run); 2] {
+        [
+            (
+                format!("parallel, {} triangles a task", self.task_size),
+                ParallelExecutor::with_task_size(self.task_size).run(view, scheme),
+            ),
+            (
+                format!("scheduled {:?}", self.schedule),
+                run_scheduled(view, scheme, &self.schedule, false).run,
+            ),
+        ]
+    }
+}
+
+/// A scheduling policy: random, lockstep warps, or PCT of depth 1 to 3.
+pub fn policy() -> impl Strategy<Value = Policy> {
+    prop_oneof![
+        Just(Policy::Random),
+        Just(Policy::Warps),
+        (1u32..=3).prop_map(|depth| Policy::Pct { depth }),
+    ]
+}
+
+/// A [`Concurrency`]: task sizes 1 to 8, 2 to 64 threads in flight, either granularity, any
+/// seed. Shrinks towards one triangle a task and two fragments in flight under the random policy.
+pub fn concurrency() -> impl Strategy<Value = Concurrency> {
+    (
+        1usize..=8,
+        policy(),
+        2usize..=64,
+        prop_oneof![Just(Granularity::Fragment), Just(Granularity::Triangle)],
+        any::<u64>(),
+    )
+        .prop_map(
+            |(task_size, policy, in_flight, granularity, seed)| Concurrency {
+                task_size,
+                schedule: Schedule {
+                    policy,
+                    in_flight,
+                    granularity,
+                    seed,
+                },
+            },
+        )
 }
