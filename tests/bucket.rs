@@ -42,7 +42,10 @@ fn both<S: Scheme>(view: &View<'_>, scheme: &S) -> [Run; 2] {
 /// `mantissa · 2^exponent`; zero has no exponent (`None`), so that it never forces a common scale.
 fn dyadic(key: u32) -> (u128, Option<i32>) {
     let (biased, fraction) = ((key >> 23) & 0xFF, key & 0x7F_FFFF);
-    assert!(key >> 31 == 0 && biased != 0xFF, "depth key {key:#x} is not a finite depth ≥ 0");
+    assert!(
+        key >> 31 == 0 && biased != 0xFF,
+        "depth key {key:#x} is not a finite depth ≥ 0"
+    );
     match (biased, fraction) {
         (0, 0) => (0, None),
         (0, f) => (u128::from(f), Some(-149)),
@@ -63,7 +66,10 @@ fn exact_subinterval(key: u32, near: u32, far: u32, count: u32) -> u32 {
     let integer = |(mantissa, exponent): (u128, Option<i32>)| {
         let shift = exponent.map_or(0, |e| e - scale) as u32;
         // 24-bit mantissas shifted by at most 93 bits, times a count below 2^11, fit u128.
-        assert!(shift <= 93, "depths {key:#x} {near:#x} {far:#x} span too many binades");
+        assert!(
+            shift <= 93,
+            "depths {key:#x} {near:#x} {far:#x} span too many binades"
+        );
         mantissa << shift
     };
     let (d, lo, hi) = (integer(d), integer(lo), integer(hi));
@@ -141,7 +147,11 @@ fn the_exact_router_agrees_with_eq_2_worked_by_hand() {
             assert_eq!(exact_subinterval(key(bound) - 1, near, far, 16), j - 1);
         }
     }
-    assert_eq!(exact_subinterval(far, near, far, 16), 15, "the last one is closed");
+    assert_eq!(
+        exact_subinterval(far, near, far, 16),
+        15,
+        "the last one is closed"
+    );
     assert_eq!(exact_subinterval(key(0.5), key(0.5), key(0.5), 16), 0);
     // Count 5, range [0, 1]: 0.6 is 3/5 only approximately; the f32 nearest 0.6 is
     // 10066330 · 2^-24, and 5 · 10066330 = 50331650 ≥ 3 · 2^24 = 50331648, so subinterval 3.
@@ -181,12 +191,34 @@ fn a_wrong_router_predicts_losses_the_runs_do_not_have() {
     let oracle = Oracle::build(&view);
     let vp = view.viewport();
     let measured = [
-        (oracle.diff(&run_serial(&view, &Bdp::<u32>::pairs(vp).unwrap()).capture).lost, 16, 2),
-        (oracle.diff(&run_serial(&view, &Bdp::<u32>::singles(vp).unwrap()).capture).lost, 32, 1),
-        (oracle.diff(&run_serial(&view, &Bdp2::<u32>::paper(vp).unwrap()).capture).lost, 16, 4),
+        (
+            oracle
+                .diff(&run_serial(&view, &Bdp::<u32>::pairs(vp).unwrap()).capture)
+                .lost,
+            16,
+            2,
+        ),
+        (
+            oracle
+                .diff(&run_serial(&view, &Bdp::<u32>::singles(vp).unwrap()).capture)
+                .lost,
+            32,
+            1,
+        ),
+        (
+            oracle
+                .diff(&run_serial(&view, &Bdp2::<u32>::paper(vp).unwrap()).capture)
+                .lost,
+            16,
+            4,
+        ),
     ];
     for &(lost, count, keeps) in &measured {
-        assert_eq!(predicted_loss(&oracle, count, keeps, true).0, lost, "{count} keeping {keeps}");
+        assert_eq!(
+            predicted_loss(&oracle, count, keeps, true).0,
+            lost,
+            "{count} keeping {keeps}"
+        );
     }
     for (name, mutant) in mutants {
         let wrong: Vec<u64> = measured
@@ -194,7 +226,10 @@ fn a_wrong_router_predicts_losses_the_runs_do_not_have() {
             .map(|&(_, count, keeps)| predicted_loss_routed(&oracle, count, keeps, true, mutant).0)
             .collect();
         let right: Vec<u64> = measured.iter().map(|m| m.0).collect();
-        assert_ne!(wrong, right, "router {name:?} predicts what the runs measured");
+        assert_ne!(
+            wrong, right,
+            "router {name:?} predicts what the runs measured"
+        );
     }
 }
 

@@ -1211,8 +1211,9 @@ pub struct Comparison {
     pub verdicts: Vec<u8>,
     /// Pixels per verdict.
     pub counts: VerdictCounts,
-    /// The overflow the candidate's counters claim, `Σ (counter − stored)`: equal to
-    /// `diff.overflowed` unless a counter is miscounted.
+    /// The overflow the candidate claims: its A-buffer counters' `Σ (counter − stored)`, or for
+    /// MDTS what lies beyond K (its promise); equal to `diff.overflowed` unless a counter is
+    /// miscounted.
     pub claimed_overflow: u64,
     /// Words that the layout says cannot be there (0 when no words were checked).
     pub corrupt_words: u64,
@@ -1305,7 +1306,11 @@ impl Dump {
 fn inferred_counter(stored: usize, overflow: u32) -> Counter {
     Counter {
         count: stored as u32 + overflow,
-        capacity: if overflow > 0 { stored as u32 } else { u32::MAX },
+        capacity: if overflow > 0 {
+            stored as u32
+        } else {
+            u32::MAX
+        },
     }
 }
 
@@ -1343,7 +1348,11 @@ pub fn compare_with(
         "capture and reference cover different viewports"
     );
     if let Some(words) = words {
-        assert_eq!(words.corrupt.len(), pixels, "word check of another viewport");
+        assert_eq!(
+            words.corrupt.len(),
+            pixels,
+            "word check of another viewport"
+        );
     }
     if let Some(complete) = options.complete {
         assert_eq!(complete.len(), pixels, "completeness of another viewport");
@@ -1403,6 +1412,7 @@ pub fn compare_with(
                 keeps.clone()
             }
         };
+        let counted = matches!(candidate.keeps, Keeps::All { .. });
         if options.depth_ulps > 0 {
             snap_to_reference(
                 &mut one.entries,
@@ -1429,12 +1439,18 @@ pub fn compare_with(
             flags |= verdict::OVERFLOWED;
         }
         // A pixel the diff rejects for no other reason has fewer fragments missing than the
-        // overflow it was allowed (only against a reference that does not know the pixel's
-        // count, whose claimed overflow stands): the count is wrong.
-        if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 {
+        // overflow it was allowed. Where the reference knows the count that cannot happen (the
+        // allowance is `n − capacity` and at most `capacity` are held), so it is named a miscount
+        // rather than left unnamed; where the reference does not know the count, the claimed
+        // overflow is all there is and a reference holding no more than the candidate is no gap.
+        if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 && knows_n {
             flags |= verdict::MISCOUNTED;
         }
         comparison.counts.add(flags);
+        if !counted {
+            // MDTS claims nothing: what lies beyond K is its promise.
+            comparison.claimed_overflow += d.overflowed;
+        }
         total.captured += d.captured;
         total.overflowed += d.overflowed;
         total.lost += d.lost;
@@ -1451,11 +1467,14 @@ pub fn compare_with(
                         got: one.entries.clone(),
                     }
                 });
-                total
-                    .first_mismatches
-                    .push(PixelMismatch { pixel: p, ..example });
+                total.first_mismatches.push(PixelMismatch {
+                    pixel: p,
+                    ..example
+                });
                 if let Some(words) = words {
-                    comparison.first_corrupt.extend_from_slice(&words.corrupt[p]);
+                    comparison
+                        .first_corrupt
+                        .extend_from_slice(&words.corrupt[p]);
                 }
             }
         }
