@@ -2,6 +2,14 @@
 //! the papers say they are, lose exactly the predicted fragments where buckets collide, and never
 //! invent or misorder a fragment; their captures do not depend on the executor or the schedule.
 //!
+//! What each scheme should lose is predicted here, independently of the code under test: HPG
+//! eq. 2 is written out in this file in exact rational arithmetic (`exact_subinterval`: the f32
+//! depths as integers over a common power of two, an integer division), never with the library's
+//! own routing. `a_wrong_router_predicts_losses_the_runs_do_not_have` shows the predictions
+//! depend on the routing; with the library's `subinterval` changed by hand to return one bucket
+//! higher (`(k as u32 + 1).min(count - 1)`), `cargo test --release --test bucket` failed 6 of its
+//! 15 tests (the BDP, BDP2, ADP and random-soup predictions and the control itself).
+//!
 //! The error rates on the bunny are measured by `bunny_error_rates_are_small_and_ordered`:
 //! `cargo test --release --test bucket -- --nocapture bunny` prints them (docs/baselines/bucket.md).
 

@@ -10,7 +10,11 @@
 //! and sorts them. A dump whose A-buffer lists were already sorted on the GPU (`"sorted": true`)
 //! is taken in stored order, so a broken sort kernel shows up as misordered pixels.
 //! [`compare`] then diffs a capture against an [`Oracle`] pixel by pixel with [`Oracle::diff`]
-//! and names each pixel's verdict.
+//! and names each pixel's verdict. Decoding stops where the layout says a list ends, so
+//! [`Dump::check_words`] reads every word against the layout's rules (nothing after an empty MDTS
+//! slot, no empty marker below an A-buffer counter, no key above 1.0) and [`Dump::compare`] adds
+//! what it finds: [`verdict::CORRUPT`], and [`verdict::MISCOUNTED`] for an A-buffer counter other
+//! than the pixel's fragment count, which the oracle knows.
 //!
 //! ```
 //! use fragsim_capture::mdts::Direction;
