@@ -335,8 +335,11 @@ fn a_word_after_an_empty_mdts_slot_is_corrupt_in_every_mdts_layout() {
     });
 }
 
-/// The A-buffer layouts, each with where pixel `p`'s slots start in its `slots` array.
-fn abuffer_layouts(oracle: &Oracle) -> Vec<(DumpScheme, Box<dyn Fn(usize) -> usize>)> {
+/// Where pixel `p`'s slots start in a layout's `slots` array.
+type FirstSlot = Box<dyn Fn(usize) -> usize>;
+
+/// The A-buffer layouts, each with where a pixel's slots start.
+fn abuffer_layouts(oracle: &Oracle) -> Vec<(DumpScheme, FirstSlot)> {
     let k = oracle.max_depth_complexity();
     let counts = oracle.depth_complexity();
     let offsets: Vec<usize> = std::iter::once(0)
