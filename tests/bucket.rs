@@ -2,12 +2,20 @@
 //! the papers say they are, lose exactly the predicted fragments where buckets collide, and never
 //! invent or misorder a fragment; their captures do not depend on the executor or the schedule.
 //!
+//! What each scheme should lose is predicted here, independently of the code under test: HPG
+//! eq. 2 is written out in this file in exact rational arithmetic (`exact_subinterval`: the f32
+//! depths as integers over a common power of two, an integer division), never with the library's
+//! own routing. `a_wrong_router_predicts_losses_the_runs_do_not_have` shows the predictions
+//! depend on the routing; with the library's `subinterval` changed by hand to return one bucket
+//! higher (`(k as u32 + 1).min(count - 1)`), `cargo test --release --test bucket` failed 6 of its
+//! 15 tests (the BDP, BDP2, ADP and random-soup predictions and the control itself).
+//!
 //! The error rates on the bunny are measured by `bunny_error_rates_are_small_and_ordered`:
 //! `cargo test --release --test bucket -- --nocapture bunny` prints them (docs/baselines/bucket.md).
 
 use std::collections::BTreeMap;
 
-use fragsim::capture::bucket::{subinterval, Adp, Bdp, Bdp2, Buckets, ADP_SUBINTERVALS};
+use fragsim::capture::bucket::{Adp, Bdp, Bdp2, Buckets, ADP_SUBINTERVALS};
 use fragsim::capture::executor::{run_parallel, run_serial, Run};
 use fragsim::capture::scheduled::{run_fragments, run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
@@ -38,10 +46,69 @@ fn both<S: Scheme>(view: &View<'_>, scheme: &S) -> [Run; 2] {
     [serial, parallel]
 }
 
-/// Fragments the oracle predicts lost when each pixel's range `[min, max]` is cut into `count`
-/// subintervals and a subinterval keeps at most `keeps` distinct values (distinct by the packed
-/// word, or by the key alone when `key_only`). Also returns the most fragments in one subinterval.
+/// An f32 depth as an exact dyadic rational: `(mantissa, exponent)` with value
+/// `mantissa · 2^exponent`; zero has no exponent (`None`), so that it never forces a common scale.
+fn dyadic(key: u32) -> (u128, Option<i32>) {
+    let (biased, fraction) = ((key >> 23) & 0xFF, key & 0x7F_FFFF);
+    assert!(
+        key >> 31 == 0 && biased != 0xFF,
+        "depth key {key:#x} is not a finite depth ≥ 0"
+    );
+    match (biased, fraction) {
+        (0, 0) => (0, None),
+        (0, f) => (u128::from(f), Some(-149)),
+        (e, f) => (u128::from(f | 0x80_0000), Some(e as i32 - 150)),
+    }
+}
+
+/// HPG eq. 2, written out here rather than taken from the library: the subinterval
+/// `floor(count · (d − zNear) / (zFar − zNear))` of depth key `key` in the range `[near, far]`
+/// (keys), clamped to `0..count`, a degenerate range giving 0. Computed exactly: the three f32
+/// depths are dyadic rationals, brought to their smallest common power of two they are integers,
+/// and the quotient is an integer division, so no rounding can move a fragment across a bound.
+fn exact_subinterval(key: u32, near: u32, far: u32, count: u32) -> u32 {
+    let [d, lo, hi] = [key, near, far].map(dyadic);
+    let Some(scale) = [d.1, lo.1, hi.1].into_iter().flatten().min() else {
+        return 0; // all three zero: a degenerate range
+    };
+    let integer = |(mantissa, exponent): (u128, Option<i32>)| {
+        let shift = exponent.map_or(0, |e| e - scale) as u32;
+        // 24-bit mantissas shifted by at most 93 bits, times a count below 2^11, fit u128.
+        assert!(
+            shift <= 93,
+            "depths {key:#x} {near:#x} {far:#x} span too many binades"
+        );
+        mantissa << shift
+    };
+    let (d, lo, hi) = (integer(d), integer(lo), integer(hi));
+    if hi <= lo {
+        return 0;
+    }
+    assert!(d >= lo && d <= hi, "the depth lies in its pixel's range");
+    let k = u128::from(count) * (d - lo) / (hi - lo);
+    // The exact range puts its farthest fragment at `count`: the last subinterval is closed.
+    (k as u32).min(count - 1)
+}
+
+/// Routes a depth key to a subinterval: `(key, near, far, count) -> index`.
+type Router = fn(u32, u32, u32, u32) -> u32;
+
+/// Fragments predicted lost when each pixel's range `[min, max]` (from the oracle's list) is cut
+/// into `count` subintervals by [`exact_subinterval`] and a subinterval keeps at most `keeps`
+/// distinct values (distinct by the packed word, or by the key alone when `key_only`). Also
+/// returns the most fragments in one subinterval.
 fn predicted_loss(oracle: &Oracle, count: u32, keeps: usize, key_only: bool) -> (u64, usize) {
+    predicted_loss_routed(oracle, count, keeps, key_only, exact_subinterval)
+}
+
+/// [`predicted_loss`] with another router: the control test feeds it deliberately wrong ones.
+fn predicted_loss_routed(
+    oracle: &Oracle,
+    count: u32,
+    keeps: usize,
+    key_only: bool,
+    route: Router,
+) -> (u64, usize) {
     let (mut lost, mut most) = (0u64, 0usize);
     for p in 0..oracle.pixels() {
         let list = oracle.pixel(p);
@@ -53,7 +120,7 @@ fn predicted_loss(oracle: &Oracle, count: u32, keeps: usize, key_only: bool) -> 
         for &entry in list {
             let value = if key_only { entry >> 32 } else { entry };
             buckets
-                .entry(subinterval((entry >> 32) as u32, near, far, count))
+                .entry(route((entry >> 32) as u32, near, far, count))
                 .or_default()
                 .push(value);
         }
@@ -73,6 +140,105 @@ fn honest(oracle: &Oracle, run: &Run, name: &str) -> Diff {
     assert_eq!(diff.extra, 0, "{name} invented fragments: {diff:?}");
     assert_eq!(diff.misordered_pixels, 0, "{name} misordered: {diff:?}");
     diff
+}
+
+#[test]
+fn the_exact_router_agrees_with_eq_2_worked_by_hand() {
+    let key = |d: f32| d.to_bits();
+    let (near, far) = (key(0.25), key(0.75));
+    // 0.25 + 0.5 · j / 16 is exact in f32: bound j itself opens subinterval j.
+    for j in 0..16u32 {
+        let bound = 0.25 + 0.5 * j as f32 / 16.0;
+        assert_eq!(exact_subinterval(key(bound), near, far, 16), j, "bound {j}");
+        if j > 0 {
+            // One ulp below a bound is still in the subinterval before it.
+            assert_eq!(exact_subinterval(key(bound) - 1, near, far, 16), j - 1);
+        }
+    }
+    assert_eq!(
+        exact_subinterval(far, near, far, 16),
+        15,
+        "the last one is closed"
+    );
+    assert_eq!(exact_subinterval(key(0.5), key(0.5), key(0.5), 16), 0);
+    // Count 5, range [0, 1]: 0.6 is 3/5 only approximately; the f32 nearest 0.6 is
+    // 10066330 · 2^-24, and 5 · 10066330 = 50331650 ≥ 3 · 2^24 = 50331648, so subinterval 3.
+    assert_eq!(0.6f32.to_bits() & 0x7F_FFFF | 0x80_0000, 10_066_330);
+    assert_eq!(exact_subinterval(key(0.6), key(0.0), key(1.0), 5), 3);
+    // The next f32 below it, 10066329 · 2^-24: 5 · 10066329 = 50331645 < 50331648, so 2.
+    assert_eq!(exact_subinterval(key(0.6) - 1, key(0.0), key(1.0), 5), 2);
+    // Subnormal and normal depths in one range: [2^-149, 2^-126 · 1.5], midpoint-ish.
+    let (tiny, small) = (1u32, key(1.5 * f32::MIN_POSITIVE));
+    assert_eq!(exact_subinterval(tiny, tiny, small, 2), 0);
+    assert_eq!(exact_subinterval(key(f32::MIN_POSITIVE), tiny, small, 2), 1);
+}
+
+/// The control: the loss predictions are sensitive to the routing. Each deliberately wrong router
+/// (a bucket index one too high, one subinterval too few, the last subinterval left open as
+/// HPG's Listing 1.1 leaves it) predicts a loss that the library's runs do not show, so a library
+/// routing with that bug would fail the tests below, which compare runs with the exact router.
+#[test]
+fn a_wrong_router_predicts_losses_the_runs_do_not_have() {
+    let mutants: [(&str, Router); 3] = [
+        ("index + 1", |k, n, f, c| {
+            (exact_subinterval(k, n, f, c) + 1).min(c - 1)
+        }),
+        ("count − 1 subintervals", |k, n, f, c| {
+            exact_subinterval(k, n, f, (c - 1).max(1))
+        }),
+        ("last subinterval open", |k, n, f, c| {
+            if k == f && f > n {
+                c
+            } else {
+                exact_subinterval(k, n, f, c)
+            }
+        }),
+    ];
+    let scene = Scene::procedural("quads:64").unwrap();
+    let view = view_of(&scene, 32);
+    let oracle = Oracle::build(&view);
+    let vp = view.viewport();
+    let measured = [
+        (
+            oracle
+                .diff(&run_serial(&view, &Bdp::<u32>::pairs(vp).unwrap()).capture)
+                .lost,
+            16,
+            2,
+        ),
+        (
+            oracle
+                .diff(&run_serial(&view, &Bdp::<u32>::singles(vp).unwrap()).capture)
+                .lost,
+            32,
+            1,
+        ),
+        (
+            oracle
+                .diff(&run_serial(&view, &Bdp2::<u32>::paper(vp).unwrap()).capture)
+                .lost,
+            16,
+            4,
+        ),
+    ];
+    for &(lost, count, keeps) in &measured {
+        assert_eq!(
+            predicted_loss(&oracle, count, keeps, true).0,
+            lost,
+            "{count} keeping {keeps}"
+        );
+    }
+    for (name, mutant) in mutants {
+        let wrong: Vec<u64> = measured
+            .iter()
+            .map(|&(_, count, keeps)| predicted_loss_routed(&oracle, count, keeps, true, mutant).0)
+            .collect();
+        let right: Vec<u64> = measured.iter().map(|m| m.0).collect();
+        assert_ne!(
+            wrong, right,
+            "router {name:?} predicts what the runs measured"
+        );
+    }
 }
 
 #[test]

@@ -9,7 +9,8 @@ use assert_cmd::Command;
 use fragsim::capture::mdts::Direction;
 use fragsim::capture::Identity;
 use fragsim::oracle::dump::{
-    self, verdict, Dtype, Dump, DumpScheme, SceneSpec, TriangleExport, Words,
+    self, verdict, CompareOptions, Corruption, Dtype, Dump, DumpScheme, SceneSpec, TriangleExport,
+    Words,
 };
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
@@ -77,6 +78,29 @@ fn u64_slots(dump: &mut Dump) -> &mut Vec<u64> {
     }
 }
 
+fn counters(dump: &mut Dump) -> &mut Vec<u32> {
+    match dump.arrays.get_mut("counters") {
+        Some(Words::U32(w)) => w,
+        _ => panic!("no counters"),
+    }
+}
+
+/// The dump compared with the oracle, every word read.
+fn judged(dump: &Dump, oracle: &Oracle) -> dump::Comparison {
+    let options = CompareOptions {
+        examples: 8,
+        ..CompareOptions::default()
+    };
+    dump.compare(oracle, &options).unwrap()
+}
+
+/// A pixel whose list has between `min` and `max` fragments.
+fn pixel_with(oracle: &Oracle, min: usize, max: usize) -> usize {
+    (0..oracle.pixels())
+        .find(|&p| (min..=max).contains(&oracle.pixel(p).len()))
+        .unwrap_or_else(|| panic!("no pixel with {min}..={max} fragments"))
+}
+
 #[test]
 fn every_layout_round_trips_through_files_and_decodes_to_what_its_scheme_promises() {
     with_view(|view, oracle| {
@@ -96,6 +120,16 @@ fn every_layout_round_trips_through_files_and_decodes_to_what_its_scheme_promise
             assert_eq!(comparison.diff.captured, diff.captured);
             assert_eq!(comparison.diff.overflowed, diff.overflowed);
             assert_eq!(comparison.counts.equal, u64::from(WIDTH * HEIGHT));
+            // Every word read: fragsim's own memory breaks no rule of its layout.
+            let words = back.check_words().unwrap();
+            assert_eq!(
+                (words.corrupt_words(), words.unchecked),
+                (0, 0),
+                "{scheme:?}"
+            );
+            let whole = judged(&back, oracle);
+            assert!(whole.is_equal() && whole.words_checked, "{scheme:?}");
+            assert_eq!(whole.claimed_overflow, diff.overflowed, "{scheme:?}");
         }
     });
 }
@@ -172,6 +206,15 @@ fn compare_names_missing_extra_and_misordered_pixels_and_agrees_with_the_diff() 
             u64::from(WIDTH * HEIGHT) - 3,
             "every other pixel is equal"
         );
+        // Reading every word, the hole's successors are words after an empty slot.
+        let whole = judged(&dump, oracle);
+        assert_eq!(whole.verdicts[holed], verdict::MISSING | verdict::CORRUPT);
+        assert_eq!(whole.verdicts[swapped], verdict::MISORDERED);
+        assert_eq!(
+            whole.corrupt_words,
+            oracle.pixel(holed).len().min(k) as u64 - 2,
+            "every word behind the hole"
+        );
         let whole = oracle.diff(&capture);
         assert_eq!(
             (
@@ -225,6 +268,274 @@ fn abuffer_overflow_by_design_is_equal_but_an_overstated_counter_is_caught() {
             verdict::MISCOUNTED
         );
         assert_eq!(comparison.counts.miscounted, 1);
+    });
+}
+
+/// Sets word `index` of a dump's `slots` array, whatever its word width.
+fn set_slot(dump: &mut Dump, index: usize, word: u64) {
+    match dump.arrays.get_mut("slots") {
+        Some(Words::U64(w)) => w[index] = word,
+        Some(Words::U32(w)) => w[index] = u32::try_from(word).unwrap(),
+        None => panic!("no slots"),
+    }
+}
+
+#[test]
+fn a_word_after_an_empty_mdts_slot_is_corrupt_in_every_mdts_layout() {
+    with_view(|view, oracle| {
+        let k = oracle.max_depth_complexity();
+        let p = pixel_with(oracle, 1, k as usize - 2);
+        let nearest = oracle.pixel(p)[0];
+        // A copy of a word the pixel really holds, as each layout stores it: only the layout's
+        // rule (nothing follows an empty slot) can tell it is stray.
+        let layouts = [
+            (
+                DumpScheme::Mdts {
+                    k,
+                    direction: Direction::Ascending,
+                },
+                nearest,
+            ),
+            (
+                DumpScheme::Mdts {
+                    k,
+                    direction: Direction::Descending,
+                },
+                nearest + 1,
+            ),
+            (DumpScheme::Mdts32 { k }, nearest >> 32),
+        ];
+        for (scheme, stray) in layouts {
+            let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
+            let last = p * k as usize + k as usize - 1;
+            set_slot(&mut dump, last, stray);
+            let lists = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+            assert!(
+                lists.is_equal(),
+                "{scheme:?}: decoding stops at the empty slot"
+            );
+            let whole = judged(&dump, oracle);
+            assert!(!whole.is_equal(), "{scheme:?}");
+            assert_eq!(whole.verdicts[p], verdict::CORRUPT, "{scheme:?}");
+            assert_eq!(whole.counts.corrupt, 1);
+            assert_eq!(whole.counts.equal, u64::from(WIDTH * HEIGHT) - 1);
+            assert_eq!(whole.diff.mismatched_pixels, 1);
+            assert_eq!(whole.first_corrupt.len(), 1);
+            let word = whole.first_corrupt[0];
+            assert_eq!(
+                (word.pixel, word.slot, word.word, word.why),
+                (p, k as usize - 1, stray, Corruption::AfterEmpty),
+                "{scheme:?}"
+            );
+            assert_eq!(
+                whole.diff.first_mismatches[0].pixel, p,
+                "shown though its list is equal"
+            );
+        }
+    });
+}
+
+/// Where pixel `p`'s slots start in a layout's `slots` array.
+type FirstSlot = Box<dyn Fn(usize) -> usize>;
+
+/// The A-buffer layouts, each with where a pixel's slots start.
+fn abuffer_layouts(oracle: &Oracle) -> Vec<(DumpScheme, FirstSlot)> {
+    let k = oracle.max_depth_complexity();
+    let counts = oracle.depth_complexity();
+    let offsets: Vec<usize> = std::iter::once(0)
+        .chain(counts.iter().scan(0, |sum, &c| {
+            *sum += c as usize;
+            Some(*sum)
+        }))
+        .collect();
+    vec![
+        (
+            DumpScheme::ABufferFixed {
+                capacity: k,
+                sorted: true,
+            },
+            Box::new(move |p| p * k as usize),
+        ),
+        (
+            DumpScheme::ABufferFixed {
+                capacity: k,
+                sorted: false,
+            },
+            Box::new(move |p| p * k as usize),
+        ),
+        (
+            DumpScheme::ABufferExact {
+                counts,
+                sorted: false,
+            },
+            Box::new(move |p| offsets[p]),
+        ),
+    ]
+}
+
+#[test]
+fn an_abuffer_slot_below_its_counter_holding_the_empty_marker_is_corrupt_not_extra() {
+    with_view(|view, oracle| {
+        let p = pixel_with(oracle, 2, usize::MAX);
+        for (scheme, first) in abuffer_layouts(oracle) {
+            let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
+            u64_slots(&mut dump)[first(p)] = u64::MAX;
+            let whole = judged(&dump, oracle);
+            assert_eq!(
+                whole.verdicts[p],
+                verdict::CORRUPT | verdict::MISSING,
+                "{scheme:?}"
+            );
+            assert_eq!((whole.diff.lost, whole.diff.extra), (1, 0), "{scheme:?}");
+            assert_eq!(whole.first_corrupt[0].why, Corruption::EmptyCounted);
+            assert_eq!(whole.counts.equal, u64::from(WIDTH * HEIGHT) - 1);
+        }
+    });
+}
+
+#[test]
+fn an_abuffer_word_past_its_counter_is_corrupt_when_the_header_says_slots_were_filled() {
+    with_view(|view, oracle| {
+        let k = oracle.max_depth_complexity();
+        let p = pixel_with(oracle, 1, k as usize - 1);
+        let scheme = DumpScheme::ABufferFixed {
+            capacity: k,
+            sorted: false,
+        };
+        let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
+        assert!(dump.header.filled, "fragsim's slots start empty");
+        let unused: u64 = oracle
+            .depth_complexity()
+            .iter()
+            .map(|&n| u64::from(k - n))
+            .sum();
+        u64_slots(&mut dump)[p * k as usize + k as usize - 1] = oracle.pixel(p)[0];
+        let whole = judged(&dump, oracle);
+        assert_eq!(whole.verdicts[p], verdict::CORRUPT);
+        assert_eq!(whole.first_corrupt[0].why, Corruption::BeyondCounter);
+        assert_eq!(whole.unchecked_words, 0);
+        // FreePipe leaves spare slots uninitialised: without the promise nothing is known of
+        // them, and the report says how many words went unread instead of judging them.
+        dump.header.filled = false;
+        let whole = judged(&dump, oracle);
+        assert!(whole.is_equal());
+        assert_eq!((whole.corrupt_words, whole.unchecked_words), (0, unused));
+    });
+}
+
+#[test]
+fn a_stored_depth_key_above_one_is_corrupt() {
+    with_view(|view, oracle| {
+        let k = oracle.max_depth_complexity();
+        let p = pixel_with(oracle, 1, usize::MAX);
+        let impossible = (0x3F80_0001u64 << 32) | (oracle.pixel(p)[0] & 0xFFFF_FFFF);
+        let mdts = DumpScheme::Mdts {
+            k,
+            direction: Direction::Ascending,
+        };
+        let abuffer = DumpScheme::ABufferFixed {
+            capacity: k,
+            sorted: false,
+        };
+        for scheme in [mdts, abuffer] {
+            let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
+            // The last of the pixel's words: still in order, so it is wrong only in its key.
+            let n = oracle.pixel(p).len();
+            u64_slots(&mut dump)[p * k as usize + n - 1] = impossible;
+            let whole = judged(&dump, oracle);
+            assert_eq!(
+                whole.verdicts[p],
+                verdict::CORRUPT | verdict::MISSING | verdict::EXTRA,
+                "{scheme:?}"
+            );
+            assert_eq!(whole.first_corrupt[0].why, Corruption::ImpossibleKey);
+        }
+    });
+}
+
+#[test]
+fn an_abuffer_counter_other_than_the_pixels_fragment_count_is_overflow_miscounted() {
+    with_view(|view, oracle| {
+        let capacity = 3u32;
+        let counts = oracle.depth_complexity();
+        let predicted: u64 = counts
+            .iter()
+            .map(|&n| u64::from(n.saturating_sub(capacity)))
+            .sum();
+        assert!(predicted > 0, "the scene must overflow {capacity} slots");
+        let deep = pixel_with(oracle, capacity as usize + 2, usize::MAX);
+        let shallow = pixel_with(oracle, 2, 2);
+        let n = counts[deep];
+        // (pixel, counter, verdict): a counter that never stopped (0xFFFFFFFF), one that missed
+        // the last fragment of an overflowing pixel (overflow one short of n − capacity), and
+        // one larger than a pixel of two fragments could have (its extra slot is still empty).
+        let cases = [
+            (deep, u32::MAX, verdict::MISCOUNTED | verdict::OVERFLOWED),
+            (deep, n - 1, verdict::MISCOUNTED | verdict::OVERFLOWED),
+            (shallow, 3, verdict::MISCOUNTED | verdict::CORRUPT),
+        ];
+        let scheme = DumpScheme::ABufferFixed {
+            capacity,
+            sorted: false,
+        };
+        let good = Dump::record(view, spec(), &scheme, "test").unwrap();
+        assert!(judged(&good, oracle).is_equal());
+        for (p, counter, expected) in cases {
+            let mut dump = good.clone();
+            counters(&mut dump)[p] = counter;
+            let claimed: u64 = counters(&mut dump)
+                .iter()
+                .map(|&c| u64::from(c.saturating_sub(capacity)))
+                .sum();
+            let whole = judged(&dump, oracle);
+            assert_eq!(
+                whole.verdicts[p], expected,
+                "counter {counter:#x} at pixel {p}"
+            );
+            assert_eq!(whole.counts.miscounted, 1);
+            assert_eq!(
+                whole.diff.overflowed, predicted,
+                "overflow is predicted, not claimed"
+            );
+            assert_eq!(whole.claimed_overflow, claimed);
+            assert_eq!(whole.diff.lost, 0, "every fragment that fits is there");
+            // The lists alone, counter inferred from the capture, reach the same verdict.
+            let lists = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+            assert_eq!(lists.verdicts[p] & verdict::MISCOUNTED, verdict::MISCOUNTED);
+            assert_eq!(lists.diff.overflowed, predicted);
+        }
+    });
+}
+
+#[test]
+fn a_dump_as_reference_checks_counters_only_where_it_knows_the_count() {
+    with_view(|view, oracle| {
+        let scheme = DumpScheme::ABufferFixed {
+            capacity: 2,
+            sorted: false,
+        };
+        let dump = Dump::record(view, spec(), &scheme, "test").unwrap();
+        let capture = dump.capture().unwrap();
+        let reference = Oracle::from_capture(&capture);
+        let complete = dump::complete_pixels(&capture);
+        let overflowing = oracle.depth_complexity().iter().filter(|&&n| n > 2).count() as u64;
+        assert!(overflowing > 0);
+        assert_eq!(complete.iter().filter(|&&c| !c).count() as u64, overflowing);
+        let words = dump.check_words().unwrap();
+        let knowing = CompareOptions {
+            complete: Some(&complete),
+            ..CompareOptions::default()
+        };
+        assert!(dump::compare_with(&reference, &capture, Some(&words), &knowing).is_equal());
+        // Taken as the whole truth, the reference's two fragments a pixel make every overflowing
+        // counter look too large: that is why completeness is passed.
+        let naive = dump::compare_with(
+            &reference,
+            &capture,
+            Some(&words),
+            &CompareOptions::default(),
+        );
+        assert_eq!(naive.counts.miscounted, overflowing);
     });
 }
 
@@ -512,6 +823,121 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             .arg(dir.join("absent")),
         2,
     );
+}
+
+/// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the report.
+fn json_report(dir: &Path, code: i32) -> serde_json::Value {
+    let out = stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir)
+            .args(["--json", "--no-image"]),
+        code,
+    );
+    serde_json::from_str(&out).unwrap()
+}
+
+#[test]
+fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
+    let dir = scratch("binary-corrupt");
+    let dumps = dir.join("dumps");
+    stdout_of(
+        fragsim()
+            .args([
+                "render",
+                "--scene",
+                SCENE,
+                "--scheme",
+                "mdts,mdts-desc,mdts32,abuffer",
+            ])
+            .args(SIZE)
+            .args(["--no-images", "--dump"])
+            .arg(&dumps),
+        0,
+    );
+    // (layout, slots file, bytes a word, the empty slot's word)
+    let layouts = [
+        ("mdts", "slots.u64", 8, u64::MAX),
+        ("mdts-desc", "slots.u64", 8, 0),
+        ("mdts32", "slots.u32", 4, u64::from(u32::MAX)),
+    ];
+    for (scheme, file, width, empty) in layouts {
+        let path = dumps.join(scheme);
+        let k = json_report(&path, 0)["candidate"]["k"].as_u64().unwrap() as usize;
+        let slots = path.join(file);
+        let mut bytes = std::fs::read(&slots).unwrap();
+        let word = |bytes: &[u8], i: usize| {
+            let mut le = [0u8; 8];
+            le[..width].copy_from_slice(&bytes[i * width..(i + 1) * width]);
+            u64::from_le_bytes(le)
+        };
+        // A pixel whose first slot is full and whose last two are empty; its last slot gets a
+        // copy of its first word, a word the pixel really holds.
+        let pixel = (0..bytes.len() / width / k)
+            .find(|&p| word(&bytes, p * k) != empty && word(&bytes, p * k + k - 2) == empty)
+            .unwrap();
+        let stray = word(&bytes, pixel * k);
+        let last = pixel * k + k - 1;
+        bytes[last * width..(last + 1) * width].copy_from_slice(&stray.to_le_bytes()[..width]);
+        std::fs::write(&slots, &bytes).unwrap();
+        let text = stdout_of(
+            fragsim()
+                .args(["compare", "oracle"])
+                .arg(&path)
+                .arg("--no-image"),
+            1,
+        );
+        let x = pixel % WIDTH as usize;
+        let y = pixel / WIDTH as usize;
+        for expected in [
+            "corrupt 1".to_string(),
+            format!("pixel {pixel} (x {x}, y {y}): corrupt\n"),
+            format!("slot {}: {stray:#x} written after an empty slot", k - 1),
+            "verdict: DIFFERENT".to_string(),
+        ] {
+            assert!(
+                text.contains(&expected),
+                "{scheme}: {expected:?} not in\n{text}"
+            );
+        }
+        assert!(!text.contains("EQUAL"), "{scheme}: {text}");
+        let report = json_report(&path, 1);
+        assert_eq!(report["equal"], false);
+        assert_eq!(report["verdicts"]["corrupt"], 1, "{scheme}");
+        assert_eq!(report["words"]["corrupt"], 1);
+        let first = &report["first_differences"][0];
+        assert_eq!(first["pixel"], pixel);
+        assert_eq!(first["verdict"], serde_json::json!(["corrupt"]));
+        assert_eq!(first["corrupt_words"][0]["slot"], k - 1);
+    }
+    // An A-buffer counter that never stopped: overflow-miscounted, and the overflow by design
+    // stays what the oracle predicts (none here) instead of the counter's 4294967295 − n.
+    let path = dumps.join("abuffer");
+    let counters = path.join("counters.u32");
+    let mut bytes = std::fs::read(&counters).unwrap();
+    let pixel = bytes.chunks_exact(4).position(|c| c != [0; 4]).unwrap();
+    bytes[pixel * 4..pixel * 4 + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    std::fs::write(&counters, &bytes).unwrap();
+    let report = json_report(&path, 1);
+    assert_eq!(report["verdicts"]["overflow-miscounted"], 1);
+    assert_eq!(report["fragments"]["overflowed"], 0);
+    assert_eq!(report["first_differences"][0]["pixel"], pixel);
+    assert_eq!(
+        report["first_differences"][0]["verdict"],
+        serde_json::json!(["overflow-miscounted"])
+    );
+    let text = stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(&path)
+            .arg("--no-image"),
+        1,
+    );
+    assert!(
+        text.contains("overflowed by design 0 (counters claim"),
+        "{text}"
+    );
+    assert!(text.contains("overflow-miscounted 1"), "{text}");
 }
 
 #[test]

@@ -4,14 +4,18 @@
 //! Either side is a dump directory or the word `oracle`: fragsim's serial oracle on the scene
 //! the other side's header names. The candidate's lists are decoded by the scheme's own post pass
 //! and checked with `Oracle::diff` under the candidate's promise (the K nearest for MDTS, every
-//! fragment but the counted overflow for the A-buffer). Exit code 0 only when every pixel is
-//! equal.
+//! fragment but the overflow the reference predicts for the A-buffer), and every word of its
+//! storage is checked against its layout (`Dump::check_words`): a word where the layout allows
+//! none is `corrupt`, an A-buffer counter other than the pixel's fragment count is
+//! `overflow-miscounted`. Exit code 0 only when every pixel is equal.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
-use fragsim_oracle::dump::{self, verdict, Comparison, Dump, Header, VerdictCounts};
+use fragsim_oracle::dump::{
+    self, verdict, CompareOptions, Comparison, CorruptWord, Dump, Header, VerdictCounts,
+};
 use fragsim_oracle::Oracle;
 use fragsim_raster::depth_from_key;
 use serde::Serialize;
@@ -105,6 +109,14 @@ struct Entry {
     prim: Option<u32>,
 }
 
+/// A stored word the layout says cannot be there, as the report shows it.
+#[derive(Debug, Serialize)]
+struct Corrupt {
+    slot: usize,
+    word: String,
+    why: &'static str,
+}
+
 /// One differing pixel, both lists.
 #[derive(Debug, Serialize)]
 struct Example {
@@ -114,6 +126,8 @@ struct Example {
     verdict: Vec<&'static str>,
     reference: Vec<Entry>,
     candidate: Vec<Entry>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    corrupt_words: Vec<Corrupt>,
 }
 
 /// Fragment totals.
@@ -123,7 +137,21 @@ struct Fragments {
     captured: u64,
     lost: u64,
     extra: u64,
+    /// What the reference predicts: `Σ max(0, n − capacity)` where it knows `n`.
     overflowed: u64,
+    /// What the candidate's counters claim: `Σ (counter − stored)`.
+    overflow_claimed: u64,
+}
+
+/// Word totals of the candidate's storage.
+#[derive(Debug, Serialize)]
+struct WordsReport {
+    /// Whether the words were read at all (not when the candidate is the oracle).
+    checked: bool,
+    /// Words the layout says cannot be there.
+    corrupt: u64,
+    /// Words the layout leaves undefined (unfilled A-buffer slots past the counter).
+    unchecked: u64,
 }
 
 /// The whole report (`--json`).
@@ -140,6 +168,7 @@ struct Report {
     pixels: u64,
     verdicts: VerdictCounts,
     fragments: Fragments,
+    words: WordsReport,
     first_differences: Vec<Example>,
     image: Option<String>,
     notes: Vec<String>,
@@ -193,21 +222,43 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         None
     };
     let from_dump;
+    let mut complete = None;
+    let mut reference_corrupt = 0;
     let (reference_oracle, reference_identity) = match (&reference, &oracle) {
         (Side::Dump(dump, _), _) => {
             let capture = dump.capture().map_err(|e| e.to_string())?;
             notes.extend(reference_caveats(&capture));
+            reference_corrupt = dump
+                .check_words()
+                .map_err(|e| e.to_string())?
+                .corrupt_words();
+            if reference_corrupt > 0 {
+                notes.push(format!(
+                    "the reference dump holds {reference_corrupt} words its layout says cannot \
+                     be there: the comparison cannot be trusted, and is not called equal"
+                ));
+            }
+            complete = Some(dump::complete_pixels(&capture));
             from_dump = Oracle::from_capture(&capture);
             (&from_dump, capture.identity)
         }
         (Side::Oracle, Some(oracle)) => (oracle, Identity::KeyAndPrim),
         (Side::Oracle, None) => unreachable!("the oracle is built when a side names it"),
     };
-    let mut candidate_capture = match (&candidate, &oracle) {
-        (Side::Dump(dump, _), _) => dump.capture().map_err(|e| e.to_string())?,
-        (Side::Oracle, Some(oracle)) => oracle_capture(oracle),
+    let (mut candidate_capture, words) = match (&candidate, &oracle) {
+        (Side::Dump(dump, _), _) => (
+            dump.capture().map_err(|e| e.to_string())?,
+            Some(dump.check_words().map_err(|e| e.to_string())?),
+        ),
+        (Side::Oracle, Some(oracle)) => (oracle_capture(oracle), None),
         (Side::Oracle, None) => unreachable!("the oracle is built when a side names it"),
     };
+    if let Some(unchecked) = words.as_ref().map(|w| w.unchecked).filter(|&u| u > 0) {
+        notes.push(format!(
+            "{unchecked} A-buffer slots past their pixel's counter were not checked: the header \
+             does not say every slot was filled with the empty marker (\"filled\": true)"
+        ));
+    }
     if reference_identity == Identity::KeyOnly && candidate_capture.identity != Identity::KeyOnly {
         notes.push("the reference holds depth keys only: primitive ids are not compared".into());
         candidate_capture = dump::with_identity(&candidate_capture, Identity::KeyOnly);
@@ -219,12 +270,23 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             reference_oracle.pixels()
         ));
     }
-    let comparison = dump::compare(
+    let options = CompareOptions {
+        depth_ulps: args.depth_ulps,
+        examples: args.show,
+        complete: complete.as_deref(),
+    };
+    let comparison = dump::compare_with(
         reference_oracle,
         &candidate_capture,
-        args.depth_ulps,
-        args.show,
+        words.as_ref(),
+        &options,
     );
+    if comparison.claimed_overflow != comparison.diff.overflowed {
+        notes.push(format!(
+            "the counters claim {} fragments overflowed, the reference predicts {}",
+            comparison.claimed_overflow, comparison.diff.overflowed
+        ));
+    }
     let image = if args.no_image {
         None
     } else {
@@ -238,7 +300,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         Some(args.image.display().to_string())
     };
     let report = Report {
-        equal: comparison.is_equal(),
+        equal: comparison.is_equal() && reference_corrupt == 0,
         reference: reference.describe(),
         candidate: candidate.describe(),
         scene: header.scene.clone(),
@@ -254,6 +316,12 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             lost: comparison.diff.lost,
             extra: comparison.diff.extra,
             overflowed: comparison.diff.overflowed,
+            overflow_claimed: comparison.claimed_overflow,
+        },
+        words: WordsReport {
+            checked: comparison.words_checked,
+            corrupt: comparison.corrupt_words,
+            unchecked: comparison.unchecked_words,
         },
         first_differences: examples(&comparison, header.width, candidate_capture.identity),
         image,
@@ -333,7 +401,7 @@ fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
     let promise = match &candidate.keeps {
         Keeps::Nearest(k) => format!("the {k} nearest per pixel"),
         Keeps::Farthest(k) => format!("the {k} farthest per pixel"),
-        Keeps::All { .. } => "all per pixel, less the counted overflow".into(),
+        Keeps::All { .. } => "all per pixel, less the overflow the reference predicts".into(),
     };
     let tolerance = if ulps == 0 {
         "bit for bit".to_string()
@@ -341,20 +409,6 @@ fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
         format!("depth keys within {ulps} ulps")
     };
     format!("{words}, {promise}, in stored order, {tolerance}")
-}
-
-fn verdict_names(flags: u8) -> Vec<&'static str> {
-    [
-        (verdict::MISSING, "missing"),
-        (verdict::EXTRA, "extra"),
-        (verdict::MISORDERED, "misordered"),
-        (verdict::OVERFLOWED, "overflowed"),
-        (verdict::MISCOUNTED, "overflow-miscounted"),
-    ]
-    .into_iter()
-    .filter(|(flag, _)| flags & flag != 0)
-    .map(|(_, name)| name)
-    .collect()
 }
 
 fn entry(word: u64, identity: Identity) -> Entry {
@@ -375,9 +429,22 @@ fn examples(comparison: &Comparison, width: u32, identity: Identity) -> Vec<Exam
             pixel: m.pixel,
             x: (m.pixel % width as usize) as u32,
             y: (m.pixel / width as usize) as u32,
-            verdict: verdict_names(comparison.verdicts[m.pixel]),
+            verdict: verdict::names(comparison.verdicts[m.pixel]),
             reference: m.expected.iter().map(|&w| entry(w, identity)).collect(),
             candidate: m.got.iter().map(|&w| entry(w, identity)).collect(),
+            corrupt_words: corrupt_of(&comparison.first_corrupt, m.pixel),
+        })
+        .collect()
+}
+
+fn corrupt_of(words: &[CorruptWord], pixel: usize) -> Vec<Corrupt> {
+    words
+        .iter()
+        .filter(|w| w.pixel == pixel)
+        .map(|w| Corrupt {
+            slot: w.slot,
+            word: format!("{:#x}", w.word),
+            why: w.why.describe(),
         })
         .collect()
 }
@@ -386,6 +453,7 @@ fn examples(comparison: &Comparison, width: u32, identity: Identity) -> Vec<Exam
 fn colour(flags: u8, fragments: usize) -> [u8; 3] {
     let wrong = flags & (verdict::MISSING | verdict::EXTRA);
     match () {
+        () if flags & verdict::CORRUPT != 0 => [40, 220, 40],
         () if wrong == verdict::MISSING | verdict::EXTRA => [220, 50, 220],
         () if wrong == verdict::MISSING => [230, 40, 40],
         () if wrong == verdict::EXTRA => [60, 90, 255],
@@ -435,14 +503,26 @@ fn print_report(r: &Report) {
     println!("compared: {}", r.compared);
     let v = &r.verdicts;
     println!(
-        "pixels {}: equal {}, missing {}, extra {}, misordered {}, overflowed {}, overflow-miscounted {}",
-        r.pixels, v.equal, v.missing, v.extra, v.misordered, v.overflowed, v.miscounted
+        "pixels {}: equal {}, missing {}, extra {}, misordered {}, overflowed {}, \
+         overflow-miscounted {}, corrupt {}",
+        r.pixels, v.equal, v.missing, v.extra, v.misordered, v.overflowed, v.miscounted, v.corrupt
     );
     let f = &r.fragments;
+    let claimed = if f.overflow_claimed == f.overflowed {
+        String::new()
+    } else {
+        format!(" (counters claim {})", f.overflow_claimed)
+    };
     println!(
-        "fragments: reference {}, captured {}, lost {}, extra {}, overflowed by design {}",
+        "fragments: reference {}, captured {}, lost {}, extra {}, overflowed by design {}{claimed}",
         f.reference, f.captured, f.lost, f.extra, f.overflowed
     );
+    if r.words.checked {
+        println!(
+            "words: every one read; corrupt {}, not defined by the layout {}",
+            r.words.corrupt, r.words.unchecked
+        );
+    }
     for note in &r.notes {
         println!("note: {note}");
     }
@@ -471,6 +551,9 @@ fn print_report(r: &Report) {
                 show(b)
             );
         }
+        for c in &e.corrupt_words {
+            println!("  slot {}: {} {}", c.slot, c.word, c.why);
+        }
     }
     if let Some(image) = &r.image {
         println!("difference image: {image}");
@@ -478,8 +561,12 @@ fn print_report(r: &Report) {
     println!(
         "verdict: {}",
         if r.equal {
-            if r.compared.ends_with("bit for bit") {
+            // Bit-identical only if every word was read and defined: an unfilled A-buffer's
+            // spare slots, or the oracle as the candidate, leave words unseen.
+            if r.compared.ends_with("bit for bit") && r.words.checked && r.words.unchecked == 0 {
                 "EQUAL (bit-identical)"
+            } else if r.compared.ends_with("bit for bit") {
+                "EQUAL (lists bit-identical)"
             } else {
                 "EQUAL (within tolerance)"
             }

@@ -10,7 +10,11 @@
 //! and sorts them. A dump whose A-buffer lists were already sorted on the GPU (`"sorted": true`)
 //! is taken in stored order, so a broken sort kernel shows up as misordered pixels.
 //! [`compare`] then diffs a capture against an [`Oracle`] pixel by pixel with [`Oracle::diff`]
-//! and names each pixel's verdict.
+//! and names each pixel's verdict. Decoding stops where the layout says a list ends, so
+//! [`Dump::check_words`] reads every word against the layout's rules (nothing after an empty MDTS
+//! slot, no empty marker below an A-buffer counter, no key above 1.0) and [`Dump::compare`] adds
+//! what it finds: [`verdict::CORRUPT`], and [`verdict::MISCOUNTED`] for an A-buffer counter other
+//! than the pixel's fragment count, which the oracle knows.
 //!
 //! ```
 //! use fragsim_capture::mdts::Direction;
@@ -25,7 +29,9 @@
 //! let k = oracle.max_depth_complexity();
 //! let scheme = DumpScheme::Mdts { k, direction: Direction::Ascending };
 //! let dump = Dump::record(&view, spec, &scheme, "doc").unwrap();
-//! assert!(dump::compare(&oracle, &dump.capture().unwrap(), 0, 4).is_equal());
+//! let options = dump::CompareOptions { examples: 4, ..Default::default() };
+//! let comparison = dump.compare(&oracle, &options).unwrap();
+//! assert!(comparison.is_equal() && comparison.words_checked);
 //! ```
 //!
 //! Unlike the GPU, which leaves its words in device memory, [`Dump::record`] runs fragsim's scheme
@@ -225,6 +231,11 @@ pub struct Header {
     /// A-buffer: whether each pixel's slots were sorted in place (the post-sort kernel ran).
     #[serde(default)]
     pub sorted: bool,
+    /// A-buffer: whether every slot was set to the empty marker (`u64::MAX`) before the pass, so
+    /// that a slot past its pixel's counter holding anything else is a stray write. Without it
+    /// those slots may hold anything (FreePipe leaves them uninitialised) and are not checked.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub filled: bool,
     /// The word layout, informative: `key<<32|prim`, `key`, or `(key<<32|prim)+1`.
     #[serde(default)]
     pub word: String,
@@ -556,6 +567,11 @@ impl Dump {
             arrays.insert(name.to_string(), Words::U64(words64));
         }
         let (mut k, mut capacity, mut sorted) = (None, None, false);
+        // fragsim's memory starts at the layout's initial words: the A-buffer's slots empty.
+        let filled = matches!(
+            scheme,
+            DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. }
+        );
         let slots_shape = match scheme {
             DumpScheme::Mdts { k: n, .. } | DumpScheme::Mdts32 { k: n } => {
                 k = Some(*n);
@@ -617,6 +633,7 @@ impl Dump {
                 k,
                 capacity,
                 sorted,
+                filled,
                 word: scheme.word().into(),
                 arrays: specs,
                 extra: serde_json::Value::Null,
@@ -803,6 +820,188 @@ impl Dump {
     }
 }
 
+/// The largest depth key of a fragment: depth 1.0 (fragments outside `[0, 1]` are dropped, and
+/// `-0.0` is stored as `+0.0`), so a stored key above it is no fragment's.
+const LARGEST_KEY: u32 = 0x3F80_0000;
+
+/// Why a stored word is one that its layout says cannot be there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Corruption {
+    /// An MDTS slot after the pixel's first empty one holds a word: MDTS fills a pixel's slots
+    /// from the first, each insertion shifting the larger words one slot on, so an empty slot is
+    /// never followed by a full one (a stray write, a neighbouring pixel's overrun).
+    AfterEmpty,
+    /// An A-buffer slot below its pixel's counter holds the empty marker: a slot handed out by
+    /// the counter whose write never landed (or was overwritten with the marker).
+    EmptyCounted,
+    /// An A-buffer slot past its pixel's counter holds something other than the empty marker,
+    /// in a dump whose header says every slot was filled with it (`"filled": true`).
+    BeyondCounter,
+    /// A stored word whose depth key is above 1.0's: no fragment has such a key.
+    ImpossibleKey,
+}
+
+impl Corruption {
+    /// A short description for reports.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::AfterEmpty => "written after an empty slot",
+            Self::EmptyCounted => "empty marker in a counted slot",
+            Self::BeyondCounter => "written past the counter",
+            Self::ImpossibleKey => "depth key above 1.0",
+        }
+    }
+}
+
+/// One stored word that its layout says cannot be there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct CorruptWord {
+    /// Row-major pixel index.
+    pub pixel: usize,
+    /// The slot within the pixel (`0..k`, `0..capacity`).
+    pub slot: usize,
+    /// The word as stored (a u32 word zero-extended).
+    pub word: u64,
+    /// What is wrong with it.
+    pub why: Corruption,
+}
+
+/// An A-buffer pixel's counter and how many slots it has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Counter {
+    /// The counter's value: how many fragments took a slot number.
+    pub count: u32,
+    /// The pixel's slots (the fixed capacity, or its share of exact storage).
+    pub capacity: u32,
+}
+
+/// Every word of a dump checked against its layout ([`Dump::check_words`]): what the decoded
+/// lists cannot show, since decoding stops where the layout says a pixel's list ends.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct WordCheck {
+    /// Per pixel, its words that the layout says cannot be there (most pixels: none).
+    pub corrupt: Vec<Vec<CorruptWord>>,
+    /// A-buffer dumps: each pixel's counter and capacity, for the comparison to check the
+    /// counter against the pixel's fragment count.
+    pub counters: Option<Vec<Counter>>,
+    /// Words the layout leaves undefined and so were not checked: A-buffer slots past the counter
+    /// when the header does not say they were filled.
+    pub unchecked: u64,
+}
+
+impl WordCheck {
+    /// How many words are corrupt.
+    #[must_use]
+    pub fn corrupt_words(&self) -> u64 {
+        self.corrupt.iter().map(|c| c.len() as u64).sum()
+    }
+}
+
+impl Dump {
+    /// Reads every word of the dump and names each one that its layout says cannot be there
+    /// (see [`Corruption`]); for an A-buffer, also gives each pixel's counter. Needs no
+    /// reference: it is the layout's own rules.
+    ///
+    /// # Errors
+    /// As [`Dump::capture`]: an unknown scheme, or arrays missing or of the wrong size or type.
+    pub fn check_words(&self) -> Result<WordCheck, DumpError> {
+        // Decoding validates the arrays against the scheme's layout; the check then indexes them
+        // freely.
+        self.capture()?;
+        let scheme = self.scheme()?;
+        let pixels = self.viewport()?.pixels();
+        let mut check = WordCheck {
+            corrupt: vec![Vec::new(); pixels],
+            ..WordCheck::default()
+        };
+        let missing = |n: &str| DumpError(format!("missing array {n:?}"));
+        match &scheme {
+            DumpScheme::Mdts { k, direction } => {
+                let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
+                let (empty, key): (u64, fn(u64) -> u32) = match direction {
+                    Direction::Ascending => (u64::MAX, |w| (w >> 32) as u32),
+                    Direction::Descending => (0, |w| (w.wrapping_sub(1) >> 32) as u32),
+                };
+                check_mdts(&mut check, slots, *k as usize, empty, key);
+            }
+            DumpScheme::Mdts32 { k } => {
+                let slots = self.u32s("slots")?.ok_or_else(|| missing("slots"))?;
+                let wide: Vec<u64> = slots.iter().map(|&w| u64::from(w)).collect();
+                check_mdts(&mut check, &wide, *k as usize, u64::from(u32::MAX), |w| {
+                    w as u32
+                });
+            }
+            DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. } => {
+                let counters = self.u32s("counters")?.ok_or_else(|| missing("counters"))?;
+                let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
+                let at = abuffer_slots(&scheme);
+                let mut all = Vec::with_capacity(pixels);
+                for (p, &count) in counters.iter().enumerate() {
+                    let (first, capacity) = at(p);
+                    let stored = (count as usize).min(capacity);
+                    for (slot, &word) in slots[first..first + capacity].iter().enumerate() {
+                        let why = if slot < stored {
+                            if word == u64::MAX {
+                                Some(Corruption::EmptyCounted)
+                            } else {
+                                ((word >> 32) as u32 > LARGEST_KEY)
+                                    .then_some(Corruption::ImpossibleKey)
+                            }
+                        } else if self.header.filled {
+                            (word != u64::MAX).then_some(Corruption::BeyondCounter)
+                        } else {
+                            check.unchecked += 1;
+                            None
+                        };
+                        if let Some(why) = why {
+                            check.corrupt[p].push(CorruptWord {
+                                pixel: p,
+                                slot,
+                                word,
+                                why,
+                            });
+                        }
+                    }
+                    all.push(Counter {
+                        count,
+                        capacity: capacity as u32,
+                    });
+                }
+                check.counters = Some(all);
+            }
+        }
+        Ok(check)
+    }
+}
+
+/// The MDTS rules over `k` slots a pixel: full slots first, each holding a possible key, then
+/// only empty ones.
+fn check_mdts(check: &mut WordCheck, slots: &[u64], k: usize, empty: u64, key: fn(u64) -> u32) {
+    for (p, words) in slots.chunks_exact(k).enumerate() {
+        let mut seen_empty = false;
+        for (slot, &word) in words.iter().enumerate() {
+            let why = if word == empty {
+                seen_empty = true;
+                None
+            } else if seen_empty {
+                Some(Corruption::AfterEmpty)
+            } else {
+                (key(word) > LARGEST_KEY).then_some(Corruption::ImpossibleKey)
+            };
+            if let Some(why) = why {
+                check.corrupt[p].push(CorruptWord {
+                    pixel: p,
+                    slot,
+                    word,
+                    why,
+                });
+            }
+        }
+    }
+}
+
 /// Pixel `p`'s slot range in an A-buffer's flat slot array.
 fn abuffer_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
     let offsets: Vec<usize> = match scheme {
@@ -932,7 +1131,7 @@ pub fn with_identity(capture: &Capture, identity: Identity) -> Capture {
     }
 }
 
-/// Per-pixel verdict flags of a comparison (a pixel with none is equal).
+/// Per-pixel verdict flags of a comparison (a pixel with none of [`verdict::DIFFERS`] is equal).
 pub mod verdict {
     /// Fragments the reference has and the candidate should have kept are missing.
     pub const MISSING: u8 = 1;
@@ -942,13 +1141,36 @@ pub mod verdict {
     pub const MISORDERED: u8 = 4;
     /// Storage overflowed by design (beyond K, past a capacity): counted, not an error by itself.
     pub const OVERFLOWED: u8 = 8;
-    /// An A-buffer counter claims more overflow than fragments are missing.
+    /// An A-buffer counter that is not the pixel's fragment count: larger than the pixel could
+    /// have, or an overflow `counter − capacity` other than `max(0, n − capacity)`.
     pub const MISCOUNTED: u8 = 16;
+    /// A stored word that the layout says cannot be there ([`super::Corruption`]).
+    pub const CORRUPT: u8 = 32;
     /// Flags that make a pixel differ.
-    pub const DIFFERS: u8 = MISSING | EXTRA | MISORDERED | MISCOUNTED;
+    pub const DIFFERS: u8 = MISSING | EXTRA | MISORDERED | MISCOUNTED | CORRUPT;
+
+    /// Each flag with its name in reports, in report order.
+    pub const NAMES: [(u8, &str); 6] = [
+        (MISSING, "missing"),
+        (EXTRA, "extra"),
+        (MISORDERED, "misordered"),
+        (OVERFLOWED, "overflowed"),
+        (MISCOUNTED, "overflow-miscounted"),
+        (CORRUPT, "corrupt"),
+    ];
+
+    /// The names of the flags set in `flags`.
+    #[must_use]
+    pub fn names(flags: u8) -> Vec<&'static str> {
+        NAMES
+            .iter()
+            .filter(|(flag, _)| flags & flag != 0)
+            .map(|&(_, name)| name)
+            .collect()
+    }
 }
 
-/// Pixel counts per verdict.
+/// Pixel counts per verdict; the JSON keys are the verdicts' names.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct VerdictCounts {
     /// Pixels equal to the reference (possibly with overflow by design).
@@ -961,20 +1183,56 @@ pub struct VerdictCounts {
     pub misordered: u64,
     /// Pixels whose storage overflowed by design.
     pub overflowed: u64,
-    /// Pixels whose overflow count is larger than what is missing.
+    /// Pixels whose A-buffer counter is not their fragment count.
+    #[serde(rename = "overflow-miscounted")]
     pub miscounted: u64,
+    /// Pixels holding a word their layout says cannot be there.
+    pub corrupt: u64,
 }
 
-/// The result of [`compare`].
+impl VerdictCounts {
+    /// Counts one pixel's flags.
+    fn add(&mut self, flags: u8) {
+        let counters = [
+            (verdict::MISSING, &mut self.missing),
+            (verdict::EXTRA, &mut self.extra),
+            (verdict::MISORDERED, &mut self.misordered),
+            (verdict::OVERFLOWED, &mut self.overflowed),
+            (verdict::MISCOUNTED, &mut self.miscounted),
+            (verdict::CORRUPT, &mut self.corrupt),
+        ];
+        for (flag, count) in counters {
+            *count += u64::from(flags & flag != 0);
+        }
+        self.equal += u64::from(flags & verdict::DIFFERS == 0);
+    }
+}
+
+/// The result of [`compare`] and [`compare_with`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Comparison {
     /// Totals over every pixel (the sum of one [`Oracle::diff`] per pixel), with the first
-    /// `examples` differing pixels.
+    /// `examples` differing pixels. `overflowed` is the overflow the reference predicts where it
+    /// knows the pixel's fragment count (`max(0, n − capacity)`), not what counters claim;
+    /// `mismatched_pixels` counts every pixel with a [`verdict::DIFFERS`] flag.
     pub diff: Diff,
     /// Per pixel, `verdict` flags.
     pub verdicts: Vec<u8>,
     /// Pixels per verdict.
     pub counts: VerdictCounts,
+    /// The overflow the candidate claims: its A-buffer counters' `Σ (counter − stored)`, or for
+    /// MDTS what lies beyond K (its promise); equal to `diff.overflowed` unless a counter is
+    /// miscounted.
+    pub claimed_overflow: u64,
+    /// Words that the layout says cannot be there (0 when no words were checked).
+    pub corrupt_words: u64,
+    /// Words the layout leaves undefined, not checked ([`WordCheck::unchecked`]).
+    pub unchecked_words: u64,
+    /// Whether the candidate's words were checked at all ([`compare_with`] with a
+    /// [`WordCheck`]), not only its decoded lists.
+    pub words_checked: bool,
+    /// The corrupt words of the pixels in `diff.first_mismatches`.
+    pub first_corrupt: Vec<CorruptWord>,
 }
 
 impl Comparison {
@@ -985,11 +1243,35 @@ impl Comparison {
     }
 }
 
-/// Compares `candidate` with `reference` pixel by pixel under the candidate's promise, with
-/// [`Oracle::diff`] on each pixel. With `depth_ulps > 0`, a candidate fragment whose key lies
-/// within that many f32 ulps of an otherwise unmatched reference fragment of the same primitive
-/// (any, for key-only words) counts as that fragment; a list the candidate stored in order stays
-/// in order. `examples` bounds the differing pixels kept.
+/// How [`compare_with`] judges.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CompareOptions<'a> {
+    /// Accept a candidate key within this many f32 ulps of an otherwise unmatched reference
+    /// fragment of the same primitive (any, for key-only words); 0: bit for bit.
+    pub depth_ulps: u32,
+    /// How many differing pixels to keep as examples.
+    pub examples: usize,
+    /// Per pixel, whether the reference knows every fragment there; `None`: everywhere, as the
+    /// oracle does. An A-buffer counter is checked against the pixel's fragment count only
+    /// where the reference knows it ([`complete_pixels`] of a dump used as the reference).
+    pub complete: Option<&'a [bool]>,
+}
+
+/// Per pixel, whether a capture holds every fragment of the pixel: fewer than K in an MDTS
+/// pixel, no overflow in an A-buffer one. Where it does not, a comparison against it cannot
+/// know the pixel's fragment count.
+#[must_use]
+pub fn complete_pixels(capture: &Capture) -> Vec<bool> {
+    (0..capture.pixels())
+        .map(|p| match &capture.keeps {
+            Keeps::Nearest(k) | Keeps::Farthest(k) => capture.pixel(p).len() < *k as usize,
+            Keeps::All { overflow, .. } => overflow[p] == 0,
+        })
+        .collect()
+}
+
+/// Compares `candidate`'s decoded lists with `reference` pixel by pixel under the candidate's
+/// promise ([`compare_with`] with no word check and a reference that knows every fragment).
 ///
 /// # Panics
 /// If the capture and the reference cover different numbers of pixels.
@@ -1000,40 +1282,164 @@ pub fn compare(
     depth_ulps: u32,
     examples: usize,
 ) -> Comparison {
+    let options = CompareOptions {
+        depth_ulps,
+        examples,
+        complete: None,
+    };
+    compare_with(reference, candidate, None, &options)
+}
+
+impl Dump {
+    /// Compares this dump with `reference`: its decoded lists ([`Dump::capture`]) and every one
+    /// of its words ([`Dump::check_words`]), with [`compare_with`].
+    ///
+    /// # Errors
+    /// As [`Dump::capture`].
+    ///
+    /// # Panics
+    /// If the dump and the reference cover different numbers of pixels.
+    pub fn compare(
+        &self,
+        reference: &Oracle,
+        options: &CompareOptions<'_>,
+    ) -> Result<Comparison, DumpError> {
+        let capture = self.capture()?;
+        let words = self.check_words()?;
+        Ok(compare_with(reference, &capture, Some(&words), options))
+    }
+}
+
+/// An A-buffer pixel's counter as a capture alone shows it: `stored + overflow`, and a capacity
+/// of `stored` when it overflowed (storage ran out), unknown (at least `stored`) when not.
+fn inferred_counter(stored: usize, overflow: u32) -> Counter {
+    Counter {
+        count: stored as u32 + overflow,
+        capacity: if overflow > 0 {
+            stored as u32
+        } else {
+            u32::MAX
+        },
+    }
+}
+
+/// Compares `candidate` with `reference` pixel by pixel under the candidate's promise, with
+/// [`Oracle::diff`] on each pixel, and adds what `words` (the candidate dump's
+/// [`WordCheck`]) found: a pixel with a corrupt word is [`verdict::CORRUPT`] whatever its list,
+/// and an A-buffer slot holding the empty marker is taken out of the list (it is no fragment,
+/// so it is corrupt, not extra).
+///
+/// An A-buffer counter must equal its pixel's fragment count `n`, which the reference knows
+/// (where `options.complete` says so): every fragment adds one and the counter never wraps. A
+/// counter that differs is [`verdict::MISCOUNTED`]: larger than the pixel could have, or an
+/// overflow `counter − capacity` other than `max(0, n − capacity)`. The overflow allowed to be
+/// missing is then `max(0, n − capacity)`, never what the counter claims; without `words` the
+/// counter and capacity are inferred from the capture ([`Keeps::All`]'s overflow).
+///
+/// With `options.depth_ulps > 0`, a candidate fragment whose key lies within that many f32 ulps
+/// of an otherwise unmatched reference fragment of the same primitive (any, for key-only words)
+/// counts as that fragment; a list the candidate stored in order stays in order.
+///
+/// # Panics
+/// If the capture, the reference, `words` or `options.complete` cover different numbers of
+/// pixels.
+#[must_use]
+pub fn compare_with(
+    reference: &Oracle,
+    candidate: &Capture,
+    words: Option<&WordCheck>,
+    options: &CompareOptions<'_>,
+) -> Comparison {
+    let pixels = candidate.pixels();
     assert_eq!(
         reference.pixels(),
-        candidate.pixels(),
+        pixels,
         "capture and reference cover different viewports"
     );
-    let mut total = Diff::default();
-    let mut counts = VerdictCounts::default();
-    let mut verdicts = Vec::with_capacity(candidate.pixels());
+    if let Some(words) = words {
+        assert_eq!(
+            words.corrupt.len(),
+            pixels,
+            "word check of another viewport"
+        );
+    }
+    if let Some(complete) = options.complete {
+        assert_eq!(complete.len(), pixels, "completeness of another viewport");
+    }
+    let mut comparison = Comparison {
+        diff: Diff::default(),
+        verdicts: Vec::with_capacity(pixels),
+        counts: VerdictCounts::default(),
+        claimed_overflow: 0,
+        corrupt_words: words.map_or(0, WordCheck::corrupt_words),
+        unchecked_words: words.map_or(0, |w| w.unchecked),
+        words_checked: words.is_some(),
+        first_corrupt: Vec::new(),
+    };
+    let total = &mut comparison.diff;
     let mut one_ref = Oracle {
         offsets: vec![0, 0],
         entries: Vec::new(),
     };
     let mut one = Capture::with_pixels(1, candidate.identity, Keeps::Nearest(0));
     one.offsets.push(0);
-    for p in 0..candidate.pixels() {
+    for p in 0..pixels {
         let all = reference.pixel(p);
+        let n = all.len();
+        let knows_n = options.complete.is_none_or(|c| c[p]);
         one_ref.entries.clear();
         one_ref.entries.extend_from_slice(all);
-        one_ref.offsets[1] = all.len();
+        one_ref.offsets[1] = n;
+        let got = candidate.pixel(p);
         one.entries.clear();
-        one.entries.extend_from_slice(candidate.pixel(p));
-        if depth_ulps > 0 {
-            snap_to_reference(&mut one.entries, all, candidate.identity, depth_ulps);
+        let mut flags = 0;
+        one.keeps = match &candidate.keeps {
+            Keeps::All { overflow, .. } => {
+                let counter = match words.and_then(|w| w.counters.as_ref()) {
+                    Some(counters) => counters[p],
+                    None => inferred_counter(got.len(), overflow[p]),
+                };
+                comparison.claimed_overflow += u64::from(overflow[p]);
+                // The marker is no fragment: its word check calls it corrupt.
+                let marker_is_corrupt = words.is_some();
+                one.entries
+                    .extend(got.iter().filter(|&&e| !marker_is_corrupt || e != u64::MAX));
+                let (capacity, allowed) = if knows_n {
+                    if counter.count as usize != n {
+                        flags |= verdict::MISCOUNTED;
+                    }
+                    let allowed = n.saturating_sub(counter.capacity as usize) as u32;
+                    (Capacity::PerPixel(counter.capacity), allowed)
+                } else {
+                    // The reference does not know the count: the claimed overflow stands, as
+                    // the capacity that predicts exactly it from the fragments the reference has.
+                    let stands = n.saturating_sub(overflow[p] as usize) as u32;
+                    (Capacity::PerPixel(stands), overflow[p])
+                };
+                Keeps::All {
+                    capacity,
+                    overflow: vec![allowed],
+                }
+            }
+            keeps => {
+                one.entries.extend_from_slice(got);
+                keeps.clone()
+            }
+        };
+        let counted = matches!(candidate.keeps, Keeps::All { .. });
+        if options.depth_ulps > 0 {
+            snap_to_reference(
+                &mut one.entries,
+                all,
+                candidate.identity,
+                options.depth_ulps,
+            );
         }
         one.offsets[1] = one.entries.len();
-        one.keeps = match &candidate.keeps {
-            Keeps::All { capacity, overflow } => Keeps::All {
-                capacity: *capacity,
-                overflow: vec![overflow[p]],
-            },
-            keeps => keeps.clone(),
-        };
         let d = one_ref.diff(&one);
-        let mut flags = 0;
+        if words.is_some_and(|w| !w.corrupt[p].is_empty()) {
+            flags |= verdict::CORRUPT;
+        }
         if d.lost > 0 {
             flags |= verdict::MISSING;
         }
@@ -1046,40 +1452,49 @@ pub fn compare(
         if d.overflowed > 0 {
             flags |= verdict::OVERFLOWED;
         }
-        if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 {
+        // A pixel the diff rejects for no other reason has fewer fragments missing than the
+        // overflow it was allowed. Where the reference knows the count that cannot happen (the
+        // allowance is `n − capacity` and at most `capacity` are held), so it is named a miscount
+        // rather than left unnamed; where the reference does not know the count, the claimed
+        // overflow is all there is and a reference holding no more than the candidate is no gap.
+        if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 && knows_n {
             flags |= verdict::MISCOUNTED;
         }
-        let counters = [
-            (verdict::MISSING, &mut counts.missing),
-            (verdict::EXTRA, &mut counts.extra),
-            (verdict::MISORDERED, &mut counts.misordered),
-            (verdict::OVERFLOWED, &mut counts.overflowed),
-            (verdict::MISCOUNTED, &mut counts.miscounted),
-        ];
-        for (flag, count) in counters {
-            *count += u64::from(flags & flag != 0);
+        comparison.counts.add(flags);
+        if !counted {
+            // MDTS claims nothing: what lies beyond K is its promise.
+            comparison.claimed_overflow += d.overflowed;
         }
-        counts.equal += u64::from(flags & verdict::DIFFERS == 0);
         total.captured += d.captured;
         total.overflowed += d.overflowed;
         total.lost += d.lost;
         total.extra += d.extra;
         total.misordered_pixels += d.misordered_pixels;
-        total.mismatched_pixels += d.mismatched_pixels;
-        if total.first_mismatches.len() < examples {
-            total.first_mismatches.extend(
-                d.first_mismatches
-                    .into_iter()
-                    .map(|m| PixelMismatch { pixel: p, ..m }),
-            );
+        if flags & verdict::DIFFERS != 0 {
+            total.mismatched_pixels += 1;
+            if total.first_mismatches.len() < options.examples {
+                let example = d.first_mismatches.into_iter().next().unwrap_or_else(|| {
+                    // Equal lists, wrong words: both sides are the list the pixel holds.
+                    PixelMismatch {
+                        pixel: p,
+                        expected: one.entries.clone(),
+                        got: one.entries.clone(),
+                    }
+                });
+                total.first_mismatches.push(PixelMismatch {
+                    pixel: p,
+                    ..example
+                });
+                if let Some(words) = words {
+                    comparison
+                        .first_corrupt
+                        .extend_from_slice(&words.corrupt[p]);
+                }
+            }
         }
-        verdicts.push(flags);
+        comparison.verdicts.push(flags);
     }
-    Comparison {
-        diff: total,
-        verdicts,
-        counts,
-    }
+    comparison
 }
 
 /// Replaces each candidate fragment that has no exact match in `reference` by the nearest
