@@ -56,3 +56,163 @@ fn bunny_both_schemes_both_executors_equal_the_oracle() {
     let diff = oracle.diff(&run_parallel(&view, &descending).capture);
     assert!(diff.is_exact(), "{diff:?}");
 }
+
+/// `fragsim render ARGS --json --no-images`: the exit status and the rows.
+fn render_json(args: &[&str]) -> (i32, Vec<serde_json::Value>, String) {
+    let output = assert_cmd::Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(args)
+        .args(["--json", "--no-images"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    let rows = serde_json::from_slice(&output.stdout).unwrap_or_else(|e| panic!("{e}: {stderr}"));
+    (output.status.code().unwrap_or(-1), rows, stderr)
+}
+
+/// The row of `scheme` (its first executor).
+fn row<'a>(rows: &'a [serde_json::Value], scheme: &str) -> &'a serde_json::Value {
+    rows.iter()
+        .find(|r| r["scheme"] == scheme)
+        .unwrap_or_else(|| panic!("no row for {scheme}"))
+}
+
+/// FreePipe's A-buffer is one pass over fixed arrays; the exact-storage variant is two, and its
+/// counting pass is timed and counted; MDTS with a fixed K is one pass.
+#[test]
+fn abuffer_is_one_pass_over_fixed_arrays_and_abuffer_exact_reports_its_count_pass() {
+    let (code, rows, stderr) = render_json(&["--scheme", "abuffer,abuffer-exact,mdts"]);
+    assert_eq!(code, 0, "{stderr}");
+    let pixels = 512 * 512u64;
+    let fragments = row(&rows, "mdts")["fragments"].as_u64().unwrap();
+    // The oracle's fragment count, computed here independently of any scheme's storage.
+    let scene = Scene::default_scene();
+    let view = scene
+        .view(
+            Viewport::new(512, 512).unwrap(),
+            &OrbitCamera::default().at_angle(30.0),
+        )
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    assert_eq!(fragments as usize, oracle.fragments());
+
+    let fixed = row(&rows, "abuffer");
+    assert_eq!(fixed["passes"], 1);
+    assert!(fixed["count_pass_ms"].is_null());
+    assert_eq!(fixed["slots_per_pixel"], 20);
+    // 20 slots of 8 bytes and a 4-byte counter per pixel, whatever the scene.
+    assert_eq!(
+        fixed["memory_bytes"].as_u64().unwrap(),
+        pixels * (4 + 20 * 8)
+    );
+    assert_eq!(fixed["guarantee"], "exact-within-capacity(20)");
+
+    let exact = row(&rows, "abuffer-exact");
+    assert_eq!(exact["passes"], 2);
+    assert!(exact["count_pass_ms"].as_f64().unwrap() > 0.0);
+    assert!(exact["time_ms"].as_f64().unwrap() >= exact["count_pass_ms"].as_f64().unwrap());
+    // Both passes rasterize every fragment.
+    assert_eq!(exact["fragments"].as_u64().unwrap(), 2 * fragments);
+    // Counters, slots and 32-bit offsets: sized to the fragments its own pass counted.
+    assert_eq!(
+        exact["memory_bytes"].as_u64().unwrap(),
+        pixels * 4 + fragments * 8 + (pixels + 1) * 4
+    );
+    let mdts = row(&rows, "mdts");
+    assert_eq!(mdts["passes"], 1);
+    assert_eq!(mdts["memory_bytes"].as_u64().unwrap(), pixels * 20 * 8);
+    for r in &rows {
+        assert_eq!(r["keeps_guarantee"], true, "{r}");
+        assert_eq!(r["lost"], 0, "{r}");
+    }
+}
+
+/// No scheme's storage is sized by anything but the user's numbers and its own counting pass:
+/// on two scenes of different depth complexity, a scheme whose memory differs must report a
+/// counting pass. With fixed sizes, no scheme but those sized to the scene by design may differ.
+/// A scheme sized from the oracle (which knows the scene without a pass) would fail this.
+#[test]
+fn no_scheme_is_sized_from_the_oracle() {
+    let schemes_run = |scene: &str, sizes: &[&str]| {
+        let mut args = vec![
+            "--scene",
+            scene,
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--view",
+            "0",
+            "--elevation",
+            "0",
+            "--scheme",
+            "all",
+            "--executor",
+            "serial",
+        ];
+        args.extend_from_slice(sizes);
+        let (code, rows, stderr) = render_json(&args);
+        assert_eq!(code, 0, "{stderr}");
+        rows
+    };
+    for sizes in [
+        &["--k", "auto", "--capacity", "auto"][..],
+        &["--k", "3", "--capacity", "3"],
+    ] {
+        let shallow = schemes_run("quads:2", sizes);
+        let deep = schemes_run("quads:7", sizes);
+        assert_eq!(shallow.len(), deep.len());
+        let mut sized_by_scene = 0;
+        for (a, b) in shallow.iter().zip(&deep) {
+            assert_eq!(a["scheme"], b["scheme"]);
+            if a["memory_bytes"] != b["memory_bytes"] {
+                sized_by_scene += 1;
+                for r in [a, b] {
+                    assert!(
+                        r["count_pass_ms"].is_f64(),
+                        "{} is sized to the scene without a counting pass: {r}",
+                        r["scheme"]
+                    );
+                }
+            }
+        }
+        assert!(
+            sized_by_scene > 0,
+            "the scenes must differ in depth complexity"
+        );
+    }
+}
+
+/// A scheme that counts its overflow one fragment wrong breaks its guarantee: `render` exits 1
+/// and names it, though every fragment it holds is right.
+#[test]
+fn a_scheme_misreporting_its_overflow_by_one_fails_render() {
+    for scheme in ["abuffer", "abuffer-exact"] {
+        let args = [
+            "--scene",
+            "quads:4",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--capacity",
+            "2",
+            "--scheme",
+            scheme,
+        ];
+        let (code, rows, _) = render_json(&args);
+        assert_eq!(code, 0);
+        assert_eq!(rows[0]["keeps_guarantee"], true);
+        let mut faulty = args.to_vec();
+        faulty.extend(["--inject-fault", "miscount-overflow"]);
+        let (code, rows, stderr) = render_json(&faulty);
+        assert_eq!(code, 1, "{stderr}");
+        assert_eq!(rows[0]["keeps_guarantee"], false);
+        assert_eq!(rows[0]["overflow_miscounted_pixels"], 1);
+        assert_eq!(
+            rows[0]["lost"], 0,
+            "the fragments are right; only the count is wrong"
+        );
+        assert!(stderr.contains("breaks its guarantee"), "{stderr}");
+    }
+}

@@ -15,8 +15,7 @@ use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
     CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, SerialMemory, Step,
-    WordMemory,
-    MEMORY_CAP_DEFAULT,
+    WordMemory, MEMORY_CAP_DEFAULT,
 };
 use fragsim::oracle::Oracle;
 use fragsim::raster::{
@@ -591,8 +590,17 @@ fn cuda_atomic_inc_past_capacity_overwrites_silently_where_fetch_add_counts_the_
         assert_eq!(run.stats.counters.dropped, 0);
         assert_eq!(run.capture.entries.len() as u64, kept);
         let diff = oracle.diff(&run.capture);
-        assert_eq!(diff.overflowed, 0, "atomicInc reports no overflow");
-        assert_eq!(diff.lost, oracle.fragments() as u64 - kept, "{diff:?}");
+        assert_eq!(diff.reported_overflow, 0, "atomicInc reports no overflow");
+        // The oracle predicts what should have overflowed, so the silence is a miscount at
+        // every pixel past capacity, and what is missing beyond that prediction is lost.
+        assert_eq!(diff.overflowed, overwritten);
+        let past_capacity = complexity.iter().filter(|&&n| n > capacity).count() as u64;
+        assert_eq!(diff.overflow_miscounted_pixels, past_capacity);
+        assert_eq!(
+            diff.lost + diff.overflowed,
+            oracle.fragments() as u64 - kept,
+            "{diff:?}"
+        );
         assert!(!diff.is_exact());
     }
     // Even a pixel of exactly `capacity` fragments reads as empty: its counter wrapped to 0.
@@ -623,7 +631,9 @@ fn atomic_inc_on_ten_thousand_coincident_fragments_keeps_only_the_remainder() {
     let run = run_serial(&view, &inc);
     // 10,000 = 1250 · 8: the counter ends at 0 and the pixel reads as empty.
     assert!(run.capture.pixel(0).is_empty());
-    assert_eq!(oracle.diff(&run.capture).lost, u64::from(n));
+    let diff = oracle.diff(&run.capture);
+    assert_eq!((diff.overflowed, diff.lost), (u64::from(n) - 8, 8));
+    assert_eq!(diff.overflow_miscounted_pixels, 1);
     // With one fragment fewer the counter ends at 9999 mod 8 = 7: slots 0..=6 hold primitives
     // 9992..=9998, the last written there; slot 7 (primitive 9991) is not read.
     let fewer = Mesh {
@@ -1033,9 +1043,9 @@ fn the_binary_refuses_a_16384_square_viewport_beyond_the_memory_cap_before_the_o
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success());
     assert!(!stderr.contains("panicked"), "{stderr}");
-    // MDTS with 64-bit words needs at least K = 1 word per pixel: 16384² × 8 bytes.
+    // MDTS with 64-bit words and the default K = 20: 16384² × 20 × 8 bytes.
     assert!(
-        stderr.contains("2147483648") && stderr.contains("1000000"),
+        stderr.contains("42949672960") && stderr.contains("1000000"),
         "{stderr}"
     );
     // Refused before the oracle's counting pass (which took 20 s and 5.4 GB here before the fix).

@@ -33,8 +33,8 @@ use fragsim::capture::linked_list::{LinkedList, Resolve};
 use fragsim::capture::loop32::Loop32;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
-    Capacity, Guarantee, Identity, Keeps, Layout, Memory, Promise, Scheme, SerialMemory, Step,
-    WordMemory, MEMORY_CAP_DEFAULT,
+    Guarantee, Identity, Keeps, Layout, Memory, Promise, Scheme, SerialMemory, Step, WordMemory,
+    MEMORY_CAP_DEFAULT,
 };
 use fragsim::raster::{depth_key, Fragment, Viewport};
 use loom::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
@@ -355,7 +355,12 @@ fn abuffer_model(
         assert_eq!(
             capture.keeps,
             Keeps::All {
-                capacity: Capacity::PerPixel(capacity as u32),
+                // Fixed storage names its capacity; exact storage promises that nothing overflows
+                // (a stale count that makes it overflow is then a miscount the oracle reports).
+                capacity: match scheme.promise() {
+                    Promise::All(capacity) => capacity,
+                    other => panic!("the A-buffer keeps all, not {other:?}"),
+                },
                 overflow: vec![(n - fit) as u32]
             },
             "overflow reported"

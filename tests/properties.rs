@@ -22,9 +22,9 @@ use fragsim::raster::{
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use support::strategies::{
-    closed_mesh, concurrency, Concurrency, depth_plane, hinge, identity_camera, is_closed, k_choice, orbit_camera,
-    orbit_camera_outside, scene_spec, small_capacity, unit_depth_pair, viewport,
-    viewport_and_tiling, KChoice, PlanarTiling, SceneSpec,
+    closed_mesh, concurrency, depth_plane, hinge, identity_camera, is_closed, k_choice,
+    orbit_camera, orbit_camera_outside, scene_spec, small_capacity, unit_depth_pair, viewport,
+    viewport_and_tiling, Concurrency, KChoice, PlanarTiling, SceneSpec,
 };
 
 /// A config with `cases` cases (or `PROPTEST_CASES` when set, for a longer run) and no failure
@@ -66,7 +66,14 @@ fn check_mdts_concurrent<W: MdtsWord>(
             let diff = oracle.diff(&run.capture);
             let name = scheme.name();
             prop_assert!(diff.is_exact(), "{name} K={k} {how}: {diff:?}");
-            prop_assert_eq!(run.stats.counters.dropped, beyond, "{} K={} {}", name, k, how);
+            prop_assert_eq!(
+                run.stats.counters.dropped,
+                beyond,
+                "{} K={} {}",
+                name,
+                k,
+                how
+            );
         }
     }
     Ok(())
@@ -522,7 +529,10 @@ fn the_concurrency_settings_make_the_kbuffer_lose_fragments() {
             }
         }
     }
-    eprintln!("k-buffer broken in {} of 20 runs: {broken:#?}", broken.len());
+    eprintln!(
+        "k-buffer broken in {} of 20 runs: {broken:#?}",
+        broken.len()
+    );
     assert!(!broken.is_empty(), "no setting interleaved the k-buffer");
 }
 

@@ -25,7 +25,7 @@ use fragsim::capture::scheduled::{
     run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
 };
 use fragsim::capture::tiled::run_tiled;
-use fragsim::capture::{Capture, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Capture, Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
 use proptest::prelude::*;
@@ -105,6 +105,15 @@ fn repeats_within_distinct(list: &[u64], k: u32) -> bool {
         .any(|d| keys.iter().filter(|&&x| x == *d).count() > 1)
 }
 
+/// `capture` judged as if it promised the `k` nearest: what a shipping scheme that keeps `k` of
+/// a longer list by arrival (within its capacity, by its own promise) departs from on screen.
+fn as_nearest(capture: &Capture, k: u32) -> Capture {
+    Capture {
+        keeps: Keeps::Nearest(k),
+        ..capture.clone()
+    }
+}
+
 /// The oracle's `k` nearest of pixel `p` (the `Promise::Nearest` list).
 fn nearest(oracle: &Oracle, p: usize, k: u32) -> &[u64] {
     let all = oracle.pixel(p);
@@ -144,8 +153,9 @@ proptest! {
     }
 
     /// The layer counter loses exactly `max(0, n − layer_count)` fragments of a pixel of depth
-    /// complexity `n`, on every interleaving, and nothing else: the pixel differs iff
-    /// `n > layer_count`. Serially the kept are the first arrivals.
+    /// complexity `n`, on every interleaving, and nothing else: within its capacity it is exact
+    /// (the oracle supplies the overflow it cannot count), and against the nearest `layer_count`
+    /// the pixel differs only if `n > layer_count`. Serially the kept are the first arrivals.
     #[test]
     fn layer_counter_loses_exactly_the_excess(
         stream in stream(),
@@ -174,8 +184,13 @@ proptest! {
                 prop_assert_eq!(got.pixel(p), first.as_slice());
             }
         }
-        prop_assert_eq!((diff.lost, diff.extra, diff.misordered_pixels), (excess, 0, 0));
-        prop_assert_eq!(diff.mismatched_pixels, over);
+        prop_assert_eq!(
+            (diff.overflowed, diff.lost, diff.extra, diff.misordered_pixels),
+            (excess, 0, 0, 0)
+        );
+        prop_assert!(diff.is_exact(), "{:?}", diff);
+        let on_screen = oracle.diff(&as_nearest(&got, layers));
+        prop_assert!(on_screen.mismatched_pixels <= over);
     }
 
     /// Keep-first differs in a pixel iff the `N` most recent head exchanges (read from the trace)
@@ -207,7 +222,12 @@ proptest! {
             prop_assert_eq!(differs, recent.as_slice() != nearest(&oracle, p, n), "pixel {}", p);
             departing += u64::from(differs);
         }
-        prop_assert_eq!(oracle.diff(&run.run.capture).mismatched_pixels, departing);
+        // Within its capacity keep-first is exact; it departs from the nearest `N`.
+        prop_assert!(oracle.diff(&run.run.capture).is_exact());
+        prop_assert_eq!(
+            oracle.diff(&as_nearest(&run.run.capture, n)).mismatched_pixels,
+            departing
+        );
         let nearest_first =
             LinkedList::new(view, pool, n, Resolve::KeepNearest, MEMORY_CAP_DEFAULT).unwrap();
         prop_assert!(oracle.diff(&capture(&nearest_first, &stream, &schedule)).is_exact());
@@ -287,7 +307,17 @@ fn layer_counter_loses_the_nearest_arriving_last() {
     let got = capture(&scheme, &stream, &serial());
     let oracle = Oracle::from_fragments(1, &stream.fragments);
     assert_eq!(got.pixel(0), &oracle.pixel(0)[1..]);
-    assert_eq!(oracle.diff(&got).lost, 1);
+    let diff = oracle.diff(&got);
+    assert_eq!(
+        (diff.overflowed, diff.lost),
+        (1, 0),
+        "within its capacity of 2"
+    );
+    assert_eq!(
+        oracle.diff(&as_nearest(&got, 2)).lost,
+        1,
+        "the nearest is gone"
+    );
 }
 
 /// Three fragments, `N` = 2, the nearest arriving first: keep-first resolves the two most recent
@@ -299,10 +329,9 @@ fn linked_list_keep_first_loses_the_nearest_arriving_first() {
     let list = |resolve| LinkedList::new(viewport(1), 3, 2, resolve, MEMORY_CAP_DEFAULT).unwrap();
     let first = capture(&list(Resolve::KeepFirst), &stream, &serial());
     assert_eq!(first.pixel(0), &oracle.pixel(0)[1..]);
-    assert_eq!(
-        (oracle.diff(&first).lost, oracle.diff(&first).extra),
-        (1, 1)
-    );
+    assert!(oracle.diff(&first).is_exact(), "two of three, within N = 2");
+    let on_screen = oracle.diff(&as_nearest(&first, 2));
+    assert_eq!((on_screen.lost, on_screen.extra), (1, 1));
     let nearest = capture(&list(Resolve::KeepNearest), &stream, &serial());
     assert_eq!(nearest.pixel(0), &oracle.pixel(0)[..2]);
 }
@@ -352,7 +381,9 @@ fn shipping_schemes_on_every_executor() {
     let captures =
         |f: &dyn Fn(&str) -> Capture| ["serial", "parallel", "tiled", "scheduled"].map(f);
     for got in captures(&|e| on(e, &view, &counter, &schedule)) {
-        assert_eq!(oracle.diff(&got).lost, excess);
+        let diff = oracle.diff(&got);
+        assert_eq!((diff.overflowed, diff.lost), (excess, 0));
+        assert!(diff.is_exact());
     }
     for got in captures(&|e| on(e, &view, &loop32, &schedule)) {
         assert!(oracle.diff_with(&got, Ties::MergeEqualDepths).is_exact());
@@ -375,24 +406,28 @@ fn on<S: Scheme>(executor: &str, view: &View<'_>, scheme: &S, schedule: &Schedul
     }
 }
 
-/// `fragsim render` on `args` (no images): per row, (scheme, executor, lost, mismatches).
-fn render_rows(args: &[&str]) -> Vec<(String, String, u64, u64)> {
+/// `fragsim render` on `args` (no images, JSON): per row, (scheme, executor, overflowed, lost,
+/// mismatches).
+fn render_rows(args: &[&str]) -> Vec<(String, String, u64, u64, u64)> {
     let output = assert_cmd::Command::cargo_bin("fragsim")
         .unwrap()
-        .arg("--no-images")
+        .args(["--no-images", "--json"])
         .args(args)
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert_eq!(output.status.code(), Some(0), "{args:?}: {stdout}");
-    stdout
-        .lines()
-        .skip(2)
-        .filter(|line| !line.starts_with("memory sized"))
-        .map(|line| {
-            let cells: Vec<&str> = line.split_whitespace().collect();
-            let number = |i: usize| cells[i].parse::<u64>().unwrap();
-            (cells[0].into(), cells[2].into(), number(12), number(13))
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&output.stdout).unwrap();
+    rows.iter()
+        .map(|r| {
+            let number = |key: &str| r[key].as_u64().unwrap();
+            (
+                r["scheme"].as_str().unwrap().into(),
+                r["executor"].as_str().unwrap().into(),
+                number("overflowed"),
+                number("lost"),
+                number("mismatches"),
+            )
         })
         .collect()
 }
@@ -407,7 +442,7 @@ fn smallest_scenes_through_the_command_line() {
     );
     let one_pixel = ["--width", "1", "--height", "1", "--elevation", "0"];
     let run = |extra: &[&str]| render_rows(&[&one_pixel[..], extra].concat());
-    for (scheme, executor, lost, mismatches) in run(&[
+    for (scheme, executor, _, lost, mismatches) in run(&[
         "--mesh",
         tie,
         "--view",
@@ -440,7 +475,7 @@ fn smallest_scenes_through_the_command_line() {
         "--ties",
         "merge-equal-depths",
     ]);
-    assert_eq!(merged, [("loop32".into(), "scheduled".into(), 0, 0)]);
+    assert_eq!(merged, [("loop32".into(), "scheduled".into(), 0, 0, 0)]);
     let counter = run(&[
         "--scene",
         "quads:3",
@@ -453,7 +488,11 @@ fn smallest_scenes_through_the_command_line() {
         "--executor",
         "serial",
     ]);
-    assert_eq!(counter, [("layer-counter".into(), "serial".into(), 1, 1)]);
+    // One fragment past its 2 layers: overflow the scheme cannot count, supplied by the oracle.
+    assert_eq!(
+        counter,
+        [("layer-counter".into(), "serial".into(), 1, 0, 0)]
+    );
     let lists = run(&[
         "--scene",
         "quads:3",
@@ -469,8 +508,8 @@ fn smallest_scenes_through_the_command_line() {
     assert_eq!(
         lists,
         [
-            ("linked-list".into(), "serial".into(), 1, 1),
-            ("linked-list-nearest".into(), "serial".into(), 0, 0)
+            ("linked-list".into(), "serial".into(), 1, 0, 0),
+            ("linked-list-nearest".into(), "serial".into(), 1, 0, 0)
         ]
     );
 }
