@@ -5,7 +5,7 @@ use fragsim_capture::abuffer::{ABuffer, PostSort};
 use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
 use fragsim_capture::dual_peeling::DualDepthPeeling;
 use fragsim_capture::executor::{self, ParallelExecutor, Run, SerialExecutor};
-use fragsim_capture::kbuffer::KBuffer;
+use fragsim_capture::kbuffer::{KBuffer, WriteBack};
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::layer_counter::LayerCounter;
 use fragsim_capture::linked_list::{LinkedList, Resolve};
@@ -58,10 +58,16 @@ pub enum SchemeName {
     Bdp2,
     /// Adaptive bucket depth peeling (§3.3).
     Adp,
-    /// The k-buffer: read–insert–write of K slots, exact only without concurrent hazards.
+    /// The k-buffer: read–insert–write of K slots, exact only without concurrent hazards;
+    /// render-target write-backs (one step each, committed in primitive order).
     Kbuffer,
-    /// The multi-pass k-buffer: k-buffer passes beyond the last captured depth until complete.
+    /// The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.
+    KbufferStores,
+    /// The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every
+    /// fragment is confirmed by a count (render-target write-backs).
     KbufferMultipass,
+    /// The multi-pass k-buffer with K separate loads and stores.
+    KbufferMultipassStores,
     /// The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.
     Srab,
     /// MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).
@@ -83,7 +89,7 @@ pub enum SchemeName {
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 24] = [
+    pub const EVERY: [SchemeName; 26] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
@@ -101,7 +107,9 @@ impl SchemeName {
         SchemeName::Bdp2,
         SchemeName::Adp,
         SchemeName::Kbuffer,
+        SchemeName::KbufferStores,
         SchemeName::KbufferMultipass,
+        SchemeName::KbufferMultipassStores,
         SchemeName::Srab,
         SchemeName::MdtsPacked,
         SchemeName::Loop32,
@@ -124,7 +132,7 @@ impl SchemeName {
                 "approximate"
             }
             // Exact on the serial executor; concurrent read–modify–write hazards lose fragments.
-            SchemeName::Kbuffer | SchemeName::KbufferMultipass => "exact-without-hazards",
+            SchemeName::Kbuffer | SchemeName::KbufferStores => "exact-without-hazards",
             // Exact up to 8 samples per pass (the rest counted as overflow); its passes must see
             // one arrival order, which the parallel executor does not promise.
             SchemeName::Srab => "exact-in-arrival-order",
@@ -138,6 +146,18 @@ impl SchemeName {
                 "exact-within-capacity"
             }
             _ => "exact",
+        }
+    }
+
+    /// The machine a k-buffer scheme runs on: separate stores for the `-stores` names, render
+    /// targets otherwise.
+    #[must_use]
+    pub fn write_back(self) -> WriteBack {
+        match self {
+            SchemeName::KbufferStores | SchemeName::KbufferMultipassStores => {
+                WriteBack::SeparateStores
+            }
+            _ => WriteBack::RenderTarget,
         }
     }
 
@@ -293,9 +313,13 @@ impl Executors {
                 &Adp::<u32>::new(viewport, layers, cap).map_err(err)?,
                 Some(layers),
             ),
-            SchemeName::Kbuffer => go(&KBuffer::new(viewport, k, cap).map_err(err)?, Some(k)),
-            SchemeName::KbufferMultipass => go(
-                &KBufferMultipass::new(viewport, k, layers, cap).map_err(err)?,
+            SchemeName::Kbuffer | SchemeName::KbufferStores => go(
+                &KBuffer::with_write_back(viewport, k, name.write_back(), cap).map_err(err)?,
+                Some(k),
+            ),
+            SchemeName::KbufferMultipass | SchemeName::KbufferMultipassStores => go(
+                &KBufferMultipass::with_write_back(viewport, k, layers, name.write_back(), cap)
+                    .map_err(err)?,
                 Some(k),
             ),
             SchemeName::Srab => go(
