@@ -238,7 +238,9 @@ impl KBufferMultipass {
                 self.emit(memory, pixel, &captured);
                 c = COMPLETE;
             } else {
-                for (i, &v) in captured.iter().enumerate() {
+                // All K words: a shorter list must not leave the last one's tail behind.
+                for i in 0..self.slots.k as usize {
+                    let v = captured.get(i).copied().unwrap_or(EMPTY);
                     WordMemory::<u64>::store(memory, self.tentative(pixel) + i, v);
                 }
                 more = true;
