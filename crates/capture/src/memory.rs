@@ -97,7 +97,10 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
     /// threads (loom's) must override both methods with their own fences and a yielding spin.
     fn lock(&self, index: usize) {
         while WordMemory::<u32>::swap(self, index, 1) != 0 {
-            std::hint::spin_loop();
+            // Wait with plain loads, so that waiting threads do not bounce the line.
+            while WordMemory::<u32>::load(self, index) != 0 {
+                std::hint::spin_loop();
+            }
         }
         std::sync::atomic::fence(std::sync::atomic::Ordering::Acquire);
     }
