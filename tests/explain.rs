@@ -43,7 +43,10 @@ fn explain_finds_a_losing_kbuffer_interleaving_and_names_the_lost_value() {
     );
     // The table has a column per thread and a write-back over another fragment's value.
     assert!(text.contains("| T0 ("), "{text}");
-    assert!(text.contains("write [") && text.contains("(was ["), "{text}");
+    assert!(
+        text.contains("write [") && text.contains("(was ["),
+        "{text}"
+    );
 }
 
 #[test]
@@ -65,13 +68,20 @@ fn shrinking_yields_no_more_steps_than_the_unshrunk_interleaving() {
 
 #[test]
 fn the_shortest_losing_interleaving_is_4_steps_on_render_targets_and_4k_with_separate_stores() {
-    for (depths, k) in [("0.3,0.5,0.1", 3), ("0.3,0.5,0.1,0.2,0.7", 5), ("0.2,0.6", 1)] {
+    for (depths, k) in [
+        ("0.3,0.5,0.1", 3),
+        ("0.3,0.5,0.1,0.2,0.7", 5),
+        ("0.2,0.6", 1),
+    ] {
         let k_arg = k.to_string();
         let (ok, text) = explain(&["--depths", depths, "--k", &k_arg]);
         assert!(ok, "{text}");
         // Read, read, write-back, write-back: a read is one row, a write-back one row.
         assert_eq!(steps(&text, "shrunk"), 4, "{text}");
-        assert!(text.starts_with("k-buffer (render-target write-backs)"), "{text}");
+        assert!(
+            text.starts_with("k-buffer (render-target write-backs)"),
+            "{text}"
+        );
         let rows = |prefix: &str| {
             text.lines()
                 .filter(|l| l.split('|').any(|c| c.trim().starts_with(prefix)))

@@ -169,7 +169,10 @@ fn interleaved_read_insert_write_loses_a_fragment_on_both_machines() {
     // Both read the empty slots before either writes; the later write-back, [late, empty],
     // overwrites [early, empty]: K loads and K stores each, or one read and one write-back each.
     for (write_back, script) in [
-        (WriteBack::SeparateStores, &[early, early, late, late, early, early, late, late][..]),
+        (
+            WriteBack::SeparateStores,
+            &[early, early, late, late, early, early, late, late][..],
+        ),
         (WriteBack::RenderTarget, &[early, late, early, late][..]),
     ] {
         let scheme = kbuffer(&view, 2, write_back);
@@ -369,7 +372,10 @@ fn on_the_bunny_render_targets_only_lose_and_separate_stores_also_tear() {
             match write_back {
                 WriteBack::RenderTarget => {
                     // Losses only: every list sorted, distinct and the pixel's own.
-                    assert!(sorted_distinct_and_genuine(&run.capture, &oracle), "K = {k}");
+                    assert!(
+                        sorted_distinct_and_genuine(&run.capture, &oracle),
+                        "K = {k}"
+                    );
                     assert_eq!((diff.misordered_pixels, dups), (0, 0), "K = {k}");
                     rt_lost += diff.lost;
                 }
@@ -379,7 +385,10 @@ fn on_the_bunny_render_targets_only_lose_and_separate_stores_also_tear() {
             }
         }
     }
-    assert!(rt_lost > 0, "no stale read lost a fragment: the schedule does not interleave");
+    assert!(
+        rt_lost > 0,
+        "no stale read lost a fragment: the schedule does not interleave"
+    );
     assert!(stores_torn > 0, "separate stores never tore a write-back");
 }
 
@@ -502,12 +511,19 @@ fn multipass_under_random_interleavings_is_exact_in_at_least_the_serial_passes()
                     if !more {
                         break;
                     }
-                    assert!(pass <= 2 * d + 1, "more than 2 D + 1 = {} passes", 2 * d + 1);
+                    assert!(
+                        pass <= 2 * d + 1,
+                        "more than 2 D + 1 = {} passes",
+                        2 * d + 1
+                    );
                 }
                 let diff = oracle.diff(&scheme.resolve(&memory));
                 assert!(diff.is_exact(), "k = {k}, {write_back:?}: {diff:?}");
                 let serial = serial_passes(&oracle, k);
-                assert!(pass >= serial, "{pass} passes, fewer than serially ({serial})");
+                assert!(
+                    pass >= serial,
+                    "{pass} passes, fewer than serially ({serial})"
+                );
                 extra_passes += pass - serial;
             }
         }

@@ -970,17 +970,21 @@ fn negative_control_rmw_kbuffer_separate_stores_2_threads_k3_loses_a_fragment() 
     let scheme = leaked_kbuffer(K, WriteBack::SeparateStores);
     let values: Vec<u64> = list.iter().map(|f| f.packed()).collect();
     let failed = catch_unwind(AssertUnwindSafe(|| {
-        explore("negative_control_rmw_kbuffer_stores_panics", None, move || {
-            let (memory, Walks { outcomes, .. }) = run_threads(scheme, &list);
-            let capture = scheme.resolve(memory);
-            check_k_best(
-                Direction::Ascending,
-                K,
-                &values,
-                capture.pixel(0),
-                &outcomes,
-            );
-        })
+        explore(
+            "negative_control_rmw_kbuffer_stores_panics",
+            None,
+            move || {
+                let (memory, Walks { outcomes, .. }) = run_threads(scheme, &list);
+                let capture = scheme.resolve(memory);
+                check_k_best(
+                    Direction::Ascending,
+                    K,
+                    &values,
+                    capture.pixel(0),
+                    &outcomes,
+                );
+            },
+        )
     }));
     let message = failed.expect_err("loom must reject the non-atomic k-buffer");
     let text = message
@@ -1027,7 +1031,10 @@ fn kbuffer_separate_stores_3_threads_k3_preemption_bound_2_tears_a_write_back() 
         &list,
         Some(2),
     );
-    assert!(wrong > 0 && torn > 0, "separate stores never tore a write-back");
+    assert!(
+        wrong > 0 && torn > 0,
+        "separate stores never tore a write-back"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------

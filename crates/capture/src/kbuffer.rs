@@ -224,7 +224,11 @@ impl Slots {
                 self.insert_in_registers(insert)
             }
             Phase::Write(i) => {
-                WordMemory::<u64>::store(memory, insert.base + i as usize, insert.local[i as usize]);
+                WordMemory::<u64>::store(
+                    memory,
+                    insert.base + i as usize,
+                    insert.local[i as usize],
+                );
                 if i + 1 < k {
                     insert.phase = Phase::Write(i + 1);
                     Outcome::Continue

@@ -171,9 +171,7 @@ impl KBufferMultipass {
 
     /// The first word of `pixel`'s output list.
     fn output(&self, pixel: usize) -> usize {
-        2 * self.slots.words(self.pixels)
-            + self.pixels * BOUNDS
-            + pixel * self.capacity as usize
+        2 * self.slots.words(self.pixels) + self.pixels * BOUNDS + pixel * self.capacity as usize
     }
 
     /// Appends `values` to `pixel`'s output list, counting those past its capacity.
@@ -419,11 +417,16 @@ mod tests {
         // near commits, then mid (a later primitive) commits [mid]: near is erased; far then reads
         // [mid] and writes [mid, far]. Passed 3, kept 2: tentative [mid, far].
         let fragments = [frag(10, 0), frag(20, 1), frag(30, 2)];
-        let scheme =
-            KBufferMultipass::new(Viewport::new(1, 1).unwrap(), 2, 3, u64::MAX).unwrap();
+        let scheme = KBufferMultipass::new(Viewport::new(1, 1).unwrap(), 2, 3, u64::MAX).unwrap();
         let memory: SerialMemory = scheme.layout().allocate();
         // Steps per walk in pass 0: count, read, write.
-        assert!(pass_in_order(&scheme, &memory, 0, &fragments, &[0, 1, 0, 1, 0, 1]));
+        assert!(pass_in_order(
+            &scheme,
+            &memory,
+            0,
+            &fragments,
+            &[0, 1, 0, 1, 0, 1]
+        ));
         // Pass 1: the window [mid, far] holds near too (3 fragments, list of 2): only near, the
         // exact nearest, is output.
         assert!(pass_in_order(&scheme, &memory, 1, &fragments, &[]));

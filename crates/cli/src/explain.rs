@@ -178,11 +178,7 @@ fn step_count(trace: &Trace) -> usize {
 
 /// Times the running thread changes from one step to the next.
 fn switches(trace: &Trace) -> usize {
-    trace
-        .order()
-        .windows(2)
-        .filter(|w| w[0] != w[1])
-        .count()
+    trace.order().windows(2).filter(|w| w[0] != w[1]).count()
 }
 
 /// The pixel's `k` slot words (the `u64` words; a render target's lock and last writer are `u32`)

@@ -536,7 +536,10 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
                 .filter(|&(i, _)| report.buckets[i].1 > 0)
                 .map(|(i, &x)| (i as f64, x))
                 .collect();
-            (format!("{} {} W={}", r.write_back, r.policy, r.width), points)
+            (
+                format!("{} {} W={}", r.write_back, r.policy, r.width),
+                points,
+            )
         })
         .collect();
     chart(
