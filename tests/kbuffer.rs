@@ -303,10 +303,15 @@ fn three_fragments_show_each_machines_failure_classes() {
             "{write_back:?}: {} interleavings: {exact} exact, {lossy} only lose, {torn} duplicate or misorder",
             scripts.len()
         );
-        // Both machines lose in some interleavings and are exact in others (on render targets at
-        // least the primitive-order serial one; a later primitive that runs first has read before
-        // the earlier one committed, which loses the earlier one, as on the GPU).
-        assert!(exact >= 1 && lossy > 0, "{write_back:?}");
+        // Both machines lose in some interleavings and are exact in others; on render targets,
+        // the 6 serial orders at least (one walk after another, in any order, reads what the
+        // previous one committed).
+        let least = if write_back == WriteBack::RenderTarget {
+            6
+        } else {
+            1
+        };
+        assert!(exact >= least && lossy > 0, "{write_back:?}: {exact} exact");
         match write_back {
             WriteBack::RenderTarget => assert_eq!(torn, 0, "render targets tore a write-back"),
             WriteBack::SeparateStores => assert!(torn > 0, "separate stores never tore"),
@@ -685,16 +690,16 @@ fn constructors_reject_k_zero_no_passes_and_too_much_memory() {
     assert!(bad(StencilRouted::new(v, 0, MEMORY_CAP_DEFAULT).map(drop)));
     let too_much =
         |e: Result<(), CaptureError>| matches!(e, Err(CaptureError::TooMuchMemory { .. }));
-    // 4,096 pixels: 8 slots of 8 bytes are 256 KiB, and render targets add a lock and a last
-    // writer (8 bytes a pixel).
+    // 4,096 pixels: 8 slots of 8 bytes are 256 KiB, and render targets add a lock and two
+    // tickets (12 bytes a pixel).
     let stores = |k, cap| KBuffer::with_write_back(v, k, WriteBack::SeparateStores, cap);
     assert!(stores(8, 256 << 10).is_ok());
     assert!(too_much(stores(8, (256 << 10) - 1).map(drop)));
-    assert!(KBuffer::new(v, 8, 4096 * 72).is_ok());
-    assert!(too_much(KBuffer::new(v, 8, 4096 * 72 - 1).map(drop)));
+    assert!(KBuffer::new(v, 8, 4096 * 76).is_ok());
+    assert!(too_much(KBuffer::new(v, 8, 4096 * 76 - 1).map(drop)));
     // The multi-pass k-buffer: slots and tentative list (2 × 64), c, t and the window's nearest
-    // (24), three counts (12), the render-target words (8); the output list counts too.
-    let per_pixel = 128 + 24 + 12 + 8;
+    // (24), three counts (12), the render-target words (12); the output list counts too.
+    let per_pixel = 128 + 24 + 12 + 12;
     assert!(KBufferMultipass::new(v, 8, 0, 4096 * per_pixel).is_ok());
     assert!(too_much(
         KBufferMultipass::new(v, 8, 1, 4096 * per_pixel).map(drop)

@@ -13,7 +13,7 @@
 //! - [`WriteBack::RenderTarget`] (the default; the papers' GPUs): the read is a texture fetch of
 //!   the render targets being drawn and the write-back is the MRT output through the ROP. The read
 //!   of the `K` slots is **one** step (a consistent snapshot of the pixel), the write-back **one**
-//!   step (all `K` slots at once), and write-backs to a pixel commit in primitive order (the ROP's
+//!   step (all `K` slots at once), and write-backs to a pixel commit in primitive order (the ROP.s
 //!   API order). Only the read can be stale: it may miss a write-back that commits before this
 //!   one. The only failure is a **lost** fragment: the slots always hold a sorted list of distinct
 //!   fragments, because every write-back is one fragment's sorted insertion into one snapshot.
@@ -37,21 +37,22 @@
 //! steps, so no executor can deadlock on it. The lock is the CPU's stand-in for the ROP and costs
 //! a locked operation per step, which `count_locked_ops` reports; a GPU pays nothing for it.
 //!
-//! **How "commit in primitive order" is modelled.** The ROP would hold a write-back until every
-//! earlier primitive's fragment of the pixel has committed; an executor that runs triangles out of
-//! order (the parallel and scheduled ones) cannot wait for a fragment that is not rasterized yet,
-//! or it would deadlock. Instead each pixel keeps the primitive of its last committed write-back
-//! (`prim + 1`, 0 for none) and a write-back from an earlier primitive than that one is dropped
-//! inside its step (Thomas's write rule): in primitive order it committed *before* the later one,
-//! which overwrote it entirely, so dropping it gives the same slots. The walk still ends `Stored`
-//! (the ROP did write it). Departure: the model lets a fragment read a later primitive's
-//! write-back, which the GPU cannot (that write waits for this fragment); the result is the same
-//! (that fragment's own write-back is then dropped, so it is lost, as on the GPU, where the later
-//! primitive's stale read erases it), and every final state of the model is one the GPU can reach:
-//! the surviving write-back chain is in increasing primitive order, each link reading the previous
-//! link's write-back, which a GPU's stale read can see. Two write-backs of one primitive (which a
-//! real pipeline never puts on one pixel, but a hand-written fragment list can) commit in arrival
-//! order.
+//! **How "commit in primitive order" is modelled.** The ROP commits a pixel's write-backs in the
+//! order its fragments arrived (primitive order: rasterization is in order), holding a write-back
+//! until the earlier ones have committed. An executor that runs triangles out of order (parallel,
+//! scheduled) cannot wait for a fragment that is not rasterized yet, or it would deadlock. So each
+//! fragment takes a *ticket* with its read (a per-pixel counter, inside the read's step): the
+//! commit order is the order of the reads. Each pixel keeps the last committed ticket, and a
+//! write-back whose ticket is older is dropped inside its step (Thomas's write rule): in commit
+//! order it came first and the newer one, whose read missed it, overwrote it whole, so dropping it
+//! gives the same slots. The walk still ends `Stored` (the ROP did write it). Departure: the ticket
+//! order is the reads' order, which is primitive order wherever an executor starts a pixel's reads
+//! in primitive order (serial, tiled) but not always within the scheduled executor's window or
+//! across the parallel executor's threads. There a stale pair loses the earlier *reader* where a GPU
+//! would lose the earlier *primitive*: one fragment either way. Walks run one after another in any
+//! order are exact, as on the serial executor, and every final state is one a GPU reaches with
+//! fragments that read in primitive order: the surviving write-back chain is in increasing ticket
+//! order, each link reading the previous link's write-back, which a stale read can see.
 //!
 //! **The shortest losing interleaving** under render-target writes is **4 steps**: two fragments,
 //! both reads before either write-back (read A, read B, write A, write B). A loss needs a
@@ -63,7 +64,7 @@
 //!
 //! **Cost.** One geometry pass. Render targets: 2 steps per fragment (1 when it is discarded);
 //! separate stores: `2 K` memory operations (`K` when it is discarded). Memory: `8 K` bytes per
-//! pixel, plus 8 for the render-target machine (the lock and the last writer's primitive).
+//! pixel, plus 12 for the render-target machine (the lock, the next ticket, the last committed one).
 //!
 //! Unlike the paper, which keeps a depth and a colour per slot in RGBA render targets, a slot is
 //! one `u64` `depth_key << 32 | prim`, so the capture is compared fragment for fragment with the
@@ -85,7 +86,7 @@ pub const EMPTY: u64 = u64::MAX;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum WriteBack {
     /// Render targets, as on the papers' GPUs: the read of the `K` slots is one step, the
-    /// write-back one step, and write-backs to a pixel commit in primitive order. Only the read
+    /// write-back one step, and write-backs to a pixel commit in order. Only the read
     /// can be stale, so the only failure is a lost fragment.
     #[default]
     RenderTarget,
@@ -134,6 +135,8 @@ pub struct Insert {
     pub local: Vec<u64>,
     /// Whether the insertion pushed a value off the end.
     pub evicted: bool,
+    /// Render targets: the fragment's place in the pixel's commit order, taken with its read.
+    pub ticket: u32,
 }
 
 /// How a step of [`Slots::step`] ended.
@@ -147,8 +150,8 @@ pub(crate) enum Outcome {
     Evicted,
     /// The fragment was farther than all `K` values read: it writes nothing.
     FellOff,
-    /// Render targets only: a later primitive's write-back had already committed, so in primitive
-    /// order this one committed first and was overwritten; nothing was written.
+    /// Render targets only: the write-back of a fragment that read later had already committed,
+    /// so in commit order this one came first and was overwritten; nothing was written.
     Overtaken,
 }
 
@@ -156,8 +159,8 @@ pub(crate) enum Outcome {
 /// the multi-pass one (`kbuffer_multipass`), which peels with it.
 ///
 /// The slots of pixel `p` are `u64` words `p K .. (p + 1) K`; with render targets, `u32` words
-/// `2 p` (the lock) and `2 p + 1` (the last committed write-back's primitive + 1) are the pixel's
-/// too.
+/// `3 p` (the lock), `3 p + 1` (the next ticket) and `3 p + 2` (the last committed ticket + 1) are
+/// the pixel's too.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Slots {
     /// Slots per pixel.
@@ -182,10 +185,11 @@ impl Slots {
         pixels * self.k as usize
     }
 
-    /// `u32` words of `pixels` pixels' render-target bookkeeping (none for separate stores).
+    /// `u32` words of `pixels` pixels' render-target bookkeeping (none for separate stores):
+    /// the lock, the next ticket, the last committed ticket + 1.
     pub fn sync_words(self, pixels: usize) -> usize {
         match self.write_back {
-            WriteBack::RenderTarget => 2 * pixels,
+            WriteBack::RenderTarget => 3 * pixels,
             WriteBack::SeparateStores => 0,
         }
     }
@@ -198,6 +202,7 @@ impl Slots {
             phase: Phase::Read(0),
             local: Vec::with_capacity(self.k as usize + 1),
             evicted: false,
+            ticket: 0,
         }
     }
 
@@ -244,10 +249,12 @@ impl Slots {
     fn step_render_target<M: Memory>(self, insert: &mut Insert, memory: &M) -> Outcome {
         let k = self.k as usize;
         let pixel = insert.base / k;
-        let (lock, last_writer) = (2 * pixel, 2 * pixel + 1);
+        let (lock, next_ticket, last_writer) = (3 * pixel, 3 * pixel + 1, 3 * pixel + 2);
         match insert.phase {
             Phase::Read(_) => {
                 memory.lock(lock);
+                insert.ticket = WordMemory::<u32>::load(memory, next_ticket);
+                WordMemory::<u32>::store(memory, next_ticket, insert.ticket.wrapping_add(1));
                 insert.local.extend(
                     (insert.base..insert.base + k).map(|w| WordMemory::<u64>::load(memory, w)),
                 );
@@ -255,11 +262,10 @@ impl Slots {
                 self.insert_in_registers(insert)
             }
             Phase::Write(_) => {
-                // `prim + 1`, so that 0 means "no write-back yet"; equal primitives commit in
-                // arrival order (`>=`).
-                let mine = (insert.value as u32).saturating_add(1);
+                // `ticket + 1`, so that 0 means "no write-back yet".
+                let mine = insert.ticket.saturating_add(1);
                 memory.lock(lock);
-                let commits = mine >= WordMemory::<u32>::load(memory, last_writer);
+                let commits = mine > WordMemory::<u32>::load(memory, last_writer);
                 if commits {
                     for (i, &v) in insert.local.iter().enumerate() {
                         WordMemory::<u64>::store(memory, insert.base + i, v);
@@ -303,7 +309,8 @@ impl Slots {
             WordMemory::<u64>::store(memory, w, EMPTY);
         }
         if self.write_back == WriteBack::RenderTarget {
-            WordMemory::<u32>::store(memory, 2 * pixel + 1, 0);
+            WordMemory::<u32>::store(memory, 3 * pixel + 1, 0);
+            WordMemory::<u32>::store(memory, 3 * pixel + 2, 0);
         }
     }
 
@@ -403,7 +410,7 @@ impl Scheme for KBuffer {
     fn step<M: Memory>(&self, insert: &mut Insert, memory: &M) -> Step {
         match self.slots.step(insert, memory) {
             Outcome::Continue => Step::Continue,
-            // An overtaken write-back did reach the pixel, in primitive order before the one that
+            // An overtaken write-back did reach the pixel, in commit order before the one that
             // overwrote it: stored, then lost to that one's stale read.
             Outcome::Stored | Outcome::Overtaken => Step::Stored,
             Outcome::Evicted | Outcome::FellOff => Step::Dropped,
@@ -469,19 +476,19 @@ mod tests {
     }
 
     #[test]
-    fn a_render_target_write_back_from_an_earlier_primitive_than_the_last_committed_is_dropped() {
+    fn a_render_target_write_back_that_read_before_the_last_committed_one_is_dropped() {
         let scheme = KBuffer::with_k(Viewport::new(1, 1).unwrap(), 2).unwrap();
         let memory: SerialMemory = scheme.layout().allocate();
         let (mut early, mut late) = (scheme.begin(fragment(3, 1)), scheme.begin(fragment(5, 2)));
-        // Both read the empty pixel; the later primitive commits first.
+        // Both read the empty pixel, early first; the later reader commits first.
         assert_eq!(scheme.step(&mut early, &memory), Step::Continue);
         assert_eq!(scheme.step(&mut late, &memory), Step::Continue);
         assert_eq!(scheme.step(&mut late, &memory), Step::Stored);
         assert_eq!(scheme.step(&mut early, &memory), Step::Stored);
         let mut out = Vec::new();
         scheme.resolve_pixel(&memory, 0, &mut out);
-        // In primitive order the early write-back committed first and the late one, read before
-        // it, overwrote it.
+        // In commit order the early write-back came first and the late one, read before it
+        // committed, overwrote it.
         assert_eq!(out, vec![5 << 32 | 2]);
     }
 }

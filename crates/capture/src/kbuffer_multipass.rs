@@ -41,8 +41,8 @@
 //! in `RunStats::passes`.
 //!
 //! **Memory per pixel:** `8 K` (slots) + `8 K` (tentative list) + 24 (`c`, `t`, the window's
-//! nearest) + `8 D` (output) + 12 (output, passed and window counts) bytes, plus 8 on the
-//! render-target machine (its lock and last writer).
+//! nearest) + `8 D` (output) + 12 (output, passed and window counts) bytes, plus 12 on the
+//! render-target machine (its lock and two tickets).
 //!
 //! Unlike the paper, whose passes composite each pass's layers into the frame and keep only the
 //! `K` render targets (FreePipe's Table 3: 20 MB at 512×512, as the k-buffer), the layers are kept

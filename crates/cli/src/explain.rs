@@ -242,8 +242,8 @@ fn kbuffer_hazard(
 const EXHAUSTIVE_LIMIT: u64 = 200_000;
 
 /// What shrinking minimises, in order: steps; render-target write-backs dropped because a later
-/// primitive's had committed (the same loss reads more plainly as the later one's stale read
-/// erasing the earlier write-back, in primitive order); context switches.
+/// reader's had committed (the same loss reads more plainly as the later one's stale read
+/// erasing the earlier write-back, in commit order); context switches.
 fn rank(trace: &Trace) -> (usize, usize, usize) {
     let dropped = trace
         .steps()
@@ -445,7 +445,7 @@ fn explain_kbuffer(
         match args.write_back {
             WriteBackArg::RenderTarget =>
                 "machine: render targets: a read of the K slots is one step and a write-back one \
-                 step, write-backs commit in primitive order; only a read can be stale, so the \
+                 step, write-backs commit in order; only a read can be stale, so the \
                  only failure is a lost fragment",
             WriteBackArg::SeparateStores =>
                 "machine: separate stores: K loads, then K stores, one step each; write-backs can \
@@ -604,13 +604,13 @@ fn step_cell(events: &[TraceEvent]) -> String {
         )
     };
     if slots.is_empty() {
-        // The write-back found a later primitive's committed: in primitive order it came first.
+        // The write-back found a later reader's committed: in commit order it came first.
         let last = events
             .iter()
             .find(|e| e.width == 32 && e.op == Op::Load)
             .map_or(0, |e| e.returned);
         format!(
-            "write-back dropped: primitive {} committed after it in primitive order",
+            "write-back dropped: ticket {} (a later read) committed after it in commit order",
             last.saturating_sub(1)
         )
     } else if slots.iter().all(|e| e.op == Op::Load) {
