@@ -1,5 +1,6 @@
-//! `fragsim explain`: it finds and names a k-buffer loss, shrinks without growing the
-//! interleaving, and shows MDTS's invariant holding at every step.
+//! `fragsim explain`: it finds and names a k-buffer loss on both write-back machines, shrinks
+//! without growing the interleaving (to the 4 steps of render-target write-backs, the `4 K` of
+//! separate stores), and shows MDTS's invariant holding at every step.
 
 use assert_cmd::Command;
 
@@ -40,22 +41,68 @@ fn explain_finds_a_losing_kbuffer_interleaving_and_names_the_lost_value() {
         ["0.3#", "0.5#", "0.1#"].iter().any(|d| lost.contains(d)),
         "{lost}"
     );
-    // The table has a column per thread and a store overwriting another fragment's value.
+    // The table has a column per thread and a write-back over another fragment's value.
     assert!(text.contains("| T0 ("), "{text}");
-    assert!(text.contains("store w"), "{text}");
+    assert!(
+        text.contains("write [") && text.contains("(was ["),
+        "{text}"
+    );
 }
 
 #[test]
 fn shrinking_yields_no_more_steps_than_the_unshrunk_interleaving() {
-    for depths in ["0.3,0.5,0.1", "0.3,0.5,0.1,0.2,0.7"] {
-        let (ok, shrunk) = explain(&["--depths", depths]);
-        let (ok_raw, raw) = explain(&["--depths", depths, "--no-shrink"]);
-        assert!(ok && ok_raw, "{shrunk}\n{raw}");
-        let found = steps(&raw, "k-buffer");
-        assert_eq!(steps(&raw, "unshrunk"), found);
-        assert!(steps(&shrunk, "shrunk") <= found, "{shrunk}\n{raw}");
-        // Two fragments suffice for the hazard: shrinking finds them.
-        assert!(shrunk.contains(", 2 threads,"), "{shrunk}");
+    for machine in ["render-target", "separate-stores"] {
+        for depths in ["0.3,0.5,0.1", "0.3,0.5,0.1,0.2,0.7"] {
+            let args = ["--depths", depths, "--write-back", machine];
+            let (ok, shrunk) = explain(&args);
+            let (ok_raw, raw) = explain(&[&args[..], &["--no-shrink"]].concat());
+            assert!(ok && ok_raw, "{shrunk}\n{raw}");
+            let found = steps(&raw, "k-buffer");
+            assert_eq!(steps(&raw, "unshrunk"), found);
+            assert!(steps(&shrunk, "shrunk") <= found, "{shrunk}\n{raw}");
+            // Two fragments suffice for the hazard: shrinking finds them.
+            assert!(shrunk.contains(", 2 threads,"), "{shrunk}");
+        }
+    }
+}
+
+#[test]
+fn the_shortest_losing_interleaving_is_4_steps_on_render_targets_and_4k_with_separate_stores() {
+    for (depths, k) in [
+        ("0.3,0.5,0.1", 3),
+        ("0.3,0.5,0.1,0.2,0.7", 5),
+        ("0.2,0.6", 1),
+    ] {
+        let k_arg = k.to_string();
+        let (ok, text) = explain(&["--depths", depths, "--k", &k_arg]);
+        assert!(ok, "{text}");
+        // Read, read, write-back, write-back: a read is one row, a write-back one row.
+        assert_eq!(steps(&text, "shrunk"), 4, "{text}");
+        assert!(
+            text.starts_with("k-buffer (render-target write-backs)"),
+            "{text}"
+        );
+        let rows = |prefix: &str| {
+            text.lines()
+                .filter(|l| l.split('|').any(|c| c.trim().starts_with(prefix)))
+                .count()
+        };
+        assert_eq!((rows("read ["), rows("write [")), (2, 2), "{text}");
+        // Render targets lose; they never duplicate.
+        assert!(text.contains("LOST: "), "{text}");
+        assert!(!text.contains("DUPLICATED"), "{text}");
+
+        let (ok, text) = explain(&[
+            "--depths",
+            depths,
+            "--k",
+            &k_arg,
+            "--write-back",
+            "separate-stores",
+        ]);
+        assert!(ok, "{text}");
+        assert_eq!(steps(&text, "shrunk"), 4 * k, "{text}");
+        assert!(text.contains("store w"), "{text}");
     }
 }
 

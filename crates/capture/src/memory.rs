@@ -83,6 +83,33 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
     fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self
     where
         Self: Sized;
+
+    /// Takes the spin lock held in `u32` word `index` (0 free, 1 held), waiting while another
+    /// thread holds it; everything the previous holder did before its [`Memory::unlock`] is
+    /// visible after this returns.
+    ///
+    /// A scheme uses it to make one step of several words indivisible: a render target's read or
+    /// write of a pixel's `K` slots, which the GPU's ROP performs as one operation
+    /// (`crate::kbuffer::WriteBack::RenderTarget`). The words themselves stay `Relaxed`: the
+    /// ordering comes from the fences around the lock word's `swap` and `store` (C++ fence–fence
+    /// synchronisation: a release fence before the store that frees the lock synchronises with the
+    /// acquire fence after the `swap` that reads it free). Memories whose threads are not OS
+    /// threads (loom's) must override both methods with their own fences and a yielding spin.
+    fn lock(&self, index: usize) {
+        while WordMemory::<u32>::swap(self, index, 1) != 0 {
+            // Wait with plain loads, so that waiting threads do not bounce the line.
+            while WordMemory::<u32>::load(self, index) != 0 {
+                std::hint::spin_loop();
+            }
+        }
+        std::sync::atomic::fence(std::sync::atomic::Ordering::Acquire);
+    }
+
+    /// Frees the lock taken by [`Memory::lock`] on `u32` word `index`.
+    fn unlock(&self, index: usize) {
+        std::sync::atomic::fence(std::sync::atomic::Ordering::Release);
+        WordMemory::<u32>::store(self, index, 0);
+    }
 }
 
 /// Plain cells for one thread: the fastest memory and the reference behaviour of a scheme.

@@ -127,6 +127,18 @@ pub struct Trace {
 }
 
 impl Trace {
+    /// The thread that ran each step, in order: one entry per step, however many memory
+    /// operations the step did (what [`run_fragments_in_order`] replays).
+    #[must_use]
+    pub fn order(&self) -> Vec<u32> {
+        self.steps().map(|events| events[0].thread).collect()
+    }
+
+    /// The events grouped by step (consecutive events with one `step` index), in order.
+    pub fn steps(&self) -> impl Iterator<Item = &[TraceEvent]> + '_ {
+        self.events.chunk_by(|a, b| a.step == b.step)
+    }
+
     /// The events that touched `pixel`'s fragments.
     #[must_use]
     pub fn pixel(&self, pixel: u32) -> Trace {
@@ -382,7 +394,9 @@ pub fn run_fragments<S: Scheme>(
 /// `fragments[t]` (one thread per fragment), and step `i` runs thread `order[i]`. Entries naming a
 /// thread that has finished are skipped; when `order` runs out, the remaining steps run the
 /// lowest-numbered unfinished thread first. So every `order` is a valid schedule, and
-/// `order` = the `thread` column of a recorded trace replays that trace exactly.
+/// `order` = the thread of each step of a recorded trace replays that trace exactly (a step that
+/// does several memory operations, as a render-target k-buffer's read, records several events with
+/// one `step` index: [`Trace::order`]).
 pub fn run_fragments_in_order<S: Scheme>(
     scheme: &S,
     fragments: &[Fragment],

@@ -1,24 +1,29 @@
 //! `fragsim explain`: finds an interleaving of a few fragments on one pixel that shows a scheme's
 //! property, shrinks it, and prints it step by step, one column per thread.
 //!
-//! - `--scheme kbuffer`: the read–insert–write k-buffer. Seeds of the scheduled executor
-//!   (uniform random and PCT, one thread per fragment) are searched for a run whose slots differ
-//!   from the sorted input (a fragment lost or duplicated); that run is shrunk (fragments dropped,
-//!   then context switches removed, each change kept only if the hazard still shows) and printed
-//!   with the lost value named.
+//! - `--scheme kbuffer`: the read–insert–write k-buffer, on the machine `--write-back` names
+//!   (`render-target`, the default: the read and the write-back are one step each and write-backs
+//!   commit in primitive order; `separate-stores`: `K` loads and `K` stores, one step each). Seeds
+//!   of the scheduled executor (uniform random and PCT, one thread per fragment) are searched for a
+//!   run whose slots differ from the sorted input (a fragment lost or duplicated); that run is
+//!   shrunk (fragments dropped, then context switches removed, each change kept only if the hazard
+//!   still shows) and printed with the lost value named. The shortest losing interleaving is 4
+//!   steps on render targets and `4 K` with separate stores (`fragsim_capture::kbuffer` says why).
 //! - `--scheme mdts`: the densest interleaving (most context switches) among the seeds, with
 //!   `docs/proof.md`'s invariant checked after every step: each slot only ever decreases, and the
 //!   multiset of slot values plus the values carried in flight (plus those carried past the last
 //!   slot) equals the inputs.
 //!
 //! Every run is a replay of an explicit order through
-//! [`fragsim_capture::scheduled::run_fragments_in_order`], so what is printed is what ran.
+//! [`fragsim_capture::scheduled::run_fragments_in_order`], so what is printed is what ran. A row
+//! is one step, however many memory operations it did (a render-target read is `K` loads under the
+//! pixel's lock, printed as one `read`).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use clap::{Args, ValueEnum};
-use fragsim_capture::kbuffer::{KBuffer, EMPTY};
+use fragsim_capture::kbuffer::{KBuffer, WriteBack, EMPTY};
 use fragsim_capture::mdts::Mdts;
 use fragsim_capture::scheduled::{
     run_fragments, run_fragments_in_order, Op, Policy, Schedule, Trace, TraceEvent,
@@ -54,6 +59,39 @@ pub struct ExplainArgs {
     /// Print the interleaving as found, without shrinking it.
     #[arg(long)]
     pub no_shrink: bool,
+    /// The k-buffer's machine: render targets (the papers' GPUs) or separate stores (CUDA).
+    #[arg(long, value_enum, default_value = "render-target")]
+    pub write_back: WriteBackArg,
+}
+
+/// The k-buffer's machine, on the command line (`fragsim_capture::kbuffer::WriteBack`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum WriteBackArg {
+    /// The read of the K slots is one step, the write-back one step, write-backs commit in
+    /// primitive order: only reads can be stale.
+    RenderTarget,
+    /// K loads and K stores, one step each, as CUDA code does: write-backs can tear.
+    SeparateStores,
+}
+
+impl WriteBackArg {
+    /// The library's value.
+    #[must_use]
+    pub fn machine(self) -> WriteBack {
+        match self {
+            WriteBackArg::RenderTarget => WriteBack::RenderTarget,
+            WriteBackArg::SeparateStores => WriteBack::SeparateStores,
+        }
+    }
+
+    /// How reports name the machine.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            WriteBackArg::RenderTarget => "render-target write-backs",
+            WriteBackArg::SeparateStores => "separate stores",
+        }
+    }
 }
 
 /// Runs `explain`: `Ok(true)` when the property was shown (a hazard for the k-buffer, the
@@ -93,7 +131,13 @@ pub fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String> {
     let viewport = Viewport::new(1, 1)?;
     match args.scheme {
         ExplainScheme::Kbuffer => {
-            let scheme = KBuffer::with_k(viewport, k).map_err(|e| e.to_string())?;
+            let scheme = KBuffer::with_write_back(
+                viewport,
+                k,
+                args.write_back.machine(),
+                fragsim_capture::MEMORY_CAP_DEFAULT,
+            )
+            .map_err(|e| e.to_string())?;
             Ok(explain_kbuffer(&scheme, k, &fragments, args))
         }
         ExplainScheme::Mdts => {
@@ -124,33 +168,36 @@ fn record<S: Scheme>(scheme: &S, fragments: &[Fragment], order: &[u32]) -> Trace
 }
 
 fn order_of(trace: &Trace) -> Vec<u32> {
-    trace.events.iter().map(|e| e.thread).collect()
+    trace.order()
+}
+
+/// Steps in the trace (a step may record several memory operations).
+fn step_count(trace: &Trace) -> usize {
+    trace.steps().count()
 }
 
 /// Times the running thread changes from one step to the next.
 fn switches(trace: &Trace) -> usize {
-    trace
-        .events
-        .windows(2)
-        .filter(|w| w[0].thread != w[1].thread)
-        .count()
+    trace.order().windows(2).filter(|w| w[0] != w[1]).count()
 }
 
-/// The pixel's `k` words after each event, replayed from the trace's (operand, returned) pairs.
+/// The pixel's `k` slot words (the `u64` words; a render target's lock and last writer are `u32`)
+/// after each step, replayed from the trace's (operand, returned) pairs.
 fn memory_after(trace: &Trace, k: u32, init: u64) -> Vec<Vec<u64>> {
     let mut words = vec![init; k as usize];
     trace
-        .events
-        .iter()
-        .map(|e| {
-            words[e.word] = match e.op {
-                Op::Load => e.returned,
-                Op::Store | Op::Swap => e.operand,
-                Op::FetchMin => e.returned.min(e.operand),
-                Op::FetchMax => e.returned.max(e.operand),
-                Op::FetchAdd => e.returned.wrapping_add(e.operand),
-                Op::FetchOr => e.returned | e.operand,
-            };
+        .steps()
+        .map(|events| {
+            for e in events.iter().filter(|e| e.width == 64) {
+                words[e.word] = match e.op {
+                    Op::Load => e.returned,
+                    Op::Store | Op::Swap => e.operand,
+                    Op::FetchMin => e.returned.min(e.operand),
+                    Op::FetchMax => e.returned.max(e.operand),
+                    Op::FetchAdd => e.returned.wrapping_add(e.operand),
+                    Op::FetchOr => e.returned | e.operand,
+                };
+            }
             words.clone()
         })
         .collect()
@@ -191,6 +238,60 @@ fn kbuffer_hazard(
     (!lost.is_empty() || !duplicated.is_empty()).then_some((trace, lost, duplicated))
 }
 
+/// Interleavings of the shrunk walks tried one by one when there are at most this many.
+const EXHAUSTIVE_LIMIT: u64 = 200_000;
+
+/// What shrinking minimises, in order: steps; render-target write-backs dropped because a later
+/// reader's had committed (the same loss reads more plainly as the later one's stale read
+/// erasing the earlier write-back, in commit order); context switches.
+fn rank(trace: &Trace) -> (usize, usize, usize) {
+    let dropped = trace
+        .steps()
+        .filter(|events| events.len() > 1 && events.iter().all(|e| e.width == 32))
+        .count();
+    (step_count(trace), dropped, switches(trace))
+}
+
+/// Every distinct reordering of `order` (the same steps per thread), or `None` when there are
+/// more than `limit`.
+fn interleavings(order: &[u32], limit: u64) -> Option<Vec<Vec<u32>>> {
+    let threads = order.iter().max().map_or(0, |&t| t as usize + 1);
+    let mut left = vec![0usize; threads];
+    for &t in order {
+        left[t as usize] += 1;
+    }
+    // The multinomial coefficient, stopping once past the limit.
+    let mut count: u64 = 1;
+    let mut placed: u64 = 0;
+    for &n in &left {
+        for i in 1..=n as u64 {
+            placed += 1;
+            count = count.checked_mul(placed)? / i;
+            if count > limit {
+                return None;
+            }
+        }
+    }
+    fn extend(left: &mut [usize], prefix: &mut Vec<u32>, len: usize, out: &mut Vec<Vec<u32>>) {
+        if prefix.len() == len {
+            out.push(prefix.clone());
+            return;
+        }
+        for t in 0..left.len() {
+            if left[t] > 0 {
+                left[t] -= 1;
+                prefix.push(t as u32);
+                extend(left, prefix, len, out);
+                prefix.pop();
+                left[t] += 1;
+            }
+        }
+    }
+    let mut out = Vec::new();
+    extend(&mut left, &mut Vec::new(), order.len(), &mut out);
+    Some(out)
+}
+
 /// Drops fragments, then context switches, while the hazard still shows: fewer steps first.
 fn shrink(
     scheme: &KBuffer,
@@ -225,7 +326,19 @@ fn shrink(
             }
         }
     }
-    // Move one step earlier wherever the hazard survives it: fewer context switches.
+    // Few enough interleavings of these walks: try them all. Else move one step earlier
+    // wherever the hazard survives it and the rank improves.
+    if let Some(all) = interleavings(&order, EXHAUSTIVE_LIMIT) {
+        if let Some(best) = all
+            .iter()
+            .filter_map(|candidate| kbuffer_hazard(scheme, k, &fragments, candidate))
+            .map(|(trace, ..)| trace)
+            .min_by_key(|trace| (rank(trace), order_of(trace)))
+        {
+            order = order_of(&best);
+        }
+        return (fragments, order);
+    }
     let mut best = record(scheme, &fragments, &order);
     let mut changed = true;
     while changed {
@@ -239,8 +352,7 @@ fn shrink(
                 let moved = candidate.remove(j);
                 candidate.insert(i, moved);
                 if let Some((trace, ..)) = kbuffer_hazard(scheme, k, &fragments, &candidate) {
-                    if (trace.events.len(), switches(&trace)) < (best.events.len(), switches(&best))
-                    {
+                    if rank(&trace) < rank(&best) {
                         order = order_of(&trace);
                         best = trace;
                         changed = true;
@@ -266,19 +378,20 @@ fn explain_kbuffer(
         let order = order_of(&run.trace.expect("recorded"));
         kbuffer_hazard(scheme, k, fragments, &order).map(|(trace, ..)| (seed, trace))
     });
+    let machine = args.write_back.label();
     let Some((seed, trace)) = found else {
         let _ = writeln!(
             out,
-            "k-buffer, K = {k}, {threads} fragments: no losing interleaving in {} seeds",
+            "k-buffer ({machine}), K = {k}, {threads} fragments: no losing interleaving in {} seeds",
             args.seeds
         );
         return (out, false);
     };
     let _ = writeln!(
         out,
-        "k-buffer, K = {k}: found at seed {seed} ({:?}): {} steps, {} threads, {} switches",
+        "k-buffer ({machine}), K = {k}: found at seed {seed} ({:?}): {} steps, {} threads, {} switches",
         schedule(seed, threads).policy,
-        trace.events.len(),
+        step_count(&trace),
         threads,
         switches(&trace)
     );
@@ -293,7 +406,7 @@ fn explain_kbuffer(
         out,
         "{}: {} steps, {} threads, {} switches",
         if args.no_shrink { "unshrunk" } else { "shrunk" },
-        trace.events.len(),
+        step_count(&trace),
         fragments.len(),
         switches(&trace)
     );
@@ -317,7 +430,7 @@ fn explain_kbuffer(
     for v in &lost {
         let _ = writeln!(
             out,
-            "LOST: {} (fragment {}, depth {}): overwritten by a stale write-back",
+            "LOST: {} (fragment {}, depth {}): overwritten by a write-back computed from a read that missed it",
             value(*v),
             *v as u32,
             f32::from_bits((v >> 32) as u32)
@@ -326,6 +439,19 @@ fn explain_kbuffer(
     for v in &duplicated {
         let _ = writeln!(out, "DUPLICATED: {} is in two slots", value(*v));
     }
+    let _ = writeln!(
+        out,
+        "{}",
+        match args.write_back {
+            WriteBackArg::RenderTarget =>
+                "machine: render targets: a read of the K slots is one step and a write-back one \
+                 step, write-backs commit in order; only a read can be stale, so the \
+                 only failure is a lost fragment",
+            WriteBackArg::SeparateStores =>
+                "machine: separate stores: K loads, then K stores, one step each; write-backs can \
+                 interleave store by store (duplicates, slots out of order) as well as lose",
+        }
+    );
     (out, true)
 }
 
@@ -394,7 +520,7 @@ fn explain_mdts(scheme: &Mdts<u64>, k: u32, fragments: &[Fragment], seeds: u64) 
         out,
         "MDTS, K = {k}: densest of {seeds} seeds is seed {seed} ({:?}): {} steps, {threads} threads, {} switches",
         schedule(seed, threads).policy,
-        trace.events.len(),
+        step_count(&trace),
         switches(&trace)
     );
     out.push_str(&table(
@@ -460,6 +586,44 @@ fn cell(e: &TraceEvent) -> String {
     }
 }
 
+/// One step's cell: its memory operation, or, for a step of several (a render target's read or
+/// write-back of the pixel's slots, under its lock), what it did to the slots as a whole.
+fn step_cell(events: &[TraceEvent]) -> String {
+    if let [e] = events {
+        return cell(e);
+    }
+    let slots: Vec<&TraceEvent> = events.iter().filter(|e| e.width == 64).collect();
+    let list = |f: fn(&TraceEvent) -> u64| {
+        format!(
+            "[{}]",
+            slots
+                .iter()
+                .map(|&e| value(f(e)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    if slots.is_empty() {
+        // The write-back found a later reader's committed: in commit order it came first.
+        let last = events
+            .iter()
+            .find(|e| e.width == 32 && e.op == Op::Load)
+            .map_or(0, |e| e.returned);
+        format!(
+            "write-back dropped: ticket {} (a later read) committed after it in commit order",
+            last.saturating_sub(1)
+        )
+    } else if slots.iter().all(|e| e.op == Op::Load) {
+        format!("read {}", list(|e| e.returned))
+    } else {
+        format!(
+            "write {} (was {})",
+            list(|e| e.operand),
+            list(|e| e.returned)
+        )
+    }
+}
+
 /// The step-by-step table: a column per thread, then the memory after the step, then `extra`
 /// columns (title, one cell per step).
 fn table(
@@ -479,11 +643,11 @@ fn table(
     header.push("memory after".into());
     header.extend(extra.iter().map(|(title, _)| (*title).to_string()));
     let mut rows = vec![header];
-    for (i, (e, m)) in trace.events.iter().zip(memory).enumerate() {
+    for (i, (events, m)) in trace.steps().zip(memory).enumerate() {
         let mut row = vec![i.to_string()];
         row.extend((0..threads).map(|t| {
-            if e.thread as usize == t {
-                cell(e)
+            if events[0].thread as usize == t {
+                step_cell(events)
             } else {
                 String::new()
             }

@@ -6,7 +6,7 @@ use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
 use fragsim_capture::depth_count::{DepthCount, DepthCounts};
 use fragsim_capture::dual_peeling::DualDepthPeeling;
 use fragsim_capture::executor::{self, Executor, ParallelExecutor, Run, SerialExecutor};
-use fragsim_capture::kbuffer::KBuffer;
+use fragsim_capture::kbuffer::{KBuffer, WriteBack};
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::layer_counter::LayerCounter;
 use fragsim_capture::linked_list::{LinkedList, Resolve};
@@ -61,10 +61,16 @@ pub enum SchemeName {
     Bdp2,
     /// Adaptive bucket depth peeling (§3.3).
     Adp,
-    /// The k-buffer: read–insert–write of K slots, exact only without concurrent hazards.
+    /// The k-buffer: read–insert–write of K slots, exact only without concurrent hazards;
+    /// render-target write-backs (one step each, committed in primitive order).
     Kbuffer,
-    /// The multi-pass k-buffer: k-buffer passes beyond the last captured depth until complete.
+    /// The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.
+    KbufferStores,
+    /// The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every
+    /// fragment is confirmed by a count (render-target write-backs).
     KbufferMultipass,
+    /// The multi-pass k-buffer with K separate loads and stores.
+    KbufferMultipassStores,
     /// The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.
     Srab,
     /// MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).
@@ -86,7 +92,7 @@ pub enum SchemeName {
 
 impl SchemeName {
     /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 24] = [
+    pub const EVERY: [SchemeName; 26] = [
         SchemeName::Mdts,
         SchemeName::Mdts32,
         SchemeName::MdtsDesc,
@@ -104,7 +110,9 @@ impl SchemeName {
         SchemeName::Bdp2,
         SchemeName::Adp,
         SchemeName::Kbuffer,
+        SchemeName::KbufferStores,
         SchemeName::KbufferMultipass,
+        SchemeName::KbufferMultipassStores,
         SchemeName::Srab,
         SchemeName::MdtsPacked,
         SchemeName::Loop32,
@@ -112,6 +120,18 @@ impl SchemeName {
         SchemeName::LinkedList,
         SchemeName::LinkedListNearest,
     ];
+
+    /// The machine a k-buffer scheme runs on: separate stores for the `-stores` names, render
+    /// targets otherwise.
+    #[must_use]
+    pub fn write_back(self) -> WriteBack {
+        match self {
+            SchemeName::KbufferStores | SchemeName::KbufferMultipassStores => {
+                WriteBack::SeparateStores
+            }
+            _ => WriteBack::RenderTarget,
+        }
+    }
 
     /// `names` with `all` expanded and duplicates removed, in the order given.
     #[must_use]
@@ -156,6 +176,7 @@ impl SchemeName {
             | SchemeName::MdtsProbe
             | SchemeName::MdtsPacked
             | SchemeName::Kbuffer
+            | SchemeName::KbufferStores
             | SchemeName::Loop32
             | SchemeName::LayerCounter => k_auto,
             SchemeName::Abuffer | SchemeName::AbufferBitonic => capacity_auto,
@@ -167,7 +188,8 @@ impl SchemeName {
             | SchemeName::DualPeeling
             | SchemeName::DualPeeling32
             | SchemeName::Adp
-            | SchemeName::KbufferMultipass => true,
+            | SchemeName::KbufferMultipass
+            | SchemeName::KbufferMultipassStores => true,
             SchemeName::Zbuffer
             | SchemeName::Bdp
             | SchemeName::BdpSingle
@@ -312,9 +334,13 @@ impl Executors {
                 &Adp::<u32>::new(viewport, layers, cap).map_err(err)?,
                 Some(layers),
             ),
-            SchemeName::Kbuffer => go(&KBuffer::new(viewport, k, cap).map_err(err)?, Some(k)),
-            SchemeName::KbufferMultipass => go(
-                &KBufferMultipass::new(viewport, k, layers, cap).map_err(err)?,
+            SchemeName::Kbuffer | SchemeName::KbufferStores => go(
+                &KBuffer::with_write_back(viewport, k, name.write_back(), cap).map_err(err)?,
+                Some(k),
+            ),
+            SchemeName::KbufferMultipass | SchemeName::KbufferMultipassStores => go(
+                &KBufferMultipass::with_write_back(viewport, k, layers, name.write_back(), cap)
+                    .map_err(err)?,
                 Some(k),
             ),
             SchemeName::Srab => go(
