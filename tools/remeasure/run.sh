@@ -23,6 +23,7 @@ done
 "$B" bench --frames 5 --json --out bench-bunny > "$R/bench-bunny.json"
 "$B" bench --mesh "$D" --frames 5 --json --out bench-dragon > "$R/bench-dragon.json"
 "$B" bench --scene bunny-spheres --frames 3 --json --out bench-bunny-spheres > "$R/bench-bunny-spheres.json"
-"$B" sweep --scene bunny-spheres --width 256 --height 256 \
+[ "${SWEEP:-0}" = 1 ] && "$B" sweep --scene bunny-spheres --width 256 --height 256 \
   --scheme bdp,bdp-single,bdp2,adp,kbuffer,mdts-packed,mdts,abuffer --out sweep-bunny-spheres > /dev/null
-cp sweep-bunny-spheres/sweep.json "$R/sweep-bunny-spheres.json"
+[ "${SWEEP:-0}" = 1 ] && cp sweep-bunny-spheres/sweep.json "$R/sweep-bunny-spheres.json"
+true

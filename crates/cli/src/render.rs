@@ -255,7 +255,7 @@ fn print_table(
     );
     type Cell = fn(&RunSummary) -> String;
     let columns: [(&str, usize, Cell); 16] = [
-        ("scheme", 19, |r| r.scheme.clone()),
+        ("scheme", 24, |r| r.scheme.clone()),
         ("guarantee", 26, |r| r.guarantee.clone()),
         ("executor", 9, |r| r.executor.clone()),
         ("thr", 3, |r| r.threads.to_string()),
