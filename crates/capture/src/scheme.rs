@@ -102,9 +102,11 @@ pub enum CaptureError {
 
 /// A capture scheme: how a fragment walks per-pixel memory, and how the memory is read back.
 ///
-/// Contract: [`Scheme::step`] performs **exactly one** operation on `memory` per call. That is the
-/// granularity at which GPU atomics are atomic, so executors may interleave steps of different
-/// fragments arbitrarily and get every behaviour the GPU could show.
+/// Contract: [`Scheme::step`] performs **exactly one** indivisible operation on `memory` per call:
+/// one atomic or plain word operation, the granularity at which GPU atomics are atomic, or one
+/// operation the hardware makes indivisible on a whole pixel (the k-buffer's render-target read
+/// and write-back, each a step under the pixel's lock). Executors may interleave steps of
+/// different fragments arbitrarily and get every behaviour the GPU could show.
 pub trait Scheme: Sync {
     /// A fragment's progress between steps.
     type State: Send + Clone + Debug;
