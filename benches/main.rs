@@ -1,12 +1,14 @@
 //! Benchmarks of the core on the embedded default scene (the Stanford bunny, 512 × 512, view 30°).
 //!
 //! - `pass/*`: one frame of the executors end to end (storage re-initialisation, rasterization,
-//!   capture, resolve), serial against parallel; the executors keep their storage between frames
-//!   as a GPU application does.
+//!   capture, resolve), serial against parallel, in FreePipe's configuration (MDTS with K = 20 and
+//!   the A-buffer's fixed arrays of 20 slots: one pass each); the executors keep their storage
+//!   between frames as a GPU application does.
 //! - `capture/*`: capture alone over the pre-rasterized fragment stream, the generic scheme code
 //!   (state machine behind the `Memory` seam) against a bare hand-written loop of `fetch_min` /
 //!   `fetch_add` on the same per-pixel arrays with the same fragment addresses: the speed limit of
-//!   the memory system for this work.
+//!   the memory system for this work. The A-buffer here is the exact one, sized by its own
+//!   counting pass (run once, outside the timing, for both sides alike).
 //!
 //! - `scheduled/*`: the scheduled executor on one core, in simulated memory operations per second
 //!   (criterion's throughput: one element = one step = one memory operation).
@@ -21,12 +23,12 @@
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use fragsim::capture::abuffer::ABuffer;
+use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::executor::{ParallelExecutor, SerialExecutor};
 use fragsim::capture::mdts::Mdts;
 use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::{AtomicMemory, Scheme};
-use fragsim::oracle::Oracle;
+use fragsim::capture::depth_count::{DepthCount, DepthCounts};
+use fragsim::capture::{AtomicMemory, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
 use rayon::prelude::*;
 
@@ -41,10 +43,16 @@ fn benches(c: &mut Criterion) {
             &OrbitCamera::default().at_angle(30.0),
         )
         .unwrap();
-    let oracle = Oracle::build(&view);
-    let k = oracle.max_depth_complexity();
+    // FreePipe's configuration: fixed arrays of 20 slots, one pass, as `fragsim` runs by default.
+    let k = 20;
     let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
-    let abuffer = ABuffer::exact_default(&oracle.depth_complexity()).unwrap();
+    let abuffer = ABuffer::fixed(view.viewport(), k, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
+    // The capture benches compare the scheme with a bare atomic loop on the same exact storage,
+    // sized by the scheme's own counting pass (never by the oracle).
+    let counts =
+        DepthCounts::from_run(SerialExecutor::default().run(&view, &DepthCount::new(view.viewport())))
+            .counts;
+    let abuffer_exact = ABuffer::exact_default(&counts).unwrap();
 
     let mut pass = c.benchmark_group("pass");
     pass.sample_size(20);
@@ -57,7 +65,7 @@ fn benches(c: &mut Criterion) {
     });
     pass.finish();
 
-    let mut fragments: Vec<Fragment> = Vec::with_capacity(oracle.fragments());
+    let mut fragments: Vec<Fragment> = Vec::new();
     for prim in 0..view.triangle_count() {
         view.rasterize(prim, &mut |f| fragments.push(f));
     }
@@ -107,12 +115,12 @@ fn benches(c: &mut Criterion) {
     });
     capture.bench_function("abuffer/generic", |b| {
         b.iter_batched(
-            || abuffer.layout().allocate::<AtomicMemory>(),
+            || abuffer_exact.layout().allocate::<AtomicMemory>(),
             |memory| {
                 fragments.par_chunks(FRAGMENTS_PER_TASK).for_each(|chunk| {
                     let mut steps = 0;
                     for &f in chunk {
-                        abuffer.insert(f, &memory, &mut steps);
+                        abuffer_exact.insert(f, &memory, &mut steps);
                     }
                 });
                 memory
@@ -120,7 +128,6 @@ fn benches(c: &mut Criterion) {
             BatchSize::LargeInput,
         );
     });
-    let counts = oracle.depth_complexity();
     let mut offsets = vec![0usize; pixels + 1];
     for p in 0..pixels {
         offsets[p + 1] = offsets[p] + counts[p] as usize;
