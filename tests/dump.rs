@@ -1148,8 +1148,9 @@ proptest! {
     }
 
     /// Any decimal, not only the shortest ones fragsim writes (a backend's printf may write 17 or
-    /// 40 digits), parses in a header to the nearest f64: what Rust's own correctly rounded
-    /// `str::parse` gives, an independent implementation; past the f64 range it is an error.
+    /// 40 digits), parses in a header to the nearest f64, and as an f32 to the nearest f32: what
+    /// Rust's own correctly rounded `str::parse` gives, an independent implementation; past the
+    /// range it is an error.
     #[test]
     fn any_decimal_in_a_header_parses_to_the_nearest_f64(
         negative in any::<bool>(),
@@ -1175,6 +1176,12 @@ proptest! {
                 prop_assert!(nearest.is_infinite(), "{}: {}", decimal, e);
                 prop_assert!(e.contains("out of range"), "{}: {}", decimal, e);
             }
+        }
+        // Read as an f32 (report fields), the same decimal rounds once, to the nearest f32.
+        let nearest: f32 = decimal.parse().unwrap();
+        match serde_json::from_str::<f32>(&decimal) {
+            Ok(got) => prop_assert_eq!(got.to_bits(), nearest.to_bits(), "{} read as f32 {}, nearest is {}", decimal, got, nearest),
+            Err(e) => prop_assert!(nearest.is_infinite(), "{}: {}", decimal, e),
         }
     }
 }
