@@ -86,6 +86,12 @@ fn io_err(what: &str, path: &Path, e: impl fmt::Display) -> DumpError {
 }
 
 /// The scene and orbit camera that produced a dump: enough to rebuild the view and its oracle.
+///
+/// Its numbers are exact across the file: serde_json is built with `float_roundtrip`, so a
+/// decimal parses to the nearest f64, and writes the shortest decimal that parses back to the same
+/// bits (ryu), so encode then parse gives every finite value back bit for bit. JSON has no NaN or
+/// infinity: [`SceneSpec::check_finite`] refuses them before a header is written (serde_json would
+/// write `null`), and a decimal past the f64 range is a parse error.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SceneSpec {
     /// A named scene (`Scene::procedural`: `bunny`, `spheres:8`, …); absent when `mesh` is set.
@@ -168,6 +174,27 @@ impl SceneSpec {
             (None, None) => return err("the scene names neither a mesh nor a named scene"),
         };
         scene.map_err(|e| DumpError(format!("scene: {e}")))
+    }
+
+    /// Refuses a NaN or infinite number, which JSON cannot hold (serde_json would silently write
+    /// `null`, which then fails to parse as a number far from its cause).
+    ///
+    /// # Errors
+    /// The first field that is not finite, by name.
+    pub fn check_finite(&self) -> Result<(), DumpError> {
+        for (field, value) in [
+            ("view_degrees", self.view_degrees),
+            ("elevation_degrees", self.elevation_degrees),
+            ("fov_y_degrees", self.fov_y_degrees),
+            ("distance_scale", self.distance_scale),
+        ] {
+            if !value.is_finite() {
+                return err(format!(
+                    "scene {field} is {value}: numbers in a header must be finite (JSON has no NaN or infinity)"
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// A short description for reports.
@@ -646,7 +673,8 @@ impl Dump {
     /// [`Dump::write`] puts in a directory, and [`Dump::parse`] reads back.
     ///
     /// # Errors
-    /// Arrays that disagree with the header, or a file name that is not a plain name.
+    /// Arrays that disagree with the header, a file name that is not a plain name, or a scene
+    /// number that is not finite ([`SceneSpec::check_finite`]).
     pub fn encode(&self) -> Result<(String, BTreeMap<String, Vec<u8>>), DumpError> {
         let mut files = BTreeMap::new();
         for (name, spec) in &self.header.arrays {
@@ -658,6 +686,7 @@ impl Dump {
             check_array(name, spec, words.dtype(), words.len() as u64)?;
             files.insert(spec.file.clone(), words.to_le_bytes());
         }
+        self.header.scene.check_finite()?;
         let text = serde_json::to_string_pretty(&self.header)
             .map_err(|e| DumpError(format!("cannot encode the header: {e}")))?;
         Ok((text + "\n", files))
@@ -1581,8 +1610,10 @@ impl TriangleExport {
     /// The file's bytes (`docs/dump-format.md`).
     ///
     /// # Errors
-    /// A coordinate outside i32 (impossible within the guard band) or too many triangles.
+    /// A coordinate outside i32 (impossible within the guard band), too many triangles, or a
+    /// scene number that is not finite ([`SceneSpec::check_finite`]).
     pub fn to_bytes(&self) -> Result<Vec<u8>, DumpError> {
+        self.scene.check_finite()?;
         let json = serde_json::to_string(&self.scene)
             .map_err(|e| DumpError(format!("cannot encode the scene: {e}")))?;
         let padded = json.len().next_multiple_of(8);
