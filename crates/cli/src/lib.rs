@@ -14,7 +14,7 @@ macro_rules! outln {
     };
 }
 
-/// `print!` with [`outln!`]'s handling of a closed stdout.
+/// `print!` with `outln!`'s handling of a closed stdout.
 macro_rules! out {
     ($($arg:tt)*) => {
         $crate::write_stdout(format_args!($($arg)*))
