@@ -332,6 +332,16 @@ fn a_closed_stdout_ends_the_output_quietly_keeping_the_exit_code() {
     json.extend(size);
     assert_quiet_on_a_closed_pipe(&json);
     assert_quiet_on_a_closed_pipe(&["explain", "--depths", "0.3,0.5,0.1,0.7"]);
+    let dumps = std::env::temp_dir().join(format!("fragsim-cli-pipe-{}", std::process::id()));
+    let dumps = dumps.to_str().unwrap();
+    let made = fragsim(&["--scene", "quads:3", "--scheme", "mdts", "--dump", dumps]);
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let dump = format!("{dumps}/mdts");
+    assert_quiet_on_a_closed_pipe(&["compare", "oracle", dump.as_str(), "--no-image"]);
 }
 
 // ---------------------------------------------------------------------------------------------
