@@ -281,3 +281,303 @@ fn non_finite_camera_angles_are_refused() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 20, item 2: a closed stdout
+
+/// `fragsim args` with its stdout closed before it writes: the exit code must be the one the
+/// same command gives when its output is read, and no panic.
+fn assert_quiet_on_a_closed_pipe(args: &[&str]) {
+    use std::process::Stdio;
+    let binary = assert_cmd::cargo::cargo_bin("fragsim");
+    let read = std::process::Command::new(&binary)
+        .args(args)
+        .output()
+        .unwrap();
+    let mut child = std::process::Command::new(&binary)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Closed before the child's first line: the embedded bunny alone takes it milliseconds.
+    drop(child.stdout.take());
+    let closed = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&closed.stderr);
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    assert!(
+        !read.stdout.is_empty(),
+        "{args:?} prints nothing to close on"
+    );
+    assert_eq!(
+        closed.status.code(),
+        read.status.code(),
+        "{args:?}: {stderr}"
+    );
+}
+
+#[test]
+fn a_closed_stdout_ends_the_output_quietly_keeping_the_exit_code() {
+    let size = ["--width", "16", "--height", "16"];
+    let mut render = vec!["--scheme", "all", "--no-images"];
+    render.extend(size);
+    assert_quiet_on_a_closed_pipe(&render);
+    let mut json = vec![
+        "render",
+        "--scheme",
+        "mdts,abuffer",
+        "--no-images",
+        "--json",
+    ];
+    json.extend(size);
+    assert_quiet_on_a_closed_pipe(&json);
+    assert_quiet_on_a_closed_pipe(&["explain", "--depths", "0.3,0.5,0.1,0.7"]);
+    let dumps = std::env::temp_dir().join(format!("fragsim-cli-pipe-{}", std::process::id()));
+    let dumps = dumps.to_str().unwrap();
+    let made = fragsim(&["--scene", "quads:3", "--scheme", "mdts", "--dump", dumps]);
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let dump = format!("{dumps}/mdts");
+    assert_quiet_on_a_closed_pipe(&["compare", "oracle", dump.as_str(), "--no-image"]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 20, item 5: meshes told by content, errors naming the format, the file and the line
+
+/// `data` gzipped as one stored (uncompressed) deflate block: gzip without a compressor.
+fn gzip_stored(data: &[u8]) -> Vec<u8> {
+    let crc = !data.iter().fold(!0u32, |crc, &byte| {
+        (0..8).fold(crc ^ u32::from(byte), |c, _| {
+            (c >> 1) ^ (0xEDB8_8320 & (c & 1).wrapping_neg())
+        })
+    });
+    let len = u16::try_from(data.len()).expect("one stored block holds 65535 bytes");
+    let mut out = vec![0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 255, 1];
+    out.extend(len.to_le_bytes());
+    out.extend((!len).to_le_bytes());
+    out.extend(data);
+    out.extend(crc.to_le_bytes());
+    out.extend((data.len() as u32).to_le_bytes());
+    out
+}
+
+const QUAD_PLY: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n\
+    property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+    end_header\n-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n4 0 1 2 3\n";
+
+/// Renders `path` as a mesh, expecting success and `triangles` triangles.
+fn assert_loads(path: &std::path::Path, triangles: u32) {
+    let output = fragsim(&["--mesh", path.to_str().unwrap(), "--json"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{}: {stderr}", path.display());
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        stdout.contains(&format!("\"triangles\": {triangles}")),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn the_embedded_gzipped_bunny_loads_from_a_file_whatever_its_name() {
+    let gz = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/raster/assets/stanford-bunny.obj.gz"
+    ))
+    .unwrap();
+    for name in ["stanford-bunny.obj.gz", "bunny.obj", "bunny"] {
+        assert_loads(&obj_file(name, &gz), 69_451);
+    }
+}
+
+#[test]
+fn ply_is_told_by_content_gzipped_or_not() {
+    assert_loads(&obj_file("quad-ply.txt", QUAD_PLY.as_bytes()), 2);
+    let gz = gzip_stored(QUAD_PLY.as_bytes());
+    assert_loads(&obj_file("quad.ply.gz", &gz), 2);
+    assert_loads(&obj_file("quad.ply", &gz), 2);
+}
+
+#[test]
+fn ply_errors_name_ply_not_obj() {
+    let broken = QUAD_PLY.replace("format ascii 1.0", "format zip 9");
+    let path = obj_file("broken.ply", broken.as_bytes());
+    let path = path.to_str().unwrap();
+    let output = fragsim(&["--mesh", path]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("OBJ"), "{stderr}");
+    assert_refused(&["--mesh", path], &["malformed PLY", path, "header"]);
+    let faceless = QUAD_PLY
+        .replace("element face 1", "element face 0")
+        .replace("4 0 1 2 3\n", "");
+    let path = obj_file("faceless.ply", faceless.as_bytes());
+    let path = path.to_str().unwrap();
+    assert_refused(
+        &["--mesh", path],
+        &[&format!("PLY {path} has no triangles")],
+    );
+}
+
+#[test]
+fn utf16_and_binary_files_are_refused_saying_what_they_are_not() {
+    let text = format!("{TRIANGLE_VERTICES}f 1 2 3\n");
+    let mut utf16 = vec![0xFF, 0xFE];
+    utf16.extend(text.encode_utf16().flat_map(u16::to_le_bytes));
+    let path = obj_file("utf16.obj", &utf16);
+    let path = path.to_str().unwrap();
+    assert_refused(&["--mesh", path], &[path, "not OBJ text", "UTF-16"]);
+    let no_bom: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let path = obj_file("utf16-no-bom.obj", &no_bom);
+    let path = path.to_str().unwrap();
+    assert_refused(&["--mesh", path], &[path, "not OBJ text", "UTF-16"]);
+    let path = obj_file("binary.obj", &[b'v', b' ', 0x00, 0x01, 0x9F, 0x80, b'\n']);
+    let path = path.to_str().unwrap();
+    assert_refused(
+        &["--mesh", path],
+        &[path, "not OBJ text", "binary data", "offset 2"],
+    );
+}
+
+#[test]
+fn obj_errors_name_the_format_and_the_line() {
+    assert_obj_refused(
+        "letters-line.obj",
+        &format!("{TRIANGLE_VERTICES}v 1 x 0\nf 1 2 3\n"),
+        &["malformed OBJ", "line 4", "position parse error", "\"x\""],
+    );
+    assert_obj_refused(
+        "empty-format.obj",
+        TRIANGLE_VERTICES,
+        &["OBJ ", "has no triangles"],
+    );
+}
+
+#[test]
+fn a_scene_entirely_outside_the_view_warns_and_exits_0() {
+    let path = obj_file(
+        "far-outlier.obj",
+        format!("{TRIANGLE_VERTICES}v 1e38 0 0\nf 1 2 3\nf 1 2 4\n").as_bytes(),
+    );
+    let output = fragsim(&["--mesh", path.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("warning: "), "{stderr}");
+    assert!(stderr.contains("covers a pixel"), "{stderr}");
+    // A visible scene gets no such warning.
+    let output = fragsim(&["--scene", "quads:2"]);
+    assert!(!String::from_utf8_lossy(&output.stderr).contains("warning"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 20, item 6: flags that do nothing in their context
+
+/// `fragsim args` exactly as given (subcommands first).
+fn fragsim_raw(args: &[&str]) -> Output {
+    Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn threads_on_a_one_thread_executor_is_a_warning() {
+    for executor in ["serial", "scheduled"] {
+        let output = fragsim(&[
+            "--scene",
+            "quads:2",
+            "--threads",
+            "2",
+            "--executor",
+            executor,
+        ]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(0), "{stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "warning: --threads has no effect on the {executor} executor"
+            )),
+            "{stderr}"
+        );
+    }
+    let output = fragsim(&[
+        "--scene",
+        "quads:2",
+        "--threads",
+        "2",
+        "--executor",
+        "parallel",
+    ]);
+    assert!(!String::from_utf8_lossy(&output.stderr).contains("warning"));
+}
+
+#[test]
+fn sweep_view_is_refused() {
+    let out = std::env::temp_dir().join(format!("fragsim-cli-sweep-{}", std::process::id()));
+    let output = fragsim_raw(&[
+        "sweep",
+        "--scene",
+        "quads:2",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--angles",
+        "1",
+        "--view",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("sweep sets the view angle itself"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_elevation_the_camera_would_clamp_is_refused() {
+    for value in ["1000", "-90", "89.5"] {
+        assert_refused(
+            &["--elevation", value],
+            &["--elevation", "between -89 and 89 degrees"],
+        );
+    }
+    let output = fragsim(&["--scene", "quads:2", "--elevation", "-89"]);
+    assert!(output.status.success());
+}
+
+#[test]
+fn compare_image_with_no_image_is_refused() {
+    let output = fragsim_raw(&["compare", "a", "b", "--image", "x.png", "--no-image"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("cannot be used with"), "{stderr}");
+}
+
+#[test]
+fn explain_negative_depths_are_values_refused_by_range() {
+    let output = fragsim_raw(&["explain", "--depths", "-0.1,0.5"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("depth -0.1 is outside [0, 1]"), "{stderr}");
+}
+
+#[test]
+fn help_with_help_prints_help() {
+    for args in [&["help", "--help"][..], &["help", "render", "-h"]] {
+        let output = fragsim_raw(args);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert_eq!(
+            output.status.code(),
+            Some(0),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(stdout.contains("Usage: fragsim"), "{args:?}: {stdout}");
+    }
+}

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use fragsim_capture::executor::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
-use fragsim_raster::{OrbitCamera, Scene, Viewport, DEFAULT_SCENE_NAME};
+use fragsim_raster::{OrbitCamera, Scene, View, Viewport, DEFAULT_SCENE_NAME};
 
 use crate::schemes::Sizing;
 
@@ -30,8 +30,9 @@ pub struct SceneArgs {
     /// Orbit angle of the camera around the model, in degrees.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = finite)]
     pub view: f64,
-    /// Camera elevation above the model's equator, in degrees.
-    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = finite)]
+    /// Camera elevation above the model's equator, in degrees, within ±89 (the camera cannot
+    /// look straight down its up axis).
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = elevation)]
     pub elevation: f64,
 }
 
@@ -64,6 +65,14 @@ impl SceneArgs {
             elevation_degrees: self.elevation,
             ..OrbitCamera::default()
         }
+    }
+}
+
+/// Says on stderr when `view` of `scene` covers no pixel: the command still runs (and exits 0
+/// where its verdicts hold), but its outputs are empty.
+pub(crate) fn warn_if_empty(scene: &Scene, view: &View<'_>) {
+    if let Some(warning) = scene.empty_view_warning(view) {
+        eprintln!("warning: {warning}");
     }
 }
 
@@ -165,6 +174,21 @@ fn finite(text: &str) -> Result<f64, String> {
         Ok(v) if v.is_finite() => Ok(v),
         _ => Err(format!("expected a finite number of degrees, got {text:?}")),
     }
+}
+
+/// The largest elevation the orbit camera takes (`OrbitCamera` clamps beyond it): refused
+/// rather than quietly clamped.
+const MAX_ELEVATION: f64 = 89.0;
+
+fn elevation(text: &str) -> Result<f64, String> {
+    let degrees = finite(text)?;
+    if degrees.abs() > MAX_ELEVATION {
+        return Err(format!(
+            "the elevation must be between -{MAX_ELEVATION} and {MAX_ELEVATION} degrees \
+             (the camera cannot look along its up axis), got {degrees}"
+        ));
+    }
+    Ok(degrees)
 }
 
 /// Which executors run.

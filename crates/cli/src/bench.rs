@@ -167,6 +167,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .build()
         .map_err(|e| e.to_string())?;
     let mut view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+    crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     check_memory_cap_early(&args.scheme, viewport, &sizing)?;
     let raster_times: Vec<Duration> = (0..frames)
@@ -352,9 +353,9 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
         true,
     )?;
     if args.json {
-        println!("{json}");
+        outln!("{json}");
     } else {
-        print!("{markdown}");
+        out!("{markdown}");
     }
     Ok(())
 }

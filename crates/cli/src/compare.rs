@@ -43,7 +43,7 @@ pub struct CompareArgs {
     #[arg(long, value_name = "PATH", default_value = "out/compare-diff.png")]
     pub image: PathBuf,
     /// Write no difference image.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "image")]
     pub no_image: bool,
 }
 
@@ -328,7 +328,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         notes,
     };
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
         );
@@ -492,7 +492,7 @@ fn print_report(r: &Report) {
             format!("{} ({}{size}, by {})", s.source, s.scheme, s.producer)
         }
     };
-    println!(
+    outln!(
         "reference {}\ncandidate {}\nscene {} at {}x{}",
         side(&r.reference),
         side(&r.candidate),
@@ -500,12 +500,19 @@ fn print_report(r: &Report) {
         r.width,
         r.height
     );
-    println!("compared: {}", r.compared);
+    outln!("compared: {}", r.compared);
     let v = &r.verdicts;
-    println!(
+    outln!(
         "pixels {}: equal {}, missing {}, extra {}, misordered {}, overflowed {}, \
          overflow-miscounted {}, corrupt {}",
-        r.pixels, v.equal, v.missing, v.extra, v.misordered, v.overflowed, v.miscounted, v.corrupt
+        r.pixels,
+        v.equal,
+        v.missing,
+        v.extra,
+        v.misordered,
+        v.overflowed,
+        v.miscounted,
+        v.corrupt
     );
     let f = &r.fragments;
     let claimed = if f.overflow_claimed == f.overflowed {
@@ -513,28 +520,33 @@ fn print_report(r: &Report) {
     } else {
         format!(" (counters claim {})", f.overflow_claimed)
     };
-    println!(
+    outln!(
         "fragments: reference {}, captured {}, lost {}, extra {}, overflowed by design {}{claimed}",
-        f.reference, f.captured, f.lost, f.extra, f.overflowed
+        f.reference,
+        f.captured,
+        f.lost,
+        f.extra,
+        f.overflowed
     );
     if r.words.checked {
-        println!(
+        outln!(
             "words: every one read; corrupt {}, not defined by the layout {}",
-            r.words.corrupt, r.words.unchecked
+            r.words.corrupt,
+            r.words.unchecked
         );
     }
     for note in &r.notes {
-        println!("note: {note}");
+        outln!("note: {note}");
     }
     for e in &r.first_differences {
-        println!(
+        outln!(
             "pixel {} (x {}, y {}): {}",
             e.pixel,
             e.x,
             e.y,
             e.verdict.join(", ")
         );
-        println!("  {:<36} {:<36}", "reference", "candidate");
+        outln!("  {:<36} {:<36}", "reference", "candidate");
         let show = |e: Option<&Entry>| {
             e.map_or(String::new(), |e| match e.prim {
                 Some(prim) => format!("{:.9} [{}] prim {prim}", e.depth, e.key),
@@ -544,7 +556,7 @@ fn print_report(r: &Report) {
         for i in 0..e.reference.len().max(e.candidate.len()) {
             let (a, b) = (e.reference.get(i), e.candidate.get(i));
             let same = matches!((a, b), (Some(a), Some(b)) if a.key == b.key && a.prim == b.prim);
-            println!(
+            outln!(
                 "{} {:<36} {:<36}",
                 if same { ' ' } else { '*' },
                 show(a),
@@ -552,13 +564,13 @@ fn print_report(r: &Report) {
             );
         }
         for c in &e.corrupt_words {
-            println!("  slot {}: {} {}", c.slot, c.word, c.why);
+            outln!("  slot {}: {} {}", c.slot, c.word, c.why);
         }
     }
     if let Some(image) = &r.image {
-        println!("difference image: {image}");
+        outln!("difference image: {image}");
     }
-    println!(
+    outln!(
         "verdict: {}",
         if r.equal {
             // Bit-identical only if every word was read and defined: an unfilled A-buffer's

@@ -48,7 +48,13 @@ pub struct ExplainArgs {
     pub scheme: ExplainScheme,
     /// Depths (in [0, 1]) of the fragments on the one pixel, comma-separated; fragment `i` is
     /// primitive `i` and runs on thread `i`.
-    #[arg(long, value_delimiter = ',', default_value = "0.3,0.5,0.1")]
+    // `-0.1,0.5` is a value to check (and refuse, out of [0, 1]), not an unknown flag.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "0.3,0.5,0.1",
+        allow_hyphen_values = true
+    )]
     pub depths: Vec<f32>,
     /// Slots per pixel (default: the number of fragments, so nothing falls off by design).
     #[arg(long)]
@@ -101,7 +107,7 @@ impl WriteBackArg {
 /// Bad depths or parameters.
 pub fn explain(args: &ExplainArgs) -> Result<bool, String> {
     let (text, shown) = explain_text(args)?;
-    print!("{text}");
+    out!("{text}");
     Ok(shown)
 }
 

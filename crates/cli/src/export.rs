@@ -42,7 +42,7 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let export = TriangleExport::from_view(&view, spec);
     export.write(&args.out).map_err(|e| e.to_string())?;
-    println!(
+    outln!(
         "wrote {}: {} screen triangles of {} mesh triangles ({}, {}x{})",
         args.out.display(),
         export.triangles.len(),

@@ -427,7 +427,7 @@ fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), Strin
     std::fs::write(out.join("baselines.md"), &md).map_err(|e| e.to_string())?;
     let json = serde_json::to_string_pretty(&report.baselines).map_err(|e| e.to_string())?;
     std::fs::write(out.join("baselines.json"), json).map_err(|e| e.to_string())?;
-    print!("{md}");
+    out!("{md}");
     Ok(())
 }
 
@@ -500,7 +500,7 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
     std::fs::write(out.join("hazard.md"), &md).map_err(|e| e.to_string())?;
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
     std::fs::write(out.join("hazard.json"), json).map_err(|e| e.to_string())?;
-    print!("{md}");
+    out!("{md}");
     let mut by_width: Vec<Series> = Vec::new();
     for &write_back in &args.write_back {
         for p in ["random", "warps"] {

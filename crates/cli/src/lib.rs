@@ -1,6 +1,44 @@
 //! The `fragsim` command line: `render` (the default) runs schemes on a scene, checks them
 //! against the serial oracle and writes a table, JSON and PNGs.
 
+use std::ffi::OsString;
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// `println!` for a command's output on stdout: once stdout is closed (`fragsim … | head -1`)
+/// the rest of the output is dropped quietly instead of panicking, and the command finishes with
+/// its documented exit code.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::write_stdout(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// `print!` with `outln!`'s handling of a closed stdout.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::write_stdout(format_args!($($arg)*))
+    };
+}
+
+/// Set when a write to stdout failed: the reader is gone, so nothing more is written.
+static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+
+/// Writes to stdout; a closed pipe ends the output silently, any other failure once on stderr.
+fn write_stdout(text: std::fmt::Arguments<'_>) {
+    if STDOUT_CLOSED.load(Ordering::Relaxed) {
+        return;
+    }
+    if let Err(error) = std::io::stdout().lock().write_fmt(text) {
+        STDOUT_CLOSED.store(true, Ordering::Relaxed);
+        if error.kind() != std::io::ErrorKind::BrokenPipe {
+            eprintln!(
+                "warning: cannot write to stdout ({error}); the rest of the output is dropped"
+            );
+        }
+    }
+}
+
 mod args;
 mod bench;
 mod compare;
@@ -14,7 +52,8 @@ mod sweep;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
@@ -66,7 +105,12 @@ pub enum Command {
 /// Parses the command line and runs it; errors go to stderr with a non-zero exit code.
 #[must_use]
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches_from(help_flag_dropped(std::env::args_os().collect()));
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let Err(message) = check_flags(&cli, &matches) {
+        eprintln!("error: {message}");
+        return ExitCode::from(2);
+    }
     let args = match cli.command {
         Some(Command::Render(args)) => args,
         Some(Command::Sweep(args)) => return exit_code(sweep::sweep(&args).map(|_| true), ""),
@@ -109,6 +153,66 @@ pub fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// `fragsim help … --help` as `fragsim help …`: clap's `help` subcommand takes no flags, so
+/// the `--help` a user adds out of habit would otherwise be an "unrecognized subcommand" error.
+fn help_flag_dropped(mut argv: Vec<OsString>) -> Vec<OsString> {
+    if argv.get(1).is_some_and(|word| word == "help") {
+        let rest = argv.split_off(2);
+        argv.extend(
+            rest.into_iter()
+                .filter(|word| word != "--help" && word != "-h"),
+        );
+    }
+    argv
+}
+
+/// Flags given where they do nothing: an error where the command would contradict them, a
+/// warning on stderr where they are merely unused.
+///
+/// # Errors
+/// `sweep --view` (the sweep sets the angle itself).
+fn check_flags(cli: &Cli, matches: &ArgMatches) -> Result<(), String> {
+    let (schemes, sub) = match &cli.command {
+        None => (&cli.render.schemes, matches),
+        Some(Command::Render(args)) => (&args.schemes, sub_matches(matches, "render")),
+        Some(Command::Bench(args)) => (&args.schemes, sub_matches(matches, "bench")),
+        Some(Command::Sweep(args)) => {
+            let sub = sub_matches(matches, "sweep");
+            if sub.value_source("view") == Some(ValueSource::CommandLine) {
+                return Err(format!(
+                    "sweep sets the view angle itself ({} angles over a full turn: --angles); \
+                     --view {} would be ignored",
+                    args.angles, args.scene.view
+                ));
+            }
+            (&args.schemes, sub)
+        }
+        Some(_) => return Ok(()),
+    };
+    if sub.value_source("threads") == Some(ValueSource::CommandLine)
+        && matches!(
+            schemes.executor,
+            ExecutorChoice::Serial | ExecutorChoice::Scheduled
+        )
+    {
+        let executor = if schemes.executor == ExecutorChoice::Serial {
+            "serial"
+        } else {
+            "scheduled"
+        };
+        eprintln!(
+            "warning: --threads has no effect on the {executor} executor, which captures on one \
+             thread (it sets the parallel and tiled executors' threads)"
+        );
+    }
+    Ok(())
+}
+
+/// The matches of subcommand `name`, which clap has just parsed.
+fn sub_matches<'a>(matches: &'a ArgMatches, name: &str) -> &'a ArgMatches {
+    matches.subcommand_matches(name).unwrap_or(matches)
 }
 
 /// 0 when `result` is `Ok(true)`, 1 (after `failure` on stderr) when `Ok(false)`, 2 on errors.

@@ -136,6 +136,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let view = scene
         .view(viewport, &args.scene.orbit(args.scene.view))
         .map_err(|e| e.to_string())?;
+    crate::args::warn_if_empty(&scene, &view);
     let schemes = SchemeName::expand(&args.scheme);
     let sizing = args.schemes.sizing();
     check_memory_cap_early(&schemes, viewport, &sizing)?;
@@ -213,7 +214,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))?;
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?
         );
@@ -244,7 +245,7 @@ fn print_table(
     oracle_ms: f64,
     args: &RenderArgs,
 ) {
-    println!(
+    outln!(
         "scene {scene}: {} triangles, {}x{} pixels, {} fragments, max depth complexity {} (oracle {:.1} ms)",
         rows.first().map_or(0, |r| r.triangles),
         viewport.width,
@@ -291,7 +292,7 @@ fn print_table(
                 }
             })
             .collect();
-        println!("{}", padded.join(" "));
+        outln!("{}", padded.join(" "));
     };
     line(
         columns
@@ -303,10 +304,10 @@ fn print_table(
         line(columns.iter().map(|(_, _, cell)| cell(r)).collect());
     }
     if rows.iter().any(|r| r.count_pass_ms.is_some()) {
-        println!("passes marked c include the scheme's own counting pass, which sized its storage");
+        outln!("passes marked c include the scheme's own counting pass, which sized its storage");
     }
     if !args.no_images {
-        println!(
+        outln!(
             "images: {}/depth-complexity.png, {}/nearest-depth.png",
             args.out.display(),
             args.out.display()

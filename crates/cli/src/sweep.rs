@@ -14,7 +14,7 @@ use crate::schemes::{Executors, SchemeName};
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
 pub struct SweepArgs {
-    /// The scene (`--view` is ignored: the sweep sets the angle).
+    /// The scene (`--view` is refused: the sweep sets the angle).
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Scheme sizing and executors (the first executor chosen runs).
@@ -155,9 +155,12 @@ fn write_outputs(
         &scatter,
         true,
     )?;
-    println!(
+    outln!(
         "{:<20} {:>12} {:>12} {:>12}",
-        "scheme", "mean EPR %", "max EPR %", "mean ms"
+        "scheme",
+        "mean EPR %",
+        "max EPR %",
+        "mean ms"
     );
     for s in series {
         let rates: Vec<f64> = s
@@ -174,12 +177,15 @@ fn write_outputs(
             .reduce(f64::max)
             .map_or("n/a".into(), |r| format!("{r:.4}"));
         let mean_ms = mean(&mut s.time_ms.iter().copied()).unwrap_or(0.0);
-        println!(
+        outln!(
             "{:<20} {:>12} {:>12} {:>12.2}",
-            s.scheme, mean_rate, max_rate, mean_ms
+            s.scheme,
+            mean_rate,
+            max_rate,
+            mean_ms
         );
     }
-    println!(
+    outln!(
         "wrote {}/sweep.json, sweep-epr.png, sweep-speed-accuracy.png",
         args.out.display()
     );

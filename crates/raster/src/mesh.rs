@@ -1,7 +1,11 @@
 //! Triangle meshes and OBJ loading.
 
-use std::io::BufRead;
+use std::io::{BufRead, Read};
 use std::path::Path;
+
+/// The first two bytes of every gzip stream (RFC 1952): files are decompressed by content, so a
+/// gzipped mesh loads whatever its name.
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
 /// Why a mesh could not be loaded or used.
 #[derive(Debug, thiserror::Error)]
@@ -14,23 +18,43 @@ pub enum MeshError {
         /// The reason the OS gave.
         source: std::io::Error,
     },
-    /// The OBJ parser rejected the file.
+    /// The file starts as gzip but does not decompress.
+    #[error("cannot decompress gzipped mesh file {path}: {source}")]
+    Gzip {
+        /// The file.
+        path: String,
+        /// What the decoder reported.
+        source: std::io::Error,
+    },
+    /// The OBJ parser rejected the file (or it is not text at all).
     #[error("malformed OBJ {path}: {reason}")]
     Obj {
         /// The file.
         path: String,
-        /// What tobj reported.
+        /// What is wrong, with the line where there is one.
+        reason: String,
+    },
+    /// The PLY parser rejected the file.
+    #[error("malformed PLY {path}: {reason}")]
+    Ply {
+        /// The file.
+        path: String,
+        /// What is wrong.
         reason: String,
     },
     /// The file parsed but holds no triangle.
-    #[error("mesh {path} has no triangles")]
+    #[error("{format} {path} has no triangles")]
     Empty {
+        /// `OBJ`, `PLY`, or `mesh` for one built in memory.
+        format: &'static str,
         /// The file.
         path: String,
     },
     /// A vertex coordinate is NaN or infinite.
-    #[error("mesh {path}: vertex {vertex} has a non-finite coordinate {value}")]
+    #[error("{format} {path}: vertex {vertex} has a non-finite coordinate {value}")]
     NonFinite {
+        /// `OBJ`, `PLY`, or `mesh` for one built in memory.
+        format: &'static str,
         /// The file.
         path: String,
         /// Index of the vertex.
@@ -40,9 +64,11 @@ pub enum MeshError {
     },
     /// A triangle refers to a vertex that does not exist.
     #[error(
-        "mesh {path}: triangle {triangle} refers to vertex {index}, but there are only {vertices}"
+        "{format} {path}: triangle {triangle} refers to vertex {index}, but there are only {vertices}"
     )]
     BadIndex {
+        /// `OBJ`, `PLY`, or `mesh` for one built in memory.
+        format: &'static str,
         /// The file.
         path: String,
         /// Index of the triangle.
@@ -69,9 +95,19 @@ impl Mesh {
     /// # Errors
     /// The first problem found, naming `source` (a file name or a scene name).
     pub fn validate(&self, source: &str) -> Result<(), MeshError> {
+        self.validate_as("mesh", source)
+    }
+
+    /// [`Mesh::validate`] for a mesh read from a file of `format` (`OBJ`, `PLY`), which the
+    /// errors name.
+    ///
+    /// # Errors
+    /// As [`Mesh::validate`].
+    pub fn validate_as(&self, format: &'static str, source: &str) -> Result<(), MeshError> {
         for (vertex, p) in self.positions.iter().enumerate() {
             if let Some(&value) = p.iter().find(|c| !c.is_finite()) {
                 return Err(MeshError::NonFinite {
+                    format,
                     path: source.into(),
                     vertex,
                     value,
@@ -81,6 +117,7 @@ impl Mesh {
         for (triangle, tri) in self.triangles.iter().enumerate() {
             if let Some(&index) = tri.iter().find(|&&i| i as usize >= self.positions.len()) {
                 return Err(MeshError::BadIndex {
+                    format,
                     path: source.into(),
                     triangle,
                     index,
@@ -99,11 +136,7 @@ impl Mesh {
     /// non-finite coordinate or an out-of-range index: each names the file.
     pub fn load_obj(path: &Path) -> Result<Self, MeshError> {
         let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
-            path: name.clone(),
-            source,
-        })?;
-        Self::read_obj(&mut std::io::BufReader::new(file), &name)
+        Self::read_obj(&mut read_mesh_file(path)?.as_slice(), &name)
     }
 
     /// Parses OBJ text from a reader; `name` is used in error messages.
@@ -124,10 +157,16 @@ impl Mesh {
                 path: name.into(),
                 source,
             })?;
-        check_faces(&String::from_utf8_lossy(&text)).map_err(|reason| MeshError::Obj {
+        let obj = |reason| MeshError::Obj {
             path: name.into(),
             reason,
-        })?;
+        };
+        let text = String::from_utf8(text).map_err(|e| obj(not_text(e.as_bytes())))?;
+        if text.contains('\0') {
+            return Err(obj(not_text(text.as_bytes())));
+        }
+        check_faces(&text).map_err(obj)?;
+        let text = text.into_bytes();
         let (models, _materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |_| {
             // Materials are irrelevant to depth; an absent .mtl must not fail the load.
             Ok(Default::default())
@@ -157,9 +196,12 @@ impl Mesh {
             }
         }
         if mesh.triangles.is_empty() {
-            return Err(MeshError::Empty { path: name.into() });
+            return Err(MeshError::Empty {
+                format: "OBJ",
+                path: name.into(),
+            });
         }
-        mesh.validate(name)?;
+        mesh.validate_as("OBJ", name)?;
         Ok(mesh)
     }
 
@@ -192,6 +234,65 @@ impl Mesh {
     }
 }
 
+/// The bytes of a mesh file, decompressed when they start with the gzip magic (whatever the
+/// file's name: fragsim's own `stanford-bunny.obj.gz` is gzipped OBJ).
+///
+/// # Errors
+/// The file cannot be read ([`MeshError::Io`]) or its gzip stream is corrupt
+/// ([`MeshError::Gzip`]), naming the file.
+pub fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
+    let name = || path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+        path: name(),
+        source,
+    })?;
+    if !bytes.starts_with(&GZIP_MAGIC) {
+        return Ok(bytes);
+    }
+    let mut text = Vec::new();
+    // Multi-member: `cat a.gz b.gz` is valid gzip, and gzip(1) decompresses it whole.
+    flate2::read::MultiGzDecoder::new(bytes.as_slice())
+        .read_to_end(&mut text)
+        .map_err(|source| MeshError::Gzip {
+            path: name(),
+            source,
+        })?;
+    Ok(text)
+}
+
+/// Whether `bytes` (decompressed) are a PLY file: its first line is `ply` (ASCII and binary
+/// PLY alike start with a text header).
+#[must_use]
+pub fn is_ply(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")
+}
+
+/// What a file that is not UTF-8 text without NUL bytes is, for the error: UTF-16 text (by its
+/// byte-order mark or its NUL high bytes) or binary data, naming the first offending byte.
+fn not_text(bytes: &[u8]) -> String {
+    const WHAT: &str = "not OBJ text (nor a PLY file, which starts with a `ply` line)";
+    let head = &bytes[..bytes.len().min(64)];
+    if head.starts_with(&[0xFF, 0xFE]) || head.starts_with(&[0xFE, 0xFF]) {
+        return format!(
+            "{WHAT}: it is UTF-16 text (byte-order mark {:02X} {:02X}); save it as ASCII or UTF-8",
+            head[0], head[1]
+        );
+    }
+    // ASCII in UTF-16 without a byte-order mark: every other byte is NUL.
+    let nul_halves =
+        |parity: usize| head.len() >= 4 && head.iter().skip(parity).step_by(2).all(|&b| b == 0);
+    if nul_halves(0) || nul_halves(1) {
+        return format!("{WHAT}: it looks like UTF-16 text (every other byte is NUL); save it as ASCII or UTF-8");
+    }
+    let nul = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+    let invalid = std::str::from_utf8(bytes).map_or_else(|e| e.valid_up_to(), |_| bytes.len());
+    let offset = nul.min(invalid);
+    format!(
+        "{WHAT}: it is binary data (byte 0x{:02X} at offset {offset} is not text)",
+        bytes.get(offset).copied().unwrap_or(0)
+    )
+}
+
 /// Face checks made before tobj parses: a face of fewer than 3 vertices (tobj makes it a
 /// degenerate triangle), and every vertex, texture-coordinate and normal index of a face or line
 /// element in range. tobj drops references to attributes the file has none of, and its index
@@ -218,6 +319,7 @@ fn check_faces(text: &str) -> Result<(), String> {
         let Some(tag) = words.next() else { continue };
         if let Some(k) = kind_of(tag) {
             before[k] += 1;
+            check_numbers(k, words).map_err(|e| format!("line {}: {e}", number + 1))?;
             continue;
         }
         if tag != "f" && tag != "l" {
@@ -252,6 +354,25 @@ fn check_faces(text: &str) -> Result<(), String> {
                 }
             }
         }
+    }
+    Ok(())
+}
+
+/// The numbers of a `v` (`k` = 0), `vt` (1) or `vn` (2) line, checked as tobj parses them (the
+/// first three as `f32`; positions and normals need three) so that the error can give the line,
+/// which tobj's does not.
+fn check_numbers<'a>(k: usize, words: impl Iterator<Item = &'a str>) -> Result<(), String> {
+    const WHAT: [&str; 3] = ["position", "texture coordinate", "normal"];
+    let numbers: Vec<&str> = words.take(3).collect();
+    if let Some(word) = numbers.iter().find(|w| w.parse::<f32>().is_err()) {
+        return Err(format!("{} parse error: {word:?} is not a number", WHAT[k]));
+    }
+    if k != 1 && numbers.len() < 3 {
+        return Err(format!(
+            "{} parse error: needs 3 numbers, got {}",
+            WHAT[k],
+            numbers.len()
+        ));
     }
     Ok(())
 }

@@ -67,26 +67,14 @@ impl PropertyAccess for PlyFace {
 }
 
 impl Mesh {
-    /// Loads a PLY file, ASCII or binary, gzipped when the name ends in `.gz`.
+    /// Loads a PLY file, ASCII or binary, gzipped or not (told by content, not by name).
     ///
     /// # Errors
     /// A missing or unreadable file, a file the PLY parser rejects, no `vertex` or `face`
     /// element, a negative or out-of-range index, a non-finite coordinate: each names the file.
     pub fn load_ply(path: &Path) -> Result<Self, MeshError> {
         let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
-            path: name.clone(),
-            source,
-        })?;
-        let gzipped = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
-        let source: Box<dyn Read> = if gzipped {
-            Box::new(flate2::read::GzDecoder::new(file))
-        } else {
-            Box::new(file)
-        };
-        Self::read_ply(source, &name)
+        Self::read_ply(crate::mesh::read_mesh_file(path)?.as_slice(), &name)
     }
 
     /// Parses PLY from a reader; `name` is used in error messages.
@@ -94,7 +82,7 @@ impl Mesh {
     /// # Errors
     /// As [`Mesh::load_ply`].
     pub fn read_ply(source: impl Read, name: &str) -> Result<Self, MeshError> {
-        let bad = |reason: String| MeshError::Obj {
+        let bad = |reason: String| MeshError::Ply {
             path: name.into(),
             reason,
         };
@@ -102,7 +90,7 @@ impl Mesh {
         let vertex_parser = Parser::<PlyVertex>::new();
         let header = vertex_parser
             .read_header(&mut reader)
-            .map_err(|e| bad(format!("PLY header: {e}")))?;
+            .map_err(|e| bad(format!("header: {e}")))?;
         let mut mesh = Mesh::default();
         // Elements come in header order; each must be read (or skipped) in turn.
         for (element_name, element) in &header.elements {
@@ -110,13 +98,13 @@ impl Mesh {
                 "vertex" => {
                     let vertices = vertex_parser
                         .read_payload_for_element(&mut reader, element, &header)
-                        .map_err(|e| bad(format!("PLY vertices: {e}")))?;
+                        .map_err(|e| bad(format!("vertices: {e}")))?;
                     mesh.positions = vertices.into_iter().map(|v| v.0).collect();
                 }
                 "face" => {
                     let faces = Parser::<PlyFace>::new()
                         .read_payload_for_element(&mut reader, element, &header)
-                        .map_err(|e| bad(format!("PLY faces: {e}")))?;
+                        .map_err(|e| bad(format!("faces: {e}")))?;
                     for (face, PlyFace(indices)) in faces.into_iter().enumerate() {
                         let index = |i: i64| {
                             u32::try_from(i)
@@ -139,9 +127,12 @@ impl Mesh {
             }
         }
         if mesh.triangles.is_empty() {
-            return Err(MeshError::Empty { path: name.into() });
+            return Err(MeshError::Empty {
+                format: "PLY",
+                path: name.into(),
+            });
         }
-        mesh.validate(name)?;
+        mesh.validate_as("PLY", name)?;
         Ok(mesh)
     }
 }

@@ -5,7 +5,7 @@ use std::io::Read;
 use std::path::Path;
 
 use crate::camera::OrbitCamera;
-use crate::mesh::{Mesh, MeshError};
+use crate::mesh::{is_ply, read_mesh_file, Mesh, MeshError};
 use crate::pipeline::{CullMode, View, Viewport};
 use crate::rng::SplitMix64;
 
@@ -66,16 +66,18 @@ impl Scene {
         }
     }
 
-    /// A mesh from a file: PLY (`.ply`, `.ply.gz`: ASCII or binary) or OBJ (anything else).
+    /// A mesh from a file, told by its content, not its name: gzipped or not, PLY (ASCII or
+    /// binary: the first line is `ply`) or OBJ (anything else).
     ///
     /// # Errors
     /// See [`Mesh::load_obj`] and [`Mesh::load_ply`].
     pub fn from_file(path: &Path) -> Result<Self, SceneError> {
-        let lower = path.to_string_lossy().to_ascii_lowercase();
-        let mesh = if lower.ends_with(".ply") || lower.ends_with(".ply.gz") {
-            Mesh::load_ply(path)?
+        let bytes = read_mesh_file(path)?;
+        let name = path.display().to_string();
+        let mesh = if is_ply(&bytes) {
+            Mesh::read_ply(bytes.as_slice(), &name)?
         } else {
-            Mesh::load_obj(path)?
+            Mesh::read_obj(&mut bytes.as_slice(), &name)?
         };
         Ok(Self {
             name: path.display().to_string(),
@@ -160,6 +162,31 @@ impl Scene {
         let aspect = f64::from(viewport.width) / f64::from(viewport.height);
         let camera = orbit.camera(self.mesh.bounds(), aspect);
         Ok(View::new(&self.mesh, &camera, viewport, CullMode::None))
+    }
+
+    /// A warning when `view` (of this scene) rasterizes no fragment at all: every triangle lies
+    /// outside it or covers no pixel centre (a far outlier such as a 1e38 coordinate shrinks the
+    /// fitted camera's view of the rest below a pixel). Every output is then empty, which is
+    /// better said than left to be noticed.
+    #[must_use]
+    pub fn empty_view_warning(&self, view: &View<'_>) -> Option<String> {
+        // Stops at the first triangle that covers a pixel: one or a few for a visible scene.
+        let empty = (0..view.triangle_count()).all(|prim| {
+            let mut covered = false;
+            view.rasterize(prim, &mut |_| covered = true);
+            !covered
+        });
+        let viewport = view.viewport();
+        empty.then(|| {
+            format!(
+                "scene {}: none of its {} triangles covers a pixel of the {}x{} view \
+                 (outside it, or smaller than a pixel); every output is empty",
+                self.name,
+                view.triangle_count(),
+                viewport.width,
+                viewport.height
+            )
+        })
     }
 }
 
