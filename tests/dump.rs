@@ -1262,3 +1262,23 @@ fn a_header_number_json_cannot_hold_is_a_parse_error_naming_the_header() {
         );
     }
 }
+
+#[test]
+fn regression_dump_parse_refuses_two_arrays_naming_the_same_file() {
+    // `dump_parse` found it (issue 23, seed `regression-two-arrays-one-file`): an A-buffer whose
+    // `offsets` and `slots` both named `slots.u64` parsed, then encoded one array's words under
+    // both names and failed to parse back.
+    let header = r#"{"format": "fragsim-dump", "version": 1, "scene": {"name": "quads:2",
+        "view_degrees": 30.0, "elevation_degrees": 15.0}, "width": 2, "height": 2,
+        "scheme": "abuffer", "arrays": {
+        "counters": {"file": "counters.u32", "dtype": "u32", "shape": [4]},
+        "offsets": {"file": "slots.u64", "dtype": "u32", "shape": [5]},
+        "slots": {"file": "slots.u64", "dtype": "u64", "shape": [4]}}}"#;
+    let (parsed, asked) = parse_recording(header);
+    let error = parsed.unwrap_err();
+    assert!(
+        error.contains(r#"arrays "offsets" and "slots" both name file "slots.u64""#),
+        "{error}"
+    );
+    assert!(asked.is_empty(), "the reader was asked for {asked:?}");
+}

@@ -676,6 +676,7 @@ impl Dump {
     /// Arrays that disagree with the header, a file name that is not a plain name, or a scene
     /// number that is not finite ([`SceneSpec::check_finite`]).
     pub fn encode(&self) -> Result<(String, BTreeMap<String, Vec<u8>>), DumpError> {
+        check_distinct_files(&self.header.arrays)?;
         let mut files = BTreeMap::new();
         for (name, spec) in &self.header.arrays {
             check_file_name(name, &spec.file)?;
@@ -761,6 +762,7 @@ impl Dump {
             ));
         }
         Viewport::new(header.width, header.height).map_err(DumpError)?;
+        check_distinct_files(&header.arrays)?;
         let mut arrays = BTreeMap::new();
         for (name, spec) in &header.arrays {
             check_file_name(name, &spec.file)?;
@@ -1091,6 +1093,21 @@ fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme: &DumpSche
 
 /// Refuses an array file name with a directory part (`/`, `\\`, a drive's `:`), `.`, `..` or
 /// nothing: a dump's arrays lie in its own directory.
+/// Refuses two arrays that name the same file: one file cannot hold both, so encoding would keep
+/// one array's words under both names (found by `dump_parse`).
+fn check_distinct_files(arrays: &BTreeMap<String, ArraySpec>) -> Result<(), DumpError> {
+    let mut owner: BTreeMap<&str, &str> = BTreeMap::new();
+    for (name, spec) in arrays {
+        if let Some(first) = owner.insert(&spec.file, name) {
+            return err(format!(
+                "arrays {first:?} and {name:?} both name file {:?}",
+                spec.file
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn check_file_name(name: &str, file: &str) -> Result<(), DumpError> {
     let plain =
         !file.is_empty() && file != "." && file != ".." && !file.contains(['/', '\\', ':', '\0']);
