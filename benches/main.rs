@@ -24,10 +24,10 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use fragsim::capture::abuffer::{ABuffer, PostSort};
+use fragsim::capture::depth_count::{DepthCount, DepthCounts};
 use fragsim::capture::executor::{ParallelExecutor, SerialExecutor};
 use fragsim::capture::mdts::Mdts;
 use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::depth_count::{DepthCount, DepthCounts};
 use fragsim::capture::{AtomicMemory, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
 use rayon::prelude::*;
@@ -46,12 +46,14 @@ fn benches(c: &mut Criterion) {
     // FreePipe's configuration: fixed arrays of 20 slots, one pass, as `fragsim` runs by default.
     let k = 20;
     let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
-    let abuffer = ABuffer::fixed(view.viewport(), k, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
+    let abuffer =
+        ABuffer::fixed(view.viewport(), k, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
     // The capture benches compare the scheme with a bare atomic loop on the same exact storage,
     // sized by the scheme's own counting pass (never by the oracle).
-    let counts =
-        DepthCounts::from_run(SerialExecutor::default().run(&view, &DepthCount::new(view.viewport())))
-            .counts;
+    let counts = DepthCounts::from_run(
+        SerialExecutor::default().run(&view, &DepthCount::new(view.viewport())),
+    )
+    .counts;
     let abuffer_exact = ABuffer::exact_default(&counts).unwrap();
 
     let mut pass = c.benchmark_group("pass");

@@ -119,10 +119,7 @@ fn every_shared_mesh_loads_and_both_schemes_equal_the_oracle() {
 }
 
 /// An atomic scheme's runs on the two concurrent executors.
-fn concurrently<S: Scheme>(
-    view: &fragsim::raster::View<'_>,
-    scheme: &S,
-) -> [(Executor, Run); 2] {
+fn concurrently<S: Scheme>(view: &fragsim::raster::View<'_>, scheme: &S) -> [(Executor, Run); 2] {
     [
         (Executor::Parallel, run_parallel(view, scheme)),
         (Executor::Tiled, run_tiled(view, scheme)),

@@ -378,8 +378,7 @@ fn shipping_schemes_on_every_executor() {
         MEMORY_CAP_DEFAULT,
     )
     .unwrap();
-    let captures =
-        |f: &dyn Fn(Executor) -> Capture| Executor::EVERY.map(f);
+    let captures = |f: &dyn Fn(Executor) -> Capture| Executor::EVERY.map(f);
     for got in captures(&|e| on(e, &view, &counter, &schedule)) {
         let diff = oracle.diff(&got);
         assert_eq!((diff.overflowed, diff.lost), (excess, 0));
@@ -492,7 +491,13 @@ fn smallest_scenes_through_the_command_line() {
     // One fragment past its 2 layers: overflow the scheme cannot count, supplied by the oracle.
     assert_eq!(
         counter,
-        [("layer-counter".into(), Executor::Serial.name().into(), 1, 0, 0)]
+        [(
+            "layer-counter".into(),
+            Executor::Serial.name().into(),
+            1,
+            0,
+            0
+        )]
     );
     let lists = run(&[
         "--scene",
@@ -509,8 +514,20 @@ fn smallest_scenes_through_the_command_line() {
     assert_eq!(
         lists,
         [
-            ("linked-list".into(), Executor::Serial.name().into(), 1, 0, 0),
-            ("linked-list-nearest".into(), Executor::Serial.name().into(), 1, 0, 0)
+            (
+                "linked-list".into(),
+                Executor::Serial.name().into(),
+                1,
+                0,
+                0
+            ),
+            (
+                "linked-list-nearest".into(),
+                Executor::Serial.name().into(),
+                1,
+                0,
+                0
+            )
         ]
     );
 }
