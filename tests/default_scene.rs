@@ -2,7 +2,7 @@
 //! executors equal the serial oracle fragment for fragment.
 
 use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::executor::{run_parallel, run_serial, Executor};
 use fragsim::capture::mdts::{Direction, Mdts};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
@@ -148,7 +148,7 @@ fn no_scheme_is_sized_from_the_oracle() {
             "--scheme",
             "all",
             "--executor",
-            "serial",
+            Executor::Serial.name(),
         ];
         args.extend_from_slice(sizes);
         let (code, rows, stderr) = render_json(&args);

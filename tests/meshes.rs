@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use fragsim::capture::abuffer::ABuffer;
 use fragsim::capture::dual_peeling::DualDepthPeeling;
-use fragsim::capture::executor::{run_parallel, run_serial, Run};
+use fragsim::capture::executor::{run_parallel, run_serial, Executor, Run};
 use fragsim::capture::kbuffer::KBuffer;
 use fragsim::capture::kbuffer_multipass::KBufferMultipass;
 use fragsim::capture::mdts::{Direction, Mdts};
@@ -58,7 +58,7 @@ fn every_shared_mesh_loads_and_both_schemes_equal_the_oracle() {
         );
         let (viewport, depth) = (view.viewport(), oracle.max_depth_complexity());
         let cap = MEMORY_CAP_DEFAULT;
-        let check = |scheme: &str, runs: [(&str, Run); 2]| {
+        let check = |scheme: &str, runs: [(Executor, Run); 2]| {
             for (executor, run) in runs {
                 let diff = oracle.diff(&run.capture);
                 assert!(diff.is_exact(), "{file} {scheme} {executor}: {diff:?}");
@@ -119,13 +119,10 @@ fn every_shared_mesh_loads_and_both_schemes_equal_the_oracle() {
 }
 
 /// An atomic scheme's runs on the two concurrent executors.
-fn concurrently<S: Scheme>(
-    view: &fragsim::raster::View<'_>,
-    scheme: &S,
-) -> [(&'static str, Run); 2] {
+fn concurrently<S: Scheme>(view: &fragsim::raster::View<'_>, scheme: &S) -> [(Executor, Run); 2] {
     [
-        ("parallel", run_parallel(view, scheme)),
-        ("tiled", run_tiled(view, scheme)),
+        (Executor::Parallel, run_parallel(view, scheme)),
+        (Executor::Tiled, run_tiled(view, scheme)),
     ]
 }
 
@@ -133,9 +130,9 @@ fn concurrently<S: Scheme>(
 fn one_writer_per_pixel<S: Scheme>(
     view: &fragsim::raster::View<'_>,
     scheme: &S,
-) -> [(&'static str, Run); 2] {
+) -> [(Executor, Run); 2] {
     [
-        ("serial", run_serial(view, scheme)),
-        ("tiled", run_tiled(view, scheme)),
+        (Executor::Serial, run_serial(view, scheme)),
+        (Executor::Tiled, run_tiled(view, scheme)),
     ]
 }

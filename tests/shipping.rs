@@ -16,7 +16,7 @@
 //! values, so that ties are common; "serial" is the scheduled executor with one fragment in flight
 //! (submission order), the rest are seeded GPU-like interleavings.
 
-use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::executor::{run_parallel, run_serial, Executor};
 use fragsim::capture::layer_counter::LayerCounter;
 use fragsim::capture::linked_list::{LinkedList, Resolve};
 use fragsim::capture::loop32::Loop32;
@@ -378,8 +378,7 @@ fn shipping_schemes_on_every_executor() {
         MEMORY_CAP_DEFAULT,
     )
     .unwrap();
-    let captures =
-        |f: &dyn Fn(&str) -> Capture| ["serial", "parallel", "tiled", "scheduled"].map(f);
+    let captures = |f: &dyn Fn(Executor) -> Capture| Executor::EVERY.map(f);
     for got in captures(&|e| on(e, &view, &counter, &schedule)) {
         let diff = oracle.diff(&got);
         assert_eq!((diff.overflowed, diff.lost), (excess, 0));
@@ -397,12 +396,12 @@ fn shipping_schemes_on_every_executor() {
     }
 }
 
-fn on<S: Scheme>(executor: &str, view: &View<'_>, scheme: &S, schedule: &Schedule) -> Capture {
+fn on<S: Scheme>(executor: Executor, view: &View<'_>, scheme: &S, schedule: &Schedule) -> Capture {
     match executor {
-        "serial" => run_serial(view, scheme).capture,
-        "parallel" => run_parallel(view, scheme).capture,
-        "tiled" => run_tiled(view, scheme).capture,
-        _ => run_scheduled(view, scheme, schedule, false).run.capture,
+        Executor::Serial => run_serial(view, scheme).capture,
+        Executor::Parallel => run_parallel(view, scheme).capture,
+        Executor::Tiled => run_tiled(view, scheme).capture,
+        Executor::Scheduled => run_scheduled(view, scheme, schedule, false).run.capture,
     }
 }
 
@@ -471,11 +470,12 @@ fn smallest_scenes_through_the_command_line() {
         "--scheme",
         "loop32",
         "--executor",
-        "scheduled",
+        Executor::Scheduled.name(),
         "--ties",
         "merge-equal-depths",
     ]);
-    assert_eq!(merged, [("loop32".into(), "scheduled".into(), 0, 0, 0)]);
+    let scheduled = Executor::Scheduled.name().to_string();
+    assert_eq!(merged, [("loop32".into(), scheduled, 0, 0, 0)]);
     let counter = run(&[
         "--scene",
         "quads:3",
@@ -486,12 +486,18 @@ fn smallest_scenes_through_the_command_line() {
         "--scheme",
         "layer-counter",
         "--executor",
-        "serial",
+        Executor::Serial.name(),
     ]);
     // One fragment past its 2 layers: overflow the scheme cannot count, supplied by the oracle.
     assert_eq!(
         counter,
-        [("layer-counter".into(), "serial".into(), 1, 0, 0)]
+        [(
+            "layer-counter".into(),
+            Executor::Serial.name().into(),
+            1,
+            0,
+            0
+        )]
     );
     let lists = run(&[
         "--scene",
@@ -503,13 +509,25 @@ fn smallest_scenes_through_the_command_line() {
         "--scheme",
         "linked-list,linked-list-nearest",
         "--executor",
-        "serial",
+        Executor::Serial.name(),
     ]);
     assert_eq!(
         lists,
         [
-            ("linked-list".into(), "serial".into(), 1, 0, 0),
-            ("linked-list-nearest".into(), "serial".into(), 1, 0, 0)
+            (
+                "linked-list".into(),
+                Executor::Serial.name().into(),
+                1,
+                0,
+                0
+            ),
+            (
+                "linked-list-nearest".into(),
+                Executor::Serial.name().into(),
+                1,
+                0,
+                0
+            )
         ]
     );
 }

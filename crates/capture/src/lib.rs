@@ -19,6 +19,9 @@
 //!   depths merge), [`layer_counter`] (Bevy 0.15) and [`linked_list`] (per-pixel linked lists,
 //!   Yang et al. 2010, with the resolve policies the samples ship).
 //!
+//! The [`catalog`] lists every scheme by name, with its passes, its sizing and a constructor
+//! that builds and runs it on any executor.
+//!
 //! Executors: [`executor`] (serial and parallel, storage kept between frames), [`tiled`]
 //! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`]
 //! (replayable GPU-like interleavings with traces).
@@ -38,6 +41,7 @@ pub mod abuffer;
 pub mod abuffer_atomic_inc;
 pub mod bucket;
 mod capture;
+pub mod catalog;
 mod counting;
 pub mod depth_count;
 pub mod dual_peeling;

@@ -114,11 +114,9 @@ impl Scheme for StencilRouted {
     type State = Route;
 
     fn name(&self) -> String {
-        if self.passes == 1 {
-            "srab".into()
-        } else {
-            format!("srab-{}pass", self.passes)
-        }
+        // The pass count is a parameter, like MDTS's K: the catalog's one spelling for every
+        // configuration (runs report their passes and slots beside it).
+        "srab".into()
     }
 
     fn layout(&self) -> Layout {

@@ -7,7 +7,8 @@ use fragsim_capture::executor::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::{OrbitCamera, Scene, View, Viewport, DEFAULT_SCENE_NAME};
 
-use crate::schemes::Sizing;
+pub use fragsim_capture::catalog::Count;
+use fragsim_capture::catalog::Sizing;
 
 /// The scene and the camera.
 #[derive(Debug, Clone, Args)]
@@ -91,7 +92,7 @@ pub struct SchemeArgs {
     pub capacity: Count,
     /// Executor: serial, parallel, tiled, scheduled (a replayable GPU-like interleaving) or all
     /// (serial, parallel and tiled).
-    #[arg(long, default_value = "parallel")]
+    #[arg(long, value_enum, default_value_t = ExecutorChoice::Parallel)]
     pub executor: ExecutorChoice,
     /// Threads of the parallel executor (default: one per core).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1024))]
@@ -138,15 +139,6 @@ impl SchemeArgs {
             memory_cap: self.memory_cap,
         }
     }
-}
-
-/// A slot count: a number, or derived from the scene.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Count {
-    /// Sized to the scene's depth complexity by a counting pass of the scheme's own.
-    Auto,
-    /// Exactly this many.
-    Fixed(u32),
 }
 
 fn parse_count(text: &str) -> Result<Count, String> {

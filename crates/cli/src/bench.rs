@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{AttributePass, EffectName, Judge, Judged};
-use crate::schemes::{check_memory_cap_early, Executors, SchemeName};
+use crate::schemes::{check_memory_cap_early, Executors, SchemeChoice};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -30,7 +30,7 @@ pub struct BenchArgs {
     pub schemes: SchemeArgs,
     /// Schemes to run, comma-separated, or `all`.
     #[arg(long, value_delimiter = ',', default_value = "all")]
-    pub scheme: Vec<SchemeName>,
+    pub scheme: Vec<SchemeChoice>,
     /// Frames timed per scheme and executor (the median, min and max are reported).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
@@ -169,7 +169,8 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let mut view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
-    check_memory_cap_early(&args.scheme, viewport, &sizing)?;
+    let schemes = SchemeChoice::expand(&args.scheme);
+    check_memory_cap_early(&schemes, viewport, &sizing)?;
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
@@ -181,7 +182,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         fragsim_shade::save_png(image, &args.out.join(name))?;
     }
     let mut rows = Vec::new();
-    for name in SchemeName::expand(&args.scheme) {
+    for &name in &schemes {
         for &executor in args.schemes.executors() {
             let mut runner = Executors::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial

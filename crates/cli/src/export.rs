@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use fragsim_capture::mdts::Direction;
 use fragsim_oracle::dump::{Dump, DumpScheme, SceneSpec, TriangleExport};
 use fragsim_raster::View;
@@ -99,10 +99,7 @@ pub(crate) fn write_dump(
     let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
     let dump =
         Dump::record(view, scene_spec(scene), &scheme, &producer).map_err(|e| e.to_string())?;
-    let sub = name
-        .to_possible_value()
-        .map_or_else(|| format!("{name:?}"), |v| v.get_name().to_string());
-    let path = dir.join(sub);
+    let path = dir.join(name.name());
     dump.write(&path).map_err(|e| e.to_string())?;
     Ok(path)
 }

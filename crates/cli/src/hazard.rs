@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_capture::executor::{run_parallel, run_serial, Run};
+use fragsim_capture::executor::{run_parallel, run_serial, Executor, Run};
 use fragsim_capture::kbuffer::KBuffer;
 use fragsim_capture::kbuffer_multipass::KBufferMultipass;
 use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
@@ -54,8 +54,8 @@ pub struct HazardArgs {
     )]
     pub write_back: Vec<WriteBackArg>,
     /// Instead of the hazard rates: passes and losses of `kbuffer`, `kbuffer-stores`,
-    /// `kbuffer-multipass`, `kbuffer-multipass-stores` (for each K of `--ks`), `srab` and
-    /// `srab-2pass` on the serial, parallel and scheduled executors (`baselines.md`).
+    /// `kbuffer-multipass`, `kbuffer-multipass-stores` (for each K of `--ks`), `srab` with 1
+    /// and 2 passes (8 and 16 slots) on the serial, parallel and scheduled executors (`baselines.md`).
     #[arg(long)]
     pub baselines: bool,
     /// Slots per pixel for `--baselines`, comma-separated.
@@ -339,7 +339,9 @@ fn baselines(
     for passes in [1, 2] {
         measure(
             &StencilRouted::new(viewport, passes, MEMORY_CAP_DEFAULT).map_err(err)?,
-            8,
+            // Its slots (8 a pass): both configurations are named `srab` (the catalog's one
+            // spelling), so the column tells them apart.
+            8 * passes,
         );
     }
     Ok(rows)
@@ -382,8 +384,8 @@ impl<S: Scheme> MeasuredScheme for S {
 
     fn runs(&self, view: &View<'_>) -> Vec<(&'static str, Run)> {
         let mut runs = vec![
-            ("serial", run_serial(view, self)),
-            ("parallel", run_parallel(view, self)),
+            (Executor::Serial.name(), run_serial(view, self)),
+            (Executor::Parallel.name(), run_parallel(view, self)),
         ];
         for (label, schedule) in &BASELINE_SCHEDULES {
             runs.push((*label, run_scheduled(view, self, schedule, false).run));

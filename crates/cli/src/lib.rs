@@ -63,7 +63,7 @@ pub use export::ExportArgs;
 pub use hazard::{BaselineRow, HazardArgs, HazardReport, HazardRow};
 pub use judge::{AttributePass, EffectName};
 pub use render::{RenderArgs, RunSummary, TieChoice};
-pub use schemes::{Fault, SchemeName, Sizing};
+pub use schemes::{Fault, SchemeChoice, SchemeName, Sizing};
 pub use sweep::{SweepArgs, SweepSeries};
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.

@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::schemes::{check_memory_cap_early, Executors, Fault, SchemeName};
+use crate::schemes::{check_memory_cap_early, Executors, Fault, SchemeChoice};
 
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
@@ -23,7 +23,7 @@ pub struct RenderArgs {
     pub schemes: SchemeArgs,
     /// Schemes to run, comma-separated, or `all`.
     #[arg(long, value_delimiter = ',', default_value = "mdts,abuffer")]
-    pub scheme: Vec<SchemeName>,
+    pub scheme: Vec<SchemeChoice>,
     /// Directory for the PNG images.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -137,7 +137,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         .view(viewport, &args.scene.orbit(args.scene.view))
         .map_err(|e| e.to_string())?;
     crate::args::warn_if_empty(&scene, &view);
-    let schemes = SchemeName::expand(&args.scheme);
+    let schemes = SchemeChoice::expand(&args.scheme);
     let sizing = args.schemes.sizing();
     check_memory_cap_early(&schemes, viewport, &sizing)?;
     let executors = args.schemes.executors();
@@ -149,13 +149,13 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     progress.inc(1);
     let max_dc = oracle.max_depth_complexity();
     let mut runner = Executors::default();
-    runner.fault = args.inject_fault;
+    runner.fault = args.inject_fault.map(Into::into);
     let mut rows = Vec::new();
     let mut nearest_written = false;
     for &name in &schemes {
         let mut last = None;
         for &executor in executors {
-            progress.set_message(format!("{name:?} on the {executor} executor"));
+            progress.set_message(format!("{name} on the {executor} executor"));
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             let run = &named.run;
             let diff = oracle.diff_with(&run.capture, args.ties.into());

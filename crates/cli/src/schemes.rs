@@ -1,218 +1,62 @@
-//! The registry of schemes the command line can run: one name, one constructor.
+//! The command line's names for schemes: exactly the catalog's ([`fragsim_capture::catalog`]),
+//! plus `all`. Building and running them is the library's ([`Executors::run`]).
 
+use clap::builder::PossibleValue;
 use clap::ValueEnum;
-use fragsim_capture::abuffer::{ABuffer, PostSort};
-use fragsim_capture::bucket::{Adp, Bdp, Bdp2, Buckets};
-use fragsim_capture::depth_count::{DepthCount, DepthCounts};
-use fragsim_capture::dual_peeling::DualDepthPeeling;
-use fragsim_capture::executor::{self, Executor, ParallelExecutor, Run, SerialExecutor};
-use fragsim_capture::kbuffer::{KBuffer, WriteBack};
-use fragsim_capture::kbuffer_multipass::KBufferMultipass;
-use fragsim_capture::layer_counter::LayerCounter;
-use fragsim_capture::linked_list::{LinkedList, Resolve};
-use fragsim_capture::loop32::Loop32;
-use fragsim_capture::mdts::{Direction, Mdts};
-use fragsim_capture::mdts_packed::{Colours, MdtsPacked};
-use fragsim_capture::peeling::DepthPeeling;
-use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim_capture::stencil_routed::StencilRouted;
-use fragsim_capture::tiled::TiledExecutor;
-use fragsim_capture::zbuffer::ZBuffer;
-use fragsim_capture::{CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step};
-use fragsim_raster::{Fragment, View, Viewport};
+use std::sync::OnceLock;
 
-use crate::args::Count;
+pub use fragsim_capture::catalog::{
+    check_memory_cap_early, Executors, NamedRun, SchemeName, Sizing, CATALOG,
+};
 
-/// The schemes the command line can run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SchemeName {
-    /// MDTS, 64-bit words (depth key and primitive id), ascending.
-    Mdts,
-    /// MDTS, 32-bit depth keys as in FreePipe's Table 1.
-    Mdts32,
-    /// MDTS with `atomicMax`, descending.
-    MdtsDesc,
-    /// MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would
-    /// change the slot (same lists, fewer locked operations).
-    MdtsProbe,
-    /// FreePipe's A-buffer: `--capacity` slots per pixel (fixed arrays, FreePipe §4.2), overflow
-    /// counted; insertion-sorted.
-    Abuffer,
-    /// The A-buffer as above, bitonic-sorted.
-    AbufferBitonic,
-    /// The A-buffer with storage sized exactly by its own counting pass (`fetch_add` per
-    /// fragment, then a prefix sum): two geometry passes.
-    AbufferExact,
-    /// Classical depth peeling, 64-bit words (ties ordered by primitive id): one pass per layer.
-    Peeling,
-    /// Classical depth peeling on 32-bit depth keys: equal depths merge.
-    Peeling32,
-    /// Dual depth peeling (nearest and farthest layer per pass), 64-bit words.
-    DualPeeling,
-    /// Dual depth peeling on 32-bit depth keys.
-    DualPeeling32,
-    /// The opaque z-buffer via `atomicMin`: the nearest fragment only.
-    Zbuffer,
-    /// Bucket depth peeling, one pass, 16 bucket pairs (HPG 2009 §3.2).
-    Bdp,
-    /// Bucket depth peeling, 32 single-value buckets.
-    BdpSingle,
-    /// Two-pass bucket depth peeling (§3.2).
-    Bdp2,
-    /// Adaptive bucket depth peeling (§3.3).
-    Adp,
-    /// The k-buffer: read–insert–write of K slots, exact only without concurrent hazards;
-    /// render-target write-backs (one step each, committed in primitive order).
-    Kbuffer,
-    /// The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.
-    KbufferStores,
-    /// The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every
-    /// fragment is confirmed by a count (render-target write-backs).
-    KbufferMultipass,
-    /// The multi-pass k-buffer with K separate loads and stores.
-    KbufferMultipassStores,
-    /// The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.
-    Srab,
-    /// MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).
-    MdtsPacked,
-    /// nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths
-    /// merge), then a colour pass; K = `--k`.
-    Loop32,
-    /// Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.
-    LayerCounter,
-    /// Per-pixel linked lists (node counter, head exchange), the resolve keeping the first `--k`
-    /// nodes (the most recent: Vulkan-Samples); node pool `--capacity` per pixel, `exact` = the
-    /// scene's fragments.
-    LinkedList,
-    /// Per-pixel linked lists, the resolve keeping the `--k` nearest (nvpro-samples).
-    LinkedListNearest,
-    /// Every scheme above.
+/// A `--scheme` value: one catalog entry, or `all` of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SchemeChoice {
+    /// One scheme.
+    One(SchemeName),
+    /// Every catalog entry.
     All,
 }
 
-impl SchemeName {
-    /// Every concrete scheme, in the order tables list them.
-    pub const EVERY: [SchemeName; 26] = [
-        SchemeName::Mdts,
-        SchemeName::Mdts32,
-        SchemeName::MdtsDesc,
-        SchemeName::MdtsProbe,
-        SchemeName::Abuffer,
-        SchemeName::AbufferBitonic,
-        SchemeName::AbufferExact,
-        SchemeName::Peeling,
-        SchemeName::Peeling32,
-        SchemeName::DualPeeling,
-        SchemeName::DualPeeling32,
-        SchemeName::Zbuffer,
-        SchemeName::Bdp,
-        SchemeName::BdpSingle,
-        SchemeName::Bdp2,
-        SchemeName::Adp,
-        SchemeName::Kbuffer,
-        SchemeName::KbufferStores,
-        SchemeName::KbufferMultipass,
-        SchemeName::KbufferMultipassStores,
-        SchemeName::Srab,
-        SchemeName::MdtsPacked,
-        SchemeName::Loop32,
-        SchemeName::LayerCounter,
-        SchemeName::LinkedList,
-        SchemeName::LinkedListNearest,
-    ];
-
-    /// The machine a k-buffer scheme runs on: separate stores for the `-stores` names, render
-    /// targets otherwise.
+impl SchemeChoice {
+    /// `choices` with `all` expanded and duplicates removed, in the order given.
     #[must_use]
-    pub fn write_back(self) -> WriteBack {
-        match self {
-            SchemeName::KbufferStores | SchemeName::KbufferMultipassStores => {
-                WriteBack::SeparateStores
-            }
-            _ => WriteBack::RenderTarget,
-        }
-    }
-
-    /// `names` with `all` expanded and duplicates removed, in the order given.
-    #[must_use]
-    pub fn expand(names: &[SchemeName]) -> Vec<SchemeName> {
-        if names.contains(&SchemeName::All) {
-            return Self::EVERY.to_vec();
+    pub fn expand(choices: &[SchemeChoice]) -> Vec<SchemeName> {
+        if choices.contains(&SchemeChoice::All) {
+            return CATALOG.iter().map(|e| e.scheme).collect();
         }
         let mut unique = Vec::new();
-        for &n in names {
-            if !unique.contains(&n) {
-                unique.push(n);
+        for &choice in choices {
+            if let SchemeChoice::One(name) = choice {
+                if !unique.contains(&name) {
+                    unique.push(name);
+                }
             }
         }
         unique
     }
 }
 
-/// How the user sized the schemes. Nothing here comes from the oracle: where a size is `auto`
-/// (or a scheme's storage is sized to the scene by design), the scheme runs its own counting pass
-/// first ([`fragsim_capture::depth_count`]), and its row reports that pass.
-#[derive(Debug, Clone, Copy)]
-pub struct Sizing {
-    /// `--k`.
-    pub k: Count,
-    /// `--capacity`.
-    pub capacity: Count,
-    /// `--memory-cap`.
-    pub memory_cap: u64,
-}
-
-impl SchemeName {
-    /// Whether the scheme, sized by `sizing`, needs the scene's per-pixel depth complexity, and
-    /// so a counting pass before its capture.
-    #[must_use]
-    pub fn needs_count_pass(self, sizing: &Sizing) -> bool {
-        let k_auto = sizing.k == Count::Auto;
-        let capacity_auto = sizing.capacity == Count::Auto;
-        match self {
-            SchemeName::Mdts
-            | SchemeName::Mdts32
-            | SchemeName::MdtsDesc
-            | SchemeName::MdtsProbe
-            | SchemeName::MdtsPacked
-            | SchemeName::Kbuffer
-            | SchemeName::KbufferStores
-            | SchemeName::Loop32
-            | SchemeName::LayerCounter => k_auto,
-            SchemeName::Abuffer | SchemeName::AbufferBitonic => capacity_auto,
-            SchemeName::LinkedList | SchemeName::LinkedListNearest => k_auto || capacity_auto,
-            // Storage for every fragment, or a record of every layer: sized to the scene.
-            SchemeName::AbufferExact
-            | SchemeName::Peeling
-            | SchemeName::Peeling32
-            | SchemeName::DualPeeling
-            | SchemeName::DualPeeling32
-            | SchemeName::Adp
-            | SchemeName::KbufferMultipass
-            | SchemeName::KbufferMultipassStores => true,
-            SchemeName::Zbuffer
-            | SchemeName::Bdp
-            | SchemeName::BdpSingle
-            | SchemeName::Bdp2
-            | SchemeName::Srab
-            | SchemeName::All => false,
-        }
+impl ValueEnum for SchemeChoice {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: OnceLock<Vec<SchemeChoice>> = OnceLock::new();
+        VARIANTS.get_or_init(|| {
+            CATALOG
+                .iter()
+                .map(|e| SchemeChoice::One(e.scheme))
+                .chain([SchemeChoice::All])
+                .collect()
+        })
     }
-}
 
-/// A finished run of a named scheme.
-#[derive(Debug, Clone)]
-pub struct NamedRun {
-    /// The run (with its counting pass folded in, where one ran).
-    pub run: Run,
-    /// The scheme's own name (`Scheme::name`).
-    pub name: String,
-    /// What the scheme guarantees (`Scheme::guarantee`).
-    pub guarantee: Guarantee,
-    /// Slots per pixel, where the scheme has a fixed number.
-    pub slots: Option<u32>,
-    /// The per-pixel counts of the scheme's own counting pass, where one sized its storage.
-    pub counts: Option<Vec<u32>>,
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(match self {
+            SchemeChoice::One(name) => {
+                PossibleValue::new(name.name()).help(name.entry().description)
+            }
+            SchemeChoice::All => PossibleValue::new("all").help("Every scheme above."),
+        })
+    }
 }
 
 /// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
@@ -222,312 +66,10 @@ pub enum Fault {
     MiscountOverflow,
 }
 
-/// Executors that keep their storage between frames of the same scheme.
-#[derive(Debug, Default)]
-pub struct Executors {
-    serial: SerialExecutor,
-    parallel: ParallelExecutor,
-    tiled: TiledExecutor,
-    /// Run the next frames on fresh storage that counts read-modify-write operations
-    /// ([`RunStats::locked_ops`](fragsim_capture::executor::RunStats)), untimed.
-    pub count_locked_ops: bool,
-    /// A fault injected into every scheme run (tests only).
-    pub fault: Option<Fault>,
-}
-
-impl Executors {
-    /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor` (on the
-    /// current rayon pool where it is parallel): first its counting pass where it needs one,
-    /// then its own passes.
-    ///
-    /// # Errors
-    /// A parameter the scheme rejects, or storage beyond the memory cap.
-    pub fn run(
-        &mut self,
-        name: SchemeName,
-        executor: Executor,
-        view: &View<'_>,
-        sizing: &Sizing,
-    ) -> Result<NamedRun, String> {
-        let viewport = view.viewport();
-        let counted = name
-            .needs_count_pass(sizing)
-            .then(|| DepthCounts::from_run(DepthCount::new(viewport).run(self, executor, view)));
-        // What `auto` sizes resolve to: the count pass's maximum depth complexity (at least 1).
-        let scene_max = counted.as_ref().map_or(1, |c| c.max().max(1));
-        let resolve = |count: Count| match count {
-            Count::Auto => scene_max,
-            Count::Fixed(n) => n,
-        };
-        let (k, capacity) = (resolve(sizing.k), resolve(sizing.capacity));
-        let layers = scene_max;
-        let cap = sizing.memory_cap;
-        let err = |e: CaptureError| e.to_string();
-        let mut go = |scheme: &dyn ErasedScheme, slots: Option<u32>| NamedRun {
-            run: scheme.run(self, executor, view),
-            name: scheme.name(),
-            guarantee: scheme.guarantee(),
-            slots,
-            counts: None,
-        };
-        let mut named = match name {
-            SchemeName::Mdts => go(
-                &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Mdts32 => go(
-                &Mdts::<u32>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::MdtsProbe => go(
-                &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap)
-                    .map_err(err)?
-                    .probing(),
-                Some(k),
-            ),
-            SchemeName::MdtsDesc => go(
-                &Mdts::<u64>::new(viewport, k, Direction::Descending, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Abuffer => go(
-                &ABuffer::fixed(viewport, capacity, PostSort::Insertion, cap).map_err(err)?,
-                Some(capacity),
-            ),
-            SchemeName::AbufferBitonic => go(
-                &ABuffer::fixed(viewport, capacity, PostSort::Bitonic, cap).map_err(err)?,
-                Some(capacity),
-            ),
-            SchemeName::AbufferExact => {
-                let counts = &counted.as_ref().expect("sized by its count pass").counts;
-                go(
-                    &ABuffer::exact(counts, PostSort::Insertion, cap).map_err(err)?,
-                    None,
-                )
-            }
-            SchemeName::Peeling => go(
-                &DepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::Peeling32 => go(
-                &DepthPeeling::<u32>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::DualPeeling => go(
-                &DualDepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::DualPeeling32 => go(
-                &DualDepthPeeling::<u32>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::Zbuffer => go(&ZBuffer::new(viewport, cap).map_err(err)?, Some(1)),
-            SchemeName::Bdp => go(
-                &Bdp::<u32>::new(viewport, Buckets::Pairs(16), cap).map_err(err)?,
-                Some(32),
-            ),
-            SchemeName::BdpSingle => go(
-                &Bdp::<u32>::new(viewport, Buckets::Singles(32), cap).map_err(err)?,
-                Some(32),
-            ),
-            SchemeName::Bdp2 => go(&Bdp2::<u32>::new(viewport, 16, cap).map_err(err)?, Some(64)),
-            SchemeName::Adp => go(
-                &Adp::<u32>::new(viewport, layers, cap).map_err(err)?,
-                Some(layers),
-            ),
-            SchemeName::Kbuffer | SchemeName::KbufferStores => go(
-                &KBuffer::with_write_back(viewport, k, name.write_back(), cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::KbufferMultipass | SchemeName::KbufferMultipassStores => go(
-                &KBufferMultipass::with_write_back(viewport, k, layers, name.write_back(), cap)
-                    .map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Srab => go(
-                &StencilRouted::new(viewport, 2, cap).map_err(err)?,
-                Some(16),
-            ),
-            SchemeName::MdtsPacked => go(
-                &MdtsPacked::new(viewport, k, Colours::Prim, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Loop32 => go(&Loop32::new(viewport, k, cap).map_err(err)?, Some(k)),
-            SchemeName::LayerCounter => {
-                go(&LayerCounter::new(viewport, k, cap).map_err(err)?, Some(k))
-            }
-            SchemeName::LinkedList | SchemeName::LinkedListNearest => {
-                let pool = match (sizing.capacity, &counted) {
-                    (Count::Auto, Some(counted)) => counted.total().max(1),
-                    _ => viewport.pixels() * capacity as usize,
-                };
-                let resolve = if name == SchemeName::LinkedList {
-                    Resolve::KeepFirst
-                } else {
-                    Resolve::KeepNearest
-                };
-                go(
-                    &LinkedList::new(viewport, pool, k, resolve, cap).map_err(err)?,
-                    Some(k),
-                )
-            }
-            SchemeName::All => return Err("`all` names a list of schemes, not one".into()),
-        };
-        if let Some(counted) = counted {
-            named.run = named.run.after_count_pass(&counted.run);
-            named.counts = Some(counted.counts);
+impl From<Fault> for fragsim_capture::catalog::Fault {
+    fn from(fault: Fault) -> Self {
+        match fault {
+            Fault::MiscountOverflow => fragsim_capture::catalog::Fault::MiscountOverflow,
         }
-        Ok(named)
-    }
-}
-
-/// Refuses, before the oracle and any counting pass, any scheme of `names` whose storage on
-/// `viewport` would exceed `memory_cap` even at its smallest.
-///
-/// With `--k auto`, `--capacity auto` or a scheme sized to the scene, storage is known only after
-/// a counting pass, and the oracle alone needs 24 bytes a pixel (6 GiB at 16384 × 16384): a
-/// refusal must not wait for them. The smallest storage is one slot per pixel for MDTS and the
-/// fixed A-buffer, and for the exact A-buffer its counters and offsets with no fragment (4 + 4
-/// bytes a pixel, as `ABuffer::exact` counts them). Schemes not listed here are checked when they
-/// are built.
-///
-/// # Errors
-/// The first scheme refused, with the bytes it would need at least.
-pub fn check_memory_cap_early(
-    names: &[SchemeName],
-    viewport: Viewport,
-    sizing: &Sizing,
-) -> Result<(), String> {
-    let smallest = |count: Count| match count {
-        Count::Auto => 1,
-        Count::Fixed(n) => n,
-    };
-    let (k_least, capacity_least) = (smallest(sizing.k), smallest(sizing.capacity));
-    let memory_cap = sizing.memory_cap;
-    for name in SchemeName::expand(names) {
-        let result = match name {
-            SchemeName::Mdts | SchemeName::MdtsProbe => {
-                Mdts::<u64>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
-            }
-            SchemeName::Mdts32 => {
-                Mdts::<u32>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
-            }
-            SchemeName::MdtsDesc => {
-                Mdts::<u64>::new(viewport, k_least, Direction::Descending, memory_cap).map(drop)
-            }
-            SchemeName::AbufferExact => {
-                ABuffer::exact(&vec![0; viewport.pixels()], PostSort::Insertion, memory_cap)
-                    .map(drop)
-            }
-            SchemeName::Abuffer | SchemeName::AbufferBitonic => {
-                ABuffer::fixed(viewport, capacity_least, PostSort::Insertion, memory_cap).map(drop)
-            }
-            _ => Ok(()),
-        };
-        if let Err(error) = result {
-            return Err(if name.needs_count_pass(sizing) {
-                format!(
-                    "{error} (at least: sized to the scene, it needs one slot per pixel or more)"
-                )
-            } else {
-                error.to_string()
-            });
-        }
-    }
-    Ok(())
-}
-
-/// The interleaving `--executor scheduled` runs: the scheduled executor's random policy with 256
-/// fragments in flight, seed 0 (replayable; `fragsim explain` and `fragsim hazard` search seeds).
-const SCHEDULE: Schedule = Schedule {
-    policy: Policy::Random,
-    in_flight: 256,
-    granularity: Granularity::Fragment,
-    seed: 0,
-};
-
-/// A scheme behind a vtable, so the registry needs one call site per executor rather than one
-/// per (scheme, executor) pair. The per-step code stays statically dispatched inside `run`.
-trait ErasedScheme {
-    fn name(&self) -> String;
-    fn guarantee(&self) -> Guarantee;
-    fn run(&self, executors: &mut Executors, executor: Executor, view: &View<'_>) -> Run;
-}
-
-impl<S: Scheme> ErasedScheme for S {
-    fn name(&self) -> String {
-        Scheme::name(self)
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Scheme::guarantee(self)
-    }
-
-    fn run(&self, executors: &mut Executors, executor: Executor, view: &View<'_>) -> Run {
-        match executors.fault {
-            Some(Fault::MiscountOverflow) => {
-                run_on(&MiscountOverflow(self), executors, executor, view)
-            }
-            None => run_on(self, executors, executor, view),
-        }
-    }
-}
-
-/// One frame of `scheme` on `executor`.
-fn run_on<S: Scheme>(
-    scheme: &S,
-    executors: &mut Executors,
-    executor: Executor,
-    view: &View<'_>,
-) -> Run {
-    if executors.count_locked_ops {
-        return executor::count_locked_ops(view, scheme, executor != Executor::Serial);
-    }
-    match executor {
-        Executor::Serial => executors.serial.run(view, scheme),
-        Executor::Parallel => executors.parallel.run(view, scheme),
-        Executor::Tiled => executors.tiled.run(view, scheme),
-        Executor::Scheduled => run_scheduled(view, scheme, &SCHEDULE, false).run,
-    }
-}
-
-/// [`Fault::MiscountOverflow`]: the scheme, reporting one overflowing fragment more at pixel 0
-/// than it counted.
-struct MiscountOverflow<'a, S>(&'a S);
-
-impl<S: Scheme> Scheme for MiscountOverflow<'_, S> {
-    type State = S::State;
-
-    fn name(&self) -> String {
-        self.0.name()
-    }
-    fn layout(&self) -> Layout {
-        self.0.layout()
-    }
-    fn identity(&self) -> Identity {
-        self.0.identity()
-    }
-    fn promise(&self) -> Promise {
-        self.0.promise()
-    }
-    fn guarantee(&self) -> Guarantee {
-        self.0.guarantee()
-    }
-    fn begin(&self, fragment: Fragment) -> S::State {
-        self.0.begin(fragment)
-    }
-    fn begin_pass(&self, pass: u32, fragment: Fragment) -> Option<S::State> {
-        self.0.begin_pass(pass, fragment)
-    }
-    fn step<M: Memory>(&self, state: &mut S::State, memory: &M) -> Step {
-        self.0.step(state, memory)
-    }
-    fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
-        self.0.end_pass(pass, memory)
-    }
-    fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        self.0.resolve_pixel(memory, pixel, out) + u32::from(pixel == 0)
-    }
-    fn pixels(&self) -> usize {
-        self.0.pixels()
     }
 }

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{EffectName, Judge};
-use crate::schemes::{Executors, SchemeName};
+use crate::schemes::{Executors, SchemeChoice};
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -26,7 +26,7 @@ pub struct SweepArgs {
         value_delimiter = ',',
         default_value = "bdp,bdp-single,bdp2,adp,mdts-packed,mdts"
     )]
-    pub scheme: Vec<SchemeName>,
+    pub scheme: Vec<SchemeChoice>,
     /// View angles, evenly spaced over a full turn.
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=3600))]
     pub angles: u32,
@@ -58,7 +58,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let scene = args.scene.scene()?;
     let viewport = args.scene.viewport()?;
     let executor = args.schemes.executors()[0];
-    let schemes = SchemeName::expand(&args.scheme);
+    let schemes = SchemeChoice::expand(&args.scheme);
     let mut series: Vec<SweepSeries> = Vec::new();
     let mut angles = Vec::new();
     for step in 0..args.angles {
