@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use fragsim_capture::executor::Executor;
-use fragsim_oracle::Oracle;
+use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::View;
 use fragsim_shade::effects;
 use rayon::prelude::*;
@@ -231,10 +231,12 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             rows.push(BenchRow {
                 scheme: named.name.clone(),
                 guarantee: named.guarantee.to_string(),
-                keeps_guarantee: oracle.keeps_guarantee(
+                keeps_guarantee: oracle.keeps_guarantee_given(
                     &named.run.capture,
                     named.guarantee,
                     executor.serialises_pixels(),
+                    &diff,
+                    Ties::ByPrimitive,
                 ),
                 executor: executor.name().into(),
                 threads: stats.threads,

@@ -159,8 +159,13 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             let run = &named.run;
             let diff = oracle.diff_with(&run.capture, args.ties.into());
-            let keeps_guarantee =
-                oracle.keeps_guarantee(&run.capture, named.guarantee, executor.serialises_pixels());
+            let keeps_guarantee = oracle.keeps_guarantee_given(
+                &run.capture,
+                named.guarantee,
+                executor.serialises_pixels(),
+                &diff,
+                args.ties.into(),
+            );
             if !args.no_images && !nearest_written {
                 let nearest: Vec<Option<f32>> = run
                     .capture

@@ -928,6 +928,18 @@ impl WordCheck {
     pub fn corrupt_words(&self) -> u64 {
         self.corrupt.iter().map(|c| c.len() as u64).sum()
     }
+
+    /// Records `word` in `slot` of pixel `pixel` as corrupt, when a rule gave a reason.
+    fn flag(&mut self, pixel: usize, slot: usize, word: u64, why: Option<Corruption>) {
+        if let Some(why) = why {
+            self.corrupt[pixel].push(CorruptWord {
+                pixel,
+                slot,
+                word,
+                why,
+            });
+        }
+    }
 }
 
 impl Dump {
@@ -986,14 +998,7 @@ impl Dump {
                             check.unchecked += 1;
                             None
                         };
-                        if let Some(why) = why {
-                            check.corrupt[p].push(CorruptWord {
-                                pixel: p,
-                                slot,
-                                word,
-                                why,
-                            });
-                        }
+                        check.flag(p, slot, word, why);
                     }
                     all.push(Counter {
                         count,
@@ -1021,14 +1026,7 @@ fn check_mdts(check: &mut WordCheck, slots: &[u64], k: usize, empty: u64, key: f
             } else {
                 (key(word) > LARGEST_KEY).then_some(Corruption::ImpossibleKey)
             };
-            if let Some(why) = why {
-                check.corrupt[p].push(CorruptWord {
-                    pixel: p,
-                    slot,
-                    word,
-                    why,
-                });
-            }
+            check.flag(p, slot, word, why);
         }
     }
 }

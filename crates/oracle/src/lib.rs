@@ -174,12 +174,40 @@ impl Oracle {
         if !guarantee.owes_exactness(pixels_serialised) {
             return true;
         }
-        let ties = if guarantee.merges_equal_depths() {
+        self.diff_with(capture, Self::judging_ties(guarantee))
+            .is_exact()
+    }
+
+    /// [`Oracle::keeps_guarantee`] for a capture already diffed under `ties` (`diff`): that diff is
+    /// reused when the guarantee is judged by the same tie policy, so a report pays for one diff.
+    ///
+    /// # Panics
+    /// If the capture covers a different number of pixels.
+    #[must_use]
+    pub fn keeps_guarantee_given(
+        &self,
+        capture: &Capture,
+        guarantee: Guarantee,
+        pixels_serialised: bool,
+        diff: &Diff,
+        ties: Ties,
+    ) -> bool {
+        if !guarantee.owes_exactness(pixels_serialised) {
+            return true;
+        }
+        if ties == Self::judging_ties(guarantee) {
+            return diff.is_exact();
+        }
+        self.keeps_guarantee(capture, guarantee, pixels_serialised)
+    }
+
+    /// The tie policy a guarantee is judged by.
+    fn judging_ties(guarantee: Guarantee) -> Ties {
+        if guarantee.merges_equal_depths() {
             Ties::MergeEqualDepths
         } else {
             Ties::ByPrimitive
-        };
-        self.diff_with(capture, ties).is_exact()
+        }
     }
 
     /// Compares a capture with this oracle, pixel by pixel, under the capture's promise, with
@@ -526,5 +554,14 @@ mod tests {
         assert!(!oracle.keeps_guarantee(&merged, Guarantee::ExactWithoutHazards, true));
         assert!(oracle.keeps_guarantee(&merged, Guarantee::ExactWithoutHazards, false));
         assert!(oracle.keeps_guarantee(&merged, Guarantee::Approximate, true));
+        // A diff already made under the judging ties is reused, and gives the same verdict.
+        let canonical = oracle.diff(&merged);
+        for g in [Guarantee::Exact, Guarantee::ExactDistinctDepths] {
+            assert_eq!(
+                oracle.keeps_guarantee_given(&merged, g, true, &canonical, Ties::ByPrimitive),
+                oracle.keeps_guarantee(&merged, g, true),
+                "{g}"
+            );
+        }
     }
 }
