@@ -17,6 +17,7 @@ nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=c
 nvcc --version | tail -1
 nproc
 echo "== build"
+# One translation unit: fragsim_cuda.cu and the headers that mirror the Rust tree (README.md).
 make -C backends/cuda OUT="$W" || exit 1
 chmod +x "$F"
 
@@ -41,8 +42,9 @@ for size in $SIZES; do
       "$W/fragsim_cuda" "$W/$tag.tri" "$W/$tag-k20" --k 20 --schemes mdts,abuffer --reps "$REPS" \
         | sed "s/^/$tag-k20 /"
     fi
-    # fragsim's CPU executors on this machine's cores, same scene (GPU idle by now).
-    $F render $args --json --no-images --scheme mdts,mdts32,abuffer-fixed > "$W/cpu-$tag.json" \
+    # fragsim's CPU executors on this machine's cores, same scene (GPU idle by now); `abuffer` is
+    # FreePipe's fixed arrays, as the GPU's (it was called `abuffer-fixed` before the catalog).
+    $F render $args --json --no-images --scheme mdts,mdts32,abuffer > "$W/cpu-$tag.json" \
       && echo "$tag CPU $(tr -d ' \n' < "$W/cpu-$tag.json")"
     # The verdicts, in parallel (each compare rebuilds the oracle from the dump's header).
     for d in "$W/$tag"/* "$W/$tag-k20"/*; do

@@ -45,7 +45,7 @@ def main():
               f"| {v['misordered']} | {v['overflowed']} | {f['lost']} | {f['extra']} |")
     print("\n### Kernel times (median ms; frame = init + raster [+ sort])\n")
     head = ["scene", "triangles", "fragments", "max dc", "K", "GPU mdts", "GPU mdts32", "GPU abuffer (sort)",
-            "GPU kbuffer (broken)", "CPU mdts", "CPU abuffer-fixed", "CPU/GPU mdts", "CPU/GPU abuffer",
+            "GPU kbuffer (broken)", "CPU mdts", "CPU abuffer", "CPU/GPU mdts", "CPU/GPU abuffer",
             "GTX 280 mdts / abuffer", "GTX 280/GPU mdts", "GTX 280/GPU abuffer"]
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * len(head))
@@ -60,7 +60,7 @@ def main():
         t = {scheme: gpu.get((tag, scheme), {}).get("timings")
              for scheme in ("mdts", "mdts32", "abuffer", "kbuffer")}
         base = tag.replace("-k20", "")
-        cm, ca = cpu.get((base, "mdts")), cpu.get((base, "abuffer-fixed"))
+        cm, ca = cpu.get((base, "mdts")), cpu.get((base, "abuffer"))
         fp = FREEPIPE.get(tag.split("-")[0]) if tag.endswith("-512-k20") else None
         fp_m, fp_a = (1000 / fp["mdts"], 1000 / fp["abuffer"]) if fp else (None, None)
         gm = t["mdts"] and t["mdts"]["frame_ms"]

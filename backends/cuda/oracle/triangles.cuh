@@ -1,0 +1,46 @@
+// Mirrors crates/oracle/src/triangles.rs: reads the FRAGTRI1 triangle export that
+// `fragsim export-scene` writes (docs/dump-format.md): the screen triangles after fragsim's vertex
+// stage, and the scene's JSON, which every dump copies so that `fragsim compare` can rebuild the
+// oracle from it.
+#pragma once
+
+#include "device.cuh"
+#include "raster/pipeline.cuh"
+
+struct Scene {
+  u32 width = 0, height = 0, mesh_triangles = 0;
+  std::string scene_json;  // copied verbatim into each dump's "scene"
+  std::vector<Tri> tris;
+};
+
+static u32 le32(const unsigned char* b) { return b[0] | b[1] << 8 | b[2] << 16 | (u32)b[3] << 24; }
+
+static Scene read_scene(const char* path) {
+  FILE* f = fopen(path, "rb");
+  if (!f) { fprintf(stderr, "cannot open %s\n", path); exit(2); }
+  unsigned char h[40];
+  if (fread(h, 1, 40, f) != 40 || memcmp(h, "FRAGTRI1", 8) != 0 || le32(h + 8) != 1) {
+    fprintf(stderr, "%s: not a version-1 fragsim triangle export\n", path);
+    exit(2);
+  }
+  Scene s;
+  s.width = le32(h + 12);
+  s.height = le32(h + 16);
+  if (le32(h + 20) != (u32)SUBPIXEL_BITS || le32(h + 36) != sizeof(Tri)) {
+    fprintf(stderr, "%s: unexpected subpixel bits or record size\n", path);
+    exit(2);
+  }
+  s.mesh_triangles = le32(h + 24);
+  u32 count = le32(h + 28), json_len = le32(h + 32);
+  u32 padded = (json_len + 7) / 8 * 8;
+  std::vector<char> json(padded);
+  s.tris.resize(count);
+  if (fread(json.data(), 1, padded, f) != padded ||
+      fread(s.tris.data(), sizeof(Tri), count, f) != count) {
+    fprintf(stderr, "%s: truncated\n", path);
+    exit(2);
+  }
+  fclose(f);
+  s.scene_json.assign(json.data(), json_len);
+  return s;
+}
