@@ -1,0 +1,264 @@
+//! Unit tests of the pipeline's rules.
+
+use super::vertex::{round_half_away, VertexStage};
+use super::*;
+
+fn view_of(mesh: &Mesh, side: u32) -> View<'_> {
+    // Identity projection: model x, y in [-1, 1] map straight to the window, z is depth.
+    let camera = Camera {
+        view_projection: DMat4::IDENTITY,
+    };
+    View::new(
+        mesh,
+        &camera,
+        Viewport::new(side, side).unwrap(),
+        CullMode::None,
+    )
+}
+
+fn coverage(view: &View<'_>) -> Vec<u32> {
+    let mut counts = vec![0; view.viewport().pixels()];
+    for prim in 0..view.triangle_count() {
+        view.rasterize(prim, &mut |f| counts[f.pixel as usize] += 1);
+    }
+    counts
+}
+
+#[test]
+fn two_triangles_sharing_a_diagonal_cover_each_centre_once() {
+    // A full-screen quad split along the diagonal, which passes through pixel centres.
+    let mesh = Mesh {
+        positions: vec![
+            [-1.0, -1.0, 0.5],
+            [1.0, -1.0, 0.5],
+            [1.0, 1.0, 0.5],
+            [-1.0, 1.0, 0.5],
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    };
+    assert!(coverage(&view_of(&mesh, 8)).iter().all(|&c| c == 1));
+}
+
+#[test]
+fn depth_is_interpolated_and_keyed() {
+    let mesh = Mesh {
+        positions: vec![[-1.0, -1.0, 0.25], [3.0, -1.0, 0.25], [-1.0, 3.0, 0.25]],
+        triangles: vec![[0, 1, 2]],
+    };
+    let view = view_of(&mesh, 4);
+    let mut keys = Vec::new();
+    view.rasterize(0, &mut |f| keys.push(f.depth_key));
+    assert_eq!(keys.len(), 16);
+    assert!(keys.iter().all(|&k| k == 0.25f32.to_bits()));
+}
+
+#[test]
+fn fragments_beyond_far_are_dropped() {
+    let mesh = Mesh {
+        positions: vec![[-1.0, -1.0, 1.5], [3.0, -1.0, 1.5], [-1.0, 3.0, 1.5]],
+        triangles: vec![[0, 1, 2]],
+    };
+    assert!(coverage(&view_of(&mesh, 4)).iter().all(|&c| c == 0));
+}
+
+#[test]
+fn a_clipped_vertex_lost_to_cancellation_is_clamped_into_the_guard_band() {
+    // Found by the rasterize fuzz target: clipping the edge from x = 1.9e38 to x = −2.55e38
+    // against x ≥ −513 w cancelled to x ≈ −3.8e22, which snapped to i64::MIN and overflowed
+    // the edge function (a panic with overflow checks, garbage without).
+    let mesh = Mesh {
+        positions: vec![
+            [-2.552_080_4e38, -2.046_936_3, 0.012],
+            [1.900_796_2e38, 0.0, 0.004],
+        ],
+        triangles: vec![[0, 1, 1]],
+    };
+    let view = view_of(&mesh, 64);
+    let [a, b] = [0, 1].map(|i| view.clip_position(i));
+    let polygon = view.clip([a, b, b]);
+    assert!(polygon.len() >= 3);
+    let [gx, gy] = view.guard;
+    for v in &polygon {
+        assert!(v.x.abs() <= gx * v.w && v.y.abs() <= gy * v.w, "{v:?}");
+    }
+    assert!(coverage(&view).iter().all(|&c| c == 0));
+}
+
+#[test]
+fn the_written_out_outcode_equals_the_plane_dot_products() {
+    let mesh = Mesh {
+        positions: vec![],
+        triangles: vec![],
+    };
+    let view = view_of(&mesh, 37);
+    let stage = VertexStage {
+        view_projection: DMat4::IDENTITY,
+        planes: view.planes(),
+    };
+    let by_dot_products = |clip: DVec4| {
+        let mut code = stage
+            .planes
+            .iter()
+            .enumerate()
+            .fold(0u8, |code, (i, plane)| {
+                code | (u8::from(plane.dot(clip) < 0.0) << i)
+            });
+        if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
+            code |= FAR_BIT;
+        }
+        if !in_front(clip) {
+            code |= NOT_IN_FRONT_BIT;
+        }
+        code
+    };
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let specials = [0.0, -0.0, 1.0, -1.0, 1e-300, 3.4e38, -3.4e38, 1e300];
+    for _ in 0..200_000 {
+        let mut coordinate = || {
+            let bits = next();
+            match bits % 4 {
+                0 => specials[(bits >> 8) as usize % specials.len()],
+                1 => (bits >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0,
+                _ => f64::from_bits(bits).clamp(-1e300, 1e300),
+            }
+        };
+        let clip = DVec4::new(coordinate(), coordinate(), coordinate(), coordinate());
+        if clip.is_finite() {
+            assert_eq!(stage.outcode(clip), by_dot_products(clip), "{clip:?}");
+        }
+    }
+}
+
+#[test]
+fn rounding_without_libm_equals_f64_round() {
+    let mut values = vec![
+        0.5,
+        -0.5,
+        1.5,
+        -2.5,
+        0.499_999_999_999_999_94,
+        -0.499_999_999_999_999_94,
+        4_503_599_627_370_495.5,
+        4_503_599_627_370_497.0,
+        1e30,
+        -1e30,
+        f64::MAX,
+        f64::MIN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        0.0,
+        -0.0,
+        f64::MIN_POSITIVE,
+    ];
+    // Halves and their neighbours over the snapped range, and a deterministic spread.
+    for i in -3000i32..3000 {
+        let half = f64::from(i) + 0.5;
+        values.extend([half, half.next_up(), half.next_down()]);
+    }
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    for _ in 0..100_000 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        values.push(f64::from_bits(x));
+    }
+    for v in values {
+        assert_eq!(round_half_away(v), v.round() as i64, "{v:e}");
+    }
+}
+
+/// Views of a triangle soup seen from far (tiny triangles), near (clipped ones) and inside
+/// (w ≤ 0), on a viewport of odd sides.
+fn soup_views(mesh: &Mesh) -> impl Iterator<Item = (f64, View<'_>)> {
+    [40.0, 1.0, 0.3, 0.01].into_iter().map(|distance_scale| {
+        let orbit = crate::OrbitCamera {
+            distance_scale,
+            ..crate::OrbitCamera::default()
+        };
+        let camera = orbit.camera(mesh.bounds(), 1.0);
+        let viewport = Viewport::new(97, 61).unwrap();
+        (
+            distance_scale,
+            View::new(mesh, &camera, viewport, CullMode::None),
+        )
+    })
+}
+
+#[test]
+fn the_inlined_fast_path_emits_what_the_general_path_emits() {
+    // `rasterize` skips `screen_triangles` for unclipped triangles; both must agree.
+    let mesh = crate::scenes::triangle_soup(3000, 7);
+    for (distance_scale, view) in soup_views(&mesh) {
+        let mut fragments = 0;
+        for prim in 0..view.triangle_count() {
+            let (mut fast, mut general) = (Vec::new(), Vec::new());
+            view.rasterize(prim, &mut |f| fast.push(f));
+            view.screen_triangles(prim, &mut |t| view.scan(&t, &mut |f| general.push(f)));
+            assert_eq!(
+                fast, general,
+                "triangle {prim} at distance {distance_scale}"
+            );
+            fragments += fast.len();
+        }
+        assert!(fragments > 0, "distance {distance_scale} drew nothing");
+    }
+}
+
+#[test]
+fn tiles_split_a_triangle_s_fragments_exactly_and_its_bounds_hold_them() {
+    // Tiles of 13 × 8 pixels, misaligned with the 97 × 61 viewport's sides on purpose.
+    let mesh = crate::scenes::triangle_soup(3000, 11);
+    for (distance_scale, view) in soup_views(&mesh) {
+        let Viewport { width, height } = view.viewport();
+        let tiles: Vec<PixelRect> = (0..height.div_ceil(8))
+            .flat_map(|row| {
+                (0..width.div_ceil(13)).map(move |column| PixelRect {
+                    x: (column * 13, (column * 13 + 12).min(width - 1)),
+                    y: (row * 8, (row * 8 + 7).min(height - 1)),
+                })
+            })
+            .collect();
+        for prim in 0..view.triangle_count() {
+            let mut whole = Vec::new();
+            view.rasterize(prim, &mut |f| whole.push(f));
+            let bounds = view.pixel_bounds(prim);
+            let inside = |rect: &PixelRect, pixel: u32| {
+                let (x, y) = (pixel % width, pixel / width);
+                (rect.x.0..=rect.x.1).contains(&x) && (rect.y.0..=rect.y.1).contains(&y)
+            };
+            match bounds {
+                None => assert!(whole.is_empty(), "triangle {prim} at {distance_scale}"),
+                Some(rect) => assert!(whole.iter().all(|f| inside(&rect, f.pixel))),
+            }
+            for tile in &tiles {
+                let mut part = Vec::new();
+                view.rasterize_in(prim, *tile, &mut |f| part.push(f));
+                let expected: Vec<Fragment> = whole
+                    .iter()
+                    .copied()
+                    .filter(|f| inside(tile, f.pixel))
+                    .collect();
+                assert_eq!(part, expected, "triangle {prim} at {distance_scale}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_triangle_crossing_the_near_plane_is_clipped_not_lost() {
+    let mesh = Mesh {
+        positions: vec![[-1.0, -1.0, -0.5], [3.0, -1.0, 0.5], [-1.0, 3.0, 0.5]],
+        triangles: vec![[0, 1, 2]],
+    };
+    let counts = coverage(&view_of(&mesh, 8));
+    let covered = counts.iter().filter(|&&c| c == 1).count();
+    assert!(covered > 0 && covered < 64, "{covered}");
+    assert!(counts.iter().all(|&c| c <= 1));
+}
