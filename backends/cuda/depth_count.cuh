@@ -6,7 +6,7 @@
 #include "device.cuh"
 #include "executors/frame.cuh"
 #include "executors/parallel.cuh"
-#include "memory/memory.cuh"
+#include "memory/mod.cuh"
 
 struct CountOp {
   u32* counters;

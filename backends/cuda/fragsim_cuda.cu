@@ -25,7 +25,7 @@
 #include "depth_count.cuh"
 #include "device.cuh"
 #include "executors/frame.cuh"
-#include "memory/memory.cuh"
+#include "memory/mod.cuh"
 #include "oracle/triangles.cuh"
 #include "schemes/abuffer.cuh"
 #include "schemes/kbuffer.cuh"

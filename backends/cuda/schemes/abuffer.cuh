@@ -8,10 +8,10 @@
 #include "device.cuh"
 #include "executors/frame.cuh"
 #include "executors/parallel.cuh"
-#include "memory/memory.cuh"
+#include "memory/mod.cuh"
 #include "oracle/dump/write.cuh"
 #include "schemes/common/sort.cuh"
-#include "schemes/common/words.cuh"
+#include "schemes/common/word.cuh"
 
 struct ABufferOp {
   u32* counters;

@@ -8,7 +8,7 @@
 #include "device.cuh"
 #include "executors/frame.cuh"
 #include "schemes/common/sort.cuh"
-#include "schemes/common/words.cuh"
+#include "schemes/common/word.cuh"
 #include "schemes/mdts.cuh"
 
 struct KBufferOp {

@@ -8,9 +8,9 @@
 #include "device.cuh"
 #include "executors/frame.cuh"
 #include "executors/parallel.cuh"
-#include "memory/memory.cuh"
+#include "memory/mod.cuh"
 #include "oracle/dump/write.cuh"
-#include "schemes/common/words.cuh"
+#include "schemes/common/word.cuh"
 
 // FreePipe Table 1 on 64-bit words: carry the larger value on, stop on an empty slot.
 struct MdtsOp {
