@@ -15,7 +15,10 @@
 //! assert_eq!(oracle.max_depth_complexity(), 6);
 //! ```
 
+pub mod compare;
 pub mod dump;
+pub mod scene;
+pub mod triangles;
 
 use fragsim_capture::{Capture, Guarantee, Identity, Keeps};
 use fragsim_raster::{Fragment, View};
