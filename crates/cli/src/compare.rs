@@ -348,19 +348,14 @@ fn dump_dir(path: &Path) -> PathBuf {
 
 /// The oracle's lists as a capture that promises every fragment.
 fn oracle_capture(oracle: &Oracle) -> Capture {
-    let pixels = oracle.pixels();
-    let mut capture = Capture::with_pixels(
-        pixels,
-        Identity::KeyAndPrim,
-        Keeps::All {
+    Capture {
+        lists: oracle.lists().clone(),
+        identity: Identity::KeyAndPrim,
+        keeps: Keeps::All {
             capacity: Capacity::Unbounded,
-            overflow: vec![0; pixels],
+            overflow: vec![0; oracle.pixels()],
         },
-    );
-    for p in 0..pixels {
-        capture.push_pixel(oracle.pixel(p).iter().copied());
     }
-    capture
 }
 
 /// Why a dump used as the reference may not be the whole truth.

@@ -1,27 +1,11 @@
 //! Comparing a capture (a dump's decoded lists, or a run's) with a reference pixel by pixel: the
 //! verdict of every pixel, and the totals.
 
-use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use serde::Serialize;
 
 use crate::dump::{CorruptWord, Counter, Dump, DumpError, WordCheck};
 use crate::{Diff, Oracle, PixelMismatch};
-
-impl Oracle {
-    /// An oracle whose per-pixel lists are a capture's (each sorted to canonical order): a dump
-    /// used as the reference of a comparison.
-    #[must_use]
-    pub fn from_capture(capture: &Capture) -> Self {
-        let mut entries = capture.entries.clone();
-        for p in 0..capture.pixels() {
-            entries[capture.offsets[p]..capture.offsets[p + 1]].sort_unstable();
-        }
-        Self {
-            offsets: capture.offsets.clone(),
-            entries,
-        }
-    }
-}
 
 /// A capture reduced to a coarser identity (e.g. to compare a u64 dump with a u32 reference).
 #[must_use]
@@ -32,9 +16,12 @@ pub fn with_identity(capture: &Capture, identity: Identity) -> Capture {
         Identity::PrimOnly => u64::from(u32::MAX),
     };
     Capture {
-        entries: capture.entries.iter().map(|e| e & mask).collect(),
+        lists: PixelLists {
+            offsets: capture.offsets.clone(),
+            entries: capture.entries.iter().map(|e| e & mask).collect(),
+        },
         identity,
-        ..capture.clone()
+        keeps: capture.keeps.clone(),
     }
 }
 
@@ -285,8 +272,10 @@ pub fn compare_with(
     };
     let total = &mut comparison.diff;
     let mut one_ref = Oracle {
-        offsets: vec![0, 0],
-        entries: Vec::new(),
+        lists: PixelLists {
+            offsets: vec![0, 0],
+            entries: Vec::new(),
+        },
     };
     let mut one = Capture::with_pixels(1, candidate.identity, Keeps::Nearest(0));
     one.offsets.push(0);
@@ -294,9 +283,9 @@ pub fn compare_with(
         let all = reference.pixel(p);
         let n = all.len();
         let knows_n = options.complete.is_none_or(|c| c[p]);
-        one_ref.entries.clear();
-        one_ref.entries.extend_from_slice(all);
-        one_ref.offsets[1] = n;
+        one_ref.lists.entries.clear();
+        one_ref.lists.entries.extend_from_slice(all);
+        one_ref.lists.offsets[1] = n;
         let got = candidate.pixel(p);
         one.entries.clear();
         let mut flags = 0;

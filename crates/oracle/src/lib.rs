@@ -20,7 +20,7 @@ pub mod dump;
 pub mod scene;
 pub mod triangles;
 
-use fragsim_capture::{Capture, Guarantee, Identity, Keeps};
+use fragsim_capture::{Capture, Guarantee, Identity, Keeps, PixelLists};
 use fragsim_raster::{Fragment, View};
 
 /// How the oracle orders (or merges) fragments of one pixel at one depth key: the tie policies
@@ -69,8 +69,8 @@ impl Ties {
 /// The exact per-pixel fragment lists of a view.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Oracle {
-    offsets: Vec<usize>,
-    entries: Vec<u64>,
+    /// Every pixel's fragments in canonical order: the same type a capture's lists have.
+    lists: PixelLists,
 }
 
 impl Oracle {
@@ -107,47 +107,54 @@ impl Oracle {
             entries[next[p]] = f.packed();
             next[p] += 1;
         });
-        for p in 0..pixels {
-            entries[offsets[p]..offsets[p + 1]].sort_unstable();
-        }
-        Self { offsets, entries }
+        let mut lists = PixelLists { offsets, entries };
+        lists.sort_each_pixel();
+        Self { lists }
+    }
+
+    /// An oracle whose per-pixel lists are a capture's (each sorted to canonical order): a dump
+    /// used as the reference of a comparison.
+    #[must_use]
+    pub fn from_capture(capture: &Capture) -> Self {
+        let mut lists = capture.lists.clone();
+        lists.sort_each_pixel();
+        Self { lists }
+    }
+
+    /// Every pixel's fragments in canonical order.
+    #[must_use]
+    pub fn lists(&self) -> &PixelLists {
+        &self.lists
     }
 
     /// Number of pixels.
     #[must_use]
     pub fn pixels(&self) -> usize {
-        self.offsets.len() - 1
+        self.lists.pixels()
     }
 
     /// Pixel `p`'s fragments, packed `key << 32 | prim`, in canonical order.
     #[must_use]
     pub fn pixel(&self, p: usize) -> &[u64] {
-        &self.entries[self.offsets[p]..self.offsets[p + 1]]
+        self.lists.pixel(p)
     }
 
     /// Total fragments.
     #[must_use]
     pub fn fragments(&self) -> usize {
-        self.entries.len()
+        self.lists.entries.len()
     }
 
     /// Per-pixel depth complexity (fragment count).
     #[must_use]
     pub fn depth_complexity(&self) -> Vec<u32> {
-        self.offsets
-            .windows(2)
-            .map(|w| (w[1] - w[0]) as u32)
-            .collect()
+        self.lists.lengths().map(|n| n as u32).collect()
     }
 
     /// The largest depth complexity of any pixel.
     #[must_use]
     pub fn max_depth_complexity(&self) -> u32 {
-        self.offsets
-            .windows(2)
-            .map(|w| (w[1] - w[0]) as u32)
-            .max()
-            .unwrap_or(0)
+        self.lists.lengths().max().unwrap_or(0) as u32
     }
 
     /// Pixel `p`'s list as `ties` expects it: canonical (`ByPrimitive`), depth keys only with
@@ -409,13 +416,11 @@ mod tests {
     use fragsim_capture::{Capacity, Capture};
 
     fn oracle_of(lists: &[&[u64]]) -> Oracle {
-        let mut offsets = vec![0];
-        let mut entries = Vec::new();
+        let mut all = PixelLists::with_pixels(lists.len());
         for l in lists {
-            entries.extend_from_slice(l);
-            offsets.push(entries.len());
+            all.push_pixel(l.iter().copied());
         }
-        Oracle { offsets, entries }
+        Oracle { lists: all }
     }
 
     fn capture_of(lists: &[&[u64]], keeps: Keeps) -> Capture {
