@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use fragsim_capture::mdts::Direction;
-use fragsim_oracle::dump::{Dump, DumpScheme, SceneSpec, TriangleExport};
+use fragsim_oracle::dump::{Dump, DumpScheme};
+use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::triangles::TriangleExport;
 use fragsim_raster::View;
 
 use crate::args::SceneArgs;
@@ -23,10 +25,10 @@ pub struct ExportArgs {
 }
 
 /// The scene description a dump or an export carries.
-fn scene_spec(args: &SceneArgs) -> SceneSpec {
+fn scene_spec(args: &SceneArgs) -> SceneAndCamera {
     match &args.mesh {
-        Some(path) => SceneSpec::mesh(path, args.view, args.elevation),
-        None => SceneSpec::named(&args.scene, args.view, args.elevation),
+        Some(path) => SceneAndCamera::mesh(path, args.view, args.elevation),
+        None => SceneAndCamera::named(&args.scene, args.view, args.elevation),
     }
 }
 

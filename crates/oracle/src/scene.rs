@@ -13,10 +13,10 @@ use crate::dump::{err, DumpError};
 /// Its numbers are exact across the file: serde_json is built with `float_roundtrip`, so a
 /// decimal parses to the nearest f64, and writes the shortest decimal that parses back to the same
 /// bits (ryu), so encode then parse gives every finite value back bit for bit. JSON has no NaN or
-/// infinity: [`SceneSpec::check_finite`] refuses them before a header is written (serde_json would
+/// infinity: [`SceneAndCamera::check_finite`] refuses them before a header is written (serde_json would
 /// write `null`), and a decimal past the f64 range is a parse error.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SceneSpec {
+pub struct SceneAndCamera {
     /// A named scene (`Scene::procedural`: `bunny`, `spheres:8`, …); absent when `mesh` is set.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
@@ -44,7 +44,7 @@ fn default_distance() -> f64 {
     OrbitCamera::default().distance_scale
 }
 
-impl SceneSpec {
+impl SceneAndCamera {
     /// A named scene seen from the default orbit at `view_degrees` and `elevation_degrees`.
     #[must_use]
     pub fn named(name: &str, view_degrees: f64, elevation_degrees: f64) -> Self {

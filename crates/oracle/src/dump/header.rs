@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::{err, DumpError};
-use crate::scene::SceneSpec;
+use crate::scene::SceneAndCamera;
 
 /// The element type of an array file: always little-endian.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -41,7 +41,7 @@ pub struct Header {
     #[serde(default)]
     pub producer: String,
     /// The scene and camera.
-    pub scene: SceneSpec,
+    pub scene: SceneAndCamera,
     /// Viewport width in pixels.
     pub width: u32,
     /// Viewport height in pixels.

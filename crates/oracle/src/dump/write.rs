@@ -11,7 +11,7 @@ use super::header::{check_array, check_distinct_files, check_file_name};
 use super::layouts::{sort_abuffer_in_place, SchemeVisitor};
 use super::{io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{FORMAT, HEADER_FILE, VERSION};
-use crate::scene::SceneSpec;
+use crate::scene::SceneAndCamera;
 
 /// Runs a scheme serially over a view and copies its memory out.
 struct Record<'a, 'm> {
@@ -53,7 +53,7 @@ impl Dump {
     /// Scheme parameters out of range.
     pub fn record(
         view: &View<'_>,
-        scene: SceneSpec,
+        scene: SceneAndCamera,
         scheme: &DumpScheme,
         producer: &str,
     ) -> Result<Self, DumpError> {
@@ -149,7 +149,7 @@ impl Dump {
     ///
     /// # Errors
     /// Arrays that disagree with the header, a file name that is not a plain name, or a scene
-    /// number that is not finite ([`SceneSpec::check_finite`]).
+    /// number that is not finite ([`SceneAndCamera::check_finite`]).
     pub fn encode(&self) -> Result<(String, BTreeMap<String, Vec<u8>>), DumpError> {
         check_distinct_files(&self.header.arrays)?;
         let mut files = BTreeMap::new();
