@@ -1,9 +1,14 @@
 //! The layouts a dump's words may have: which scheme's memory, with its parameters, and the rules
 //! every word of that layout obeys ([`Dump::check_words`]).
+//!
+//! The layouts and the header names that select them are the catalog's
+//! ([`fragsim_capture::catalog::DumpLayout`]): a header's `scheme` is the name of the catalog entry
+//! that heads a layout, and [`DumpScheme`] is that layout with the parameters its arrays need.
 
 use std::collections::BTreeMap;
 
 use fragsim_capture::abuffer::{ABuffer, PostSort};
+use fragsim_capture::catalog::{DumpLayout, SchemeName, SlotWord, Storage, CATALOG};
 use fragsim_capture::mdts::{Direction, Mdts};
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, Scheme};
 use fragsim_raster::Viewport;
@@ -44,6 +49,16 @@ pub enum DumpScheme {
     },
 }
 
+/// Catalog names as an alternative for an error message: `mdts, mdts32, mdts-desc or abuffer`.
+fn either<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let names: Vec<&str> = names.collect();
+    match names.split_last() {
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
 /// Names of the memory's two word arrays in a dump (`None`: the scheme uses no such words).
 pub(super) struct ArrayNames {
     pub(super) words32: Option<&'static str>,
@@ -57,45 +72,95 @@ pub(super) trait SchemeVisitor {
 }
 
 impl DumpScheme {
-    /// The header's `scheme` field.
+    /// The catalog's layout of these words.
     #[must_use]
-    pub fn name(&self) -> &'static str {
+    pub fn layout(&self) -> DumpLayout {
         match self {
             Self::Mdts {
                 direction: Direction::Ascending,
                 ..
-            } => "mdts",
+            } => DumpLayout::SlotArray(SlotWord::Fragment),
             Self::Mdts {
                 direction: Direction::Descending,
                 ..
-            } => "mdts-desc",
-            Self::Mdts32 { .. } => "mdts32",
-            Self::ABufferFixed { .. } | Self::ABufferExact { .. } => "abuffer",
+            } => DumpLayout::SlotArray(SlotWord::FragmentPlusOne),
+            Self::Mdts32 { .. } => DumpLayout::SlotArray(SlotWord::Key),
+            Self::ABufferFixed { .. } | Self::ABufferExact { .. } => DumpLayout::CountersAndSlots,
         }
     }
 
-    pub(super) fn word(&self) -> &'static str {
-        match self {
-            Self::Mdts {
+    /// The header's `scheme` field: the catalog name of the scheme that heads the layout.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        self.layout().scheme().name()
+    }
+
+    /// The layout scheme `name`'s memory has after a run of it with `slots` slots per pixel (K,
+    /// or the capacity) and the per-pixel `counts` of its counting pass, where one ran.
+    ///
+    /// # Errors
+    /// A scheme the catalog gives no dump layout (the error lists those it gives one), or storage
+    /// sized by a counting pass without its counts.
+    pub fn for_run(
+        name: SchemeName,
+        slots: u32,
+        counts: Option<&[u32]>,
+    ) -> Result<Self, DumpError> {
+        let entry = name.entry();
+        let Some(layout) = entry.dump else {
+            let dumpable = CATALOG.iter().filter(|e| e.dump.is_some());
+            return err(format!(
+                "scheme {name} has no dump layout; these have one: {}",
+                either(dumpable.map(|e| e.name))
+            ));
+        };
+        Ok(match layout {
+            DumpLayout::SlotArray(SlotWord::Fragment) => Self::Mdts {
+                k: slots,
+                direction: Direction::Ascending,
+            },
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => Self::Mdts {
+                k: slots,
                 direction: Direction::Descending,
-                ..
-            } => "(key<<32|prim)+1",
-            Self::Mdts32 { .. } => "key",
-            _ => "key<<32|prim",
+            },
+            DumpLayout::SlotArray(SlotWord::Key) => Self::Mdts32 { k: slots },
+            DumpLayout::CountersAndSlots if entry.storage == Storage::Counted => {
+                Self::ABufferExact {
+                    counts: counts
+                        .ok_or_else(|| DumpError(format!("{name} ran without its counting pass")))?
+                        .to_vec(),
+                    sorted: false,
+                }
+            }
+            DumpLayout::CountersAndSlots => Self::ABufferFixed {
+                capacity: slots,
+                sorted: false,
+            },
+        })
+    }
+
+    /// The header's `word` field (informative).
+    pub(super) fn word(&self) -> &'static str {
+        match self.layout() {
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => "(key<<32|prim)+1",
+            DumpLayout::SlotArray(SlotWord::Key) => "key",
+            DumpLayout::SlotArray(SlotWord::Fragment) | DumpLayout::CountersAndSlots => {
+                "key<<32|prim"
+            }
         }
     }
 
     pub(super) fn names(&self) -> ArrayNames {
-        match self {
-            Self::Mdts { .. } => ArrayNames {
-                words32: None,
-                words64: Some("slots"),
-            },
-            Self::Mdts32 { .. } => ArrayNames {
+        match self.layout() {
+            DumpLayout::SlotArray(SlotWord::Key) => ArrayNames {
                 words32: Some("slots"),
                 words64: None,
             },
-            Self::ABufferFixed { .. } | Self::ABufferExact { .. } => ArrayNames {
+            DumpLayout::SlotArray(_) => ArrayNames {
+                words32: None,
+                words64: Some("slots"),
+            },
+            DumpLayout::CountersAndSlots => ArrayNames {
                 words32: Some("counters"),
                 words64: Some("slots"),
             },
@@ -144,36 +209,41 @@ impl DumpScheme {
             Some(k) if k > 0 => Ok(k),
             _ => err(format!("scheme {} needs \"k\" ≥ 1", header.scheme)),
         };
-        match header.scheme.as_str() {
-            "mdts" => Ok(Self::Mdts {
+        let Some(layout) = DumpLayout::named(&header.scheme) else {
+            return err(format!(
+                "unknown scheme {:?}: expected {}",
+                header.scheme,
+                either(DumpLayout::names())
+            ));
+        };
+        let name = &header.scheme;
+        match layout {
+            DumpLayout::SlotArray(SlotWord::Fragment) => Ok(Self::Mdts {
                 k: k()?,
                 direction: Direction::Ascending,
             }),
-            "mdts-desc" => Ok(Self::Mdts {
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => Ok(Self::Mdts {
                 k: k()?,
                 direction: Direction::Descending,
             }),
-            "mdts32" => Ok(Self::Mdts32 { k: k()? }),
-            "abuffer" => match (header.capacity, offsets) {
-                (Some(0), _) => err("abuffer \"capacity\" must be at least 1"),
+            DumpLayout::SlotArray(SlotWord::Key) => Ok(Self::Mdts32 { k: k()? }),
+            DumpLayout::CountersAndSlots => match (header.capacity, offsets) {
+                (Some(0), _) => err(format!("{name} \"capacity\" must be at least 1")),
                 (Some(capacity), _) => Ok(Self::ABufferFixed {
                     capacity,
                     sorted: header.sorted,
                 }),
                 (None, Some(offsets)) => {
                     if offsets.first() != Some(&0) || offsets.windows(2).any(|w| w[0] > w[1]) {
-                        return err("abuffer offsets must start at 0 and never decrease");
+                        return err(format!("{name} offsets must start at 0 and never decrease"));
                     }
                     Ok(Self::ABufferExact {
                         counts: offsets.windows(2).map(|w| w[1] - w[0]).collect(),
                         sorted: header.sorted,
                     })
                 }
-                (None, None) => err("abuffer needs \"capacity\" or an \"offsets\" array"),
+                (None, None) => err(format!("{name} needs \"capacity\" or an \"offsets\" array")),
             },
-            other => err(format!(
-                "unknown scheme {other:?}: expected mdts, mdts32, mdts-desc or abuffer"
-            )),
         }
     }
 }

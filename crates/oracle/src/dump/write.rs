@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use fragsim_capture::catalog::DumpLayout;
 use fragsim_capture::{Scheme, SerialMemory, Step, WordMemory};
 use fragsim_raster::View;
 
@@ -70,10 +71,7 @@ impl Dump {
         }
         let (mut k, mut capacity, mut sorted) = (None, None, false);
         // fragsim's memory starts at the layout's initial words: the A-buffer's slots empty.
-        let filled = matches!(
-            scheme,
-            DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. }
-        );
+        let filled = scheme.layout() == DumpLayout::CountersAndSlots;
         let slots_shape = match scheme {
             DumpScheme::Mdts { k: n, .. } | DumpScheme::Mdts32 { k: n } => {
                 k = Some(*n);
