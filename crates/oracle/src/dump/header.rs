@@ -33,9 +33,9 @@ pub struct ArraySpec {
 /// The JSON header of a dump (`dump.json`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Header {
-    /// Always [`FORMAT`].
+    /// Always [`FORMAT`](super::FORMAT).
     pub format: String,
-    /// [`VERSION`].
+    /// [`VERSION`](super::VERSION).
     pub version: u32,
     /// Who wrote it (`fragsim 0.1.0`, `fragsim-cuda`, …): informative.
     #[serde(default)]
@@ -46,7 +46,8 @@ pub struct Header {
     pub width: u32,
     /// Viewport height in pixels.
     pub height: u32,
-    /// `mdts`, `mdts32`, `mdts-desc` or `abuffer` (see `docs/dump-format.md`).
+    /// The layout's name: the catalog name of the scheme that heads it (`docs/dump-format.md`,
+    /// [`DumpLayout::scheme`](fragsim_capture::catalog::DumpLayout::scheme)).
     pub scheme: String,
     /// MDTS slots per pixel.
     #[serde(default, skip_serializing_if = "Option::is_none")]

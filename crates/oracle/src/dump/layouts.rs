@@ -485,3 +485,79 @@ pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dump::{FORMAT, VERSION};
+    use crate::scene::SceneAndCamera;
+
+    fn header(scheme: &str) -> Header {
+        Header {
+            format: FORMAT.into(),
+            version: VERSION,
+            producer: String::new(),
+            scene: SceneAndCamera::named("quads:1", 0.0, 0.0),
+            width: 1,
+            height: 1,
+            scheme: scheme.into(),
+            k: Some(2),
+            capacity: Some(2),
+            sorted: false,
+            filled: false,
+            word: String::new(),
+            arrays: BTreeMap::new(),
+            extra: serde_json::Value::Null,
+        }
+    }
+
+    #[test]
+    fn header_names_are_the_catalogs_layouts() {
+        for name in DumpLayout::names() {
+            let scheme = DumpScheme::from_header(&header(name), None).unwrap();
+            assert_eq!(scheme.name(), name);
+            assert_eq!(Some(scheme.layout()), DumpLayout::named(name));
+        }
+        // A scheme that dumps under another's name is no header name of its own.
+        let unknown = DumpScheme::from_header(&header("abuffer-exact"), None).unwrap_err();
+        assert_eq!(
+            unknown.0,
+            "unknown scheme \"abuffer-exact\": expected mdts, mdts32, mdts-desc or abuffer"
+        );
+    }
+
+    #[test]
+    fn every_catalog_entry_with_a_layout_dumps_in_it() {
+        for entry in CATALOG {
+            let dumped = DumpScheme::for_run(entry.scheme, 3, Some(&[1, 2]));
+            match entry.dump {
+                Some(layout) => assert_eq!(dumped.unwrap().layout(), layout, "{}", entry.name),
+                None => {
+                    let error = dumped.unwrap_err().0;
+                    let expected = format!(
+                        "scheme {} has no dump layout; these have one: mdts, ",
+                        entry.name
+                    );
+                    assert!(error.starts_with(&expected), "{error}");
+                }
+            }
+        }
+        let exact = DumpScheme::for_run(SchemeName::AbufferExact, 1, Some(&[1, 2])).unwrap();
+        assert_eq!(
+            exact,
+            DumpScheme::ABufferExact {
+                counts: vec![1, 2],
+                sorted: false
+            }
+        );
+        assert!(DumpScheme::for_run(SchemeName::AbufferExact, 1, None).is_err());
+        let fixed = DumpScheme::for_run(SchemeName::AbufferBitonic, 4, Some(&[1, 2])).unwrap();
+        assert_eq!(
+            fixed,
+            DumpScheme::ABufferFixed {
+                capacity: 4,
+                sorted: false
+            }
+        );
+    }
+}

@@ -35,6 +35,11 @@
 //! assert!(comparison.is_equal() && comparison.words_checked);
 //! ```
 //!
+//! The parts: the header and its words (`header.rs`), the layouts and their word rules
+//! (`layouts.rs`, from the catalog's [`DumpLayout`](fragsim_capture::catalog::DumpLayout)),
+//! parsing and decoding (`read.rs`), recording and writing (`write.rs`); the scene a dump names is
+//! [`crate::scene`], the comparison [`crate::compare`], the triangle export [`crate::triangles`].
+//!
 //! Unlike the GPU, which leaves its words in device memory, [`Dump::record`] runs fragsim's scheme
 //! serially on [`SerialMemory`] and copies every word out; for MDTS the words are the same under
 //! any interleaving (the sortedness proof), for the A-buffer the slot order within a pixel is the
@@ -63,8 +68,9 @@ pub use crate::compare::{
     compare, compare_with, complete_pixels, verdict, with_identity, CompareOptions, Comparison,
     VerdictCounts,
 };
-/// [`SceneAndCamera`](crate::scene::SceneAndCamera)'s former name, which the property tests' scene strategy also has: kept for
-/// the callers of `dump::SceneSpec` until they move to the new name.
+/// [`SceneAndCamera`](crate::scene::SceneAndCamera)'s former name, which the property tests'
+/// scene strategy also has: kept for the callers of `dump::SceneSpec` until they move to the new
+/// name.
 pub type SceneSpec = crate::scene::SceneAndCamera;
 pub use crate::triangles::{
     TriangleExport, TRIANGLES_MAGIC, TRIANGLES_VERSION, TRIANGLE_RECORD_BYTES,
