@@ -71,33 +71,28 @@ impl Capacity {
     }
 }
 
-/// Per-pixel lists of captured fragments in the order the scheme's post pass produced them.
+/// Per-pixel lists of packed fragment words, pixel after pixel: what a scheme captures
+/// ([`Capture`]) and what the oracle holds (`fragsim_oracle::Oracle`), one type so that either
+/// side reads the other's lists without a conversion.
 ///
-/// Entries are packed `depth_key << 32 | prim` (see `Fragment::packed`); with
-/// [`Identity::KeyOnly`] the low half is zero.
+/// Entries are packed `depth_key << 32 | prim` (see `Fragment::packed`).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Capture {
-    /// `offsets[p]..offsets[p + 1]` indexes pixel `p`'s entries.
+pub struct PixelLists {
+    /// `offsets[p]..offsets[p + 1]` indexes pixel `p`'s entries; `offsets[0]` is 0.
     pub offsets: Vec<usize>,
     /// The entries of all pixels, pixel after pixel.
     pub entries: Vec<u64>,
-    /// What the entries identify.
-    pub identity: Identity,
-    /// What the scheme promises to keep.
-    pub keeps: Keeps,
 }
 
-impl Capture {
-    /// An empty capture builder for `pixels` pixels.
+impl PixelLists {
+    /// No pixel yet, room for `pixels` of them: a builder for [`PixelLists::push_pixel`].
     #[must_use]
-    pub fn with_pixels(pixels: usize, identity: Identity, keeps: Keeps) -> Self {
+    pub fn with_pixels(pixels: usize) -> Self {
         let mut offsets = Vec::with_capacity(pixels + 1);
         offsets.push(0);
         Self {
             offsets,
             entries: Vec::new(),
-            identity,
-            keeps,
         }
     }
 
@@ -117,6 +112,60 @@ impl Capture {
     #[must_use]
     pub fn pixel(&self, p: usize) -> &[u64] {
         &self.entries[self.offsets[p]..self.offsets[p + 1]]
+    }
+
+    /// Each pixel's entry count, pixel after pixel.
+    pub fn lengths(&self) -> impl Iterator<Item = usize> + '_ {
+        self.offsets.windows(2).map(|w| w[1] - w[0])
+    }
+
+    /// Sorts each pixel's list (ascending words: canonical order for `key << 32 | prim`).
+    pub fn sort_each_pixel(&mut self) {
+        for p in 0..self.pixels() {
+            self.entries[self.offsets[p]..self.offsets[p + 1]].sort_unstable();
+        }
+    }
+}
+
+/// Per-pixel lists of captured fragments in the order the scheme's post pass produced them, with
+/// what they identify and what the scheme promised to keep.
+///
+/// The lists are [`Capture::lists`]; a capture dereferences to them, so `capture.pixel(p)` and
+/// `capture.entries` read them directly. With [`Identity::KeyOnly`] the low half of each entry
+/// is zero.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Capture {
+    /// The per-pixel lists.
+    pub lists: PixelLists,
+    /// What the entries identify.
+    pub identity: Identity,
+    /// What the scheme promises to keep.
+    pub keeps: Keeps,
+}
+
+impl std::ops::Deref for Capture {
+    type Target = PixelLists;
+
+    fn deref(&self) -> &PixelLists {
+        &self.lists
+    }
+}
+
+impl std::ops::DerefMut for Capture {
+    fn deref_mut(&mut self) -> &mut PixelLists {
+        &mut self.lists
+    }
+}
+
+impl Capture {
+    /// An empty capture builder for `pixels` pixels ([`PixelLists::push_pixel`] adds them).
+    #[must_use]
+    pub fn with_pixels(pixels: usize, identity: Identity, keeps: Keeps) -> Self {
+        Self {
+            lists: PixelLists::with_pixels(pixels),
+            identity,
+            keeps,
+        }
     }
 
     /// The nearest depth key per pixel (`None` where nothing was captured), for images.

@@ -401,7 +401,7 @@ pub(crate) fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: 
     let mut all_overflow = vec![0; pixels];
     // Each chunk's share of the entries, cut in order; offsets and overflow cut evenly.
     let mut entry_slices = Vec::with_capacity(chunks.len());
-    let (mut rest, mut base) = (capture.entries.as_mut_slice(), 0);
+    let (mut rest, mut base) = (capture.lists.entries.as_mut_slice(), 0);
     for (entries, _, _) in &chunks {
         let (slice, tail) = rest.split_at_mut(entries.len());
         entry_slices.push((slice, base));
@@ -411,7 +411,7 @@ pub(crate) fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: 
     chunks
         .into_par_iter()
         .zip(entry_slices)
-        .zip(capture.offsets[1..].par_chunks_mut(PIXELS_PER_TASK))
+        .zip(capture.lists.offsets[1..].par_chunks_mut(PIXELS_PER_TASK))
         .zip(all_overflow.par_chunks_mut(PIXELS_PER_TASK))
         .for_each(
             |((((entries, ends, overflow), (entry_slice, base)), offsets), overflow_out)| {

@@ -62,7 +62,7 @@ pub mod stencil_routed;
 pub mod tiled;
 pub mod zbuffer;
 
-pub use capture::{Capacity, Capture, Identity, Keeps};
+pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 pub use counting::CountingMemory;
 pub use guarantee::Guarantee;
 pub use memory::{AtomicMemory, Memory, SerialMemory, Word, WordMemory};

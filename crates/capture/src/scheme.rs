@@ -159,7 +159,7 @@ pub trait Scheme: Sync {
         let mut overflow = Vec::with_capacity(self.pixels());
         for pixel in 0..self.pixels() {
             overflow.push(self.resolve_pixel(memory, pixel, &mut capture.entries));
-            capture.offsets.push(capture.entries.len());
+            capture.lists.offsets.push(capture.lists.entries.len());
         }
         capture.keeps = self.keeps(overflow);
         capture

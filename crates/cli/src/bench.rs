@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{AttributePass, EffectName, Judge, Judged};
-use crate::schemes::{check_memory_cap_early, Executors, SchemeChoice};
+use crate::schemes::{check_memory_cap_early, Executors, SchemeChoice, SchemeName};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -304,11 +304,18 @@ fn time_raster_alone(view: &View<'_>) -> Duration {
     start.elapsed()
 }
 
-/// Depth peeling is the papers' baseline: every row gets the ratio of its time to it.
+/// Classical depth peeling (64- or 32-bit words) is the papers' baseline: every row gets the
+/// ratio of its time to it.
 fn set_speedups(rows: &mut [BenchRow]) {
+    let is_baseline = |scheme: &str| {
+        matches!(
+            SchemeName::from_name(scheme),
+            Some(SchemeName::Peeling | SchemeName::Peeling32)
+        )
+    };
     let baselines: Vec<(String, f64)> = rows
         .iter()
-        .filter(|r| r.scheme.starts_with("peeling") || r.scheme == "dp")
+        .filter(|r| is_baseline(&r.scheme))
         .map(|r| (r.executor.clone(), r.median_ms))
         .collect();
     for row in rows.iter_mut() {

@@ -13,9 +13,12 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
-use fragsim_oracle::dump::{
-    self, verdict, CompareOptions, Comparison, CorruptWord, Dump, Header, VerdictCounts,
+use fragsim_oracle::compare::{
+    compare_with, complete_pixels, verdict, with_identity, CompareOptions, Comparison,
+    VerdictCounts,
 };
+use fragsim_oracle::dump::{CorruptWord, Dump, Header};
+use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::depth_from_key;
 use serde::Serialize;
@@ -160,7 +163,7 @@ struct Report {
     equal: bool,
     reference: SideReport,
     candidate: SideReport,
-    scene: dump::SceneSpec,
+    scene: SceneAndCamera,
     width: u32,
     height: u32,
     compared: String,
@@ -238,7 +241,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
                      be there: the comparison cannot be trusted, and is not called equal"
                 ));
             }
-            complete = Some(dump::complete_pixels(&capture));
+            complete = Some(complete_pixels(&capture));
             from_dump = Oracle::from_capture(&capture);
             (&from_dump, capture.identity)
         }
@@ -261,7 +264,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     }
     if reference_identity == Identity::KeyOnly && candidate_capture.identity != Identity::KeyOnly {
         notes.push("the reference holds depth keys only: primitive ids are not compared".into());
-        candidate_capture = dump::with_identity(&candidate_capture, Identity::KeyOnly);
+        candidate_capture = with_identity(&candidate_capture, Identity::KeyOnly);
     }
     if candidate_capture.pixels() != reference_oracle.pixels() {
         return Err(format!(
@@ -275,7 +278,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         examples: args.show,
         complete: complete.as_deref(),
     };
-    let comparison = dump::compare_with(
+    let comparison = compare_with(
         reference_oracle,
         &candidate_capture,
         words.as_ref(),
@@ -348,19 +351,14 @@ fn dump_dir(path: &Path) -> PathBuf {
 
 /// The oracle's lists as a capture that promises every fragment.
 fn oracle_capture(oracle: &Oracle) -> Capture {
-    let pixels = oracle.pixels();
-    let mut capture = Capture::with_pixels(
-        pixels,
-        Identity::KeyAndPrim,
-        Keeps::All {
+    Capture {
+        lists: oracle.lists().clone(),
+        identity: Identity::KeyAndPrim,
+        keeps: Keeps::All {
             capacity: Capacity::Unbounded,
-            overflow: vec![0; pixels],
+            overflow: vec![0; oracle.pixels()],
         },
-    );
-    for p in 0..pixels {
-        capture.push_pixel(oracle.pixel(p).iter().copied());
     }
-    capture
 }
 
 /// Why a dump used as the reference may not be the whole truth.

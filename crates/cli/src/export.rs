@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_capture::mdts::Direction;
-use fragsim_oracle::dump::{Dump, DumpScheme, SceneSpec, TriangleExport};
+use fragsim_oracle::dump::{Dump, DumpScheme};
+use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::triangles::TriangleExport;
 use fragsim_raster::View;
 
 use crate::args::SceneArgs;
@@ -23,10 +24,10 @@ pub struct ExportArgs {
 }
 
 /// The scene description a dump or an export carries.
-fn scene_spec(args: &SceneArgs) -> SceneSpec {
+fn scene_spec(args: &SceneArgs) -> SceneAndCamera {
     match &args.mesh {
-        Some(path) => SceneSpec::mesh(path, args.view, args.elevation),
-        None => SceneSpec::named(&args.scene, args.view, args.elevation),
+        Some(path) => SceneAndCamera::mesh(path, args.view, args.elevation),
+        None => SceneAndCamera::named(&args.scene, args.view, args.elevation),
     }
 }
 
@@ -54,35 +55,6 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The dump layout of a `render` scheme, with K and capacity as its run had them.
-fn dump_scheme(name: SchemeName, run: &NamedRun) -> Result<DumpScheme, String> {
-    let slots = run.slots.unwrap_or(1);
-    Ok(match name {
-        SchemeName::Mdts => DumpScheme::Mdts {
-            k: slots,
-            direction: Direction::Ascending,
-        },
-        SchemeName::MdtsDesc => DumpScheme::Mdts {
-            k: slots,
-            direction: Direction::Descending,
-        },
-        SchemeName::Mdts32 => DumpScheme::Mdts32 { k: slots },
-        SchemeName::Abuffer | SchemeName::AbufferBitonic => DumpScheme::ABufferFixed {
-            capacity: slots,
-            sorted: false,
-        },
-        SchemeName::AbufferExact => DumpScheme::ABufferExact {
-            counts: run
-                .counts
-                .clone()
-                .ok_or("abuffer-exact ran without its counting pass")?,
-            sorted: false,
-        },
-        #[allow(unreachable_patterns)]
-        other => return Err(format!("scheme {other:?} has no dump layout")),
-    })
-}
-
 /// Writes scheme `name`'s memory, sized as `run` was, after a serial run, as a dump in `dir/<scheme>/`; returns
 /// that directory.
 ///
@@ -95,7 +67,8 @@ pub(crate) fn write_dump(
     view: &View<'_>,
     scene: &SceneArgs,
 ) -> Result<PathBuf, String> {
-    let scheme = dump_scheme(name, run)?;
+    let scheme = DumpScheme::for_run(name, run.slots.unwrap_or(1), run.counts.as_deref())
+        .map_err(|e| e.to_string())?;
     let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
     let dump =
         Dump::record(view, scene_spec(scene), &scheme, &producer).map_err(|e| e.to_string())?;

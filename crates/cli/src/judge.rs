@@ -23,7 +23,7 @@ use std::borrow::Cow;
 use std::time::Instant;
 
 use clap::ValueEnum;
-use fragsim_capture::{Capture, Identity};
+use fragsim_capture::{Capture, Identity, PixelLists};
 use fragsim_oracle::Oracle;
 use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
@@ -265,8 +265,10 @@ pub fn complete<'c>(
                 .flat_map_iter(|p| prims_of_keys(capture.pixel(p), oracle.pixel(p)))
                 .collect();
             let full = Capture {
-                offsets: capture.offsets.clone(),
-                entries,
+                lists: PixelLists {
+                    offsets: capture.offsets.clone(),
+                    entries,
+                },
                 identity: Identity::KeyAndPrim,
                 keeps: capture.keeps.clone(),
             };

@@ -1,0 +1,255 @@
+//! The catalog: every scheme the simulator can run by name, and how to build and run it.
+//!
+//! One entry per scheme ([`CATALOG`]): its name (the one spelling used on the command line, in
+//! JSON, in file names and in dump headers, and the one its [`Scheme::name`](crate::Scheme::name)
+//! returns), its geometry passes, how it sizes its storage, its memory's layout in a dump
+//! ([`DumpLayout`], where it has one), a one-line description, and — through [`Executors::run`] —
+//! a constructor from a [`Sizing`] that builds it and runs one frame. What a scheme guarantees is
+//! never listed here: it comes from the built scheme
+//! ([`Scheme::guarantee`](crate::Scheme::guarantee)). Front ends (the command line, the dump
+//! reader and writer, the property tests) iterate this list, so adding a scheme means its module
+//! plus one entry and one constructor arm here.
+//!
+//! The catalog's parts: the entries and their columns here, [`DumpLayout`] in `dump_layout.rs`,
+//! building and running an entry in `run.rs`.
+
+mod dump_layout;
+mod run;
+
+pub use dump_layout::{DumpLayout, SlotWord};
+pub use run::{check_memory_cap_early, Executors, Fault, NamedRun};
+
+use crate::kbuffer::WriteBack;
+
+/// A slot count: a number, or derived from the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Count {
+    /// Sized to the scene's depth complexity by a counting pass of the scheme's own.
+    Auto,
+    /// Exactly this many.
+    Fixed(u32),
+}
+
+/// How the user sized the schemes. Nothing here comes from the oracle: where a size is `auto`
+/// (or a scheme's storage is sized to the scene by design), the scheme runs its own counting pass
+/// first ([`crate::depth_count`]), and its run reports that pass.
+#[derive(Debug, Clone, Copy)]
+pub struct Sizing {
+    /// Slots per pixel of the K-sized schemes (`--k`).
+    pub k: Count,
+    /// Slots per pixel of the capacity-sized schemes (`--capacity`; linked lists: pool nodes).
+    pub capacity: Count,
+    /// Refuse storage beyond this many bytes (`--memory-cap`).
+    pub memory_cap: u64,
+}
+
+/// How a scheme sizes its per-pixel storage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Storage {
+    /// This many slots per pixel, whatever the sizing.
+    Slots(u32),
+    /// [`Sizing::k`] slots per pixel (a counting pass first where it is `auto`).
+    K,
+    /// [`Sizing::capacity`] slots per pixel (a counting pass first where it is `auto`).
+    Capacity,
+    /// [`Sizing::k`] nodes kept by the resolve, from a pool of [`Sizing::capacity`] nodes per
+    /// pixel (a counting pass first where either is `auto`; `auto` pools hold the scene's
+    /// fragments).
+    KAndPool,
+    /// Sized to the scene by its own counting pass, always (storage for every fragment, or a
+    /// record of every layer).
+    Counted,
+}
+
+/// How many geometry passes a scheme runs (its counting pass, where one runs, not included).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Passes {
+    /// Exactly this many.
+    Fixed(u32),
+    /// At most this many: a later pass runs only where an earlier one overflowed.
+    UpTo(u32),
+    /// `before` passes, then one per `per` layers of the scene's maximum depth complexity
+    /// (rounded up), then `after` passes (peeling's last one, which finds nothing).
+    PerLayers {
+        /// Passes before the layers' (ADP's range and histogram).
+        before: u32,
+        /// Layers captured per pass.
+        per: u32,
+        /// Passes after the layers'.
+        after: u32,
+    },
+    /// At least one, repeated until every fragment is confirmed by a count (hazards cost
+    /// passes).
+    UntilConfirmed,
+}
+
+impl Passes {
+    /// The least and the most passes (`None`: unbounded) on a scene of maximum depth complexity
+    /// `layers`.
+    #[must_use]
+    pub fn bounds(self, layers: u32) -> (u32, Option<u32>) {
+        match self {
+            Passes::Fixed(n) => (n, Some(n)),
+            Passes::UpTo(n) => (1, Some(n)),
+            Passes::PerLayers { before, per, after } => {
+                let n = before + layers.div_ceil(per) + after;
+                (n, Some(n))
+            }
+            Passes::UntilConfirmed => (1, None),
+        }
+    }
+}
+
+/// One scheme of the catalog.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Entry {
+    /// Which scheme.
+    pub scheme: SchemeName,
+    /// Its one spelling: the command line's, JSON's, file names' and dump headers'.
+    pub name: &'static str,
+    /// Its geometry passes.
+    pub passes: Passes,
+    /// How it sizes its storage.
+    pub storage: Storage,
+    /// How its memory is laid out in a dump; `None`: it cannot be dumped.
+    pub dump: Option<DumpLayout>,
+    /// One line on what it is (the command line's help).
+    pub description: &'static str,
+}
+
+macro_rules! catalog {
+    ($($scheme:ident $name:literal $passes:expr, $storage:expr, $dump:expr,
+        $description:literal;)*) => {
+        /// Every scheme the simulator runs by name.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum SchemeName {
+            $(#[doc = $description] $scheme,)*
+        }
+
+        /// Every scheme, in the order tables list them.
+        pub const CATALOG: &[Entry] = &[
+            $(Entry {
+                scheme: SchemeName::$scheme,
+                name: $name,
+                passes: $passes,
+                storage: $storage,
+                dump: $dump,
+                description: $description,
+            },)*
+        ];
+    };
+}
+
+use DumpLayout::{CountersAndSlots, SlotArray};
+use Passes::{Fixed, PerLayers, UntilConfirmed, UpTo};
+use SlotWord::{Fragment, FragmentPlusOne, Key};
+use Storage::{Capacity, Counted, KAndPool, Slots, K};
+
+catalog! {
+    Mdts "mdts" Fixed(1), K, Some(SlotArray(Fragment)),
+        "MDTS, 64-bit words (depth key and primitive id), ascending.";
+    Mdts32 "mdts32" Fixed(1), K, Some(SlotArray(Key)),
+        "MDTS, 32-bit depth keys as in FreePipe's Table 1.";
+    MdtsDesc "mdts-desc" Fixed(1), K, Some(SlotArray(FragmentPlusOne)),
+        "MDTS with `atomicMax`, descending.";
+    MdtsProbe "mdts-probe" Fixed(1), K, None,
+        "MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would change the slot (same lists, fewer locked operations).";
+    Abuffer "abuffer" Fixed(1), Capacity, Some(CountersAndSlots),
+        "FreePipe's A-buffer: `--capacity` slots per pixel (fixed arrays, FreePipe §4.2), overflow counted; insertion-sorted.";
+    AbufferBitonic "abuffer-bitonic" Fixed(1), Capacity, Some(CountersAndSlots),
+        "The A-buffer as above, bitonic-sorted.";
+    AbufferExact "abuffer-exact" Fixed(1), Counted, Some(CountersAndSlots),
+        "The A-buffer with storage sized exactly by its own counting pass (`fetch_add` per fragment, then a prefix sum): two geometry passes.";
+    Peeling "peeling" PerLayers { before: 0, per: 1, after: 1 }, Counted, None,
+        "Classical depth peeling, 64-bit words (ties ordered by primitive id): one pass per layer.";
+    Peeling32 "peeling32" PerLayers { before: 0, per: 1, after: 1 }, Counted, None,
+        "Classical depth peeling on 32-bit depth keys: equal depths merge.";
+    DualPeeling "dual-peeling" PerLayers { before: 0, per: 2, after: 1 }, Counted, None,
+        "Dual depth peeling (nearest and farthest layer per pass), 64-bit words.";
+    DualPeeling32 "dual-peeling32" PerLayers { before: 0, per: 2, after: 1 }, Counted, None,
+        "Dual depth peeling on 32-bit depth keys.";
+    Zbuffer "zbuffer" Fixed(1), Slots(1), None,
+        "The opaque z-buffer via `atomicMin`: the nearest fragment only.";
+    Bdp "bdp" Fixed(2), Slots(32), None,
+        "Bucket depth peeling, one pass, 16 bucket pairs (HPG 2009 §3.2).";
+    BdpSingle "bdp-single" Fixed(2), Slots(32), None,
+        "Bucket depth peeling, 32 single-value buckets.";
+    Bdp2 "bdp2" Fixed(3), Slots(64), None,
+        "Two-pass bucket depth peeling (§3.2).";
+    Adp "adp" PerLayers { before: 2, per: 32, after: 0 }, Counted, None,
+        "Adaptive bucket depth peeling (§3.3).";
+    Kbuffer "kbuffer" Fixed(1), K, None,
+        "The k-buffer: read–insert–write of K slots, exact only without concurrent hazards; render-target write-backs (one step each, committed in primitive order).";
+    KbufferStores "kbuffer-stores" Fixed(1), K, None,
+        "The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.";
+    KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
+        "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
+    KbufferMultipassStores "kbuffer-multipass-stores" UntilConfirmed, Counted, None,
+        "The multi-pass k-buffer with K separate loads and stores.";
+    Srab "srab" UpTo(2), Slots(16), None,
+        "The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.";
+    MdtsPacked "mdts-packed" Fixed(1), K, None,
+        "MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).";
+    Loop32 "loop32" Fixed(2), K, None,
+        "nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths merge), then a colour pass; K = `--k`.";
+    LayerCounter "layer-counter" Fixed(1), K, None,
+        "Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.";
+    LinkedList "linked-list" Fixed(1), KAndPool, None,
+        "Per-pixel linked lists (node counter, head exchange), the resolve keeping the first `--k` nodes (the most recent: Vulkan-Samples); node pool `--capacity` per pixel, `exact` = the scene's fragments.";
+    LinkedListNearest "linked-list-nearest" Fixed(1), KAndPool, None,
+        "Per-pixel linked lists, the resolve keeping the `--k` nearest (nvpro-samples).";
+}
+
+impl SchemeName {
+    /// The scheme's catalog entry.
+    #[must_use]
+    pub fn entry(self) -> &'static Entry {
+        // The catalog lists the variants in declaration order (one macro writes both).
+        &CATALOG[self as usize]
+    }
+
+    /// The scheme's one spelling.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        self.entry().name
+    }
+
+    /// The scheme spelled `name`, if the catalog has one.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<SchemeName> {
+        CATALOG.iter().find(|e| e.name == name).map(|e| e.scheme)
+    }
+
+    /// The machine a k-buffer scheme runs on: separate stores for the `-stores` names, render
+    /// targets otherwise.
+    #[must_use]
+    pub fn write_back(self) -> WriteBack {
+        match self {
+            SchemeName::KbufferStores | SchemeName::KbufferMultipassStores => {
+                WriteBack::SeparateStores
+            }
+            _ => WriteBack::RenderTarget,
+        }
+    }
+
+    /// Whether the scheme, sized by `sizing`, needs the scene's per-pixel depth complexity, and
+    /// so a counting pass before its capture.
+    #[must_use]
+    pub fn needs_count_pass(self, sizing: &Sizing) -> bool {
+        let k_auto = sizing.k == Count::Auto;
+        let capacity_auto = sizing.capacity == Count::Auto;
+        match self.entry().storage {
+            Storage::Slots(_) => false,
+            Storage::K => k_auto,
+            Storage::Capacity => capacity_auto,
+            Storage::KAndPool => k_auto || capacity_auto,
+            Storage::Counted => true,
+        }
+    }
+}
+
+impl std::fmt::Display for SchemeName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -1,0 +1,433 @@
+//! Comparing a capture (a dump's decoded lists, or a run's) with a reference pixel by pixel: the
+//! verdict of every pixel, and the totals.
+
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
+use serde::Serialize;
+
+use crate::dump::{CorruptWord, Counter, Dump, DumpError, WordCheck};
+use crate::{Diff, Oracle, PixelMismatch};
+
+/// A capture reduced to a coarser identity (e.g. to compare a u64 dump with a u32 reference).
+#[must_use]
+pub fn with_identity(capture: &Capture, identity: Identity) -> Capture {
+    let mask = match identity {
+        Identity::KeyAndPrim => u64::MAX,
+        Identity::KeyOnly => u64::MAX << 32,
+        Identity::PrimOnly => u64::from(u32::MAX),
+    };
+    Capture {
+        lists: PixelLists {
+            offsets: capture.offsets.clone(),
+            entries: capture.entries.iter().map(|e| e & mask).collect(),
+        },
+        identity,
+        keeps: capture.keeps.clone(),
+    }
+}
+
+/// Per-pixel verdict flags of a comparison (a pixel with none of [`verdict::DIFFERS`] is equal).
+pub mod verdict {
+    /// Fragments the reference has and the candidate should have kept are missing.
+    pub const MISSING: u8 = 1;
+    /// The candidate has fragments the reference does not.
+    pub const EXTRA: u8 = 2;
+    /// The candidate's list is out of canonical order.
+    pub const MISORDERED: u8 = 4;
+    /// Storage overflowed by design (beyond K, past a capacity): counted, not an error by itself.
+    pub const OVERFLOWED: u8 = 8;
+    /// An A-buffer counter that is not the pixel's fragment count: larger than the pixel could
+    /// have, or an overflow `counter − capacity` other than `max(0, n − capacity)`.
+    pub const MISCOUNTED: u8 = 16;
+    /// A stored word that the layout says cannot be there ([`crate::dump::Corruption`]).
+    pub const CORRUPT: u8 = 32;
+    /// Flags that make a pixel differ.
+    pub const DIFFERS: u8 = MISSING | EXTRA | MISORDERED | MISCOUNTED | CORRUPT;
+
+    /// Each flag with its name in reports, in report order.
+    pub const NAMES: [(u8, &str); 6] = [
+        (MISSING, "missing"),
+        (EXTRA, "extra"),
+        (MISORDERED, "misordered"),
+        (OVERFLOWED, "overflowed"),
+        (MISCOUNTED, "overflow-miscounted"),
+        (CORRUPT, "corrupt"),
+    ];
+
+    /// The names of the flags set in `flags`.
+    #[must_use]
+    pub fn names(flags: u8) -> Vec<&'static str> {
+        NAMES
+            .iter()
+            .filter(|(flag, _)| flags & flag != 0)
+            .map(|&(_, name)| name)
+            .collect()
+    }
+}
+
+/// Pixel counts per verdict; the JSON keys are the verdicts' names.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct VerdictCounts {
+    /// Pixels equal to the reference (possibly with overflow by design).
+    pub equal: u64,
+    /// Pixels missing fragments.
+    pub missing: u64,
+    /// Pixels with extra fragments.
+    pub extra: u64,
+    /// Pixels out of order.
+    pub misordered: u64,
+    /// Pixels whose storage overflowed by design.
+    pub overflowed: u64,
+    /// Pixels whose A-buffer counter is not their fragment count.
+    #[serde(rename = "overflow-miscounted")]
+    pub miscounted: u64,
+    /// Pixels holding a word their layout says cannot be there.
+    pub corrupt: u64,
+}
+
+impl VerdictCounts {
+    /// Counts one pixel's flags.
+    fn add(&mut self, flags: u8) {
+        let counters = [
+            (verdict::MISSING, &mut self.missing),
+            (verdict::EXTRA, &mut self.extra),
+            (verdict::MISORDERED, &mut self.misordered),
+            (verdict::OVERFLOWED, &mut self.overflowed),
+            (verdict::MISCOUNTED, &mut self.miscounted),
+            (verdict::CORRUPT, &mut self.corrupt),
+        ];
+        for (flag, count) in counters {
+            *count += u64::from(flags & flag != 0);
+        }
+        self.equal += u64::from(flags & verdict::DIFFERS == 0);
+    }
+}
+
+/// The result of [`compare`] and [`compare_with`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Comparison {
+    /// Totals over every pixel (the sum of one [`Oracle::diff`] per pixel), with the first
+    /// `examples` differing pixels. `overflowed` is the overflow the reference predicts where it
+    /// knows the pixel's fragment count (`max(0, n − capacity)`), not what counters claim;
+    /// `mismatched_pixels` counts every pixel with a [`verdict::DIFFERS`] flag.
+    pub diff: Diff,
+    /// Per pixel, `verdict` flags.
+    pub verdicts: Vec<u8>,
+    /// Pixels per verdict.
+    pub counts: VerdictCounts,
+    /// The overflow the candidate claims: its A-buffer counters' `Σ (counter − stored)`, or for
+    /// MDTS what lies beyond K (its promise); equal to `diff.overflowed` unless a counter is
+    /// miscounted.
+    pub claimed_overflow: u64,
+    /// Words that the layout says cannot be there (0 when no words were checked).
+    pub corrupt_words: u64,
+    /// Words the layout leaves undefined, not checked ([`WordCheck::unchecked`]).
+    pub unchecked_words: u64,
+    /// Whether the candidate's words were checked at all ([`compare_with`] with a
+    /// [`WordCheck`]), not only its decoded lists.
+    pub words_checked: bool,
+    /// The corrupt words of the pixels in `diff.first_mismatches`.
+    pub first_corrupt: Vec<CorruptWord>,
+}
+
+impl Comparison {
+    /// Whether every pixel is equal (overflow by design allowed).
+    #[must_use]
+    pub fn is_equal(&self) -> bool {
+        self.diff.is_exact()
+    }
+}
+
+/// How [`compare_with`] judges.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CompareOptions<'a> {
+    /// Accept a candidate key within this many f32 ulps of an otherwise unmatched reference
+    /// fragment of the same primitive (any, for key-only words); 0: bit for bit.
+    pub depth_ulps: u32,
+    /// How many differing pixels to keep as examples.
+    pub examples: usize,
+    /// Per pixel, whether the reference knows every fragment there; `None`: everywhere, as the
+    /// oracle does. An A-buffer counter is checked against the pixel's fragment count only
+    /// where the reference knows it ([`complete_pixels`] of a dump used as the reference).
+    pub complete: Option<&'a [bool]>,
+}
+
+/// Per pixel, whether a capture holds every fragment of the pixel: fewer than K in an MDTS
+/// pixel, no overflow in an A-buffer one. Where it does not, a comparison against it cannot
+/// know the pixel's fragment count.
+#[must_use]
+pub fn complete_pixels(capture: &Capture) -> Vec<bool> {
+    (0..capture.pixels())
+        .map(|p| match &capture.keeps {
+            Keeps::Nearest(k) | Keeps::Farthest(k) => capture.pixel(p).len() < *k as usize,
+            Keeps::All { overflow, .. } => overflow[p] == 0,
+        })
+        .collect()
+}
+
+/// Compares `candidate`'s decoded lists with `reference` pixel by pixel under the candidate's
+/// promise ([`compare_with`] with no word check and a reference that knows every fragment).
+///
+/// # Panics
+/// If the capture and the reference cover different numbers of pixels.
+#[must_use]
+pub fn compare(
+    reference: &Oracle,
+    candidate: &Capture,
+    depth_ulps: u32,
+    examples: usize,
+) -> Comparison {
+    let options = CompareOptions {
+        depth_ulps,
+        examples,
+        complete: None,
+    };
+    compare_with(reference, candidate, None, &options)
+}
+
+impl Dump {
+    /// Compares this dump with `reference`: its decoded lists ([`Dump::capture`]) and every one
+    /// of its words ([`Dump::check_words`]), with [`compare_with`].
+    ///
+    /// # Errors
+    /// As [`Dump::capture`].
+    ///
+    /// # Panics
+    /// If the dump and the reference cover different numbers of pixels.
+    pub fn compare(
+        &self,
+        reference: &Oracle,
+        options: &CompareOptions<'_>,
+    ) -> Result<Comparison, DumpError> {
+        let capture = self.capture()?;
+        let words = self.check_words()?;
+        Ok(compare_with(reference, &capture, Some(&words), options))
+    }
+}
+
+/// An A-buffer pixel's counter as a capture alone shows it: `stored + overflow`, and a capacity
+/// of `stored` when it overflowed (storage ran out), unknown (at least `stored`) when not.
+fn inferred_counter(stored: usize, overflow: u32) -> Counter {
+    Counter {
+        count: stored as u32 + overflow,
+        capacity: if overflow > 0 {
+            stored as u32
+        } else {
+            u32::MAX
+        },
+    }
+}
+
+/// Compares `candidate` with `reference` pixel by pixel under the candidate's promise, with
+/// [`Oracle::diff`] on each pixel, and adds what `words` (the candidate dump's
+/// [`WordCheck`]) found: a pixel with a corrupt word is [`verdict::CORRUPT`] whatever its list,
+/// and an A-buffer slot holding the empty marker is taken out of the list (it is no fragment,
+/// so it is corrupt, not extra).
+///
+/// An A-buffer counter must equal its pixel's fragment count `n`, which the reference knows
+/// (where `options.complete` says so): every fragment adds one and the counter never wraps. A
+/// counter that differs is [`verdict::MISCOUNTED`]: larger than the pixel could have, or an
+/// overflow `counter − capacity` other than `max(0, n − capacity)`. The overflow allowed to be
+/// missing is then `max(0, n − capacity)`, never what the counter claims; without `words` the
+/// counter and capacity are inferred from the capture ([`Keeps::All`]'s overflow).
+///
+/// With `options.depth_ulps > 0`, a candidate fragment whose key lies within that many f32 ulps
+/// of an otherwise unmatched reference fragment of the same primitive (any, for key-only words)
+/// counts as that fragment; a list the candidate stored in order stays in order.
+///
+/// # Panics
+/// If the capture, the reference, `words` or `options.complete` cover different numbers of
+/// pixels.
+#[must_use]
+pub fn compare_with(
+    reference: &Oracle,
+    candidate: &Capture,
+    words: Option<&WordCheck>,
+    options: &CompareOptions<'_>,
+) -> Comparison {
+    let pixels = candidate.pixels();
+    assert_eq!(
+        reference.pixels(),
+        pixels,
+        "capture and reference cover different viewports"
+    );
+    if let Some(words) = words {
+        assert_eq!(
+            words.corrupt.len(),
+            pixels,
+            "word check of another viewport"
+        );
+    }
+    if let Some(complete) = options.complete {
+        assert_eq!(complete.len(), pixels, "completeness of another viewport");
+    }
+    let mut comparison = Comparison {
+        diff: Diff::default(),
+        verdicts: Vec::with_capacity(pixels),
+        counts: VerdictCounts::default(),
+        claimed_overflow: 0,
+        corrupt_words: words.map_or(0, WordCheck::corrupt_words),
+        unchecked_words: words.map_or(0, |w| w.unchecked),
+        words_checked: words.is_some(),
+        first_corrupt: Vec::new(),
+    };
+    let total = &mut comparison.diff;
+    let mut one_ref = Oracle {
+        lists: PixelLists {
+            offsets: vec![0, 0],
+            entries: Vec::new(),
+        },
+    };
+    let mut one = Capture::with_pixels(1, candidate.identity, Keeps::Nearest(0));
+    one.offsets.push(0);
+    for p in 0..pixels {
+        let all = reference.pixel(p);
+        let n = all.len();
+        let knows_n = options.complete.is_none_or(|c| c[p]);
+        one_ref.lists.entries.clear();
+        one_ref.lists.entries.extend_from_slice(all);
+        one_ref.lists.offsets[1] = n;
+        let got = candidate.pixel(p);
+        one.entries.clear();
+        let mut flags = 0;
+        one.keeps = match &candidate.keeps {
+            Keeps::All { overflow, .. } => {
+                let counter = match words.and_then(|w| w.counters.as_ref()) {
+                    Some(counters) => counters[p],
+                    None => inferred_counter(got.len(), overflow[p]),
+                };
+                comparison.claimed_overflow += u64::from(overflow[p]);
+                // The marker is no fragment: its word check calls it corrupt.
+                let marker_is_corrupt = words.is_some();
+                one.entries
+                    .extend(got.iter().filter(|&&e| !marker_is_corrupt || e != u64::MAX));
+                let (capacity, allowed) = if knows_n {
+                    if counter.count as usize != n {
+                        flags |= verdict::MISCOUNTED;
+                    }
+                    let allowed = n.saturating_sub(counter.capacity as usize) as u32;
+                    (Capacity::PerPixel(counter.capacity), allowed)
+                } else {
+                    // The reference does not know the count: the claimed overflow stands, as
+                    // the capacity that predicts exactly it from the fragments the reference has.
+                    let stands = n.saturating_sub(overflow[p] as usize) as u32;
+                    (Capacity::PerPixel(stands), overflow[p])
+                };
+                Keeps::All {
+                    capacity,
+                    overflow: vec![allowed],
+                }
+            }
+            keeps => {
+                one.entries.extend_from_slice(got);
+                keeps.clone()
+            }
+        };
+        let counted = matches!(candidate.keeps, Keeps::All { .. });
+        if options.depth_ulps > 0 {
+            snap_to_reference(
+                &mut one.entries,
+                all,
+                candidate.identity,
+                options.depth_ulps,
+            );
+        }
+        one.offsets[1] = one.entries.len();
+        let d = one_ref.diff(&one);
+        if words.is_some_and(|w| !w.corrupt[p].is_empty()) {
+            flags |= verdict::CORRUPT;
+        }
+        if d.lost > 0 {
+            flags |= verdict::MISSING;
+        }
+        if d.extra > 0 {
+            flags |= verdict::EXTRA;
+        }
+        if d.misordered_pixels > 0 {
+            flags |= verdict::MISORDERED;
+        }
+        if d.overflowed > 0 {
+            flags |= verdict::OVERFLOWED;
+        }
+        // A pixel the diff rejects for no other reason has fewer fragments missing than the
+        // overflow it was allowed. Where the reference knows the count that cannot happen (the
+        // allowance is `n − capacity` and at most `capacity` are held), so it is named a miscount
+        // rather than left unnamed; where the reference does not know the count, the claimed
+        // overflow is all there is and a reference holding no more than the candidate is no gap.
+        if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 && knows_n {
+            flags |= verdict::MISCOUNTED;
+        }
+        comparison.counts.add(flags);
+        if !counted {
+            // MDTS claims nothing: what lies beyond K is its promise.
+            comparison.claimed_overflow += d.overflowed;
+        }
+        total.captured += d.captured;
+        total.overflowed += d.overflowed;
+        total.lost += d.lost;
+        total.extra += d.extra;
+        total.misordered_pixels += d.misordered_pixels;
+        if flags & verdict::DIFFERS != 0 {
+            total.mismatched_pixels += 1;
+            if total.first_mismatches.len() < options.examples {
+                let example = d.first_mismatches.into_iter().next().unwrap_or_else(|| {
+                    // Equal lists, wrong words: both sides are the list the pixel holds.
+                    PixelMismatch {
+                        pixel: p,
+                        expected: one.entries.clone(),
+                        got: one.entries.clone(),
+                    }
+                });
+                total.first_mismatches.push(PixelMismatch {
+                    pixel: p,
+                    ..example
+                });
+                if let Some(words) = words {
+                    comparison
+                        .first_corrupt
+                        .extend_from_slice(&words.corrupt[p]);
+                }
+            }
+        }
+        comparison.verdicts.push(flags);
+    }
+    comparison
+}
+
+/// Replaces each candidate fragment that has no exact match in `reference` by the nearest
+/// unmatched reference fragment of the same primitive within `ulps` (the depth key is the f32's
+/// bit pattern, so a key difference is a distance in ulps).
+fn snap_to_reference(got: &mut [u64], reference: &[u64], identity: Identity, ulps: u32) {
+    if identity == Identity::PrimOnly {
+        return;
+    }
+    let mask = if identity == Identity::KeyOnly {
+        u64::MAX << 32
+    } else {
+        u64::MAX
+    };
+    let was_sorted = got.windows(2).all(|w| w[0] <= w[1]);
+    let mut used = vec![false; reference.len()];
+    let mut unmatched = Vec::new();
+    for (i, g) in got.iter().enumerate() {
+        match (0..reference.len()).find(|&j| !used[j] && reference[j] & mask == *g) {
+            Some(j) => used[j] = true,
+            None => unmatched.push(i),
+        }
+    }
+    for i in unmatched {
+        let (key, prim) = ((got[i] >> 32) as u32, got[i] as u32);
+        let nearest = (0..reference.len())
+            .filter(|&j| !used[j])
+            .filter(|&j| identity == Identity::KeyOnly || reference[j] as u32 == prim)
+            .map(|j| (((reference[j] >> 32) as u32).abs_diff(key), j))
+            .filter(|&(distance, _)| distance <= ulps)
+            .min();
+        if let Some((_, j)) = nearest {
+            used[j] = true;
+            got[i] = reference[j] & mask;
+        }
+    }
+    if was_sorted {
+        got.sort_unstable();
+    }
+}

@@ -1,0 +1,183 @@
+//! A dump's JSON header (`dump.json`), its array specs and the words of one array file, with the
+//! checks every header passes before its arrays are read or written.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::{err, DumpError};
+use crate::scene::SceneAndCamera;
+
+/// The element type of an array file: always little-endian.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Dtype {
+    /// 32-bit unsigned (NumPy `<u4`).
+    #[serde(rename = "u32", alias = "<u4", alias = "uint32")]
+    U32,
+    /// 64-bit unsigned (NumPy `<u8`).
+    #[serde(rename = "u64", alias = "<u8", alias = "uint64")]
+    U64,
+}
+
+/// Where an array lives and what it holds.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ArraySpec {
+    /// File name, relative to the dump directory.
+    pub file: String,
+    /// Element type.
+    pub dtype: Dtype,
+    /// Dimensions, row-major; the file holds their product of elements and nothing else.
+    pub shape: Vec<u64>,
+}
+
+/// The JSON header of a dump (`dump.json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// Always [`FORMAT`](super::FORMAT).
+    pub format: String,
+    /// [`VERSION`](super::VERSION).
+    pub version: u32,
+    /// Who wrote it (`fragsim 0.1.0`, `fragsim-cuda`, …): informative.
+    #[serde(default)]
+    pub producer: String,
+    /// The scene and camera.
+    pub scene: SceneAndCamera,
+    /// Viewport width in pixels.
+    pub width: u32,
+    /// Viewport height in pixels.
+    pub height: u32,
+    /// The layout's name: the catalog name of the scheme that heads it (`docs/dump-format.md`,
+    /// [`DumpLayout::scheme`](fragsim_capture::catalog::DumpLayout::scheme)).
+    pub scheme: String,
+    /// MDTS slots per pixel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k: Option<u32>,
+    /// A-buffer slots per pixel (fixed storage); absent with an `offsets` array (exact storage).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<u32>,
+    /// A-buffer: whether each pixel's slots were sorted in place (the post-sort kernel ran).
+    #[serde(default)]
+    pub sorted: bool,
+    /// A-buffer: whether every slot was set to the empty marker (`u64::MAX`) before the pass, so
+    /// that a slot past its pixel's counter holding anything else is a stray write. Without it
+    /// those slots may hold anything (FreePipe leaves them uninitialised) and are not checked.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub filled: bool,
+    /// The word layout, informative: `key<<32|prim`, `key`, or `(key<<32|prim)+1`.
+    #[serde(default)]
+    pub word: String,
+    /// The arrays by name: `slots`, and for the A-buffer `counters` and maybe `offsets`.
+    pub arrays: BTreeMap<String, ArraySpec>,
+    /// Anything else the producer wants to keep (timings, device): ignored by the reader.
+    #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
+    pub extra: serde_json::Value,
+}
+
+/// The contents of one array file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Words {
+    /// `u32` elements.
+    U32(Vec<u32>),
+    /// `u64` elements.
+    U64(Vec<u64>),
+}
+
+impl Words {
+    pub(super) fn dtype(&self) -> Dtype {
+        match self {
+            Self::U32(_) => Dtype::U32,
+            Self::U64(_) => Dtype::U64,
+        }
+    }
+
+    pub(super) fn len(&self) -> usize {
+        match self {
+            Self::U32(w) => w.len(),
+            Self::U64(w) => w.len(),
+        }
+    }
+
+    pub(super) fn to_le_bytes(&self) -> Vec<u8> {
+        match self {
+            Self::U32(w) => w.iter().flat_map(|v| v.to_le_bytes()).collect(),
+            Self::U64(w) => w.iter().flat_map(|v| v.to_le_bytes()).collect(),
+        }
+    }
+
+    pub(super) fn from_le_bytes(dtype: Dtype, bytes: &[u8]) -> Self {
+        match dtype {
+            Dtype::U32 => Self::U32(
+                bytes
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect(),
+            ),
+            Dtype::U64 => Self::U64(
+                bytes
+                    .chunks_exact(8)
+                    .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+/// Refuses an array file name with a directory part (`/`, `\\`, a drive's `:`), `.`, `..` or
+/// nothing: a dump's arrays lie in its own directory.
+/// Refuses two arrays that name the same file: one file cannot hold both, so encoding would keep
+/// one array's words under both names (found by `dump_parse`).
+pub(super) fn check_distinct_files(arrays: &BTreeMap<String, ArraySpec>) -> Result<(), DumpError> {
+    let mut owner: BTreeMap<&str, &str> = BTreeMap::new();
+    for (name, spec) in arrays {
+        if let Some(first) = owner.insert(&spec.file, name) {
+            return err(format!(
+                "arrays {first:?} and {name:?} both name file {:?}",
+                spec.file
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn check_file_name(name: &str, file: &str) -> Result<(), DumpError> {
+    let plain =
+        !file.is_empty() && file != "." && file != ".." && !file.contains(['/', '\\', ':', '\0']);
+    if plain {
+        Ok(())
+    } else {
+        err(format!(
+            "array {name:?}: file {file:?} must be a plain file name in the dump's directory"
+        ))
+    }
+}
+
+/// The element count of a shape, refused when it overflows 64 bits.
+pub(super) fn elements(name: &str, shape: &[u64]) -> Result<u64, DumpError> {
+    shape
+        .iter()
+        .try_fold(1u64, |n, &d| n.checked_mul(d))
+        .ok_or_else(|| {
+            DumpError(format!(
+                "array {name:?}: shape {shape:?} has more than 2^64 elements"
+            ))
+        })
+}
+
+pub(super) fn check_array(
+    name: &str,
+    spec: &ArraySpec,
+    dtype: Dtype,
+    len: u64,
+) -> Result<(), DumpError> {
+    let expected = elements(name, &spec.shape)?;
+    if spec.dtype != dtype {
+        return err(format!("array {name:?}: dtype {:?} expected", spec.dtype));
+    }
+    if expected != len {
+        return err(format!(
+            "array {name:?}: shape {:?} is {expected} elements, the data has {len}",
+            spec.shape
+        ));
+    }
+    Ok(())
+}

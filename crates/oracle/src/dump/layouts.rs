@@ -1,0 +1,563 @@
+//! The layouts a dump's words may have: which scheme's memory, with its parameters, and the rules
+//! every word of that layout obeys ([`Dump::check_words`]).
+//!
+//! The layouts and the header names that select them are the catalog's
+//! ([`fragsim_capture::catalog::DumpLayout`]): a header's `scheme` is the name of the catalog entry
+//! that heads a layout, and [`DumpScheme`] is that layout with the parameters its arrays need.
+
+use std::collections::BTreeMap;
+
+use fragsim_capture::abuffer::{ABuffer, PostSort};
+use fragsim_capture::catalog::{DumpLayout, SchemeName, SlotWord, Storage, CATALOG};
+use fragsim_capture::mdts::{Direction, Mdts};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, Scheme};
+use fragsim_raster::Viewport;
+use serde::Serialize;
+
+use super::{err, Dump, DumpError, Header, Words};
+
+/// Which scheme's memory a dump holds, with its parameters.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum DumpScheme {
+    /// MDTS on u64 words `key << 32 | prim`: `slots` `[pixels, k]`.
+    Mdts {
+        /// Slots per pixel.
+        k: u32,
+        /// Ascending (`mdts`, empty = all ones) or descending (`mdts-desc`, word + 1, empty = 0).
+        direction: Direction,
+    },
+    /// MDTS on u32 depth keys (FreePipe's Table 1), ascending: `slots` `[pixels, k]`.
+    Mdts32 {
+        /// Slots per pixel.
+        k: u32,
+    },
+    /// A-buffer with `capacity` slots per pixel: `counters` `[pixels]`, `slots`
+    /// `[pixels, capacity]`.
+    ABufferFixed {
+        /// Slots per pixel.
+        capacity: u32,
+        /// Whether each pixel's slots were sorted in place.
+        sorted: bool,
+    },
+    /// A-buffer sized by a counting pass: `counters` `[pixels]`, `offsets` `[pixels + 1]`
+    /// (prefix sums of `counts`), `slots` `[offsets[pixels]]`.
+    ABufferExact {
+        /// Slots of each pixel.
+        counts: Vec<u32>,
+        /// Whether each pixel's slots were sorted in place.
+        sorted: bool,
+    },
+}
+
+/// Catalog names as an alternative for an error message: `mdts, mdts32, mdts-desc or abuffer`.
+fn either<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let names: Vec<&str> = names.collect();
+    match names.split_last() {
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+/// Names of the memory's two word arrays in a dump (`None`: the scheme uses no such words).
+pub(super) struct ArrayNames {
+    pub(super) words32: Option<&'static str>,
+    pub(super) words64: Option<&'static str>,
+}
+
+/// Something done with the concrete scheme a [`DumpScheme`] names (Rust has no generic closures).
+pub(super) trait SchemeVisitor {
+    type Output;
+    fn visit<S: Scheme>(self, scheme: &S) -> Self::Output;
+}
+
+impl DumpScheme {
+    /// The catalog's layout of these words.
+    #[must_use]
+    pub fn layout(&self) -> DumpLayout {
+        match self {
+            Self::Mdts {
+                direction: Direction::Ascending,
+                ..
+            } => DumpLayout::SlotArray(SlotWord::Fragment),
+            Self::Mdts {
+                direction: Direction::Descending,
+                ..
+            } => DumpLayout::SlotArray(SlotWord::FragmentPlusOne),
+            Self::Mdts32 { .. } => DumpLayout::SlotArray(SlotWord::Key),
+            Self::ABufferFixed { .. } | Self::ABufferExact { .. } => DumpLayout::CountersAndSlots,
+        }
+    }
+
+    /// The header's `scheme` field: the catalog name of the scheme that heads the layout.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        self.layout().scheme().name()
+    }
+
+    /// The layout scheme `name`'s memory has after a run of it with `slots` slots per pixel (K,
+    /// or the capacity) and the per-pixel `counts` of its counting pass, where one ran.
+    ///
+    /// # Errors
+    /// A scheme the catalog gives no dump layout (the error lists those it gives one), or storage
+    /// sized by a counting pass without its counts.
+    pub fn for_run(
+        name: SchemeName,
+        slots: u32,
+        counts: Option<&[u32]>,
+    ) -> Result<Self, DumpError> {
+        let entry = name.entry();
+        let Some(layout) = entry.dump else {
+            let dumpable = CATALOG.iter().filter(|e| e.dump.is_some());
+            return err(format!(
+                "scheme {name} has no dump layout; these have one: {}",
+                either(dumpable.map(|e| e.name))
+            ));
+        };
+        Ok(match layout {
+            DumpLayout::SlotArray(SlotWord::Fragment) => Self::Mdts {
+                k: slots,
+                direction: Direction::Ascending,
+            },
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => Self::Mdts {
+                k: slots,
+                direction: Direction::Descending,
+            },
+            DumpLayout::SlotArray(SlotWord::Key) => Self::Mdts32 { k: slots },
+            DumpLayout::CountersAndSlots if entry.storage == Storage::Counted => {
+                Self::ABufferExact {
+                    counts: counts
+                        .ok_or_else(|| DumpError(format!("{name} ran without its counting pass")))?
+                        .to_vec(),
+                    sorted: false,
+                }
+            }
+            DumpLayout::CountersAndSlots => Self::ABufferFixed {
+                capacity: slots,
+                sorted: false,
+            },
+        })
+    }
+
+    /// The header's `word` field (informative).
+    pub(super) fn word(&self) -> &'static str {
+        match self.layout() {
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => "(key<<32|prim)+1",
+            DumpLayout::SlotArray(SlotWord::Key) => "key",
+            DumpLayout::SlotArray(SlotWord::Fragment) | DumpLayout::CountersAndSlots => {
+                "key<<32|prim"
+            }
+        }
+    }
+
+    pub(super) fn names(&self) -> ArrayNames {
+        match self.layout() {
+            DumpLayout::SlotArray(SlotWord::Key) => ArrayNames {
+                words32: Some("slots"),
+                words64: None,
+            },
+            DumpLayout::SlotArray(_) => ArrayNames {
+                words32: None,
+                words64: Some("slots"),
+            },
+            DumpLayout::CountersAndSlots => ArrayNames {
+                words32: Some("counters"),
+                words64: Some("slots"),
+            },
+        }
+    }
+
+    /// Builds fragsim's scheme for a viewport (no memory cap: the words exist already).
+    pub(super) fn with_scheme<V: SchemeVisitor>(
+        &self,
+        viewport: Viewport,
+        visitor: V,
+    ) -> Result<V::Output, DumpError> {
+        let cap = u64::MAX;
+        Ok(match self {
+            Self::Mdts { k, direction } => {
+                visitor.visit(&Mdts::<u64>::new(viewport, *k, *direction, cap)?)
+            }
+            Self::Mdts32 { k } => {
+                visitor.visit(&Mdts::<u32>::new(viewport, *k, Direction::Ascending, cap)?)
+            }
+            Self::ABufferFixed { capacity, .. } => visitor.visit(&ABuffer::fixed(
+                viewport,
+                *capacity,
+                PostSort::Insertion,
+                cap,
+            )?),
+            Self::ABufferExact { counts, .. } => {
+                if counts.len() != viewport.pixels() {
+                    return err(format!(
+                        "offsets cover {} pixels, the viewport has {}",
+                        counts.len(),
+                        viewport.pixels()
+                    ));
+                }
+                visitor.visit(&ABuffer::exact(counts, PostSort::Insertion, cap)?)
+            }
+        })
+    }
+
+    /// Reads the scheme and its parameters from a header.
+    ///
+    /// # Errors
+    /// An unknown scheme, or a missing or zero parameter.
+    pub fn from_header(header: &Header, offsets: Option<&[u32]>) -> Result<Self, DumpError> {
+        let k = || match header.k {
+            Some(k) if k > 0 => Ok(k),
+            _ => err(format!("scheme {} needs \"k\" ≥ 1", header.scheme)),
+        };
+        let Some(layout) = DumpLayout::named(&header.scheme) else {
+            return err(format!(
+                "unknown scheme {:?}: expected {}",
+                header.scheme,
+                either(DumpLayout::names())
+            ));
+        };
+        let name = &header.scheme;
+        match layout {
+            DumpLayout::SlotArray(SlotWord::Fragment) => Ok(Self::Mdts {
+                k: k()?,
+                direction: Direction::Ascending,
+            }),
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => Ok(Self::Mdts {
+                k: k()?,
+                direction: Direction::Descending,
+            }),
+            DumpLayout::SlotArray(SlotWord::Key) => Ok(Self::Mdts32 { k: k()? }),
+            DumpLayout::CountersAndSlots => match (header.capacity, offsets) {
+                (Some(0), _) => err(format!("{name} \"capacity\" must be at least 1")),
+                (Some(capacity), _) => Ok(Self::ABufferFixed {
+                    capacity,
+                    sorted: header.sorted,
+                }),
+                (None, Some(offsets)) => {
+                    if offsets.first() != Some(&0) || offsets.windows(2).any(|w| w[0] > w[1]) {
+                        return err(format!("{name} offsets must start at 0 and never decrease"));
+                    }
+                    Ok(Self::ABufferExact {
+                        counts: offsets.windows(2).map(|w| w[1] - w[0]).collect(),
+                        sorted: header.sorted,
+                    })
+                }
+                (None, None) => err(format!("{name} needs \"capacity\" or an \"offsets\" array")),
+            },
+        }
+    }
+}
+
+/// The largest depth key of a fragment: depth 1.0 (fragments outside `[0, 1]` are dropped, and
+/// `-0.0` is stored as `+0.0`), so a stored key above it is no fragment's.
+const LARGEST_KEY: u32 = 0x3F80_0000;
+
+/// Why a stored word is one that its layout says cannot be there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Corruption {
+    /// An MDTS slot after the pixel's first empty one holds a word: MDTS fills a pixel's slots
+    /// from the first, each insertion shifting the larger words one slot on, so an empty slot is
+    /// never followed by a full one (a stray write, a neighbouring pixel's overrun).
+    AfterEmpty,
+    /// An A-buffer slot below its pixel's counter holds the empty marker: a slot handed out by
+    /// the counter whose write never landed (or was overwritten with the marker).
+    EmptyCounted,
+    /// An A-buffer slot past its pixel's counter holds something other than the empty marker,
+    /// in a dump whose header says every slot was filled with it (`"filled": true`).
+    BeyondCounter,
+    /// A stored word whose depth key is above 1.0's: no fragment has such a key.
+    ImpossibleKey,
+}
+
+impl Corruption {
+    /// A short description for reports.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::AfterEmpty => "written after an empty slot",
+            Self::EmptyCounted => "empty marker in a counted slot",
+            Self::BeyondCounter => "written past the counter",
+            Self::ImpossibleKey => "depth key above 1.0",
+        }
+    }
+}
+
+/// One stored word that its layout says cannot be there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct CorruptWord {
+    /// Row-major pixel index.
+    pub pixel: usize,
+    /// The slot within the pixel (`0..k`, `0..capacity`).
+    pub slot: usize,
+    /// The word as stored (a u32 word zero-extended).
+    pub word: u64,
+    /// What is wrong with it.
+    pub why: Corruption,
+}
+
+/// An A-buffer pixel's counter and how many slots it has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Counter {
+    /// The counter's value: how many fragments took a slot number.
+    pub count: u32,
+    /// The pixel's slots (the fixed capacity, or its share of exact storage).
+    pub capacity: u32,
+}
+
+/// Every word of a dump checked against its layout ([`Dump::check_words`]): what the decoded
+/// lists cannot show, since decoding stops where the layout says a pixel's list ends.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct WordCheck {
+    /// Per pixel, its words that the layout says cannot be there (most pixels: none).
+    pub corrupt: Vec<Vec<CorruptWord>>,
+    /// A-buffer dumps: each pixel's counter and capacity, for the comparison to check the
+    /// counter against the pixel's fragment count.
+    pub counters: Option<Vec<Counter>>,
+    /// Words the layout leaves undefined and so were not checked: A-buffer slots past the counter
+    /// when the header does not say they were filled.
+    pub unchecked: u64,
+}
+
+impl WordCheck {
+    /// How many words are corrupt.
+    #[must_use]
+    pub fn corrupt_words(&self) -> u64 {
+        self.corrupt.iter().map(|c| c.len() as u64).sum()
+    }
+
+    /// Records `word` in `slot` of pixel `pixel` as corrupt, when a rule gave a reason.
+    fn flag(&mut self, pixel: usize, slot: usize, word: u64, why: Option<Corruption>) {
+        if let Some(why) = why {
+            self.corrupt[pixel].push(CorruptWord {
+                pixel,
+                slot,
+                word,
+                why,
+            });
+        }
+    }
+}
+
+impl Dump {
+    /// Reads every word of the dump and names each one that its layout says cannot be there
+    /// (see [`Corruption`]); for an A-buffer, also gives each pixel's counter. Needs no
+    /// reference: it is the layout's own rules.
+    ///
+    /// # Errors
+    /// As [`Dump::capture`]: an unknown scheme, or arrays missing or of the wrong size or type.
+    pub fn check_words(&self) -> Result<WordCheck, DumpError> {
+        // Decoding validates the arrays against the scheme's layout; the check then indexes them
+        // freely.
+        self.capture()?;
+        let scheme = self.scheme()?;
+        let pixels = self.viewport()?.pixels();
+        let mut check = WordCheck {
+            corrupt: vec![Vec::new(); pixels],
+            ..WordCheck::default()
+        };
+        let missing = |n: &str| DumpError(format!("missing array {n:?}"));
+        match &scheme {
+            DumpScheme::Mdts { k, direction } => {
+                let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
+                let (empty, key): (u64, fn(u64) -> u32) = match direction {
+                    Direction::Ascending => (u64::MAX, |w| (w >> 32) as u32),
+                    Direction::Descending => (0, |w| (w.wrapping_sub(1) >> 32) as u32),
+                };
+                check_mdts(&mut check, slots, *k as usize, empty, key);
+            }
+            DumpScheme::Mdts32 { k } => {
+                let slots = self.u32s("slots")?.ok_or_else(|| missing("slots"))?;
+                let wide: Vec<u64> = slots.iter().map(|&w| u64::from(w)).collect();
+                check_mdts(&mut check, &wide, *k as usize, u64::from(u32::MAX), |w| {
+                    w as u32
+                });
+            }
+            DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. } => {
+                let counters = self.u32s("counters")?.ok_or_else(|| missing("counters"))?;
+                let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
+                let at = abuffer_slots(&scheme);
+                let mut all = Vec::with_capacity(pixels);
+                for (p, &count) in counters.iter().enumerate() {
+                    let (first, capacity) = at(p);
+                    let stored = (count as usize).min(capacity);
+                    for (slot, &word) in slots[first..first + capacity].iter().enumerate() {
+                        let why = if slot < stored {
+                            if word == u64::MAX {
+                                Some(Corruption::EmptyCounted)
+                            } else {
+                                ((word >> 32) as u32 > LARGEST_KEY)
+                                    .then_some(Corruption::ImpossibleKey)
+                            }
+                        } else if self.header.filled {
+                            (word != u64::MAX).then_some(Corruption::BeyondCounter)
+                        } else {
+                            check.unchecked += 1;
+                            None
+                        };
+                        check.flag(p, slot, word, why);
+                    }
+                    all.push(Counter {
+                        count,
+                        capacity: capacity as u32,
+                    });
+                }
+                check.counters = Some(all);
+            }
+        }
+        Ok(check)
+    }
+}
+
+/// The MDTS rules over `k` slots a pixel: full slots first, each holding a possible key, then
+/// only empty ones.
+fn check_mdts(check: &mut WordCheck, slots: &[u64], k: usize, empty: u64, key: fn(u64) -> u32) {
+    for (p, words) in slots.chunks_exact(k).enumerate() {
+        let mut seen_empty = false;
+        for (slot, &word) in words.iter().enumerate() {
+            let why = if word == empty {
+                seen_empty = true;
+                None
+            } else if seen_empty {
+                Some(Corruption::AfterEmpty)
+            } else {
+                (key(word) > LARGEST_KEY).then_some(Corruption::ImpossibleKey)
+            };
+            check.flag(p, slot, word, why);
+        }
+    }
+}
+
+/// Pixel `p`'s slot range in an A-buffer's flat slot array.
+fn abuffer_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
+    let offsets: Vec<usize> = match scheme {
+        DumpScheme::ABufferExact { counts, .. } => std::iter::once(0)
+            .chain(counts.iter().scan(0usize, |sum, &c| {
+                *sum += c as usize;
+                Some(*sum)
+            }))
+            .collect(),
+        _ => Vec::new(),
+    };
+    move |p| match scheme {
+        DumpScheme::ABufferFixed { capacity, .. } => (p * *capacity as usize, *capacity as usize),
+        _ => (offsets[p], offsets[p + 1] - offsets[p]),
+    }
+}
+
+/// A-buffer lists as the GPU's sort kernel left them: `min(counter, capacity)` slots, unsorted.
+pub(super) fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture {
+    let at = abuffer_slots(scheme);
+    let capacity = match scheme {
+        DumpScheme::ABufferFixed { capacity, .. } => Capacity::PerPixel(*capacity),
+        _ => Capacity::Unbounded,
+    };
+    let mut overflow = Vec::with_capacity(counters.len());
+    let mut capture = Capture::with_pixels(
+        counters.len(),
+        Identity::KeyAndPrim,
+        Keeps::All {
+            capacity,
+            overflow: Vec::new(),
+        },
+    );
+    for (p, &count) in counters.iter().enumerate() {
+        let (first, capacity) = at(p);
+        let stored = (count as usize).min(capacity);
+        capture.push_pixel(slots[first..first + stored].iter().copied());
+        overflow.push(count - stored as u32);
+    }
+    capture.keeps = Keeps::All { capacity, overflow };
+    capture
+}
+
+/// What a GPU's post-sort kernel does to an A-buffer's memory: each pixel's stored slots sorted.
+pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme: &DumpScheme) {
+    let counters = match arrays.get("counters") {
+        Some(Words::U32(c)) => c.clone(),
+        _ => return,
+    };
+    let at = abuffer_slots(scheme);
+    if let Some(Words::U64(slots)) = arrays.get_mut("slots") {
+        for (p, &count) in counters.iter().enumerate() {
+            let (first, capacity) = at(p);
+            slots[first..first + (count as usize).min(capacity)].sort_unstable();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dump::{FORMAT, VERSION};
+    use crate::scene::SceneAndCamera;
+
+    fn header(scheme: &str) -> Header {
+        Header {
+            format: FORMAT.into(),
+            version: VERSION,
+            producer: String::new(),
+            scene: SceneAndCamera::named("quads:1", 0.0, 0.0),
+            width: 1,
+            height: 1,
+            scheme: scheme.into(),
+            k: Some(2),
+            capacity: Some(2),
+            sorted: false,
+            filled: false,
+            word: String::new(),
+            arrays: BTreeMap::new(),
+            extra: serde_json::Value::Null,
+        }
+    }
+
+    #[test]
+    fn header_names_are_the_catalogs_layouts() {
+        for name in DumpLayout::names() {
+            let scheme = DumpScheme::from_header(&header(name), None).unwrap();
+            assert_eq!(scheme.name(), name);
+            assert_eq!(Some(scheme.layout()), DumpLayout::named(name));
+        }
+        // A scheme that dumps under another's name is no header name of its own.
+        let unknown = DumpScheme::from_header(&header("abuffer-exact"), None).unwrap_err();
+        assert_eq!(
+            unknown.0,
+            "unknown scheme \"abuffer-exact\": expected mdts, mdts32, mdts-desc or abuffer"
+        );
+    }
+
+    #[test]
+    fn every_catalog_entry_with_a_layout_dumps_in_it() {
+        for entry in CATALOG {
+            let dumped = DumpScheme::for_run(entry.scheme, 3, Some(&[1, 2]));
+            match entry.dump {
+                Some(layout) => assert_eq!(dumped.unwrap().layout(), layout, "{}", entry.name),
+                None => {
+                    let error = dumped.unwrap_err().0;
+                    let expected = format!(
+                        "scheme {} has no dump layout; these have one: mdts, ",
+                        entry.name
+                    );
+                    assert!(error.starts_with(&expected), "{error}");
+                }
+            }
+        }
+        let exact = DumpScheme::for_run(SchemeName::AbufferExact, 1, Some(&[1, 2])).unwrap();
+        assert_eq!(
+            exact,
+            DumpScheme::ABufferExact {
+                counts: vec![1, 2],
+                sorted: false
+            }
+        );
+        assert!(DumpScheme::for_run(SchemeName::AbufferExact, 1, None).is_err());
+        let fixed = DumpScheme::for_run(SchemeName::AbufferBitonic, 4, Some(&[1, 2])).unwrap();
+        assert_eq!(
+            fixed,
+            DumpScheme::ABufferFixed {
+                capacity: 4,
+                sorted: false
+            }
+        );
+    }
+}

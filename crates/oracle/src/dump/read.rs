@@ -1,0 +1,197 @@
+//! Parsing a dump (from bytes or a directory) and decoding its words into per-pixel lists through
+//! the scheme's own post pass.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use fragsim_capture::{Capture, Scheme, SerialMemory, WordMemory};
+use fragsim_raster::Viewport;
+
+use super::header::{check_array, check_distinct_files, check_file_name, elements};
+use super::layouts::{stored_lists, SchemeVisitor};
+use super::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
+use super::{FORMAT, HEADER_FILE, VERSION};
+
+fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W]) {
+    for (i, &w) in words.iter().enumerate() {
+        memory.store(i, w);
+    }
+}
+
+/// Loads the words into the scheme's memory and runs its post pass; a sorted A-buffer's lists
+/// are taken as stored instead.
+struct Resolve<'a> {
+    scheme: &'a DumpScheme,
+    words32: &'a [u32],
+    words64: &'a [u64],
+}
+
+impl SchemeVisitor for Resolve<'_> {
+    type Output = Result<Capture, DumpError>;
+    fn visit<S: Scheme>(self, scheme: &S) -> Self::Output {
+        let layout = scheme.layout();
+        if layout.words32 != self.words32.len() || layout.words64 != self.words64.len() {
+            return err(format!(
+                "{} over this viewport holds {} u32 and {} u64 words; the dump has {} and {}",
+                scheme.name(),
+                layout.words32,
+                layout.words64,
+                self.words32.len(),
+                self.words64.len()
+            ));
+        }
+        if let DumpScheme::ABufferFixed { sorted: true, .. }
+        | DumpScheme::ABufferExact { sorted: true, .. } = self.scheme
+        {
+            return Ok(stored_lists(self.scheme, self.words32, self.words64));
+        }
+        let memory: SerialMemory = layout.allocate();
+        write_all(&memory, self.words32);
+        write_all(&memory, self.words64);
+        Ok(scheme.resolve(&memory))
+    }
+}
+
+impl Dump {
+    /// Reads a dump from its directory (or from the path of its `dump.json`).
+    ///
+    /// # Errors
+    /// Missing files, a malformed header, another format or version, or array files whose size
+    /// disagrees with their shape.
+    pub fn read(path: &Path) -> Result<Self, DumpError> {
+        let (dir, header_path) = if path.is_dir() {
+            (path.to_path_buf(), path.join(HEADER_FILE))
+        } else {
+            (
+                path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+                path.to_path_buf(),
+            )
+        };
+        let text = std::fs::read(&header_path).map_err(|e| io_err("read", &header_path, e))?;
+        Self::parse(&header_path.display().to_string(), &text, |file| {
+            let path = dir.join(file);
+            std::fs::read(&path).map_err(|e| io_err("read", &path, e))
+        })
+    }
+
+    /// Decodes a dump from its header's bytes (`dump.json`, named `header_name` in errors) and
+    /// `read_file`, which returns an array file's bytes by its name in the header. Never touches
+    /// the file system itself: [`Dump::read`] passes a reader of the dump's directory, the
+    /// `dump_parse` fuzz target one over its input.
+    ///
+    /// Array file names must be plain names (no directory part, not `.` or `..`), so that a
+    /// header cannot make the reader open a file outside the dump's directory; shapes whose
+    /// element count overflows 64 bits are refused before anything is read.
+    ///
+    /// # Errors
+    /// A malformed header, another format or version, a bad viewport, an array file name that is
+    /// not plain, a shape that overflows, `read_file`'s own errors, or array files whose size
+    /// disagrees with their shape.
+    pub fn parse(
+        header_name: &str,
+        header_bytes: &[u8],
+        mut read_file: impl FnMut(&str) -> Result<Vec<u8>, DumpError>,
+    ) -> Result<Self, DumpError> {
+        let header: Header = serde_json::from_slice(header_bytes)
+            .map_err(|e| DumpError(format!("{header_name}: {e}")))?;
+        if header.format != FORMAT {
+            return err(format!(
+                "{header_name}: format {:?}, expected {FORMAT:?}",
+                header.format
+            ));
+        }
+        if header.version != VERSION {
+            return err(format!(
+                "{header_name}: dump format version {}, this fragsim reads version {VERSION}",
+                header.version
+            ));
+        }
+        Viewport::new(header.width, header.height).map_err(DumpError)?;
+        check_distinct_files(&header.arrays)?;
+        let mut arrays = BTreeMap::new();
+        for (name, spec) in &header.arrays {
+            check_file_name(name, &spec.file)?;
+            elements(name, &spec.shape)?;
+            let bytes = read_file(&spec.file)?;
+            let width = match spec.dtype {
+                Dtype::U32 => 4,
+                Dtype::U64 => 8,
+            };
+            if bytes.len() % width != 0 {
+                return err(format!(
+                    "{}: {} bytes is not a whole number of {width}-byte words",
+                    spec.file,
+                    bytes.len()
+                ));
+            }
+            check_array(name, spec, spec.dtype, (bytes.len() / width) as u64)?;
+            arrays.insert(name.clone(), Words::from_le_bytes(spec.dtype, &bytes));
+        }
+        Ok(Self { header, arrays })
+    }
+
+    /// The viewport.
+    ///
+    /// # Errors
+    /// A zero or oversized side.
+    pub fn viewport(&self) -> Result<Viewport, DumpError> {
+        Viewport::new(self.header.width, self.header.height).map_err(DumpError)
+    }
+
+    pub(super) fn u32s(&self, name: &str) -> Result<Option<&[u32]>, DumpError> {
+        match self.arrays.get(name) {
+            None => Ok(None),
+            Some(Words::U32(w)) => Ok(Some(w)),
+            Some(Words::U64(_)) => err(format!("array {name:?} must be u32")),
+        }
+    }
+
+    pub(super) fn u64s(&self, name: &str) -> Result<Option<&[u64]>, DumpError> {
+        match self.arrays.get(name) {
+            None => Ok(None),
+            Some(Words::U64(w)) => Ok(Some(w)),
+            Some(Words::U32(_)) => err(format!("array {name:?} must be u64")),
+        }
+    }
+
+    /// The scheme the header names.
+    ///
+    /// # Errors
+    /// See [`DumpScheme::from_header`].
+    pub fn scheme(&self) -> Result<DumpScheme, DumpError> {
+        DumpScheme::from_header(&self.header, self.u32s("offsets")?)
+    }
+
+    /// Decodes the words into per-pixel lists with the scheme's own post pass (sorted A-buffer
+    /// dumps: in stored order).
+    ///
+    /// # Errors
+    /// A header that names no known scheme, or arrays missing or of the wrong size or type.
+    pub fn capture(&self) -> Result<Capture, DumpError> {
+        let scheme = self.scheme()?;
+        let names = scheme.names();
+        let fetch32 = |name: Option<&str>| -> Result<&[u32], DumpError> {
+            match name {
+                None => Ok(&[]),
+                Some(n) => self
+                    .u32s(n)?
+                    .ok_or_else(|| DumpError(format!("missing array {n:?}"))),
+            }
+        };
+        let fetch64 = |name: Option<&str>| -> Result<&[u64], DumpError> {
+            match name {
+                None => Ok(&[]),
+                Some(n) => self
+                    .u64s(n)?
+                    .ok_or_else(|| DumpError(format!("missing array {n:?}"))),
+            }
+        };
+        let (words32, words64) = (fetch32(names.words32)?, fetch64(names.words64)?);
+        let resolve = Resolve {
+            scheme: &scheme,
+            words32,
+            words64,
+        };
+        scheme.with_scheme(self.viewport()?, resolve)?
+    }
+}

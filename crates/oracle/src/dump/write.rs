@@ -1,0 +1,183 @@
+//! Recording: fragsim's scheme run serially over a view, its memory copied out as a dump, and the
+//! dump encoded and written to a directory.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use fragsim_capture::catalog::DumpLayout;
+use fragsim_capture::{Scheme, SerialMemory, Step, WordMemory};
+use fragsim_raster::View;
+
+use super::header::{check_array, check_distinct_files, check_file_name};
+use super::layouts::{sort_abuffer_in_place, SchemeVisitor};
+use super::{io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
+use super::{FORMAT, HEADER_FILE, VERSION};
+use crate::scene::SceneAndCamera;
+
+/// Runs a scheme serially over a view and copies its memory out.
+struct Record<'a, 'm> {
+    view: &'a View<'m>,
+}
+
+impl SchemeVisitor for Record<'_, '_> {
+    type Output = (Vec<u32>, Vec<u64>);
+    fn visit<S: Scheme>(self, scheme: &S) -> Self::Output {
+        let memory: SerialMemory = scheme.layout().allocate();
+        let mut steps = 0;
+        let mut pass = 0;
+        loop {
+            for prim in 0..self.view.triangle_count() {
+                self.view.rasterize(prim, &mut |fragment| {
+                    if let Some(state) = scheme.begin_pass(pass, fragment) {
+                        let end: Step = scheme.insert_state(state, &memory, &mut steps);
+                        debug_assert_ne!(end, Step::Continue);
+                    }
+                });
+            }
+            if !scheme.end_pass(pass, &memory) {
+                break;
+            }
+            pass += 1;
+        }
+        (read_all(&memory), read_all(&memory))
+    }
+}
+
+fn read_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>) -> Vec<W> {
+    (0..memory.len()).map(|i| memory.load(i)).collect()
+}
+
+impl Dump {
+    /// Runs fragsim's `scheme` serially over `view` and records its memory as a dump.
+    ///
+    /// # Errors
+    /// Scheme parameters out of range.
+    pub fn record(
+        view: &View<'_>,
+        scene: SceneAndCamera,
+        scheme: &DumpScheme,
+        producer: &str,
+    ) -> Result<Self, DumpError> {
+        let viewport = view.viewport();
+        let (words32, words64) = scheme.with_scheme(viewport, Record { view })?;
+        let pixels = viewport.pixels() as u64;
+        let mut arrays = BTreeMap::new();
+        let names = scheme.names();
+        if let Some(name) = names.words32 {
+            arrays.insert(name.to_string(), Words::U32(words32));
+        }
+        if let Some(name) = names.words64 {
+            arrays.insert(name.to_string(), Words::U64(words64));
+        }
+        let (mut k, mut capacity, mut sorted) = (None, None, false);
+        // fragsim's memory starts at the layout's initial words: the A-buffer's slots empty.
+        let filled = scheme.layout() == DumpLayout::CountersAndSlots;
+        let slots_shape = match scheme {
+            DumpScheme::Mdts { k: n, .. } | DumpScheme::Mdts32 { k: n } => {
+                k = Some(*n);
+                vec![pixels, u64::from(*n)]
+            }
+            DumpScheme::ABufferFixed {
+                capacity: c,
+                sorted: s,
+            } => {
+                (capacity, sorted) = (Some(*c), *s);
+                vec![pixels, u64::from(*c)]
+            }
+            DumpScheme::ABufferExact { counts, sorted: s } => {
+                sorted = *s;
+                let mut offsets = Vec::with_capacity(counts.len() + 1);
+                offsets.push(0u32);
+                for &c in counts {
+                    offsets.push(offsets[offsets.len() - 1] + c);
+                }
+                let total = u64::from(offsets[counts.len()]);
+                arrays.insert("offsets".into(), Words::U32(offsets));
+                vec![total]
+            }
+        };
+        if sorted {
+            sort_abuffer_in_place(&mut arrays, scheme);
+        }
+        let shapes: BTreeMap<&str, Vec<u64>> = [
+            ("slots", slots_shape),
+            ("counters", vec![pixels]),
+            ("offsets", vec![pixels + 1]),
+        ]
+        .into_iter()
+        .collect();
+        let specs = arrays
+            .iter()
+            .map(|(name, words)| {
+                let suffix = match words.dtype() {
+                    Dtype::U32 => "u32",
+                    Dtype::U64 => "u64",
+                };
+                let spec = ArraySpec {
+                    file: format!("{name}.{suffix}"),
+                    dtype: words.dtype(),
+                    shape: shapes[name.as_str()].clone(),
+                };
+                (name.clone(), spec)
+            })
+            .collect();
+        Ok(Self {
+            header: Header {
+                format: FORMAT.into(),
+                version: VERSION,
+                producer: producer.into(),
+                scene,
+                width: viewport.width,
+                height: viewport.height,
+                scheme: scheme.name().into(),
+                k,
+                capacity,
+                sorted,
+                filled,
+                word: scheme.word().into(),
+                arrays: specs,
+                extra: serde_json::Value::Null,
+            },
+            arrays,
+        })
+    }
+
+    /// The header as `dump.json` text and each array file's bytes, by file name: what
+    /// [`Dump::write`] puts in a directory, and [`Dump::parse`] reads back.
+    ///
+    /// # Errors
+    /// Arrays that disagree with the header, a file name that is not a plain name, or a scene
+    /// number that is not finite ([`SceneAndCamera::check_finite`]).
+    pub fn encode(&self) -> Result<(String, BTreeMap<String, Vec<u8>>), DumpError> {
+        check_distinct_files(&self.header.arrays)?;
+        let mut files = BTreeMap::new();
+        for (name, spec) in &self.header.arrays {
+            check_file_name(name, &spec.file)?;
+            let words = self
+                .arrays
+                .get(name)
+                .ok_or_else(|| DumpError(format!("the header names array {name:?}, absent")))?;
+            check_array(name, spec, words.dtype(), words.len() as u64)?;
+            files.insert(spec.file.clone(), words.to_le_bytes());
+        }
+        self.header.scene.check_finite()?;
+        let text = serde_json::to_string_pretty(&self.header)
+            .map_err(|e| DumpError(format!("cannot encode the header: {e}")))?;
+        Ok((text + "\n", files))
+    }
+
+    /// Writes `dump.json` and the array files into `dir`, creating it.
+    ///
+    /// # Errors
+    /// I/O failures, or arrays that disagree with the header.
+    pub fn write(&self, dir: &Path) -> Result<(), DumpError> {
+        let (text, files) = self.encode()?;
+        std::fs::create_dir_all(dir).map_err(|e| io_err("create", dir, e))?;
+        for (file, bytes) in files {
+            let path = dir.join(file);
+            std::fs::write(&path, bytes).map_err(|e| io_err("write", &path, e))?;
+        }
+        let path = dir.join(HEADER_FILE);
+        std::fs::write(&path, text).map_err(|e| io_err("write", &path, e))
+    }
+}
