@@ -101,8 +101,8 @@ fn rank(trace: &Trace) -> (usize, usize, usize) {
 
 /// Shrinks a damaging run of `fragments` in `order`: drops fragments while the damage still
 /// shows, then, among the interleavings of what is left (all of them when there are at most
-/// [`EXHAUSTIVE_LIMIT`], else one step moved earlier at a time), keeps the damaging one of least
-/// [`rank`]. Returns the fragments (renumbered so that thread `t` carries primitive `t`) and the
+/// [`EXHAUSTIVE_LIMIT`], else one step moved earlier at a time), keeps the damaging one with the
+/// fewest steps, then write-backs dropped behind a later reader's, then switches. Returns the fragments (renumbered so that thread `t` carries primitive `t`) and the
 /// order; a run without damage comes back as it is.
 #[must_use]
 pub fn shrink(
