@@ -133,3 +133,44 @@ fn explain_rejects_depths_outside_the_unit_interval() {
     let (ok, _) = explain(&["--depths", "0.3,1.5"]);
     assert!(!ok);
 }
+
+#[test]
+fn explain_offers_the_catalogs_kbuffer_stores_as_the_kbuffer_on_separate_stores() {
+    let depths = ["--depths", "0.3,0.5,0.1"];
+    let (ok, stores) = explain(&[&["--scheme", "kbuffer-stores"], &depths[..]].concat());
+    let (ok_flag, flag) = explain(
+        &[
+            &["--scheme", "kbuffer", "--write-back", "separate-stores"],
+            &depths[..],
+        ]
+        .concat(),
+    );
+    assert!(ok && ok_flag, "{stores}\n{flag}");
+    assert!(stores.starts_with("k-buffer (separate stores)"), "{stores}");
+    assert_eq!(stores, flag);
+    // A `-stores` name fixes its machine: naming the other one is refused, not ignored.
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(["explain", "--scheme", "kbuffer-stores", "--write-back"])
+        .arg("render-target")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(!output.status.success());
+    assert!(
+        stderr.contains("kbuffer-stores runs on separate stores"),
+        "{stderr}"
+    );
+    // A catalog scheme explain cannot build on one pixel is refused, naming those it can.
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(["explain", "--scheme", "abuffer"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(!output.status.success());
+    assert!(
+        stderr.contains("mdts") && stderr.contains("kbuffer-stores"),
+        "{stderr}"
+    );
+}

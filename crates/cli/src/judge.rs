@@ -2,38 +2,30 @@
 //! counts the pixels whose 8-bit colour differs from the oracle's image (the papers' EPR).
 //!
 //! **The judge shades what the scheme holds.** Entries with a depth key and a primitive id are
-//! shaded as they are. FreePipe's packed MDTS ([`Identity::PrimOnly`]) is shaded from its own
-//! words: the primitive ids its colours decode to, in its own slot order, at the depths its 20
-//! bits hold (the entries' high half, `mdts_packed::held_depth`), so its precision loss (FreePipe
-//! §5) shows in every effect. Nothing of it comes from the oracle.
+//! shaded as they are. FreePipe's packed MDTS ([`Identity::PrimOnly`](fragsim_capture::Identity))
+//! is shaded from its own words: the primitive ids its colours decode to, in its own slot order,
+//! at the depths its 20 bits hold (the entries' high half, `mdts_packed::held_depth`), so its
+//! precision loss (FreePipe §5) shows in every effect. Nothing of it comes from the oracle.
 //!
-//! Two things are not in the words, and each is reported ([`AttributePass`]):
-//! - **Normals** (Fresnel only): the **deferred attribute pass** recomputes each captured entry's
-//!   interpolated normal from its pixel and primitive id (`raster::attributes`), as a GPU
-//!   application shades from a visibility buffer. Counted (entries) and timed.
-//! - **Primitive ids of key-only captures** (32-bit MDTS, peeling and bucket schemes): a depth
-//!   key names no colour, so these captures are **completed from the oracle's lists** (what
-//!   rasterizing again gives): the i-th occurrence of a key takes the primitive of the i-th
-//!   fragment with that key in canonical order; a key that matches no fragment (a scheme that
-//!   invented one) keeps [`UNKNOWN_PRIM`]. The row names what was completed.
+//! Two things are not in the words; the deferred attribute pass
+//! ([`fragsim_shade::deferred`]) supplies them, and each row reports what it did
+//! ([`AttributePass`]): the **normals** (Fresnel only), recomputed per captured entry from its
+//! pixel and primitive id, counted and timed; and the **primitive ids of key-only captures**
+//! (32-bit MDTS, peeling and bucket schemes), completed from the oracle's lists.
 //!
 //! Every capture is then compared with the one reference image, shaded from the oracle's lists.
 
-use std::borrow::Cow;
 use std::time::Instant;
 
 use clap::ValueEnum;
-use fragsim_capture::{Capture, Identity, PixelLists};
+use fragsim_capture::Capture;
 use fragsim_oracle::Oracle;
 use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
+use fragsim_shade::deferred::{self, PerEntry};
 use fragsim_shade::effects::{self, Effect, Entries, Geometry, Material};
 use image::RgbImage;
-use rayon::prelude::*;
 use serde::Serialize;
-
-/// The primitive id the deferred pass gives a key that matches no fragment of its pixel.
-pub const UNKNOWN_PRIM: u32 = u32::MAX;
 
 /// Effects whose images are compared.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -94,42 +86,6 @@ pub(crate) struct Judged<'j> {
     pub errors: u64,
     /// What was completed or recomputed, if anything.
     pub pass: Option<AttributePass>,
-}
-
-/// One value per entry of per-pixel lists: `values[offsets[p] + i]` belongs to entry `i` of
-/// pixel `p`.
-struct PerEntry {
-    offsets: Vec<usize>,
-    values: Vec<f64>,
-}
-
-impl PerEntry {
-    /// `value(p, entry)` of every entry of `lists`, pixels in parallel.
-    fn of<'l>(
-        pixels: usize,
-        lists: impl Fn(usize) -> &'l [u64] + Sync,
-        value: impl Fn(usize, u64) -> f64 + Sync,
-    ) -> Self {
-        let mut offsets = Vec::with_capacity(pixels + 1);
-        offsets.push(0);
-        for p in 0..pixels {
-            offsets.push(offsets[p] + lists(p).len());
-        }
-        let values = (0..pixels)
-            .into_par_iter()
-            .with_min_len(256)
-            .flat_map_iter(|p| lists(p).iter().map(move |&e| (p, e)))
-            .map(|(p, e)| value(p, e))
-            .collect();
-        Self { offsets, values }
-    }
-
-    /// The value of `entry` in pixel `p`'s list (the first equal entry: equal entries are the
-    /// same fragment, with the same value).
-    fn get(&self, list: &[u64], p: usize, entry: u64) -> f64 {
-        let i = list.iter().position(|&e| e == entry).unwrap_or(0);
-        self.values[self.offsets[p] + i]
-    }
 }
 
 /// Shades captures and compares them with the oracle's image.
@@ -199,9 +155,7 @@ impl<'a> Judge<'a> {
     /// `None` when the effect needs no normals.
     fn recompute<'l>(&self, lists: impl Fn(usize) -> &'l [u64] + Sync) -> Option<PerEntry> {
         let attributes = self.attributes.as_ref()?;
-        Some(PerEntry::of(self.pixels(), lists, |p, entry| {
-            attributes.cosine(entry as u32, p as u32).unwrap_or(1.0)
-        }))
+        Some(deferred::cosines(attributes, self.pixels(), lists))
     }
 
     fn shade<'l>(
@@ -228,10 +182,10 @@ impl<'a> Judge<'a> {
     /// The capture's image, compared with the oracle's.
     pub fn judge(&self, capture: &Capture) -> Option<Judged<'_>> {
         let start = Instant::now();
-        let (full, completed) = complete(capture, self.oracle);
+        let (full, completed) = deferred::complete(capture, self.oracle);
         let cosines = self.recompute(|p| full.pixel(p));
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        let recomputed_entries = cosines.as_ref().map_or(0, |c| c.values.len() as u64);
+        let recomputed_entries = cosines.as_ref().map_or(0, |c| c.len() as u64);
         let pass = (completed.is_some() || cosines.is_some()).then_some(AttributePass {
             completed_from_oracle: completed,
             recomputed_entries,
@@ -248,83 +202,10 @@ impl<'a> Judge<'a> {
     }
 }
 
-/// The capture with a depth key and a primitive id in every entry, in the capture's order, and
-/// what had to be taken from the oracle for it (see the module's documentation).
-#[must_use]
-pub fn complete<'c>(
-    capture: &'c Capture,
-    oracle: &Oracle,
-) -> (Cow<'c, Capture>, Option<&'static str>) {
-    match capture.identity {
-        // Packed MDTS carries its own (lossy) depth in the high half: shaded as it is.
-        Identity::KeyAndPrim | Identity::PrimOnly => (Cow::Borrowed(capture), None),
-        Identity::KeyOnly => {
-            let entries = (0..capture.pixels())
-                .into_par_iter()
-                .with_min_len(256)
-                .flat_map_iter(|p| prims_of_keys(capture.pixel(p), oracle.pixel(p)))
-                .collect();
-            let full = Capture {
-                lists: PixelLists {
-                    offsets: capture.offsets.clone(),
-                    entries,
-                },
-                identity: Identity::KeyAndPrim,
-                keeps: capture.keeps.clone(),
-            };
-            (
-                Cow::Owned(full),
-                Some("primitive ids (matched by depth key)"),
-            )
-        }
-    }
-}
-
-/// Key-only entries to full ones: the i-th occurrence of a key takes the primitive of the i-th
-/// fragment with that key in canonical order.
-fn prims_of_keys(list: &[u64], fragments: &[u64]) -> Vec<u64> {
-    let mut order: Vec<usize> = (0..list.len()).collect();
-    order.sort_by_key(|&i| list[i] >> 32);
-    let mut out = vec![0u64; list.len()];
-    let mut previous: Option<(u64, usize)> = None;
-    for i in order {
-        let key = list[i] >> 32;
-        let occurrence = match previous {
-            Some((k, n)) if k == key => n + 1,
-            _ => 0,
-        };
-        previous = Some((key, occurrence));
-        let first = fragments.partition_point(|&f| f >> 32 < key);
-        let prim = fragments
-            .get(first + occurrence)
-            .filter(|&&f| f >> 32 == key)
-            .map_or(UNKNOWN_PRIM, |&f| f as u32);
-        out[i] = (key << 32) | u64::from(prim);
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fragsim_capture::Keeps;
-
-    #[test]
-    fn equal_keys_take_their_primitives_in_canonical_order() {
-        let fragments = [(5 << 32) | 2, (5 << 32) | 7, (9 << 32) | 1];
-        // A capture that kept both fives (in any order) and the nine, and one invented key.
-        assert_eq!(
-            prims_of_keys(&[9 << 32, 5 << 32, 5 << 32, 6 << 32], &fragments),
-            vec![
-                (9 << 32) | 1,
-                (5 << 32) | 2,
-                (5 << 32) | 7,
-                (6 << 32) | u64::from(UNKNOWN_PRIM)
-            ]
-        );
-        // A merging scheme that kept one five gets the first.
-        assert_eq!(prims_of_keys(&[5 << 32], &fragments), vec![(5 << 32) | 2]);
-    }
+    use fragsim_capture::{Identity, Keeps};
 
     /// Two stacked squares: every covered pixel has a near and a far layer.
     fn two_layers() -> (Scene, OrbitCamera) {
@@ -398,10 +279,7 @@ mod tests {
         let judged = judge.judge(&keys).unwrap();
         assert_eq!(judged.errors, 0);
         let pass = judged.pass.expect("completed and recomputed");
-        assert_eq!(
-            pass.completed_from_oracle,
-            Some("primitive ids (matched by depth key)")
-        );
+        assert_eq!(pass.completed_from_oracle, Some(deferred::COMPLETED_PRIMS));
         // Fresnel recomputes the normal of every captured entry, once each.
         assert_eq!(pass.recomputed_entries, oracle.fragments() as u64);
         let full = capture_of(&oracle, Identity::KeyAndPrim, |_, e| e);

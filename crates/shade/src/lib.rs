@@ -1,5 +1,7 @@
 //! Images of captures: the depth-complexity heat map, the nearest-layer depth, and the
-//! multi-fragment effects ([`effects`]: transparency, translucency) with the error-pixel rate.
+//! multi-fragment effects ([`effects`]: transparency, translucency) with the error-pixel rate,
+//! and the deferred attribute pass that gives captures what shading needs beyond their words
+//! ([`deferred`]: normals, primitive ids of key-only captures).
 //!
 //! ```
 //! let counts = vec![0, 1, 2, 3];
@@ -9,6 +11,7 @@
 
 use std::path::Path;
 
+pub mod deferred;
 pub mod effects;
 pub mod plot;
 

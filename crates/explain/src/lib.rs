@@ -1,0 +1,74 @@
+//! Interleavings that explain a scheme, and the walks that measure the k-buffer's hazard.
+//!
+//! The simulator's schemes are per-fragment state machines doing one memory operation per step
+//! (`fragsim_capture`), so a scheme's behaviour under concurrency is a question of how steps of
+//! different fragments interleave. This crate computes what `fragsim explain` and
+//! `fragsim hazard` print (the command line keeps only its options and the printing):
+//! - [`interleaving`]: fragments on one pixel, the scheduled executor's seeds, the replay of an
+//!   explicit order and the slot words after every step;
+//! - [`kbuffer`]: the k-buffer's damage (fragments lost or duplicated), the search for a damaging
+//!   seed and the shrinker that makes its interleaving the shortest (Bavoil et al. 2007's
+//!   read–modify–write hazard; `fragsim_capture::kbuffer` says why 4 steps suffice);
+//! - [`mdts`]: `docs/proof.md`'s invariant of MDTS (FreePipe, Liu et al. 2010) checked at every
+//!   step of the densest interleaving;
+//! - [`hazard`]: the hazard rate over a scene against the oracle, by width and depth complexity
+//!   (`docs/rmw-hazard.md`);
+//! - [`baselines`]: the k-buffer family's passes and losses on every executor
+//!   (`docs/baselines/kbuffer.md`).
+//!
+//! Which catalog schemes can be explained is [`Shown::of`]; the command line offers
+//! [`Shown::schemes`].
+
+pub mod baselines;
+pub mod hazard;
+pub mod interleaving;
+pub mod kbuffer;
+pub mod mdts;
+
+use fragsim_capture::catalog::{Entry, SchemeName, CATALOG};
+use fragsim_capture::kbuffer::WriteBack;
+
+/// What `fragsim explain` shows of a catalog scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shown {
+    /// A lost or duplicated fragment of the k-buffer on its machine ([`kbuffer`]).
+    Hazard(WriteBack),
+    /// MDTS's invariant at every step ([`mdts`]).
+    Invariant,
+}
+
+impl Shown {
+    /// What `explain` shows of `name`: `None` for a scheme it does not build on one pixel (the
+    /// catalog runs a scheme on a view; a single-pixel replay needs the scheme's own type).
+    #[must_use]
+    pub fn of(name: SchemeName) -> Option<Shown> {
+        match name {
+            SchemeName::Kbuffer | SchemeName::KbufferStores => {
+                Some(Shown::Hazard(name.write_back()))
+            }
+            SchemeName::Mdts => Some(Shown::Invariant),
+            _ => None,
+        }
+    }
+
+    /// The catalog's entries `explain` shows, in catalog order.
+    pub fn schemes() -> impl Iterator<Item = &'static Entry> {
+        CATALOG.iter().filter(|e| Shown::of(e.scheme).is_some())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn explained_schemes_are_catalog_entries_with_their_machine() {
+        let names: Vec<&str> = Shown::schemes().map(|e| e.name).collect();
+        assert_eq!(names, ["mdts", "kbuffer", "kbuffer-stores"]);
+        assert_eq!(
+            Shown::of(SchemeName::KbufferStores),
+            Some(Shown::Hazard(WriteBack::SeparateStores))
+        );
+        assert_eq!(Shown::of(SchemeName::Abuffer), None);
+    }
+}
