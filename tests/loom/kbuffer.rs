@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use fragsim::capture::kbuffer::{KBuffer, WriteBack};
 use fragsim::capture::mdts::Direction;
-use fragsim::capture::{Memory, Scheme, SerialMemory, Step, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, SerialMemory, Step, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
 
 use super::{

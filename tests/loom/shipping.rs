@@ -3,7 +3,7 @@
 use fragsim::capture::layer_counter::LayerCounter;
 use fragsim::capture::linked_list::{LinkedList, Resolve};
 use fragsim::capture::loop32::Loop32;
-use fragsim::capture::{Memory, Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT};
 
 use super::{explore, fragments, keyed, one_pixel, run_threads, LoomMemory, Walks, DISTINCT, TIES};
 

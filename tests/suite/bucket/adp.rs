@@ -3,7 +3,6 @@
 
 use fragsim::capture::bucket::{Adp, ADP_SUBINTERVALS};
 use fragsim::capture::executor::run_parallel;
-use fragsim::capture::Scheme;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, Scene};
 

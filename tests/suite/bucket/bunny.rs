@@ -2,7 +2,6 @@
 
 use fragsim::capture::bucket::{Adp, Bdp, Bdp2};
 use fragsim::capture::executor::run_parallel;
-use fragsim::capture::Scheme;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
 

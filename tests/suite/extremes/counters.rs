@@ -3,7 +3,7 @@
 use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::abuffer_atomic_inc::ABufferAtomicInc;
 use fragsim::capture::executor::{run_parallel, run_serial};
-use fragsim::capture::{Scheme, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, OrbitCamera, Scene};
 

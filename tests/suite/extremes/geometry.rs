@@ -4,7 +4,7 @@
 use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::mdts::{Direction, Mdts};
-use fragsim::capture::{Memory, Scheme, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Camera, CullMode, Mesh, OrbitCamera, Scene, View};
 

@@ -7,7 +7,7 @@ use assert_cmd::Command;
 use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::executor::run_serial;
 use fragsim::capture::mdts::{Direction, Mdts};
-use fragsim::capture::{CaptureError, Memory, Scheme, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{CaptureError, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, MeshError, OrbitCamera, Scene, Viewport};
 

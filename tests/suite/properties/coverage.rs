@@ -5,7 +5,6 @@ use fragsim::capture::abuffer::ABuffer;
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
 use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::mdts::Mdts;
-use fragsim::capture::Scheme;
 use fragsim::raster::{
     depth_from_key, depth_key, CullMode, Mesh, OrbitCamera, Scene, View, Viewport, EMPTY_KEY,
 };

@@ -1,7 +1,6 @@
 //! Strategies for planar tilings (seen through the identity camera), the depth planes they lie
 //! on and hinges across the near plane.
 
-use fragsim::capture::Scheme;
 use fragsim::raster::{Mesh, Viewport, SUBPIXEL_BITS};
 use proptest::collection::vec;
 use proptest::prelude::*;
