@@ -1,0 +1,241 @@
+//! The `fragsim` binary's `--dump`, `compare` and `export`: exit codes, verdicts and reports.
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use fragsim::oracle::dump::TriangleExport;
+
+use super::{scratch, spec, with_view, SCENE, WIDTH};
+
+fn fragsim() -> Command {
+    Command::cargo_bin("fragsim").unwrap()
+}
+
+fn stdout_of(cmd: &mut Command, code: i32) -> String {
+    let output = cmd.output().unwrap();
+    assert_eq!(
+        output.status.code(),
+        Some(code),
+        "stdout {}\nstderr {}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout).unwrap()
+}
+
+const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
+
+#[test]
+fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
+    let dir = scratch("binary");
+    let dumps = dir.join("dumps");
+    stdout_of(
+        fragsim()
+            .args([
+                "render",
+                "--scene",
+                SCENE,
+                "--scheme",
+                "mdts,mdts32,abuffer",
+            ])
+            .args(SIZE)
+            .args(["--no-images", "--dump"])
+            .arg(&dumps),
+        0,
+    );
+    for scheme in ["mdts", "mdts32", "abuffer"] {
+        let out = stdout_of(
+            fragsim()
+                .args(["compare", "oracle"])
+                .arg(dumps.join(scheme))
+                .args(["--json", "--no-image"]),
+            0,
+        );
+        assert!(out.contains("\"equal\": true"), "{out}");
+    }
+    let text = stdout_of(
+        fragsim()
+            .arg("compare")
+            .arg(dumps.join("abuffer"))
+            .arg(dumps.join("mdts"))
+            .arg("--no-image"),
+        0,
+    );
+    assert!(text.contains("EQUAL (bit-identical)"), "{text}");
+    // One corrupted word: exit 1, the verdict, both lists and a difference image.
+    let slots = dumps.join("mdts").join("slots.u64");
+    let mut bytes = std::fs::read(&slots).unwrap();
+    let first = bytes.chunks_exact(8).position(|w| w != [0xff; 8]).unwrap();
+    bytes[first * 8] ^= 1;
+    std::fs::write(&slots, bytes).unwrap();
+    let image = dir.join("diff.png");
+    let text = stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dumps.join("mdts"))
+            .arg("--image")
+            .arg(&image),
+        1,
+    );
+    assert!(text.contains("missing 1, extra 1"), "{text}");
+    assert!(text.contains("verdict: DIFFERENT"), "{text}");
+    assert!(image.exists());
+    let json = stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dumps.join("mdts"))
+            .args(["--json", "--no-image"]),
+        1,
+    );
+    assert!(json.contains("\"equal\": false") && json.contains("\"first_differences\""));
+    // Nothing to compare, or no dump at all: exit 2.
+    stdout_of(fragsim().args(["compare", "oracle", "oracle"]), 2);
+    stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join("absent")),
+        2,
+    );
+}
+
+/// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the report.
+fn json_report(dir: &Path, code: i32) -> serde_json::Value {
+    let out = stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir)
+            .args(["--json", "--no-image"]),
+        code,
+    );
+    serde_json::from_str(&out).unwrap()
+}
+
+#[test]
+fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
+    let dir = scratch("binary-corrupt");
+    let dumps = dir.join("dumps");
+    stdout_of(
+        fragsim()
+            .args([
+                "render",
+                "--scene",
+                SCENE,
+                "--scheme",
+                "mdts,mdts-desc,mdts32,abuffer",
+            ])
+            .args(SIZE)
+            .args(["--no-images", "--dump"])
+            .arg(&dumps),
+        0,
+    );
+    // (layout, slots file, bytes a word, the empty slot's word)
+    let layouts = [
+        ("mdts", "slots.u64", 8, u64::MAX),
+        ("mdts-desc", "slots.u64", 8, 0),
+        ("mdts32", "slots.u32", 4, u64::from(u32::MAX)),
+    ];
+    for (scheme, file, width, empty) in layouts {
+        let path = dumps.join(scheme);
+        let k = json_report(&path, 0)["candidate"]["k"].as_u64().unwrap() as usize;
+        let slots = path.join(file);
+        let mut bytes = std::fs::read(&slots).unwrap();
+        let word = |bytes: &[u8], i: usize| {
+            let mut le = [0u8; 8];
+            le[..width].copy_from_slice(&bytes[i * width..(i + 1) * width]);
+            u64::from_le_bytes(le)
+        };
+        // A pixel whose first slot is full and whose last two are empty; its last slot gets a
+        // copy of its first word, a word the pixel really holds.
+        let pixel = (0..bytes.len() / width / k)
+            .find(|&p| word(&bytes, p * k) != empty && word(&bytes, p * k + k - 2) == empty)
+            .unwrap();
+        let stray = word(&bytes, pixel * k);
+        let last = pixel * k + k - 1;
+        bytes[last * width..(last + 1) * width].copy_from_slice(&stray.to_le_bytes()[..width]);
+        std::fs::write(&slots, &bytes).unwrap();
+        let text = stdout_of(
+            fragsim()
+                .args(["compare", "oracle"])
+                .arg(&path)
+                .arg("--no-image"),
+            1,
+        );
+        let x = pixel % WIDTH as usize;
+        let y = pixel / WIDTH as usize;
+        for expected in [
+            "corrupt 1".to_string(),
+            format!("pixel {pixel} (x {x}, y {y}): corrupt\n"),
+            format!("slot {}: {stray:#x} written after an empty slot", k - 1),
+            "verdict: DIFFERENT".to_string(),
+        ] {
+            assert!(
+                text.contains(&expected),
+                "{scheme}: {expected:?} not in\n{text}"
+            );
+        }
+        assert!(!text.contains("EQUAL"), "{scheme}: {text}");
+        let report = json_report(&path, 1);
+        assert_eq!(report["equal"], false);
+        assert_eq!(report["verdicts"]["corrupt"], 1, "{scheme}");
+        assert_eq!(report["words"]["corrupt"], 1);
+        let first = &report["first_differences"][0];
+        assert_eq!(first["pixel"], pixel);
+        assert_eq!(first["verdict"], serde_json::json!(["corrupt"]));
+        assert_eq!(first["corrupt_words"][0]["slot"], k - 1);
+    }
+    // An A-buffer counter that never stopped: overflow-miscounted, and the overflow by design
+    // stays what the oracle predicts (none here) instead of the counter's 4294967295 − n.
+    let path = dumps.join("abuffer");
+    let counters = path.join("counters.u32");
+    let mut bytes = std::fs::read(&counters).unwrap();
+    let pixel = bytes.chunks_exact(4).position(|c| c != [0; 4]).unwrap();
+    bytes[pixel * 4..pixel * 4 + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    std::fs::write(&counters, &bytes).unwrap();
+    let report = json_report(&path, 1);
+    assert_eq!(report["verdicts"]["overflow-miscounted"], 1);
+    assert_eq!(report["fragments"]["overflowed"], 0);
+    assert_eq!(report["first_differences"][0]["pixel"], pixel);
+    assert_eq!(
+        report["first_differences"][0]["verdict"],
+        // `abuffer` is fixed storage written in full (`filled`): the slots the counter now
+        // claims hold the empty marker, which is corrupt too.
+        serde_json::json!(["overflow-miscounted", "corrupt"])
+    );
+    let text = stdout_of(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(&path)
+            .arg("--no-image"),
+        1,
+    );
+    assert!(
+        text.contains("overflowed by design 0 (counters claim"),
+        "{text}"
+    );
+    assert!(text.contains("overflow-miscounted 1"), "{text}");
+}
+
+#[test]
+fn the_binary_exports_the_triangles_of_the_view_it_names() {
+    let dir = scratch("export");
+    let file = dir.join("scene.tri");
+    let text = stdout_of(
+        fragsim()
+            .args([
+                "export-scene",
+                "--scene",
+                SCENE,
+                "--view",
+                "30",
+                "--elevation",
+                "15",
+            ])
+            .args(SIZE)
+            .arg("--out")
+            .arg(&file),
+        0,
+    );
+    assert!(text.contains("screen triangles"), "{text}");
+    let read = TriangleExport::read(&file).unwrap();
+    with_view(|view, _| assert_eq!(read, TriangleExport::from_view(view, spec())));
+}
