@@ -39,11 +39,11 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::abuffer::bitonic_sort;
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::sort::bitonic_sort;
 
 /// MSAA samples per pixel: the most D3D10 hardware offered, and the sketch's limit.
 pub const SAMPLES: u32 = 8;
