@@ -45,8 +45,8 @@ use std::path::{Path, PathBuf};
 
 use fragsim_capture::abuffer::{ABuffer, PostSort};
 use fragsim_capture::mdts::{Direction, Mdts};
+use fragsim_capture::WordMemory;
 use fragsim_capture::{Capacity, Capture, CaptureError, Identity, Keeps, Scheme, SerialMemory};
-use fragsim_capture::{Step, WordMemory};
 use fragsim_raster::{OrbitCamera, Scene, ScreenTriangle, View, Viewport, SUBPIXEL_BITS};
 use serde::{Deserialize, Serialize};
 
@@ -507,22 +507,7 @@ impl SchemeVisitor for Record<'_, '_> {
     type Output = (Vec<u32>, Vec<u64>);
     fn visit<S: Scheme>(self, scheme: &S) -> Self::Output {
         let memory: SerialMemory = scheme.layout().allocate();
-        let mut steps = 0;
-        let mut pass = 0;
-        loop {
-            for prim in 0..self.view.triangle_count() {
-                self.view.rasterize(prim, &mut |fragment| {
-                    if let Some(state) = scheme.begin_pass(pass, fragment) {
-                        let end: Step = scheme.insert_state(state, &memory, &mut steps);
-                        debug_assert_ne!(end, Step::Continue);
-                    }
-                });
-            }
-            if !scheme.end_pass(pass, &memory) {
-                break;
-            }
-            pass += 1;
-        }
+        fragsim_capture::executors::serial_passes(self.view, scheme, &memory);
         (read_all(&memory), read_all(&memory))
     }
 }
