@@ -305,3 +305,105 @@ pub(crate) fn reuse_storage<'a, S: Scheme, M: ReusableStorage>(
     };
     kept.insert(memory)
 }
+
+#[cfg(test)]
+mod tests {
+    use fragsim_raster::{depth_key, OrbitCamera, Scene, View, Viewport};
+
+    use super::*;
+    use crate::executors::run_serial;
+    use crate::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
+    use crate::mdts::Mdts;
+    use crate::peeling::DepthPeeling;
+    use crate::{WordMemory, MEMORY_CAP_DEFAULT};
+
+    /// The view's fragments in submission order.
+    fn fragments(view: &View<'_>) -> Vec<Fragment> {
+        let mut all = Vec::new();
+        for prim in 0..view.triangle_count() {
+            view.rasterize(prim, &mut |f| all.push(f));
+        }
+        all
+    }
+
+    /// Every word of `memory`, both widths.
+    fn words(memory: &SerialMemory) -> (Vec<u32>, Vec<u64>) {
+        (
+            (0..WordMemory::<u32>::len(memory))
+                .map(|i| WordMemory::<u32>::load(memory, i))
+                .collect(),
+            (0..WordMemory::<u64>::len(memory))
+                .map(|i| WordMemory::<u64>::load(memory, i))
+                .collect(),
+        )
+    }
+
+    /// Eight fragments of one pixel, depths out of order, one triangle each.
+    fn one_pixel() -> Vec<Fragment> {
+        [0.5, 0.3, 0.9, 0.1, 0.7, 0.2, 0.6, 0.4]
+            .iter()
+            .enumerate()
+            .map(|(prim, &d)| Fragment {
+                pixel: 0,
+                depth_key: depth_key(d).unwrap(),
+                prim: prim as u32,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn walks_in_submission_order_over_every_pass_are_the_serial_executors_frame() {
+        let scene = Scene::procedural("spheres:2").unwrap();
+        let view = scene
+            .view(Viewport::new(24, 24).unwrap(), &OrbitCamera::default())
+            .unwrap();
+        let peeling = DepthPeeling::<u64>::new(view.viewport(), 8, MEMORY_CAP_DEFAULT).unwrap();
+        let all = fragments(&view);
+        let memory: SerialMemory = peeling.layout().allocate();
+        let (counters, passes) = passes(&peeling, &memory, |pass| {
+            walks(&peeling, &memory, pass, &all)
+        });
+        let run = run_serial(&view, &peeling);
+        assert!(run.stats.passes > 2, "a multi-pass case");
+        assert_eq!((counters, passes), (run.stats.counters, run.stats.passes));
+        assert_eq!(peeling.resolve(&memory), run.capture);
+    }
+
+    #[test]
+    fn interleaved_walks_picked_first_are_walks_and_any_pick_ends_every_walk() {
+        let fragments = one_pixel();
+        let mdts = Mdts::<u64>::ascending(Viewport::new(1, 1).unwrap(), 3).unwrap();
+        let in_order: SerialMemory = mdts.layout().allocate();
+        let expected = walks(&mdts, &in_order, 0, &fragments);
+        let first: SerialMemory = mdts.layout().allocate();
+        let counters = interleaved(&mdts, &first, 0, &fragments, |_| 0);
+        assert_eq!(counters, expected);
+        assert_eq!(words(&first), words(&in_order));
+        // The last unfinished walk first: another order of steps, the same sorted slots (MDTS's
+        // words do not depend on the interleaving), every fragment's walk ended.
+        let last: SerialMemory = mdts.layout().allocate();
+        let counters = interleaved(&mdts, &last, 0, &fragments, |unfinished| {
+            unfinished.len() - 1
+        });
+        assert_eq!(counters.fragments, fragments.len() as u64);
+        assert_eq!(counters.stored + counters.dropped, counters.fragments);
+        assert_eq!(words(&last), words(&in_order));
+    }
+
+    #[test]
+    fn a_scheduled_run_hands_back_the_memory_its_post_pass_read() {
+        let fragments = one_pixel();
+        let mdts = Mdts::<u64>::ascending(Viewport::new(1, 1).unwrap(), 3).unwrap();
+        let schedule = Schedule {
+            policy: Policy::Random,
+            in_flight: 4,
+            granularity: Granularity::Fragment,
+            seed: 1,
+        };
+        let scheduled = run_fragments(&mdts, &fragments, &schedule, false);
+        assert_eq!(mdts.resolve(&scheduled.memory), scheduled.run.capture);
+        let serial: SerialMemory = mdts.layout().allocate();
+        walks(&mdts, &serial, 0, &fragments);
+        assert_eq!(words(&scheduled.memory), words(&serial));
+    }
+}

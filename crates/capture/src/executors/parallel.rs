@@ -76,6 +76,17 @@ pub(crate) fn parallel_frame<S: Scheme, M: Memory + Sync>(
             })
             .reduce(Counters::default, Counters::merge)
     };
+    rayon_frame(scheme, memory, start, geometry_pass)
+}
+
+/// A frame of the executors that run on the rayon pool (parallel and tiled): their geometry
+/// passes, then the post pass in parallel ([`resolve_parallel`]).
+pub(crate) fn rayon_frame<S: Scheme, M: Memory + Sync>(
+    scheme: &S,
+    memory: &M,
+    start: Instant,
+    geometry_pass: impl FnMut(u32) -> Counters,
+) -> Run {
     frame::run(
         scheme,
         memory,

@@ -25,8 +25,8 @@ use std::time::Instant;
 use fragsim_raster::{PixelRect, View, Viewport};
 use rayon::prelude::*;
 
-use super::frame::{self, rasterize_into, reuse_storage, Counters, Run};
-use super::parallel::resolve_parallel;
+use super::frame::{rasterize_into, reuse_storage, Counters, Run};
+use super::parallel::rayon_frame;
 use crate::memory::AtomicMemory;
 use crate::scheme::Scheme;
 
@@ -168,14 +168,7 @@ impl TiledExecutor {
                 })
                 .reduce(Counters::default, Counters::merge)
         };
-        frame::run(
-            scheme,
-            memory,
-            start,
-            rayon::current_num_threads(),
-            geometry_pass,
-            |memory| resolve_parallel(scheme, memory),
-        )
+        rayon_frame(scheme, memory, start, geometry_pass)
     }
 }
 
