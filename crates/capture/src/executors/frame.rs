@@ -308,7 +308,7 @@ pub(crate) fn reuse_storage<'a, S: Scheme, M: ReusableStorage>(
 
 #[cfg(test)]
 mod tests {
-    use fragsim_raster::{depth_key, OrbitCamera, Scene, View, Viewport};
+    use fragsim_raster::{OrbitCamera, Scene, View, Viewport};
 
     use super::*;
     use crate::executors::run_serial;
@@ -320,33 +320,26 @@ mod tests {
     /// The view's fragments in submission order.
     fn fragments(view: &View<'_>) -> Vec<Fragment> {
         let mut all = Vec::new();
-        for prim in 0..view.triangle_count() {
-            view.rasterize(prim, &mut |f| all.push(f));
-        }
+        (0..view.triangle_count()).for_each(|prim| view.rasterize(prim, &mut |f| all.push(f)));
         all
     }
 
-    /// Every word of `memory`, both widths.
-    fn words(memory: &SerialMemory) -> (Vec<u32>, Vec<u64>) {
-        (
-            (0..WordMemory::<u32>::len(memory))
-                .map(|i| WordMemory::<u32>::load(memory, i))
-                .collect(),
-            (0..WordMemory::<u64>::len(memory))
-                .map(|i| WordMemory::<u64>::load(memory, i))
-                .collect(),
-        )
+    /// Every word of `memory`: the `u32` array, then the `u64` array widened.
+    fn words(memory: &SerialMemory) -> Vec<u64> {
+        let narrow =
+            (0..WordMemory::<u32>::len(memory)).map(|i| WordMemory::<u32>::load(memory, i));
+        let wide = (0..WordMemory::<u64>::len(memory)).map(|i| WordMemory::<u64>::load(memory, i));
+        narrow.map(u64::from).chain(wide).collect()
     }
 
-    /// Eight fragments of one pixel, depths out of order, one triangle each.
+    /// Eight fragments of one pixel, one triangle each, depth keys out of order.
     fn one_pixel() -> Vec<Fragment> {
-        [0.5, 0.3, 0.9, 0.1, 0.7, 0.2, 0.6, 0.4]
-            .iter()
-            .enumerate()
-            .map(|(prim, &d)| Fragment {
+        let keys = [5, 3, 9, 1, 7, 2, 6, 4];
+        (0..8)
+            .map(|prim| Fragment {
                 pixel: 0,
-                depth_key: depth_key(d).unwrap(),
-                prim: prim as u32,
+                depth_key: keys[prim as usize],
+                prim,
             })
             .collect()
     }
