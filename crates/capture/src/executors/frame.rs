@@ -7,7 +7,7 @@
 //! caller keeps the memory and wants no post pass) a closure that runs one geometry pass and
 //! returns its [`Counters`]. The pieces such a closure is made of are here too:
 //! - [`walk`]: one fragment's walk of one pass to its end (what serial, parallel and tiled
-//!   executors do for every fragment they rasterize, [`rasterize_into`]);
+//!   executors do for every fragment they rasterize);
 //! - [`walks`]: a caller's list of fragments, one walk after the other, in the caller's order;
 //! - [`interleaved`]: every walk of a pass in flight at once, the caller choosing which one takes
 //!   the next step (tests that script an interleaving; the scheduled executor does the same under
