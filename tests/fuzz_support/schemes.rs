@@ -11,7 +11,7 @@
 
 use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::dual_peeling::DualDepthPeeling;
-use fragsim::capture::executor::{Counters, Run};
+use fragsim::capture::executors::frame::{self, Counters, Run};
 use fragsim::capture::kbuffer::KBuffer;
 use fragsim::capture::kbuffer_multipass::KBufferMultipass;
 use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
@@ -19,7 +19,7 @@ use fragsim::capture::peeling::DepthPeeling;
 use fragsim::capture::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::stencil_routed::StencilRouted;
 use fragsim::capture::zbuffer::ZBuffer;
-use fragsim::capture::{Capture, Identity, Keeps, Scheme, SerialMemory, Step, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Capture, Identity, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{depth_key, Fragment, Viewport};
 
 use super::input::Input;
@@ -191,28 +191,9 @@ enum Drops {
 fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Runs, drops: Drops) {
     let name = scheme.name();
     let memory: SerialMemory = scheme.layout().allocate();
-    let mut counters = Counters::default();
-    let mut pass = 0;
-    loop {
-        for &f in &case.fragments {
-            if let Some(state) = scheme.begin_pass(pass, f) {
-                let mut steps = 0;
-                let end = scheme.insert_state(state, &memory, &mut steps);
-                counters.steps += steps;
-                counters.fragments += 1;
-                match end {
-                    Step::Stored => counters.stored += 1,
-                    Step::Dropped => counters.dropped += 1,
-                    Step::Discarded => counters.discarded += 1,
-                    Step::Continue => panic!("{name}: a walk ended with Continue"),
-                }
-            }
-        }
-        if !scheme.end_pass(pass, &memory) {
-            break;
-        }
-        pass += 1;
-    }
+    let (counters, _) = frame::passes(scheme, &memory, |pass| {
+        frame::walks(scheme, &memory, pass, &case.fragments)
+    });
     // A scheme whose second pass would take no fragment is a one-pass scheme; multi-pass schemes
     // count overflow per pass.
     let one_pass = drops == Drops::Counted

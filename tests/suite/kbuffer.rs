@@ -6,13 +6,12 @@
 //! the rest as overflow.
 
 use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::executors::frame;
 use fragsim::capture::kbuffer::{KBuffer, WriteBack};
 use fragsim::capture::kbuffer_multipass::KBufferMultipass;
 use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::stencil_routed::StencilRouted;
-use fragsim::capture::{
-    Capture, CaptureError, Keeps, Scheme, SerialMemory, Step, MEMORY_CAP_DEFAULT,
-};
+use fragsim::capture::{Capture, CaptureError, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, SplitMix64, View, Viewport};
 use proptest::prelude::*;
@@ -49,19 +48,15 @@ fn one_pixel_quads(scene: &Scene) -> (View<'_>, Vec<Fragment>) {
 /// Runs a hand-written interleaving: `script[i]` names the fragment whose walk takes the i-th
 /// step. Every walk must be over when the script ends.
 fn drive<S: Scheme>(scheme: &S, memory: &SerialMemory, walks: &[Fragment], script: &[usize]) {
-    let mut states: Vec<Option<S::State>> = walks.iter().map(|&f| Some(scheme.begin(f))).collect();
-    for &w in script {
-        let state = states[w]
-            .as_mut()
-            .expect("the script steps a finished walk");
-        if scheme.step(state, memory) != Step::Continue {
-            states[w] = None;
-        }
-    }
-    assert!(
-        states.iter().all(Option::is_none),
-        "the script left a walk unfinished"
-    );
+    let mut script = script.iter();
+    frame::interleaved(scheme, memory, 0, walks, |unfinished| {
+        let w = script.next().expect("the script left a walk unfinished");
+        unfinished
+            .iter()
+            .position(|u| u == w)
+            .expect("the script steps a finished walk")
+    });
+    assert!(script.next().is_none(), "the script steps a finished walk");
 }
 
 /// Runs one pass of a multi-pass scheme over `all`, interleaving the walks as `pick` chooses among
@@ -73,19 +68,14 @@ fn drive_pass<S: Scheme>(
     all: &[Fragment],
     mut pick: impl FnMut(usize) -> usize,
 ) -> bool {
-    let mut states: Vec<S::State> = all
-        .iter()
-        .filter_map(|&f| scheme.begin_pass(pass, f))
-        .collect();
-    while !states.is_empty() {
-        let i = pick(states.len());
-        if scheme.step(&mut states[i], memory) != Step::Continue {
-            // `remove`, not `swap_remove`: `pick` returning 0 then runs the walks one after
-            // the other in submission order (primitive order, which render targets commit in).
-            states.remove(i);
-        }
-    }
-    scheme.end_pass(pass, memory)
+    // The unfinished walks stay in submission order, so `pick` returning 0 runs them one after
+    // the other in primitive order (which render targets commit in).
+    let (_, more) = frame::pass(scheme, memory, pass, |pass| {
+        frame::interleaved(scheme, memory, pass, all, |unfinished| {
+            pick(unfinished.len())
+        })
+    });
+    more
 }
 
 /// How many fragments pixel `p`'s resolve reports now.

@@ -26,10 +26,10 @@
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
-use crate::executor::Run;
+use crate::executors::Run;
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{Promise, Scheme, Step};
 
 /// The counting pass as a scheme: its capture holds one entry per pixel, the pixel's count.
 #[derive(Clone, Copy, Debug)]

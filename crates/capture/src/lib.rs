@@ -24,7 +24,31 @@
 //!
 //! Executors: [`executor`] (serial and parallel, storage kept between frames), [`tiled`]
 //! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`]
-//! (replayable GPU-like interleavings with traces).
+//! (replayable GPU-like interleavings with traces), all running one frame loop
+//! ([`executors::frame`]).
+//!
+//! # The tree
+//!
+//! ```text
+//! lib.rs          this map, and the re-exports that keep the short paths (`fragsim_capture::mdts`)
+//! scheme.rs       the Scheme trait: begin, step, end pass, resolve; Step, Promise, CaptureError
+//! guarantee.rs    what a scheme guarantees against the oracle
+//! capture.rs      the per-pixel lists a run returns, and what they keep
+//! depth_count.rs  the counting pass that sizes exact storage
+//! catalog.rs      every scheme by name: passes, sizing, a constructor that runs it
+//! memory/         the memory seam: Word, WordMemory, Memory, SerialMemory, AtomicMemory,
+//!                 Layout (the words a scheme asks for), CountingMemory (counts locked ops)
+//! schemes/        one file per scheme, named after it; bucket/ holds bucket peeling's three
+//!   common/       what several schemes share: the fragment words (MdtsWord), the post passes'
+//!                 sorts, the peeling schemes' layer storage and depth test
+//! executors/      frame.rs (the one frame loop: passes, resolve, stats), serial.rs,
+//!                 parallel.rs, tiled.rs, scheduled.rs, counting.rs (the counted frame)
+//! ```
+//!
+//! Imports go one way: `memory` needs nothing else of the crate; `scheme` needs `memory`,
+//! `capture` and `guarantee`; `schemes` need those and `schemes::common`, never another scheme's
+//! module (a scheme built on another, as the packed MDTS on MDTS's walks, names it); the
+//! executors need `scheme` and `memory`; the catalog needs everything.
 //!
 //! ```
 //! use fragsim_capture::{executor, mdts::Mdts};
@@ -37,33 +61,24 @@
 //! assert_eq!(run.stats.counters.dropped, 0);
 //! ```
 
-pub mod abuffer;
-pub mod abuffer_atomic_inc;
-pub mod bucket;
 mod capture;
 pub mod catalog;
-mod counting;
 pub mod depth_count;
-pub mod dual_peeling;
-pub mod executor;
+pub mod executors;
 mod guarantee;
-pub mod kbuffer;
-pub mod kbuffer_multipass;
-pub mod layer_counter;
-pub mod linked_list;
-pub mod loop32;
-pub mod mdts;
-pub mod mdts_packed;
 mod memory;
-pub mod peeling;
-pub mod scheduled;
 mod scheme;
-pub mod stencil_routed;
-pub mod tiled;
-pub mod zbuffer;
+pub mod schemes;
+
+// The paths the crate had before its tree: one module per scheme and per executor at the root.
+pub use executors as executor;
+pub use executors::{scheduled, tiled};
+pub use schemes::{
+    abuffer, abuffer_atomic_inc, bucket, dual_peeling, kbuffer, kbuffer_multipass, layer_counter,
+    linked_list, loop32, mdts, mdts_packed, peeling, stencil_routed, zbuffer,
+};
 
 pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
-pub use counting::CountingMemory;
 pub use guarantee::Guarantee;
-pub use memory::{AtomicMemory, Memory, SerialMemory, Word, WordMemory};
-pub use scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+pub use memory::{AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, Word, WordMemory};
+pub use scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};

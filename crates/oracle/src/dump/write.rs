@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use fragsim_capture::catalog::DumpLayout;
-use fragsim_capture::{Scheme, SerialMemory, Step, WordMemory};
+use fragsim_capture::{Scheme, SerialMemory, WordMemory};
 use fragsim_raster::View;
 
 use super::header::{check_array, check_distinct_files, check_file_name};
@@ -23,22 +23,7 @@ impl SchemeVisitor for Record<'_, '_> {
     type Output = (Vec<u32>, Vec<u64>);
     fn visit<S: Scheme>(self, scheme: &S) -> Self::Output {
         let memory: SerialMemory = scheme.layout().allocate();
-        let mut steps = 0;
-        let mut pass = 0;
-        loop {
-            for prim in 0..self.view.triangle_count() {
-                self.view.rasterize(prim, &mut |fragment| {
-                    if let Some(state) = scheme.begin_pass(pass, fragment) {
-                        let end: Step = scheme.insert_state(state, &memory, &mut steps);
-                        debug_assert_ne!(end, Step::Continue);
-                    }
-                });
-            }
-            if !scheme.end_pass(pass, &memory) {
-                break;
-            }
-            pass += 1;
-        }
+        fragsim_capture::executors::serial_passes(self.view, scheme, &memory);
         (read_all(&memory), read_all(&memory))
     }
 }

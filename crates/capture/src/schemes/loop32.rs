@@ -35,8 +35,8 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
 
 /// The empty depth slot.
 const EMPTY: u32 = u32::MAX;

@@ -13,7 +13,11 @@ use std::cell::Cell;
 use std::fmt::Debug;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
-use crate::scheme::Layout;
+mod counting;
+mod layout;
+
+pub use counting::CountingMemory;
+pub use layout::Layout;
 
 /// A memory word: `u32` or `u64`.
 pub trait Word: Copy + Eq + Ord + Debug + Send + Sync + 'static {
@@ -113,7 +117,7 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
 }
 
 /// Plain cells for one thread: the fastest memory and the reference behaviour of a scheme.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct SerialMemory {
     words32: Vec<Cell<u32>>,
     words64: Vec<Cell<u64>>,

@@ -6,7 +6,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
-use crate::memory::{Memory, Word, WordMemory};
+use super::{Memory, Word, WordMemory};
 
 /// `M` with a count of its read-modify-write operations (loads and stores are not counted).
 #[derive(Debug)]

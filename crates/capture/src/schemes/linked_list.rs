@@ -35,8 +35,8 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
 
 /// Which of a long list the resolve keeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -247,7 +247,7 @@ impl Scheme for LinkedList {
             node = WordMemory::<u32>::load(memory, self.counter() + node) as usize;
         }
         if self.resolve == Resolve::KeepFirst {
-            crate::abuffer::insertion_sort(&mut out[start..]);
+            crate::schemes::common::sort::insertion_sort(&mut out[start..]);
         }
         // Fragments past N (and past the pool) leave no per-pixel count: nothing is reported.
         0

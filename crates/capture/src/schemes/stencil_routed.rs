@@ -9,7 +9,7 @@
 //! counter: `s = fetch_add(counter, 1)`, then a `store` into sample `s` (two steps, as the
 //! A-buffer). Past the samples a fragment is lost, and counted: the counter keeps counting. A
 //! full-screen post pass sorts each pixel's samples with a bitonic network (the sketch's
-//! `O(N log² N)` sort; [`crate::abuffer::bitonic_sort`]).
+//! `O(N log² N)` sort; [`crate::schemes::common::sort::bitonic_sort`]).
 //!
 //! **Passes.** With `passes = P`, up to `P` geometry passes capture `8 P` fragments per pixel:
 //! pass `p` re-clears the stencil and keeps the fragments that arrive `8p`-th to `(8p + 7)`-th,
@@ -39,11 +39,11 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::abuffer::bitonic_sort;
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::sort::bitonic_sort;
 
 /// MSAA samples per pixel: the most D3D10 hardware offered, and the sketch's limit.
 pub const SAMPLES: u32 = 8;

@@ -25,9 +25,8 @@ use std::time::Instant;
 use fragsim_raster::{PixelRect, View, Viewport};
 use rayon::prelude::*;
 
-use crate::executor::{
-    finish, rasterize_into, resolve_parallel, reuse_storage, run_passes, Counters, Run,
-};
+use super::frame::{rasterize_into, reuse_storage, Counters, Run};
+use super::parallel::rayon_frame;
 use crate::memory::AtomicMemory;
 use crate::scheme::Scheme;
 
@@ -156,7 +155,7 @@ impl TiledExecutor {
             });
         let chunks = &self.chunks;
         let memory = &*memory;
-        let passes = run_passes(scheme, memory, |pass| {
+        let geometry_pass = |pass| {
             (0..tiles.count())
                 .into_par_iter()
                 .map(|tile| {
@@ -168,10 +167,8 @@ impl TiledExecutor {
                     counters
                 })
                 .reduce(Counters::default, Counters::merge)
-        });
-        finish(scheme, start, passes, rayon::current_num_threads(), || {
-            resolve_parallel(scheme, memory)
-        })
+        };
+        rayon_frame(scheme, memory, start, geometry_pass)
     }
 }
 

@@ -58,10 +58,10 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::mdts::MdtsWord;
-use crate::memory::{Memory, Word, WordMemory};
-use crate::peeling::LayerStorage;
-use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, Word, WordMemory};
+use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::LayerStorage;
+use crate::schemes::common::MdtsWord;
 
 /// Dual depth peeling over words of type `W` (default `u64`: exact fragment for fragment; `u32`:
 /// depth keys, equal depths merge).

@@ -61,8 +61,8 @@ use fragsim_raster::{depth_from_key, Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::mdts::{Direction, Mdts, MdtsWord, Walk};
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
 
 /// Depth bits a packed word keeps (the top of the word).
 pub const DEPTH_BITS: u32 = 20;

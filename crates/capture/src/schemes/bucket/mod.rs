@@ -67,9 +67,9 @@ pub use uniform::{Bdp, Buckets};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
-use crate::mdts::MdtsWord;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{CaptureError, Layout, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{CaptureError, Step};
+use crate::schemes::common::MdtsWord;
 
 /// u32 words of the depth-range pass per pixel: the near word (complemented key) and the far word.
 const RANGE_WORDS: usize = 2;

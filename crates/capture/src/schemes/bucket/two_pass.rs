@@ -35,9 +35,9 @@ use super::{
 };
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::mdts::MdtsWord;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::MdtsWord;
 
 /// BDP2's own stages.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

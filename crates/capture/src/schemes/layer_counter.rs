@@ -27,11 +27,11 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::abuffer::insertion_sort;
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::schemes::common::sort::insertion_sort;
 
 /// Bevy 0.15's layer-counter A-buffer.
 #[derive(Clone, Debug)]

@@ -29,7 +29,7 @@ use std::time::Instant;
 
 use fragsim_raster::{Fragment, SplitMix64, View};
 
-use crate::executor::{Counters, Run, RunStats};
+use super::frame::{self, Counters, Run};
 use crate::memory::{Memory, SerialMemory, WordMemory};
 use crate::scheme::{Scheme, Step};
 
@@ -153,13 +153,16 @@ impl Trace {
     }
 }
 
-/// A scheduled run: the usual result plus the trace, if one was asked for.
+/// A scheduled run: the usual result plus the trace, if one was asked for, and the memory the
+/// run left, for a caller that reads the words themselves.
 #[derive(Clone, Debug)]
 pub struct ScheduledRun {
     /// Capture and statistics.
     pub run: Run,
     /// The memory operations, when recording.
     pub trace: Option<Trace>,
+    /// The words after the last pass (the post pass reads them, never writes them).
+    pub memory: SerialMemory,
 }
 
 /// Storage that can record every operation: plain memory plus a log.
@@ -436,12 +439,12 @@ fn run_stream<S: Scheme>(
     if record {
         memory.log = Some(RefCell::new(Vec::new()));
     }
-    let mut counters = Counters::default();
-    let mut pass = 0;
     let mut chooser = Chooser::new(schedule, 4 * u64::from(triangles).max(1));
     chooser.order = order.map(|order| (order.to_vec(), 0));
-    loop {
-        run_pass(
+    // Step indices run on across passes: PCT's change points and the trace number the whole run.
+    let mut steps_before = 0;
+    let geometry_pass = |pass| {
+        let counters = run_pass(
             scheme,
             &memory,
             pass,
@@ -449,32 +452,20 @@ fn run_stream<S: Scheme>(
             &fragments_of,
             schedule,
             &mut chooser,
-            &mut counters,
+            steps_before,
         );
-        pass += 1;
-        if !scheme.end_pass(pass - 1, &memory) {
-            break;
-        }
-    }
-    let pass_time = start.elapsed();
-    let resolve_start = Instant::now();
-    let capture = scheme.resolve(&memory.inner);
-    let stats = RunStats {
-        counters,
-        passes: pass,
-        pass_time,
-        resolve_time: resolve_start.elapsed(),
-        memory_bytes: scheme.layout().bytes(),
-        threads: 1,
-        locked_ops: None,
-        count_pass_time: None,
+        steps_before += counters.steps;
+        counters
     };
-    let trace = memory.log.map(|log| Trace {
-        events: log.into_inner(),
+    let run = frame::run(scheme, &memory, start, 1, geometry_pass, |memory| {
+        scheme.resolve(&memory.inner)
     });
     ScheduledRun {
-        run: Run { capture, stats },
-        trace,
+        run,
+        trace: memory.log.map(|log| Trace {
+            events: log.into_inner(),
+        }),
+        memory: memory.inner,
     }
 }
 
@@ -490,8 +481,9 @@ fn run_pass<S: Scheme>(
     fragments_of: &impl Fn(u32) -> Vec<Fragment>,
     schedule: &Schedule,
     chooser: &mut Chooser,
-    counters: &mut Counters,
-) {
+    first_step: u64,
+) -> Counters {
+    let mut counters = Counters::default();
     let mut next_triangle = 0u32;
     let mut next_fragment_index = 0u64;
     let mut pending: VecDeque<(Fragment, u64)> = VecDeque::new();
@@ -538,7 +530,7 @@ fn run_pass<S: Scheme>(
             active.push(t);
         }
     }
-    let mut step = counters.steps;
+    let mut step = first_step;
     while !active.is_empty() {
         let t = chooser.choose(&mut threads, &active, step);
         let thread = &mut threads[t];
@@ -564,6 +556,7 @@ fn run_pass<S: Scheme>(
             }
         }
     }
+    counters
 }
 
 /// Starts the thread's next walk that the pass does not ignore; false when it has no more work.

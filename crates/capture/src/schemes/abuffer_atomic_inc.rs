@@ -26,11 +26,12 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::abuffer::{insertion_sort, Claim};
+use crate::abuffer::Claim;
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::schemes::common::sort::insertion_sort;
 
 /// An A-buffer with `capacity` slots per pixel whose slot counter is CUDA's wrapping `atomicInc`.
 #[derive(Clone, Debug)]

@@ -34,8 +34,10 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, Word, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+
+pub use crate::schemes::common::MdtsWord;
 
 /// Which way the array is sorted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,44 +46,6 @@ pub enum Direction {
     Ascending,
     /// `atomicMax`, empty = 0: keeps the `K` farthest.
     Descending,
-}
-
-/// A word type MDTS can sort: `u32` (depth key) or `u64` (depth key and primitive id).
-pub trait MdtsWord: Word {
-    /// What the word identifies.
-    const IDENTITY: Identity;
-    /// The word for a fragment (before the descending variant's offset).
-    fn encode(fragment: Fragment) -> Self;
-    /// The packed `key << 32 | prim` form of a word made by [`MdtsWord::encode`].
-    fn decode(self) -> u64;
-    /// This word type's array in `memory`.
-    fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self>;
-}
-
-impl MdtsWord for u32 {
-    const IDENTITY: Identity = Identity::KeyOnly;
-    fn encode(fragment: Fragment) -> Self {
-        fragment.depth_key
-    }
-    fn decode(self) -> u64 {
-        u64::from(self) << 32
-    }
-    fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self> {
-        memory
-    }
-}
-
-impl MdtsWord for u64 {
-    const IDENTITY: Identity = Identity::KeyAndPrim;
-    fn encode(fragment: Fragment) -> Self {
-        fragment.packed()
-    }
-    fn decode(self) -> u64 {
-        self
-    }
-    fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self> {
-        memory
-    }
 }
 
 /// The multi-depth test scheme over words of type `W` (default: `u64`, fragment identity kept).

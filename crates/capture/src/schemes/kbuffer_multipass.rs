@@ -58,8 +58,8 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
 
 /// The boundary of a pixel that needs no more passes: every fragment is below it.
 const COMPLETE: u64 = u64::MAX;

@@ -39,9 +39,9 @@ use super::{
 };
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::mdts::MdtsWord;
-use crate::memory::Memory;
-use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory};
+use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::MdtsWord;
 
 /// How a pixel's bucket words are used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -77,8 +77,8 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// The value of an empty slot: larger than every packed fragment.
 pub const EMPTY: u64 = u64::MAX;

@@ -60,9 +60,9 @@ use fragsim_raster::{Fragment, Viewport};
 use super::{positive, read_single, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::mdts::MdtsWord;
-use crate::memory::{Memory, WordMemory};
-use crate::scheme::{CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::MdtsWord;
 
 /// Subintervals of the depth histogram: 8 MRTs × 4 channels × 32 bits.
 pub const ADP_SUBINTERVALS: u32 = 1024;

@@ -20,9 +20,9 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
-use crate::peeling::depth_test;
-use crate::scheme::{check_cap, CaptureError, Layout, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, WordMemory};
+use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::common::depth_test;
 
 /// The z-buffer over packed `depth_key << 32 | prim` words.
 #[derive(Clone, Debug)]

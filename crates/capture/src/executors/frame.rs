@@ -1,0 +1,402 @@
+//! The frame loop, written once: begin pass, steps, end pass, resolve, stats.
+//!
+//! A frame runs geometry passes, each followed by the scheme's between-pass kernel
+//! ([`Scheme::end_pass`]), until the scheme asks for no more, then the post pass
+//! ([`Scheme::resolve`]), and reports what it measured ([`RunStats`]). Executors differ only in
+//! who runs which fragment's walk within a pass: they hand [`run`] (or [`passes`], when the
+//! caller keeps the memory and wants no post pass) a closure that runs one geometry pass and
+//! returns its [`Counters`]. The pieces such a closure is made of are here too:
+//! - [`walk`]: one fragment's walk of one pass to its end (what serial, parallel and tiled
+//!   executors do for every fragment they rasterize);
+//! - [`walks`]: a caller's list of fragments, one walk after the other, in the caller's order;
+//! - [`interleaved`]: every walk of a pass in flight at once, the caller choosing which one takes
+//!   the next step (tests that script an interleaving; the scheduled executor does the same under
+//!   a simulated GPU scheduler, with traces).
+
+use std::time::{Duration, Instant};
+
+use fragsim_raster::{Fragment, PixelRect, View};
+
+use crate::capture::Capture;
+use crate::memory::{AtomicMemory, Layout, Memory, SerialMemory};
+use crate::scheme::{Scheme, Step};
+
+/// Counts of what a pass did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Fragments rasterized and inserted.
+    pub fragments: u64,
+    /// Steps run, each one memory operation.
+    pub steps: u64,
+    /// Walks that ended with a value stored.
+    pub stored: u64,
+    /// Walks that ended with a value dropped for lack of storage.
+    pub dropped: u64,
+    /// Walks rejected by the scheme's own test (e.g. not in this peeling pass's layer).
+    pub discarded: u64,
+}
+
+impl Counters {
+    /// Counts one walk that ended with `end`.
+    ///
+    /// # Panics
+    /// If `end` is [`Step::Continue`]: a walk that did not end is not counted.
+    pub fn record(&mut self, end: Step) {
+        self.fragments += 1;
+        match end {
+            Step::Stored => self.stored += 1,
+            Step::Dropped => self.dropped += 1,
+            Step::Discarded => self.discarded += 1,
+            Step::Continue => unreachable!("a walk ends with Stored, Dropped or Discarded"),
+        }
+    }
+
+    /// The sum of two counts.
+    #[must_use]
+    pub fn merge(self, other: Self) -> Self {
+        Self {
+            fragments: self.fragments + other.fragments,
+            steps: self.steps + other.steps,
+            stored: self.stored + other.stored,
+            dropped: self.dropped + other.dropped,
+            discarded: self.discarded + other.discarded,
+        }
+    }
+}
+
+/// What a run measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RunStats {
+    /// Counts, over all passes.
+    pub counters: Counters,
+    /// Geometry passes.
+    pub passes: u32,
+    /// Initialisation, rasterization and capture.
+    pub pass_time: Duration,
+    /// The post pass.
+    pub resolve_time: Duration,
+    /// Bytes of per-pixel storage.
+    pub memory_bytes: u64,
+    /// Threads that ran the pass.
+    pub threads: usize,
+    /// Read-modify-write (locked) operations, when the run counted them
+    /// ([`count_locked_ops`](super::count_locked_ops)).
+    pub locked_ops: Option<u64>,
+    /// The counting pass that sized the storage, when one ran (its time is in `pass_time` and
+    /// its geometry pass in `passes` too): see [`Run::after_count_pass`].
+    pub count_pass_time: Option<Duration>,
+}
+
+/// A run's result.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The per-pixel lists.
+    pub capture: Capture,
+    /// What was measured.
+    pub stats: RunStats,
+}
+
+impl Run {
+    /// This run as the second half of a frame whose storage `count` sized: the counting pass's
+    /// geometry pass, counters and time (its pass and its read-back) are added in, and the
+    /// memory is the larger of the two (the counters are freed, or reused as the A-buffer's,
+    /// before the sized storage is allocated).
+    #[must_use]
+    pub fn after_count_pass(self, count: &Run) -> Run {
+        let counted = count.stats.pass_time + count.stats.resolve_time;
+        Run {
+            stats: RunStats {
+                counters: count.stats.counters.merge(self.stats.counters),
+                passes: count.stats.passes + self.stats.passes,
+                pass_time: counted + self.stats.pass_time,
+                memory_bytes: count.stats.memory_bytes.max(self.stats.memory_bytes),
+                locked_ops: self
+                    .stats
+                    .locked_ops
+                    .map(|ops| ops + count.stats.locked_ops.unwrap_or(0)),
+                count_pass_time: Some(counted),
+                ..self.stats
+            },
+            capture: self.capture,
+        }
+    }
+}
+
+/// One whole frame of `scheme` on `memory`: every geometry pass ([`passes`]), the post pass
+/// `resolve`, and the stats, the passes timed from `start` (so that what the executor did before,
+/// re-initialising the storage or binning triangles, counts as pass time) and the post pass apart.
+pub fn run<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    start: Instant,
+    threads: usize,
+    geometry_pass: impl FnMut(u32) -> Counters,
+    resolve: impl FnOnce(&M) -> Capture,
+) -> Run {
+    let (counters, passes) = passes(scheme, memory, geometry_pass);
+    let pass_time = start.elapsed();
+    let resolve_start = Instant::now();
+    let capture = resolve(memory);
+    let stats = RunStats {
+        counters,
+        passes,
+        pass_time,
+        resolve_time: resolve_start.elapsed(),
+        memory_bytes: scheme.layout().bytes(),
+        threads,
+        locked_ops: None,
+        count_pass_time: None,
+    };
+    Run { capture, stats }
+}
+
+/// Every geometry pass of a frame on `memory`, kept by the caller: `geometry_pass(pass)` runs
+/// pass `pass` (from 0) and returns its counters, then the scheme's between-pass kernel runs,
+/// until it asks for no more passes. Returns the summed counters and the number of passes.
+pub fn passes<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    mut geometry_pass: impl FnMut(u32) -> Counters,
+) -> (Counters, u32) {
+    let mut counters = Counters::default();
+    let mut pass = 0;
+    loop {
+        let (done, more) = self::pass(scheme, memory, pass, &mut geometry_pass);
+        counters = counters.merge(done);
+        pass += 1;
+        if !more {
+            return (counters, pass);
+        }
+    }
+}
+
+/// Geometry pass `pass` alone, `geometry_pass(pass)`, and the between-pass kernel after it: for a
+/// caller that looks at the memory between passes. Returns the pass's counters and whether the
+/// scheme asks for another pass.
+pub fn pass<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    pass: u32,
+    geometry_pass: impl FnOnce(u32) -> Counters,
+) -> (Counters, bool) {
+    let counters = geometry_pass(pass);
+    (counters, scheme.end_pass(pass, memory))
+}
+
+/// Runs `fragment`'s walk of geometry pass `pass` to its end, counting it into `counters`; a
+/// fragment the pass ignores ([`Scheme::begin_pass`] gives `None`) is not counted.
+pub fn walk<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    pass: u32,
+    fragment: Fragment,
+    counters: &mut Counters,
+) {
+    if let Some(state) = scheme.begin_pass(pass, fragment) {
+        let end = scheme.insert_state(state, memory, &mut counters.steps);
+        counters.record(end);
+    }
+}
+
+/// The walks of geometry pass `pass` of `fragments`, one after the other in the order given:
+/// the serial executor's behaviour on a fragment list of the caller's order.
+pub fn walks<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    pass: u32,
+    fragments: &[Fragment],
+) -> Counters {
+    let mut counters = Counters::default();
+    for &fragment in fragments {
+        walk(scheme, memory, pass, fragment, &mut counters);
+    }
+    counters
+}
+
+/// The walks of geometry pass `pass` of `fragments`, all in flight at once: before each step,
+/// `pick` is given the indices into `fragments` of the unfinished walks, in the order of
+/// `fragments`, and returns the position in that list of the walk that takes the step. A pick of
+/// 0 every time runs the walks one after the other in the order given.
+///
+/// # Panics
+/// If `pick` returns a position past the list it was given.
+pub fn interleaved<S: Scheme, M: Memory>(
+    scheme: &S,
+    memory: &M,
+    pass: u32,
+    fragments: &[Fragment],
+    mut pick: impl FnMut(&[usize]) -> usize,
+) -> Counters {
+    let mut counters = Counters::default();
+    let (mut indices, mut states): (Vec<usize>, Vec<S::State>) = fragments
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &f)| scheme.begin_pass(pass, f).map(|state| (i, state)))
+        .unzip();
+    while !indices.is_empty() {
+        let position = pick(&indices);
+        counters.steps += 1;
+        let end = scheme.step(&mut states[position], memory);
+        if end != Step::Continue {
+            counters.record(end);
+            // `remove`, not `swap_remove`: the unfinished walks stay in the order given.
+            indices.remove(position);
+            states.remove(position);
+        }
+    }
+    counters
+}
+
+/// Rasterizes the pixels of `rect` that triangle `prim` covers and runs each fragment's walk of
+/// geometry pass `pass` to its end.
+pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
+    view: &View<'_>,
+    scheme: &S,
+    memory: &M,
+    pass: u32,
+    prim: u32,
+    rect: PixelRect,
+    counters: &mut Counters,
+) {
+    view.rasterize_in(prim, rect, &mut |fragment| {
+        walk(scheme, memory, pass, fragment, counters);
+    });
+}
+
+/// Storage that a frame loop re-initialises rather than allocates again.
+pub(crate) trait ReusableStorage: Memory + Sized {
+    /// Whether this storage has exactly the words `layout` asks for.
+    fn fits(&self, layout: &Layout) -> bool;
+    /// Re-initialises every word to `layout`'s initial values.
+    fn reset(&mut self, layout: &Layout);
+}
+
+impl ReusableStorage for SerialMemory {
+    fn fits(&self, layout: &Layout) -> bool {
+        SerialMemory::fits(self, layout)
+    }
+    fn reset(&mut self, layout: &Layout) {
+        SerialMemory::reset(self, layout);
+    }
+}
+
+impl ReusableStorage for AtomicMemory {
+    fn fits(&self, layout: &Layout) -> bool {
+        AtomicMemory::fits(self, layout)
+    }
+    fn reset(&mut self, layout: &Layout) {
+        AtomicMemory::reset(self, layout);
+    }
+}
+
+/// The storage of `scheme`'s frame: `kept` re-initialised when it fits the scheme's layout, else
+/// newly allocated; kept again for the next frame.
+pub(crate) fn reuse_storage<'a, S: Scheme, M: ReusableStorage>(
+    kept: &'a mut Option<M>,
+    scheme: &S,
+) -> &'a mut M {
+    let layout = scheme.layout();
+    let memory = match kept.take() {
+        Some(mut memory) if memory.fits(&layout) => {
+            memory.reset(&layout);
+            memory
+        }
+        _ => layout.allocate(),
+    };
+    kept.insert(memory)
+}
+
+#[cfg(test)]
+mod tests {
+    use fragsim_raster::{OrbitCamera, Scene, View, Viewport};
+
+    use super::*;
+    use crate::executors::run_serial;
+    use crate::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
+    use crate::mdts::Mdts;
+    use crate::peeling::DepthPeeling;
+    use crate::{WordMemory, MEMORY_CAP_DEFAULT};
+
+    /// The view's fragments in submission order.
+    fn fragments(view: &View<'_>) -> Vec<Fragment> {
+        let mut all = Vec::new();
+        (0..view.triangle_count()).for_each(|prim| view.rasterize(prim, &mut |f| all.push(f)));
+        all
+    }
+
+    /// Every word of `memory`: the `u32` array, then the `u64` array widened.
+    fn words(memory: &SerialMemory) -> Vec<u64> {
+        let narrow =
+            (0..WordMemory::<u32>::len(memory)).map(|i| WordMemory::<u32>::load(memory, i));
+        let wide = (0..WordMemory::<u64>::len(memory)).map(|i| WordMemory::<u64>::load(memory, i));
+        narrow.map(u64::from).chain(wide).collect()
+    }
+
+    /// Eight fragments of one pixel, one triangle each, depth keys out of order.
+    fn one_pixel() -> Vec<Fragment> {
+        let keys = [5, 3, 9, 1, 7, 2, 6, 4];
+        (0..8)
+            .map(|prim| Fragment {
+                pixel: 0,
+                depth_key: keys[prim as usize],
+                prim,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn walks_in_submission_order_over_every_pass_are_the_serial_executors_frame() {
+        let scene = Scene::procedural("spheres:2").unwrap();
+        let view = scene
+            .view(Viewport::new(24, 24).unwrap(), &OrbitCamera::default())
+            .unwrap();
+        let peeling = DepthPeeling::<u64>::new(view.viewport(), 8, MEMORY_CAP_DEFAULT).unwrap();
+        let all = fragments(&view);
+        let memory: SerialMemory = peeling.layout().allocate();
+        let (counters, passes) = passes(&peeling, &memory, |pass| {
+            walks(&peeling, &memory, pass, &all)
+        });
+        let run = run_serial(&view, &peeling);
+        assert!(run.stats.passes > 2, "a multi-pass case");
+        assert_eq!((counters, passes), (run.stats.counters, run.stats.passes));
+        assert_eq!(peeling.resolve(&memory), run.capture);
+    }
+
+    #[test]
+    fn interleaved_walks_picked_first_are_walks_and_any_pick_ends_every_walk() {
+        let fragments = one_pixel();
+        let mdts = Mdts::<u64>::ascending(Viewport::new(1, 1).unwrap(), 3).unwrap();
+        let in_order: SerialMemory = mdts.layout().allocate();
+        let expected = walks(&mdts, &in_order, 0, &fragments);
+        let first: SerialMemory = mdts.layout().allocate();
+        let counters = interleaved(&mdts, &first, 0, &fragments, |_| 0);
+        assert_eq!(counters, expected);
+        assert_eq!(words(&first), words(&in_order));
+        // The last unfinished walk first: another order of steps, the same sorted slots (MDTS's
+        // words do not depend on the interleaving), every fragment's walk ended.
+        let last: SerialMemory = mdts.layout().allocate();
+        let counters = interleaved(&mdts, &last, 0, &fragments, |unfinished| {
+            unfinished.len() - 1
+        });
+        assert_eq!(counters.fragments, fragments.len() as u64);
+        assert_eq!(counters.stored + counters.dropped, counters.fragments);
+        assert_eq!(words(&last), words(&in_order));
+    }
+
+    #[test]
+    fn a_scheduled_run_hands_back_the_memory_its_post_pass_read() {
+        let fragments = one_pixel();
+        let mdts = Mdts::<u64>::ascending(Viewport::new(1, 1).unwrap(), 3).unwrap();
+        let schedule = Schedule {
+            policy: Policy::Random,
+            in_flight: 4,
+            granularity: Granularity::Fragment,
+            seed: 1,
+        };
+        let scheduled = run_fragments(&mdts, &fragments, &schedule, false);
+        assert_eq!(mdts.resolve(&scheduled.memory), scheduled.run.capture);
+        let serial: SerialMemory = mdts.layout().allocate();
+        walks(&mdts, &serial, 0, &fragments);
+        assert_eq!(words(&scheduled.memory), words(&serial));
+    }
+}
