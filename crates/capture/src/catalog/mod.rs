@@ -13,13 +13,40 @@
 //! The catalog's parts: the entries and their columns here, [`DumpLayout`] in `dump_layout.rs`,
 //! building and running an entry in `run.rs`.
 
+mod build;
 mod dump_layout;
 mod run;
 
+pub use build::{Build, SchemeVisitor};
 pub use dump_layout::{DumpLayout, SlotWord};
 pub use run::{check_memory_cap_early, Executors, Fault, NamedRun};
 
-use crate::kbuffer::WriteBack;
+use crate::schemes::abuffer::{
+    ABuffer,
+    PostSort::{Bitonic, Insertion},
+};
+use crate::schemes::bucket::{Adp, Bdp, Bdp2, Buckets};
+use crate::schemes::dual_peeling::DualDepthPeeling;
+use crate::schemes::kbuffer::{
+    KBuffer, WriteBack,
+    WriteBack::{RenderTarget, SeparateStores},
+};
+use crate::schemes::kbuffer_multipass::KBufferMultipass;
+use crate::schemes::layer_counter::LayerCounter;
+use crate::schemes::linked_list::{
+    LinkedList,
+    Resolve::{KeepFirst, KeepNearest},
+};
+use crate::schemes::loop32::Loop32;
+use crate::schemes::mdts::{
+    Direction::{Ascending, Descending},
+    Mdts,
+};
+use crate::schemes::mdts_packed::{Colours, MdtsPacked};
+use crate::schemes::peeling::DepthPeeling;
+use crate::schemes::stencil_routed::StencilRouted;
+use crate::schemes::zbuffer::ZBuffer;
+use crate::CaptureError;
 
 /// A slot count: a number, or derived from the scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -119,7 +146,7 @@ pub struct Entry {
 
 macro_rules! catalog {
     ($($scheme:ident $name:literal $passes:expr, $storage:expr, $dump:expr,
-        $description:literal;)*) => {
+        $description:literal; |$build:ident| $construct:expr;)*) => {
         /// Every scheme the simulator runs by name.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum SchemeName {
@@ -137,6 +164,27 @@ macro_rules! catalog {
                 description: $description,
             },)*
         ];
+
+        impl SchemeName {
+            /// Builds the scheme sized by `build` and hands it, with its slots per pixel where it
+            /// has a fixed number, to `visitor`.
+            ///
+            /// # Errors
+            /// A parameter the scheme rejects, or storage beyond the memory cap.
+            pub fn build<V: SchemeVisitor>(
+                self,
+                build: &Build<'_>,
+                visitor: V,
+            ) -> Result<V::Output, CaptureError> {
+                match self {
+                    $(SchemeName::$scheme => {
+                        let $build = build;
+                        let (scheme, slots) = $construct;
+                        Ok(visitor.visit(&scheme, slots))
+                    })*
+                }
+            }
+        }
     };
 }
 
@@ -148,56 +196,82 @@ use Storage::{Capacity, Counted, KAndPool, Slots, K};
 catalog! {
     Mdts "mdts" Fixed(1), K, Some(SlotArray(Fragment)),
         "MDTS, 64-bit words (depth key and primitive id), ascending.";
+        |b| (Mdts::<u64>::new(b.viewport, b.k, Ascending, b.memory_cap)?, Some(b.k));
     Mdts32 "mdts32" Fixed(1), K, Some(SlotArray(Key)),
         "MDTS, 32-bit depth keys as in FreePipe's Table 1.";
+        |b| (Mdts::<u32>::new(b.viewport, b.k, Ascending, b.memory_cap)?, Some(b.k));
     MdtsDesc "mdts-desc" Fixed(1), K, Some(SlotArray(FragmentPlusOne)),
         "MDTS with `atomicMax`, descending.";
+        |b| (Mdts::<u64>::new(b.viewport, b.k, Descending, b.memory_cap)?, Some(b.k));
     MdtsProbe "mdts-probe" Fixed(1), K, None,
         "MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would change the slot (same lists, fewer locked operations).";
+        |b| (Mdts::<u64>::new(b.viewport, b.k, Ascending, b.memory_cap)?.probing(), Some(b.k));
     Abuffer "abuffer" Fixed(1), Capacity, Some(CountersAndSlots),
         "FreePipe's A-buffer: `--capacity` slots per pixel (fixed arrays, FreePipe §4.2), overflow counted; insertion-sorted.";
+        |b| (ABuffer::fixed(b.viewport, b.capacity, Insertion, b.memory_cap)?, Some(b.capacity));
     AbufferBitonic "abuffer-bitonic" Fixed(1), Capacity, Some(CountersAndSlots),
         "The A-buffer as above, bitonic-sorted.";
+        |b| (ABuffer::fixed(b.viewport, b.capacity, Bitonic, b.memory_cap)?, Some(b.capacity));
     AbufferExact "abuffer-exact" Fixed(1), Counted, Some(CountersAndSlots),
         "The A-buffer with storage sized exactly by its own counting pass (`fetch_add` per fragment, then a prefix sum): two geometry passes.";
+        |b| (ABuffer::exact(b.counts()?, Insertion, b.memory_cap)?, None);
     Peeling "peeling" PerLayers { before: 0, per: 1, after: 1 }, Counted, None,
         "Classical depth peeling, 64-bit words (ties ordered by primitive id): one pass per layer.";
+        |b| (DepthPeeling::<u64>::new(b.viewport, b.layers, b.memory_cap)?, None);
     Peeling32 "peeling32" PerLayers { before: 0, per: 1, after: 1 }, Counted, None,
         "Classical depth peeling on 32-bit depth keys: equal depths merge.";
+        |b| (DepthPeeling::<u32>::new(b.viewport, b.layers, b.memory_cap)?, None);
     DualPeeling "dual-peeling" PerLayers { before: 0, per: 2, after: 1 }, Counted, None,
         "Dual depth peeling (nearest and farthest layer per pass), 64-bit words.";
+        |b| (DualDepthPeeling::<u64>::new(b.viewport, b.layers, b.memory_cap)?, None);
     DualPeeling32 "dual-peeling32" PerLayers { before: 0, per: 2, after: 1 }, Counted, None,
         "Dual depth peeling on 32-bit depth keys.";
+        |b| (DualDepthPeeling::<u32>::new(b.viewport, b.layers, b.memory_cap)?, None);
     Zbuffer "zbuffer" Fixed(1), Slots(1), None,
         "The opaque z-buffer via `atomicMin`: the nearest fragment only.";
+        |b| (ZBuffer::new(b.viewport, b.memory_cap)?, Some(1));
     Bdp "bdp" Fixed(2), Slots(32), None,
         "Bucket depth peeling, one pass, 16 bucket pairs (HPG 2009 §3.2).";
+        |b| (Bdp::<u32>::new(b.viewport, Buckets::Pairs(16), b.memory_cap)?, Some(32));
     BdpSingle "bdp-single" Fixed(2), Slots(32), None,
         "Bucket depth peeling, 32 single-value buckets.";
+        |b| (Bdp::<u32>::new(b.viewport, Buckets::Singles(32), b.memory_cap)?, Some(32));
     Bdp2 "bdp2" Fixed(3), Slots(64), None,
         "Two-pass bucket depth peeling (§3.2).";
+        |b| (Bdp2::<u32>::new(b.viewport, 16, b.memory_cap)?, Some(64));
     Adp "adp" PerLayers { before: 2, per: 32, after: 0 }, Counted, None,
         "Adaptive bucket depth peeling (§3.3).";
+        |b| (Adp::<u32>::new(b.viewport, b.layers, b.memory_cap)?, Some(b.layers));
     Kbuffer "kbuffer" Fixed(1), K, None,
         "The k-buffer: read–insert–write of K slots, exact only without concurrent hazards; render-target write-backs (one step each, committed in primitive order).";
+        |b| (KBuffer::with_write_back(b.viewport, b.k, RenderTarget, b.memory_cap)?, Some(b.k));
     KbufferStores "kbuffer-stores" Fixed(1), K, None,
         "The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.";
+        |b| (KBuffer::with_write_back(b.viewport, b.k, SeparateStores, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
+        |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, RenderTarget, b.memory_cap)?, Some(b.k));
     KbufferMultipassStores "kbuffer-multipass-stores" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer with K separate loads and stores.";
+        |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, SeparateStores, b.memory_cap)?, Some(b.k));
     Srab "srab" UpTo(2), Slots(16), None,
         "The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.";
+        |b| (StencilRouted::new(b.viewport, 2, b.memory_cap)?, Some(16));
     MdtsPacked "mdts-packed" Fixed(1), K, None,
         "MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).";
+        |b| (MdtsPacked::new(b.viewport, b.k, Colours::Prim, b.memory_cap)?, Some(b.k));
     Loop32 "loop32" Fixed(2), K, None,
         "nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths merge), then a colour pass; K = `--k`.";
+        |b| (Loop32::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     LayerCounter "layer-counter" Fixed(1), K, None,
         "Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.";
+        |b| (LayerCounter::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     LinkedList "linked-list" Fixed(1), KAndPool, None,
         "Per-pixel linked lists (node counter, head exchange), the resolve keeping the first `--k` nodes (the most recent: Vulkan-Samples); node pool `--capacity` per pixel, `exact` = the scene's fragments.";
+        |b| (LinkedList::new(b.viewport, b.pool, b.k, KeepFirst, b.memory_cap)?, Some(b.k));
     LinkedListNearest "linked-list-nearest" Fixed(1), KAndPool, None,
         "Per-pixel linked lists, the resolve keeping the `--k` nearest (nvpro-samples).";
+        |b| (LinkedList::new(b.viewport, b.pool, b.k, KeepNearest, b.memory_cap)?, Some(b.k));
 }
 
 impl SchemeName {

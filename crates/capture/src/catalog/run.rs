@@ -2,26 +2,13 @@
 //! one, and one frame on an executor ([`Executors::run`]); the memory cap checked before any of it
 //! ([`check_memory_cap_early`]).
 
-use super::{Count, SchemeName, Sizing};
+use super::{Build, Count, SchemeName, SchemeVisitor, Sizing};
 
-use crate::abuffer::{ABuffer, PostSort};
-use crate::bucket::{Adp, Bdp, Bdp2, Buckets};
 use crate::depth_count::{DepthCount, DepthCounts};
-use crate::dual_peeling::DualDepthPeeling;
-use crate::executor::{self, Executor, ParallelExecutor, Run, SerialExecutor};
-use crate::kbuffer::KBuffer;
-use crate::kbuffer_multipass::KBufferMultipass;
-use crate::layer_counter::LayerCounter;
-use crate::linked_list::{LinkedList, Resolve};
-use crate::loop32::Loop32;
-use crate::mdts::{Direction, Mdts};
-use crate::mdts_packed::{Colours, MdtsPacked};
-use crate::peeling::DepthPeeling;
-use crate::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use crate::stencil_routed::StencilRouted;
-use crate::tiled::TiledExecutor;
-use crate::zbuffer::ZBuffer;
-use crate::{CaptureError, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step};
+use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use crate::executors::tiled::TiledExecutor;
+use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
+use crate::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step};
 use fragsim_raster::{Fragment, View, Viewport};
 
 /// A finished run of a named scheme.
@@ -74,127 +61,44 @@ impl Executors {
         sizing: &Sizing,
     ) -> Result<NamedRun, String> {
         let viewport = view.viewport();
-        let counted = name
-            .needs_count_pass(sizing)
-            .then(|| DepthCounts::from_run(DepthCount::new(viewport).run(self, executor, view)));
+        let counted = name.needs_count_pass(sizing).then(|| {
+            DepthCounts::from_run(run_with_fault(
+                &DepthCount::new(viewport),
+                self,
+                executor,
+                view,
+            ))
+        });
         // What `auto` sizes resolve to: the count pass's maximum depth complexity (at least 1).
         let scene_max = counted.as_ref().map_or(1, |c| c.max().max(1));
         let resolve = |count: Count| match count {
             Count::Auto => scene_max,
             Count::Fixed(n) => n,
         };
-        let (k, capacity) = (resolve(sizing.k), resolve(sizing.capacity));
-        let layers = scene_max;
-        let cap = sizing.memory_cap;
-        let err = |e: CaptureError| e.to_string();
-        let mut go = |scheme: &dyn ErasedScheme, slots: Option<u32>| NamedRun {
-            run: scheme.run(self, executor, view),
-            name: scheme.name(),
-            guarantee: scheme.guarantee(),
-            slots,
-            counts: None,
+        let capacity = resolve(sizing.capacity);
+        let build = Build {
+            viewport,
+            k: resolve(sizing.k),
+            capacity,
+            layers: scene_max,
+            // An `auto` pool holds the scene's fragments; otherwise `capacity` nodes a pixel.
+            pool: match (sizing.capacity, &counted) {
+                (Count::Auto, Some(counted)) => counted.total().max(1),
+                _ => viewport.pixels() * capacity as usize,
+            },
+            memory_cap: sizing.memory_cap,
+            counts: counted.as_ref().map(|c| c.counts.as_slice()),
         };
-        let mut named = match name {
-            SchemeName::Mdts => go(
-                &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Mdts32 => go(
-                &Mdts::<u32>::new(viewport, k, Direction::Ascending, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::MdtsProbe => go(
-                &Mdts::<u64>::new(viewport, k, Direction::Ascending, cap)
-                    .map_err(err)?
-                    .probing(),
-                Some(k),
-            ),
-            SchemeName::MdtsDesc => go(
-                &Mdts::<u64>::new(viewport, k, Direction::Descending, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Abuffer => go(
-                &ABuffer::fixed(viewport, capacity, PostSort::Insertion, cap).map_err(err)?,
-                Some(capacity),
-            ),
-            SchemeName::AbufferBitonic => go(
-                &ABuffer::fixed(viewport, capacity, PostSort::Bitonic, cap).map_err(err)?,
-                Some(capacity),
-            ),
-            SchemeName::AbufferExact => {
-                let counts = &counted.as_ref().expect("sized by its count pass").counts;
-                go(
-                    &ABuffer::exact(counts, PostSort::Insertion, cap).map_err(err)?,
-                    None,
-                )
-            }
-            SchemeName::Peeling => go(
-                &DepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::Peeling32 => go(
-                &DepthPeeling::<u32>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::DualPeeling => go(
-                &DualDepthPeeling::<u64>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::DualPeeling32 => go(
-                &DualDepthPeeling::<u32>::new(viewport, layers, cap).map_err(err)?,
-                None,
-            ),
-            SchemeName::Zbuffer => go(&ZBuffer::new(viewport, cap).map_err(err)?, Some(1)),
-            SchemeName::Bdp => go(
-                &Bdp::<u32>::new(viewport, Buckets::Pairs(16), cap).map_err(err)?,
-                Some(32),
-            ),
-            SchemeName::BdpSingle => go(
-                &Bdp::<u32>::new(viewport, Buckets::Singles(32), cap).map_err(err)?,
-                Some(32),
-            ),
-            SchemeName::Bdp2 => go(&Bdp2::<u32>::new(viewport, 16, cap).map_err(err)?, Some(64)),
-            SchemeName::Adp => go(
-                &Adp::<u32>::new(viewport, layers, cap).map_err(err)?,
-                Some(layers),
-            ),
-            SchemeName::Kbuffer | SchemeName::KbufferStores => go(
-                &KBuffer::with_write_back(viewport, k, name.write_back(), cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::KbufferMultipass | SchemeName::KbufferMultipassStores => go(
-                &KBufferMultipass::with_write_back(viewport, k, layers, name.write_back(), cap)
-                    .map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Srab => go(
-                &StencilRouted::new(viewport, 2, cap).map_err(err)?,
-                Some(16),
-            ),
-            SchemeName::MdtsPacked => go(
-                &MdtsPacked::new(viewport, k, Colours::Prim, cap).map_err(err)?,
-                Some(k),
-            ),
-            SchemeName::Loop32 => go(&Loop32::new(viewport, k, cap).map_err(err)?, Some(k)),
-            SchemeName::LayerCounter => {
-                go(&LayerCounter::new(viewport, k, cap).map_err(err)?, Some(k))
-            }
-            SchemeName::LinkedList | SchemeName::LinkedListNearest => {
-                let pool = match (sizing.capacity, &counted) {
-                    (Count::Auto, Some(counted)) => counted.total().max(1),
-                    _ => viewport.pixels() * capacity as usize,
-                };
-                let resolve = if name == SchemeName::LinkedList {
-                    Resolve::KeepFirst
-                } else {
-                    Resolve::KeepNearest
-                };
-                go(
-                    &LinkedList::new(viewport, pool, k, resolve, cap).map_err(err)?,
-                    Some(k),
-                )
-            }
-        };
+        let mut named = name
+            .build(
+                &build,
+                RunOn {
+                    executors: self,
+                    executor,
+                    view,
+                },
+            )
+            .map_err(|e| e.to_string())?;
         if let Some(counted) = counted {
             named.run = named.run.after_count_pass(&counted.run);
             named.counts = Some(counted.counts);
@@ -210,8 +114,8 @@ impl Executors {
 /// a counting pass, and the oracle alone needs 24 bytes a pixel (6 GiB at 16384 × 16384): a
 /// refusal must not wait for them. The smallest storage is one slot per pixel for MDTS and the
 /// fixed A-buffer, and for the exact A-buffer its counters and offsets with no fragment (4 + 4
-/// bytes a pixel, as `ABuffer::exact` counts them). Schemes not listed here are checked when they
-/// are built.
+/// bytes a pixel, as `ABuffer::exact` counts them): every catalog entry is built at its smallest
+/// (one slot or layer, the least pool, no fragments) and refused if even that exceeds the cap.
 ///
 /// # Errors
 /// The first scheme refused, with the bytes it would need at least.
@@ -224,28 +128,21 @@ pub fn check_memory_cap_early(
         Count::Auto => 1,
         Count::Fixed(n) => n,
     };
-    let (k_least, capacity_least) = (smallest(sizing.k), smallest(sizing.capacity));
-    let memory_cap = sizing.memory_cap;
+    let capacity_least = smallest(sizing.capacity);
+    let no_fragments = vec![0; viewport.pixels()];
+    let least = Build {
+        counts: Some(&no_fragments),
+        pool: viewport.pixels().max(1),
+        ..Build::fixed(
+            viewport,
+            smallest(sizing.k),
+            capacity_least,
+            1,
+            sizing.memory_cap,
+        )
+    };
     for &name in names {
-        let result = match name {
-            SchemeName::Mdts | SchemeName::MdtsProbe => {
-                Mdts::<u64>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
-            }
-            SchemeName::Mdts32 => {
-                Mdts::<u32>::new(viewport, k_least, Direction::Ascending, memory_cap).map(drop)
-            }
-            SchemeName::MdtsDesc => {
-                Mdts::<u64>::new(viewport, k_least, Direction::Descending, memory_cap).map(drop)
-            }
-            SchemeName::AbufferExact => {
-                ABuffer::exact(&vec![0; viewport.pixels()], PostSort::Insertion, memory_cap)
-                    .map(drop)
-            }
-            SchemeName::Abuffer | SchemeName::AbufferBitonic => {
-                ABuffer::fixed(viewport, capacity_least, PostSort::Insertion, memory_cap).map(drop)
-            }
-            _ => Ok(()),
-        };
+        let result = name.build(&least, Unused);
         if let Err(error) = result {
             return Err(if name.needs_count_pass(sizing) {
                 format!(
@@ -259,6 +156,14 @@ pub fn check_memory_cap_early(
     Ok(())
 }
 
+/// The visitor of a scheme built only to see whether it can be.
+struct Unused;
+
+impl SchemeVisitor for Unused {
+    type Output = ();
+    fn visit<S: Scheme>(self, _: &S, _: Option<u32>) {}
+}
+
 /// The interleaving `--executor scheduled` runs: the scheduled executor's random policy with 256
 /// fragments in flight, seed 0 (replayable; `fragsim explain` and `fragsim hazard` search seeds).
 const SCHEDULE: Schedule = Schedule {
@@ -268,30 +173,38 @@ const SCHEDULE: Schedule = Schedule {
     seed: 0,
 };
 
-/// A scheme behind a vtable, so the registry needs one call site per executor rather than one
-/// per (scheme, executor) pair. The per-step code stays statically dispatched inside `run`.
-trait ErasedScheme {
-    fn name(&self) -> String;
-    fn guarantee(&self) -> Guarantee;
-    fn run(&self, executors: &mut Executors, executor: Executor, view: &View<'_>) -> Run;
+/// The catalog visitor that runs one frame of the built scheme on an executor.
+struct RunOn<'e, 'v, 'm> {
+    executors: &'e mut Executors,
+    executor: Executor,
+    view: &'v View<'m>,
 }
 
-impl<S: Scheme> ErasedScheme for S {
-    fn name(&self) -> String {
-        Scheme::name(self)
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Scheme::guarantee(self)
-    }
-
-    fn run(&self, executors: &mut Executors, executor: Executor, view: &View<'_>) -> Run {
-        match executors.fault {
-            Some(Fault::MiscountOverflow) => {
-                run_on(&MiscountOverflow(self), executors, executor, view)
-            }
-            None => run_on(self, executors, executor, view),
+impl SchemeVisitor for RunOn<'_, '_, '_> {
+    type Output = NamedRun;
+    fn visit<S: Scheme>(self, scheme: &S, slots: Option<u32>) -> NamedRun {
+        NamedRun {
+            run: run_with_fault(scheme, self.executors, self.executor, self.view),
+            name: scheme.name(),
+            guarantee: scheme.guarantee(),
+            slots,
+            counts: None,
         }
+    }
+}
+
+/// One frame of `scheme` on `executor`, with the executors' fault injected where one is set.
+fn run_with_fault<S: Scheme>(
+    scheme: &S,
+    executors: &mut Executors,
+    executor: Executor,
+    view: &View<'_>,
+) -> Run {
+    match executors.fault {
+        Some(Fault::MiscountOverflow) => {
+            run_on(&MiscountOverflow(scheme), executors, executor, view)
+        }
+        None => run_on(scheme, executors, executor, view),
     }
 }
 
@@ -303,7 +216,7 @@ fn run_on<S: Scheme>(
     view: &View<'_>,
 ) -> Run {
     if executors.count_locked_ops {
-        return executor::count_locked_ops(view, scheme, executor != Executor::Serial);
+        return executors::count_locked_ops(view, scheme, executor != Executor::Serial);
     }
     match executor {
         Executor::Serial => executors.serial.run(view, scheme),

@@ -7,10 +7,11 @@
 
 use std::collections::BTreeMap;
 
-use fragsim_capture::abuffer::{ABuffer, PostSort};
-use fragsim_capture::catalog::{DumpLayout, SchemeName, SlotWord, Storage, CATALOG};
-use fragsim_capture::mdts::{Direction, Mdts};
-use fragsim_capture::{Capacity, Capture, Identity, Keeps, Scheme};
+use fragsim_capture::catalog::{
+    Build, DumpLayout, SchemeName, SchemeVisitor, SlotWord, Storage, CATALOG,
+};
+use fragsim_capture::mdts::Direction;
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::Viewport;
 use serde::Serialize;
 
@@ -63,12 +64,6 @@ fn either<'a>(names: impl Iterator<Item = &'a str>) -> String {
 pub(super) struct ArrayNames {
     pub(super) words32: Option<&'static str>,
     pub(super) words64: Option<&'static str>,
-}
-
-/// Something done with the concrete scheme a [`DumpScheme`] names (Rust has no generic closures).
-pub(super) trait SchemeVisitor {
-    type Output;
-    fn visit<S: Scheme>(self, scheme: &S) -> Self::Output;
 }
 
 impl DumpScheme {
@@ -167,37 +162,32 @@ impl DumpScheme {
         }
     }
 
-    /// Builds fragsim's scheme for a viewport (no memory cap: the words exist already).
+    /// Builds fragsim's scheme for a viewport through the catalog entry that heads the layout
+    /// (no memory cap: the words exist already).
     pub(super) fn with_scheme<V: SchemeVisitor>(
         &self,
         viewport: Viewport,
         visitor: V,
     ) -> Result<V::Output, DumpError> {
-        let cap = u64::MAX;
-        Ok(match self {
-            Self::Mdts { k, direction } => {
-                visitor.visit(&Mdts::<u64>::new(viewport, *k, *direction, cap)?)
+        let slots = match self {
+            Self::Mdts { k, .. } | Self::Mdts32 { k } => *k,
+            Self::ABufferFixed { capacity, .. } => *capacity,
+            Self::ABufferExact { .. } => 0,
+        };
+        let mut build = Build::fixed(viewport, slots, slots, 1, u64::MAX);
+        let mut scheme = self.layout().scheme();
+        if let Self::ABufferExact { counts, .. } = self {
+            if counts.len() != viewport.pixels() {
+                return err(format!(
+                    "offsets cover {} pixels, the viewport has {}",
+                    counts.len(),
+                    viewport.pixels()
+                ));
             }
-            Self::Mdts32 { k } => {
-                visitor.visit(&Mdts::<u32>::new(viewport, *k, Direction::Ascending, cap)?)
-            }
-            Self::ABufferFixed { capacity, .. } => visitor.visit(&ABuffer::fixed(
-                viewport,
-                *capacity,
-                PostSort::Insertion,
-                cap,
-            )?),
-            Self::ABufferExact { counts, .. } => {
-                if counts.len() != viewport.pixels() {
-                    return err(format!(
-                        "offsets cover {} pixels, the viewport has {}",
-                        counts.len(),
-                        viewport.pixels()
-                    ));
-                }
-                visitor.visit(&ABuffer::exact(counts, PostSort::Insertion, cap)?)
-            }
-        })
+            build.counts = Some(counts);
+            scheme = SchemeName::AbufferExact;
+        }
+        Ok(scheme.build(&build, visitor)?)
     }
 
     /// Reads the scheme and its parameters from a header.

@@ -8,9 +8,10 @@ use fragsim_capture::{Capture, Scheme, SerialMemory, WordMemory};
 use fragsim_raster::Viewport;
 
 use super::header::{check_array, check_distinct_files, check_file_name, elements};
-use super::layouts::{stored_lists, SchemeVisitor};
+use super::layouts::stored_lists;
 use super::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{FORMAT, HEADER_FILE, VERSION};
+use fragsim_capture::catalog::SchemeVisitor;
 
 fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W]) {
     for (i, &w) in words.iter().enumerate() {
@@ -28,7 +29,7 @@ struct Resolve<'a> {
 
 impl SchemeVisitor for Resolve<'_> {
     type Output = Result<Capture, DumpError>;
-    fn visit<S: Scheme>(self, scheme: &S) -> Self::Output {
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> Self::Output {
         let layout = scheme.layout();
         if layout.words32 != self.words32.len() || layout.words64 != self.words64.len() {
             return err(format!(

@@ -9,10 +9,11 @@ use fragsim_capture::{Scheme, SerialMemory, WordMemory};
 use fragsim_raster::View;
 
 use super::header::{check_array, check_distinct_files, check_file_name};
-use super::layouts::{sort_abuffer_in_place, SchemeVisitor};
+use super::layouts::sort_abuffer_in_place;
 use super::{io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{FORMAT, HEADER_FILE, VERSION};
 use crate::scene::SceneAndCamera;
+use fragsim_capture::catalog::SchemeVisitor;
 
 /// Runs a scheme serially over a view and copies its memory out.
 struct Record<'a, 'm> {
@@ -21,7 +22,7 @@ struct Record<'a, 'm> {
 
 impl SchemeVisitor for Record<'_, '_> {
     type Output = (Vec<u32>, Vec<u64>);
-    fn visit<S: Scheme>(self, scheme: &S) -> Self::Output {
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> Self::Output {
         let memory: SerialMemory = scheme.layout().allocate();
         fragsim_capture::executors::serial_passes(self.view, scheme, &memory);
         (read_all(&memory), read_all(&memory))

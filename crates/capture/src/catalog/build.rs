@@ -1,0 +1,67 @@
+//! Building a catalog entry: what its constructor is given ([`Build`]) and what receives the
+//! built scheme ([`SchemeVisitor`]).
+//!
+//! Each entry of the `catalog!` table carries its constructor, so the table is the only place a
+//! scheme is named and built. A scheme's type differs per entry, and Rust has no generic
+//! closures, so the built scheme is handed to a visitor whose `visit` is generic: the executors'
+//! run ([`Executors::run`](super::Executors::run)), the dump recorder and reader, the fuzz
+//! targets' checks and `explain`'s replays are each one visitor, statically dispatched.
+
+use crate::{CaptureError, Scheme};
+use fragsim_raster::Viewport;
+
+/// The sizes a constructor builds with, every `auto` already resolved.
+#[derive(Debug, Clone, Copy)]
+pub struct Build<'a> {
+    /// The viewport the scheme's storage covers.
+    pub viewport: Viewport,
+    /// Slots per pixel of the K-sized schemes.
+    pub k: u32,
+    /// Slots per pixel of the capacity-sized schemes.
+    pub capacity: u32,
+    /// The scene's maximum depth complexity (at least 1), for schemes that record every layer.
+    pub layers: u32,
+    /// Linked lists' node pool, in nodes.
+    pub pool: usize,
+    /// Refuse storage beyond this many bytes.
+    pub memory_cap: u64,
+    /// The per-pixel fragment counts of the scheme's own counting pass, where one ran.
+    pub counts: Option<&'a [u32]>,
+}
+
+impl<'a> Build<'a> {
+    /// Sizes without a counting pass: `k` and `capacity` slots, `layers` layers, a pool of
+    /// `capacity` nodes per pixel.
+    #[must_use]
+    pub fn fixed(viewport: Viewport, k: u32, capacity: u32, layers: u32, memory_cap: u64) -> Self {
+        Build {
+            viewport,
+            k,
+            capacity,
+            layers: layers.max(1),
+            pool: viewport.pixels() * capacity as usize,
+            memory_cap,
+            counts: None,
+        }
+    }
+
+    /// The counting pass's per-pixel counts, which a scheme sized exactly to the scene needs.
+    ///
+    /// # Errors
+    /// No counting pass ran.
+    pub fn counts(&self) -> Result<&'a [u32], CaptureError> {
+        self.counts.ok_or_else(|| {
+            CaptureError::BadParameter(
+                "this scheme is sized by its counting pass, and none ran".to_string(),
+            )
+        })
+    }
+}
+
+/// Something done with a built catalog scheme, whatever its type.
+pub trait SchemeVisitor {
+    /// What the visit returns.
+    type Output;
+    /// Uses `scheme`, which holds `slots` slots per pixel where it has a fixed number.
+    fn visit<S: Scheme>(self, scheme: &S, slots: Option<u32>) -> Self::Output;
+}
