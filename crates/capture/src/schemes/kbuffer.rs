@@ -288,7 +288,7 @@ impl Slots {
     /// The insertion, in registers, after the last read: no memory operation. Under a hazard the
     /// values read may hold gaps, duplicates or be out of order (separate stores only); they are
     /// sorted as they are, as a shader sorting its `K + 1` registers would.
-    fn insert_in_registers(self, insert: &mut Insert) -> Outcome {
+    pub(crate) fn insert_in_registers(self, insert: &mut Insert) -> Outcome {
         let k = self.k as usize;
         insert.local.retain(|&v| v != EMPTY);
         let full = insert.local.len() == k;
