@@ -248,6 +248,9 @@ catalog! {
     KbufferStores "kbuffer-stores" Fixed(1), K, None,
         "The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.";
         |b| (KBuffer::with_write_back(b.viewport, b.k, SeparateStores, b.memory_cap)?, Some(b.k));
+    KbufferInterlock "kbuffer-interlock" Fixed(1), K, None,
+        "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
+        |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
         |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, RenderTarget, b.memory_cap)?, Some(b.k));

@@ -8,6 +8,7 @@ pub mod bucket;
 pub mod common;
 pub mod dual_peeling;
 pub mod kbuffer;
+pub mod kbuffer_interlock;
 pub mod kbuffer_multipass;
 pub mod layer_counter;
 pub mod linked_list;
