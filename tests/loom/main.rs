@@ -36,6 +36,7 @@ use loom::sync::atomic::{
 
 mod abuffer;
 mod kbuffer;
+mod kbuffer_interlock;
 mod mdts;
 mod shipping;
 mod table1;
