@@ -13,6 +13,8 @@
 //!   overwrite on overflow, not a scheme to use);
 //! - the baselines the papers measure: [`zbuffer`] (opaque), [`peeling`] (Everitt 2001),
 //!   [`dual_peeling`] (Bavoil & Myers 2008), [`kbuffer`] (Bavoil et al. 2007),
+//!   [`kbuffer_interlock`](schemes::kbuffer_interlock) (the k-buffer inside a fragment-shader
+//!   interlock: nvpro-samples' interlock mode, exact under any interleaving),
 //!   [`kbuffer_multipass`] (Liu et al. 2006), [`stencil_routed`] (Myers & Bavoil 2007) and
 //!   [`bucket`] (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive);
 //! - shipping OIT backends (`docs/baselines/shipping.md`): [`loop32`] (nvpro-samples, equal
