@@ -158,7 +158,7 @@ fn check_tiled_equals_serial<S: Scheme>(view: &View<'_>, scheme: &S) -> Result<(
 }
 
 proptest! {
-    // 32 cases: each runs all 26 catalog entries on two executors. Measured with `cargo test
+    // 32 cases: each runs every catalog entry (26 when measured) on two executors. Measured with `cargo test
     // --release --test properties -- the_tiled`, one binary per suite then: 96 cases 23.5 s, 32 cases 70.5 s, on two cores
     // under a load average of about 5 (other builds), so the figures say little about the test.
     #![proptest_config(config(32))]
