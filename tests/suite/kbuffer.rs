@@ -5,12 +5,12 @@
 //! hazards with extra passes; the stencil-routed A-buffer exact up to 8 fragments a pass, counting
 //! the rest as overflow.
 
-use fragsim::capture::executor::{run_parallel, run_serial};
 use fragsim::capture::executors::frame;
-use fragsim::capture::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::kbuffer_multipass::KBufferMultipass;
-use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::stencil_routed::StencilRouted;
+use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::executors::{run_parallel, run_serial};
+use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim::capture::schemes::kbuffer_multipass::KBufferMultipass;
+use fragsim::capture::schemes::stencil_routed::StencilRouted;
 use fragsim::capture::{Capture, CaptureError, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, SplitMix64, View, Viewport};

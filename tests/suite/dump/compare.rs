@@ -2,7 +2,7 @@
 //! design against an overstated counter, corrupt words and miscounted overflow, the depth tolerance
 //! and key-only references.
 
-use fragsim::capture::mdts::Direction;
+use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::Identity;
 use fragsim::oracle::dump::{self, verdict, CompareOptions, Corruption, Dump, DumpScheme, Words};
 use fragsim::oracle::Oracle;

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use fragsim::capture::mdts::Direction;
+use fragsim::capture::schemes::mdts::Direction;
 use fragsim::oracle::dump::{self, Dtype, Dump, DumpScheme, SceneSpec, TriangleExport};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};

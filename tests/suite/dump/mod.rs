@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use fragsim::capture::mdts::Direction;
+use fragsim::capture::schemes::mdts::Direction;
 use fragsim::oracle::dump::{self, CompareOptions, Dump, DumpScheme, SceneSpec, Words};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Scene, Viewport};

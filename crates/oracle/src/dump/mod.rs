@@ -17,7 +17,7 @@
 //! than the pixel's fragment count, which the oracle knows.
 //!
 //! ```
-//! use fragsim_capture::mdts::Direction;
+//! use fragsim_capture::schemes::mdts::Direction;
 //! use fragsim_oracle::dump::{self, Dump, DumpScheme};
 //! use fragsim_oracle::scene::SceneAndCamera;
 //! use fragsim_oracle::Oracle;
