@@ -23,11 +23,11 @@
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use fragsim::capture::abuffer::{ABuffer, PostSort};
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
-use fragsim::capture::executor::{ParallelExecutor, SerialExecutor};
-use fragsim::capture::mdts::Mdts;
-use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::executors::{ParallelExecutor, SerialExecutor};
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::{AtomicMemory, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
 use rayon::prelude::*;

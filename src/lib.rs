@@ -8,7 +8,7 @@
 //! - [`shade`]: images of the results.
 //!
 //! ```
-//! use fragsim::capture::{executor, mdts::Mdts};
+//! use fragsim::capture::{executors, schemes::mdts::Mdts};
 //! use fragsim::raster::{OrbitCamera, Scene, Viewport};
 //! use fragsim::oracle::Oracle;
 //!
@@ -16,7 +16,7 @@
 //! let view = scene.view(Viewport::new(48, 48).unwrap(), &OrbitCamera::default()).unwrap();
 //! let oracle = Oracle::build(&view);
 //! let scheme = Mdts::<u64>::ascending(view.viewport(), oracle.max_depth_complexity().max(1)).unwrap();
-//! let run = executor::run_parallel(&view, &scheme);
+//! let run = executors::run_parallel(&view, &scheme);
 //! assert!(oracle.diff(&run.capture).is_exact());
 //! ```
 

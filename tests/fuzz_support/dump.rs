@@ -7,7 +7,8 @@
 //! per pixel of the viewport, or fails with an error.
 
 use fragsim::capture::Keeps;
-use fragsim::oracle::dump::{self, Dump, DumpError};
+use fragsim::oracle::compare::compare;
+use fragsim::oracle::dump::{Dump, DumpError};
 use fragsim::oracle::Oracle;
 
 use super::input::Input;
@@ -57,7 +58,7 @@ pub fn check(data: &[u8]) {
     // A capture whose lists are in canonical order, with no overflow, is what it promises of
     // itself (with overflow it claims fragments that its own lists lack).
     let reference = Oracle::from_capture(&capture);
-    let comparison = dump::compare(&reference, &capture, 0, 4);
+    let comparison = compare(&reference, &capture, 0, 4);
     let no_overflow = match &capture.keeps {
         Keeps::All { overflow, .. } => overflow.iter().all(|&o| o == 0),
         _ => true,

@@ -9,16 +9,16 @@
 //! what the scheme promises of an oracle computed here by sorting, and for one-pass schemes the
 //! counted drops must equal what the capture is missing.
 
-use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::dual_peeling::DualDepthPeeling;
 use fragsim::capture::executors::frame::{self, Counters, Run};
-use fragsim::capture::kbuffer::KBuffer;
-use fragsim::capture::kbuffer_multipass::KBufferMultipass;
-use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
-use fragsim::capture::peeling::DepthPeeling;
-use fragsim::capture::scheduled::{run_fragments, Granularity, Policy, Schedule};
-use fragsim::capture::stencil_routed::StencilRouted;
-use fragsim::capture::zbuffer::ZBuffer;
+use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
+use fragsim::capture::schemes::kbuffer::KBuffer;
+use fragsim::capture::schemes::kbuffer_multipass::KBufferMultipass;
+use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::schemes::peeling::DepthPeeling;
+use fragsim::capture::schemes::stencil_routed::StencilRouted;
+use fragsim::capture::schemes::zbuffer::ZBuffer;
 use fragsim::capture::{Capture, Identity, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{depth_key, Fragment, Viewport};
 

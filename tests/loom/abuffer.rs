@@ -1,6 +1,6 @@
 //! The A-buffer.
 
-use fragsim::capture::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 
 use super::{abuffer_model, fragments, one_pixel, DISTINCT};

@@ -5,8 +5,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::mdts::Direction;
+use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, SerialMemory, Step, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
 
@@ -83,7 +83,7 @@ fn kbuffer_model(
 }
 
 /// The negative control (2 threads, K = 3, exhaustive): the library's k-buffer with separate
-/// stores (`crates/capture/src/kbuffer.rs`: `K` loads, an insertion in registers, `K` stores, one
+/// stores (`crates/capture/src/schemes/kbuffer.rs`: `K` loads, an insertion in registers, `K` stores, one
 /// memory operation per step) is correct when its two walks run one after the other, but loom
 /// finds interleavings that lose a fragment, and the very checker that passes MDTS
 /// (`check_k_best`) panics on them.

@@ -25,8 +25,8 @@ use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use fragsim::capture::abuffer::ABuffer;
-use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::schemes::abuffer::ABuffer;
+use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{Keeps, Memory, Promise, Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT};
 use fragsim::raster::{depth_key, Fragment, Viewport};
 use loom::sync::atomic::{

@@ -1,8 +1,8 @@
 //! Shipping OIT schemes (issue 8, `docs/baselines/shipping.md`).
 
-use fragsim::capture::layer_counter::LayerCounter;
-use fragsim::capture::linked_list::{LinkedList, Resolve};
-use fragsim::capture::loop32::Loop32;
+use fragsim::capture::schemes::layer_counter::LayerCounter;
+use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};
+use fragsim::capture::schemes::loop32::Loop32;
 use fragsim::capture::{Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT};
 
 use super::{explore, fragments, keyed, one_pixel, run_threads, LoomMemory, Walks, DISTINCT, TIES};

@@ -3,7 +3,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::mdts::Direction;
+use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory};
 use fragsim::raster::Fragment;
 

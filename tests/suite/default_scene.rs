@@ -1,9 +1,9 @@
 //! The acceptance check of the core: on the embedded default scene, both schemes on both
 //! executors equal the serial oracle fragment for fragment.
 
-use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::executor::{run_parallel, run_serial, Executor};
-use fragsim::capture::mdts::{Direction, Mdts};
+use fragsim::capture::executors::{run_parallel, run_serial, Executor};
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};

@@ -1,12 +1,12 @@
 //! FreePipe §4.1.2's depth-and-colour MDTS (`mdts_packed`): where it is exact, each way it is
 //! not, and how often it is not on real scenes; and the exact 64-bit alternative (MDTS-64).
 
-use fragsim::capture::executor::{run_parallel, run_serial};
-use fragsim::capture::mdts::Mdts;
-use fragsim::capture::mdts_packed::{
+use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
+use fragsim::capture::executors::{run_parallel, run_serial};
+use fragsim::capture::schemes::mdts::Mdts;
+use fragsim::capture::schemes::mdts_packed::{
     depth20, held_depth, remapped_depth, Colours, MdtsPacked, COLOURS,
 };
-use fragsim::capture::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::{Capture, CaptureError, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};

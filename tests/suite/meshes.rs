@@ -5,16 +5,16 @@
 
 use std::path::PathBuf;
 
-use fragsim::capture::abuffer::ABuffer;
-use fragsim::capture::dual_peeling::DualDepthPeeling;
-use fragsim::capture::executor::{run_parallel, run_serial, Executor, Run};
-use fragsim::capture::kbuffer::KBuffer;
-use fragsim::capture::kbuffer_multipass::KBufferMultipass;
-use fragsim::capture::mdts::{Direction, Mdts};
-use fragsim::capture::peeling::DepthPeeling;
-use fragsim::capture::stencil_routed::StencilRouted;
-use fragsim::capture::tiled::run_tiled;
-use fragsim::capture::zbuffer::ZBuffer;
+use fragsim::capture::executors::tiled::run_tiled;
+use fragsim::capture::executors::{run_parallel, run_serial, Executor, Run};
+use fragsim::capture::schemes::abuffer::ABuffer;
+use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
+use fragsim::capture::schemes::kbuffer::KBuffer;
+use fragsim::capture::schemes::kbuffer_multipass::KBufferMultipass;
+use fragsim::capture::schemes::mdts::{Direction, Mdts};
+use fragsim::capture::schemes::peeling::DepthPeeling;
+use fragsim::capture::schemes::stencil_routed::StencilRouted;
+use fragsim::capture::schemes::zbuffer::ZBuffer;
 use fragsim::capture::Scheme;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;

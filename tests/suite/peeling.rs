@@ -3,11 +3,13 @@
 //! lose exactly the fragments that share a depth with another (the classical merge), their pass
 //! counts are the layer counts the papers give, and overflowing storage is counted, not hidden.
 
-use fragsim::capture::dual_peeling::DualDepthPeeling;
-use fragsim::capture::executor::{run_parallel, run_serial, Run};
-use fragsim::capture::peeling::DepthPeeling;
-use fragsim::capture::scheduled::{run_fragments, run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::zbuffer::ZBuffer;
+use fragsim::capture::executors::scheduled::{
+    run_fragments, run_scheduled, Granularity, Policy, Schedule,
+};
+use fragsim::capture::executors::{run_parallel, run_serial, Run};
+use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
+use fragsim::capture::schemes::peeling::DepthPeeling;
+use fragsim::capture::schemes::zbuffer::ZBuffer;
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};

@@ -1,11 +1,11 @@
 //! The scheduled executor: atomic schemes give the oracle's answer under every policy, width and
 //! seed; runs are pure functions of the schedule; traces record every memory operation.
 
-use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::mdts::{Direction, Mdts};
-use fragsim::capture::scheduled::{
+use fragsim::capture::executors::scheduled::{
     run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
 };
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{Capture, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};

@@ -16,15 +16,15 @@
 //! values, so that ties are common; "serial" is the scheduled executor with one fragment in flight
 //! (submission order), the rest are seeded GPU-like interleavings.
 
-use fragsim::capture::executor::{run_parallel, run_serial, Executor};
-use fragsim::capture::layer_counter::LayerCounter;
-use fragsim::capture::linked_list::{LinkedList, Resolve};
-use fragsim::capture::loop32::Loop32;
-use fragsim::capture::mdts::Mdts;
-use fragsim::capture::scheduled::{
+use fragsim::capture::executors::scheduled::{
     run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
 };
-use fragsim::capture::tiled::run_tiled;
+use fragsim::capture::executors::tiled::run_tiled;
+use fragsim::capture::executors::{run_parallel, run_serial, Executor};
+use fragsim::capture::schemes::layer_counter::LayerCounter;
+use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};
+use fragsim::capture::schemes::loop32::Loop32;
+use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::{Capture, Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};

@@ -3,41 +3,42 @@
 //! The one idea (see `docs/architecture.md`): every scheme is a per-fragment state machine that
 //! performs **exactly one memory operation per step** on a [`Memory`]. The same scheme code then
 //! runs on plain memory (the serial executor), on std atomics (the parallel executor) and on loom's
-//! atomics (the model-checking suite in `tests/loom.rs`), and whether a scheme is safe under
+//! atomics (the model-checking suite in `tests/loom/`), and whether a scheme is safe under
 //! concurrency is a question of where its steps are cut.
 //!
 //! Schemes, one module each, every one stating its algorithm, guarantee, passes and memory:
-//! - FreePipe (Liu et al., I3D 2010): [`mdts`] (the multi-depth test scheme, §4.1.1),
-//!   [`mdts_packed`] (depth and colour packed in 32-bit words, §4.1.2), [`abuffer`] (§4.2), and
-//!   [`abuffer_atomic_inc`] (its counter as CUDA's wrapping `atomicInc`: a model of the silent
+//! - FreePipe (Liu et al., I3D 2010): [`mdts`](schemes::mdts) (the multi-depth test scheme, §4.1.1),
+//!   [`mdts_packed`](schemes::mdts_packed) (depth and colour packed in 32-bit words, §4.1.2), [`abuffer`](schemes::abuffer) (§4.2), and
+//!   [`abuffer_atomic_inc`](schemes::abuffer_atomic_inc) (its counter as CUDA's wrapping `atomicInc`: a model of the silent
 //!   overwrite on overflow, not a scheme to use);
-//! - the baselines the papers measure: [`zbuffer`] (opaque), [`peeling`] (Everitt 2001),
-//!   [`dual_peeling`] (Bavoil & Myers 2008), [`kbuffer`] (Bavoil et al. 2007),
+//! - the baselines the papers measure: [`zbuffer`](schemes::zbuffer) (opaque), [`peeling`](schemes::peeling) (Everitt 2001),
+//!   [`dual_peeling`](schemes::dual_peeling) (Bavoil & Myers 2008), [`kbuffer`](schemes::kbuffer) (Bavoil et al. 2007),
 //!   [`kbuffer_interlock`](schemes::kbuffer_interlock) (the k-buffer inside a fragment-shader
 //!   interlock: nvpro-samples' interlock mode, exact under any interleaving),
-//!   [`kbuffer_multipass`] (Liu et al. 2006), [`stencil_routed`] (Myers & Bavoil 2007) and
-//!   [`bucket`] (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive);
-//! - shipping OIT backends (`docs/baselines/shipping.md`): [`loop32`] (nvpro-samples, equal
-//!   depths merge), [`layer_counter`] (Bevy 0.15) and [`linked_list`] (per-pixel linked lists,
+//!   [`kbuffer_multipass`](schemes::kbuffer_multipass) (Liu et al. 2006), [`stencil_routed`](schemes::stencil_routed) (Myers & Bavoil 2007) and
+//!   [`bucket`](schemes::bucket) (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive);
+//! - shipping OIT backends (`docs/baselines/shipping.md`): [`loop32`](schemes::loop32) (nvpro-samples, equal
+//!   depths merge), [`layer_counter`](schemes::layer_counter) (Bevy 0.15) and [`linked_list`](schemes::linked_list) (per-pixel linked lists,
 //!   Yang et al. 2010, with the resolve policies the samples ship).
 //!
 //! The [`catalog`] lists every scheme by name, with its passes, its sizing and a constructor
 //! that builds and runs it on any executor.
 //!
-//! Executors: [`executor`] (serial and parallel, storage kept between frames), [`tiled`]
-//! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`]
+//! Executors: [`executors`] (serial and parallel, storage kept between frames), [`tiled`](executors::tiled)
+//! (triangles binned into screen tiles, one thread per tile at a time) and [`scheduled`](executors::scheduled)
 //! (replayable GPU-like interleavings with traces), all running one frame loop
 //! ([`executors::frame`]).
 //!
 //! # The tree
 //!
 //! ```text
-//! lib.rs          this map, and the re-exports that keep the short paths (`fragsim_capture::mdts`)
+//! lib.rs          this map, and the re-exports of the core types (Scheme, Memory, Capture, ...)
 //! scheme.rs       the Scheme trait: begin, step, end pass, resolve; Step, Promise, CaptureError
 //! guarantee.rs    what a scheme guarantees against the oracle
 //! capture.rs      the per-pixel lists a run returns, and what they keep
 //! depth_count.rs  the counting pass that sizes exact storage
-//! catalog.rs      every scheme by name: passes, sizing, a constructor that runs it
+//! catalog/        every scheme by name: passes, sizing, dump layout, its constructor (mod.rs),
+//!                 building it for a visitor (build.rs), running it (run.rs), dump layouts
 //! memory/         the memory seam: Word, WordMemory, Memory, SerialMemory, AtomicMemory,
 //!                 Layout (the words a scheme asks for), CountingMemory (counts locked ops)
 //! schemes/        one file per scheme, named after it; bucket/ holds bucket peeling's three
@@ -53,13 +54,13 @@
 //! executors need `scheme` and `memory`; the catalog needs everything.
 //!
 //! ```
-//! use fragsim_capture::{executor, mdts::Mdts};
+//! use fragsim_capture::{executors, schemes::mdts::Mdts};
 //! use fragsim_raster::{OrbitCamera, Scene, Viewport};
 //!
 //! let scene = Scene::procedural("quads:3").unwrap();
 //! let view = scene.view(Viewport::new(16, 16).unwrap(), &OrbitCamera::default()).unwrap();
 //! let scheme = Mdts::<u64>::ascending(view.viewport(), 4).unwrap();
-//! let run = executor::run_serial(&view, &scheme);
+//! let run = executors::run_serial(&view, &scheme);
 //! assert_eq!(run.stats.counters.dropped, 0);
 //! ```
 
@@ -71,14 +72,6 @@ mod guarantee;
 mod memory;
 mod scheme;
 pub mod schemes;
-
-// The paths the crate had before its tree: one module per scheme and per executor at the root.
-pub use executors as executor;
-pub use executors::{scheduled, tiled};
-pub use schemes::{
-    abuffer, abuffer_atomic_inc, bucket, dual_peeling, kbuffer, kbuffer_multipass, layer_counter,
-    linked_list, loop32, mdts, mdts_packed, peeling, stencil_routed, zbuffer,
-};
 
 pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 pub use guarantee::Guarantee;

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use fragsim_capture::executor::Executor;
+use fragsim_capture::executors::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::{OrbitCamera, Scene, View, Viewport, DEFAULT_SCENE_NAME};
 

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use clap::Args;
-use fragsim_capture::executor::Executor;
+use fragsim_capture::executors::Executor;
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::View;
 use fragsim_shade::effects;

@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_capture::kbuffer::KBuffer;
+use fragsim_capture::schemes::kbuffer::KBuffer;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_explain::baselines;
 use fragsim_explain::hazard::{covered_by_bucket, machine_name, rate, BUCKETS, POLICIES};

@@ -8,11 +8,11 @@
 //! machines asked for, and `srab` at every pass count its catalog entry allows.
 
 use fragsim_capture::catalog::{SchemeName, CATALOG};
-use fragsim_capture::executor::{run_parallel, run_serial, Executor, Run};
-use fragsim_capture::kbuffer::{KBuffer, WriteBack};
-use fragsim_capture::kbuffer_multipass::KBufferMultipass;
-use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim_capture::stencil_routed::StencilRouted;
+use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim_capture::executors::{run_parallel, run_serial, Executor, Run};
+use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim_capture::schemes::kbuffer_multipass::KBufferMultipass;
+use fragsim_capture::schemes::stencil_routed::StencilRouted;
 use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim_oracle::Oracle;
 use fragsim_raster::{View, Viewport};

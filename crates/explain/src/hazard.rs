@@ -8,8 +8,8 @@
 //! reads); separate stores also tear write-backs, which leaves duplicates and slots out of order.
 //! `fragsim hazard` prints these rows (`docs/rmw-hazard.md`).
 
-use fragsim_capture::kbuffer::{KBuffer, WriteBack};
-use fragsim_capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack};
 use fragsim_capture::Capture;
 use fragsim_oracle::Oracle;
 use fragsim_raster::View;

@@ -2,11 +2,11 @@
 //! replay of an explicit order, the words after every step, and every reordering of a set of walks.
 //!
 //! Every run here replays an explicit order of threads through
-//! [`fragsim_capture::scheduled::run_fragments_in_order`], so what a caller prints is what ran.
+//! [`fragsim_capture::executors::scheduled::run_fragments_in_order`], so what a caller prints is what ran.
 //! A step may do several memory operations (a render-target read is `K` loads under the pixel's
 //! lock); [`Trace::steps`] groups them.
 
-use fragsim_capture::scheduled::{
+use fragsim_capture::executors::scheduled::{
     run_fragments_in_order, Granularity, Op, Policy, Schedule, Trace,
 };
 use fragsim_capture::Scheme;
@@ -151,8 +151,8 @@ pub fn interleavings(order: &[u32], limit: u64) -> Option<Vec<Vec<u32>>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fragsim_capture::kbuffer::EMPTY;
-    use fragsim_capture::mdts::Mdts;
+    use fragsim_capture::schemes::kbuffer::EMPTY;
+    use fragsim_capture::schemes::mdts::Mdts;
     use fragsim_raster::Viewport;
 
     #[test]
@@ -187,7 +187,7 @@ mod tests {
 
     /// The order seed 1 (PCT) runs.
     fn schedule_order<S: Scheme>(scheme: &S, fragments: &[Fragment]) -> Vec<u32> {
-        let run = fragsim_capture::scheduled::run_fragments(
+        let run = fragsim_capture::executors::scheduled::run_fragments(
             scheme,
             fragments,
             &schedule(1, fragments.len()),

@@ -4,13 +4,13 @@
 //!
 //! Why: `fragsim explain` prints the interleaving, and a loss reads only when it is small. The
 //! shortest losing interleaving is 4 steps on render targets and `4 K` with separate stores
-//! (`fragsim_capture::kbuffer` says why); the shrinker reaches them from what a seed found by
+//! (`fragsim_capture::schemes::kbuffer` says why); the shrinker reaches them from what a seed found by
 //! dropping fragments, then moving steps, each change kept only while the damage still shows.
 
 use std::collections::BTreeMap;
 
-use fragsim_capture::kbuffer::{KBuffer, EMPTY};
-use fragsim_capture::scheduled::{run_fragments, Trace};
+use fragsim_capture::executors::scheduled::{run_fragments, Trace};
+use fragsim_capture::schemes::kbuffer::{KBuffer, EMPTY};
 use fragsim_raster::Fragment;
 
 use crate::interleaving::{
@@ -181,7 +181,7 @@ pub fn shrink(
 mod tests {
     use super::*;
     use crate::interleaving::one_pixel;
-    use fragsim_capture::kbuffer::WriteBack;
+    use fragsim_capture::schemes::kbuffer::WriteBack;
     use fragsim_raster::Viewport;
 
     fn kbuffer(k: u32, machine: WriteBack) -> KBuffer {
@@ -209,7 +209,7 @@ mod tests {
         for machine in [WriteBack::RenderTarget, WriteBack::SeparateStores] {
             let scheme = kbuffer(3, machine);
             // One thread in flight: each walk runs alone, nothing is lost.
-            let alone = fragsim_capture::scheduled::Schedule {
+            let alone = fragsim_capture::executors::scheduled::Schedule {
                 in_flight: 1,
                 ..schedule(0, fragments.len())
             };

@@ -6,9 +6,9 @@
 //! Why: `fragsim explain --scheme mdts` prints the interleaving with the invariant beside every
 //! step, so the proof's induction can be followed on a run that actually happened.
 
-use fragsim_capture::kbuffer::EMPTY;
-use fragsim_capture::mdts::Mdts;
-use fragsim_capture::scheduled::{run_fragments, Trace};
+use fragsim_capture::executors::scheduled::{run_fragments, Trace};
+use fragsim_capture::schemes::kbuffer::EMPTY;
+use fragsim_capture::schemes::mdts::Mdts;
 use fragsim_raster::Fragment;
 
 use crate::interleaving::{record, schedule, switches};

@@ -1,8 +1,8 @@
 //! ADP: exact when layers are farther apart than a subinterval, merging closer ones, and counting
 //! storage below the depth complexity as overflow.
 
-use fragsim::capture::bucket::{Adp, ADP_SUBINTERVALS};
-use fragsim::capture::executor::run_parallel;
+use fragsim::capture::executors::run_parallel;
+use fragsim::capture::schemes::bucket::{Adp, ADP_SUBINTERVALS};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, Scene};
 

@@ -1,7 +1,7 @@
 //! BDP and BDP2: exact within their bucket capacities, and losing exactly what a bucket cannot hold.
 
-use fragsim::capture::bucket::{Adp, Bdp, Bdp2, Buckets};
-use fragsim::capture::scheduled::{run_fragments, Granularity, Policy, Schedule};
+use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
+use fragsim::capture::schemes::bucket::{Adp, Bdp, Bdp2, Buckets};
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, Scene, Viewport};

@@ -1,7 +1,7 @@
 //! The error rates on the bunny (`docs/baselines/bucket.md`).
 
-use fragsim::capture::bucket::{Adp, Bdp, Bdp2};
-use fragsim::capture::executor::run_parallel;
+use fragsim::capture::executors::run_parallel;
+use fragsim::capture::schemes::bucket::{Adp, Bdp, Bdp2};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
 

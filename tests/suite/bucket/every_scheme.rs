@@ -1,9 +1,9 @@
 //! What the three schemes share: losses on random soups are exactly the bucket overflows, captures
 //! do not depend on the schedule, memory is the documented accounting, and bad parameters are errors.
 
-use fragsim::capture::bucket::{Adp, Bdp, Bdp2, Buckets, ADP_SUBINTERVALS};
-use fragsim::capture::executor::run_serial;
-use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::executors::run_serial;
+use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::schemes::bucket::{Adp, Bdp, Bdp2, Buckets, ADP_SUBINTERVALS};
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, View, Viewport};

@@ -15,7 +15,7 @@
 
 use std::collections::BTreeMap;
 
-use fragsim::capture::executor::{run_parallel, run_serial, Run};
+use fragsim::capture::executors::{run_parallel, run_serial, Run};
 use fragsim::capture::Scheme;
 use fragsim::oracle::{Diff, Oracle};
 use fragsim::raster::{OrbitCamera, Scene, View, Viewport};

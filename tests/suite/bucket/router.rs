@@ -1,8 +1,8 @@
 //! The prediction itself: the exact router agrees with HPG eq. 2 worked by hand, and a wrong router
 //! predicts losses the runs do not have (the control that the predictions depend on the routing).
 
-use fragsim::capture::bucket::{Bdp, Bdp2};
-use fragsim::capture::executor::run_serial;
+use fragsim::capture::executors::run_serial;
+use fragsim::capture::schemes::bucket::{Bdp, Bdp2};
 use fragsim::oracle::Oracle;
 use fragsim::raster::Scene;
 

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use assert_cmd::Command;
-use fragsim::oracle::dump::TriangleExport;
+use fragsim::oracle::triangles::TriangleExport;
 
 use super::{scratch, spec, with_view, SCENE, WIDTH};
 

@@ -2,9 +2,10 @@
 //! design against an overstated counter, corrupt words and miscounted overflow, the depth tolerance
 //! and key-only references.
 
-use fragsim::capture::mdts::Direction;
+use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::Identity;
-use fragsim::oracle::dump::{self, verdict, CompareOptions, Corruption, Dump, DumpScheme, Words};
+use fragsim::oracle::compare::{self, verdict, CompareOptions};
+use fragsim::oracle::dump::{Corruption, Dump, DumpScheme, Words};
 use fragsim::oracle::Oracle;
 
 use super::{counters, judged, pixel_with, spec, u64_slots, with_view, HEIGHT, WIDTH};
@@ -29,7 +30,7 @@ fn compare_names_missing_extra_and_misordered_pixels_and_agrees_with_the_diff() 
         slots[renamed * k] ^= 1; // another primitive id
         slots[holed * k + 1] = u64::MAX; // an empty slot: what follows is unreachable
         let capture = dump.capture().unwrap();
-        let comparison = dump::compare(oracle, &capture, 0, 8);
+        let comparison = compare::compare(oracle, &capture, 0, 8);
         let flags = |p: usize| comparison.verdicts[p];
         assert_eq!(flags(swapped), verdict::MISORDERED);
         assert_eq!(flags(renamed), verdict::MISSING | verdict::EXTRA);
@@ -94,7 +95,7 @@ fn abuffer_overflow_by_design_is_equal_but_an_overstated_counter_is_caught() {
             sorted: true,
         };
         let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
-        let comparison = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+        let comparison = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
         assert!(comparison.is_equal());
         assert!(comparison.counts.overflowed > 0);
         assert!(comparison.diff.overflowed > 0);
@@ -105,7 +106,7 @@ fn abuffer_overflow_by_design_is_equal_but_an_overstated_counter_is_caught() {
             Some(Words::U32(c)) => c[deep] += 1,
             _ => panic!("no counters"),
         }
-        let comparison = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+        let comparison = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
         assert!(!comparison.is_equal());
         assert_eq!(
             comparison.verdicts[deep] & verdict::MISCOUNTED,
@@ -153,7 +154,7 @@ fn a_word_after_an_empty_mdts_slot_is_corrupt_in_every_mdts_layout() {
             let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
             let last = p * k as usize + k as usize - 1;
             set_slot(&mut dump, last, stray);
-            let lists = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+            let lists = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
             assert!(
                 lists.is_equal(),
                 "{scheme:?}: decoding stops at the empty slot"
@@ -344,7 +345,7 @@ fn an_abuffer_counter_other_than_the_pixels_fragment_count_is_overflow_miscounte
             assert_eq!(whole.claimed_overflow, claimed);
             assert_eq!(whole.diff.lost, 0, "every fragment that fits is there");
             // The lists alone, counter inferred from the capture, reach the same verdict.
-            let lists = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+            let lists = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
             assert_eq!(lists.verdicts[p] & verdict::MISCOUNTED, verdict::MISCOUNTED);
             assert_eq!(lists.diff.overflowed, predicted);
         }
@@ -361,7 +362,7 @@ fn a_dump_as_reference_checks_counters_only_where_it_knows_the_count() {
         let dump = Dump::record(view, spec(), &scheme, "test").unwrap();
         let capture = dump.capture().unwrap();
         let reference = Oracle::from_capture(&capture);
-        let complete = dump::complete_pixels(&capture);
+        let complete = compare::complete_pixels(&capture);
         let overflowing = oracle.depth_complexity().iter().filter(|&&n| n > 2).count() as u64;
         assert!(overflowing > 0);
         assert_eq!(complete.iter().filter(|&&c| !c).count() as u64, overflowing);
@@ -370,10 +371,10 @@ fn a_dump_as_reference_checks_counters_only_where_it_knows_the_count() {
             complete: Some(&complete),
             ..CompareOptions::default()
         };
-        assert!(dump::compare_with(&reference, &capture, Some(&words), &knowing).is_equal());
+        assert!(compare::compare_with(&reference, &capture, Some(&words), &knowing).is_equal());
         // Taken as the whole truth, the reference's two fragments a pixel make every overflowing
         // counter look too large: that is why completeness is passed.
-        let naive = dump::compare_with(
+        let naive = compare::compare_with(
             &reference,
             &capture,
             Some(&words),
@@ -399,7 +400,7 @@ fn a_sorted_abuffer_dump_is_judged_in_stored_order_an_unsorted_one_is_sorted_fir
             let base = deep * k as usize;
             let slots = u64_slots(&mut dump);
             slots.swap(base, base + 1);
-            let comparison = dump::compare(oracle, &dump.capture().unwrap(), 0, 8);
+            let comparison = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
             if sorted {
                 assert_eq!(comparison.verdicts[deep], verdict::MISORDERED);
             } else {
@@ -432,7 +433,7 @@ fn depth_ulps_accepts_keys_within_the_tolerance_and_no_further() {
         ] {
             let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
             u64_slots(&mut dump)[pixel * k as usize] += nudge << 32;
-            let comparison = dump::compare(oracle, &dump.capture().unwrap(), tolerance, 8);
+            let comparison = compare::compare(oracle, &dump.capture().unwrap(), tolerance, 8);
             assert_eq!(
                 comparison.is_equal(),
                 equal,
@@ -442,7 +443,7 @@ fn depth_ulps_accepts_keys_within_the_tolerance_and_no_further() {
         // A different primitive is never a tolerance match.
         let mut dump = Dump::record(view, spec(), &scheme, "test").unwrap();
         u64_slots(&mut dump)[pixel * k as usize] += (1 << 32) + 1;
-        assert!(!dump::compare(oracle, &dump.capture().unwrap(), 5, 8).is_equal());
+        assert!(!compare::compare(oracle, &dump.capture().unwrap(), 5, 8).is_equal());
     });
 }
 
@@ -466,8 +467,8 @@ fn a_key_only_reference_compares_keys_only() {
         .capture()
         .unwrap();
         let as_oracle = Oracle::from_capture(&reference);
-        assert!(!dump::compare(&as_oracle, &candidate, 0, 1).is_equal());
-        let coarse = dump::with_identity(&candidate, Identity::KeyOnly);
-        assert!(dump::compare(&as_oracle, &coarse, 0, 1).is_equal());
+        assert!(!compare::compare(&as_oracle, &candidate, 0, 1).is_equal());
+        let coarse = compare::with_identity(&candidate, Identity::KeyOnly);
+        assert!(compare::compare(&as_oracle, &coarse, 0, 1).is_equal());
     });
 }

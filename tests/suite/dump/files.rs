@@ -4,8 +4,11 @@
 
 use std::path::Path;
 
-use fragsim::capture::mdts::Direction;
-use fragsim::oracle::dump::{self, Dtype, Dump, DumpScheme, SceneSpec, TriangleExport};
+use fragsim::capture::schemes::mdts::Direction;
+use fragsim::oracle::compare;
+use fragsim::oracle::dump::{Dtype, Dump, DumpScheme};
+use fragsim::oracle::scene::SceneAndCamera;
+use fragsim::oracle::triangles::TriangleExport;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
 
@@ -25,7 +28,7 @@ fn every_layout_round_trips_through_files_and_decodes_to_what_its_scheme_promise
             let capture = back.capture().unwrap();
             let diff = oracle.diff(&capture);
             assert!(diff.is_exact(), "{scheme:?}: {diff:?}");
-            let comparison = dump::compare(oracle, &capture, 0, 4);
+            let comparison = compare::compare(oracle, &capture, 0, 4);
             assert!(comparison.is_equal());
             assert_eq!(comparison.diff.captured, diff.captured);
             assert_eq!(comparison.diff.overflowed, diff.overflowed);
@@ -156,8 +159,10 @@ fn the_triangle_export_round_trips_and_rescanning_it_reproduces_the_oracle() {
             .view(Viewport::new(WIDTH, HEIGHT).unwrap(), &camera)
             .unwrap();
         let oracle = Oracle::build(&view);
-        let export =
-            TriangleExport::from_view(&view, SceneSpec::named(scene, camera.angle_degrees, 15.0));
+        let export = TriangleExport::from_view(
+            &view,
+            SceneAndCamera::named(scene, camera.angle_degrees, 15.0),
+        );
         let bytes = export.to_bytes().unwrap();
         assert_eq!(&bytes[..8], b"FRAGTRI1");
         assert_eq!(u32::from_le_bytes(bytes[12..16].try_into().unwrap()), WIDTH);

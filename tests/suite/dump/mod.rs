@@ -5,8 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use fragsim::capture::mdts::Direction;
-use fragsim::oracle::dump::{self, CompareOptions, Dump, DumpScheme, SceneSpec, Words};
+use fragsim::capture::schemes::mdts::Direction;
+use fragsim::oracle::compare::{CompareOptions, Comparison};
+use fragsim::oracle::dump::{Dump, DumpScheme, Words};
+use fragsim::oracle::scene::SceneAndCamera;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Scene, Viewport};
 
@@ -31,8 +33,8 @@ const SCENE: &str = "spheres:3";
 const WIDTH: u32 = 48;
 const HEIGHT: u32 = 36;
 
-fn spec() -> SceneSpec {
-    SceneSpec::named(SCENE, 30.0, 15.0)
+fn spec() -> SceneAndCamera {
+    SceneAndCamera::named(SCENE, 30.0, 15.0)
 }
 
 fn with_view<R>(f: impl FnOnce(&fragsim::raster::View<'_>, &Oracle) -> R) -> R {
@@ -87,7 +89,7 @@ fn counters(dump: &mut Dump) -> &mut Vec<u32> {
 }
 
 /// The dump compared with the oracle, every word read.
-fn judged(dump: &Dump, oracle: &Oracle) -> dump::Comparison {
+fn judged(dump: &Dump, oracle: &Oracle) -> Comparison {
     let options = CompareOptions {
         examples: 8,
         ..CompareOptions::default()

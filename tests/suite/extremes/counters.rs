@@ -1,8 +1,8 @@
 //! Counters: CUDA's `atomicInc` past capacity against the library's counted `fetch_add`.
 
-use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::abuffer_atomic_inc::ABufferAtomicInc;
-use fragsim::capture::executor::{run_parallel, run_serial};
+use fragsim::capture::executors::{run_parallel, run_serial};
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::abuffer_atomic_inc::ABufferAtomicInc;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, OrbitCamera, Scene};

@@ -1,9 +1,9 @@
 //! Geometry: degenerate and sliver triangles, huge and tiny coordinates and models, the near and
 //! eye planes, and layers closer than the depth precision.
 
-use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::executor::{run_parallel, run_serial};
-use fragsim::capture::mdts::{Direction, Mdts};
+use fragsim::capture::executors::{run_parallel, run_serial};
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Camera, CullMode, Mesh, OrbitCamera, Scene, View};

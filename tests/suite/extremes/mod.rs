@@ -6,8 +6,8 @@
 mod camera;
 
 use camera::{camera_from_columns, identity_camera};
-use fragsim::capture::executor::{run_parallel, run_serial};
-use fragsim::capture::mdts::{Direction, Mdts};
+use fragsim::capture::executors::{run_parallel, run_serial};
+use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{Memory, Scheme, Step, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Camera, CullMode, Fragment, Mesh, View, Viewport};

@@ -1,8 +1,8 @@
 //! Sentinels: no depth key collides with the empty values, against the integer semantics of
 //! signed and unsigned `atomicMin`, and FreePipe's Table 1 with its mixed sentinels.
 
-use fragsim::capture::executor::run_serial;
-use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::executors::run_serial;
+use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
     Guarantee, Identity, Layout, Memory, Promise, Scheme, SerialMemory, Step, WordMemory,
     MEMORY_CAP_DEFAULT,

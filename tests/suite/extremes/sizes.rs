@@ -4,9 +4,9 @@
 use std::time::Instant;
 
 use assert_cmd::Command;
-use fragsim::capture::abuffer::{ABuffer, PostSort};
-use fragsim::capture::executor::run_serial;
-use fragsim::capture::mdts::{Direction, Mdts};
+use fragsim::capture::executors::run_serial;
+use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{CaptureError, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, MeshError, OrbitCamera, Scene, Viewport};

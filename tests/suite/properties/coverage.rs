@@ -1,10 +1,10 @@
 //! Fragment counts, crack-free coverage of closed meshes and planar tilings (near-clipped too), the
 //! depth-key order, and the strategies' own building blocks.
 
-use fragsim::capture::abuffer::ABuffer;
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
-use fragsim::capture::executor::{run_parallel, run_serial};
-use fragsim::capture::mdts::Mdts;
+use fragsim::capture::executors::{run_parallel, run_serial};
+use fragsim::capture::schemes::abuffer::ABuffer;
+use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::raster::{
     depth_from_key, depth_key, CullMode, Mesh, OrbitCamera, Scene, View, Viewport, EMPTY_KEY,
 };

@@ -7,8 +7,8 @@
 //! persisted to disk: a failing case found here is recorded below as an explicit regression test.
 
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
-use fragsim::capture::executor::{ParallelExecutor, Run};
-use fragsim::capture::mdts::{Direction, Mdts, MdtsWord};
+use fragsim::capture::executors::{ParallelExecutor, Run};
+use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{CullMode, OrbitCamera, Scene, View, Viewport};

@@ -40,7 +40,7 @@ pub struct Executors {
     parallel: ParallelExecutor,
     tiled: TiledExecutor,
     /// Run the next frames on fresh storage that counts read-modify-write operations
-    /// ([`RunStats::locked_ops`](crate::executor::RunStats)), untimed.
+    /// ([`RunStats::locked_ops`](crate::executors::RunStats)), untimed.
     pub count_locked_ops: bool,
     /// A fault injected into every scheme run (tests only).
     pub fault: Option<Fault>,

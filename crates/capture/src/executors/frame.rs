@@ -313,8 +313,8 @@ mod tests {
     use super::*;
     use crate::executors::run_serial;
     use crate::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
-    use crate::mdts::Mdts;
-    use crate::peeling::DepthPeeling;
+    use crate::schemes::mdts::Mdts;
+    use crate::schemes::peeling::DepthPeeling;
     use crate::{WordMemory, MEMORY_CAP_DEFAULT};
 
     /// The view's fragments in submission order.

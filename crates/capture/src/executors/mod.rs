@@ -37,7 +37,7 @@ pub enum Executor {
     Parallel,
     /// Triangles binned into screen tiles, one thread per tile at a time.
     Tiled,
-    /// A replayable GPU-like interleaving on one thread ([`crate::scheduled`]).
+    /// A replayable GPU-like interleaving on one thread ([`crate::executors::scheduled`]).
     Scheduled,
 }
 

@@ -1,6 +1,6 @@
 //! The A-buffer as GPU code often writes it, with CUDA's wrapping `atomicInc(addr, bound)` for
 //! the slot counter: a model of what goes wrong when storage overflows (issue 5), next to
-//! [`ABuffer`](crate::abuffer::ABuffer), which uses `fetch_add` and counts every drop.
+//! [`ABuffer`](crate::schemes::abuffer::ABuffer), which uses `fetch_add` and counts every drop.
 //!
 //! **CUDA's `atomicInc(addr, bound)`** reads `old = *addr`, stores `old >= bound ? 0 : old + 1`
 //! and returns `old`, in one atomic operation. Started from 0 and applied only with one `bound`
@@ -18,7 +18,7 @@
 //! A-buffer, dropping and counting what does not fit.
 //!
 //! Not in the CLI's scheme registry on purpose: it exists to be compared with the A-buffer in
-//! tests (`tests/extremes.rs`, counters) and in `docs/extremes.md`, not to be used.
+//! tests (`tests/suite/extremes/`, counters) and in `docs/extremes.md`, not to be used.
 //!
 //! Unlike the GPU, the counter word holds the unwrapped count (there is no wrapping RMW in
 //! [`Memory`]); every reader reduces it modulo `bound + 1`, which is what `atomicInc` would have
@@ -26,11 +26,11 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::abuffer::Claim;
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::schemes::abuffer::Claim;
 use crate::schemes::common::sort::insertion_sort;
 
 /// An A-buffer with `capacity` slots per pixel whose slot counter is CUDA's wrapping `atomicInc`.
@@ -159,8 +159,8 @@ impl Scheme for ABufferAtomicInc {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::abuffer::{ABuffer, PostSort};
     use crate::memory::SerialMemory;
+    use crate::schemes::abuffer::{ABuffer, PostSort};
     use crate::{Keeps, MEMORY_CAP_DEFAULT};
 
     /// `n` fragments on one pixel, depths ascending, inserted in order; the kept list, the

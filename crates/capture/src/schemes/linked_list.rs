@@ -20,7 +20,7 @@
 //!
 //! **Guarantee.** The exchange makes list construction safe under any interleaving: every
 //! fragment that gets a node is in its pixel's list exactly once (loom checks it in
-//! `tests/loom.rs`). With a pool that suffices, `KeepNearest` is exact up to `N`
+//! `tests/loom/`). With a pool that suffices, `KeepNearest` is exact up to `N`
 //! ([`Promise::Nearest`]); `KeepFirst` is exact when every list has at most `N` nodes and
 //! otherwise keeps `N` of them, uncounted ([`Capacity::PerPixelUncounted`]: the oracle supplies
 //! the count and checks it). A fragment past the pool is lost silently (no per-pixel count survives), and the

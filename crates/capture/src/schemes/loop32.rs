@@ -8,7 +8,7 @@
 //!    discard the fragment if its depth key is larger; load slot `K / 2` and start there if the
 //!    key is larger. Then, slot by slot, `ztest = imageAtomicMin(&slot[i], zcur)`; **stop if
 //!    `ztest` is empty or equal to `zcur`**; else `zcur = max(ztest, zcur)` goes to slot `i + 1`.
-//!    This is FreePipe's MDTS walk (`crate::mdts`) except for the stop on an equal depth.
+//!    This is FreePipe's MDTS walk (`crate::schemes::mdts`) except for the stop on an equal depth.
 //! 2. *Colour pass.* A fragment loads slot `K − 1` and goes to the tail blend (not captured here)
 //!    if its key is larger; otherwise it binary-searches the slots for its key (one load a probe)
 //!    and stores its colour, here its primitive id, into the matching colour slot (a plain store).

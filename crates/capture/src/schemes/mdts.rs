@@ -9,7 +9,7 @@
 //! **Guarantee.** Under any interleaving of the fragments' steps, when all are done each pixel's
 //! array holds exactly the `K` smallest values in ascending order (the `K` largest, descending, for
 //! the descending variant), each value once: the proof is in `docs/proof.md`, loom checks it
-//! exhaustively for small cases (`tests/loom.rs`). Exact up to `K`; with `K` at least the depth
+//! exhaustively for small cases (`tests/loom/`). Exact up to `K`; with `K` at least the depth
 //! complexity it is exact. Memory: `K` words per pixel. One geometry pass; at most `K` atomic
 //! operations per fragment.
 //!
@@ -22,7 +22,7 @@
 //! run the `atomicMin`. A slot only ever decreases, so a slot seen at or below the carried value
 //! would have made the `atomicMin` a no-op returning that value: the load *is* that `atomicMin`,
 //! linearised at the load. The lists are therefore those of the plain walk under some
-//! interleaving (proof in `docs/proof.md`; loom checks it in `tests/loom.rs`), with fewer locked
+//! interleaving (proof in `docs/proof.md`; loom checks it in `tests/loom/`), with fewer locked
 //! instructions (`fetch_min` is a `lock cmpxchg` loop on x86): `fragsim bench` reports both.
 //!
 //! Unlike the paper's Table 1, which initialises to `0xFFFFFFFF` but stops on `0x7FFFFFFF`, the

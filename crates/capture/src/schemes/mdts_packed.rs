@@ -10,7 +10,7 @@
 //! inserted into two per-pixel arrays of `K` `u32` words each (initially `0xFFFF_FFFF`) by "two
 //! sequential atomic operations": the whole MDTS walk (§4.1.1, Table 1) of array A (high halves),
 //! then the whole walk of array B (low halves), one `atomicMin` per step, at most `2K` steps per
-//! fragment. The walks are [`crate::mdts::Mdts<u32>`]'s, re-based onto each array. The post pass
+//! fragment. The walks are [`crate::schemes::mdts::Mdts<u32>`]'s, re-based onto each array. The post pass
 //! rejoins slot `i` of A and slot `i` of B into a colour, hence a primitive id, nearest first
 //! ([`Identity::PrimOnly`], [`Promise::Nearest`]`(K)`). Each entry's high half is the depth the
 //! scheme holds for that slot, not the fragment's: [`held_depth`] of slot `i`'s 20 bits, as a
@@ -45,13 +45,13 @@
 //!
 //! **Passes and memory.** One geometry pass. Memory per pixel: two arrays of `K` `u32` words,
 //! `2 × K × 4` bytes, the paper's "two copies of the depth values" (a depth buffer and a colour
-//! buffer of `K` layers each). The exact alternative, [`crate::mdts::Mdts<u64>`] with
+//! buffer of `K` layers each). The exact alternative, [`crate::schemes::mdts::Mdts<u64>`] with
 //! `depth_key << 32 | prim`, takes the same `8K` bytes with 64-bit atomics, which CUDA lacked in
 //! 2010, and half the atomic operations.
 //!
 //! Unlike the paper, the colour is not shaded: it is a bijection of the primitive id, so that the
 //! capture can be compared with the oracle fragment by fragment. Unlike Table 1, which stops on
-//! `0x7FFFFFFF`, the sentinel tested is the one stored, `0xFFFF_FFFF` (as in [`crate::mdts`]); with
+//! `0x7FFFFFFF`, the sentinel tested is the one stored, `0xFFFF_FFFF` (as in [`crate::schemes::mdts`]); with
 //! packed words a fragment can produce it (above). Fragments beyond `K` are counted once, by the
 //! walk of array B: each array drops `n − K` words at a pixel of `n` fragments, so the walks ending
 //! [`Step::Dropped`] count the fragments the promise does not keep.
@@ -60,9 +60,9 @@ use fragsim_raster::{depth_from_key, Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::mdts::{Direction, Mdts, MdtsWord, Walk};
 use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::schemes::mdts::{Direction, Mdts, MdtsWord, Walk};
 
 /// Depth bits a packed word keeps (the top of the word).
 pub const DEPTH_BITS: u32 = 20;

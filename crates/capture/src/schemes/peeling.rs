@@ -14,7 +14,7 @@
 //!
 //! **Guarantee.** Pass `i` captures, at every pixel, the smallest value strictly above layer
 //! `i − 1`: the `(i+1)`-th value in ascending order. Per-location atomicity of `atomicMin` is all
-//! this needs, so it holds under any interleaving (`tests/peeling.rs` runs the serial, parallel and
+//! this needs, so it holds under any interleaving (`tests/suite/peeling.rs` runs the serial, parallel and
 //! scheduled executors). What the value is decides what is exact:
 //! - `DepthPeeling<u64>` (default): `depth_key << 32 | prim`. Every fragment is distinct, so every
 //!   fragment is one layer: exact, fragment for fragment ([`Promise::All`]).

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use fragsim_capture::catalog::{
     Build, DumpLayout, SchemeName, SchemeVisitor, SlotWord, Storage, CATALOG,
 };
-use fragsim_capture::mdts::Direction;
+use fragsim_capture::schemes::mdts::Direction;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::Viewport;
 use serde::Serialize;

@@ -9,16 +9,17 @@
 //! each pixel's slots until the first empty one, the A-buffer reads `min(counter, capacity)` slots
 //! and sorts them. A dump whose A-buffer lists were already sorted on the GPU (`"sorted": true`)
 //! is taken in stored order, so a broken sort kernel shows up as misordered pixels.
-//! [`compare`] then diffs a capture against an [`Oracle`] pixel by pixel with [`Oracle::diff`]
+//! [`compare`](crate::compare::compare) then diffs a capture against an [`Oracle`] pixel by pixel with [`Oracle::diff`]
 //! and names each pixel's verdict. Decoding stops where the layout says a list ends, so
 //! [`Dump::check_words`] reads every word against the layout's rules (nothing after an empty MDTS
 //! slot, no empty marker below an A-buffer counter, no key above 1.0) and [`Dump::compare`] adds
-//! what it finds: [`verdict::CORRUPT`], and [`verdict::MISCOUNTED`] for an A-buffer counter other
+//! what it finds: [`verdict::CORRUPT`](crate::compare::verdict::CORRUPT), and [`verdict::MISCOUNTED`](crate::compare::verdict::MISCOUNTED) for an A-buffer counter other
 //! than the pixel's fragment count, which the oracle knows.
 //!
 //! ```
-//! use fragsim_capture::mdts::Direction;
-//! use fragsim_oracle::dump::{self, Dump, DumpScheme};
+//! use fragsim_capture::schemes::mdts::Direction;
+//! use fragsim_oracle::compare::CompareOptions;
+//! use fragsim_oracle::dump::{Dump, DumpScheme};
 //! use fragsim_oracle::scene::SceneAndCamera;
 //! use fragsim_oracle::Oracle;
 //! use fragsim_raster::Viewport;
@@ -30,7 +31,7 @@
 //! let k = oracle.max_depth_complexity();
 //! let scheme = DumpScheme::Mdts { k, direction: Direction::Ascending };
 //! let dump = Dump::record(&view, spec, &scheme, "doc").unwrap();
-//! let options = dump::CompareOptions { examples: 4, ..Default::default() };
+//! let options = CompareOptions { examples: 4, ..Default::default() };
 //! let comparison = dump.compare(&oracle, &options).unwrap();
 //! assert!(comparison.is_equal() && comparison.words_checked);
 //! ```
@@ -63,18 +64,6 @@ use crate::Oracle;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{CorruptWord, Corruption, Counter, DumpScheme, WordCheck};
-// The paths the dump API had before it was split into modules, kept for its callers.
-pub use crate::compare::{
-    compare, compare_with, complete_pixels, verdict, with_identity, CompareOptions, Comparison,
-    VerdictCounts,
-};
-/// [`SceneAndCamera`](crate::scene::SceneAndCamera)'s former name, which the property tests'
-/// scene strategy also has: kept for the callers of `dump::SceneSpec` until they move to the new
-/// name.
-pub type SceneSpec = crate::scene::SceneAndCamera;
-pub use crate::triangles::{
-    TriangleExport, TRIANGLES_MAGIC, TRIANGLES_VERSION, TRIANGLE_RECORD_BYTES,
-};
 
 /// The `format` field of every dump header.
 pub const FORMAT: &str = "fragsim-dump";

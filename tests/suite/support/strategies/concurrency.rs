@@ -1,7 +1,7 @@
 //! Strategies for concurrency: how a run interleaves (task size, schedule).
 
-use fragsim::capture::executor::{ParallelExecutor, Run};
-use fragsim::capture::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim::capture::executors::{ParallelExecutor, Run};
 use fragsim::capture::Scheme;
 use fragsim::raster::View;
 use proptest::prelude::*;

@@ -1,7 +1,7 @@
 //! ADP, adaptive bucket depth peeling: HPG 2009 §3.3 (Table 1) and GPU Pro §1.5 (Listings 1.1,
 //! 1.2).
 //!
-//! **Algorithm.** After the shared depth-range pass (see [`crate::bucket`]):
+//! **Algorithm.** After the shared depth-range pass (see [`crate::schemes::bucket`]):
 //! 1. *Histogram pass.* The pixel's range is cut into [`ADP_SUBINTERVALS`] = 1024 equal
 //!    subintervals; a fragment in subinterval `k` sets bit `k` of its pixel's 1024-bit histogram
 //!    (32 u32 words, bit `k` = word `k / 32`, mask `0x8000_0000 >> (k % 32)` as in Listing 1.1)

@@ -40,7 +40,7 @@
 //! only for `d ≥ 0.5` (Sterbenz), below that distinct depths can share one `1 − d` and
 //! `1 − (1 − d) ≠ d` (`d = 0.1` comes back 3 ulps larger), whereas the complement is a bijection, so the
 //! minimum comes back bit for bit. An empty word stays recognisable: `!key ≥ 0xC07F_FFFF > 0`.
-//! `tests/bucket.rs` measures how many of the bunny's depths `1 − d` would have altered.
+//! `tests/suite/bucket/` measures how many of the bunny's depths `1 − d` would have altered.
 //!
 //! **Routing arithmetic.** [`subinterval`] computes `floor(count · (d − zNear) / (zFar − zNear))`
 //! (HPG eq. 2) in f64 from the f32 depths, clamped to the last subinterval; every pass of a

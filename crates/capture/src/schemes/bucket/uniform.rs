@@ -1,6 +1,6 @@
 //! BDP, bucket depth peeling in one capture pass: HPG 2009 §3.2 and GPU Pro §1.3.
 //!
-//! **Algorithm.** After the shared depth-range pass (see [`crate::bucket`]), the capture pass
+//! **Algorithm.** After the shared depth-range pass (see [`crate::schemes::bucket`]), the capture pass
 //! routes each fragment to bucket `floor(B · (d − zNear) / (zFar − zNear))` of its pixel (HPG
 //! eq. 2, clamped to the last bucket) and MAX-blends it there:
 //! - [`Buckets::Pairs`] (the paper's depth form, `B = 16`): bucket `k` is a pair of words,
