@@ -3,15 +3,18 @@
 //! One entry per scheme ([`CATALOG`]): its name (the one spelling used on the command line, in
 //! JSON, in file names and in dump headers, and the one its [`Scheme::name`](crate::Scheme::name)
 //! returns), its geometry passes, how it sizes its storage, its memory's layout in a dump
-//! ([`DumpLayout`], where it has one), a one-line description, and — through [`Executors::run`] —
-//! a constructor from a [`Sizing`] that builds it and runs one frame. What a scheme guarantees is
+//! ([`DumpLayout`], where it has one), a one-line description, and its constructor: the sizes of
+//! a [`Build`] to the scheme, handed to a [`SchemeVisitor`] ([`SchemeName::build`];
+//! [`Executors::run`] is the visitor that runs one frame). What a scheme guarantees is
 //! never listed here: it comes from the built scheme
 //! ([`Scheme::guarantee`](crate::Scheme::guarantee)). Front ends (the command line, the dump
 //! reader and writer, the property tests) iterate this list, so adding a scheme means its module
-//! plus one entry and one constructor arm here.
+//! plus one `catalog!` line here (`kbuffer-interlock` was added so: its module, its `pub mod` line
+//! and its entry).
 //!
-//! The catalog's parts: the entries and their columns here, [`DumpLayout`] in `dump_layout.rs`,
-//! building and running an entry in `run.rs`.
+//! The catalog's parts: the entries, their columns and constructors here, [`Build`] and
+//! [`SchemeVisitor`] in `build.rs`, [`DumpLayout`] in `dump_layout.rs`, running an entry and the
+//! early memory-cap check in `run.rs`.
 
 mod build;
 mod dump_layout;
