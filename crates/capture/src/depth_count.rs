@@ -15,11 +15,11 @@
 //! is what the result is checked against, and a scheme that read it would be sized by the answer.
 //!
 //! ```
-//! use fragsim_capture::{depth_count::{DepthCount, DepthCounts}, executor};
+//! use fragsim_capture::{depth_count::{DepthCount, DepthCounts}, executors};
 //! use fragsim_raster::{OrbitCamera, Scene, Viewport};
 //! let scene = Scene::procedural("spheres:3").unwrap();
 //! let view = scene.view(Viewport::new(32, 32).unwrap(), &OrbitCamera::default()).unwrap();
-//! let counts = DepthCounts::from_run(executor::run_serial(&view, &DepthCount::new(view.viewport())));
+//! let counts = DepthCounts::from_run(executors::run_serial(&view, &DepthCount::new(view.viewport())));
 //! assert_eq!(counts.max(), 6);
 //! ```
 
