@@ -20,6 +20,7 @@
 
 pub mod attributes;
 mod camera;
+pub mod conventions;
 mod fragment;
 mod mesh;
 mod pipeline;
@@ -28,6 +29,7 @@ mod rng;
 mod scenes;
 
 pub use camera::{Camera, OrbitCamera};
+pub use conventions::Conventions;
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError};
 pub use pipeline::{

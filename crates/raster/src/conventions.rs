@@ -1,0 +1,88 @@
+//! The rasterization conventions an implementation declares: the parameters of fragsim's pipeline
+//! that differ between graphics APIs and hardware generations.
+//!
+//! fragsim's reference pipeline (`docs/semantics.md`) is one point in this space, the default:
+//! upper-left window origin (D3D, Vulkan, WebGPU), 8 subpixel bits, clip-space depth in `[0, 1]`,
+//! vertices transformed in f64. An engine's capture names its own point (an OpenGL engine: lower-left
+//! origin and depth in `[−1, 1]`; any vertex shader: f32), and the oracle is rebuilt under it, so
+//! that a conforming implementation and the oracle disagree only where precision allows
+//! (`docs/semantics.md`, "Conventions").
+
+/// Where window row 0 lies, which decides which edge the fill rule gives a shared pixel centre.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum WindowOrigin {
+    /// Row 0 at the top, y grows downwards (D3D, Vulkan, WebGPU, Metal): fragsim's pixel order.
+    #[default]
+    UpperLeft,
+    /// Row 0 at the bottom, y grows upwards (OpenGL's default `glClipControl(GL_LOWER_LEFT, …)`).
+    LowerLeft,
+}
+
+/// The clip-space depth range that maps to window depth `[0, 1]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DepthRange {
+    /// `0 ≤ z ≤ w`, window depth `z / w` (D3D, Vulkan, WebGPU, Metal).
+    #[default]
+    ZeroToOne,
+    /// `−w ≤ z ≤ w`, window depth `(z / w + 1) / 2` (OpenGL's default `GL_NEGATIVE_ONE_TO_ONE`).
+    MinusOneToOne,
+}
+
+/// The arithmetic of the vertex stage (transform, perspective divide, viewport mapping).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum VertexPrecision {
+    /// f64 throughout: fragsim's reference, exact enough that snapping decides alone.
+    #[default]
+    F64,
+    /// f32, as a vertex shader computes: the matrix and positions rounded to f32, each product and
+    /// sum rounded to f32.
+    F32,
+}
+
+/// The conventions under which a scene was rasterized.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Conventions {
+    /// Where row 0 lies.
+    pub window_origin: WindowOrigin,
+    /// Fractional bits of the snapped vertex grid, 1 to [`MAX_SUBPIXEL_BITS`] (8 on current
+    /// hardware and Vulkan's common `subPixelPrecisionBits`, 4 on older hardware).
+    pub subpixel_bits: u32,
+    /// The clip-space depth range.
+    pub depth_range: DepthRange,
+    /// The vertex stage's arithmetic.
+    pub vertex_precision: VertexPrecision,
+}
+
+/// The most subpixel bits fragsim's fixed-point grid holds ([`crate::SUBPIXEL_BITS`]).
+pub const MAX_SUBPIXEL_BITS: u32 = crate::SUBPIXEL_BITS;
+
+impl Conventions {
+    /// fragsim's reference conventions: upper-left, 8 subpixel bits, `[0, 1]`, f64.
+    pub const REFERENCE: Self = Self {
+        window_origin: WindowOrigin::UpperLeft,
+        subpixel_bits: MAX_SUBPIXEL_BITS,
+        depth_range: DepthRange::ZeroToOne,
+        vertex_precision: VertexPrecision::F64,
+    };
+
+    /// Refuses conventions fragsim cannot rasterize under.
+    ///
+    /// # Errors
+    /// Subpixel bits outside `1..=MAX_SUBPIXEL_BITS`, by value.
+    pub fn check(&self) -> Result<(), String> {
+        if (1..=MAX_SUBPIXEL_BITS).contains(&self.subpixel_bits) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} subpixel bits: fragsim rasterizes with 1 to {MAX_SUBPIXEL_BITS}",
+                self.subpixel_bits
+            ))
+        }
+    }
+}
+
+impl Default for Conventions {
+    fn default() -> Self {
+        Self::REFERENCE
+    }
+}
