@@ -1,25 +1,18 @@
 //! The `schemes_vs_oracle` target: an arbitrary fragment stream on a viewport of fewer than 16
 //! pixels (depth keys from arbitrary f32 in `[0, 1]`, primitive ids distinct per pixel) through
-//! every exact scheme — MDTS with u64 words ascending, probing and descending, with u32 words, the
-//! A-buffer with exact and fixed storage, insertion and bitonic post-sort, the z-buffer, depth
-//! peeling and dual depth peeling on u64 words, and serially the k-buffer, the multi-pass
-//! k-buffer and stencil routing — run serially (every pass, submission order) and, the atomic
-//! ones, by the scheduled executor under a schedule decoded from the input (multi-pass schemes on
-//! cases of depth complexity up to 24, where they cost a pass per layer). Each capture must be
-//! what the scheme promises of an oracle computed here by sorting, and for one-pass schemes the
-//! counted drops must equal what the capture is missing.
+//! every scheme of the catalog, each checked as its guarantee owes: run serially (every pass,
+//! submission order) and, those exact under any interleaving, by the scheduled executor under a
+//! schedule decoded from the input (schemes with a pass per layer on cases of depth complexity up
+//! to 24). Each capture must be what the scheme promises of an oracle computed here by sorting,
+//! and for one-pass schemes that count every drop the counted drops must equal what the capture
+//! is missing.
 
+use fragsim::capture::catalog::{Build, Passes, SchemeVisitor, CATALOG};
 use fragsim::capture::executors::frame::{self, Counters, Run};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
-use fragsim::capture::schemes::kbuffer::KBuffer;
-use fragsim::capture::schemes::kbuffer_multipass::KBufferMultipass;
-use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
-use fragsim::capture::schemes::peeling::DepthPeeling;
-use fragsim::capture::schemes::stencil_routed::StencilRouted;
-use fragsim::capture::schemes::zbuffer::ZBuffer;
-use fragsim::capture::{Capture, Identity, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{
+    Capture, Guarantee, Identity, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT,
+};
 use fragsim::raster::{depth_key, Fragment, Viewport};
 
 use super::input::Input;
@@ -164,31 +157,38 @@ pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped:
     }
 }
 
-/// How a scheme is checked: every one serially (in submission order, every pass), and the
-/// atomic ones also under the case's schedule. Read–modify–write schemes (the k-buffers) are
-/// exact only without concurrent hazards, and stencil routing only in one arrival order, so they
-/// are checked serially alone.
+/// How a scheme is checked, from its guarantee: every exact one serially (in submission order,
+/// every pass), and those exact under any interleaving also under the case's schedule. The
+/// read–modify–write schemes (the k-buffers) are owed exactness only without concurrent hazards,
+/// and stencil routing only in one arrival order, so they are checked serially alone; the
+/// schemes that merge equal depths only on cases whose pixels hold distinct depths; approximate
+/// schemes not at all (their losses are what they report).
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Runs {
     SerialAndScheduled,
     SerialOnly,
+    Skip,
 }
 
-/// Whether every fragment a one-pass scheme does not keep ends its own walk as
-/// [`Step::Dropped`] (MDTS carries the evicted value to the end of the array; the A-buffer drops
-/// past its capacity), so that the counted drops must equal the fragments missing. A z-buffer's
-/// `atomicMin` overwrites the farther value without a walk to count it: `Uncounted`.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Drops {
-    Counted,
-    Uncounted,
+impl Runs {
+    fn owed(guarantee: Guarantee, distinct_depths: bool) -> Self {
+        match guarantee {
+            Guarantee::Exact | Guarantee::ExactWithinCapacity(_) => Runs::SerialAndScheduled,
+            Guarantee::ExactDistinctDepths if distinct_depths => Runs::SerialAndScheduled,
+            Guarantee::ExactWithoutHazards | Guarantee::ExactInArrivalOrder => Runs::SerialOnly,
+            Guarantee::ExactDistinctDepths | Guarantee::Approximate => Runs::Skip,
+        }
+    }
 }
 
 /// Runs `scheme` over the case and checks each capture: serially (every pass, fragments in
 /// submission order, each walk to its end), and for `Runs::SerialAndScheduled` under the case's
-/// schedule too. For one-pass schemes of [`Drops::Counted`] the counted drops must equal the
-/// fragments missing.
-fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Runs, drops: Drops) {
+/// schedule too. For one-pass schemes that count every drop
+/// ([`Scheme::counts_every_drop`]) the counted drops must equal the fragments missing.
+fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Runs) {
+    if runs == Runs::Skip {
+        return;
+    }
     let name = scheme.name();
     let memory: SerialMemory = scheme.layout().allocate();
     let (counters, _) = frame::passes(scheme, &memory, |pass| {
@@ -196,7 +196,7 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
     });
     // A scheme whose second pass would take no fragment is a one-pass scheme; multi-pass schemes
     // count overflow per pass.
-    let one_pass = drops == Drops::Counted
+    let one_pass = scheme.counts_every_drop()
         && case
             .fragments
             .first()
@@ -216,77 +216,72 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
     check_capture(&name, lists, &capture, dropped);
 }
 
-/// The drops that must equal the fragments missing: those of a one-pass scheme of counted drops.
+/// The drops that must equal the fragments missing: those of a one-pass scheme that counts every
+/// drop.
 fn counted_drops(one_pass: bool, counters: &Counters) -> Option<u64> {
     one_pass.then_some(counters.dropped)
 }
 
-fn check_mdts<W: MdtsWord>(case: &Case, lists: &[Vec<u64>], k: u32) {
-    let viewport = Viewport::new(case.pixels, 1).expect("1..=15 pixels");
-    for direction in [Direction::Ascending, Direction::Descending] {
-        let scheme = Mdts::<W>::new(viewport, k, direction, MEMORY_CAP_DEFAULT)
-            .expect("K ≥ 1 on a few pixels");
-        check_scheme(
-            &scheme,
-            case,
-            lists,
-            Runs::SerialAndScheduled,
-            Drops::Counted,
-        );
-        if direction == Direction::Ascending {
-            check_scheme(
-                &scheme.probing(),
-                case,
-                lists,
-                Runs::SerialAndScheduled,
-                Drops::Counted,
-            );
-        }
+/// The catalog's schemes, each checked as its guarantee owes.
+struct CheckOwed<'a> {
+    case: &'a Case,
+    lists: &'a [Vec<u64>],
+    distinct_depths: bool,
+}
+
+impl SchemeVisitor for CheckOwed<'_> {
+    type Output = ();
+
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) {
+        let runs = Runs::owed(scheme.guarantee(), self.distinct_depths);
+        check_scheme(scheme, self.case, self.lists, runs);
     }
 }
 
-/// Decodes a fragment stream and checks every exact scheme on it (those `fragsim` lists as
-/// `exact`, and the `exact-without-hazards` and `exact-in-arrival-order` ones serially), with
-/// storage for the deepest pixel and with the case's smaller `k`; multi-pass schemes on cases of
-/// depth complexity up to [`MAX_MULTIPASS_LAYERS`].
+/// Whether no two fragments of a pixel share a depth key.
+fn distinct_depths(lists: &[Vec<u64>]) -> bool {
+    lists
+        .iter()
+        .all(|list| list.windows(2).all(|w| w[0] >> 32 != w[1] >> 32))
+}
+
+/// Decodes a fragment stream and checks every scheme of the catalog as its guarantee owes (see
+/// [`Runs`]), with storage for the deepest pixel and with the case's smaller `k` (K, capacity,
+/// and for multi-pass schemes the layers they peel); linked lists get a pool of the case's
+/// fragments; schemes whose passes grow with the layers only on cases of depth complexity up to
+/// [`MAX_MULTIPASS_LAYERS`].
 pub fn check(data: &[u8]) {
     let case = decode(data);
     let lists = sorted_lists(case.pixels, &case.fragments);
     let counts: Vec<u32> = lists.iter().map(|l| l.len() as u32).collect();
     let full = counts.iter().copied().max().unwrap_or(0).max(1);
     let viewport = Viewport::new(case.pixels, 1).expect("1..=15 pixels");
-    let cap = MEMORY_CAP_DEFAULT;
-    let both = Runs::SerialAndScheduled;
+    let distinct_depths = distinct_depths(&lists);
     for k in [case.k, full] {
-        check_mdts::<u64>(&case, &lists, k);
-        check_mdts::<u32>(&case, &lists, k);
-        // A multi-pass scheme costs a pass per layer over every fragment: deep cases run the
-        // one-pass schemes only, so that the fuzzer keeps its pace.
-        if full > MAX_MULTIPASS_LAYERS {
-            continue;
+        let build = Build {
+            counts: Some(&counts),
+            pool: case.fragments.len().max(1),
+            ..Build::fixed(viewport, k, k, full, MEMORY_CAP_DEFAULT)
+        };
+        for entry in CATALOG {
+            // A pass per layer over every fragment: deep cases skip these schemes, so that the
+            // fuzzer keeps its pace.
+            let per_layer = matches!(
+                entry.passes,
+                Passes::PerLayers { .. } | Passes::UntilConfirmed
+            );
+            if per_layer && full > MAX_MULTIPASS_LAYERS {
+                continue;
+            }
+            let visitor = CheckOwed {
+                case: &case,
+                lists: &lists,
+                distinct_depths,
+            };
+            entry
+                .scheme
+                .build(&build, visitor)
+                .unwrap_or_else(|e| panic!("{}: cannot build for the case: {e}", entry.name));
         }
-        let peeling = DepthPeeling::<u64>::new(viewport, k, cap).expect("layers ≥ 1");
-        check_scheme(&peeling, &case, &lists, both, Drops::Counted);
-        let dual = DualDepthPeeling::<u64>::new(viewport, k, cap).expect("layers ≥ 1");
-        check_scheme(&dual, &case, &lists, both, Drops::Counted);
-        let kbuffer = KBuffer::new(viewport, k, cap).expect("K ≥ 1");
-        check_scheme(&kbuffer, &case, &lists, Runs::SerialOnly, Drops::Counted);
-        let multipass = KBufferMultipass::new(viewport, case.k, k, cap).expect("K ≥ 1");
-        check_scheme(&multipass, &case, &lists, Runs::SerialOnly, Drops::Counted);
-        let srab = StencilRouted::new(viewport, k.div_ceil(8), cap).expect("passes ≥ 1");
-        check_scheme(&srab, &case, &lists, Runs::SerialOnly, Drops::Counted);
-    }
-    check_scheme(
-        &ZBuffer::new(viewport, cap).expect("one word a pixel"),
-        &case,
-        &lists,
-        both,
-        Drops::Uncounted,
-    );
-    for sort in [PostSort::Insertion, PostSort::Bitonic] {
-        let exact = ABuffer::exact(&counts, sort, cap).expect("tiny storage");
-        check_scheme(&exact, &case, &lists, both, Drops::Counted);
-        let fixed = ABuffer::fixed(viewport, case.k, sort, cap).expect("tiny storage");
-        check_scheme(&fixed, &case, &lists, both, Drops::Counted);
     }
 }

@@ -84,6 +84,16 @@ pub trait Scheme: Sync {
     /// What the scheme guarantees against the oracle (each module's header says why).
     fn guarantee(&self) -> Guarantee;
 
+    /// Whether every fragment a one-pass frame does not keep ends some walk as [`Step::Dropped`]
+    /// (MDTS carries each evicted value to the end of its slots, the A-buffer and the layer
+    /// counter drop past their storage, the k-buffer drops what falls off its K slots), so that
+    /// the frame's counted drops equal what its capture lacks. Schemes that lose values with no
+    /// walk to count them say no, the default: a z-buffer's `atomicMin` overwrites the farther
+    /// value, a linked list's resolve stops after its `K` nodes.
+    fn counts_every_drop(&self) -> bool {
+        false
+    }
+
     /// The state of a fragment before its first step in the first geometry pass.
     fn begin(&self, fragment: Fragment) -> Self::State;
 

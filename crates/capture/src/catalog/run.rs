@@ -248,6 +248,9 @@ impl<S: Scheme> Scheme for MiscountOverflow<'_, S> {
     fn guarantee(&self) -> Guarantee {
         self.0.guarantee()
     }
+    fn counts_every_drop(&self) -> bool {
+        self.0.counts_every_drop()
+    }
     fn begin(&self, fragment: Fragment) -> S::State {
         self.0.begin(fragment)
     }

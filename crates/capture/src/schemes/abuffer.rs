@@ -222,6 +222,10 @@ impl Scheme for ABuffer {
         }
     }
 
+    fn counts_every_drop(&self) -> bool {
+        true
+    }
+
     fn promise(&self) -> Promise {
         Promise::All(match self.storage {
             Storage::Fixed { capacity, .. } => Capacity::PerPixel(capacity as u32),

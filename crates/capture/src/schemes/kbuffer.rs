@@ -404,6 +404,10 @@ impl Scheme for KBuffer {
         Guarantee::ExactWithoutHazards
     }
 
+    fn counts_every_drop(&self) -> bool {
+        true
+    }
+
     fn promise(&self) -> Promise {
         Promise::Nearest(self.slots.k)
     }

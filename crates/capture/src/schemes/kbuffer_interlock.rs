@@ -126,6 +126,10 @@ impl Scheme for KBufferInterlock {
         Guarantee::Exact
     }
 
+    fn counts_every_drop(&self) -> bool {
+        true
+    }
+
     fn promise(&self) -> Promise {
         Promise::Nearest(self.slots.k)
     }

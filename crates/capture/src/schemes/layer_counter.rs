@@ -113,6 +113,10 @@ impl Scheme for LayerCounter {
         Guarantee::ExactWithinCapacity(self.layer_count)
     }
 
+    fn counts_every_drop(&self) -> bool {
+        true
+    }
+
     fn promise(&self) -> Promise {
         Promise::All(Capacity::PerPixelUncounted(self.layer_count))
     }

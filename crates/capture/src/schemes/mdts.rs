@@ -235,6 +235,10 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         Guarantee::Exact
     }
 
+    fn counts_every_drop(&self) -> bool {
+        true
+    }
+
     fn promise(&self) -> Promise {
         match self.direction {
             Direction::Ascending => Promise::Nearest(self.k),
