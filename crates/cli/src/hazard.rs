@@ -105,11 +105,10 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
         for baseline in baselines::table(viewport, &args.ks, &machines, layers)? {
             report
                 .baselines
-                .extend(baselines::rows(&baseline, &view, &oracle));
+                .extend(baselines::rows(&baseline, &view, &oracle)?);
             eprintln!(
                 "hazard --baselines: {} K = {} done",
-                baseline.scheme.name(),
-                baseline.k
+                baseline.scheme, baseline.k
             );
         }
         write_baselines(args, &report)?;

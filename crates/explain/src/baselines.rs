@@ -4,14 +4,13 @@
 //!
 //! Why: the k-buffer family trades passes for exactness, and the table shows where each one
 //! loses (only under concurrent hazards) and what its exactness costs. The schemes come from the
-//! catalog ([`fragsim_capture::catalog::CATALOG`]): the entries [`kbuffer_scheme`] builds, on the
-//! machines asked for, and `srab` at every pass count its catalog entry allows.
+//! catalog ([`fragsim_capture::catalog::CATALOG`]): the k-buffer entries on the machines asked for,
+//! built by their catalog constructors, and `srab` at every pass count its catalog entry allows.
 
-use fragsim_capture::catalog::{SchemeName, CATALOG};
+use fragsim_capture::catalog::{Build, SchemeName, SchemeVisitor, CATALOG};
 use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim_capture::executors::{run_parallel, run_serial, Executor, Run};
-use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim_capture::schemes::kbuffer_multipass::KBufferMultipass;
+use fragsim_capture::schemes::kbuffer::WriteBack;
 use fragsim_capture::schemes::stencil_routed::StencilRouted;
 use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim_oracle::Oracle;
@@ -71,73 +70,57 @@ pub const BASELINE_SCHEDULES: [(&str, Schedule); 2] = [
     ),
 ];
 
-/// A scheme behind a vtable, run on every executor of the table.
-pub trait MeasuredScheme {
-    /// `Scheme::name`.
-    fn name(&self) -> String;
-    /// Its runs on `view`: serial, parallel, then [`BASELINE_SCHEDULES`], each with its label.
-    fn runs(&self, view: &View<'_>) -> Vec<(&'static str, Run)>;
+/// A scheme's runs on every executor of the table: serial, parallel, then
+/// [`BASELINE_SCHEDULES`], each with its label.
+fn runs<S: Scheme>(scheme: &S, view: &View<'_>) -> Vec<(&'static str, Run)> {
+    let mut runs = vec![
+        (Executor::Serial.name(), run_serial(view, scheme)),
+        (Executor::Parallel.name(), run_parallel(view, scheme)),
+    ];
+    for (label, schedule) in &BASELINE_SCHEDULES {
+        runs.push((*label, run_scheduled(view, scheme, schedule, false).run));
+    }
+    runs
 }
 
-impl<S: Scheme> MeasuredScheme for S {
-    fn name(&self) -> String {
-        Scheme::name(self)
-    }
-
-    fn runs(&self, view: &View<'_>) -> Vec<(&'static str, Run)> {
-        let mut runs = vec![
-            (Executor::Serial.name(), run_serial(view, self)),
-            (Executor::Parallel.name(), run_parallel(view, self)),
-        ];
-        for (label, schedule) in &BASELINE_SCHEDULES {
-            runs.push((*label, run_scheduled(view, self, schedule, false).run));
-        }
-        runs
-    }
-}
-
-/// Catalog scheme `name` as a k-buffer of `k` slots on its own machine
-/// ([`SchemeName::write_back`]), multi-pass ones with output lists of `layers`; `None` for a
-/// scheme that is no k-buffer.
-///
-/// # Errors
-/// (Inside the `Some`) a parameter the scheme refuses, or storage beyond the default memory cap.
-pub fn kbuffer_scheme(
-    name: SchemeName,
-    viewport: Viewport,
-    k: u32,
-    layers: u32,
-) -> Option<Result<Box<dyn MeasuredScheme>, String>> {
-    let machine = name.write_back();
-    let built: Result<Box<dyn MeasuredScheme>, _> = match name {
-        SchemeName::Kbuffer | SchemeName::KbufferStores => {
-            KBuffer::with_write_back(viewport, k, machine, MEMORY_CAP_DEFAULT)
-                .map(|s| Box::new(s) as Box<dyn MeasuredScheme>)
-        }
-        SchemeName::KbufferMultipass | SchemeName::KbufferMultipassStores => {
-            KBufferMultipass::with_write_back(viewport, k, layers, machine, MEMORY_CAP_DEFAULT)
-                .map(|s| Box::new(s) as Box<dyn MeasuredScheme>)
-        }
-        _ => return None,
-    };
-    Some(built.map_err(|e| e.to_string()))
+/// How a row of the table builds its scheme.
+#[derive(Debug, Clone)]
+enum Built {
+    /// By its catalog entry's constructor, with these sizes.
+    Catalog(Build<'static>),
+    /// The stencil-routed A-buffer at a pass count below its catalog entry's.
+    Srab(StencilRouted),
 }
 
 /// One scheme of the table to run: how to build it and the `K` column it shows.
+#[derive(Debug, Clone)]
 pub struct Baseline {
     /// The catalog's scheme.
     pub name: SchemeName,
     /// Slots per pixel (for `srab`: its slots, 8 a pass; both of its configurations carry the
     /// catalog's one spelling, so this column tells them apart).
     pub k: u32,
-    /// The scheme, built.
-    pub scheme: Box<dyn MeasuredScheme>,
+    /// The built scheme's [`Scheme::name`].
+    pub scheme: String,
+    built: Built,
+}
+
+/// A built scheme's name: building it checks its parameters and the memory cap.
+struct NameOf;
+
+impl SchemeVisitor for NameOf {
+    type Output = String;
+
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> String {
+        scheme.name()
+    }
 }
 
 /// The table's schemes, in its order: for each K of `ks` and each machine of `machines`, the
-/// catalog's k-buffer schemes on that machine (catalog order); then `srab` at 1 up to the
-/// passes of its catalog entry. Multi-pass k-buffers' output lists hold `layers` (the scene's
-/// maximum depth complexity, as `render` sizes them).
+/// catalog's k-buffer schemes on that machine (catalog order,
+/// [`Entry::read_modify_write`](fragsim_capture::catalog::Entry::read_modify_write)); then `srab`
+/// at 1 up to the passes of its catalog entry. Multi-pass k-buffers' output lists hold `layers`
+/// (the scene's maximum depth complexity, as `render` sizes them).
 ///
 /// # Errors
 /// A parameter a scheme refuses (`K = 0`), or storage beyond the default memory cap.
@@ -150,14 +133,20 @@ pub fn table(
     let mut out = Vec::new();
     for &k in ks {
         for &machine in machines {
-            for entry in CATALOG.iter().filter(|e| e.scheme.write_back() == machine) {
-                if let Some(scheme) = kbuffer_scheme(entry.scheme, viewport, k, layers) {
-                    out.push(Baseline {
-                        name: entry.scheme,
-                        k,
-                        scheme: scheme?,
-                    });
-                }
+            let on_machine = CATALOG
+                .iter()
+                .filter(|e| e.read_modify_write == Some(machine));
+            for entry in on_machine {
+                let build = Build::fixed(viewport, k, k, layers, MEMORY_CAP_DEFAULT);
+                out.push(Baseline {
+                    name: entry.scheme,
+                    k,
+                    scheme: entry
+                        .scheme
+                        .build(&build, NameOf)
+                        .map_err(|e| e.to_string())?,
+                    built: Built::Catalog(build),
+                });
             }
         }
     }
@@ -170,36 +159,64 @@ pub fn table(
         out.push(Baseline {
             name: srab,
             k: 8 * passes,
-            scheme: Box::new(scheme),
+            scheme: scheme.name(),
+            built: Built::Srab(scheme),
         });
     }
     Ok(out)
 }
 
+/// The table's rows of one built scheme.
+struct Rows<'a, 'v> {
+    k: u32,
+    view: &'a View<'v>,
+    oracle: &'a Oracle,
+}
+
+impl SchemeVisitor for Rows<'_, '_> {
+    type Output = Vec<BaselineRow>;
+
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> Vec<BaselineRow> {
+        runs(scheme, self.view)
+            .into_iter()
+            .map(|(executor, run)| {
+                let diff = self.oracle.diff(&run.capture);
+                BaselineRow {
+                    scheme: scheme.name(),
+                    k: self.k,
+                    executor: executor.into(),
+                    passes: run.stats.passes,
+                    overflowed: diff.overflowed,
+                    lost: diff.lost,
+                    extra: diff.extra,
+                    duplicates: duplicates(&run.capture),
+                    misordered_pixels: diff.misordered_pixels,
+                    error_pixels: diff.mismatched_pixels,
+                    memory_bytes: run.stats.memory_bytes,
+                }
+            })
+            .collect()
+    }
+}
+
 /// The table's rows of `baseline`: one per executor, each run diffed against `oracle`.
-#[must_use]
-pub fn rows(baseline: &Baseline, view: &View<'_>, oracle: &Oracle) -> Vec<BaselineRow> {
-    let scheme = &baseline.scheme;
-    scheme
-        .runs(view)
-        .into_iter()
-        .map(|(executor, run)| {
-            let diff = oracle.diff(&run.capture);
-            BaselineRow {
-                scheme: scheme.name(),
-                k: baseline.k,
-                executor: executor.into(),
-                passes: run.stats.passes,
-                overflowed: diff.overflowed,
-                lost: diff.lost,
-                extra: diff.extra,
-                duplicates: duplicates(&run.capture),
-                misordered_pixels: diff.misordered_pixels,
-                error_pixels: diff.mismatched_pixels,
-                memory_bytes: run.stats.memory_bytes,
-            }
-        })
-        .collect()
+///
+/// # Errors
+/// A parameter the scheme refuses (`K = 0`), or storage beyond the default memory cap.
+pub fn rows(
+    baseline: &Baseline,
+    view: &View<'_>,
+    oracle: &Oracle,
+) -> Result<Vec<BaselineRow>, String> {
+    let rows = Rows {
+        k: baseline.k,
+        view,
+        oracle,
+    };
+    match &baseline.built {
+        Built::Catalog(build) => baseline.name.build(build, rows).map_err(|e| e.to_string()),
+        Built::Srab(scheme) => Ok(rows.visit(scheme, None)),
+    }
 }
 
 #[cfg(test)]
@@ -225,7 +242,7 @@ mod tests {
         expected.extend([("srab", 8), ("srab", 16)]);
         assert_eq!(listed, expected);
         // Each built scheme is the catalog's: the same spelling.
-        assert!(table.iter().all(|b| b.scheme.name() == b.name.name()));
+        assert!(table.iter().all(|b| b.scheme == b.name.name()));
         // One machine only: its k-buffers.
         let one = super::table(viewport, &[2], &machines[1..], 3).unwrap();
         assert_eq!(one.len(), 2 + 2);
@@ -240,7 +257,7 @@ mod tests {
             .unwrap();
         let oracle = Oracle::build(&view);
         let table = table(view.viewport(), &[4], &[WriteBack::RenderTarget], 3).unwrap();
-        let rows = rows(&table[0], &view, &oracle);
+        let rows = rows(&table[0], &view, &oracle).unwrap();
         let executors: Vec<&str> = rows.iter().map(|r| r.executor.as_str()).collect();
         assert_eq!(
             executors,

@@ -25,7 +25,7 @@ pub mod interleaving;
 pub mod kbuffer;
 pub mod mdts;
 
-use fragsim_capture::catalog::{Entry, SchemeName, CATALOG};
+use fragsim_capture::catalog::{DumpLayout, Entry, Passes, SchemeName, SlotWord, CATALOG};
 use fragsim_capture::schemes::kbuffer::WriteBack;
 
 /// What `fragsim explain` shows of a catalog scheme.
@@ -38,15 +38,17 @@ pub enum Shown {
 }
 
 impl Shown {
-    /// What `explain` shows of `name`: `None` for a scheme it does not build on one pixel (the
-    /// catalog runs a scheme on a view; a single-pixel replay needs the scheme's own type).
+    /// What `explain` shows of `name`, from its catalog entry: the hazard of a one-pass k-buffer
+    /// on its machine, and the invariant of the scheme whose memory is ascending u64 fragment
+    /// words in K slots (the words the invariant's replay prints: `mdts`); `None` otherwise.
     #[must_use]
     pub fn of(name: SchemeName) -> Option<Shown> {
-        match name {
-            SchemeName::Kbuffer | SchemeName::KbufferStores => {
-                Some(Shown::Hazard(name.write_back()))
+        let entry = name.entry();
+        match (entry.read_modify_write, entry.passes, entry.dump) {
+            (Some(machine), Passes::Fixed(1), _) => Some(Shown::Hazard(machine)),
+            (None, Passes::Fixed(1), Some(DumpLayout::SlotArray(SlotWord::Fragment))) => {
+                Some(Shown::Invariant)
             }
-            SchemeName::Mdts => Some(Shown::Invariant),
             _ => None,
         }
     }

@@ -145,11 +145,15 @@ pub struct Entry {
     pub dump: Option<DumpLayout>,
     /// One line on what it is (the command line's help).
     pub description: &'static str,
+    /// For the k-buffer family, the machine its read–modify–write of the K slots runs on (whose
+    /// hazard `explain` and `hazard` show); `None` for schemes without a read–modify–write of a
+    /// pixel's slots (atomic walks, critical sections).
+    pub read_modify_write: Option<WriteBack>,
 }
 
 macro_rules! catalog {
     ($($scheme:ident $name:literal $passes:expr, $storage:expr, $dump:expr,
-        $description:literal; |$build:ident| $construct:expr;)*) => {
+        $description:literal; $(read-modify-write $machine:expr;)? |$build:ident| $construct:expr;)*) => {
         /// Every scheme the simulator runs by name.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum SchemeName {
@@ -165,6 +169,7 @@ macro_rules! catalog {
                 storage: $storage,
                 dump: $dump,
                 description: $description,
+                read_modify_write: catalog!(@optional $($machine)?),
             },)*
         ];
 
@@ -189,6 +194,8 @@ macro_rules! catalog {
             }
         }
     };
+    (@optional) => { None };
+    (@optional $value:expr) => { Some($value) };
 }
 
 use DumpLayout::{CountersAndSlots, SlotArray};
@@ -247,18 +254,22 @@ catalog! {
         |b| (Adp::<u32>::new(b.viewport, b.layers, b.memory_cap)?, Some(b.layers));
     Kbuffer "kbuffer" Fixed(1), K, None,
         "The k-buffer: read–insert–write of K slots, exact only without concurrent hazards; render-target write-backs (one step each, committed in primitive order).";
+        read-modify-write RenderTarget;
         |b| (KBuffer::with_write_back(b.viewport, b.k, RenderTarget, b.memory_cap)?, Some(b.k));
     KbufferStores "kbuffer-stores" Fixed(1), K, None,
         "The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.";
+        read-modify-write SeparateStores;
         |b| (KBuffer::with_write_back(b.viewport, b.k, SeparateStores, b.memory_cap)?, Some(b.k));
     KbufferInterlock "kbuffer-interlock" Fixed(1), K, None,
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
         |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
+        read-modify-write RenderTarget;
         |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, RenderTarget, b.memory_cap)?, Some(b.k));
     KbufferMultipassStores "kbuffer-multipass-stores" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer with K separate loads and stores.";
+        read-modify-write SeparateStores;
         |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, SeparateStores, b.memory_cap)?, Some(b.k));
     Srab "srab" UpTo(2), Slots(16), None,
         "The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.";
@@ -298,18 +309,6 @@ impl SchemeName {
     #[must_use]
     pub fn from_name(name: &str) -> Option<SchemeName> {
         CATALOG.iter().find(|e| e.name == name).map(|e| e.scheme)
-    }
-
-    /// The machine a k-buffer scheme runs on: separate stores for the `-stores` names, render
-    /// targets otherwise.
-    #[must_use]
-    pub fn write_back(self) -> WriteBack {
-        match self {
-            SchemeName::KbufferStores | SchemeName::KbufferMultipassStores => {
-                WriteBack::SeparateStores
-            }
-            _ => WriteBack::RenderTarget,
-        }
     }
 
     /// Whether the scheme, sized by `sizing`, needs the scene's per-pixel depth complexity, and
