@@ -254,6 +254,12 @@ catalog! {
     KbufferInterlock "kbuffer-interlock" Fixed(1), K, None,
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
         |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+    KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, None,
+        "The k-buffer's read–insert–write of K slots under a per-pixel spinlock (compare-and-swap, critical section after the spin loop; nvpro-samples' spinlock mode): exact under independent thread scheduling, deadlocks lockstep warps.";
+        |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
+    KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, None,
+        "The spinlocked k-buffer with the critical section and release inside the lock loop's body: exact, and terminates under lockstep warps too.";
+        |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Fixed, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
         |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, RenderTarget, b.memory_cap)?, Some(b.k));

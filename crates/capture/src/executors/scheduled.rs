@@ -468,7 +468,8 @@ impl Chooser {
             Policy::Lockstep => {
                 let warps = threads.len().div_ceil(WARP_LANES);
                 while self.issue.is_empty() {
-                    let lanes = self.warp * WARP_LANES..((self.warp + 1) * WARP_LANES).min(threads.len());
+                    let lanes =
+                        self.warp * WARP_LANES..((self.warp + 1) * WARP_LANES).min(threads.len());
                     self.warp = (self.warp + 1) % warps;
                     let walks = |t: &usize| threads[*t].walk.as_ref().map(|(s, _, _)| s);
                     let running: VecDeque<usize> = lanes
@@ -690,9 +691,7 @@ fn run_pass<S: Scheme>(
     let bound = DEADLOCK_SPINS_PER_THREAD * schedule.in_flight as u64;
     let mut spins = 0;
     while !active.is_empty() {
-        let t = chooser.choose(&mut threads, &active, step, |s| {
-            scheme.simt(s).reconverging
-        });
+        let t = chooser.choose(&mut threads, &active, step, |s| scheme.simt(s).reconverging);
         let thread = &mut threads[t];
         let (state, fragment, index) = thread.walk.as_mut().expect("chosen threads are active");
         memory
@@ -709,12 +708,15 @@ fn run_pass<S: Scheme>(
                     .iter()
                     .enumerate()
                     .filter_map(|(t, thread)| {
-                        thread.walk.as_ref().map(|(state, fragment, index)| StuckLane {
-                            thread: t as u32,
-                            fragment: *index,
-                            pixel: fragment.pixel,
-                            simt: scheme.simt(state),
-                        })
+                        thread
+                            .walk
+                            .as_ref()
+                            .map(|(state, fragment, index)| StuckLane {
+                                thread: t as u32,
+                                fragment: *index,
+                                pixel: fragment.pixel,
+                                simt: scheme.simt(state),
+                            })
                     })
                     .collect();
                 let deadlock = Deadlock {

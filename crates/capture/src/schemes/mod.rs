@@ -10,6 +10,7 @@ pub mod dual_peeling;
 pub mod kbuffer;
 pub mod kbuffer_interlock;
 pub mod kbuffer_multipass;
+pub mod kbuffer_spinlock;
 pub mod layer_counter;
 pub mod linked_list;
 pub mod loop32;
