@@ -24,6 +24,7 @@ pub mod hazard;
 pub mod interleaving;
 pub mod kbuffer;
 pub mod mdts;
+pub mod spinlock;
 
 use fragsim_capture::catalog::{Entry, SchemeName, CATALOG};
 use fragsim_capture::schemes::kbuffer::WriteBack;
@@ -35,6 +36,8 @@ pub enum Shown {
     Hazard(WriteBack),
     /// MDTS's invariant at every step ([`mdts`]).
     Invariant,
+    /// The spinlock's shortest deadlock under lockstep warps ([`spinlock`]).
+    Deadlock,
 }
 
 impl Shown {
@@ -47,6 +50,7 @@ impl Shown {
                 Some(Shown::Hazard(name.write_back()))
             }
             SchemeName::Mdts => Some(Shown::Invariant),
+            SchemeName::KbufferSpinlock => Some(Shown::Deadlock),
             _ => None,
         }
     }
@@ -64,7 +68,10 @@ mod tests {
     #[test]
     fn explained_schemes_are_catalog_entries_with_their_machine() {
         let names: Vec<&str> = Shown::schemes().map(|e| e.name).collect();
-        assert_eq!(names, ["mdts", "kbuffer", "kbuffer-stores"]);
+        assert_eq!(
+            names,
+            ["mdts", "kbuffer", "kbuffer-stores", "kbuffer-spinlock"]
+        );
         assert_eq!(
             Shown::of(SchemeName::KbufferStores),
             Some(Shown::Hazard(WriteBack::SeparateStores))
