@@ -45,19 +45,14 @@ fn spinlock_model(name: &str, shape: Loop, k: u32, list: &[Fragment]) -> (usize,
                     let mut walk = scheme.begin(f);
                     loop {
                         let before = walk.lock;
+                        if let Lock::Release { .. } = before {
+                            // Counted out before the release step frees the lock, so that the
+                            // next holder cannot count itself in while this one still counts.
+                            inside.fetch_sub(1, SeqCst);
+                        }
                         let outcome = scheme.step(&mut walk, memory);
-                        match (before, walk.lock) {
-                            (Lock::Acquire { .. }, Lock::Held { .. }) => {
-                                assert_eq!(
-                                    inside.fetch_add(1, SeqCst),
-                                    0,
-                                    "two walks hold the lock"
-                                );
-                            }
-                            (Lock::Release { .. }, _) => {
-                                inside.fetch_sub(1, SeqCst);
-                            }
-                            _ => {}
+                        if let (Lock::Acquire { .. }, Lock::Held { .. }) = (before, walk.lock) {
+                            assert_eq!(inside.fetch_add(1, SeqCst), 0, "two walks hold the lock");
                         }
                         match outcome {
                             Step::Continue if scheme.simt(&walk).spinning => {
