@@ -152,3 +152,43 @@ fn the_lock_based_entries_are_exact_on_every_executor() {
         }
     }
 }
+
+/// `fragsim explain --scheme kbuffer-spinlock` prints the two-step deadlock (lane 0 takes the
+/// lock, lane 1 finds it held) and the fixed loop terminating; with one fragment it shows nothing
+/// and exits 1.
+#[test]
+fn explain_prints_the_shortest_deadlocking_schedule() {
+    let run = |depths: &str| {
+        let output = assert_cmd::Command::cargo_bin("fragsim")
+            .unwrap()
+            .args([
+                "explain",
+                "--scheme",
+                "kbuffer-spinlock",
+                "--depths",
+                depths,
+            ])
+            .output()
+            .unwrap();
+        (
+            output.status.success(),
+            String::from_utf8(output.stdout).unwrap(),
+        )
+    };
+    let (shown, text) = run("0.3,0.5,0.1");
+    assert!(shown, "{text}");
+    assert!(text.contains("2 fragments of one pixel"), "{text}");
+    assert!(text.contains("(2 steps)"), "{text}");
+    assert!(
+        text.contains("step 0: lane 0 (fragment 0) compare-and-swap on the lock: free"),
+        "{text}"
+    );
+    assert!(
+        text.contains("step 1: lane 1 (fragment 1) compare-and-swap on the lock: held"),
+        "{text}"
+    );
+    assert!(text.contains("every fragment kept in order"), "{text}");
+    let (shown, text) = run("0.3");
+    assert!(!shown, "{text}");
+    assert!(text.contains("cannot deadlock"), "{text}");
+}
