@@ -15,6 +15,7 @@ pub mod layer_counter;
 pub mod linked_list;
 pub mod loop32;
 pub mod mdts;
+pub mod mdts_emulated64;
 pub mod mdts_packed;
 pub mod peeling;
 pub mod stencil_routed;
