@@ -39,6 +39,7 @@ mod kbuffer;
 mod kbuffer_interlock;
 mod kbuffer_spinlock;
 mod mdts;
+mod mdts_emulated64;
 mod shipping;
 mod table1;
 
