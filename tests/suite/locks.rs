@@ -13,6 +13,7 @@ use fragsim::capture::executors::scheduled::{
 };
 use fragsim::capture::executors::Executor;
 use fragsim::capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Loop};
+use fragsim::capture::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
 use fragsim::capture::{Guarantee, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
@@ -83,6 +84,33 @@ proptest! {
         }
     }
 
+    /// The 64-bit emulations: locked, exact under every policy (lockstep too: its loop has the
+    /// fixed shape); unlocked, exact with one fragment in flight (no hazard can happen), and under
+    /// concurrency where no two fragments share a pixel.
+    #[test]
+    fn the_locked_64_bit_emulation_is_exact_everywhere_and_the_torn_one_without_hazards(
+        (pixels, fragments) in stream(),
+        k in 1u32..=5,
+        policy in prop_oneof![independent_policy(), Just(Policy::Lockstep)],
+        seed in any::<u64>(),
+    ) {
+        let oracle = Oracle::from_fragments(pixels, &fragments);
+        let viewport = Viewport::new(pixels as u32, 1).unwrap();
+        let concurrent = all_in_flight(policy, &fragments, seed);
+        let locked = MdtsEmulated64::new(viewport, k, Emulation::Locked, MEMORY_CAP_DEFAULT).unwrap();
+        let run = run_fragments(&locked, &fragments, &concurrent, false);
+        prop_assert!(run.deadlock.is_none());
+        prop_assert!(oracle.diff(&run.run.capture).is_exact());
+        let torn = MdtsEmulated64::new(viewport, k, Emulation::Torn, MEMORY_CAP_DEFAULT).unwrap();
+        let one_at_a_time = Schedule { in_flight: 1, ..concurrent };
+        let run = run_fragments(&torn, &fragments, &one_at_a_time, false);
+        prop_assert!(oracle.diff(&run.run.capture).is_exact());
+        if oracle.depth_complexity().iter().all(|&n| n <= 1) {
+            let run = run_fragments(&torn, &fragments, &concurrent, false);
+            prop_assert!(oracle.diff(&run.run.capture).is_exact());
+        }
+    }
+
     /// Lockstep, one warp: the naive loop deadlocks iff a pixel has two fragments (the first
     /// lane of each pixel takes its lock and waits at the loop's exit; the others spin), and is
     /// exact otherwise; the fixed loop is exact on every stream.
@@ -132,6 +160,7 @@ fn the_lock_based_entries_are_exact_on_every_executor() {
         "kbuffer-interlock",
         "kbuffer-spinlock",
         "kbuffer-spinlock-fixed",
+        "mdts-emulated64",
     ];
     for name in names {
         let scheme = SchemeName::from_name(name).unwrap();
