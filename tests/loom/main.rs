@@ -37,7 +37,9 @@ use loom::sync::atomic::{
 mod abuffer;
 mod kbuffer;
 mod kbuffer_interlock;
+mod kbuffer_spinlock;
 mod mdts;
+mod mdts_emulated64;
 mod shipping;
 mod table1;
 
@@ -104,6 +106,14 @@ impl Memory for LoomMemory {
         {
             loom::thread::yield_now();
         }
+    }
+
+    // The spinlock's one attempt: the same acquire compare-exchange, once (the caller yields
+    // before a retry).
+    fn try_lock(&self, index: usize) -> bool {
+        self.words32[index]
+            .compare_exchange(0, 1, Acquire, Relaxed)
+            .is_ok()
     }
 
     fn unlock(&self, index: usize) {

@@ -22,6 +22,7 @@ mod effects;
 mod explain;
 mod extremes;
 mod kbuffer;
+mod locks;
 mod mdts_packed;
 mod meshes;
 mod peeling;

@@ -5,6 +5,7 @@ use std::fmt::Debug;
 use fragsim_raster::Fragment;
 
 use crate::capture::{Capacity, Capture, Identity, Keeps};
+use crate::executors::scheduled::Simt;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory};
 
@@ -105,6 +106,14 @@ pub trait Scheme: Sync {
 
     /// One memory operation of the fragment's walk.
     fn step<M: Memory>(&self, state: &mut Self::State, memory: &M) -> Step;
+
+    /// Where the walk stands for a SIMT scheduler (a spin on a lock, a reconvergence point): what
+    /// the scheduled executor's lockstep policy and deadlock detection read. Schemes without
+    /// locks need not override it.
+    fn simt(&self, state: &Self::State) -> Simt {
+        let _ = state;
+        Simt::default()
+    }
 
     /// Work between geometry passes, after pass `pass` (a per-pixel kernel on the GPU); returns
     /// whether another geometry pass is needed. One-pass schemes need not override it.

@@ -158,6 +158,14 @@ pub fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String> {
             let scheme = Mdts::<u64>::ascending(viewport, k).map_err(|e| e.to_string())?;
             Ok(explain_mdts(&scheme, k, &fragments, args.seeds))
         }
+        Shown::Deadlock => match fragsim_explain::spinlock::shortest_deadlock(k, &fragments) {
+            Ok(Some(report)) => Ok((format!("{report}\n"), true)),
+            Ok(None) => Ok((
+                "kbuffer-spinlock: one fragment cannot deadlock\n".into(),
+                false,
+            )),
+            Err(e) => Err(e.to_string()),
+        },
     }
 }
 

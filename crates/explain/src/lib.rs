@@ -24,6 +24,7 @@ pub mod hazard;
 pub mod interleaving;
 pub mod kbuffer;
 pub mod mdts;
+pub mod spinlock;
 
 use fragsim_capture::catalog::{DumpLayout, Entry, Passes, SchemeName, SlotWord, CATALOG};
 use fragsim_capture::schemes::kbuffer::WriteBack;
@@ -35,18 +36,26 @@ pub enum Shown {
     Hazard(WriteBack),
     /// MDTS's invariant at every step ([`mdts`]).
     Invariant,
+    /// The spinlock's shortest deadlock under lockstep warps ([`spinlock`]).
+    Deadlock,
 }
 
 impl Shown {
     /// What `explain` shows of `name`, from its catalog entry: the hazard of a one-pass k-buffer
-    /// on its machine, and the invariant of the scheme whose memory is ascending u64 fragment
-    /// words in K slots (the words the invariant's replay prints: `mdts`); `None` otherwise.
+    /// on its machine; the invariant of the scheme that heads the layout of ascending u64
+    /// fragment words in K slots (the words the invariant's replay prints: `mdts`); the deadlock
+    /// of the spinlock whose loop deadlocks under lockstep warps (its fixed loop has none to
+    /// show); `None` otherwise.
     #[must_use]
     pub fn of(name: SchemeName) -> Option<Shown> {
         let entry = name.entry();
+        let fragment_slots = DumpLayout::SlotArray(SlotWord::Fragment);
         match (entry.read_modify_write, entry.passes, entry.dump) {
             (Some(machine), Passes::Fixed(1), _) => Some(Shown::Hazard(machine)),
-            (None, Passes::Fixed(1), Some(DumpLayout::SlotArray(SlotWord::Fragment))) => {
+            _ if name == SchemeName::KbufferSpinlock => Some(Shown::Deadlock),
+            (None, Passes::Fixed(1), Some(layout))
+                if layout == fragment_slots && layout.scheme() == name =>
+            {
                 Some(Shown::Invariant)
             }
             _ => None,
@@ -66,7 +75,10 @@ mod tests {
     #[test]
     fn explained_schemes_are_catalog_entries_with_their_machine() {
         let names: Vec<&str> = Shown::schemes().map(|e| e.name).collect();
-        assert_eq!(names, ["mdts", "kbuffer", "kbuffer-stores"]);
+        assert_eq!(
+            names,
+            ["mdts", "kbuffer", "kbuffer-stores", "kbuffer-spinlock"]
+        );
         assert_eq!(
             Shown::of(SchemeName::KbufferStores),
             Some(Shown::Hazard(WriteBack::SeparateStores))

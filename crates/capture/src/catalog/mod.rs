@@ -216,6 +216,12 @@ catalog! {
     MdtsProbe "mdts-probe" Fixed(1), K, None,
         "MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would change the slot (same lists, fewer locked operations).";
         |b| (Mdts::<u64>::new(b.viewport, b.k, Ascending, b.memory_cap)?.probing(), Some(b.k));
+    MdtsEmulated64 "mdts-emulated64" Fixed(1), K, None,
+        "MDTS with each 64-bit `atomicMin` emulated on two 32-bit words inside a per-slot compare-and-swap lock (WebGPU has no 64-bit atomics): exact.";
+        |b| (crate::schemes::mdts_emulated64::MdtsEmulated64::new(b.viewport, b.k, crate::schemes::mdts_emulated64::Emulation::Locked, b.memory_cap)?, Some(b.k));
+    MdtsEmulated64Torn "mdts-emulated64-torn" Fixed(1), K, None,
+        "MDTS with each 64-bit `atomicMin` emulated by unlocked loads and stores of the two halves: exact only without hazards, tears under concurrency.";
+        |b| (crate::schemes::mdts_emulated64::MdtsEmulated64::new(b.viewport, b.k, crate::schemes::mdts_emulated64::Emulation::Torn, b.memory_cap)?, Some(b.k));
     Abuffer "abuffer" Fixed(1), Capacity, Some(CountersAndSlots),
         "FreePipe's A-buffer: `--capacity` slots per pixel (fixed arrays, FreePipe §4.2), overflow counted; insertion-sorted.";
         |b| (ABuffer::fixed(b.viewport, b.capacity, Insertion, b.memory_cap)?, Some(b.capacity));
@@ -263,6 +269,12 @@ catalog! {
     KbufferInterlock "kbuffer-interlock" Fixed(1), K, None,
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
         |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+    KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, None,
+        "The k-buffer's read–insert–write of K slots under a per-pixel spinlock (compare-and-swap, critical section after the spin loop; nvpro-samples' spinlock mode): exact under independent thread scheduling, deadlocks lockstep warps.";
+        |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
+    KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, None,
+        "The spinlocked k-buffer with the critical section and release inside the lock loop's body: exact, and terminates under lockstep warps too.";
+        |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Fixed, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
         read-modify-write RenderTarget;

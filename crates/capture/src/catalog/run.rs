@@ -260,6 +260,9 @@ impl<S: Scheme> Scheme for MiscountOverflow<'_, S> {
     fn step<M: Memory>(&self, state: &mut S::State, memory: &M) -> Step {
         self.0.step(state, memory)
     }
+    fn simt(&self, state: &S::State) -> crate::executors::scheduled::Simt {
+        self.0.simt(state)
+    }
     fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
         self.0.end_pass(pass, memory)
     }

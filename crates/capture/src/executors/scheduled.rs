@@ -13,6 +13,18 @@
 //!   lanes, in lane order, so conflicting atomics on one word serialise in lane order and of plain
 //!   stores to one word the last lane wins); or PCT (Burckhardt et al., ASPLOS 2010: random thread
 //!   priorities, the highest-priority thread runs, with `depth − 1` random priority change points).
+//! - Under [`Policy::Lockstep`] a warp's lanes execute one instruction together, as on GPUs before
+//!   Volta: a lane standing at a reconvergence point ([`Simt::reconverging`]) waits there until
+//!   every other active lane of its warp does too, so a lane that took a spinlock and left the
+//!   spin loop waits for lanes still spinning on that lock, which never get it (below).
+//! - **Deadlock detection.** A step that fails to take a lock and will retry it is a spin
+//!   ([`Simt::spinning`]); a run in which [`DEADLOCK_SPINS_PER_THREAD`] × `W` consecutive steps
+//!   are spins stops and reports a [`Deadlock`] (the lanes stuck, where, and the schedule to replay
+//!   it) instead of hanging. Under the warps, lockstep and PCT policies a lock's holder that can
+//!   run does so within `W` steps (PCT lowers a spinning thread's priority, as a yield), so the
+//!   bound is never reached by a run that can progress; under the random policy the holder is
+//!   chosen with probability at least 1 / `W` at each step, so a run that can progress reaches the
+//!   bound with probability below (1 − 1/`W`)^(64 `W`) < e^−64.
 //! - Everything is a pure function of (scene, scheme, policy, `W`, seed): the same [`Schedule`]
 //!   replays the same interleaving, step for step.
 //! - Every memory operation can be recorded as a [`TraceEvent`]; a trace can be filtered to one
@@ -33,8 +45,87 @@ use super::frame::{self, Counters, Run};
 use crate::memory::{Memory, SerialMemory, WordMemory};
 use crate::scheme::{Scheme, Step};
 
-/// Lanes of a warp in [`Policy::Warps`].
+/// Lanes of a warp in [`Policy::Warps`] and [`Policy::Lockstep`].
 pub const WARP_LANES: usize = 32;
+
+/// The deadlock bound: a run stops with a [`Deadlock`] after this many consecutive spins per
+/// thread in flight (module doc: why no run that can progress reaches it).
+pub const DEADLOCK_SPINS_PER_THREAD: u64 = 64;
+
+/// Where a walk stands for a SIMT scheduler ([`Scheme::simt`]): all `false` for a scheme
+/// without locks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Simt {
+    /// The walk's last step failed to take a lock and its next step retries it: no progress.
+    pub spinning: bool,
+    /// The walk stands at a reconvergence point (the exit of a loop, the end of a divergent
+    /// branch): under [`Policy::Lockstep`] its next step runs only once every other active lane of
+    /// its warp stands at one too.
+    pub reconverging: bool,
+}
+
+/// A lane stuck when a [`Deadlock`] was detected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StuckLane {
+    /// The logical thread (lane `thread % 32` of warp `thread / 32`).
+    pub thread: u32,
+    /// Index of its fragment in the pass's stream.
+    pub fragment: u64,
+    /// The fragment's pixel.
+    pub pixel: u32,
+    /// What the walk reported ([`Scheme::simt`]).
+    pub simt: Simt,
+}
+
+/// The verdict of a run that stopped making progress: [`DEADLOCK_SPINS_PER_THREAD`] × `W`
+/// consecutive steps were spins.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Deadlock {
+    /// The schedule that deadlocked: replaying it deadlocks again.
+    pub schedule: Schedule,
+    /// The geometry pass.
+    pub pass: u32,
+    /// The step (of the whole run) at which the bound was reached.
+    pub step: u64,
+    /// The bound: consecutive spins.
+    pub spins: u64,
+    /// Every lane still active, in thread order.
+    pub lanes: Vec<StuckLane>,
+}
+
+impl std::fmt::Display for Deadlock {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "deadlock: {} consecutive spins (the bound: {} per thread in flight, {} threads) at step {} of pass {}, {:?} policy, seed {}",
+            self.spins,
+            DEADLOCK_SPINS_PER_THREAD,
+            self.schedule.in_flight,
+            self.step,
+            self.pass,
+            self.schedule.policy,
+            self.schedule.seed
+        )?;
+        for lane in &self.lanes {
+            let what = match (lane.simt.spinning, lane.simt.reconverging) {
+                (true, _) => "spins on a lock it never gets",
+                (false, true) => "waits at a reconvergence point for its warp",
+                (false, false) => "is runnable",
+            };
+            write!(
+                f,
+                "; warp {} lane {} (fragment {}, pixel {}) {what}",
+                lane.thread as usize / WARP_LANES,
+                lane.thread as usize % WARP_LANES,
+                lane.fragment,
+                lane.pixel
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Deadlock {}
 
 /// How the next step is chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,6 +135,10 @@ pub enum Policy {
     /// Warps of [`WARP_LANES`] threads in round-robin; a warp issues one step per active lane, in
     /// lane order.
     Warps,
+    /// Lockstep warps (SIMT before Volta's independent thread scheduling): as [`Policy::Warps`],
+    /// but a warp issues its step only for its active lanes not standing at a reconvergence point
+    /// ([`Simt::reconverging`]), or for all of them when every one stands at one.
+    Lockstep,
     /// Probabilistic concurrency testing with `depth − 1` priority change points.
     Pct {
         /// PCT's bug depth `d` (≥ 1).
@@ -163,6 +258,22 @@ pub struct ScheduledRun {
     pub trace: Option<Trace>,
     /// The words after the last pass (the post pass reads them, never writes them).
     pub memory: SerialMemory,
+    /// Where the run stopped making progress, if it did: then the walks still active were
+    /// abandoned and the capture holds only what the others stored.
+    pub deadlock: Option<Deadlock>,
+}
+
+impl ScheduledRun {
+    /// The run, or its deadlock as the error.
+    ///
+    /// # Errors
+    /// The [`Deadlock`] the run stopped on.
+    pub fn checked(self) -> Result<ScheduledRun, Deadlock> {
+        match self.deadlock {
+            Some(deadlock) => Err(deadlock),
+            None => Ok(self),
+        }
+    }
 }
 
 /// Storage that can record every operation: plain memory plus a log.
@@ -266,6 +377,8 @@ struct Chooser {
     /// Warps: the warp being issued and the next lane to issue in it.
     warp: usize,
     lane: usize,
+    /// Lockstep: the lanes of the current issue still to step.
+    issue: VecDeque<usize>,
     /// PCT: steps at which the running thread's priority drops, and the next low priority.
     change_points: Vec<u64>,
     next_low: u64,
@@ -291,6 +404,7 @@ impl Chooser {
             rng,
             warp: 0,
             lane: 0,
+            issue: VecDeque::new(),
             change_points,
             next_low: u64::from(u32::MAX),
             order: None,
@@ -302,8 +416,24 @@ impl Chooser {
         (1 << 32) + (self.rng.next_u64() >> 32)
     }
 
-    /// The next thread to step among `threads`, of which those with `walk.is_some()` are active.
-    fn choose<S>(&mut self, threads: &mut [Thread<S>], active: &[usize], step: u64) -> usize {
+    /// Lowers a thread's priority below every other's (PCT only): what a thread that spun does,
+    /// so that the lock's holder runs.
+    fn spun<S>(&mut self, thread: &mut Thread<S>) {
+        if let Policy::Pct { .. } = self.policy {
+            thread.priority = self.next_low;
+            self.next_low = self.next_low.saturating_sub(1);
+        }
+    }
+
+    /// The next thread to step among `threads`, of which those with `walk.is_some()` are active;
+    /// `reconverging` says whether a walk stands at a reconvergence point.
+    fn choose<S>(
+        &mut self,
+        threads: &mut [Thread<S>],
+        active: &[usize],
+        step: u64,
+        reconverging: impl Fn(&S) -> bool,
+    ) -> usize {
         if let Some((order, next)) = &mut self.order {
             // Entries naming a finished thread are skipped, so every order is a valid schedule
             // (what shrinking needs); past the end, the lowest-numbered thread runs.
@@ -334,6 +464,26 @@ impl Chooser {
                     self.warp = (self.warp + 1) % warps;
                     self.lane = 0;
                 }
+            }
+            Policy::Lockstep => {
+                let warps = threads.len().div_ceil(WARP_LANES);
+                while self.issue.is_empty() {
+                    let lanes =
+                        self.warp * WARP_LANES..((self.warp + 1) * WARP_LANES).min(threads.len());
+                    self.warp = (self.warp + 1) % warps;
+                    let walks = |t: &usize| threads[*t].walk.as_ref().map(|(s, _, _)| s);
+                    let running: VecDeque<usize> = lanes
+                        .clone()
+                        .filter(|t| walks(t).is_some_and(|s| !reconverging(s)))
+                        .collect();
+                    // Every active lane at the reconvergence point: the warp reconverges.
+                    self.issue = if running.is_empty() {
+                        lanes.filter(|t| walks(t).is_some()).collect()
+                    } else {
+                        running
+                    };
+                }
+                self.issue.pop_front().expect("the issue is not empty")
             }
             Policy::Pct { .. } => {
                 let best = *active
@@ -443,8 +593,13 @@ fn run_stream<S: Scheme>(
     chooser.order = order.map(|order| (order.to_vec(), 0));
     // Step indices run on across passes: PCT's change points and the trace number the whole run.
     let mut steps_before = 0;
+    let mut deadlock = None;
     let geometry_pass = |pass| {
-        let counters = run_pass(
+        if deadlock.is_some() {
+            // The walks of a deadlocked pass were abandoned: no later pass runs a step.
+            return Counters::default();
+        }
+        let (counters, stuck) = run_pass(
             scheme,
             &memory,
             pass,
@@ -455,6 +610,7 @@ fn run_stream<S: Scheme>(
             steps_before,
         );
         steps_before += counters.steps;
+        deadlock = stuck;
         counters
     };
     let run = frame::run(scheme, &memory, start, 1, geometry_pass, |memory| {
@@ -466,6 +622,7 @@ fn run_stream<S: Scheme>(
             events: log.into_inner(),
         }),
         memory: memory.inner,
+        deadlock,
     }
 }
 
@@ -482,7 +639,7 @@ fn run_pass<S: Scheme>(
     schedule: &Schedule,
     chooser: &mut Chooser,
     first_step: u64,
-) -> Counters {
+) -> (Counters, Option<Deadlock>) {
     let mut counters = Counters::default();
     let mut next_triangle = 0u32;
     let mut next_fragment_index = 0u64;
@@ -531,8 +688,10 @@ fn run_pass<S: Scheme>(
         }
     }
     let mut step = first_step;
+    let bound = DEADLOCK_SPINS_PER_THREAD * schedule.in_flight as u64;
+    let mut spins = 0;
     while !active.is_empty() {
-        let t = chooser.choose(&mut threads, &active, step);
+        let t = chooser.choose(&mut threads, &active, step, |s| scheme.simt(s).reconverging);
         let thread = &mut threads[t];
         let (state, fragment, index) = thread.walk.as_mut().expect("chosen threads are active");
         memory
@@ -541,6 +700,38 @@ fn run_pass<S: Scheme>(
         step += 1;
         counters.steps += 1;
         let outcome = scheme.step(state, memory);
+        if outcome == Step::Continue && scheme.simt(state).spinning {
+            spins += 1;
+            chooser.spun(thread);
+            if spins >= bound {
+                let lanes = threads
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(t, thread)| {
+                        thread
+                            .walk
+                            .as_ref()
+                            .map(|(state, fragment, index)| StuckLane {
+                                thread: t as u32,
+                                fragment: *index,
+                                pixel: fragment.pixel,
+                                simt: scheme.simt(state),
+                            })
+                    })
+                    .collect();
+                let deadlock = Deadlock {
+                    schedule: *schedule,
+                    pass,
+                    // `step` already counts the spin just run.
+                    step: step - 1,
+                    spins,
+                    lanes,
+                };
+                return (counters, Some(deadlock));
+            }
+        } else {
+            spins = 0;
+        }
         if outcome != Step::Continue {
             counters.record(outcome);
             thread.walk = None;
@@ -556,7 +747,7 @@ fn run_pass<S: Scheme>(
             }
         }
     }
-    counters
+    (counters, None)
 }
 
 /// Starts the thread's next walk that the pass does not ignore; false when it has no more work.

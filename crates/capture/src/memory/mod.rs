@@ -109,6 +109,17 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
         std::sync::atomic::fence(std::sync::atomic::Ordering::Acquire);
     }
 
+    /// One attempt at the lock of [`Memory::lock`] (GLSL's `atomicCompSwap(lock, 0, 1) == 0`):
+    /// true when it was free and is now held, with the previous holder's writes visible. A scheme
+    /// that holds a lock across steps (a spinlock) takes it with this, one attempt per step.
+    fn try_lock(&self, index: usize) -> bool {
+        let taken = WordMemory::<u32>::swap(self, index, 1) == 0;
+        if taken {
+            std::sync::atomic::fence(std::sync::atomic::Ordering::Acquire);
+        }
+        taken
+    }
+
     /// Frees the lock taken by [`Memory::lock`] on `u32` word `index`.
     fn unlock(&self, index: usize) {
         std::sync::atomic::fence(std::sync::atomic::Ordering::Release);
