@@ -48,7 +48,9 @@
 
 mod header;
 mod layouts;
+mod lists;
 mod read;
+mod spec;
 mod write;
 
 use std::collections::BTreeMap;
@@ -64,6 +66,7 @@ use crate::Oracle;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{CorruptWord, Corruption, Counter, DumpScheme, WordCheck};
+pub use spec::{DepthFormat, LayoutSpec, Payload};
 
 /// The `format` field of every dump header.
 pub const FORMAT: &str = "fragsim-dump";

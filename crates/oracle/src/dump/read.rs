@@ -170,29 +170,37 @@ impl Dump {
     /// A header that names no known scheme, or arrays missing or of the wrong size or type.
     pub fn capture(&self) -> Result<Capture, DumpError> {
         let scheme = self.scheme()?;
-        let names = scheme.names();
-        let fetch32 = |name: Option<&str>| -> Result<&[u32], DumpError> {
-            match name {
-                None => Ok(&[]),
-                Some(n) => self
-                    .u32s(n)?
-                    .ok_or_else(|| DumpError(format!("missing array {n:?}"))),
+        let translated;
+        let (words32, words64) = match scheme {
+            DumpScheme::LinkedLists { .. } | DumpScheme::LayerMajor { .. } => {
+                translated = self.translate(&scheme)?;
+                (&translated.words32[..], &translated.words64[..])
+            }
+            _ => {
+                let names = scheme.names();
+                (
+                    self.fetch(names.words32, Self::u32s)?,
+                    self.fetch(names.words64, Self::u64s)?,
+                )
             }
         };
-        let fetch64 = |name: Option<&str>| -> Result<&[u64], DumpError> {
-            match name {
-                None => Ok(&[]),
-                Some(n) => self
-                    .u64s(n)?
-                    .ok_or_else(|| DumpError(format!("missing array {n:?}"))),
-            }
-        };
-        let (words32, words64) = (fetch32(names.words32)?, fetch64(names.words64)?);
         let resolve = Resolve {
             scheme: &scheme,
             words32,
             words64,
         };
         scheme.with_scheme(self.viewport()?, resolve)?
+    }
+
+    /// The array `name` (none: no words), which must exist.
+    fn fetch<'a, W>(
+        &'a self,
+        name: Option<&str>,
+        get: fn(&'a Self, &str) -> Result<Option<&'a [W]>, DumpError>,
+    ) -> Result<&'a [W], DumpError> {
+        match name {
+            None => Ok(&[]),
+            Some(n) => get(self, n)?.ok_or_else(|| DumpError(format!("missing array {n:?}"))),
+        }
     }
 }
