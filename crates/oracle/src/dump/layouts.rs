@@ -345,12 +345,25 @@ impl DumpScheme {
                 return Ok(Self::LayerMajor { k: k()?, payload });
             }
             (DumpLayout::Memory, _) => {
-                // Each size defaults to 1, as a scheme that does not use it is built.
+                // Each size defaults to 1, as a scheme that does not use it is built. A scheme
+                // holds at least one word per slot or layer, so a size past the dump's words is
+                // refused before the scheme is built (its storage would not fit a u64 count).
+                let words = header.arrays.iter().try_fold(0u64, |sum, (name, spec)| {
+                    sum.checked_add(super::header::elements(name, &spec.shape)?)
+                        .ok_or_else(|| DumpError("the arrays' elements overflow 64 bits".into()))
+                })?;
+                let size = |field: &str, value: Option<u32>| match value {
+                    Some(0) => err(format!("{name} \"{field}\" must be at least 1")),
+                    Some(v) if u64::from(v) > words.max(1) => err(format!(
+                        "{name} \"{field}\" {v} is more than the dump's {words} words"
+                    )),
+                    v => Ok(v.unwrap_or(1)),
+                };
                 return Ok(Self::Memory {
                     scheme,
-                    k: header.k.unwrap_or(1),
-                    capacity: header.capacity.unwrap_or(1),
-                    layers: header.layers.unwrap_or(1),
+                    k: size("k", header.k)?,
+                    capacity: size("capacity", header.capacity)?,
+                    layers: size("layers", header.layers)?,
                 });
             }
             _ => {}
