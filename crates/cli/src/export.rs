@@ -119,6 +119,17 @@ impl DumpStage {
     /// # Errors
     /// A directory that cannot be replaced or moved.
     pub(crate) fn finish(self) -> Result<(), String> {
+        // Every place is checked before anything moves: a file in a dump's place fails the
+        // whole, with nothing written.
+        for name in &self.written {
+            let target = self.dir.join(name);
+            if target.exists() && !target.is_dir() {
+                return Err(format!(
+                    "cannot write the {name} dump: {} is not a directory",
+                    target.display()
+                ));
+            }
+        }
         for name in &self.written {
             let target = self.dir.join(name);
             if target.exists() {

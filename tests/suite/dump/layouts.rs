@@ -44,6 +44,7 @@ fn sizing() -> Sizing {
 fn every_catalog_scheme_dumps_reads_back_what_it_captured_and_compares_equal() {
     with_view(|view, oracle| {
         let dir = scratch("every-scheme");
+        let mut inexact = Vec::new();
         for entry in CATALOG {
             assert!(entry.dump.is_some(), "{} has no dump layout", entry.name);
             let (dump, captured) = dumped(entry.name, view, &sizing());
@@ -56,10 +57,26 @@ fn every_catalog_scheme_dumps_reads_back_what_it_captured_and_compares_equal() {
             assert_eq!(read.capture().unwrap(), captured, "{}", entry.name);
             let own = compare::compare(oracle, &captured, 0, 4);
             let comparison = judged(&read, oracle);
+            // The dump is judged as the scheme's own run is: equal where the run is exact, the
+            // same pixels otherwise (bucket schemes' collisions, 32-bit keys' merged ties).
             assert_eq!(comparison.verdicts, own.verdicts, "{}", entry.name);
-            assert!(comparison.is_equal(), "{}: {comparison:?}", entry.name);
+            assert_eq!(comparison.is_equal(), own.is_equal(), "{}", entry.name);
             assert_eq!(comparison.corrupt_words, 0, "{}", entry.name);
+            if !comparison.is_equal() {
+                inexact.push(entry.name);
+            }
         }
+        // Every layout the shipping schemes need compares equal on this scene.
+        for name in [
+            "mdts",
+            "abuffer",
+            "linked-list",
+            "linked-list-nearest",
+            "layer-counter",
+        ] {
+            assert!(!inexact.contains(&name), "{name} differs from the oracle");
+        }
+        eprintln!("not equal to the oracle on their own runs either: {inexact:?}");
     });
 }
 
@@ -175,13 +192,18 @@ fn a_vulkan_samples_linked_list_reads_as_fragsims() {
         let decoded = packed.capture().unwrap();
         let original = dump.capture().unwrap();
         assert_eq!(decoded.pixels(), original.pixels());
+        let depth = |w: u64| f64::from(f32::from_bits((w >> 32) as u32));
         for p in 0..original.pixels() {
             let (a, b) = (decoded.pixel(p), original.pixel(p));
             assert_eq!(a.len(), b.len());
-            for (&got, &want) in a.iter().zip(b) {
-                let depth = |w: u64| f64::from(f32::from_bits((w >> 32) as u32));
-                assert!((depth(got) - depth(want)).abs() <= 0.6 / 16_777_215.0);
-                assert_eq!(got as u8, want as u8);
+            // Quantised depths and 8-bit ids may reorder a list: each decoded word has an
+            // original of its id within half a quantum (and a little for the f32 rounding).
+            for &got in a {
+                assert!(
+                    b.iter().any(|&want| got as u8 == want as u8
+                        && (depth(got) - depth(want)).abs() <= 0.6 / 16_777_215.0),
+                    "pixel {p}: {got:#x} is no fragment's"
+                );
             }
         }
         assert_eq!(packed.check_words().unwrap().corrupt_words(), 0);
@@ -193,7 +215,8 @@ fn a_layer_counter_past_its_layers_and_an_impossible_layer_are_corrupt() {
     with_view(|view, oracle| {
         let (mut dump, _) = dumped("layer-counter", view, &sizing());
         let k = dump.header.k.unwrap();
-        let p = pixel_with(oracle, 1, usize::MAX);
+        // A pixel of exactly `k` fragments: a counter past `k` reads only layers it wrote.
+        let p = pixel_with(oracle, k as usize, k as usize);
         let mut past = dump.clone();
         u32s(&mut past, "counters")[p] = k + 1;
         assert_eq!(

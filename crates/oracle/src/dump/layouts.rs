@@ -764,7 +764,17 @@ mod tests {
             layers: None,
             layout: None,
             word: String::new(),
-            arrays: BTreeMap::new(),
+            // Memory dumps' sizes are bounded by their words.
+            arrays: [(
+                "words32".to_string(),
+                crate::dump::ArraySpec {
+                    file: "words32.u32".into(),
+                    dtype: Dtype::U32,
+                    shape: vec![8],
+                },
+            )]
+            .into_iter()
+            .collect(),
             extra: serde_json::Value::Null,
         }
     }
