@@ -179,8 +179,8 @@ impl Dump {
             _ => {
                 let names = scheme.names();
                 (
-                    self.fetch(names.words32, Self::u32s)?,
-                    self.fetch(names.words64, Self::u64s)?,
+                    required(names.words32, self.u32s(names.words32.unwrap_or_default()))?,
+                    required(names.words64, self.u64s(names.words64.unwrap_or_default()))?,
                 )
             }
         };
@@ -191,16 +191,15 @@ impl Dump {
         };
         scheme.with_scheme(self.viewport()?, resolve)?
     }
+}
 
-    /// The array `name` (none: no words), which must exist.
-    fn fetch<'a, W>(
-        &'a self,
-        name: Option<&str>,
-        get: fn(&'a Self, &str) -> Result<Option<&'a [W]>, DumpError>,
-    ) -> Result<&'a [W], DumpError> {
-        match name {
-            None => Ok(&[]),
-            Some(n) => get(self, n)?.ok_or_else(|| DumpError(format!("missing array {n:?}"))),
-        }
+/// The words of array `name` the layout uses, which must exist (`None`: the layout uses none).
+fn required<'a, W>(
+    name: Option<&str>,
+    found: Result<Option<&'a [W]>, DumpError>,
+) -> Result<&'a [W], DumpError> {
+    match name {
+        None => Ok(&[]),
+        Some(n) => found?.ok_or_else(|| DumpError(format!("missing array {n:?}"))),
     }
 }
