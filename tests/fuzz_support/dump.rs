@@ -3,7 +3,9 @@
 //! it, each array file the parser asks for takes the next chunk (a little-endian `u16` length,
 //! then that many bytes, cut short where the input ends). Checked: the parser only ever asks for
 //! plain file names; a dump it accepts encodes and parses back to itself; decoding its words
-//! ([`Dump::capture`]) and comparing them with an oracle made of them either works, with one list
+//! ([`Dump::capture`], any layout: slots, A-buffer, linked lists with arbitrary links and
+//! counters, layer-major layers, a scheme's memory), checking them ([`Dump::check_words`]) and
+//! comparing them with an oracle made of them either works, with one list
 //! per pixel of the viewport, or fails with an error.
 
 use fragsim::capture::Keeps;
@@ -52,6 +54,12 @@ pub fn check(data: &[u8]) {
     };
     let pixels = dump.viewport().expect("parse checked it").pixels();
     assert_eq!(capture.pixels(), pixels, "one list per pixel");
+    // Every word rule runs on what decodes, linked lists whose links leave the pool or close a
+    // cycle included (the walk is bounded by the pool: a hang is a fuzz timeout).
+    let words = dump
+        .check_words()
+        .expect("a dump that decodes has its words checked");
+    assert_eq!(words.corrupt.len(), pixels, "one word check per pixel");
     if let Keeps::All { overflow, .. } = &capture.keeps {
         assert_eq!(overflow.len(), pixels, "one overflow count per pixel");
     }

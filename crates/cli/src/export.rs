@@ -55,24 +55,97 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes scheme `name`'s memory, sized as `run` was, after a serial run, as a dump in `dir/<scheme>/`; returns
-/// that directory.
-///
-/// # Errors
-/// A scheme without a dump layout, a directory that cannot be written.
-pub(crate) fn write_dump(
-    dir: &Path,
-    name: SchemeName,
-    run: &NamedRun,
-    view: &View<'_>,
-    scene: &SceneArgs,
-) -> Result<PathBuf, String> {
-    let scheme = DumpScheme::for_run(name, run.slots.unwrap_or(1), run.counts.as_deref())
-        .map_err(|e| e.to_string())?;
-    let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-    let dump =
-        Dump::record(view, scene_spec(scene), &scheme, &producer).map_err(|e| e.to_string())?;
-    let path = dir.join(name.name());
-    dump.write(&path).map_err(|e| e.to_string())?;
-    Ok(path)
+/// The dumps of `render --dump DIR`: each written into a staging directory inside `DIR` and moved
+/// to `DIR/<scheme>/` only when every chosen scheme's is written ([`DumpStage::finish`]), so that a
+/// failure leaves no half-written dump (dropping an unfinished stage removes it).
+pub(crate) struct DumpStage {
+    dir: PathBuf,
+    staging: PathBuf,
+    written: Vec<&'static str>,
+}
+
+impl DumpStage {
+    /// Creates `dir` and its staging directory.
+    ///
+    /// # Errors
+    /// A directory that cannot be created.
+    pub(crate) fn new(dir: &Path) -> Result<Self, String> {
+        let staging = dir.join(format!(".fragsim-partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&staging);
+        std::fs::create_dir_all(&staging)
+            .map_err(|e| format!("cannot create {}: {e}", staging.display()))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            staging,
+            written: Vec::new(),
+        })
+    }
+
+    /// Stages scheme `name`'s memory, sized as `run` was, after a serial run; a scheme whose
+    /// memory has no dump layout is skipped with the reason on stderr.
+    ///
+    /// # Errors
+    /// A dump that cannot be recorded or written.
+    pub(crate) fn add(
+        &mut self,
+        name: SchemeName,
+        run: &NamedRun,
+        view: &View<'_>,
+        scene: &SceneArgs,
+    ) -> Result<(), String> {
+        let scheme = match DumpScheme::for_run(
+            name,
+            run.slots.unwrap_or(1),
+            &run.sizes,
+            run.counts.as_deref(),
+        ) {
+            Ok(scheme) => scheme,
+            Err(why) => {
+                eprintln!("render --dump: skipped {name}: {why}");
+                return Ok(());
+            }
+        };
+        let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
+        let dump =
+            Dump::record(view, scene_spec(scene), &scheme, &producer).map_err(|e| e.to_string())?;
+        dump.write(&self.staging.join(name.name()))
+            .map_err(|e| e.to_string())?;
+        self.written.push(name.name());
+        Ok(())
+    }
+
+    /// Moves every staged dump to `DIR/<scheme>/`, replacing an older one.
+    ///
+    /// # Errors
+    /// A directory that cannot be replaced or moved.
+    pub(crate) fn finish(self) -> Result<(), String> {
+        // Every place is checked before anything moves: a file in a dump's place fails the
+        // whole, with nothing written.
+        for name in &self.written {
+            let target = self.dir.join(name);
+            if target.exists() && !target.is_dir() {
+                return Err(format!(
+                    "cannot write the {name} dump: {} is not a directory",
+                    target.display()
+                ));
+            }
+        }
+        for name in &self.written {
+            let target = self.dir.join(name);
+            if target.exists() {
+                std::fs::remove_dir_all(&target)
+                    .map_err(|e| format!("cannot replace {}: {e}", target.display()))?;
+            }
+            std::fs::rename(self.staging.join(name), &target)
+                .map_err(|e| format!("cannot move a dump to {}: {e}", target.display()))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for DumpStage {
+    fn drop(&mut self) {
+        // Finished or failed, the staging directory goes: it holds only unfinished dumps.
+        let _ = std::fs::remove_dir_all(&self.staging);
+    }
 }

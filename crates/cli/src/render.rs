@@ -152,6 +152,11 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     runner.fault = args.inject_fault.map(Into::into);
     let mut rows = Vec::new();
     let mut nearest_written = false;
+    let mut dumps = args
+        .dump
+        .as_deref()
+        .map(crate::export::DumpStage::new)
+        .transpose()?;
     for &name in &schemes {
         let mut last = None;
         for &executor in executors {
@@ -208,9 +213,12 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             progress.inc(1);
             last = Some(named);
         }
-        if let (Some(dir), Some(run)) = (&args.dump, &last) {
-            crate::export::write_dump(dir, name, run, &view, &args.scene)?;
+        if let (Some(stage), Some(run)) = (&mut dumps, &last) {
+            stage.add(name, run, &view, &args.scene)?;
         }
+    }
+    if let Some(stage) = dumps {
+        stage.finish()?;
     }
     progress.finish_and_clear();
     if !args.no_images {

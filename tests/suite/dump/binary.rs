@@ -239,3 +239,59 @@ fn the_binary_exports_the_triangles_of_the_view_it_names() {
     let read = TriangleExport::read(&file).unwrap();
     with_view(|view, _| assert_eq!(read, TriangleExport::from_view(view, spec())));
 }
+
+#[test]
+fn render_dumps_every_scheme_or_nothing() {
+    let dir = scratch("binary-all");
+    let dumps = dir.join("dumps");
+    let render = |dumps: &Path| {
+        fragsim()
+            .args(["render", "--scene", SCENE, "--scheme", "all"])
+            .args(SIZE)
+            .args(["--no-images", "--dump"])
+            .arg(dumps)
+            .output()
+            .unwrap()
+    };
+    let made = render(&dumps);
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let mut written: Vec<String> = std::fs::read_dir(&dumps)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    written.sort();
+    let mut every: Vec<String> = fragsim::capture::catalog::CATALOG
+        .iter()
+        .map(|e| e.name.to_string())
+        .collect();
+    every.sort();
+    // One dump a scheme, and no staging directory left.
+    assert_eq!(written, every);
+    for scheme in ["linked-list", "layer-counter", "peeling", "zbuffer"] {
+        let out = stdout_of(
+            fragsim()
+                .args(["compare", "oracle"])
+                .arg(dumps.join(scheme))
+                .args(["--json", "--no-image"]),
+            0,
+        );
+        assert!(out.contains("\"equal\": true"), "{scheme}: {out}");
+    }
+    // A file where one dump goes fails the whole run before anything is moved into place.
+    let blocked = dir.join("blocked");
+    std::fs::create_dir_all(&blocked).unwrap();
+    std::fs::write(blocked.join("loop32"), b"not a dump").unwrap();
+    let failed = render(&blocked);
+    assert!(!failed.status.success());
+    let stderr = String::from_utf8_lossy(&failed.stderr);
+    assert!(
+        stderr.contains("loop32") && stderr.contains("not a directory"),
+        "{stderr}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&blocked).unwrap().collect();
+    assert_eq!(left.len(), 1, "only the file that was there");
+}

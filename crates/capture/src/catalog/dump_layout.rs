@@ -1,6 +1,6 @@
 //! What a scheme's memory looks like in a dump (`docs/dump-format.md`): the layout each catalog
 //! entry states, so that the dump reader and writer take the schemes they know, and the names a
-//! dump header may carry, from the catalog.
+//! dump header may carry, from the catalog. Every entry has one.
 
 use super::{SchemeName, CATALOG};
 
@@ -8,12 +8,22 @@ use super::{SchemeName, CATALOG};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DumpLayout {
     /// `slots` `[pixels, k]`: each pixel's `k` slots of one word each, pixel-major, full slots
-    /// first (MDTS).
+    /// first (MDTS; the z-buffer is its `k` = 1).
     SlotArray(SlotWord),
     /// The A-buffer's `counters` `[pixels]` (fetch-and-add counts, u32) and `slots` of fragment
     /// words (u64): `[pixels, capacity]` for fixed storage, or `[total]` beside `offsets`
     /// `[pixels + 1]` for storage sized by a counting pass ([`super::Storage::Counted`]).
     CountersAndSlots,
+    /// Per-pixel linked lists: `heads` `[pixels]`, the pool's `next` and `nodes` `[pool]` and
+    /// its `counter` `[1]`, the terminator and the first node's number in the header. Each entry
+    /// with it dumps under its own name: the words are the same, the resolves differ.
+    LinkedLists,
+    /// Layer-major layers (Bevy's `layers[layer * pixels + pixel]`) beside per-pixel `counters`.
+    LayerMajor,
+    /// The scheme's own words as they are after its last pass (`words32`, `words64`), decoded by
+    /// its own resolve: schemes whose memory is no list per pixel (bucket histograms, peeling's
+    /// layer records, the k-buffer's slots beside its locks). Each entry dumps under its own name.
+    Memory,
 }
 
 /// The word a [`DumpLayout::SlotArray`] slot holds, and so its order and its empty marker.
@@ -28,9 +38,18 @@ pub enum SlotWord {
 }
 
 impl DumpLayout {
-    /// The scheme whose name a dump of this layout carries in its header: the first catalog entry
-    /// with the layout. Other entries with it leave the same words (`abuffer-bitonic` and
-    /// `abuffer-exact` dump as `abuffer`), so a reader rebuilds them as that one.
+    /// Whether a dump of this layout carries the name of the scheme that wrote it (its words
+    /// need that scheme's own resolve) rather than the name of the layout's first entry.
+    #[must_use]
+    pub fn names_its_scheme(self) -> bool {
+        matches!(self, DumpLayout::LinkedLists | DumpLayout::Memory)
+    }
+
+    /// The scheme whose name a dump of this layout carries in its header, for a layout that
+    /// does not name its scheme ([`DumpLayout::names_its_scheme`]): the first catalog entry with
+    /// the layout. Other entries with it leave the same words (`abuffer-bitonic` and
+    /// `abuffer-exact` dump as `abuffer`, `mdts-probe` and `zbuffer` as `mdts`), so a reader
+    /// rebuilds them as that one.
     ///
     /// # Panics
     /// If no catalog entry has the layout (a unit test checks that every layout has one).
@@ -43,19 +62,30 @@ impl DumpLayout {
             .expect("every dump layout is some catalog entry's")
     }
 
-    /// The layout a dump header's `scheme` names: `name` must be the catalog name of the scheme
-    /// that heads a layout ([`DumpLayout::scheme`]).
+    /// The scheme whose name a dump of `scheme`'s memory carries (`None`: it has no layout).
+    #[must_use]
+    pub fn header_scheme(scheme: SchemeName) -> Option<SchemeName> {
+        let layout = scheme.entry().dump?;
+        Some(if layout.names_its_scheme() {
+            scheme
+        } else {
+            layout.scheme()
+        })
+    }
+
+    /// The layout a dump header's `scheme` names: `name` must be the catalog name that a dump of
+    /// the layout carries ([`DumpLayout::header_scheme`]).
     #[must_use]
     pub fn named(name: &str) -> Option<DumpLayout> {
-        let layout = SchemeName::from_name(name)?.entry().dump?;
-        (layout.scheme().name() == name).then_some(layout)
+        let scheme = SchemeName::from_name(name)?;
+        (Self::header_scheme(scheme)? == scheme).then(|| scheme.entry().dump)?
     }
 
     /// The names a dump header may carry, in catalog order.
     pub fn names() -> impl Iterator<Item = &'static str> {
         CATALOG
             .iter()
-            .filter(|e| e.dump.is_some_and(|layout| layout.scheme() == e.scheme))
+            .filter(|e| Self::header_scheme(e.scheme) == Some(e.scheme))
             .map(|e| e.name)
     }
 }
@@ -71,20 +101,28 @@ mod tests {
             DumpLayout::SlotArray(SlotWord::FragmentPlusOne),
             DumpLayout::SlotArray(SlotWord::Key),
             DumpLayout::CountersAndSlots,
+            DumpLayout::LinkedLists,
+            DumpLayout::LayerMajor,
+            DumpLayout::Memory,
         ];
         for layout in layouts {
             let name = layout.scheme().name();
             assert_eq!(DumpLayout::named(name), Some(layout), "{name}");
         }
-        // Four layouts, four header names: the format's (docs/dump-format.md).
-        assert_eq!(DumpLayout::names().count(), layouts.len());
+        // Every entry dumps (issue 16), and each header name is a catalog entry's.
+        assert!(CATALOG.iter().all(|e| e.dump.is_some()));
+        let own = CATALOG
+            .iter()
+            .filter(|e| e.dump.is_some_and(DumpLayout::names_its_scheme))
+            .count();
+        assert_eq!(DumpLayout::names().count(), 5 + own);
     }
 
     #[test]
     fn schemes_that_share_a_layout_dump_under_its_heads_name() {
         for entry in CATALOG {
             match entry.dump {
-                Some(layout) if layout.scheme() != entry.scheme => {
+                Some(layout) if !layout.names_its_scheme() && layout.scheme() != entry.scheme => {
                     assert_eq!(DumpLayout::named(entry.name), None, "{}", entry.name);
                     assert_eq!(DumpLayout::named(layout.scheme().name()), Some(layout));
                 }

@@ -198,7 +198,7 @@ macro_rules! catalog {
     (@optional $value:expr) => { Some($value) };
 }
 
-use DumpLayout::{CountersAndSlots, SlotArray};
+use DumpLayout::{CountersAndSlots, LayerMajor, LinkedLists, Memory, SlotArray};
 use Passes::{Fixed, PerLayers, UntilConfirmed, UpTo};
 use SlotWord::{Fragment, FragmentPlusOne, Key};
 use Storage::{Capacity, Counted, KAndPool, Slots, K};
@@ -213,13 +213,13 @@ catalog! {
     MdtsDesc "mdts-desc" Fixed(1), K, Some(SlotArray(FragmentPlusOne)),
         "MDTS with `atomicMax`, descending.";
         |b| (Mdts::<u64>::new(b.viewport, b.k, Descending, b.memory_cap)?, Some(b.k));
-    MdtsProbe "mdts-probe" Fixed(1), K, None,
+    MdtsProbe "mdts-probe" Fixed(1), K, Some(SlotArray(Fragment)),
         "MDTS (64-bit words) with the probing walk: a load first, `atomicMin` only where it would change the slot (same lists, fewer locked operations).";
         |b| (Mdts::<u64>::new(b.viewport, b.k, Ascending, b.memory_cap)?.probing(), Some(b.k));
-    MdtsEmulated64 "mdts-emulated64" Fixed(1), K, None,
+    MdtsEmulated64 "mdts-emulated64" Fixed(1), K, Some(Memory),
         "MDTS with each 64-bit `atomicMin` emulated on two 32-bit words inside a per-slot compare-and-swap lock (WebGPU has no 64-bit atomics): exact.";
         |b| (crate::schemes::mdts_emulated64::MdtsEmulated64::new(b.viewport, b.k, crate::schemes::mdts_emulated64::Emulation::Locked, b.memory_cap)?, Some(b.k));
-    MdtsEmulated64Torn "mdts-emulated64-torn" Fixed(1), K, None,
+    MdtsEmulated64Torn "mdts-emulated64-torn" Fixed(1), K, Some(Memory),
         "MDTS with each 64-bit `atomicMin` emulated by unlocked loads and stores of the two halves: exact only without hazards, tears under concurrency.";
         |b| (crate::schemes::mdts_emulated64::MdtsEmulated64::new(b.viewport, b.k, crate::schemes::mdts_emulated64::Emulation::Torn, b.memory_cap)?, Some(b.k));
     Abuffer "abuffer" Fixed(1), Capacity, Some(CountersAndSlots),
@@ -231,74 +231,74 @@ catalog! {
     AbufferExact "abuffer-exact" Fixed(1), Counted, Some(CountersAndSlots),
         "The A-buffer with storage sized exactly by its own counting pass (`fetch_add` per fragment, then a prefix sum): two geometry passes.";
         |b| (ABuffer::exact(b.counts()?, Insertion, b.memory_cap)?, None);
-    Peeling "peeling" PerLayers { before: 0, per: 1, after: 1 }, Counted, None,
+    Peeling "peeling" PerLayers { before: 0, per: 1, after: 1 }, Counted, Some(Memory),
         "Classical depth peeling, 64-bit words (ties ordered by primitive id): one pass per layer.";
         |b| (DepthPeeling::<u64>::new(b.viewport, b.layers, b.memory_cap)?, None);
-    Peeling32 "peeling32" PerLayers { before: 0, per: 1, after: 1 }, Counted, None,
+    Peeling32 "peeling32" PerLayers { before: 0, per: 1, after: 1 }, Counted, Some(Memory),
         "Classical depth peeling on 32-bit depth keys: equal depths merge.";
         |b| (DepthPeeling::<u32>::new(b.viewport, b.layers, b.memory_cap)?, None);
-    DualPeeling "dual-peeling" PerLayers { before: 0, per: 2, after: 1 }, Counted, None,
+    DualPeeling "dual-peeling" PerLayers { before: 0, per: 2, after: 1 }, Counted, Some(Memory),
         "Dual depth peeling (nearest and farthest layer per pass), 64-bit words.";
         |b| (DualDepthPeeling::<u64>::new(b.viewport, b.layers, b.memory_cap)?, None);
-    DualPeeling32 "dual-peeling32" PerLayers { before: 0, per: 2, after: 1 }, Counted, None,
+    DualPeeling32 "dual-peeling32" PerLayers { before: 0, per: 2, after: 1 }, Counted, Some(Memory),
         "Dual depth peeling on 32-bit depth keys.";
         |b| (DualDepthPeeling::<u32>::new(b.viewport, b.layers, b.memory_cap)?, None);
-    Zbuffer "zbuffer" Fixed(1), Slots(1), None,
+    Zbuffer "zbuffer" Fixed(1), Slots(1), Some(SlotArray(Fragment)),
         "The opaque z-buffer via `atomicMin`: the nearest fragment only.";
         |b| (ZBuffer::new(b.viewport, b.memory_cap)?, Some(1));
-    Bdp "bdp" Fixed(2), Slots(32), None,
+    Bdp "bdp" Fixed(2), Slots(32), Some(Memory),
         "Bucket depth peeling, one pass, 16 bucket pairs (HPG 2009 §3.2).";
         |b| (Bdp::<u32>::new(b.viewport, Buckets::Pairs(16), b.memory_cap)?, Some(32));
-    BdpSingle "bdp-single" Fixed(2), Slots(32), None,
+    BdpSingle "bdp-single" Fixed(2), Slots(32), Some(Memory),
         "Bucket depth peeling, 32 single-value buckets.";
         |b| (Bdp::<u32>::new(b.viewport, Buckets::Singles(32), b.memory_cap)?, Some(32));
-    Bdp2 "bdp2" Fixed(3), Slots(64), None,
+    Bdp2 "bdp2" Fixed(3), Slots(64), Some(Memory),
         "Two-pass bucket depth peeling (§3.2).";
         |b| (Bdp2::<u32>::new(b.viewport, 16, b.memory_cap)?, Some(64));
-    Adp "adp" PerLayers { before: 2, per: 32, after: 0 }, Counted, None,
+    Adp "adp" PerLayers { before: 2, per: 32, after: 0 }, Counted, Some(Memory),
         "Adaptive bucket depth peeling (§3.3).";
         |b| (Adp::<u32>::new(b.viewport, b.layers, b.memory_cap)?, Some(b.layers));
-    Kbuffer "kbuffer" Fixed(1), K, None,
+    Kbuffer "kbuffer" Fixed(1), K, Some(Memory),
         "The k-buffer: read–insert–write of K slots, exact only without concurrent hazards; render-target write-backs (one step each, committed in primitive order).";
         read-modify-write RenderTarget;
         |b| (KBuffer::with_write_back(b.viewport, b.k, RenderTarget, b.memory_cap)?, Some(b.k));
-    KbufferStores "kbuffer-stores" Fixed(1), K, None,
+    KbufferStores "kbuffer-stores" Fixed(1), K, Some(Memory),
         "The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.";
         read-modify-write SeparateStores;
         |b| (KBuffer::with_write_back(b.viewport, b.k, SeparateStores, b.memory_cap)?, Some(b.k));
-    KbufferInterlock "kbuffer-interlock" Fixed(1), K, None,
+    KbufferInterlock "kbuffer-interlock" Fixed(1), K, Some(Memory),
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
         |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
-    KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, None,
+    KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, Some(Memory),
         "The k-buffer's read–insert–write of K slots under a per-pixel spinlock (compare-and-swap, critical section after the spin loop; nvpro-samples' spinlock mode): exact under independent thread scheduling, deadlocks lockstep warps.";
         |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
-    KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, None,
+    KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, Some(Memory),
         "The spinlocked k-buffer with the critical section and release inside the lock loop's body: exact, and terminates under lockstep warps too.";
         |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Fixed, b.memory_cap)?, Some(b.k));
-    KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, None,
+    KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, Some(Memory),
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
         read-modify-write RenderTarget;
         |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, RenderTarget, b.memory_cap)?, Some(b.k));
-    KbufferMultipassStores "kbuffer-multipass-stores" UntilConfirmed, Counted, None,
+    KbufferMultipassStores "kbuffer-multipass-stores" UntilConfirmed, Counted, Some(Memory),
         "The multi-pass k-buffer with K separate loads and stores.";
         read-modify-write SeparateStores;
         |b| (KBufferMultipass::with_write_back(b.viewport, b.k, b.layers, SeparateStores, b.memory_cap)?, Some(b.k));
-    Srab "srab" UpTo(2), Slots(16), None,
+    Srab "srab" UpTo(2), Slots(16), Some(Memory),
         "The stencil-routed A-buffer: 8 samples per pixel and pass, 2 passes.";
         |b| (StencilRouted::new(b.viewport, 2, b.memory_cap)?, Some(16));
-    MdtsPacked "mdts-packed" Fixed(1), K, None,
+    MdtsPacked "mdts-packed" Fixed(1), K, Some(Memory),
         "MDTS with depth and colour packed into two 32-bit arrays (FreePipe §4.1.2).";
         |b| (MdtsPacked::new(b.viewport, b.k, Colours::Prim, b.memory_cap)?, Some(b.k));
-    Loop32 "loop32" Fixed(2), K, None,
+    Loop32 "loop32" Fixed(2), K, Some(Memory),
         "nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths merge), then a colour pass; K = `--k`.";
         |b| (Loop32::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
-    LayerCounter "layer-counter" Fixed(1), K, None,
+    LayerCounter "layer-counter" Fixed(1), K, Some(LayerMajor),
         "Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.";
         |b| (LayerCounter::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
-    LinkedList "linked-list" Fixed(1), KAndPool, None,
+    LinkedList "linked-list" Fixed(1), KAndPool, Some(LinkedLists),
         "Per-pixel linked lists (node counter, head exchange), the resolve keeping the first `--k` nodes (the most recent: Vulkan-Samples); node pool `--capacity` per pixel, `exact` = the scene's fragments.";
         |b| (LinkedList::new(b.viewport, b.pool, b.k, KeepFirst, b.memory_cap)?, Some(b.k));
-    LinkedListNearest "linked-list-nearest" Fixed(1), KAndPool, None,
+    LinkedListNearest "linked-list-nearest" Fixed(1), KAndPool, Some(LinkedLists),
         "Per-pixel linked lists, the resolve keeping the `--k` nearest (nvpro-samples).";
         |b| (LinkedList::new(b.viewport, b.pool, b.k, KeepNearest, b.memory_cap)?, Some(b.k));
 }

@@ -24,6 +24,9 @@ pub struct NamedRun {
     pub slots: Option<u32>,
     /// The per-pixel counts of the scheme's own counting pass, where one sized its storage.
     pub counts: Option<Vec<u32>>,
+    /// The sizes the scheme was built with (their `counts` are [`NamedRun::counts`]): what a
+    /// dump of its memory needs to rebuild it.
+    pub sizes: Build<'static>,
 }
 
 /// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
@@ -96,6 +99,10 @@ impl Executors {
                     executors: self,
                     executor,
                     view,
+                    sizes: Build {
+                        counts: None,
+                        ..build
+                    },
                 },
             )
             .map_err(|e| e.to_string())?;
@@ -178,6 +185,7 @@ struct RunOn<'e, 'v, 'm> {
     executors: &'e mut Executors,
     executor: Executor,
     view: &'v View<'m>,
+    sizes: Build<'static>,
 }
 
 impl SchemeVisitor for RunOn<'_, '_, '_> {
@@ -189,6 +197,7 @@ impl SchemeVisitor for RunOn<'_, '_, '_> {
             guarantee: scheme.guarantee(),
             slots,
             counts: None,
+            sizes: self.sizes,
         }
     }
 }

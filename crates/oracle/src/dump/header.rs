@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use super::{err, DumpError};
+use super::{err, DumpError, LayoutSpec};
 use crate::scene::SceneAndCamera;
 
 /// The element type of an array file: always little-endian.
@@ -63,6 +63,18 @@ pub struct Header {
     /// those slots may hold anything (FreePipe leaves them uninitialised) and are not checked.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub filled: bool,
+    /// Linked lists: nodes in the pool (`next` and `nodes` hold this many).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pool: Option<u64>,
+    /// Memory dumps of schemes that record every layer (peeling, ADP, the multi-pass k-buffer):
+    /// the scene's maximum depth complexity they were sized to.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layers: Option<u32>,
+    /// How the arrays hold the scheme's memory (linked lists, layer-major layers, a scheme's own
+    /// memory: [`LayoutSpec`]); absent for the slot and A-buffer layouts, which `scheme` fixes,
+    /// and in headers written before it, which read as fragsim's own encoding.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layout: Option<LayoutSpec>,
     /// The word layout, informative: `key<<32|prim`, `key`, or `(key<<32|prim)+1`.
     #[serde(default)]
     pub word: String,

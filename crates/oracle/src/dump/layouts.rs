@@ -15,7 +15,9 @@ use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::Viewport;
 use serde::Serialize;
 
-use super::{err, Dump, DumpError, Header, Words};
+use super::lists::{layer_major, linked_lists, ListArrays, Translated};
+use super::spec::{LayoutSpec, Payload, LARGEST_KEY};
+use super::{err, Dtype, Dump, DumpError, Header, Words};
 
 /// Which scheme's memory a dump holds, with its parameters.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -47,6 +49,38 @@ pub enum DumpScheme {
         counts: Vec<u32>,
         /// Whether each pixel's slots were sorted in place.
         sorted: bool,
+    },
+    /// Per-pixel linked lists (`linked-list`, `linked-list-nearest`): `heads` `[pixels]`,
+    /// `next` and `nodes` `[pool]`, `counter` `[1]` ([`LayoutSpec::LinkedList`]).
+    LinkedLists {
+        /// Which of the two resolves decodes the lists.
+        scheme: SchemeName,
+        /// Nodes the resolve keeps (`--k`).
+        k: u32,
+        /// Nodes in the pool.
+        pool: u32,
+        /// The terminator, the first node's number and the payload.
+        spec: LayoutSpec,
+    },
+    /// Bevy's layer counter (`layer-counter`): `counters` `[pixels]`, `layers` `[k, pixels]`
+    /// layer-major ([`LayoutSpec::LayerMajor`]).
+    LayerMajor {
+        /// Layers per pixel.
+        k: u32,
+        /// The payload.
+        payload: Payload,
+    },
+    /// Any other scheme's own memory after its last pass: `words32`, `words64`
+    /// ([`LayoutSpec::Memory`]), rebuilt and resolved as `scheme` sized so.
+    Memory {
+        /// The scheme.
+        scheme: SchemeName,
+        /// Its `--k`.
+        k: u32,
+        /// Its `--capacity`.
+        capacity: u32,
+        /// The scene's maximum depth complexity it was sized to (schemes that record every layer).
+        layers: u32,
     },
 }
 
@@ -81,24 +115,50 @@ impl DumpScheme {
             } => DumpLayout::SlotArray(SlotWord::FragmentPlusOne),
             Self::Mdts32 { .. } => DumpLayout::SlotArray(SlotWord::Key),
             Self::ABufferFixed { .. } | Self::ABufferExact { .. } => DumpLayout::CountersAndSlots,
+            Self::LinkedLists { .. } => DumpLayout::LinkedLists,
+            Self::LayerMajor { .. } => DumpLayout::LayerMajor,
+            Self::Memory { .. } => DumpLayout::Memory,
         }
     }
 
-    /// The header's `scheme` field: the catalog name of the scheme that heads the layout.
+    /// The header's `scheme` field: the catalog name of the scheme that heads the layout, or of
+    /// the scheme itself where the layout names its scheme.
     #[must_use]
     pub fn name(&self) -> &'static str {
-        self.layout().scheme().name()
+        self.scheme_name().name()
     }
 
-    /// The layout scheme `name`'s memory has after a run of it with `slots` slots per pixel (K,
-    /// or the capacity) and the per-pixel `counts` of its counting pass, where one ran.
+    /// The catalog scheme the dump's words are rebuilt as.
+    fn scheme_name(&self) -> SchemeName {
+        match self {
+            Self::LinkedLists { scheme, .. } | Self::Memory { scheme, .. } => *scheme,
+            _ => self.layout().scheme(),
+        }
+    }
+
+    /// The header's `"layout"`: the description of the new layouts (`None` for the slot and
+    /// A-buffer layouts, which their name fixes).
+    #[must_use]
+    pub fn spec(&self) -> Option<LayoutSpec> {
+        match self {
+            Self::LinkedLists { spec, .. } => Some(*spec),
+            Self::LayerMajor { payload, .. } => Some(LayoutSpec::LayerMajor { payload: *payload }),
+            Self::Memory { .. } => Some(LayoutSpec::Memory),
+            _ => None,
+        }
+    }
+
+    /// The layout scheme `name`'s memory has after a run of it built with `sizes`, with `slots`
+    /// slots per pixel (K, or the capacity) and the per-pixel `counts` of its counting pass,
+    /// where one ran ([`NamedRun`](fragsim_capture::catalog::NamedRun) holds all three).
     ///
     /// # Errors
-    /// A scheme the catalog gives no dump layout (the error lists those it gives one), or storage
-    /// sized by a counting pass without its counts.
+    /// A scheme the catalog gives no dump layout (the error lists those it gives one), storage
+    /// sized by a counting pass without its counts, or a pool past 2^32 nodes.
     pub fn for_run(
         name: SchemeName,
         slots: u32,
+        sizes: &Build<'_>,
         counts: Option<&[u32]>,
     ) -> Result<Self, DumpError> {
         let entry = name.entry();
@@ -131,6 +191,23 @@ impl DumpScheme {
                 capacity: slots,
                 sorted: false,
             },
+            DumpLayout::LinkedLists => Self::LinkedLists {
+                scheme: name,
+                k: sizes.k,
+                pool: u32::try_from(sizes.pool)
+                    .map_err(|_| DumpError(format!("{name}: a pool past 2^32 nodes")))?,
+                spec: LayoutSpec::FRAGSIM_LISTS,
+            },
+            DumpLayout::LayerMajor => Self::LayerMajor {
+                k: slots,
+                payload: Payload::FRAGMENT,
+            },
+            DumpLayout::Memory => Self::Memory {
+                scheme: name,
+                k: sizes.k,
+                capacity: sizes.capacity,
+                layers: sizes.layers,
+            },
         })
     }
 
@@ -142,6 +219,8 @@ impl DumpScheme {
             DumpLayout::SlotArray(SlotWord::Fragment) | DumpLayout::CountersAndSlots => {
                 "key<<32|prim"
             }
+            // The description is in `"layout"`.
+            DumpLayout::LinkedLists | DumpLayout::LayerMajor | DumpLayout::Memory => "",
         }
     }
 
@@ -159,6 +238,15 @@ impl DumpScheme {
                 words32: Some("counters"),
                 words64: Some("slots"),
             },
+            DumpLayout::LayerMajor => ArrayNames {
+                words32: Some("counters"),
+                words64: Some("layers"),
+            },
+            // Linked lists split the u32 words three ways (`Dump::record`).
+            DumpLayout::LinkedLists | DumpLayout::Memory => ArrayNames {
+                words32: Some("words32"),
+                words64: Some("words64"),
+            },
         }
     }
 
@@ -170,12 +258,19 @@ impl DumpScheme {
         visitor: V,
     ) -> Result<V::Output, DumpError> {
         let slots = match self {
-            Self::Mdts { k, .. } | Self::Mdts32 { k } => *k,
+            Self::Mdts { k, .. } | Self::Mdts32 { k } | Self::LayerMajor { k, .. } => *k,
             Self::ABufferFixed { capacity, .. } => *capacity,
             Self::ABufferExact { .. } => 0,
+            Self::LinkedLists { k, .. } => *k,
+            Self::Memory { capacity, .. } => *capacity,
         };
         let mut build = Build::fixed(viewport, slots, slots, 1, u64::MAX);
-        let mut scheme = self.layout().scheme();
+        match *self {
+            Self::LinkedLists { pool, .. } => build.pool = pool as usize,
+            Self::Memory { k, layers, .. } => (build.k, build.layers) = (k, layers.max(1)),
+            _ => {}
+        }
+        let mut scheme = self.scheme_name();
         if let Self::ABufferExact { counts, .. } = self {
             if counts.len() != viewport.pixels() {
                 return err(format!(
@@ -207,6 +302,72 @@ impl DumpScheme {
             ));
         };
         let name = &header.scheme;
+        let spec = match (header.layout, layout) {
+            (None, DumpLayout::LinkedLists) => Some(LayoutSpec::FRAGSIM_LISTS),
+            (None, DumpLayout::LayerMajor) => Some(LayoutSpec::FRAGSIM_LAYERS),
+            (None, DumpLayout::Memory) => Some(LayoutSpec::Memory),
+            (None, _) => None,
+            (Some(spec), _) => {
+                let expected = match layout {
+                    DumpLayout::LinkedLists => "linked-list",
+                    DumpLayout::LayerMajor => "layer-major",
+                    DumpLayout::Memory => "memory",
+                    _ => "no \"layout\" (its name fixes it)",
+                };
+                if spec.kind() != expected {
+                    return err(format!(
+                        "scheme {name} dumps as {expected}, the header's layout is {}",
+                        spec.kind()
+                    ));
+                }
+                Some(spec)
+            }
+        };
+        let scheme = SchemeName::from_name(name).unwrap_or(layout.scheme());
+        match (layout, spec) {
+            (DumpLayout::LinkedLists, Some(spec)) => {
+                if let LayoutSpec::LinkedList { payload, .. } = spec {
+                    payload.check()?;
+                }
+                let pool = match header.pool {
+                    Some(pool) if (1..=u64::from(u32::MAX)).contains(&pool) => pool as u32,
+                    _ => return err(format!("{name} needs \"pool\" of 1 to 2^32 − 1 nodes")),
+                };
+                return Ok(Self::LinkedLists {
+                    scheme,
+                    k: k()?,
+                    pool,
+                    spec,
+                });
+            }
+            (DumpLayout::LayerMajor, Some(LayoutSpec::LayerMajor { payload })) => {
+                payload.check()?;
+                return Ok(Self::LayerMajor { k: k()?, payload });
+            }
+            (DumpLayout::Memory, _) => {
+                // Each size defaults to 1, as a scheme that does not use it is built. A scheme
+                // holds at least one word per slot or layer, so a size past the dump's words is
+                // refused before the scheme is built (its storage would not fit a u64 count).
+                let words = header.arrays.iter().try_fold(0u64, |sum, (name, spec)| {
+                    sum.checked_add(super::header::elements(name, &spec.shape)?)
+                        .ok_or_else(|| DumpError("the arrays' elements overflow 64 bits".into()))
+                })?;
+                let size = |field: &str, value: Option<u32>| match value {
+                    Some(0) => err(format!("{name} \"{field}\" must be at least 1")),
+                    Some(v) if u64::from(v) > words.max(1) => err(format!(
+                        "{name} \"{field}\" {v} is more than the dump's {words} words"
+                    )),
+                    v => Ok(v.unwrap_or(1)),
+                };
+                return Ok(Self::Memory {
+                    scheme,
+                    k: size("k", header.k)?,
+                    capacity: size("capacity", header.capacity)?,
+                    layers: size("layers", header.layers)?,
+                });
+            }
+            _ => {}
+        }
         match layout {
             DumpLayout::SlotArray(SlotWord::Fragment) => Ok(Self::Mdts {
                 k: k()?,
@@ -234,13 +395,12 @@ impl DumpScheme {
                 }
                 (None, None) => err(format!("{name} needs \"capacity\" or an \"offsets\" array")),
             },
+            DumpLayout::LinkedLists | DumpLayout::LayerMajor | DumpLayout::Memory => {
+                unreachable!("handled above")
+            }
         }
     }
 }
-
-/// The largest depth key of a fragment: depth 1.0 (fragments outside `[0, 1]` are dropped, and
-/// `-0.0` is stored as `+0.0`), so a stored key above it is no fragment's.
-const LARGEST_KEY: u32 = 0x3F80_0000;
 
 /// Why a stored word is one that its layout says cannot be there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -258,6 +418,16 @@ pub enum Corruption {
     BeyondCounter,
     /// A stored word whose depth key is above 1.0's: no fragment has such a key.
     ImpossibleKey,
+    /// A linked-list link (a head or a `next`) to a node number outside the pool.
+    OutOfPool,
+    /// A linked-list link to a node of the pool that the counter never handed out.
+    Unallocated,
+    /// A linked-list link to a node already reached: a cycle, or two lists sharing a node. The
+    /// walk stops there, so a cycle costs one visit per node.
+    Revisited,
+    /// A counter above the layers it counts, which no run leaves (Bevy's clamp stores the layer
+    /// count back over any counter that passed it).
+    CounterPastStorage,
 }
 
 impl Corruption {
@@ -269,6 +439,10 @@ impl Corruption {
             Self::EmptyCounted => "empty marker in a counted slot",
             Self::BeyondCounter => "written past the counter",
             Self::ImpossibleKey => "depth key above 1.0",
+            Self::OutOfPool => "link out of the node pool",
+            Self::Unallocated => "link to a node never allocated",
+            Self::Revisited => "link to a node already in a list (a cycle)",
+            Self::CounterPastStorage => "counter past its storage",
         }
     }
 }
@@ -305,8 +479,12 @@ pub struct WordCheck {
     /// counter against the pixel's fragment count.
     pub counters: Option<Vec<Counter>>,
     /// Words the layout leaves undefined and so were not checked: A-buffer slots past the counter
-    /// when the header does not say they were filled.
+    /// when the header does not say they were filled, layers past a counter, pool nodes past the
+    /// node counter, every word of a memory dump (its scheme's memory has no rules here).
     pub unchecked: u64,
+    /// Linked lists: nodes the counter handed out that no list reaches (a lost node; its
+    /// fragment is missing from the lists, which the comparison counts).
+    pub unreachable: u64,
 }
 
 impl WordCheck {
@@ -394,6 +572,15 @@ impl Dump {
                 }
                 check.counters = Some(all);
             }
+            DumpScheme::LinkedLists { .. } | DumpScheme::LayerMajor { .. } => {
+                let translated = self.translate(&scheme)?;
+                check.corrupt = translated.corrupt;
+                check.unchecked = translated.unchecked;
+                check.unreachable = translated.unreachable;
+            }
+            DumpScheme::Memory { .. } => {
+                check.unchecked = self.arrays.values().map(|w| w.len() as u64).sum();
+            }
         }
         Ok(check)
     }
@@ -476,6 +663,84 @@ pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme
     }
 }
 
+impl Dump {
+    /// An array's words widened to u64, which must have `dtype`.
+    fn widened(&self, name: &str, dtype: Dtype) -> Result<Vec<u64>, DumpError> {
+        match (self.arrays.get(name), dtype) {
+            (Some(Words::U32(w)), Dtype::U32) => Ok(w.iter().map(|&w| u64::from(w)).collect()),
+            (Some(Words::U64(w)), Dtype::U64) => Ok(w.clone()),
+            (Some(_), _) => err(format!("array {name:?} must be {dtype:?}, as its payload")),
+            (None, _) => err(format!("missing array {name:?}")),
+        }
+    }
+
+    /// A u32 array of `len` words.
+    fn u32s_of(&self, name: &str, len: usize) -> Result<&[u32], DumpError> {
+        let words = self
+            .u32s(name)?
+            .ok_or_else(|| DumpError(format!("missing array {name:?}")))?;
+        if words.len() == len {
+            Ok(words)
+        } else {
+            err(format!(
+                "array {name:?} has {} words, {len} expected",
+                words.len()
+            ))
+        }
+    }
+
+    /// A linked-list or layer-major dump as fragsim's memory of its scheme.
+    pub(super) fn translate(&self, scheme: &DumpScheme) -> Result<Translated, DumpError> {
+        let pixels = self.viewport()?.pixels();
+        match scheme {
+            DumpScheme::LinkedLists {
+                pool,
+                spec:
+                    LayoutSpec::LinkedList {
+                        payload,
+                        null,
+                        node_base,
+                    },
+                ..
+            } => {
+                let pool = *pool as usize;
+                let nodes = self.widened("nodes", payload.dtype)?;
+                if nodes.len() != pool {
+                    return err(format!(
+                        "array \"nodes\" has {} words, the pool {pool}",
+                        nodes.len()
+                    ));
+                }
+                Ok(linked_lists(&ListArrays {
+                    heads: self.u32s_of("heads", pixels)?,
+                    next: self.u32s_of("next", pool)?,
+                    nodes: &nodes,
+                    counter: self.u32s_of("counter", 1)?[0],
+                    null: *null,
+                    node_base: *node_base,
+                    payload: *payload,
+                }))
+            }
+            DumpScheme::LayerMajor { k, payload } => {
+                let layers = self.widened("layers", payload.dtype)?;
+                if layers.len() as u64 != pixels as u64 * u64::from(*k) {
+                    return err(format!(
+                        "array \"layers\" has {} words, {k} layers of {pixels} pixels expected",
+                        layers.len()
+                    ));
+                }
+                Ok(layer_major(
+                    self.u32s_of("counters", pixels)?,
+                    &layers,
+                    *k,
+                    *payload,
+                ))
+            }
+            _ => err(format!("{} dumps are read as they are", scheme.name())),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -495,8 +760,21 @@ mod tests {
             capacity: Some(2),
             sorted: false,
             filled: false,
+            pool: Some(4),
+            layers: None,
+            layout: None,
             word: String::new(),
-            arrays: BTreeMap::new(),
+            // Memory dumps' sizes are bounded by their words.
+            arrays: [(
+                "words32".to_string(),
+                crate::dump::ArraySpec {
+                    file: "words32.u32".into(),
+                    dtype: Dtype::U32,
+                    shape: vec![8],
+                },
+            )]
+            .into_iter()
+            .collect(),
             extra: serde_json::Value::Null,
         }
     }
@@ -510,16 +788,27 @@ mod tests {
         }
         // A scheme that dumps under another's name is no header name of its own.
         let unknown = DumpScheme::from_header(&header("abuffer-exact"), None).unwrap_err();
+        assert!(
+            unknown.0.starts_with(
+                "unknown scheme \"abuffer-exact\": expected mdts, mdts32, mdts-desc, abuffer, "
+            ),
+            "{unknown}"
+        );
+        // A layout description of another kind than the scheme's is refused.
+        let mut lists = header("linked-list");
+        lists.layout = Some(LayoutSpec::Memory);
+        let refused = DumpScheme::from_header(&lists, None).unwrap_err();
         assert_eq!(
-            unknown.0,
-            "unknown scheme \"abuffer-exact\": expected mdts, mdts32, mdts-desc or abuffer"
+            refused.0,
+            "scheme linked-list dumps as linked-list, the header's layout is memory"
         );
     }
 
     #[test]
     fn every_catalog_entry_with_a_layout_dumps_in_it() {
+        let sizes = Build::fixed(Viewport::new(2, 1).unwrap(), 3, 3, 1, u64::MAX);
         for entry in CATALOG {
-            let dumped = DumpScheme::for_run(entry.scheme, 3, Some(&[1, 2]));
+            let dumped = DumpScheme::for_run(entry.scheme, 3, &sizes, Some(&[1, 2]));
             match entry.dump {
                 Some(layout) => assert_eq!(dumped.unwrap().layout(), layout, "{}", entry.name),
                 None => {
@@ -532,7 +821,8 @@ mod tests {
                 }
             }
         }
-        let exact = DumpScheme::for_run(SchemeName::AbufferExact, 1, Some(&[1, 2])).unwrap();
+        let exact =
+            DumpScheme::for_run(SchemeName::AbufferExact, 1, &sizes, Some(&[1, 2])).unwrap();
         assert_eq!(
             exact,
             DumpScheme::ABufferExact {
@@ -540,8 +830,9 @@ mod tests {
                 sorted: false
             }
         );
-        assert!(DumpScheme::for_run(SchemeName::AbufferExact, 1, None).is_err());
-        let fixed = DumpScheme::for_run(SchemeName::AbufferBitonic, 4, Some(&[1, 2])).unwrap();
+        assert!(DumpScheme::for_run(SchemeName::AbufferExact, 1, &sizes, None).is_err());
+        let fixed =
+            DumpScheme::for_run(SchemeName::AbufferBitonic, 4, &sizes, Some(&[1, 2])).unwrap();
         assert_eq!(
             fixed,
             DumpScheme::ABufferFixed {

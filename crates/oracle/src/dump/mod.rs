@@ -36,9 +36,18 @@
 //! assert!(comparison.is_equal() && comparison.words_checked);
 //! ```
 //!
-//! The parts: the header and its words (`header.rs`), the layouts and their word rules
-//! (`layouts.rs`, from the catalog's [`DumpLayout`](fragsim_capture::catalog::DumpLayout)),
-//! parsing and decoding (`read.rs`), recording and writing (`write.rs`); the scene a dump names is
+//! Every catalog scheme has a layout: MDTS slots, the A-buffer's counters and slots, linked lists
+//! (heads, next, nodes, the pool counter), Bevy's layer-major layers, or, for schemes whose memory
+//! is no list per pixel, the scheme's own memory words. Linked-list and layer-major dumps carry a
+//! description ([`LayoutSpec`]: the terminator, the node numbering, the payload's u32 or u64 word,
+//! f32, unorm24 or unorm16 depth and id bits), so an engine's own buffers can be dumped as they
+//! are.
+//!
+//! The parts: the header and its words (`header.rs`), the layout description (`spec.rs`), the
+//! layouts and their word rules (`layouts.rs`, from the catalog's
+//! [`DumpLayout`](fragsim_capture::catalog::DumpLayout)), linked lists and layers turned into
+//! fragsim's memory with their links checked (`lists.rs`), parsing and decoding (`read.rs`),
+//! recording and writing (`write.rs`); the scene a dump names is
 //! [`crate::scene`], the comparison [`crate::compare`], the triangle export [`crate::triangles`].
 //!
 //! Unlike the GPU, which leaves its words in device memory, [`Dump::record`] runs fragsim's scheme
@@ -48,7 +57,9 @@
 
 mod header;
 mod layouts;
+mod lists;
 mod read;
+mod spec;
 mod write;
 
 use std::collections::BTreeMap;
@@ -64,6 +75,7 @@ use crate::Oracle;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{CorruptWord, Corruption, Counter, DumpScheme, WordCheck};
+pub use spec::{DepthFormat, LayoutSpec, Payload};
 
 /// The `format` field of every dump header.
 pub const FORMAT: &str = "fragsim-dump";

@@ -170,29 +170,36 @@ impl Dump {
     /// A header that names no known scheme, or arrays missing or of the wrong size or type.
     pub fn capture(&self) -> Result<Capture, DumpError> {
         let scheme = self.scheme()?;
-        let names = scheme.names();
-        let fetch32 = |name: Option<&str>| -> Result<&[u32], DumpError> {
-            match name {
-                None => Ok(&[]),
-                Some(n) => self
-                    .u32s(n)?
-                    .ok_or_else(|| DumpError(format!("missing array {n:?}"))),
+        let translated;
+        let (words32, words64) = match scheme {
+            DumpScheme::LinkedLists { .. } | DumpScheme::LayerMajor { .. } => {
+                translated = self.translate(&scheme)?;
+                (&translated.words32[..], &translated.words64[..])
+            }
+            _ => {
+                let names = scheme.names();
+                (
+                    required(names.words32, self.u32s(names.words32.unwrap_or_default()))?,
+                    required(names.words64, self.u64s(names.words64.unwrap_or_default()))?,
+                )
             }
         };
-        let fetch64 = |name: Option<&str>| -> Result<&[u64], DumpError> {
-            match name {
-                None => Ok(&[]),
-                Some(n) => self
-                    .u64s(n)?
-                    .ok_or_else(|| DumpError(format!("missing array {n:?}"))),
-            }
-        };
-        let (words32, words64) = (fetch32(names.words32)?, fetch64(names.words64)?);
         let resolve = Resolve {
             scheme: &scheme,
             words32,
             words64,
         };
         scheme.with_scheme(self.viewport()?, resolve)?
+    }
+}
+
+/// The words of array `name` the layout uses, which must exist (`None`: the layout uses none).
+fn required<'a, W>(
+    name: Option<&str>,
+    found: Result<Option<&'a [W]>, DumpError>,
+) -> Result<&'a [W], DumpError> {
+    match name {
+        None => Ok(&[]),
+        Some(n) => found?.ok_or_else(|| DumpError(format!("missing array {n:?}"))),
     }
 }

@@ -48,50 +48,88 @@ impl Dump {
         let (words32, words64) = scheme.with_scheme(viewport, Record { view })?;
         let pixels = viewport.pixels() as u64;
         let mut arrays = BTreeMap::new();
-        let names = scheme.names();
-        if let Some(name) = names.words32 {
-            arrays.insert(name.to_string(), Words::U32(words32));
-        }
-        if let Some(name) = names.words64 {
-            arrays.insert(name.to_string(), Words::U64(words64));
-        }
+        let mut shapes: BTreeMap<&str, Vec<u64>> = BTreeMap::new();
         let (mut k, mut capacity, mut sorted) = (None, None, false);
+        let (mut pool, mut layers) = (None, None);
         // fragsim's memory starts at the layout's initial words: the A-buffer's slots empty.
         let filled = scheme.layout() == DumpLayout::CountersAndSlots;
-        let slots_shape = match scheme {
-            DumpScheme::Mdts { k: n, .. } | DumpScheme::Mdts32 { k: n } => {
-                k = Some(*n);
-                vec![pixels, u64::from(*n)]
-            }
-            DumpScheme::ABufferFixed {
-                capacity: c,
-                sorted: s,
-            } => {
-                (capacity, sorted) = (Some(*c), *s);
-                vec![pixels, u64::from(*c)]
-            }
-            DumpScheme::ABufferExact { counts, sorted: s } => {
-                sorted = *s;
-                let mut offsets = Vec::with_capacity(counts.len() + 1);
-                offsets.push(0u32);
-                for &c in counts {
-                    offsets.push(offsets[offsets.len() - 1] + c);
+        match scheme {
+            DumpScheme::LinkedLists { k: n, pool: p, .. } => {
+                (k, pool) = (Some(*n), Some(u64::from(*p)));
+                // fragsim's u32 words: the heads, the node counter, the `next` of each node.
+                let pixels = viewport.pixels();
+                let (heads, rest) = words32.split_at(pixels);
+                let (counter, next) = rest.split_at(1);
+                for (name, words) in [("heads", heads), ("counter", counter), ("next", next)] {
+                    shapes.insert(name, vec![words.len() as u64]);
+                    arrays.insert(name.to_string(), Words::U32(words.to_vec()));
                 }
-                let total = u64::from(offsets[counts.len()]);
-                arrays.insert("offsets".into(), Words::U32(offsets));
-                vec![total]
+                shapes.insert("nodes", vec![words64.len() as u64]);
+                arrays.insert("nodes".into(), Words::U64(words64));
             }
-        };
+            DumpScheme::LayerMajor { k: n, .. } => {
+                k = Some(*n);
+                shapes.insert("counters", vec![pixels]);
+                shapes.insert("layers", vec![u64::from(*n), pixels]);
+                arrays.insert("counters".into(), Words::U32(words32));
+                arrays.insert("layers".into(), Words::U64(words64));
+            }
+            DumpScheme::Memory {
+                k: n,
+                capacity: c,
+                layers: l,
+                ..
+            } => {
+                (k, capacity, layers) = (Some(*n), Some(*c), Some(*l));
+                shapes.insert("words32", vec![words32.len() as u64]);
+                shapes.insert("words64", vec![words64.len() as u64]);
+                arrays.insert("words32".into(), Words::U32(words32));
+                arrays.insert("words64".into(), Words::U64(words64));
+            }
+            _ => {
+                let names = scheme.names();
+                if let Some(name) = names.words32 {
+                    arrays.insert(name.to_string(), Words::U32(words32));
+                }
+                if let Some(name) = names.words64 {
+                    arrays.insert(name.to_string(), Words::U64(words64));
+                }
+                let slots_shape = match scheme {
+                    DumpScheme::ABufferFixed {
+                        capacity: c,
+                        sorted: s,
+                    } => {
+                        (capacity, sorted) = (Some(*c), *s);
+                        vec![pixels, u64::from(*c)]
+                    }
+                    DumpScheme::ABufferExact { counts, sorted: s } => {
+                        sorted = *s;
+                        let mut offsets = Vec::with_capacity(counts.len() + 1);
+                        offsets.push(0u32);
+                        for &c in counts {
+                            offsets.push(offsets[offsets.len() - 1] + c);
+                        }
+                        let total = u64::from(offsets[counts.len()]);
+                        arrays.insert("offsets".into(), Words::U32(offsets));
+                        vec![total]
+                    }
+                    // The slot layouts: MDTS on either word.
+                    DumpScheme::Mdts { k: n, .. } | DumpScheme::Mdts32 { k: n } => {
+                        k = Some(*n);
+                        vec![pixels, u64::from(*n)]
+                    }
+                    DumpScheme::LinkedLists { .. }
+                    | DumpScheme::LayerMajor { .. }
+                    | DumpScheme::Memory { .. } => Vec::new(),
+                };
+                shapes.insert("slots", slots_shape);
+                shapes.insert("counters", vec![pixels]);
+                shapes.insert("offsets", vec![pixels + 1]);
+            }
+        }
         if sorted {
             sort_abuffer_in_place(&mut arrays, scheme);
         }
-        let shapes: BTreeMap<&str, Vec<u64>> = [
-            ("slots", slots_shape),
-            ("counters", vec![pixels]),
-            ("offsets", vec![pixels + 1]),
-        ]
-        .into_iter()
-        .collect();
         let specs = arrays
             .iter()
             .map(|(name, words)| {
@@ -120,6 +158,9 @@ impl Dump {
                 capacity,
                 sorted,
                 filled,
+                pool,
+                layers,
+                layout: scheme.spec(),
                 word: scheme.word().into(),
                 arrays: specs,
                 extra: serde_json::Value::Null,

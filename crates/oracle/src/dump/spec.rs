@@ -1,0 +1,219 @@
+//! The layout description a dump header carries (`"layout"`, `docs/dump-format.md`): how the
+//! arrays of a linked-list, layer-major or memory dump hold the scheme's memory, and how a
+//! payload word packs a fragment's depth and primitive id.
+//!
+//! The description is what lets a dump carry the engine's own buffers rather than fragsim's: a
+//! linked list may end at `0xFFFFFFFF` and number its nodes from 0 (Vulkan-Samples) or end at 0
+//! and number them from 1 (nvpro-samples, fragsim); a node may hold a u32 word of a unorm24
+//! depth above an 8-bit primitive id. The reader converts each payload word to fragsim's
+//! fragment word (`depth_key << 32 | prim`, [`Payload::fragment`]) and each node number to
+//! fragsim's before the scheme's own resolve runs. A header without the description (a dump
+//! written before it existed, or one of the slot and A-buffer layouts) has the layout its
+//! `scheme` names, with fragsim's own encoding ([`Payload::FRAGMENT`]).
+
+use serde::{Deserialize, Serialize};
+
+use super::{err, Dtype, DumpError};
+
+/// How a payload word stores the depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DepthFormat {
+    /// The 32 bits of the f32 depth (`floatBitsToUint(gl_FragCoord.z)`): fragsim's depth key.
+    F32,
+    /// A 24-bit unsigned normalised depth (`uint(z * 16777215.0)`, a D24 depth buffer's).
+    Unorm24,
+    /// A 16-bit unsigned normalised depth (`uint(z * 65535.0)`, a D16 depth buffer's).
+    Unorm16,
+}
+
+impl DepthFormat {
+    /// The field's width in bits.
+    #[must_use]
+    pub fn bits(self) -> u32 {
+        match self {
+            Self::F32 => 32,
+            Self::Unorm24 => 24,
+            Self::Unorm16 => 16,
+        }
+    }
+}
+
+/// Where a payload word keeps the depth and the primitive id: the depth field of
+/// [`DepthFormat::bits`] bits starts at bit `depth_shift`, the primitive id is the low
+/// `prim_bits` bits (below the depth, so that words sort by depth first).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Payload {
+    /// The word's type.
+    pub dtype: Dtype,
+    /// How the depth is stored.
+    pub depth: DepthFormat,
+    /// The depth field's lowest bit.
+    pub depth_shift: u32,
+    /// Bits of primitive id at the bottom of the word (1 to 32).
+    pub prim_bits: u32,
+}
+
+/// The largest depth key of a fragment: depth 1.0 (fragments outside `[0, 1]` are dropped, and
+/// `-0.0` is stored as `+0.0`), so a stored key above it is no fragment's.
+pub(super) const LARGEST_KEY: u32 = 0x3F80_0000;
+
+impl Payload {
+    /// fragsim's own fragment word: u64 `depth_key << 32 | prim`.
+    pub const FRAGMENT: Payload = Payload {
+        dtype: Dtype::U64,
+        depth: DepthFormat::F32,
+        depth_shift: 32,
+        prim_bits: 32,
+    };
+
+    /// Refuses fields that overlap or do not fit the word.
+    ///
+    /// # Errors
+    /// A primitive id of no bits or more than 32, above the depth field, or a depth field past
+    /// the word's top bit.
+    pub fn check(&self) -> Result<(), DumpError> {
+        let word_bits = match self.dtype {
+            Dtype::U32 => 32,
+            Dtype::U64 => 64,
+        };
+        if self.prim_bits == 0 || self.prim_bits > 32 {
+            return err(format!(
+                "payload \"prim_bits\" {} must be 1 to 32: fragments are told apart by their \
+                 primitive id",
+                self.prim_bits
+            ));
+        }
+        if self.prim_bits > self.depth_shift {
+            return err(format!(
+                "payload: the primitive id's {} bits overlap the depth field at bit {}",
+                self.prim_bits, self.depth_shift
+            ));
+        }
+        if u64::from(self.depth_shift) + u64::from(self.depth.bits()) > word_bits {
+            return err(format!(
+                "payload: a {:?} depth at bit {} does not fit a {word_bits}-bit word",
+                self.depth, self.depth_shift
+            ));
+        }
+        Ok(())
+    }
+
+    /// The fragment word (`depth_key << 32 | prim`) a payload word holds, and whether its depth
+    /// key is one a fragment can have (at most 1.0's). Needs a [`Payload::check`]ed payload.
+    #[must_use]
+    pub fn fragment(&self, word: u64) -> (u64, bool) {
+        let field = (word >> self.depth_shift) & mask(self.depth.bits());
+        let key = match self.depth {
+            DepthFormat::F32 => field as u32,
+            // The nearest f32 to the normalised value: what the GPU's depth was rounded from.
+            DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
+                ((field as f64 / mask(self.depth.bits()) as f64) as f32).to_bits()
+            }
+        };
+        let prim = word & mask(self.prim_bits);
+        ((u64::from(key) << 32) | prim, key <= LARGEST_KEY)
+    }
+}
+
+fn mask(bits: u32) -> u64 {
+    if bits >= 64 {
+        u64::MAX
+    } else {
+        (1 << bits) - 1
+    }
+}
+
+/// A header's `"layout"`: how its arrays hold the scheme's memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum LayoutSpec {
+    /// Per-pixel linked lists: `heads` `[pixels]` u32, `next` `[pool]` u32, `nodes` `[pool]`
+    /// payload words, `counter` `[1]` u32 (nodes handed out, which may pass the pool). Node
+    /// number `n` is array index `n − node_base`; `null` ends a list.
+    LinkedList {
+        /// The node payload.
+        payload: Payload,
+        /// The terminator (`0` for fragsim and nvpro-samples, `4294967295` for Vulkan-Samples).
+        null: u32,
+        /// The first node's number (`1` for fragsim and nvpro-samples, `0` for Vulkan-Samples).
+        node_base: u32,
+    },
+    /// Layer-major layers (Bevy's): `counters` `[pixels]` u32, `layers` `[k, pixels]` payload
+    /// words, layer `l` of pixel `p` at `l * pixels + p`.
+    LayerMajor {
+        /// The layer payload.
+        payload: Payload,
+    },
+    /// The scheme's own memory after its last pass: `words32` and `words64`, in the order its
+    /// module documents.
+    Memory,
+}
+
+impl LayoutSpec {
+    /// fragsim's own linked lists: node 0 ends a list, nodes numbered from 1.
+    pub const FRAGSIM_LISTS: LayoutSpec = LayoutSpec::LinkedList {
+        payload: Payload::FRAGMENT,
+        null: 0,
+        node_base: 1,
+    };
+
+    /// fragsim's own layer-major layers.
+    pub const FRAGSIM_LAYERS: LayoutSpec = LayoutSpec::LayerMajor {
+        payload: Payload::FRAGMENT,
+    };
+
+    /// The `kind` field, for messages.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::LinkedList { .. } => "linked-list",
+            Self::LayerMajor { .. } => "layer-major",
+            Self::Memory => "memory",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unorm_depths_decode_to_the_nearest_f32_of_their_value() {
+        let unorm24 = Payload {
+            dtype: Dtype::U32,
+            depth: DepthFormat::Unorm24,
+            depth_shift: 8,
+            prim_bits: 8,
+        };
+        unorm24.check().unwrap();
+        let (word, possible) = unorm24.fragment(0xFF_FFFF << 8 | 0x2A);
+        assert_eq!(word, u64::from(1.0f32.to_bits()) << 32 | 0x2A);
+        assert!(possible);
+        let half = unorm24.fragment(0x80_0000 << 8).0;
+        assert_eq!(
+            (half >> 32) as u32,
+            ((8_388_608.0 / 16_777_215.0) as f32).to_bits()
+        );
+    }
+
+    #[test]
+    fn f32_keys_above_one_are_flagged_and_bad_packings_refused() {
+        let (_, possible) = Payload::FRAGMENT.fragment(u64::from(LARGEST_KEY + 1) << 32);
+        assert!(!possible);
+        let overlap = Payload {
+            prim_bits: 33,
+            ..Payload::FRAGMENT
+        };
+        assert!(overlap.check().is_err());
+        let past = Payload {
+            dtype: Dtype::U32,
+            ..Payload::FRAGMENT
+        };
+        assert!(past
+            .check()
+            .unwrap_err()
+            .0
+            .contains("does not fit a 32-bit word"));
+    }
+}
