@@ -276,3 +276,37 @@ fn a_dump_that_travelled_finds_its_mesh_with_compare_mesh() {
     let text = run(&mut compare(Some(&other)), 2);
     assert!(text.contains("hash"), "{text}");
 }
+
+#[test]
+fn render_dumps_under_the_conventions_it_is_given_and_compare_agrees() {
+    let dir = scratch("render-gl");
+    let gl = [
+        "--window-origin",
+        "lower-left",
+        "--subpixel-bits",
+        "4",
+        "--depth-range",
+        "minus-one-to-one",
+        "--vertex-precision",
+        "f32",
+    ];
+    run(
+        fragsim()
+            .args(["render", "--scene", "spheres:3", "--scheme", "mdts"])
+            .args(["--width", "40", "--height", "28"])
+            .args(gl)
+            .args(["--no-images", "--dump"])
+            .arg(&dir),
+        0,
+    );
+    let dump = Dump::read(&dir.join("mdts")).unwrap();
+    assert_eq!(dump.header.scene.conventions, GL_F32);
+    let text = run(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join("mdts"))
+            .arg("--no-image"),
+        0,
+    );
+    assert!(text.contains("EQUAL"), "{text}");
+}

@@ -163,7 +163,7 @@ impl SceneAndCamera {
                 if let Some(expected) = &self.mesh_hash {
                     let bytes = std::fs::read(&path).map_err(|e| io_err("read mesh", &path, e))?;
                     let found = mesh_hash(&bytes);
-                    if &found != expected {
+                    if found != *expected {
                         return err(format!(
                             "mesh {}: its bytes hash to {found}, the scene names {expected}: \
                              a different file (pass --mesh PATH to name the one it was made of)",
@@ -228,9 +228,10 @@ impl SceneAndCamera {
                 ));
             }
         }
-        self.view_projection
-            .as_ref()
-            .map_or(Ok(()), |m| engine_matrix(m).map(drop))
+        if let Some(matrix) = &self.view_projection {
+            engine_matrix(matrix)?;
+        }
+        Ok(())
     }
 
     /// A short description for reports.

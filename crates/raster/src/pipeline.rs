@@ -19,6 +19,11 @@
 //! 7. Depth is interpolated linearly in screen space from the exact integer barycentrics, in f64,
 //!    rounded once to f32; depths outside `[0, 1]` are dropped.
 //!
+//! These are the rules under [`Conventions::REFERENCE`]; [`View::with_conventions`] varies them
+//! as `docs/semantics.md` §9 says: the arithmetic of rules 1 and 4 (f32), the near plane of rules
+//! 2–3 and the window depth (`[−1, 1]`), the snapping grid of rule 4 (subpixel bits), and the
+//! window's y direction with the owner of rule 6's shared edges (lower-left origin).
+//!
 //! The stages live in submodules: `vertex` (rules 1–4: transform, outcodes, clipping, snapping),
 //! `scan` (rules 6–7: bounding box, edge functions, depth) and `viewport` (the render target and
 //! pixel rectangles); this file holds the view that ties them together and rule 5 (facing).
