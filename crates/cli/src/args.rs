@@ -5,7 +5,11 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
-use fragsim_raster::{OrbitCamera, Scene, View, Viewport, DEFAULT_SCENE_NAME};
+use fragsim_raster::conventions::MAX_SUBPIXEL_BITS;
+use fragsim_raster::{
+    Conventions, DepthRange, OrbitCamera, Scene, VertexPrecision, View, Viewport, WindowOrigin,
+    DEFAULT_SCENE_NAME,
+};
 
 pub use fragsim_capture::catalog::Count;
 use fragsim_capture::catalog::Sizing;
@@ -67,6 +71,44 @@ impl SceneArgs {
             ..OrbitCamera::default()
         }
     }
+}
+
+/// The rasterization conventions of the view (`docs/semantics.md` §9); the defaults are
+/// fragsim's reference.
+#[derive(Debug, Clone, Args)]
+pub struct ConventionsArgs {
+    /// Window origin: `upper-left` (D3D, Vulkan, WebGPU) or `lower-left` (OpenGL), which moves
+    /// the fill rule's owner of a shared horizontal edge.
+    #[arg(long, value_name = "ORIGIN", default_value = "upper-left", value_parser = kebab::<WindowOrigin>)]
+    pub window_origin: WindowOrigin,
+    /// Fractional bits of the snapped vertex grid (8, or 4 as older hardware).
+    #[arg(long, value_name = "BITS", default_value_t = MAX_SUBPIXEL_BITS, allow_negative_numbers = true,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SUBPIXEL_BITS)))]
+    pub subpixel_bits: u32,
+    /// Clip-space depth range: `zero-to-one` (D3D, Vulkan) or `minus-one-to-one` (OpenGL).
+    #[arg(long, value_name = "RANGE", default_value = "zero-to-one", value_parser = kebab::<DepthRange>)]
+    pub depth_range: DepthRange,
+    /// Vertex-stage arithmetic: `f64` (fragsim's reference) or `f32` (as a vertex shader).
+    #[arg(long, value_name = "PRECISION", default_value = "f64", value_parser = kebab::<VertexPrecision>)]
+    pub vertex_precision: VertexPrecision,
+}
+
+impl ConventionsArgs {
+    /// The conventions chosen.
+    #[must_use]
+    pub fn conventions(&self) -> Conventions {
+        Conventions {
+            window_origin: self.window_origin,
+            subpixel_bits: self.subpixel_bits,
+            depth_range: self.depth_range,
+            vertex_precision: self.vertex_precision,
+        }
+    }
+}
+
+/// A conventions value by its kebab-case name, as a dump header spells it.
+fn kebab<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, String> {
+    serde_json::from_value(serde_json::Value::String(text.into())).map_err(|e| e.to_string())
 }
 
 /// Says on stderr when `view` of `scene` covers no pixel: the command still runs (and exits 0

@@ -48,6 +48,10 @@ pub struct CompareArgs {
     /// Write no difference image.
     #[arg(long, conflicts_with = "image")]
     pub no_image: bool,
+    /// The mesh file to rebuild the oracle from instead of the one the dump names (a dump that
+    /// travelled); its bytes must still hash as the dump says.
+    #[arg(long, value_name = "PATH")]
+    pub mesh: Option<PathBuf>,
 }
 
 /// One side of a comparison.
@@ -185,7 +189,7 @@ struct Report {
 pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     let reference = Side::open(&args.reference)?;
     let candidate = Side::open(&args.candidate)?;
-    let (header, beside) = match (&reference, &candidate) {
+    let (mut header, beside) = match (&reference, &candidate) {
         (Side::Dump(dump, path), _) | (Side::Oracle, Side::Dump(dump, path)) => {
             (dump.header.clone(), dump_dir(path))
         }
@@ -193,6 +197,9 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             return Err("compare needs at least one dump: both sides are `oracle`".into())
         }
     };
+    if let Some(mesh) = &args.mesh {
+        (header.scene.mesh, header.scene.name) = (Some(mesh.display().to_string()), None);
+    }
     let mut notes = Vec::new();
     if let (Some(a), Some(b)) = (reference.header(), candidate.header()) {
         if (a.width, a.height) != (b.width, b.height) {
@@ -217,8 +224,9 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             .load(Some(&beside))
             .map_err(|e| e.to_string())?;
         let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
-        let view = scene
-            .view(viewport, &header.scene.orbit())
+        let view = header
+            .scene
+            .view(&scene, viewport)
             .map_err(|e| e.to_string())?;
         Some(Oracle::build(&view))
     } else {

@@ -23,11 +23,17 @@ pub struct ExportArgs {
     pub out: PathBuf,
 }
 
-/// The scene description a dump or an export carries.
-fn scene_spec(args: &SceneArgs) -> SceneAndCamera {
+/// The scene description a dump or an export carries (a mesh file with the hash of its bytes).
+fn scene_spec(args: &SceneArgs) -> Result<SceneAndCamera, String> {
     match &args.mesh {
-        Some(path) => SceneAndCamera::mesh(path, args.view, args.elevation),
-        None => SceneAndCamera::named(&args.scene, args.view, args.elevation),
+        Some(path) => {
+            SceneAndCamera::hashed_mesh(path, args.view, args.elevation).map_err(|e| e.to_string())
+        }
+        None => Ok(SceneAndCamera::named(
+            &args.scene,
+            args.view,
+            args.elevation,
+        )),
     }
 }
 
@@ -36,7 +42,7 @@ fn scene_spec(args: &SceneArgs) -> SceneAndCamera {
 /// # Errors
 /// A scene that cannot be loaded, a bad viewport, a file that cannot be written.
 pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
-    let spec = scene_spec(&args.scene);
+    let spec = scene_spec(&args.scene)?;
     let scene = args.scene.scene()?;
     let view = scene
         .view(args.scene.viewport()?, &spec.orbit())
@@ -106,8 +112,11 @@ impl DumpStage {
             }
         };
         let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-        let dump =
-            Dump::record(view, scene_spec(scene), &scheme, &producer).map_err(|e| e.to_string())?;
+        let spec = SceneAndCamera {
+            conventions: view.conventions(),
+            ..scene_spec(scene)?
+        };
+        let dump = Dump::record(view, spec, &scheme, &producer).map_err(|e| e.to_string())?;
         dump.write(&self.staging.join(name.name()))
             .map_err(|e| e.to_string())?;
         self.written.push(name.name());

@@ -9,7 +9,7 @@ use fragsim_raster::{depth_from_key, Viewport};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use crate::args::{SceneArgs, SchemeArgs};
+use crate::args::{ConventionsArgs, SceneArgs, SchemeArgs};
 use crate::schemes::{check_memory_cap_early, Executors, Fault, SchemeChoice};
 
 /// Options of `fragsim render`.
@@ -18,6 +18,9 @@ pub struct RenderArgs {
     /// The scene.
     #[command(flatten)]
     pub scene: SceneArgs,
+    /// The rasterization conventions (a dump records them).
+    #[command(flatten)]
+    pub conventions: ConventionsArgs,
     /// Scheme sizing and executors.
     #[command(flatten)]
     pub schemes: SchemeArgs,
@@ -133,8 +136,11 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let pool = args.schemes.pool()?;
     let scene = args.scene.scene()?;
     let viewport = args.scene.viewport()?;
+    let conventions = args.conventions.conventions();
+    let orbit = args.scene.orbit(args.scene.view);
+    let camera = scene.orbit_camera(viewport, &orbit, conventions.depth_range);
     let view = scene
-        .view(viewport, &args.scene.orbit(args.scene.view))
+        .view_under(viewport, &camera, conventions)
         .map_err(|e| e.to_string())?;
     crate::args::warn_if_empty(&scene, &view);
     let schemes = SchemeChoice::expand(&args.scheme);

@@ -1,12 +1,34 @@
-//! The orbit camera: one angle sweeps the view around a model.
+//! The camera: a view-projection matrix, an engine's own or one the orbit camera (one angle
+//! sweeps the view around a model) derives from the model's bounds.
 
 use glam::{DMat4, DVec3};
 
-/// A view-projection matrix in f64 with D3D/Vulkan clip conventions (depth in `[0, 1]`).
+use crate::conventions::DepthRange;
+
+/// A view-projection matrix in f64: model space to clip space, for the clip-space depth range
+/// the view's conventions declare (`[0, 1]` unless they say otherwise).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Model space to clip space.
     pub view_projection: DMat4,
+}
+
+impl Camera {
+    /// The camera of a matrix given row by row (`m[row * 4 + column]`, `clip = M · (x, y, z, 1)`),
+    /// as an engine's uniform is written down: the bits of every entry are kept.
+    #[must_use]
+    pub fn from_row_major(m: [f64; 16]) -> Self {
+        // glam stores columns: the row-major array read as columns is the transpose.
+        Self {
+            view_projection: DMat4::from_cols_array(&m).transpose(),
+        }
+    }
+
+    /// The matrix row by row, the inverse of [`Camera::from_row_major`].
+    #[must_use]
+    pub fn row_major(&self) -> [f64; 16] {
+        self.view_projection.transpose().to_cols_array()
+    }
 }
 
 /// An eye on a circle around the model's bounding sphere, looking at its centre.
@@ -50,8 +72,28 @@ impl OrbitCamera {
     /// The camera for a model with the given bounds and a viewport aspect ratio (width / height).
     #[must_use]
     pub fn camera(&self, bounds: ([f64; 3], [f64; 3]), aspect: f64) -> Camera {
+        self.camera_for(bounds, aspect, DepthRange::ZeroToOne)
+    }
+
+    /// [`OrbitCamera::camera`] with the projection an engine of `depth_range` builds: D3D's
+    /// `perspective_rh` for `[0, 1]`, OpenGL's `perspective_rh_gl` (`gluPerspective`) for
+    /// `[−1, 1]`. Both map the same eye-space point to the same window depth in exact arithmetic.
+    #[must_use]
+    pub fn camera_for(
+        &self,
+        bounds: ([f64; 3], [f64; 3]),
+        aspect: f64,
+        depth_range: DepthRange,
+    ) -> Camera {
         let frame = self.frame(bounds, aspect);
-        let projection = DMat4::perspective_rh(frame.fov_y, aspect, frame.near, frame.far);
+        let projection = match depth_range {
+            DepthRange::ZeroToOne => {
+                DMat4::perspective_rh(frame.fov_y, aspect, frame.near, frame.far)
+            }
+            DepthRange::MinusOneToOne => {
+                DMat4::perspective_rh_gl(frame.fov_y, aspect, frame.near, frame.far)
+            }
+        };
         Camera {
             view_projection: projection * frame.view,
         }
@@ -108,6 +150,30 @@ struct Frame {
 mod tests {
     use super::*;
     use glam::DVec4;
+
+    #[test]
+    fn a_row_major_matrix_keeps_its_rows_and_bits() {
+        let m: [f64; 16] = std::array::from_fn(|i| 0.1 * i as f64 - 0.7);
+        let camera = Camera::from_row_major(m);
+        // Row 1 times (x, y, z, 1) is clip y.
+        let clip = camera.view_projection * DVec4::new(2.0, 3.0, 5.0, 1.0);
+        assert_eq!(clip.y, m[4] * 2.0 + m[5] * 3.0 + m[6] * 5.0 + m[7]);
+        assert_eq!(camera.row_major().map(f64::to_bits), m.map(f64::to_bits));
+    }
+
+    #[test]
+    fn the_gl_orbit_gives_the_same_window_depth() {
+        let bounds = ([-1.0, -2.0, -0.5], [1.0, 2.0, 0.5]);
+        let orbit = OrbitCamera::default().at_angle(25.0);
+        let d3d = orbit.camera_for(bounds, 1.0, DepthRange::ZeroToOne);
+        let gl = orbit.camera_for(bounds, 1.0, DepthRange::MinusOneToOne);
+        assert_ne!(d3d, gl);
+        for p in [[0.0, 0.0, 0.0], [0.9, 1.9, 0.4]] {
+            let v = DVec4::new(p[0], p[1], p[2], 1.0);
+            let (a, b) = (d3d.view_projection * v, gl.view_projection * v);
+            assert!((a.z / a.w - (b.z / b.w * 0.5 + 0.5)).abs() < 1e-12);
+        }
+    }
 
     #[test]
     fn eye_distance_inverts_the_projection() {

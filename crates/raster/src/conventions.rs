@@ -6,10 +6,19 @@
 //! vertices transformed in f64. An engine's capture names its own point (an OpenGL engine: lower-left
 //! origin and depth in `[−1, 1]`; any vertex shader: f32), and the oracle is rebuilt under it, so
 //! that a conforming implementation and the oracle disagree only where precision allows
-//! (`docs/semantics.md`, "Conventions").
+//! (`docs/semantics.md`, "Conventions", gives each rule and the specification it comes from).
+//!
+//! [`View::with_conventions`](crate::View::with_conventions) rasterizes under any of them;
+//! [`View::new`](crate::View::new) keeps [`Conventions::REFERENCE`], bit for bit the pipeline
+//! fragsim had before conventions existed. In JSON (a dump header's `scene.conventions`) each
+//! field is optional and defaults to the reference's, the enums are spelled in kebab case
+//! (`"lower-left"`, `"minus-one-to-one"`, `"f32"`) and an unknown field is refused.
+
+use serde::{Deserialize, Serialize};
 
 /// Where window row 0 lies, which decides which edge the fill rule gives a shared pixel centre.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum WindowOrigin {
     /// Row 0 at the top, y grows downwards (D3D, Vulkan, WebGPU, Metal): fragsim's pixel order.
     #[default]
@@ -19,7 +28,8 @@ pub enum WindowOrigin {
 }
 
 /// The clip-space depth range that maps to window depth `[0, 1]`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum DepthRange {
     /// `0 ≤ z ≤ w`, window depth `z / w` (D3D, Vulkan, WebGPU, Metal).
     #[default]
@@ -29,7 +39,8 @@ pub enum DepthRange {
 }
 
 /// The arithmetic of the vertex stage (transform, perspective divide, viewport mapping).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum VertexPrecision {
     /// f64 throughout: fragsim's reference, exact enough that snapping decides alone.
     #[default]
@@ -40,7 +51,8 @@ pub enum VertexPrecision {
 }
 
 /// The conventions under which a scene was rasterized.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Conventions {
     /// Where row 0 lies.
     pub window_origin: WindowOrigin,
@@ -64,6 +76,12 @@ impl Conventions {
         depth_range: DepthRange::ZeroToOne,
         vertex_precision: VertexPrecision::F64,
     };
+
+    /// Whether these are the reference conventions (a header then leaves them out).
+    #[must_use]
+    pub fn is_reference(&self) -> bool {
+        *self == Self::REFERENCE
+    }
 
     /// Refuses conventions fragsim cannot rasterize under.
     ///

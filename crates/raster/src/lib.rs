@@ -2,7 +2,8 @@
 //! into a deterministic stream of [`Fragment`]s.
 //!
 //! Every rule a GPU backend must match bit for bit is written down in `docs/semantics.md` and
-//! implemented here once: f64 vertex transform, homogeneous near-plane and guard-band clipping,
+//! implemented here once, under fragsim's reference [`Conventions`] (and, with
+//! [`View::with_conventions`], under an implementation's declared ones): f64 vertex transform, homogeneous near-plane and guard-band clipping,
 //! snapping to 8 fractional bits, exact integer edge functions with the top-left fill rule, depth
 //! interpolated in f64 from the integer barycentrics and rounded once to f32, and the
 //! order-preserving depth key.
@@ -29,7 +30,7 @@ mod rng;
 mod scenes;
 
 pub use camera::{Camera, OrbitCamera};
-pub use conventions::Conventions;
+pub use conventions::{Conventions, DepthRange, VertexPrecision, WindowOrigin};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError};
 pub use pipeline::{

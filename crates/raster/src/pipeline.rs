@@ -19,6 +19,11 @@
 //! 7. Depth is interpolated linearly in screen space from the exact integer barycentrics, in f64,
 //!    rounded once to f32; depths outside `[0, 1]` are dropped.
 //!
+//! These are the rules under [`Conventions::REFERENCE`]; [`View::with_conventions`] varies them
+//! as `docs/semantics.md` §9 says: the arithmetic of rules 1 and 4 (f32), the near plane of rules
+//! 2–3 and the window depth (`[−1, 1]`), the snapping grid of rule 4 (subpixel bits), and the
+//! window's y direction with the owner of rule 6's shared edges (lower-left origin).
+//!
 //! The stages live in submodules: `vertex` (rules 1–4: transform, outcodes, clipping, snapping),
 //! `scan` (rules 6–7: bounding box, edge functions, depth) and `viewport` (the render target and
 //! pixel rectangles); this file holds the view that ties them together and rule 5 (facing).
@@ -26,9 +31,12 @@
 use glam::{DMat4, DVec4};
 
 use crate::camera::Camera;
+use crate::conventions::Conventions;
 use crate::fragment::Fragment;
 use crate::mesh::Mesh;
 
+#[cfg(test)]
+mod conventions_tests;
 mod scan;
 #[cfg(test)]
 mod tests;
@@ -36,7 +44,7 @@ mod vertex;
 mod viewport;
 
 use scan::{bounding_box, edge};
-use vertex::{in_front, snap, transform};
+use vertex::in_front;
 pub use viewport::{PixelRect, Viewport};
 
 /// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
@@ -94,6 +102,7 @@ pub struct View<'mesh> {
     viewport: Viewport,
     cull: CullMode,
     guard: [f64; 2],
+    conventions: Conventions,
 }
 
 /// A snapped window position (1/256 pixel, y down) and the window depth `z / w`.
@@ -111,9 +120,36 @@ const NOT_IN_FRONT_BIT: u8 = 1 << 6;
 const VERTICES_PER_TASK: usize = 4096;
 
 impl<'mesh> View<'mesh> {
-    /// Transforms every vertex of `mesh` once.
+    /// Transforms every vertex of `mesh` once, under fragsim's reference conventions
+    /// ([`Conventions::REFERENCE`]).
     #[must_use]
     pub fn new(mesh: &'mesh Mesh, camera: &Camera, viewport: Viewport, cull: CullMode) -> Self {
+        Self::build(mesh, camera, viewport, cull, Conventions::REFERENCE)
+    }
+
+    /// Transforms every vertex of `mesh` once under `conventions` (`docs/semantics.md`,
+    /// "Conventions"): what an implementation that declares them rasterizes.
+    ///
+    /// # Errors
+    /// Conventions fragsim cannot rasterize under ([`Conventions::check`]).
+    pub fn with_conventions(
+        mesh: &'mesh Mesh,
+        camera: &Camera,
+        viewport: Viewport,
+        cull: CullMode,
+        conventions: Conventions,
+    ) -> Result<Self, String> {
+        conventions.check()?;
+        Ok(Self::build(mesh, camera, viewport, cull, conventions))
+    }
+
+    fn build(
+        mesh: &'mesh Mesh,
+        camera: &Camera,
+        viewport: Viewport,
+        cull: CullMode,
+        conventions: Conventions,
+    ) -> Self {
         let guard = [
             1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.width),
             1.0 + 2.0 * GUARD_BAND_PIXELS / f64::from(viewport.height),
@@ -127,6 +163,7 @@ impl<'mesh> View<'mesh> {
             viewport,
             cull,
             guard,
+            conventions,
         };
         view.set_camera(camera);
         view
@@ -140,7 +177,13 @@ impl<'mesh> View<'mesh> {
 
     /// The clip-space position of vertex `index`, exactly as the vertex stage computed it.
     fn clip_position(&self, index: u32) -> DVec4 {
-        transform(self.view_projection, self.mesh.positions[index as usize])
+        self.stage().clip(self.mesh.positions[index as usize])
+    }
+
+    /// The conventions this view rasterizes under.
+    #[must_use]
+    pub fn conventions(&self) -> Conventions {
+        self.conventions
     }
 
     /// The viewport.
@@ -241,12 +284,13 @@ impl<'mesh> View<'mesh> {
         if polygon.len() < 3 {
             return;
         }
+        let stage = self.stage();
         for i in 1..polygon.len() - 1 {
             let piece = [polygon[0], polygon[i], polygon[i + 1]];
             if piece.iter().any(|v| !in_front(*v)) {
                 continue;
             }
-            self.orient(prim, piece.map(|v| snap(self.viewport, v)), visit);
+            self.orient(prim, piece.map(|v| stage.snap(v)), visit);
         }
     }
 

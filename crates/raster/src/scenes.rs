@@ -4,7 +4,8 @@ use std::f64::consts::PI;
 use std::io::Read;
 use std::path::Path;
 
-use crate::camera::OrbitCamera;
+use crate::camera::{Camera, OrbitCamera};
+use crate::conventions::{Conventions, DepthRange};
 use crate::mesh::{is_ply, read_mesh_file, Mesh, MeshError};
 use crate::pipeline::{CullMode, View, Viewport};
 use crate::rng::SplitMix64;
@@ -153,15 +154,45 @@ impl Scene {
     /// # Errors
     /// The scene has no triangles.
     pub fn view(&self, viewport: Viewport, orbit: &OrbitCamera) -> Result<View<'_>, SceneError> {
-        if self.mesh.triangles.is_empty() {
-            return Err(SceneError::BadParameter {
-                name: self.name.clone(),
-                reason: "no triangles".into(),
-            });
-        }
+        self.view_under(
+            viewport,
+            &self.orbit_camera(viewport, orbit, DepthRange::ZeroToOne),
+            Conventions::REFERENCE,
+        )
+    }
+
+    /// The matrix `orbit` gives this scene on `viewport` for `depth_range` (the camera
+    /// [`Scene::view`] uses, for [`DepthRange::ZeroToOne`]).
+    #[must_use]
+    pub fn orbit_camera(
+        &self,
+        viewport: Viewport,
+        orbit: &OrbitCamera,
+        depth_range: DepthRange,
+    ) -> Camera {
         let aspect = f64::from(viewport.width) / f64::from(viewport.height);
-        let camera = orbit.camera(self.mesh.bounds(), aspect);
-        Ok(View::new(&self.mesh, &camera, viewport, CullMode::None))
+        orbit.camera_for(self.mesh.bounds(), aspect, depth_range)
+    }
+
+    /// This scene through any camera on a viewport under `conventions`, all faces kept.
+    ///
+    /// # Errors
+    /// The scene has no triangles, or fragsim cannot rasterize under the conventions.
+    pub fn view_under(
+        &self,
+        viewport: Viewport,
+        camera: &Camera,
+        conventions: Conventions,
+    ) -> Result<View<'_>, SceneError> {
+        let bad = |reason: String| SceneError::BadParameter {
+            name: self.name.clone(),
+            reason,
+        };
+        if self.mesh.triangles.is_empty() {
+            return Err(bad("no triangles".into()));
+        }
+        View::with_conventions(&self.mesh, camera, viewport, CullMode::None, conventions)
+            .map_err(bad)
     }
 
     /// A warning when `view` (of this scene) rasterizes no fragment at all: every triangle lies

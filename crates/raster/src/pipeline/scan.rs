@@ -1,8 +1,10 @@
 //! Rules 6 and 7: the exact scan of a snapped, oriented triangle. Its bounding box gives the pixel
-//! centres to test, the three integer edge functions with the top-left rule decide coverage, and
+//! centres to test, the three integer edge functions with the fill rule of the window origin (top-left,
+//! or bottom-left in fragsim's y-down rows for a lower-left origin) decide coverage, and
 //! the depth is interpolated in f64 from the edge values and rounded once to f32.
 
 use super::{PixelRect, ScreenTriangle, View, HALF, ONE};
+use crate::conventions::WindowOrigin;
 use crate::fragment::{depth_key, Fragment};
 
 impl View<'_> {
@@ -27,7 +29,11 @@ impl View<'_> {
         let [x0, x1, y0, y1] = [x0, x1, y0, y1].map(i64::from);
         // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
         let edges = [(b, c), (c, a), (a, b)];
-        let bias = edges.map(|(p, q)| if is_top_left(p, q) { 0 } else { -1 });
+        let owns = match self.conventions.window_origin {
+            WindowOrigin::UpperLeft => is_top_left,
+            WindowOrigin::LowerLeft => is_bottom_left,
+        };
+        let bias = edges.map(|(p, q)| if owns(p, q) { 0 } else { -1 });
         let step_x = edges.map(|(p, q)| -(q[1] - p[1]) * ONE);
         let step_y = edges.map(|(p, q)| (q[0] - p[0]) * ONE);
         let start = [x0 * ONE + HALF, y0 * ONE + HALF];
@@ -94,4 +100,12 @@ pub(super) fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     dy < 0 || (dy == 0 && dx > 0)
+}
+
+/// The top-left rule of a y-up window (OpenGL's lower-left origin) seen in fragsim's y-down rows:
+/// the window's top edge is fragsim's bottom edge, so a horizontal edge with the interior above
+/// (`dy == 0 && dx < 0`) is owned; left edges stay left (`dy < 0`), x is not flipped.
+fn is_bottom_left(a: [i64; 2], b: [i64; 2]) -> bool {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    dy < 0 || (dy == 0 && dx < 0)
 }

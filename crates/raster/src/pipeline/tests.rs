@@ -2,6 +2,7 @@
 
 use super::vertex::{round_half_away, VertexStage};
 use super::*;
+use crate::conventions::Conventions;
 
 fn view_of(mesh: &Mesh, side: u32) -> View<'_> {
     // Identity projection: model x, y in [-1, 1] map straight to the window, z is depth.
@@ -94,6 +95,8 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
     let stage = VertexStage {
         view_projection: DMat4::IDENTITY,
         planes: view.planes(),
+        viewport: view.viewport(),
+        conventions: Conventions::REFERENCE,
     };
     let by_dot_products = |clip: DVec4| {
         let mut code = stage

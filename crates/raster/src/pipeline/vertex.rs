@@ -1,13 +1,17 @@
-//! Rules 1 to 4: the vertex stage (transform in f64, outcodes), homogeneous clipping against the
-//! near plane and the guard band, and snapping to the fixed-point grid.
+//! Rules 1 to 4: the vertex stage (transform, outcodes), homogeneous clipping against the near
+//! plane and the guard band, and snapping to the fixed-point grid, each under the view's
+//! [`Conventions`] (`docs/semantics.md`, "Conventions"): the arithmetic of the transform, divide
+//! and viewport mapping (f64 or f32), the near plane and window depth of the depth range, the
+//! window's y direction and the snapping grid.
+
+use std::ops::{Add, Div, Mul, Sub};
 
 use glam::{DMat4, DVec4};
 use rayon::prelude::*;
 
-use super::{
-    Snapped, View, Viewport, CLIP_BITS, FAR_BIT, NOT_IN_FRONT_BIT, ONE, VERTICES_PER_TASK,
-};
+use super::{Snapped, View, Viewport, CLIP_BITS, FAR_BIT, NOT_IN_FRONT_BIT, VERTICES_PER_TASK};
 use crate::camera::Camera;
+use crate::conventions::{Conventions, DepthRange, VertexPrecision, WindowOrigin};
 
 impl View<'_> {
     /// Runs the vertex stage again for another camera, reusing this view's buffers (a frame loop
@@ -18,10 +22,7 @@ impl View<'_> {
         self.outcodes.resize(count, 0);
         self.window_xy.resize(count, [0, 0]);
         self.window_z.resize(count, 0.0);
-        let stage = VertexStage {
-            view_projection: self.view_projection,
-            planes: self.planes(),
-        };
+        let stage = self.stage();
         // Every vertex is independent: chunks of the arrays go to the pool side by side.
         self.mesh
             .positions
@@ -35,7 +36,7 @@ impl View<'_> {
                     let clip = stage.clip(*p);
                     *outcode = stage.outcode(clip);
                     if *outcode & CLIP_BITS == 0 {
-                        let ([x, y], depth) = snap(self.viewport, clip);
+                        let ([x, y], depth) = stage.snap(clip);
                         // Inside the guard band: lossless (see `window_xy`).
                         *xy = [x as i32, y as i32];
                         *z = depth;
@@ -66,11 +67,26 @@ impl View<'_> {
         polygon
     }
 
-    /// The clipping planes as `p · v ≥ 0`: near (`z ≥ 0`) then the four guard-band planes.
+    /// The vertex stage of this view's camera, viewport and conventions.
+    pub(super) fn stage(&self) -> VertexStage {
+        VertexStage {
+            view_projection: self.view_projection,
+            planes: self.planes(),
+            viewport: self.viewport,
+            conventions: self.conventions,
+        }
+    }
+
+    /// The clipping planes as `p · v ≥ 0`: near (`z ≥ 0`, or `z ≥ −w` for
+    /// [`DepthRange::MinusOneToOne`]) then the four guard-band planes.
     pub(super) fn planes(&self) -> [DVec4; 5] {
         let [gx, gy] = self.guard;
+        let near_w = match self.conventions.depth_range {
+            DepthRange::ZeroToOne => 0.0,
+            DepthRange::MinusOneToOne => 1.0,
+        };
         [
-            DVec4::new(0.0, 0.0, 1.0, 0.0),
+            DVec4::new(0.0, 0.0, 1.0, near_w),
             DVec4::new(1.0, 0.0, 0.0, gx),
             DVec4::new(-1.0, 0.0, 0.0, gx),
             DVec4::new(0.0, 1.0, 0.0, gy),
@@ -83,11 +99,22 @@ impl View<'_> {
 pub(super) struct VertexStage {
     pub(super) view_projection: DMat4,
     pub(super) planes: [DVec4; 5],
+    pub(super) viewport: Viewport,
+    pub(super) conventions: Conventions,
 }
 
 impl VertexStage {
+    /// Rule 1: model space to clip space in the conventions' precision.
     pub(super) fn clip(&self, position: [f32; 3]) -> DVec4 {
-        transform(self.view_projection, position)
+        match self.conventions.vertex_precision {
+            VertexPrecision::F64 => transform(self.view_projection, position),
+            VertexPrecision::F32 => transform_f32(self.view_projection, position),
+        }
+    }
+
+    /// Rule 4: projects a clip-space vertex to the window and snaps x and y to the grid.
+    pub(super) fn snap(&self, v: DVec4) -> Snapped {
+        snap(self.viewport, self.conventions, v)
     }
 
     /// The outcode of [`View::planes`] and the far plane, each plane written out rather than as a
@@ -95,10 +122,10 @@ impl VertexStage {
     /// finite f32 and the matrix finite f64) the zero terms add only signed zeros, so each sum is
     /// rounded exactly as the dot product's and every comparison decides the same.
     pub(super) fn outcode(&self, clip: DVec4) -> u8 {
-        let [_, right, _, bottom, _] = self.planes;
+        let [near, right, _, bottom, _] = self.planes;
         let (gx, gy) = (right.w, bottom.w);
         let DVec4 { x, y, z, w } = clip;
-        let mut outcode = u8::from(z < 0.0)
+        let mut outcode = u8::from(z + near.w * w < 0.0)
             | u8::from(x + gx * w < 0.0) << 1
             | u8::from(-x + gx * w < 0.0) << 2
             | u8::from(y + gy * w < 0.0) << 3
@@ -118,23 +145,93 @@ pub(super) fn transform(view_projection: DMat4, p: [f32; 3]) -> DVec4 {
     view_projection * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0)
 }
 
+/// Rule 1 as a vertex shader computes `M * vec4(p, 1)` in f32: each matrix entry rounded to f32
+/// once, then every row `((m0·x + m1·y) + m2·z) + m3` with each product and sum rounded to f32 (no
+/// fused multiply-add: Rust never contracts, and `docs/semantics.md` says what a GPU's FMA
+/// changes). The result is exact in f64.
+pub(super) fn transform_f32(view_projection: DMat4, [x, y, z]: [f32; 3]) -> DVec4 {
+    // Column-major: entry (row r, column c) at c * 4 + r.
+    let m = view_projection.to_cols_array().map(|e| e as f32);
+    let row = |r: usize| f64::from(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
+    DVec4::new(row(0), row(1), row(2), row(3))
+}
+
 /// Whether a clip-space vertex has `w > 0` (false for NaN).
 pub(super) fn in_front(clip: DVec4) -> bool {
     clip.w > 0.0
 }
 
-/// Rule 4: projects a clip-space vertex to the window and snaps x and y to the fixed-point grid.
-pub(super) fn snap(viewport: Viewport, v: DVec4) -> Snapped {
-    let (w, h) = (f64::from(viewport.width), f64::from(viewport.height));
-    let x = (v.x / v.w * 0.5 + 0.5) * w;
-    let y = (0.5 - v.y / v.w * 0.5) * h;
-    (
-        [
-            round_half_away(x * ONE as f64),
-            round_half_away(y * ONE as f64),
-        ],
-        v.z / v.w,
-    )
+/// Rule 4: projects a clip-space vertex to the window (divide, viewport mapping and window
+/// depth in the conventions' precision; a clipped f32 vertex is rounded to f32 first) and snaps x
+/// and y to the conventions' grid, expressed in 1/256 pixel with y down whatever the origin.
+pub(super) fn snap(viewport: Viewport, conventions: Conventions, v: DVec4) -> Snapped {
+    let size = [viewport.width, viewport.height];
+    let ([x, y], depth) = match conventions.vertex_precision {
+        VertexPrecision::F64 => window([v.x, v.y, v.z, v.w], size.map(f64::from), conventions),
+        VertexPrecision::F32 => window(
+            v.to_array().map(|c| c as f32),
+            size.map(|s| s as f32),
+            conventions,
+        ),
+    };
+    let grid = |value: f64| {
+        let bits = conventions.subpixel_bits;
+        // Round on the coarser grid, then express the grid point in 1/256 pixel (a multiple of
+        // 2^(8 − bits)), so that the scan is the same for every grid.
+        round_half_away(value * f64::from(1u32 << bits))
+            .saturating_mul(1 << (super::SUBPIXEL_BITS - bits))
+    };
+    let y = match conventions.window_origin {
+        WindowOrigin::UpperLeft => grid(y),
+        // Snapped in the API's own y-up window, then flipped into fragsim's rows: row r of the
+        // window is fragsim's row height − 1 − r, and the flip is exact on the grid.
+        WindowOrigin::LowerLeft => (i64::from(viewport.height) << super::SUBPIXEL_BITS) - grid(y),
+    };
+    ([grid(x), y], depth)
+}
+
+/// The arithmetic the window mapping needs, for f64 and f32 alike.
+trait Real:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    const HALF: Self;
+    fn wide(self) -> f64;
+}
+
+impl Real for f64 {
+    const HALF: Self = 0.5;
+    fn wide(self) -> f64 {
+        self
+    }
+}
+
+impl Real for f32 {
+    const HALF: Self = 0.5;
+    fn wide(self) -> f64 {
+        f64::from(self)
+    }
+}
+
+/// The perspective divide and the viewport mapping in `T`'s arithmetic: window x and y (y in the
+/// API's own direction, down for upper-left, up for lower-left) in pixels and the window depth.
+/// For f64 under the reference conventions these are exactly fragsim's reference expressions.
+fn window<T: Real>(
+    [x, y, z, w]: [T; 4],
+    [width, height]: [T; 2],
+    c: Conventions,
+) -> ([f64; 2], f64) {
+    let half = T::HALF;
+    let window_x = (x / w * half + half) * width;
+    let window_y = match c.window_origin {
+        WindowOrigin::UpperLeft => (half - y / w * half) * height,
+        WindowOrigin::LowerLeft => (y / w * half + half) * height,
+    };
+    let depth = match c.depth_range {
+        DepthRange::ZeroToOne => z / w,
+        // glDepthRange(0, 1): `(f − n)/2 · z_ndc + (n + f)/2`.
+        DepthRange::MinusOneToOne => z / w * half + half,
+    };
+    ([window_x.wide(), window_y.wide()], depth.wide())
 }
 
 /// `value.round() as i64` (half away from zero, saturating, NaN to 0) without a libm call:
