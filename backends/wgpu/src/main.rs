@@ -131,8 +131,18 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         ModeArg::Engine => Mode::Engine,
     };
     let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
+    let mut failed = 0;
     for scheme in &schemes {
-        let captured = capture(&gpu, &fragsim_view, spec.clone(), scheme, mode)?;
+        // One scheme the adapter cannot run (a buffer past its limits, a missing feature) does
+        // not stop the others: it is reported and the command exits 2 at the end.
+        let captured = match capture(&gpu, &fragsim_view, spec.clone(), scheme, mode) {
+            Ok(captured) => captured,
+            Err(e) => {
+                eprintln!("fragsim-wgpu: {e}");
+                failed += 1;
+                continue;
+            }
+        };
         let dir = out.join(scheme.name());
         captured.dump.write(&dir)?;
         let gpu_ms = captured
@@ -155,6 +165,9 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
             }
         }
+    }
+    if failed > 0 {
+        return Err(format!("{failed} of {} schemes could not run", schemes.len()).into());
     }
     Ok(())
 }
