@@ -164,10 +164,15 @@ pub fn capture(
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let run = encode_and_run(gpu, viewport, &geometry, scheme, &storages, mode)?;
     if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(GpuError(format!("{}: the device refused: {e}", scheme.name())));
+        return Err(GpuError(format!(
+            "{}: the device refused: {e}",
+            scheme.name()
+        )));
     }
     let (words, gpu_ms, wall_ms) = run;
-    let dump = to_dump(gpu, view, scene, scheme, mode, &geometry, words, gpu_ms, wall_ms)?;
+    let dump = to_dump(
+        gpu, view, scene, scheme, mode, &geometry, words, gpu_ms, wall_ms,
+    )?;
     Ok(Captured {
         dump,
         gpu_ms,
@@ -384,8 +389,11 @@ fn encode_and_run(
             None => pass.draw(0..3 * geometry.count, 0..1),
         }
     }
-    let mut sources: Vec<(&wgpu::Buffer, u64)> =
-        buffers.iter().zip(storages).map(|(b, s)| (b, s.words * 4)).collect();
+    let mut sources: Vec<(&wgpu::Buffer, u64)> = buffers
+        .iter()
+        .zip(storages)
+        .map(|(b, s)| (b, s.words * 4))
+        .collect();
     if let Some((set, resolve)) = &timestamps {
         encoder.resolve_query_set(set, 0..2, resolve, 0);
         sources.push((resolve, 16));
@@ -426,8 +434,7 @@ fn encode_and_run(
     let gpu_ms = timestamps.as_ref().map(|_| {
         let t = words.pop().unwrap_or_default();
         let ticks = |i: usize| u64::from(t[2 * i]) | (u64::from(t[2 * i + 1]) << 32);
-        ticks(1).saturating_sub(ticks(0)) as f64 * f64::from(gpu.queue.get_timestamp_period())
-            / 1e6
+        ticks(1).saturating_sub(ticks(0)) as f64 * f64::from(gpu.queue.get_timestamp_period()) / 1e6
     });
     Ok((words, gpu_ms, wall_ms))
 }
@@ -463,7 +470,11 @@ fn to_dump(
                 (Dtype::U32, vec![pixels, slots], Words::U32(words))
             }
             Dtype::U32 => (Dtype::U32, vec![pixels], Words::U32(words)),
-            Dtype::U64 => (Dtype::U64, vec![pixels, slots], Words::U64(pairs_to_u64(&words))),
+            Dtype::U64 => (
+                Dtype::U64,
+                vec![pixels, slots],
+                Words::U64(pairs_to_u64(&words)),
+            ),
         };
         let ext = if dtype == Dtype::U32 { "u32" } else { "u64" };
         specs.insert(

@@ -37,8 +37,14 @@ pub struct Gpu {
 /// (engine mode's primitive id; `common.wgsl` enables it).
 pub const WANTED: [(&str, wgpu::Features); 5] = [
     ("SHADER_INT64", wgpu::Features::SHADER_INT64),
-    ("SHADER_INT64_ATOMIC_MIN_MAX", wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
-    ("SHADER_INT64_ATOMIC_ALL_OPS", wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS),
+    (
+        "SHADER_INT64_ATOMIC_MIN_MAX",
+        wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX,
+    ),
+    (
+        "SHADER_INT64_ATOMIC_ALL_OPS",
+        wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS,
+    ),
     ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
     ("PRIMITIVE_INDEX", wgpu::Features::PRIMITIVE_INDEX),
 ];

@@ -19,7 +19,10 @@ use fragsim_raster::Viewport;
 use fragsim_wgpu::{capture, judge, Gpu, GpuScheme, Mode};
 
 #[derive(Parser)]
-#[command(name = "fragsim-wgpu", about = "fragsim's schemes as WGSL fragment shaders on a Vulkan GPU")]
+#[command(
+    name = "fragsim-wgpu",
+    about = "fragsim's schemes as WGSL fragment shaders on a Vulkan GPU"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -82,7 +82,9 @@ impl GpuScheme {
             }
         };
         if scheme.slots() == 0 {
-            return Err(GpuError(format!("{name}: slots per pixel must be at least 1")));
+            return Err(GpuError(format!(
+                "{name}: slots per pixel must be at least 1"
+            )));
         }
         Ok(scheme)
     }

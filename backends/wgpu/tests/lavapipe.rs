@@ -23,7 +23,10 @@ fn gpu() -> Option<Gpu> {
         Err(e) => {
             let required = std::env::var("CI").is_ok_and(|v| v == "true")
                 || std::env::var("FRAGSIM_REQUIRE_GPU").is_ok_and(|v| v == "1");
-            assert!(!required, "a GPU is required (CI=true or FRAGSIM_REQUIRE_GPU=1): {e}");
+            assert!(
+                !required,
+                "a GPU is required (CI=true or FRAGSIM_REQUIRE_GPU=1): {e}"
+            );
             println!("skipped: {e} (set FRAGSIM_REQUIRE_GPU=1 to fail instead)");
             None
         }
@@ -74,7 +77,13 @@ fn replay_coverage_is_fragsims_for_every_scheme() {
 fn engine_mode_coverage_differs_at_most_at_a_thousandth_of_the_covered_pixels() {
     let Some(gpu) = gpu() else { return };
     for scene in SCENES {
-        let (j, oracle) = run(&gpu, scene, 128, GpuScheme::ABuffer { capacity: 32 }, Mode::Engine);
+        let (j, oracle) = run(
+            &gpu,
+            scene,
+            128,
+            GpuScheme::ABuffer { capacity: 32 },
+            Mode::Engine,
+        );
         let covered = oracle.depth_complexity().iter().filter(|&&n| n > 0).count() as u64;
         assert!(covered > 0);
         // Issue 16's bound for ambiguous pixels: an f32 vertex stage moves a few pixel centres
@@ -91,7 +100,13 @@ fn engine_mode_coverage_differs_at_most_at_a_thousandth_of_the_covered_pixels() 
 #[test]
 fn the_kbuffer_race_is_reported_as_it_is() {
     let Some(gpu) = gpu() else { return };
-    let (j, oracle) = run(&gpu, "bunny", 128, GpuScheme::Kbuffer { k: 8 }, Mode::Replay);
+    let (j, oracle) = run(
+        &gpu,
+        "bunny",
+        128,
+        GpuScheme::Kbuffer { k: 8 },
+        Mode::Replay,
+    );
     let d = &j.comparison.diff;
     // Whatever the adapter does: a lost fragment is a missing pixel, and the fragments the
     // dump holds plus those lost cover the K nearest of every pixel.
