@@ -5,7 +5,7 @@
 //!
 //! The parts: the headless device and its adapter report ([`device`]), the shaders and their
 //! buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), one capture in replay or
-//! engine mode ([`capture`]), and the judgement of a capture against fragsim's oracle
+//! engine mode ([`mod@capture`]), and the judgement of a capture against fragsim's oracle
 //! ([`judge`]). The command is `fragsim-wgpu` (`src/main.rs`).
 
 pub mod capture;
