@@ -1,0 +1,143 @@
+//! The headless GPU: a Vulkan adapter found without a surface, the device opened with the
+//! features the scheme shaders use, and a one-paragraph report of what the adapter has.
+//!
+//! Guarantee: [`Gpu::open`] never panics for want of a GPU: no Vulkan driver, no adapter, or an
+//! adapter without `PRIMITIVE_INDEX` is a [`GpuError`] naming the problem. 64-bit atomics and
+//! timestamps are optional: a scheme that needs what the adapter lacks is refused when asked for
+//! ([`Gpu::check`]).
+
+use std::fmt;
+
+/// Why no GPU could be used, or why a scheme cannot run on this one.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GpuError(pub String);
+
+impl fmt::Display for GpuError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for GpuError {}
+
+/// An open device and what its adapter is.
+pub struct Gpu {
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// The adapter's name, driver and type.
+    pub info: wgpu::AdapterInfo,
+    /// The features this device was opened with (those of [`WANTED`] the adapter has).
+    pub features: wgpu::Features,
+}
+
+/// Features the shaders use where the adapter has them, by name: 64-bit integers and their
+/// atomics (MDTS on u64 words), timestamps (GPU timings) and `PRIMITIVE_INDEX`, which is required
+/// (engine mode's primitive id; `common.wgsl` enables it).
+pub const WANTED: [(&str, wgpu::Features); 5] = [
+    ("SHADER_INT64", wgpu::Features::SHADER_INT64),
+    (
+        "SHADER_INT64_ATOMIC_MIN_MAX",
+        wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX,
+    ),
+    (
+        "SHADER_INT64_ATOMIC_ALL_OPS",
+        wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS,
+    ),
+    ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
+    ("PRIMITIVE_INDEX", wgpu::Features::PRIMITIVE_INDEX),
+];
+
+impl Gpu {
+    /// Finds a Vulkan adapter (no surface) and opens it with the adapter's own limits, so that
+    /// large per-pixel buffers fit where the hardware allows.
+    ///
+    /// # Errors
+    /// No Vulkan adapter (the message says what to install), no `PRIMITIVE_INDEX`, or a device
+    /// that would not open.
+    pub fn open() -> Result<Self, GpuError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = wgpu::Backends::VULKAN;
+        let instance = wgpu::Instance::new(desc);
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| {
+            GpuError(format!(
+                "no Vulkan adapter ({e}); install a driver, e.g. `apt-get install -y mesa-vulkan-drivers libvulkan1` for lavapipe"
+            ))
+        })?;
+        let info = adapter.get_info();
+        let wanted = WANTED
+            .iter()
+            .fold(wgpu::Features::empty(), |all, &(_, f)| all | f);
+        let features = adapter.features() & wanted;
+        if !features.contains(wgpu::Features::PRIMITIVE_INDEX) {
+            return Err(GpuError(format!(
+                "adapter {} has no PRIMITIVE_INDEX (the shaders' primitive id)",
+                info.name
+            )));
+        }
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("fragsim-wgpu"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError(format!("adapter {}: cannot open a device: {e}", info.name)))?;
+        Ok(Self {
+            device,
+            queue,
+            info,
+            features,
+        })
+    }
+
+    /// Whether the device has `feature`.
+    #[must_use]
+    pub fn has(&self, feature: wgpu::Features) -> bool {
+        self.features.contains(feature)
+    }
+
+    /// Refuses a shader that needs `needed` on a device without it.
+    ///
+    /// # Errors
+    /// The features missing, by name, with the adapter's name.
+    pub fn check(&self, what: &str, needed: wgpu::Features) -> Result<(), GpuError> {
+        let missing: Vec<&str> = WANTED
+            .iter()
+            .filter(|&&(_, f)| needed.contains(f) && !self.has(f))
+            .map(|&(name, _)| name)
+            .collect();
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(GpuError(format!(
+                "{what} needs {}, which adapter {} does not have",
+                missing.join(" and "),
+                self.info.name
+            )))
+        }
+    }
+
+    /// One line: the adapter, its driver and each wanted feature, present or not.
+    #[must_use]
+    pub fn report(&self) -> String {
+        let flags: Vec<String> = WANTED
+            .iter()
+            .map(|&(name, f)| format!("{name}: {}", if self.has(f) { "yes" } else { "no" }))
+            .collect();
+        format!(
+            "adapter {} ({:?}, driver {} {}); {}",
+            self.info.name,
+            self.info.device_type,
+            self.info.driver,
+            self.info.driver_info,
+            flags.join(", ")
+        )
+    }
+}

@@ -1,0 +1,122 @@
+//! A capture judged against fragsim's oracle: the conformance verdict (`Dump::compare`, every
+//! word read) and, separately, **coverage**: whether the GPU produced exactly fragsim's
+//! (pixel, primitive) pairs, whatever their depths.
+//!
+//! Coverage is what replay mode guarantees by construction (the GPU scans fragsim's own snapped
+//! triangles), while depth is the GPU's f32 interpolation, so a replay capture can be
+//! coverage-identical and still differ in depth keys: the two are reported apart. Coverage is
+//! checked at the pixels where the scheme keeps every fragment (A-buffer: counter within the
+//! capacity; MDTS: at most K fragments in the reference), from the primitive ids stored (or,
+//! for key-only words, the number of fragments).
+
+use fragsim_oracle::compare::{CompareOptions, Comparison};
+use fragsim_oracle::dump::{Dump, DumpError, Words};
+use fragsim_oracle::Oracle;
+
+/// The verdict and the coverage of one capture.
+#[derive(Debug)]
+pub struct Judgement {
+    /// `Dump::compare` against the oracle.
+    pub comparison: Comparison,
+    /// Pixels where coverage was checked.
+    pub coverage_checked: u64,
+    /// Of those, pixels whose stored primitive ids (or fragment count) differ from fragsim's.
+    pub coverage_differs: u64,
+    /// A-buffer: pixels whose counter is not fragsim's fragment count (coverage of every pixel,
+    /// overflowed ones included); `None` for MDTS layouts.
+    pub counters_differ: Option<u64>,
+}
+
+impl Judgement {
+    /// One line: the verdict's totals and the coverage.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let c = &self.comparison;
+        let d = &c.diff;
+        let mut line = format!(
+            "{}: {} differing pixels (missing {}, extra {}, misordered {}, miscounted {}, corrupt {}); fragments captured {}, lost {}, extra {}; coverage: {} of {} checked pixels differ",
+            if c.is_equal() { "EQUAL" } else { "DIFFERENT" },
+            d.mismatched_pixels,
+            c.counts.missing,
+            c.counts.extra,
+            c.counts.misordered,
+            c.counts.miscounted,
+            c.counts.corrupt,
+            d.captured,
+            d.lost,
+            d.extra,
+            self.coverage_differs,
+            self.coverage_checked
+        );
+        if let Some(n) = self.counters_differ {
+            line += &format!(", counters differ at {n} pixels");
+        }
+        line
+    }
+}
+
+/// Judges `dump` against `oracle`: `depth_ulps` as `fragsim compare --depth-ulps`.
+///
+/// # Errors
+/// A dump its layout cannot decode, or one over another number of pixels than the oracle's.
+pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement, DumpError> {
+    let pixels = oracle.pixels();
+    let dump_pixels = dump.viewport()?.pixels();
+    if dump_pixels != pixels {
+        return Err(DumpError(format!(
+            "the dump covers {dump_pixels} pixels, the oracle {pixels}"
+        )));
+    }
+    let options = CompareOptions {
+        depth_ulps,
+        examples: 8,
+        complete: None,
+    };
+    let comparison = dump.compare(oracle, &options)?;
+    let slots = dump.header.k.or(dump.header.capacity).unwrap_or(0) as usize;
+    let counters = match dump.arrays.get("counters") {
+        Some(Words::U32(c)) => Some(c.as_slice()),
+        _ => None,
+    };
+    let (mut checked, mut differs) = (0u64, 0u64);
+    for p in 0..pixels {
+        let reference = oracle.pixel(p);
+        // The fragments a pixel stores: an A-buffer's counted slots, an MDTS pixel's full ones.
+        let stored = match counters {
+            Some(c) => c[p] as usize,
+            None => reference.len(),
+        };
+        if stored > slots || reference.len() > slots {
+            continue;
+        }
+        checked += 1;
+        let same = match dump.arrays.get("slots") {
+            Some(Words::U64(words)) => {
+                let row = &words[p * slots..(p + 1) * slots];
+                let full = row.iter().take_while(|&&w| w != u64::MAX).count();
+                let taken = if counters.is_some() { stored } else { full };
+                let mut got: Vec<u32> = row[..taken].iter().map(|&w| w as u32).collect();
+                let mut want: Vec<u32> = reference.iter().map(|&w| w as u32).collect();
+                got.sort_unstable();
+                want.sort_unstable();
+                got == want && (counters.is_some() || full == taken)
+            }
+            Some(Words::U32(keys)) => {
+                let row = &keys[p * slots..(p + 1) * slots];
+                row.iter().take_while(|&&w| w != u32::MAX).count() == reference.len()
+            }
+            None => false,
+        };
+        differs += u64::from(!same);
+    }
+    let counters_differ = counters.map(|c| {
+        let n = oracle.depth_complexity();
+        c.iter().zip(&n).filter(|(a, b)| a != b).count() as u64
+    });
+    Ok(Judgement {
+        comparison,
+        coverage_checked: checked,
+        coverage_differs: differs,
+        counters_differ,
+    })
+}

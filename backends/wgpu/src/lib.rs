@@ -1,0 +1,18 @@
+//! fragsim's wgpu backend: the capture schemes as WGSL fragment shaders with storage-buffer
+//! atomics, rasterized by the GPU's own rasterizer through Vulkan (Mesa's lavapipe in CI, the
+//! NVIDIA driver on the H200), their buffers read back as dumps that `fragsim compare` judges
+//! (`docs/dump-format.md`).
+//!
+//! The parts: the headless device and its adapter report ([`device`]), the shaders and their
+//! buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), one capture in replay or
+//! engine mode ([`mod@capture`]), and the judgement of a capture against fragsim's oracle
+//! ([`judge`]). The command is `fragsim-wgpu` (`src/main.rs`).
+
+pub mod capture;
+pub mod device;
+pub mod judge;
+pub mod shaders;
+
+pub use capture::{capture, Captured, Mode};
+pub use device::{Gpu, GpuError};
+pub use shaders::GpuScheme;

@@ -1,0 +1,176 @@
+//! `fragsim-wgpu`: captures through the wgpu backend, written as dumps that `fragsim compare`
+//! judges, optionally judged in place.
+//!
+//! ```text
+//! fragsim-wgpu adapter
+//! fragsim-wgpu capture --scheme abuffer,mdts --scene bunny --width 512 --height 512 \
+//!     --view 30 --mode replay --out out/wgpu --judge
+//! ```
+//!
+//! Exit status: 0 on success (whatever the verdicts), 2 on an error (no adapter, bad input).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::Oracle;
+use fragsim_raster::Viewport;
+use fragsim_wgpu::{capture, judge, Gpu, GpuScheme, Mode};
+
+#[derive(Parser)]
+#[command(
+    name = "fragsim-wgpu",
+    about = "fragsim's schemes as WGSL fragment shaders on a Vulkan GPU"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ModeArg {
+    Replay,
+    Engine,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the adapter and the features the shaders use.
+    Adapter,
+    /// Capture a scene with one or more schemes; one dump per scheme in OUT/<scheme>/.
+    Capture {
+        /// Schemes, comma-separated: abuffer, mdts, mdts32, kbuffer.
+        #[arg(long, default_value = "abuffer,mdts,mdts32")]
+        scheme: String,
+        /// A mesh file (OBJ or PLY, optionally gzipped).
+        #[arg(long, conflicts_with = "scene")]
+        mesh: Option<PathBuf>,
+        /// A named scene (bunny, bunny-spheres, spheres:N, soup, quads).
+        #[arg(long, default_value = "bunny")]
+        scene: String,
+        /// Viewport width.
+        #[arg(long, default_value_t = 512)]
+        width: u32,
+        /// Viewport height.
+        #[arg(long, default_value_t = 512)]
+        height: u32,
+        /// Orbit angle, degrees.
+        #[arg(long, default_value_t = 30.0)]
+        view: f64,
+        /// Elevation, degrees.
+        #[arg(long, default_value_t = 15.0)]
+        elevation: f64,
+        /// replay: fragsim's snapped triangles; engine: the mesh and the f32 matrix.
+        #[arg(long, value_enum, default_value = "replay")]
+        mode: ModeArg,
+        /// MDTS and k-buffer slots per pixel.
+        #[arg(long, default_value_t = 8)]
+        k: u32,
+        /// A-buffer slots per pixel (FreePipe's 20).
+        #[arg(long, default_value_t = 20)]
+        capacity: u32,
+        /// Output directory.
+        #[arg(long, default_value = "out/wgpu")]
+        out: PathBuf,
+        /// Also judge each dump against fragsim's oracle here and print the verdict.
+        #[arg(long)]
+        judge: bool,
+        /// With --judge: as `fragsim compare --depth-ulps`; a comma-separated list gives one
+        /// verdict per value.
+        #[arg(long, default_value = "0", value_delimiter = ',')]
+        depth_ulps: Vec<u32>,
+    },
+}
+
+fn main() -> ExitCode {
+    // Mesa warns when XDG_RUNTIME_DIR is unset; the warning is harmless but noisy.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("fragsim-wgpu: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
+    let gpu = Gpu::open()?;
+    println!("{}", gpu.report());
+    let Command::Capture {
+        scheme,
+        mesh,
+        scene,
+        width,
+        height,
+        view,
+        elevation,
+        mode,
+        k,
+        capacity,
+        out,
+        judge: judge_it,
+        depth_ulps,
+    } = cli.command
+    else {
+        return Ok(());
+    };
+    let schemes = scheme
+        .split(',')
+        .map(|s| GpuScheme::parse(s.trim(), k, capacity))
+        .collect::<Result<Vec<_>, _>>()?;
+    let spec = match &mesh {
+        Some(path) => SceneAndCamera::mesh(path, view, elevation),
+        None => SceneAndCamera::named(&scene, view, elevation),
+    };
+    let loaded = spec.load(None)?;
+    let viewport = Viewport::new(width, height)?;
+    let fragsim_view = loaded.view(viewport, &spec.orbit())?;
+    let mode = match mode {
+        ModeArg::Replay => Mode::Replay,
+        ModeArg::Engine => Mode::Engine,
+    };
+    let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
+    let mut failed = 0;
+    for scheme in &schemes {
+        // One scheme the adapter cannot run (a buffer past its limits, a missing feature) does
+        // not stop the others: it is reported and the command exits 2 at the end.
+        let captured = match capture(&gpu, &fragsim_view, spec.clone(), scheme, mode) {
+            Ok(captured) => captured,
+            Err(e) => {
+                eprintln!("fragsim-wgpu: {e}");
+                failed += 1;
+                continue;
+            }
+        };
+        let dir = out.join(scheme.name());
+        captured.dump.write(&dir)?;
+        let gpu_ms = captured
+            .gpu_ms
+            .map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.3} ms"));
+        println!(
+            "{} {} {}x{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
+            scheme.name(),
+            mode.name(),
+            width,
+            height,
+            spec.describe(),
+            captured.triangles,
+            captured.wall_ms,
+            dir.display()
+        );
+        if let Some(oracle) = &oracle {
+            for &ulps in &depth_ulps {
+                let judgement = judge::judge(&captured.dump, oracle, ulps)?;
+                println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
+            }
+        }
+    }
+    if failed > 0 {
+        return Err(format!("{failed} of {} schemes could not run", schemes.len()).into());
+    }
+    Ok(())
+}
