@@ -17,8 +17,9 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use fragsim_oracle::dump::{ArraySpec, Dtype, Dump, Header, Words, FORMAT, VERSION};
-use fragsim_oracle::scene::SceneAndCamera;
-use fragsim_raster::View;
+use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{Conventions, View};
 
 use crate::device::{Gpu, GpuError};
 use crate::shaders::{GpuScheme, Storage, COMMON};
@@ -487,23 +488,22 @@ fn to_dump(
         );
         arrays.insert(storage.dump_name.to_string(), data);
     }
-    // Row-major, as a reader writes a matrix down (glam's arrays are column-major).
-    let m = geometry.view_projection;
-    let row_major: Vec<f64> = (0..16).map(|i| f64::from(m[(i % 4) * 4 + i / 4])).collect();
-    let conventions = match mode {
-        Mode::Replay => serde_json::json!({
-            "window_origin": "upper-left",
-            "subpixel_bits": 8,
-            "depth_range": "[0, 1]",
-            "vertex_precision": "fragsim's f64 vertex stage, snapped positions replayed exactly",
-        }),
-        Mode::Engine => serde_json::json!({
-            "window_origin": "upper-left",
-            "subpixel_bits": "the adapter's (Vulkan subPixelPrecisionBits; 8 on lavapipe and NVIDIA)",
-            "depth_range": "[0, 1]",
-            "vertex_precision": "f32",
-        }),
-    };
+    // Engine mode draws the mesh with the orbit camera's matrix in f32 and Vulkan's conventions
+    // (upper-left origin, depth in [0, 1]): the dump names both, so that compare rebuilds the
+    // oracle the engine's way. Replay mode draws fragsim's own snapped triangles: reference.
+    let mut scene = scene;
+    if mode == Mode::Engine {
+        // Row-major, as a reader writes a matrix down (glam's arrays are column-major).
+        let m = geometry.view_projection;
+        scene.view_projection = Some(ViewProjection {
+            row_major: std::array::from_fn(|i| f64::from(m[(i % 4) * 4 + i / 4])),
+            precision: VertexPrecision::F32,
+        });
+        scene.conventions = Conventions {
+            vertex_precision: VertexPrecision::F32,
+            ..Conventions::REFERENCE
+        };
+    }
     let header = Header {
         format: FORMAT.into(),
         version: VERSION,
@@ -522,16 +522,15 @@ fn to_dump(
         sorted: false,
         filled: scheme.capacity().is_some(),
         word: scheme.word().into(),
+        pool: None,
+        layers: None,
+        layout: None,
         arrays: specs,
-        // The conventions and the matrix go here until the dump header has fields for them
-        // (issue 16's conventions work): the reader ignores `extra`.
         extra: serde_json::json!({
             "device": gpu.info.name,
             "driver": format!("{} {}", gpu.info.driver, gpu.info.driver_info),
             "mode": mode.name(),
             "shader": scheme.name(),
-            "conventions": conventions,
-            "view_projection_row_major_f32": row_major,
             "triangles_drawn": geometry.count,
             "timings": {"gpu_ms": gpu_ms, "wall_ms": wall_ms},
         }),

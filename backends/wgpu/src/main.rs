@@ -123,7 +123,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| GpuScheme::parse(s.trim(), k, capacity))
         .collect::<Result<Vec<_>, _>>()?;
     let spec = match &mesh {
-        Some(path) => SceneAndCamera::mesh(path, view, elevation),
+        Some(path) => SceneAndCamera::hashed_mesh(path, view, elevation)?,
         None => SceneAndCamera::named(&scene, view, elevation),
     };
     let loaded = spec.load(None)?;
