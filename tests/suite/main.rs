@@ -25,6 +25,7 @@ mod kbuffer;
 mod mdts_packed;
 mod meshes;
 mod peeling;
+mod precision;
 mod properties;
 mod scheduled;
 mod shipping;

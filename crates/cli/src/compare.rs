@@ -18,9 +18,11 @@ use fragsim_oracle::compare::{
     VerdictCounts,
 };
 use fragsim_oracle::dump::{CorruptWord, Dump, Header};
+use fragsim_oracle::precision::{compare_within, Bounds, Precision};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
-use fragsim_raster::depth_from_key;
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{depth_from_key, Conventions};
 use serde::Serialize;
 
 /// Options of `fragsim compare`.
@@ -48,6 +50,15 @@ pub struct CompareArgs {
     /// Write no difference image.
     #[arg(long, conflicts_with = "image")]
     pub no_image: bool,
+    /// The candidate's vertex-stage precision when the reference is the oracle: `f64` owes every
+    /// bit (fragsim's own dumps, a replay of its screen triangles); `f32` (a vertex shader) is
+    /// judged within the bounds derived from it (`docs/semantics.md`, "Precision of a conforming
+    /// implementation").
+    #[arg(long, value_name = "f64|f32", default_value = "f64", value_parser = ["f64", "f32"])]
+    pub vertex_precision: String,
+    /// Compare two dumps that name different scenes (refused otherwise, exit 2).
+    #[arg(long)]
+    pub allow_different_scenes: bool,
 }
 
 /// One side of a comparison.
@@ -168,6 +179,10 @@ struct Report {
     height: u32,
     compared: String,
     depth_ulps: u32,
+    vertex_precision: String,
+    /// The bounds derived for an f32 vertex stage (absent when every bit is owed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    precision: Option<Bounds>,
     pixels: u64,
     verdicts: VerdictCounts,
     fragments: Fragments,
@@ -202,16 +217,30 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             ));
         }
         if a.scene != b.scene {
-            notes.push(format!(
+            let which = format!(
                 "the dumps name different scenes: {} and {}",
                 a.scene.describe(),
                 b.scene.describe()
-            ));
+            );
+            if !args.allow_different_scenes {
+                return Err(format!(
+                    "{which} (--allow-different-scenes compares them anyway)"
+                ));
+            }
+            notes.push(which);
         }
     }
     // The oracle is built only when a side asks for it (the scene may be a large mesh).
     let needs_oracle = matches!(reference, Side::Oracle) || matches!(candidate, Side::Oracle);
-    let oracle = if needs_oracle {
+    let conventions = Conventions {
+        vertex_precision: if args.vertex_precision == "f32" {
+            VertexPrecision::F32
+        } else {
+            VertexPrecision::F64
+        },
+        ..Conventions::REFERENCE
+    };
+    let (oracle, precision) = if needs_oracle {
         let scene = header
             .scene
             .load(Some(&beside))
@@ -220,10 +249,20 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         let view = scene
             .view(viewport, &header.scene.orbit())
             .map_err(|e| e.to_string())?;
-        Some(Oracle::build(&view))
+        (
+            Some(Oracle::build(&view)),
+            Some(Precision::derive(&view, &conventions)),
+        )
     } else {
-        None
+        (None, None)
     };
+    if conventions.vertex_precision == VertexPrecision::F32 && !matches!(reference, Side::Oracle) {
+        return Err(
+            "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
+             to derive bounds from"
+                .into(),
+        );
+    }
     let from_dump;
     let mut complete = None;
     let mut reference_corrupt = 0;
@@ -278,12 +317,25 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         examples: args.show,
         complete: complete.as_deref(),
     };
-    let comparison = compare_with(
-        reference_oracle,
-        &candidate_capture,
-        words.as_ref(),
-        &options,
-    );
+    let comparison = match &precision {
+        Some(precision) => compare_within(
+            precision,
+            reference_oracle,
+            &candidate_capture,
+            words.as_ref(),
+            &options,
+        ),
+        None => compare_with(
+            reference_oracle,
+            &candidate_capture,
+            words.as_ref(),
+            &options,
+        ),
+    };
+    let bounds = precision
+        .as_ref()
+        .filter(|p| !p.is_exact())
+        .map(Precision::bounds);
     if comparison.claimed_overflow != comparison.diff.overflowed {
         notes.push(format!(
             "the counters claim {} fragments overflowed, the reference predicts {}",
@@ -309,8 +361,10 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         scene: header.scene.clone(),
         width: header.width,
         height: header.height,
-        compared: what_is_compared(&candidate_capture, args.depth_ulps),
+        compared: what_is_compared(&candidate_capture, args.depth_ulps, bounds.is_some()),
         depth_ulps: args.depth_ulps,
+        vertex_precision: args.vertex_precision.clone(),
+        precision: bounds,
         pixels: comparison.verdicts.len() as u64,
         verdicts: comparison.counts,
         fragments: Fragments {
@@ -390,7 +444,7 @@ fn reference_caveats(capture: &Capture) -> Vec<String> {
     }
 }
 
-fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
+fn what_is_compared(candidate: &Capture, ulps: u32, within_precision: bool) -> String {
     let words = match candidate.identity {
         Identity::KeyAndPrim => "depth key (f32 bits) and primitive id of every fragment",
         Identity::KeyOnly => "depth keys (f32 bits) of every fragment",
@@ -401,7 +455,14 @@ fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
         Keeps::Farthest(k) => format!("the {k} farthest per pixel"),
         Keeps::All { .. } => "all per pixel, less the overflow the reference predicts".into(),
     };
-    let tolerance = if ulps == 0 {
+    let tolerance = if within_precision {
+        let widened = if ulps == 0 {
+            String::new()
+        } else {
+            format!(" widened by {ulps} ulps")
+        };
+        format!("within the precision of an f32 vertex stage{widened}")
+    } else if ulps == 0 {
         "bit for bit".to_string()
     } else {
         format!("depth keys within {ulps} ulps")
@@ -512,6 +573,24 @@ fn print_report(r: &Report) {
         v.miscounted,
         v.corrupt
     );
+    if let Some(b) = &r.precision {
+        outln!(
+            "precision (f32 vertex stage): vertex error up to {:.3} subpixels (snapped radius {}), \
+             depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs ({} may be \
+             present), {} clipped triangles not analysed",
+            b.max_vertex_error_subpixels,
+            b.max_snap_radius_subpixels,
+            b.max_depth_interval_ulps,
+            b.ambiguous_pairs,
+            b.may_be_present_pairs,
+            b.unanalysed_triangles
+        );
+        outln!(
+            "pixels within precision {}, ambiguous {} (counted, never errors)",
+            v.within_precision,
+            v.ambiguous
+        );
+    }
     let f = &r.fragments;
     let claimed = if f.overflow_claimed == f.overflowed {
         String::new()

@@ -13,7 +13,7 @@
 //! "definitely / maybe covered" classification).
 
 use fragsim_raster::conventions::{DepthRange, VertexPrecision};
-use fragsim_raster::{depth_key, Conventions, View, SUBPIXEL_BITS};
+use fragsim_raster::{depth_key, Conventions, View, Viewport, SUBPIXEL_BITS};
 use serde::Serialize;
 
 /// f32's unit roundoff, `2^-24`.
@@ -107,7 +107,9 @@ impl Precision {
         for prim in 0..view.triangle_count() {
             let tri = view.mesh().triangles[prim as usize].map(|i| vertices[i as usize]);
             match tri {
-                [Some(a), Some(b), Some(c)] => triangle(view, prim, [a, b, c], &mut found),
+                [Some(a), Some(b), Some(c)] => {
+                    triangle(view.viewport(), prim, [a, b, c], &mut found);
+                }
                 _ => {
                     bounds.unanalysed_triangles += 1;
                     view.rasterize(prim, &mut |f| {
@@ -295,7 +297,12 @@ fn round_up(x: f64) -> f32 {
 
 /// Lists, for every pixel centre within the grown bounding box of an unclipped triangle, what an
 /// implementation may emit there.
-fn triangle(view: &View<'_>, prim: u32, verts: [VertexBound; 3], found: &mut Vec<(u32, Possible)>) {
+fn triangle(
+    viewport: Viewport,
+    prim: u32,
+    verts: [VertexBound; 3],
+    found: &mut Vec<(u32, Possible)>,
+) {
     let [a, mut b, mut c] = verts;
     let mut area = edge(a.snapped, b.snapped, c.snapped);
     if area < 0 {
@@ -311,7 +318,6 @@ fn triangle(view: &View<'_>, prim: u32, verts: [VertexBound; 3], found: &mut Vec
     let half = one / 2;
     let lo = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).min().unwrap_or(0) - grow);
     let hi = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).max().unwrap_or(0) + grow);
-    let viewport = view.viewport();
     let span = |lo: i64, hi: i64, side: u32| {
         let from = (lo - half + one - 1).div_euclid(one).max(0);
         let to = (hi - half).div_euclid(one).min(i64::from(side) - 1);
@@ -390,6 +396,8 @@ fn triangle(view: &View<'_>, prim: u32, verts: [VertexBound; 3], found: &mut Vec
     }
 }
 
+#[cfg(test)]
+mod tests;
 mod verdict;
 
 pub use verdict::compare_within;
