@@ -26,6 +26,7 @@ mod mdts_packed;
 mod meshes;
 mod peeling;
 mod precision;
+mod precision_cli;
 mod properties;
 mod scheduled;
 mod shipping;

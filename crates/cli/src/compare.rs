@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use fragsim_oracle::compare::{
     compare_with, complete_pixels, verdict, with_identity, CompareOptions, Comparison,
     VerdictCounts,
@@ -266,6 +266,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     let from_dump;
     let mut complete = None;
     let mut reference_corrupt = 0;
+    let mut reference_keeps = None;
     let (reference_oracle, reference_identity) = match (&reference, &oracle) {
         (Side::Dump(dump, _), _) => {
             let capture = dump.capture().map_err(|e| e.to_string())?;
@@ -281,6 +282,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
                 ));
             }
             complete = Some(complete_pixels(&capture));
+            reference_keeps = Some(capture.keeps.clone());
             from_dump = Oracle::from_capture(&capture);
             (&from_dump, capture.identity)
         }
@@ -311,6 +313,16 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             candidate_capture.pixels(),
             reference_oracle.pixels()
         ));
+    }
+    if let (Some(keeps), Some(complete)) = (&reference_keeps, &complete) {
+        let (unjudged, pixels) =
+            drop_unknowable(&mut candidate_capture, reference_oracle, keeps, complete);
+        if unjudged > 0 {
+            notes.push(format!(
+                "{unjudged} candidate fragments in {pixels} pixels lie beyond what the reference \
+                 kept there (its K-th fragment) and cannot be judged: not counted as extra"
+            ));
+        }
     }
     let options = CompareOptions {
         depth_ulps: args.depth_ulps,
@@ -413,6 +425,58 @@ fn oracle_capture(oracle: &Oracle) -> Capture {
             overflow: vec![0; oracle.pixels()],
         },
     }
+}
+
+/// Takes out of `candidate` the fragments an MDTS reference cannot know: in a pixel where the
+/// reference is full (`complete` false), those beyond its K-th (farther for K nearest, nearer for K
+/// farthest), which it would have dropped itself. Returns how many, and in how many pixels.
+fn drop_unknowable(
+    candidate: &mut Capture,
+    reference: &Oracle,
+    keeps: &Keeps,
+    complete: &[bool],
+) -> (u64, u64) {
+    let nearest = match keeps {
+        Keeps::Nearest(_) => true,
+        Keeps::Farthest(_) => false,
+        Keeps::All { .. } => return (0, 0),
+    };
+    let mask = match candidate.identity {
+        Identity::KeyAndPrim => u64::MAX,
+        Identity::KeyOnly => u64::MAX << 32,
+        Identity::PrimOnly => return (0, 0),
+    };
+    let mut lists = PixelLists::with_pixels(candidate.pixels());
+    let (mut dropped, mut pixels) = (0, 0);
+    for p in 0..candidate.pixels() {
+        let bound = if nearest {
+            reference.pixel(p).last()
+        } else {
+            reference.pixel(p).first()
+        };
+        let got = candidate.pixel(p);
+        let kept: Vec<u64> = match bound.filter(|_| !complete[p]) {
+            Some(&bound) => got
+                .iter()
+                .copied()
+                .filter(|&e| {
+                    let beyond = if nearest {
+                        e & mask > bound & mask
+                    } else {
+                        e & mask < bound & mask
+                    };
+                    e == u64::MAX || !beyond
+                })
+                .collect(),
+            None => got.to_vec(),
+        };
+        let gone = (got.len() - kept.len()) as u64;
+        dropped += gone;
+        pixels += u64::from(gone > 0);
+        lists.push_pixel(kept);
+    }
+    candidate.lists = lists;
+    (dropped, pixels)
 }
 
 /// Why a dump used as the reference may not be the whole truth.
