@@ -25,15 +25,36 @@ fn run(cmd: &mut Command, code: i32) -> String {
         String::from_utf8_lossy(&output.stdout).into_owned(),
         String::from_utf8_lossy(&output.stderr).into_owned(),
     );
-    assert_eq!(output.status.code(), Some(code), "stdout {out}\nstderr {err}");
+    assert_eq!(
+        output.status.code(),
+        Some(code),
+        "stdout {out}\nstderr {err}"
+    );
     out + &err
 }
 
 fn dump(dir: &Path, schemes: &str, view: &str) {
     run(
         fragsim()
-            .args(["render", "--scene", "spheres:3", "--width", "48", "--height", "36"])
-            .args(["--view", view, "--k", "3", "--scheme", schemes, "--no-images", "--dump"])
+            .args([
+                "render",
+                "--scene",
+                "spheres:3",
+                "--width",
+                "48",
+                "--height",
+                "36",
+            ])
+            .args([
+                "--view",
+                view,
+                "--k",
+                "3",
+                "--scheme",
+                schemes,
+                "--no-images",
+                "--dump",
+            ])
             .arg(dir),
         0,
     );
@@ -61,7 +82,10 @@ fn dumps_of_different_scenes_exit_2_unless_asked_for() {
     dump(&dir.join("a"), "abuffer", "30");
     dump(&dir.join("b"), "abuffer", "75");
     let (a, b) = (dir.join("a/abuffer"), dir.join("b/abuffer"));
-    let refused = run(fragsim().arg("compare").arg(&a).arg(&b).arg("--no-image"), 2);
+    let refused = run(
+        fragsim().arg("compare").arg(&a).arg(&b).arg("--no-image"),
+        2,
+    );
     assert!(refused.contains("different scenes"), "{refused}");
     let asked = run(
         fragsim()
@@ -85,7 +109,10 @@ fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
             .args(["--no-image", "--vertex-precision", "f32"]),
         0,
     );
-    assert!(out.contains("precision (f32 vertex stage): vertex error up to"), "{out}");
+    assert!(
+        out.contains("precision (f32 vertex stage): vertex error up to"),
+        "{out}"
+    );
     let json = run(
         fragsim()
             .args(["compare", "oracle"])
@@ -94,6 +121,11 @@ fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
         0,
     );
     let report: serde_json::Value = serde_json::from_str(&json).unwrap();
-    assert!(report["precision"]["max_depth_interval_ulps"].as_u64().unwrap() > 0);
+    assert!(
+        report["precision"]["max_depth_interval_ulps"]
+            .as_u64()
+            .unwrap()
+            > 0
+    );
     assert!(report["verdicts"]["ambiguous"].is_u64(), "{json}");
 }

@@ -448,14 +448,14 @@ fn drop_unknowable(
     };
     let mut lists = PixelLists::with_pixels(candidate.pixels());
     let (mut dropped, mut pixels) = (0, 0);
-    for p in 0..candidate.pixels() {
+    for (p, &known) in complete.iter().enumerate() {
         let bound = if nearest {
             reference.pixel(p).last()
         } else {
             reference.pixel(p).first()
         };
         let got = candidate.pixel(p);
-        let kept: Vec<u64> = match bound.filter(|_| !complete[p]) {
+        let kept: Vec<u64> = match bound.filter(|_| !known) {
             Some(&bound) => got
                 .iter()
                 .copied()
