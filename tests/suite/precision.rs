@@ -11,6 +11,9 @@ use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
 use fragsim::raster::{Conventions, Fragment, OrbitCamera, Scene, ScreenTriangle, View, Viewport};
 
+/// A planted bug: an edit of one pixel's list.
+type Plant = dyn Fn(&mut Vec<u64>);
+
 const F32: Conventions = Conventions {
     vertex_precision: VertexPrecision::F32,
     ..Conventions::REFERENCE
@@ -157,8 +160,14 @@ fn planted_bugs_in_an_f32_capture_are_errors_not_ambiguities() {
         let p = certain_pixel(&precision, &lists);
         let width = lists[p].len();
         let foreign = view.triangle_count() + 7;
-        let bugs: [(&str, Box<dyn Fn(&mut Vec<u64>)>, u8); 4] = [
-            ("dropped", Box::new(|l| drop(l.remove(0))), verdict::MISSING),
+        let bugs: [(&str, Box<Plant>, u8); 4] = [
+            (
+                "dropped",
+                Box::new(|l| {
+                    l.remove(0);
+                }),
+                verdict::MISSING,
+            ),
             (
                 "wrong primitive id",
                 Box::new(move |l| l[0] = (l[0] & !u64::from(u32::MAX)) | u64::from(foreign)),
