@@ -27,6 +27,8 @@ mod locks;
 mod mdts_packed;
 mod meshes;
 mod peeling;
+mod precision;
+mod precision_cli;
 mod properties;
 mod scheduled;
 mod shipping;

@@ -12,15 +12,17 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use fragsim_oracle::compare::{
     compare_with, complete_pixels, verdict, with_identity, CompareOptions, Comparison,
     VerdictCounts,
 };
 use fragsim_oracle::dump::{CorruptWord, Dump, Header};
+use fragsim_oracle::precision::{compare_within, Bounds, Precision};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
-use fragsim_raster::depth_from_key;
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{depth_from_key, Conventions};
 use serde::Serialize;
 
 /// Options of `fragsim compare`.
@@ -52,6 +54,15 @@ pub struct CompareArgs {
     /// travelled); its bytes must still hash as the dump says.
     #[arg(long, value_name = "PATH")]
     pub mesh: Option<PathBuf>,
+    /// The candidate's vertex-stage precision when the reference is the oracle, in place of the
+    /// one its dump declares (`scene.conventions`): `f64` owes every bit (fragsim's own dumps, a
+    /// replay of its screen triangles); `f32` (a vertex shader) is judged within the bounds
+    /// derived from it (`docs/semantics.md`, "Precision of a conforming implementation").
+    #[arg(long, value_name = "f64|f32", value_parser = ["f64", "f32"])]
+    pub vertex_precision: Option<String>,
+    /// Compare two dumps that name different scenes (refused otherwise, exit 2).
+    #[arg(long)]
+    pub allow_different_scenes: bool,
 }
 
 /// One side of a comparison.
@@ -172,6 +183,10 @@ struct Report {
     height: u32,
     compared: String,
     depth_ulps: u32,
+    vertex_precision: String,
+    /// The bounds derived for an f32 vertex stage (absent when every bit is owed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    precision: Option<Bounds>,
     pixels: u64,
     verdicts: VerdictCounts,
     fragments: Fragments,
@@ -209,32 +224,58 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             ));
         }
         if a.scene != b.scene {
-            notes.push(format!(
+            let which = format!(
                 "the dumps name different scenes: {} and {}",
                 a.scene.describe(),
                 b.scene.describe()
-            ));
+            );
+            if !args.allow_different_scenes {
+                return Err(format!(
+                    "{which} (--allow-different-scenes compares them anyway)"
+                ));
+            }
+            notes.push(which);
         }
     }
     // The oracle is built only when a side asks for it (the scene may be a large mesh).
     let needs_oracle = matches!(reference, Side::Oracle) || matches!(candidate, Side::Oracle);
-    let oracle = if needs_oracle {
-        let scene = header
-            .scene
-            .load(Some(&beside))
-            .map_err(|e| e.to_string())?;
+    // The conventions the candidate declares, its vertex precision overridden by the flag. The
+    // oracle is built under them with the f64 vertex stage: the derived bounds measure an
+    // implementation's distance from the exact vertex positions, not from another f32 order.
+    let conventions = Conventions {
+        vertex_precision: match args.vertex_precision.as_deref() {
+            Some("f32") => VertexPrecision::F32,
+            Some(_) => VertexPrecision::F64,
+            None => header.scene.conventions.vertex_precision,
+        },
+        ..header.scene.conventions
+    };
+    let mut exact_scene = header.scene.clone();
+    exact_scene.conventions.vertex_precision = VertexPrecision::F64;
+    let (oracle, precision) = if needs_oracle {
+        let scene = exact_scene.load(Some(&beside)).map_err(|e| e.to_string())?;
         let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
-        let view = header
-            .scene
+        let view = exact_scene
             .view(&scene, viewport)
             .map_err(|e| e.to_string())?;
-        Some(Oracle::build(&view))
+        (
+            Some(Oracle::build(&view)),
+            Some(Precision::derive(&view, &conventions)),
+        )
     } else {
-        None
+        (None, None)
     };
+    if args.vertex_precision.as_deref() == Some("f32") && !matches!(reference, Side::Oracle) {
+        return Err(
+            "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
+             to derive bounds from"
+                .into(),
+        );
+    }
     let from_dump;
     let mut complete = None;
     let mut reference_corrupt = 0;
+    let mut reference_keeps = None;
     let (reference_oracle, reference_identity) = match (&reference, &oracle) {
         (Side::Dump(dump, _), _) => {
             let capture = dump.capture().map_err(|e| e.to_string())?;
@@ -250,6 +291,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
                 ));
             }
             complete = Some(complete_pixels(&capture));
+            reference_keeps = Some(capture.keeps.clone());
             from_dump = Oracle::from_capture(&capture);
             (&from_dump, capture.identity)
         }
@@ -281,17 +323,40 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             reference_oracle.pixels()
         ));
     }
+    if let (Some(keeps), Some(complete)) = (&reference_keeps, &complete) {
+        let (unjudged, pixels) =
+            drop_unknowable(&mut candidate_capture, reference_oracle, keeps, complete);
+        if unjudged > 0 {
+            notes.push(format!(
+                "{unjudged} candidate fragments in {pixels} pixels lie beyond what the reference \
+                 kept there (its K-th fragment) and cannot be judged: not counted as extra"
+            ));
+        }
+    }
     let options = CompareOptions {
         depth_ulps: args.depth_ulps,
         examples: args.show,
         complete: complete.as_deref(),
     };
-    let comparison = compare_with(
-        reference_oracle,
-        &candidate_capture,
-        words.as_ref(),
-        &options,
-    );
+    let comparison = match &precision {
+        Some(precision) => compare_within(
+            precision,
+            reference_oracle,
+            &candidate_capture,
+            words.as_ref(),
+            &options,
+        ),
+        None => compare_with(
+            reference_oracle,
+            &candidate_capture,
+            words.as_ref(),
+            &options,
+        ),
+    };
+    let bounds = precision
+        .as_ref()
+        .filter(|p| !p.is_exact())
+        .map(Precision::bounds);
     if comparison.claimed_overflow != comparison.diff.overflowed {
         notes.push(format!(
             "the counters claim {} fragments overflowed, the reference predicts {}",
@@ -317,8 +382,13 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         scene: header.scene.clone(),
         width: header.width,
         height: header.height,
-        compared: what_is_compared(&candidate_capture, args.depth_ulps),
+        compared: what_is_compared(&candidate_capture, args.depth_ulps, bounds.is_some()),
         depth_ulps: args.depth_ulps,
+        vertex_precision: match conventions.vertex_precision {
+            VertexPrecision::F64 => "f64".into(),
+            VertexPrecision::F32 => "f32".into(),
+        },
+        precision: bounds,
         pixels: comparison.verdicts.len() as u64,
         verdicts: comparison.counts,
         fragments: Fragments {
@@ -369,6 +439,58 @@ fn oracle_capture(oracle: &Oracle) -> Capture {
     }
 }
 
+/// Takes out of `candidate` the fragments an MDTS reference cannot know: in a pixel where the
+/// reference is full (`complete` false), those beyond its K-th (farther for K nearest, nearer for K
+/// farthest), which it would have dropped itself. Returns how many, and in how many pixels.
+fn drop_unknowable(
+    candidate: &mut Capture,
+    reference: &Oracle,
+    keeps: &Keeps,
+    complete: &[bool],
+) -> (u64, u64) {
+    let nearest = match keeps {
+        Keeps::Nearest(_) => true,
+        Keeps::Farthest(_) => false,
+        Keeps::All { .. } => return (0, 0),
+    };
+    let mask = match candidate.identity {
+        Identity::KeyAndPrim => u64::MAX,
+        Identity::KeyOnly => u64::MAX << 32,
+        Identity::PrimOnly => return (0, 0),
+    };
+    let mut lists = PixelLists::with_pixels(candidate.pixels());
+    let (mut dropped, mut pixels) = (0, 0);
+    for (p, &known) in complete.iter().enumerate() {
+        let bound = if nearest {
+            reference.pixel(p).last()
+        } else {
+            reference.pixel(p).first()
+        };
+        let got = candidate.pixel(p);
+        let kept: Vec<u64> = match bound.filter(|_| !known) {
+            Some(&bound) => got
+                .iter()
+                .copied()
+                .filter(|&e| {
+                    let beyond = if nearest {
+                        e & mask > bound & mask
+                    } else {
+                        e & mask < bound & mask
+                    };
+                    e == u64::MAX || !beyond
+                })
+                .collect(),
+            None => got.to_vec(),
+        };
+        let gone = (got.len() - kept.len()) as u64;
+        dropped += gone;
+        pixels += u64::from(gone > 0);
+        lists.push_pixel(kept);
+    }
+    candidate.lists = lists;
+    (dropped, pixels)
+}
+
 /// Why a dump used as the reference may not be the whole truth.
 fn reference_caveats(capture: &Capture) -> Vec<String> {
     match &capture.keeps {
@@ -398,7 +520,7 @@ fn reference_caveats(capture: &Capture) -> Vec<String> {
     }
 }
 
-fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
+fn what_is_compared(candidate: &Capture, ulps: u32, within_precision: bool) -> String {
     let words = match candidate.identity {
         Identity::KeyAndPrim => "depth key (f32 bits) and primitive id of every fragment",
         Identity::KeyOnly => "depth keys (f32 bits) of every fragment",
@@ -409,7 +531,14 @@ fn what_is_compared(candidate: &Capture, ulps: u32) -> String {
         Keeps::Farthest(k) => format!("the {k} farthest per pixel"),
         Keeps::All { .. } => "all per pixel, less the overflow the reference predicts".into(),
     };
-    let tolerance = if ulps == 0 {
+    let tolerance = if within_precision {
+        let widened = if ulps == 0 {
+            String::new()
+        } else {
+            format!(" widened by {ulps} ulps")
+        };
+        format!("within the precision of an f32 vertex stage{widened}")
+    } else if ulps == 0 {
         "bit for bit".to_string()
     } else {
         format!("depth keys within {ulps} ulps")
@@ -520,6 +649,24 @@ fn print_report(r: &Report) {
         v.miscounted,
         v.corrupt
     );
+    if let Some(b) = &r.precision {
+        outln!(
+            "precision (f32 vertex stage): vertex error up to {:.3} subpixels (snapped radius {}), \
+             depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs ({} may be \
+             present), {} clipped triangles not analysed",
+            b.max_vertex_error_subpixels,
+            b.max_snap_radius_subpixels,
+            b.max_depth_interval_ulps,
+            b.ambiguous_pairs,
+            b.may_be_present_pairs,
+            b.unanalysed_triangles
+        );
+        outln!(
+            "pixels within precision {}, ambiguous {} (counted, never errors)",
+            v.within_precision,
+            v.ambiguous
+        );
+    }
     let f = &r.fragments;
     let claimed = if f.overflow_claimed == f.overflowed {
         String::new()

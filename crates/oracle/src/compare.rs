@@ -40,17 +40,26 @@ pub mod verdict {
     pub const MISCOUNTED: u8 = 16;
     /// A stored word that the layout says cannot be there ([`crate::dump::Corruption`]).
     pub const CORRUPT: u8 = 32;
+    /// Every fragment matches one the reference allows, some with a depth other than the
+    /// reference's but inside the precision bound ([`crate::precision`]): not an error.
+    pub const WITHIN_PRECISION: u8 = 64;
+    /// Coverage or order decided inside the precision margin: a fragment the reference has and
+    /// a conforming implementation may lack (or the reverse), or a K-nearest cut among
+    /// overlapping depth intervals. Counted and shown, never an error.
+    pub const AMBIGUOUS: u8 = 128;
     /// Flags that make a pixel differ.
     pub const DIFFERS: u8 = MISSING | EXTRA | MISORDERED | MISCOUNTED | CORRUPT;
 
     /// Each flag with its name in reports, in report order.
-    pub const NAMES: [(u8, &str); 6] = [
+    pub const NAMES: [(u8, &str); 8] = [
         (MISSING, "missing"),
         (EXTRA, "extra"),
         (MISORDERED, "misordered"),
         (OVERFLOWED, "overflowed"),
         (MISCOUNTED, "overflow-miscounted"),
         (CORRUPT, "corrupt"),
+        (WITHIN_PRECISION, "within-precision"),
+        (AMBIGUOUS, "ambiguous"),
     ];
 
     /// The names of the flags set in `flags`.
@@ -82,11 +91,16 @@ pub struct VerdictCounts {
     pub miscounted: u64,
     /// Pixels holding a word their layout says cannot be there.
     pub corrupt: u64,
+    /// Pixels equal within the precision bound, not bit for bit.
+    #[serde(rename = "within-precision")]
+    pub within_precision: u64,
+    /// Pixels whose coverage or order is decided inside the precision margin.
+    pub ambiguous: u64,
 }
 
 impl VerdictCounts {
     /// Counts one pixel's flags.
-    fn add(&mut self, flags: u8) {
+    pub(crate) fn add(&mut self, flags: u8) {
         let counters = [
             (verdict::MISSING, &mut self.missing),
             (verdict::EXTRA, &mut self.extra),
@@ -94,6 +108,8 @@ impl VerdictCounts {
             (verdict::OVERFLOWED, &mut self.overflowed),
             (verdict::MISCOUNTED, &mut self.miscounted),
             (verdict::CORRUPT, &mut self.corrupt),
+            (verdict::WITHIN_PRECISION, &mut self.within_precision),
+            (verdict::AMBIGUOUS, &mut self.ambiguous),
         ];
         for (flag, count) in counters {
             *count += u64::from(flags & flag != 0);
@@ -206,7 +222,7 @@ impl Dump {
 
 /// An A-buffer pixel's counter as a capture alone shows it: `stored + overflow`, and a capacity
 /// of `stored` when it overflowed (storage ran out), unknown (at least `stored`) when not.
-fn inferred_counter(stored: usize, overflow: u32) -> Counter {
+pub(crate) fn inferred_counter(stored: usize, overflow: u32) -> Counter {
     Counter {
         count: stored as u32 + overflow,
         capacity: if overflow > 0 {

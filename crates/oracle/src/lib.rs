@@ -18,6 +18,7 @@
 pub mod compare;
 mod diff;
 pub mod dump;
+pub mod precision;
 pub mod scene;
 pub mod triangles;
 

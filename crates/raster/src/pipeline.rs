@@ -319,4 +319,20 @@ impl<'mesh> View<'mesh> {
             z: [za, zb, zc],
         });
     }
+
+    /// The clip-space position of vertex `index` as the vertex stage computed it (rule 1): what a
+    /// precision analysis of the stage starts from.
+    #[must_use]
+    pub fn vertex_clip(&self, index: u32) -> DVec4 {
+        self.clip_position(index)
+    }
+
+    /// The snapped window position (1/256 pixel) and window depth of vertex `index`, or `None`
+    /// when the vertex lies outside the near plane or the guard band (its triangles are clipped)
+    /// or not in front of the eye.
+    #[must_use]
+    pub fn vertex_window(&self, index: u32) -> Option<([i64; 2], f64)> {
+        let outcode = self.outcodes[index as usize];
+        (outcode & (CLIP_BITS | NOT_IN_FRONT_BIT) == 0).then(|| self.snapped(index))
+    }
 }

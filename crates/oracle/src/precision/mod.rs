@@ -1,0 +1,403 @@
+//! What a conforming implementation may produce: the bounds derived from its declared vertex-stage
+//! precision, and for every (pixel, triangle) whether coverage is decided within them and the
+//! interval of depth keys it may carry.
+//!
+//! Guarantee: for an implementation whose vertex stage computes in f32 (`VertexPrecision::F32`)
+//! and which otherwise follows `docs/semantics.md` (snapping to the declared subpixel grid with
+//! any round-to-nearest, the top-left rule, depth planes evaluated in f32), every fragment it
+//! emits at a pixel is one of the [`Possible`] entries listed for that pixel, with its depth key
+//! inside that entry's interval; every entry marked `certain` is emitted. With f64 vertex precision
+//! the contract is bit-exactness and the analysis is empty ([`Precision::is_exact`]). Source: the
+//! derivation in `docs/semantics.md`, "Precision of a conforming implementation" (standard
+//! floating-point error analysis, Higham's `γ_n`; the Vulkan CTS rasterization verifier's
+//! "definitely / maybe covered" classification).
+
+use fragsim_raster::conventions::{DepthRange, VertexPrecision};
+use fragsim_raster::{depth_key, Conventions, View, Viewport, SUBPIXEL_BITS};
+use serde::Serialize;
+
+/// f32's unit roundoff, `2^-24`.
+const U32: f64 = 1.0 / 16_777_216.0;
+/// f64's unit roundoff, `2^-53`: the reference's own rounding, added to every term.
+const U64: f64 = f64::EPSILON / 2.0;
+/// The depth key of 1.0, the largest a fragment carries.
+const KEY_ONE: u32 = 0x3F80_0000;
+
+/// `γ_n = n·u / (1 − n·u)`: the relative error bound of `n` rounded operations.
+fn gamma(n: f64, u: f64) -> f64 {
+    n * u / (1.0 - n * u)
+}
+
+/// Both roundings of `n` operations: the implementation's in f32 and the reference's in f64.
+fn gamma_both(n: f64) -> f64 {
+    gamma(n, U32) + gamma(n, U64)
+}
+
+/// One fragment a conforming implementation may emit at a pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Possible {
+    /// The triangle.
+    pub prim: u32,
+    /// The smallest depth key it may carry.
+    pub key_lo: u32,
+    /// The largest depth key it may carry.
+    pub key_hi: u32,
+    /// Whether every conforming implementation emits it (coverage decided outside the margin and
+    /// its depth interval inside `[0, 1]`).
+    pub certain: bool,
+    /// The reference's depth key where the reference emits it.
+    pub reference: Option<u32>,
+}
+
+/// The bounds the analysis derived, as `compare` prints them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Bounds {
+    /// The largest window-position error bound of any vertex before snapping, in subpixels.
+    pub max_vertex_error_subpixels: f64,
+    /// The largest snapped-position radius of any vertex, in subpixels (what the coverage test
+    /// uses: the snapped positions an implementation may reach).
+    pub max_snap_radius_subpixels: i64,
+    /// The widest depth interval of any reference fragment, in f32 ulps (`key_hi − key_lo`).
+    pub max_depth_interval_ulps: u32,
+    /// (pixel, triangle) pairs whose coverage or depth range is decided inside the margin.
+    pub ambiguous_pairs: u64,
+    /// Of those, pairs the reference does not cover (the implementation may emit them).
+    pub may_be_present_pairs: u64,
+    /// Triangles the reference clips (near plane or guard band): not analysed, their fragments
+    /// taken as ambiguous with any depth.
+    pub unanalysed_triangles: u64,
+}
+
+/// The per-pixel possibilities of a view under an implementation's conventions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Precision {
+    exact: bool,
+    offsets: Vec<usize>,
+    entries: Vec<Possible>,
+    bounds: Bounds,
+}
+
+/// A vertex's error bounds: the snapped-position radius (subpixels) and the window-depth error.
+#[derive(Clone, Copy, Debug)]
+struct VertexBound {
+    snapped: [i64; 2],
+    depth: f64,
+    radius: i64,
+    depth_error: f64,
+}
+
+impl Precision {
+    /// The analysis of `view` (built under the reference's f64 pipeline) for an implementation
+    /// declaring `conventions`: empty for f64 vertex precision, where the contract is bit-exact.
+    #[must_use]
+    pub fn derive(view: &View<'_>, conventions: &Conventions) -> Self {
+        if conventions.vertex_precision == VertexPrecision::F64 {
+            return Self {
+                exact: true,
+                offsets: Vec::new(),
+                entries: Vec::new(),
+                bounds: Bounds::default(),
+            };
+        }
+        let mut bounds = Bounds::default();
+        let vertices: Vec<Option<VertexBound>> = (0..view.mesh().positions.len() as u32)
+            .map(|i| vertex_bound(view, conventions, i, &mut bounds))
+            .collect();
+        let mut found: Vec<(u32, Possible)> = Vec::new();
+        for prim in 0..view.triangle_count() {
+            let tri = view.mesh().triangles[prim as usize].map(|i| vertices[i as usize]);
+            match tri {
+                [Some(a), Some(b), Some(c)] => {
+                    triangle(view.viewport(), prim, [a, b, c], &mut found);
+                }
+                _ => {
+                    bounds.unanalysed_triangles += 1;
+                    view.rasterize(prim, &mut |f| {
+                        found.push((
+                            f.pixel,
+                            Possible {
+                                prim,
+                                key_lo: 0,
+                                key_hi: KEY_ONE,
+                                certain: false,
+                                reference: Some(f.depth_key),
+                            },
+                        ));
+                    });
+                }
+            }
+        }
+        found.sort_by_key(|&(p, _)| p);
+        let pixels = view.viewport().pixels();
+        let mut offsets = vec![0usize; pixels + 1];
+        for &(p, _) in &found {
+            offsets[p as usize + 1] += 1;
+        }
+        for i in 0..pixels {
+            offsets[i + 1] += offsets[i];
+        }
+        let entries: Vec<Possible> = found.into_iter().map(|(_, e)| e).collect();
+        for e in &entries {
+            if !e.certain {
+                bounds.ambiguous_pairs += 1;
+                bounds.may_be_present_pairs += u64::from(e.reference.is_none());
+            }
+            if e.reference.is_some() {
+                bounds.max_depth_interval_ulps =
+                    bounds.max_depth_interval_ulps.max(e.key_hi - e.key_lo);
+            }
+        }
+        Self {
+            exact: false,
+            offsets,
+            entries,
+            bounds,
+        }
+    }
+
+    /// Whether the implementation owes bit-exactness (f64 vertex precision): no analysis, the
+    /// exact comparison applies.
+    #[must_use]
+    pub fn is_exact(&self) -> bool {
+        self.exact
+    }
+
+    /// The bounds derived.
+    #[must_use]
+    pub fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+
+    /// Number of pixels analysed (0 when exact).
+    #[must_use]
+    pub fn pixels(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// What pixel `p` may hold (empty when exact).
+    #[must_use]
+    pub fn pixel(&self, p: usize) -> &[Possible] {
+        if self.exact {
+            return &[];
+        }
+        &self.entries[self.offsets[p]..self.offsets[p + 1]]
+    }
+}
+
+/// The error bounds of vertex `index`, `None` when the reference clips it or its `w` is not
+/// bounded away from 0 by the transform's error.
+fn vertex_bound(
+    view: &View<'_>,
+    conventions: &Conventions,
+    index: u32,
+    bounds: &mut Bounds,
+) -> Option<VertexBound> {
+    let (snapped, depth) = view.vertex_window(index)?;
+    let clip = view.vertex_clip(index);
+    let m = view.view_projection().to_cols_array();
+    let p = view.mesh().positions[index as usize];
+    let v = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0];
+    // |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_5 Σ |M_rj||v_j|: four products and three sums (γ_4) on a
+    // matrix itself rounded to f32 (one more u).
+    let transform_error =
+        |row: usize| gamma_both(5.0) * (0..4).map(|c| (m[c * 4 + row] * v[c]).abs()).sum::<f64>();
+    let [ex, ey, ez, ew] = [0, 1, 2, 3].map(transform_error);
+    let w = clip.w;
+    if w.abs() <= ew {
+        return None;
+    }
+    // x̃/w̃ − x/w = (dx − (x/w) dw) / w̃, and the divide rounds once more.
+    let ndc_error = |c: f64, e: f64| {
+        let q = c / w;
+        let e = (e + q.abs() * ew) / (w.abs() - ew);
+        e + gamma_both(1.0) * (q.abs() + e)
+    };
+    let (nx, ny, nz) = (clip.x / w, clip.y / w, clip.z / w);
+    let (enx, eny, enz) = (
+        ndc_error(clip.x, ex),
+        ndc_error(clip.y, ey),
+        ndc_error(clip.z, ez),
+    );
+    // X = (ndc·½ + ½)·width: the error scaled by width/2, and three more roundings.
+    let viewport = view.viewport();
+    let window_error = |n: f64, e: f64, side: u32| {
+        let side = f64::from(side);
+        side / 2.0 * e + gamma_both(3.0) * ((n.abs() + e) / 2.0 + 0.5) * side
+    };
+    let error_x = window_error(nx, enx, viewport.width);
+    let error_y = window_error(ny, eny, viewport.height);
+    let depth_error = match conventions.depth_range {
+        DepthRange::ZeroToOne => enz,
+        DepthRange::MinusOneToOne => enz / 2.0 + gamma_both(2.0) * ((nz.abs() + enz) / 2.0 + 0.5),
+    };
+    // The reference's unsnapped position, exactly as its snap computes it.
+    let (wf, hf) = (f64::from(viewport.width), f64::from(viewport.height));
+    let exact = [(nx * 0.5 + 0.5) * wf, (0.5 - ny * 0.5) * hf];
+    let grid = 1i64 << (SUBPIXEL_BITS - conventions.subpixel_bits.min(SUBPIXEL_BITS));
+    let mut radius = 0;
+    for (axis, error) in [error_x, error_y].into_iter().enumerate() {
+        let step = (1u64 << conventions.subpixel_bits.min(SUBPIXEL_BITS)) as f64;
+        // Any round-to-nearest of a value in [X − e, X + e] lies in these grid points.
+        let lo = ((exact[axis] - error) * step - 0.5).ceil() as i64 * grid;
+        let hi = ((exact[axis] + error) * step + 0.5).floor() as i64 * grid;
+        radius = radius.max(snapped[axis] - lo).max(hi - snapped[axis]);
+        bounds.max_vertex_error_subpixels = bounds
+            .max_vertex_error_subpixels
+            .max(error * f64::from(1u32 << SUBPIXEL_BITS));
+    }
+    bounds.max_snap_radius_subpixels = bounds.max_snap_radius_subpixels.max(radius);
+    Some(VertexBound {
+        snapped,
+        depth,
+        radius,
+        depth_error,
+    })
+}
+
+/// The doubled signed area of `(a, b, p)` (the pipeline's edge function).
+fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
+    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+}
+
+/// The largest change of `edge(p0, q, p)` when `p0`, `q` and `p` move by at most `r0`, `rq`, `rp`
+/// in each coordinate: the edge function is bilinear, so with `α = r0 + rq` (the edge vector's
+/// change) and `s = rp + r0` (the offset's change) it is
+/// `|Δ| ≤ (|a| + |c|)·s + (|b| + |d|)·α + 2αs`.
+fn edge_bound(p0: [i64; 2], q: [i64; 2], p: [i64; 2], r0: i64, rq: i64, rp: i64) -> i64 {
+    let (alpha, s) = (r0 + rq, rp + r0);
+    let (a, c) = ((q[0] - p0[0]).abs(), (q[1] - p0[1]).abs());
+    let (b, d) = ((p[1] - p0[1]).abs(), (p[0] - p0[0]).abs());
+    (a + c) * s + (b + d) * alpha + 2 * alpha * s
+}
+
+/// The pipeline's top-left rule for an edge of a positively oriented triangle.
+fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    dy < 0 || (dy == 0 && dx > 0)
+}
+
+/// The largest f32 not above `x`, and the smallest not below.
+fn round_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+fn round_up(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) < x {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+/// Lists, for every pixel centre within the grown bounding box of an unclipped triangle, what an
+/// implementation may emit there.
+fn triangle(
+    viewport: Viewport,
+    prim: u32,
+    verts: [VertexBound; 3],
+    found: &mut Vec<(u32, Possible)>,
+) {
+    let [a, mut b, mut c] = verts;
+    let mut area = edge(a.snapped, b.snapped, c.snapped);
+    if area < 0 {
+        std::mem::swap(&mut b, &mut c);
+        area = -area;
+    }
+    let v = [a, b, c];
+    let area_bound = edge_bound(
+        b.snapped, c.snapped, a.snapped, b.radius, c.radius, a.radius,
+    );
+    let grow = v.iter().map(|x| x.radius).max().unwrap_or(0);
+    let one = 1i64 << SUBPIXEL_BITS;
+    let half = one / 2;
+    let lo = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).min().unwrap_or(0) - grow);
+    let hi = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).max().unwrap_or(0) + grow);
+    let span = |lo: i64, hi: i64, side: u32| {
+        let from = (lo - half + one - 1).div_euclid(one).max(0);
+        let to = (hi - half).div_euclid(one).min(i64::from(side) - 1);
+        (from, to)
+    };
+    let (x0, x1) = span(lo[0], hi[0], viewport.width);
+    let (y0, y1) = span(lo[1], hi[1], viewport.height);
+    let edges = [(1, 2), (2, 0), (0, 1)];
+    let z_lo = v.iter().map(|x| x.depth).fold(f64::INFINITY, f64::min);
+    let z_hi = v.iter().map(|x| x.depth).fold(f64::NEG_INFINITY, f64::max);
+    let area_stable = area > area_bound;
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let p = [x * one + half, y * one + half];
+            let e = edges.map(|(i, j)| edge(v[i].snapped, v[j].snapped, p));
+            let eb = edges.map(|(i, j)| {
+                edge_bound(v[i].snapped, v[j].snapped, p, v[i].radius, v[j].radius, 0)
+            });
+            let top_left = edges.map(|(i, j)| is_top_left(v[i].snapped, v[j].snapped));
+            let passes = |k: usize| e[k] > 0 || (e[k] == 0 && top_left[k]);
+            let covered = area > 0 && (0..3).all(passes);
+            let decided = |k: usize| eb[k] == 0 || e[k].abs() > eb[k];
+            let (certain, possible) = if area_stable {
+                let out = (0..3).any(|k| decided(k) && !passes(k));
+                ((0..3).all(|k| decided(k) && passes(k)), !out)
+            } else {
+                // The orientation itself may flip: either side's coverage may be emitted.
+                let pos = (0..3).all(|k| e[k] >= -eb[k]);
+                let neg = (0..3).all(|k| e[k] <= eb[k]);
+                (false, pos || neg)
+            };
+            if !possible && !covered {
+                continue;
+            }
+            let area_f = area as f64;
+            let z =
+                (e[0] as f64 * v[0].depth + e[1] as f64 * v[1].depth + e[2] as f64 * v[2].depth)
+                    / area_f;
+            let reference = if covered { depth_key(z as f32) } else { None };
+            let (key_lo, key_hi, inside) = if area_stable {
+                let denominator = area_f - area_bound as f64;
+                let mut moved = 0.0;
+                let mut weights = 0.0;
+                let mut magnitude = 0.0;
+                for k in 0..3 {
+                    let lambda = e[k] as f64 / area_f;
+                    let d = (eb[k] as f64 + lambda.abs() * area_bound as f64) / denominator;
+                    moved += d;
+                    weights += (lambda.abs() + d) * v[k].depth_error;
+                    magnitude += (lambda.abs() + d) * (v[k].depth.abs() + v[k].depth_error);
+                }
+                // Σ Δλ = 0, so the plane moves by Σ Δλ_k (Z_k − mid) ≤ Σ|Δλ| · range / 2; the
+                // vertex depths' own errors and the f32 plane evaluation (γ_6) add.
+                let delta = moved * (z_hi - z_lo) / 2.0 + weights + gamma_both(6.0) * magnitude;
+                let (lo, hi) = (round_down(z - delta), round_up(z + delta));
+                let inside = lo >= 0.0 && hi <= 1.0;
+                (
+                    depth_key(lo.max(0.0)).unwrap_or(0),
+                    depth_key(hi.min(1.0)).unwrap_or(KEY_ONE),
+                    inside,
+                )
+            } else {
+                (0, KEY_ONE, false)
+            };
+            found.push((
+                (y * i64::from(viewport.width) + x) as u32,
+                Possible {
+                    prim,
+                    key_lo,
+                    key_hi,
+                    certain: certain && inside && reference.is_some(),
+                    reference,
+                },
+            ));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
+mod verdict;
+
+pub use verdict::compare_within;

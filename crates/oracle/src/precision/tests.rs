@@ -1,0 +1,196 @@
+//! The derivation checked against brute force: every snapped position a conforming
+//! implementation may reach (each vertex moved anywhere within its radius, each vertex depth to
+//! either end of its error), rasterized by the pipeline's rules, gives only listed fragments, with
+//! depths inside their intervals, and covers every `certain` pair.
+
+use super::*;
+
+/// The pipeline's coverage and depth of one snapped triangle at every pixel centre, as
+/// `docs/semantics.md` rules 4 and 5 state them.
+fn rasterize(viewport: Viewport, xy: [[i64; 2]; 3], z: [f64; 3]) -> Vec<(u32, f64)> {
+    let (a, mut b, mut c) = (xy[0], xy[1], xy[2]);
+    let (mut zb, mut zc) = (z[1], z[2]);
+    let mut area = edge(a, b, c);
+    if area == 0 {
+        return Vec::new();
+    }
+    if area < 0 {
+        std::mem::swap(&mut b, &mut c);
+        std::mem::swap(&mut zb, &mut zc);
+        area = -area;
+    }
+    let (v, zs) = ([a, b, c], [z[0], zb, zc]);
+    let mut out = Vec::new();
+    for y in 0..i64::from(viewport.height) {
+        for x in 0..i64::from(viewport.width) {
+            let p = [x * 256 + 128, y * 256 + 128];
+            let e = [(1, 2), (2, 0), (0, 1)].map(|(i, j)| {
+                let value = edge(v[i], v[j], p);
+                (value, value > 0 || (value == 0 && is_top_left(v[i], v[j])))
+            });
+            if e.iter().all(|&(_, pass)| pass) {
+                let depth = (0..3).map(|k| e[k].0 as f64 * zs[k]).sum::<f64>() / area as f64;
+                out.push(((y * i64::from(viewport.width) + x) as u32, depth));
+            }
+        }
+    }
+    out
+}
+
+fn vertex(x: i64, y: i64, depth: f64, radius: i64, depth_error: f64) -> VertexBound {
+    VertexBound {
+        snapped: [x, y],
+        depth,
+        radius,
+        depth_error,
+    }
+}
+
+#[test]
+fn every_reachable_fragment_is_listed_and_certain_pairs_are_always_covered() {
+    let viewport = Viewport::new(6, 6).unwrap();
+    // Edges that pass within a subpixel or two of pixel centres (128 + 256 i), a sliver whose
+    // orientation may flip, and a large triangle whose interior is decided.
+    let cases = [
+        [
+            vertex(130, 40, 0.2, 1, 0.0),
+            vertex(1200, 129, 0.5, 1, 0.0),
+            vertex(385, 1400, 0.9, 1, 0.0),
+        ],
+        [
+            vertex(10, 10, 0.3, 1, 1e-6),
+            vertex(1500, 1500, 0.31, 1, 1e-6),
+            vertex(13, 1500, 0.4, 2, 1e-6),
+        ],
+        [
+            vertex(100, 100, 0.5, 1, 0.0),
+            vertex(900, 101, 0.5, 1, 0.0),
+            vertex(1500, 102, 0.6, 1, 0.0),
+        ],
+    ];
+    let (mut certain_seen, mut maybe_seen) = (0, 0);
+    for (prim, verts) in cases.into_iter().enumerate() {
+        let mut found = Vec::new();
+        triangle(viewport, prim as u32, verts, &mut found);
+        let listed = |pixel: u32| found.iter().find(|(p, _)| *p == pixel).map(|(_, q)| *q);
+        let mut always = vec![true; viewport.pixels()];
+        let r = verts.map(|v| v.radius);
+        let offsets = |r: i64| (-r..=r).flat_map(move |dx| (-r..=r).map(move |dy| [dx, dy]));
+        for da in offsets(r[0]) {
+            for db in offsets(r[1]) {
+                for dc in offsets(r[2]) {
+                    let xy: Vec<[i64; 2]> = [da, db, dc]
+                        .iter()
+                        .zip(&verts)
+                        .map(|(d, v)| [v.snapped[0] + d[0], v.snapped[1] + d[1]])
+                        .collect();
+                    for signs in 0..8u32 {
+                        let z = [0, 1, 2].map(|k| {
+                            let s = if signs >> k & 1 == 1 { 1.0 } else { -1.0 };
+                            verts[k].depth + s * verts[k].depth_error
+                        });
+                        let covered = rasterize(viewport, [xy[0], xy[1], xy[2]], z);
+                        let mut hit = vec![false; viewport.pixels()];
+                        for (pixel, depth) in covered {
+                            hit[pixel as usize] = true;
+                            let q = listed(pixel).unwrap_or_else(|| {
+                                panic!("case {prim}: pixel {pixel} reachable but not listed")
+                            });
+                            let key = (depth as f32).to_bits();
+                            assert!(
+                                (q.key_lo..=q.key_hi).contains(&key),
+                                "case {prim}: pixel {pixel} depth {depth} outside {q:?}"
+                            );
+                        }
+                        for (a, h) in always.iter_mut().zip(hit) {
+                            *a &= h;
+                        }
+                    }
+                }
+            }
+        }
+        for (pixel, q) in &found {
+            if q.certain {
+                certain_seen += 1;
+                assert!(
+                    always[*pixel as usize],
+                    "case {prim}: certain pixel {pixel} missed"
+                );
+            } else {
+                maybe_seen += 1;
+            }
+        }
+    }
+    // Not vacuous: both kinds occur.
+    assert!(
+        certain_seen > 0 && maybe_seen > 0,
+        "{certain_seen} {maybe_seen}"
+    );
+}
+
+#[test]
+fn a_centre_inside_the_edge_margin_is_ambiguous_and_outside_it_decided() {
+    // A vertical edge x = 128 + d (its vertices' radius 1) beside the centre of pixel 0
+    // (128, 128); the triangle lies to its right. The edge function there is E = −512·d, its bound
+    // (|a| + |c|)·s + (|b| + |d|)·α + 2αs with α = 2, s = 1: 512 + 2·(384 + |d|) + 4. So
+    // 512·|d| ≤ 1284 + 2·|d| ⇔ |d| ≤ 2: the centre is inside the margin for d = −2 and decided for
+    // d = −3. On the uncovered side the grown bounding box decides first: the vertices reach
+    // x = 128 + d − 1 at the least, so d = 1 may cover the centre and d = 2 cannot.
+    let viewport = Viewport::new(4, 2).unwrap();
+    let classify = |d: i64| {
+        let x = 128 + d;
+        let verts = [
+            vertex(x, 0, 0.5, 1, 0.0),
+            vertex(x, 512, 0.5, 1, 0.0),
+            vertex(x + 700, 256, 0.5, 0, 0.0),
+        ];
+        let mut found = Vec::new();
+        triangle(viewport, 0, verts, &mut found);
+        found
+            .iter()
+            .find(|(p, _)| *p == 0)
+            .map(|(_, q)| (q.certain, q.reference.is_some()))
+    };
+    assert_eq!(
+        classify(-2),
+        Some((false, true)),
+        "covered, inside the margin"
+    );
+    assert_eq!(classify(-3), Some((true, true)), "covered, decided");
+    assert_eq!(
+        classify(1),
+        Some((false, false)),
+        "not covered, may be present"
+    );
+    assert_eq!(classify(2), None, "not covered, decided");
+}
+
+#[test]
+fn the_edge_bound_holds_every_perturbation() {
+    let (p0, q, p) = ([3, -7], [40, 25], [-11, 9]);
+    let (r0, rq, rp) = (2, 1, 3);
+    let bound = edge_bound(p0, q, p, r0, rq, rp);
+    let e = edge(p0, q, p);
+    let mut largest = 0;
+    for d0 in -r0..=r0 {
+        for e0 in -r0..=r0 {
+            for dq in -rq..=rq {
+                for eq in -rq..=rq {
+                    for dp in -rp..=rp {
+                        for ep in -rp..=rp {
+                            let moved = edge(
+                                [p0[0] + d0, p0[1] + e0],
+                                [q[0] + dq, q[1] + eq],
+                                [p[0] + dp, p[1] + ep],
+                            );
+                            largest = largest.max((moved - e).abs());
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(largest <= bound, "{largest} > {bound}");
+    // Within a factor of two of the worst case: a bound this loose would still flag real edges.
+    assert!(2 * largest >= bound, "{largest} ≪ {bound}");
+}

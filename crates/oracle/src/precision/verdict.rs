@@ -1,0 +1,295 @@
+//! The verdict under precision: a capture judged against what a conforming implementation may
+//! produce ([`super::Precision`]) rather than against the reference's exact fragments.
+//!
+//! Guarantee: a pixel is an error only where no conforming implementation could have produced
+//! it: a `certain` fragment absent where the promise owes it (missing), a fragment no possibility
+//! admits (extra: another triangle, or a depth outside its interval), a list out of its own
+//! stored order (misordered: an implementation sorts its own depths), a counter outside the
+//! counts the pixel may have (overflow-miscounted), a corrupt word. Where the reference could
+//! go either way the pixel is [`verdict::AMBIGUOUS`]; equal with some depth moved inside its
+//! interval, [`verdict::WITHIN_PRECISION`]. With an exact analysis (f64 vertex precision) this is
+//! [`compare_with`], unchanged.
+
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+
+use super::{Possible, Precision};
+use crate::compare::{
+    compare_with, inferred_counter, verdict, CompareOptions, Comparison, VerdictCounts,
+};
+use crate::dump::WordCheck;
+use crate::{Diff, Oracle, PixelMismatch};
+
+/// Compares `candidate` with what `precision` allows, pixel by pixel under the candidate's
+/// promise; `reference` (the oracle of the same view) gives the examples' expected lists. With
+/// `options.depth_ulps > 0` every interval is widened by that many ulps on each side (the manual
+/// override). `options.complete` is ignored (the reference is the oracle, which knows every
+/// pixel's fragments).
+///
+/// # Panics
+/// If the capture, the reference, the analysis or `words` cover different numbers of pixels.
+#[must_use]
+pub fn compare_within(
+    precision: &Precision,
+    reference: &Oracle,
+    candidate: &Capture,
+    words: Option<&WordCheck>,
+    options: &CompareOptions<'_>,
+) -> Comparison {
+    if precision.is_exact() {
+        return compare_with(reference, candidate, words, options);
+    }
+    let pixels = candidate.pixels();
+    assert_eq!(reference.pixels(), pixels, "capture and reference differ");
+    assert_eq!(precision.pixels(), pixels, "analysis of another viewport");
+    if let Some(words) = words {
+        assert_eq!(
+            words.corrupt.len(),
+            pixels,
+            "word check of another viewport"
+        );
+    }
+    let mut comparison = Comparison {
+        diff: Diff::default(),
+        verdicts: Vec::with_capacity(pixels),
+        counts: VerdictCounts::default(),
+        claimed_overflow: 0,
+        corrupt_words: words.map_or(0, WordCheck::corrupt_words),
+        unchecked_words: words.map_or(0, |w| w.unchecked),
+        words_checked: words.is_some(),
+        first_corrupt: Vec::new(),
+    };
+    let mut got = Vec::new();
+    for p in 0..pixels {
+        got.clear();
+        let stored = candidate.pixel(p);
+        // The marker is no fragment: its word check calls it corrupt.
+        got.extend(stored.iter().filter(|&&e| {
+            words.is_none() || !matches!(candidate.keeps, Keeps::All { .. }) || e != u64::MAX
+        }));
+        let judged = judge_pixel(
+            precision.pixel(p),
+            &got,
+            candidate,
+            p,
+            words,
+            options.depth_ulps,
+        );
+        let mut flags = judged.flags;
+        if words.is_some_and(|w| !w.corrupt[p].is_empty()) {
+            flags |= verdict::CORRUPT;
+        }
+        comparison.counts.add(flags);
+        comparison.claimed_overflow += judged.claimed_overflow;
+        let total = &mut comparison.diff;
+        total.captured += got.len() as u64;
+        total.overflowed += judged.overflowed;
+        total.lost += judged.lost;
+        total.extra += judged.extra;
+        total.misordered_pixels += u64::from(flags & verdict::MISORDERED != 0);
+        total.overflow_miscounted_pixels += u64::from(flags & verdict::MISCOUNTED != 0);
+        if flags & verdict::DIFFERS != 0 {
+            total.mismatched_pixels += 1;
+            if total.first_mismatches.len() < options.examples {
+                let mask = match candidate.identity {
+                    Identity::KeyAndPrim => u64::MAX,
+                    Identity::KeyOnly => u64::MAX << 32,
+                    Identity::PrimOnly => u64::from(u32::MAX),
+                };
+                total.first_mismatches.push(PixelMismatch {
+                    pixel: p,
+                    expected: reference.pixel(p).iter().map(|e| e & mask).collect(),
+                    got: got.clone(),
+                });
+                if let Some(words) = words {
+                    comparison
+                        .first_corrupt
+                        .extend_from_slice(&words.corrupt[p]);
+                }
+            }
+        }
+        comparison.verdicts.push(flags);
+    }
+    comparison
+}
+
+/// One pixel's judgement.
+#[derive(Default)]
+struct Judged {
+    flags: u8,
+    lost: u64,
+    extra: u64,
+    overflowed: u64,
+    claimed_overflow: u64,
+}
+
+/// Assigns candidate fragments to possibilities: each candidate word, in ascending key order, to
+/// the unused admissible possibility whose interval closes first (the earliest-deadline rule, which
+/// matches as many points to intervals as any assignment can), an exact reference match first.
+fn assign(
+    possible: &[Possible],
+    got: &[u64],
+    identity: Identity,
+    widen: u32,
+) -> Vec<Option<usize>> {
+    let mut order: Vec<usize> = (0..got.len()).collect();
+    order.sort_by_key(|&i| got[i]);
+    let mut used = vec![false; possible.len()];
+    let mut assigned = vec![None; got.len()];
+    for i in order {
+        let (key, prim) = ((got[i] >> 32) as u32, got[i] as u32);
+        let admits = |q: &Possible| match identity {
+            Identity::PrimOnly => q.prim == prim,
+            Identity::KeyOnly => {
+                key >= q.key_lo.saturating_sub(widen) && key <= q.key_hi.saturating_add(widen)
+            }
+            Identity::KeyAndPrim => {
+                q.prim == prim
+                    && key >= q.key_lo.saturating_sub(widen)
+                    && key <= q.key_hi.saturating_add(widen)
+            }
+        };
+        let best = (0..possible.len())
+            .filter(|&j| !used[j] && admits(&possible[j]))
+            .min_by_key(|&j| {
+                let q = &possible[j];
+                let exact = identity != Identity::PrimOnly && q.reference == Some(key);
+                (!exact, q.key_hi, !q.certain)
+            });
+        if let Some(j) = best {
+            used[j] = true;
+            assigned[i] = Some(j);
+        }
+    }
+    assigned
+}
+
+fn judge_pixel(
+    possible: &[Possible],
+    got: &[u64],
+    candidate: &Capture,
+    p: usize,
+    words: Option<&WordCheck>,
+    widen: u32,
+) -> Judged {
+    let identity = candidate.identity;
+    let mut judged = Judged::default();
+    let assigned = assign(possible, got, identity, widen);
+    let mut matched = vec![false; possible.len()];
+    for (i, a) in assigned.iter().enumerate() {
+        match a {
+            None => judged.extra += 1,
+            Some(j) => {
+                matched[*j] = true;
+                let q = &possible[*j];
+                if !q.certain {
+                    judged.flags |= verdict::AMBIGUOUS;
+                }
+                let key = (got[i] >> 32) as u32;
+                if identity != Identity::PrimOnly && q.reference != Some(key) {
+                    judged.flags |= verdict::WITHIN_PRECISION;
+                }
+            }
+        }
+    }
+    // A reference fragment that may be absent and is: the coverage went the other way.
+    let absent_maybe = (0..possible.len())
+        .any(|j| !matched[j] && !possible[j].certain && possible[j].reference.is_some());
+    if absent_maybe {
+        judged.flags |= verdict::AMBIGUOUS;
+    }
+    let absent_certain: Vec<usize> = (0..possible.len())
+        .filter(|&j| !matched[j] && possible[j].certain)
+        .collect();
+    let widened = |q: &Possible| {
+        (
+            q.key_lo.saturating_sub(widen),
+            q.key_hi.saturating_add(widen),
+        )
+    };
+    match &candidate.keeps {
+        Keeps::Nearest(k) | Keeps::Farthest(k) => {
+            let nearest = matches!(candidate.keeps, Keeps::Nearest(_));
+            let k = *k as usize;
+            if got.len() > k {
+                judged.extra += (got.len() - k) as u64;
+            }
+            for &f in &absent_certain {
+                let (f_lo, f_hi) = widened(&possible[f]);
+                // Ahead of f in the promise's order: nearer for K nearest, farther for K farthest.
+                let (mut surely, mut maybe) = (0, 0);
+                for (j, q) in possible.iter().enumerate() {
+                    if j == f {
+                        continue;
+                    }
+                    let (lo, hi) = widened(q);
+                    let (sure, could) = if nearest {
+                        (hi < f_lo, lo <= f_hi)
+                    } else {
+                        (lo > f_hi, hi >= f_lo)
+                    };
+                    surely += usize::from(sure && q.certain);
+                    maybe += usize::from(could);
+                }
+                if maybe < k {
+                    judged.lost += 1;
+                } else if surely >= k {
+                    judged.overflowed += 1;
+                } else {
+                    judged.flags |= verdict::AMBIGUOUS;
+                }
+            }
+            if judged.overflowed > 0 {
+                judged.flags |= verdict::OVERFLOWED;
+            }
+        }
+        Keeps::All { capacity, overflow } => {
+            let counter = match words.and_then(|w| w.counters.as_ref()) {
+                Some(counters) => counters[p],
+                None => inferred_counter(got.len(), overflow[p]),
+            };
+            judged.claimed_overflow = u64::from(overflow[p]);
+            let certain = possible.iter().filter(|q| q.certain).count();
+            let count = counter.count as usize;
+            let cap = match capacity {
+                Capacity::Unbounded => usize::MAX,
+                Capacity::PerPixel(_) | Capacity::PerPixelUncounted(_) => counter.capacity as usize,
+            };
+            let counted = !matches!(capacity, Capacity::PerPixelUncounted(_));
+            if counted && (count < certain || count > possible.len()) {
+                judged.flags |= verdict::MISCOUNTED;
+            }
+            // The fragments storage could not hold: the implementation's own count past the
+            // capacity where it is one the pixel may have, else the most the pixel may have.
+            let arrived = if counted && count >= certain && count <= possible.len() {
+                count
+            } else {
+                possible.len()
+            };
+            let allowed = arrived.saturating_sub(cap);
+            judged.overflowed = allowed.min(absent_certain.len()) as u64;
+            judged.lost = absent_certain.len().saturating_sub(allowed) as u64;
+            if judged.overflowed > 0 {
+                judged.flags |= verdict::OVERFLOWED;
+            }
+        }
+    }
+    if judged.lost > 0 {
+        judged.flags |= verdict::MISSING;
+    }
+    if judged.extra > 0 {
+        judged.flags |= verdict::EXTRA;
+    }
+    let misordered = match identity {
+        // Bare ids: out of order only where the stored neighbours' depths are decided reversed.
+        Identity::PrimOnly => assigned.windows(2).any(|w| match (w[0], w[1]) {
+            (Some(a), Some(b)) => possible[a].key_lo > possible[b].key_hi.saturating_add(widen),
+            _ => false,
+        }),
+        // An implementation sorts its own depths: its stored list is in its own order.
+        _ => got.windows(2).any(|w| w[0] > w[1]),
+    };
+    if misordered {
+        judged.flags |= verdict::MISORDERED;
+    }
+    judged
+}

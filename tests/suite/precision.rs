@@ -1,0 +1,257 @@
+//! The verdict under precision on the bunny: an engine-like capture (fragsim's pipeline with an
+//! f32 vertex stage: f32 matrix and arithmetic, f32 vertex depths) judged against the f64 oracle
+//! passes with no error, and each planted bug in it (a dropped fragment, a wrong primitive id, an
+//! unsorted list, an extra fragment, a depth one ulp past its interval) is an error that no
+//! ambiguity excuses; with f64 vertex precision the verdict is today's exact one.
+
+use fragsim::capture::{Capacity, Capture, Identity, Keeps};
+use fragsim::oracle::compare::{compare_with, verdict, CompareOptions, Comparison};
+use fragsim::oracle::precision::{compare_within, Precision};
+use fragsim::oracle::Oracle;
+use fragsim::raster::conventions::VertexPrecision;
+use fragsim::raster::{Conventions, Fragment, OrbitCamera, Scene, ScreenTriangle, View, Viewport};
+
+/// A planted bug: an edit of one pixel's list.
+type Plant = dyn Fn(&mut Vec<u64>);
+
+const F32: Conventions = Conventions {
+    vertex_precision: VertexPrecision::F32,
+    ..Conventions::REFERENCE
+};
+
+fn with_bunny(test: impl FnOnce(&View<'_>, &Oracle)) {
+    let scene = Scene::default_scene();
+    let view = scene
+        .view(Viewport::new(96, 80).unwrap(), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    test(&view, &oracle);
+}
+
+/// Vertex `index` through an f32 vertex shader: the matrix rounded to f32, `M·v`, the divide
+/// and the viewport map in f32, snapped by rounding to the nearest subpixel.
+fn f32_vertex(view: &View<'_>, index: u32) -> ([i64; 2], f64) {
+    let m = view.view_projection().to_cols_array().map(|x| x as f32);
+    let p = view.mesh().positions[index as usize];
+    let row = |r: usize| m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+    let (x, y, z, w) = (row(0), row(1), row(2), row(3));
+    let viewport = view.viewport();
+    let wx = (x / w * 0.5 + 0.5) * viewport.width as f32;
+    let wy = (0.5 - y / w * 0.5) * viewport.height as f32;
+    (
+        [(wx * 256.0).round() as i64, (wy * 256.0).round() as i64],
+        f64::from(z / w),
+    )
+}
+
+/// The capture an f32 vertex stage produces: every pixel's fragments sorted, as an unbounded
+/// A-buffer with ids.
+fn engine_like(view: &View<'_>) -> Vec<Vec<u64>> {
+    let mut fragments: Vec<Fragment> = Vec::new();
+    for prim in 0..view.triangle_count() {
+        let indices = view.mesh().triangles[prim as usize];
+        assert!(indices.iter().all(|&i| view.vertex_window(i).is_some()));
+        let [(a, za), (mut b, mut zb), (mut c, mut zc)] = indices.map(|i| f32_vertex(view, i));
+        let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if area == 0 {
+            continue;
+        }
+        if area < 0 {
+            std::mem::swap(&mut b, &mut c);
+            std::mem::swap(&mut zb, &mut zc);
+        }
+        let tri = ScreenTriangle {
+            prim,
+            xy: [a, b, c],
+            z: [za, zb, zc],
+        };
+        view.scan(&tri, &mut |f| fragments.push(f));
+    }
+    let oracle = Oracle::from_fragments(view.viewport().pixels(), &fragments);
+    (0..oracle.pixels())
+        .map(|p| oracle.pixel(p).to_vec())
+        .collect()
+}
+
+fn capture_of(lists: &[Vec<u64>]) -> Capture {
+    let keeps = Keeps::All {
+        capacity: Capacity::Unbounded,
+        overflow: vec![0; lists.len()],
+    };
+    let mut capture = Capture::with_pixels(lists.len(), Identity::KeyAndPrim, keeps);
+    for list in lists {
+        capture.push_pixel(list.iter().copied());
+    }
+    capture
+}
+
+fn options() -> CompareOptions<'static> {
+    CompareOptions {
+        depth_ulps: 0,
+        examples: 4,
+        complete: None,
+    }
+}
+
+fn judge(precision: &Precision, oracle: &Oracle, lists: &[Vec<u64>]) -> Comparison {
+    compare_within(precision, oracle, &capture_of(lists), None, &options())
+}
+
+/// A pixel with at least two fragments, each of them certain (decided coverage and depth).
+fn certain_pixel(precision: &Precision, lists: &[Vec<u64>]) -> usize {
+    (0..lists.len())
+        .find(|&p| {
+            let possible = precision.pixel(p);
+            lists[p].len() >= 2
+                && possible.iter().all(|q| q.certain)
+                && possible.len() == lists[p].len()
+        })
+        .expect("a decided pixel of depth complexity 2 or more")
+}
+
+#[test]
+fn an_f32_vertex_stage_passes_within_precision_and_is_different_bit_for_bit() {
+    with_bunny(|view, oracle| {
+        let precision = Precision::derive(view, &F32);
+        let lists = engine_like(view);
+        let exact = compare_with(oracle, &capture_of(&lists), None, &options());
+        assert!(
+            exact.diff.mismatched_pixels > 0,
+            "the f32 stage must move something"
+        );
+        let judged = judge(&precision, oracle, &lists);
+        assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+        assert!(judged.counts.within_precision > 0);
+        let bounds = precision.bounds();
+        assert!(bounds.max_snap_radius_subpixels >= 1 && bounds.max_depth_interval_ulps > 0);
+        assert_eq!(bounds.unanalysed_triangles, 0);
+    });
+}
+
+#[test]
+fn the_analysis_lists_exactly_the_oracles_fragments_as_the_reference() {
+    with_bunny(|view, oracle| {
+        let precision = Precision::derive(view, &F32);
+        for p in 0..oracle.pixels() {
+            let mut listed: Vec<u64> = precision
+                .pixel(p)
+                .iter()
+                .filter_map(|q| {
+                    q.reference
+                        .map(|key| u64::from(key) << 32 | u64::from(q.prim))
+                })
+                .collect();
+            listed.sort_unstable();
+            assert_eq!(listed, oracle.pixel(p), "pixel {p}");
+            for q in precision.pixel(p) {
+                if let Some(key) = q.reference {
+                    assert!((q.key_lo..=q.key_hi).contains(&key), "pixel {p}: {q:?}");
+                }
+            }
+        }
+    });
+}
+
+#[test]
+fn planted_bugs_in_an_f32_capture_are_errors_not_ambiguities() {
+    with_bunny(|view, oracle| {
+        let precision = Precision::derive(view, &F32);
+        let lists = engine_like(view);
+        let p = certain_pixel(&precision, &lists);
+        let width = lists[p].len();
+        let foreign = view.triangle_count() + 7;
+        let bugs: [(&str, Box<Plant>, u8); 4] = [
+            (
+                "dropped",
+                Box::new(|l| {
+                    l.remove(0);
+                }),
+                verdict::MISSING,
+            ),
+            (
+                "wrong primitive id",
+                Box::new(move |l| l[0] = (l[0] & !u64::from(u32::MAX)) | u64::from(foreign)),
+                verdict::MISSING | verdict::EXTRA,
+            ),
+            ("unsorted", Box::new(|l| l.swap(0, 1)), verdict::MISORDERED),
+            (
+                "extra",
+                Box::new(move |l| l.insert(width - 1, l[width - 1])),
+                verdict::EXTRA,
+            ),
+        ];
+        for (name, plant, expected) in bugs {
+            let mut bugged = lists.clone();
+            plant(&mut bugged[p]);
+            let judged = judge(&precision, oracle, &bugged);
+            assert_eq!(judged.diff.mismatched_pixels, 1, "{name}");
+            let flags = judged.verdicts[p];
+            assert_eq!(flags & verdict::DIFFERS, expected, "{name}");
+            assert_eq!(flags & verdict::AMBIGUOUS, 0, "{name} excused as ambiguous");
+        }
+    });
+}
+
+#[test]
+fn a_depth_at_its_bound_passes_and_one_ulp_past_fails() {
+    with_bunny(|view, oracle| {
+        let precision = Precision::derive(view, &F32);
+        let lists: Vec<Vec<u64>> = (0..oracle.pixels())
+            .map(|p| oracle.pixel(p).to_vec())
+            .collect();
+        let p = certain_pixel(&precision, &lists);
+        let q = precision.pixel(p)[0];
+        for (key, passes) in [
+            (q.key_hi, true),
+            (q.key_lo, true),
+            (q.key_hi + 1, false),
+            (q.key_lo - 1, false),
+        ] {
+            let mut moved = lists.clone();
+            let i = moved[p].iter().position(|&e| e as u32 == q.prim).unwrap();
+            moved[p][i] = u64::from(key) << 32 | u64::from(q.prim);
+            moved[p].sort_unstable();
+            let judged = judge(&precision, oracle, &moved);
+            assert_eq!(
+                judged.diff.mismatched_pixels == 0,
+                passes,
+                "key {key:#x} of {q:?}"
+            );
+            if !passes {
+                assert_eq!(judged.verdicts[p], verdict::MISSING | verdict::EXTRA);
+            }
+        }
+    });
+}
+
+#[test]
+fn with_f64_vertex_precision_the_verdict_is_todays_bit_for_bit() {
+    with_bunny(|view, oracle| {
+        let precision = Precision::derive(view, &Conventions::REFERENCE);
+        assert!(precision.is_exact());
+        let mut lists: Vec<Vec<u64>> = (0..oracle.pixels())
+            .map(|p| oracle.pixel(p).to_vec())
+            .collect();
+        let deep: Vec<usize> = (0..lists.len()).filter(|&p| lists[p].len() >= 2).collect();
+        lists[deep[0]].swap(0, 1);
+        lists[deep[1]].remove(0);
+        lists[deep[2]][0] += 1 << 32; // one ulp deeper
+        for ulps in [0, 1] {
+            let options = CompareOptions {
+                depth_ulps: ulps,
+                ..options()
+            };
+            let capture = capture_of(&lists);
+            assert_eq!(
+                compare_within(&precision, oracle, &capture, None, &options),
+                compare_with(oracle, &capture, None, &options),
+                "{ulps} ulps"
+            );
+        }
+        let f64_capture = judge(&precision, oracle, &engine_like(view));
+        assert!(
+            f64_capture.diff.mismatched_pixels > 0,
+            "bit-exact owes every bit"
+        );
+    });
+}

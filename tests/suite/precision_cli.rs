@@ -1,0 +1,131 @@
+//! `fragsim compare` through the binary: the bounds an f32 vertex stage is judged by, a reference
+//! that cannot know (an MDTS K = 3 dump against an A-buffer: a note and exit 0), and dumps of
+//! different scenes (exit 2 unless `--allow-different-scenes`).
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+
+fn fragsim() -> Command {
+    Command::cargo_bin("fragsim").unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("precision-cli")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run(cmd: &mut Command, code: i32) -> String {
+    let output = cmd.output().unwrap();
+    let (out, err) = (
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    );
+    assert_eq!(
+        output.status.code(),
+        Some(code),
+        "stdout {out}\nstderr {err}"
+    );
+    out + &err
+}
+
+fn dump(dir: &Path, schemes: &str, view: &str) {
+    run(
+        fragsim()
+            .args([
+                "render",
+                "--scene",
+                "spheres:3",
+                "--width",
+                "48",
+                "--height",
+                "36",
+            ])
+            .args([
+                "--view",
+                view,
+                "--k",
+                "3",
+                "--scheme",
+                schemes,
+                "--no-images",
+                "--dump",
+            ])
+            .arg(dir),
+        0,
+    );
+}
+
+#[test]
+fn a_k3_reference_against_an_abuffer_is_a_note_and_exit_0() {
+    let dir = scratch("k3");
+    dump(&dir, "mdts,abuffer", "30");
+    let out = run(
+        fragsim()
+            .arg("compare")
+            .arg(dir.join("mdts"))
+            .arg(dir.join("abuffer"))
+            .arg("--no-image"),
+        0,
+    );
+    assert!(out.contains("cannot be judged"), "{out}");
+    assert!(out.contains("verdict: EQUAL"), "{out}");
+}
+
+#[test]
+fn dumps_of_different_scenes_exit_2_unless_asked_for() {
+    let dir = scratch("scenes");
+    dump(&dir.join("a"), "abuffer", "30");
+    dump(&dir.join("b"), "abuffer", "75");
+    let (a, b) = (dir.join("a/abuffer"), dir.join("b/abuffer"));
+    let refused = run(
+        fragsim().arg("compare").arg(&a).arg(&b).arg("--no-image"),
+        2,
+    );
+    assert!(refused.contains("different scenes"), "{refused}");
+    let asked = run(
+        fragsim()
+            .arg("compare")
+            .arg(&a)
+            .arg(&b)
+            .args(["--no-image", "--allow-different-scenes"]),
+        1,
+    );
+    assert!(asked.contains("verdict: DIFFERENT"), "{asked}");
+}
+
+#[test]
+fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
+    let dir = scratch("f32");
+    dump(&dir, "abuffer", "30");
+    let out = run(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join("abuffer"))
+            .args(["--no-image", "--vertex-precision", "f32"]),
+        0,
+    );
+    assert!(
+        out.contains("precision (f32 vertex stage): vertex error up to"),
+        "{out}"
+    );
+    let json = run(
+        fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join("abuffer"))
+            .args(["--no-image", "--json", "--vertex-precision", "f32"]),
+        0,
+    );
+    let report: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert!(
+        report["precision"]["max_depth_interval_ulps"]
+            .as_u64()
+            .unwrap()
+            > 0
+    );
+    assert!(report["verdicts"]["ambiguous"].is_u64(), "{json}");
+}
