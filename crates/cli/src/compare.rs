@@ -54,10 +54,12 @@ pub struct CompareArgs {
     /// travelled); its bytes must still hash as the dump says.
     #[arg(long, value_name = "PATH")]
     pub mesh: Option<PathBuf>,
-    /// The candidate's vertex-stage precision when the reference is the oracle, in place of the
-    /// one its dump declares (`scene.conventions`): `f64` owes every bit (fragsim's own dumps, a
-    /// replay of its screen triangles); `f32` (a vertex shader) is judged within the bounds
-    /// derived from it (`docs/semantics.md`, "Precision of a conforming implementation").
+    /// How the candidate's vertex stage is judged when the reference is the oracle: by default
+    /// (and `f64`) every bit is owed to the oracle rebuilt under the dump's declared conventions
+    /// (`scene.conventions`, its vertex stage included: fragsim's own dumps, a replay of its
+    /// screen triangles); `f32` (a vertex shader) judges it within the bounds derived for an f32
+    /// vertex stage against the exact f64 one (`docs/semantics.md`, "Precision of a conforming
+    /// implementation").
     #[arg(long, value_name = "f64|f32", value_parser = ["f64", "f32"])]
     pub vertex_precision: Option<String>,
     /// Compare two dumps that name different scenes (refused otherwise, exit 2).
@@ -239,19 +241,24 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     }
     // The oracle is built only when a side asks for it (the scene may be a large mesh).
     let needs_oracle = matches!(reference, Side::Oracle) || matches!(candidate, Side::Oracle);
-    // The conventions the candidate declares, its vertex precision overridden by the flag. The
-    // oracle is built under them with the f64 vertex stage: the derived bounds measure an
-    // implementation's distance from the exact vertex positions, not from another f32 order.
+    // Without the flag the oracle is rebuilt under the conventions the dump declares, its vertex
+    // stage included, and owes every bit (fragsim's own dumps under any conventions). With
+    // `--vertex-precision f32` the oracle takes the exact f64 vertex stage under the declared
+    // conventions, and the candidate is judged within the bounds derived for an f32 one: they
+    // measure an implementation's distance from the exact positions, not from another f32 order.
+    let judged_f32 = args.vertex_precision.as_deref() == Some("f32");
     let conventions = Conventions {
-        vertex_precision: match args.vertex_precision.as_deref() {
-            Some("f32") => VertexPrecision::F32,
-            Some(_) => VertexPrecision::F64,
-            None => header.scene.conventions.vertex_precision,
+        vertex_precision: if judged_f32 {
+            VertexPrecision::F32
+        } else {
+            VertexPrecision::F64
         },
         ..header.scene.conventions
     };
     let mut exact_scene = header.scene.clone();
-    exact_scene.conventions.vertex_precision = VertexPrecision::F64;
+    if judged_f32 {
+        exact_scene.conventions.vertex_precision = VertexPrecision::F64;
+    }
     let (oracle, precision) = if needs_oracle {
         let scene = exact_scene.load(Some(&beside)).map_err(|e| e.to_string())?;
         let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
@@ -265,7 +272,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     } else {
         (None, None)
     };
-    if args.vertex_precision.as_deref() == Some("f32") && !matches!(reference, Side::Oracle) {
+    if judged_f32 && !matches!(reference, Side::Oracle) {
         return Err(
             "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
              to derive bounds from"
