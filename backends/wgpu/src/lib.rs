@@ -14,5 +14,5 @@ pub mod judge;
 pub mod shaders;
 
 pub use capture::{capture, Captured, Mode};
-pub use device::{Gpu, GpuError};
+pub use device::{adapter_or_skip, Gpu, GpuError};
 pub use shaders::GpuScheme;
