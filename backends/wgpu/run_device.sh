@@ -9,6 +9,8 @@
 # the dumps are not written (--discard: at most 8 files come back, and the 2048² linked lists
 # are a gigabyte each). The spinlocked k-buffer runs on its own under `timeout`: a spinlock in a
 # fragment shader has no forward-progress guarantee, so a hang is reported, not waited out.
+# --capacity 4 (A-buffer slots, linked-list pool nodes per pixel) so that the fixed A-buffer's
+# off-by-one plant has pixels at its capacity to show in (the bunny has none at 20).
 # The logs are the result: $OUT/wgpu-<scene>.log, and everything on stdout.
 set -uo pipefail
 bin=target/devbin-wgpu
@@ -33,7 +35,7 @@ one_scene() {
         for view in 30 120; do
             for mode in replay engine; do
                 local common=("${what[@]}" --width "$side" --height "$side" --view "$view"
-                    --mode "$mode" --k 8 --capacity 20 --judge --discard --depth-ulps 0,4,256)
+                    --mode "$mode" --k 8 --capacity 4 --judge --discard --depth-ulps 0,256)
                 echo "== $scene ${side}x${side} view $view $mode"
                 "$bin/fragsim-wgpu" capture --scheme "$schemes" --plant all "${common[@]}"
                 timeout 60 "$bin/fragsim-wgpu" capture --scheme kbuffer-spinlock-fixed "${common[@]}" \

@@ -762,3 +762,19 @@ fn to_dump(
     };
     Ok(Dump { header, arrays })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::per_pixel_groups;
+
+    #[test]
+    fn per_pixel_dispatches_cover_every_pixel_within_the_limit() {
+        assert_eq!(per_pixel_groups(0, 65535), (1, 1));
+        assert_eq!(per_pixel_groups(64, 65535), (1, 1));
+        assert_eq!(per_pixel_groups(65, 65535), (2, 1));
+        // 2048² pixels: 65536 workgroups of 64, past one dimension's 65535.
+        let (x, y) = per_pixel_groups(2048 * 2048, 65535);
+        assert_eq!((x, y), (65535, 2));
+        assert!(u64::from(x) * u64::from(y) * 64 >= 2048 * 2048);
+    }
+}

@@ -381,3 +381,41 @@ impl GpuScheme {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_parses_to_its_scheme_and_zero_sizes_are_refused() {
+        for name in NAMES {
+            assert_eq!(GpuScheme::parse(name, 8, 4).unwrap().name(), name);
+        }
+        assert!(GpuScheme::parse("abuffer", 8, 0).is_err());
+        assert!(GpuScheme::parse("linked-list", 0, 4).is_err());
+        let e = GpuScheme::parse("mdts64", 8, 4).unwrap_err();
+        assert!(e.0.contains("abuffer, abuffer-exact"), "{e}");
+    }
+
+    #[test]
+    fn storages_have_the_shapes_of_their_dump_layouts() {
+        let list = GpuScheme::parse("linked-list-nearest", 8, 3).unwrap();
+        let shapes: Vec<(&str, Vec<u64>)> = list
+            .storages(10, 0)
+            .into_iter()
+            .map(|s| (s.name, s.shape))
+            .collect();
+        assert_eq!(
+            shapes,
+            [
+                ("heads", vec![10]),
+                ("counter", vec![1]),
+                ("next", vec![30]),
+                ("nodes", vec![30])
+            ]
+        );
+        let exact = GpuScheme::ABufferExact.storages(10, 17);
+        assert_eq!(exact[1].shape, [11]);
+        assert_eq!((exact[2].shape.clone(), exact[2].words()), (vec![17], 34));
+    }
+}
