@@ -69,10 +69,12 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
             "the dump covers {dump_pixels} pixels, the oracle {pixels}"
         )));
     }
+    // The oracle knows every fragment (`complete: None`); any option added later keeps its
+    // default.
     let options = CompareOptions {
         depth_ulps,
         examples: 8,
-        complete: None,
+        ..Default::default()
     };
     let comparison = dump.compare(oracle, &options)?;
     let capture = dump.capture()?;
