@@ -16,9 +16,47 @@ struct Params {
     // 1: replay mode, the primitive id comes from the vertex (pieces of a clipped triangle share
     // it); 0: engine mode, the primitive id is the draw's primitive_index.
     replay: u32,
+    // Linked lists: nodes in the pool.
+    pool: u32,
+    // Uniform structs are 16-byte multiples.
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
+
+// The planted bug this pipeline was built with (fragsim-wgpu's `--plant`; 0: the correct
+// shader). A pipeline-overridable constant, so each plant is its own specialised shader and the
+// correct one carries no branch on it at run time.
+override plant: u32 = 0u;
+// A planted fragment is dropped before any store.
+const PLANT_DROPPED: u32 = 1u;
+// A planted fragment is stored with primitive id prim ^ 1.
+const PLANT_WRONG_ID: u32 = 2u;
+// The A-buffer stores one slot fewer than its capacity (abuffer.wgsl).
+const PLANT_OFF_BY_ONE_CAPACITY: u32 = 3u;
+// The A-buffer's sort pass returns at once (abuffer.wgsl).
+const PLANT_UNSORTED: u32 = 4u;
+// A planted fragment's head exchange drops the old head (linked_list.wgsl).
+const PLANT_LOST_NODE: u32 = 5u;
+
+// Whether the fragment of (pixel, prim) is one the planted bugs hit: one in 256, by a hash, so
+// that every scene of a few thousand fragments has some and no pixel is singled out.
+fn planted(pixel: u32, prim: u32) -> bool {
+    var h = (pixel * 0x9E3779B1u) ^ (prim * 0x85EBCA77u);
+    h = (h ^ (h >> 15u)) * 0x2C1B3C6Du;
+    h = h ^ (h >> 12u);
+    return (h >> 24u) == 0u;
+}
+
+// The canonical order of fragment words key << 32 | prim held as (low, high) = (prim, key).
+fn word_before(a: vec2<u32>, b: vec2<u32>) -> bool {
+    return a.y < b.y || (a.y == b.y && a.x < b.x);
+}
+
+// The empty slot: all ones.
+const EMPTY_WORD: vec2<u32> = vec2<u32>(0xFFFFFFFFu, 0xFFFFFFFFu);
 
 struct Varyings {
     @builtin(position) position: vec4<f32>,
@@ -56,5 +94,13 @@ fn fragment_of(v: Varyings, primitive_index: u32) -> Fragment {
     if params.replay == 1u {
         prim = v.prim;
     }
-    return Fragment(y * params.width + x, key, prim, z >= 0.0 && z <= 1.0);
+    let pixel = y * params.width + x;
+    var inside = z >= 0.0 && z <= 1.0;
+    if plant == PLANT_DROPPED && planted(pixel, prim) {
+        inside = false;
+    }
+    if plant == PLANT_WRONG_ID && planted(pixel, prim) {
+        prim = prim ^ 1u;
+    }
+    return Fragment(pixel, key, prim, inside);
 }

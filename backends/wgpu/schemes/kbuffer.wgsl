@@ -6,26 +6,21 @@
 
 @group(0) @binding(2) var<storage, read_write> slots: array<vec2<u32>>;
 
-fn before(a: vec2<u32>, b: vec2<u32>) -> bool {
-    return a.y < b.y || (a.y == b.y && a.x < b.x);
-}
-
 @fragment
 fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
     let f = fragment_of(v, primitive_index);
     if !f.inside {
         return;
     }
-    let empty = vec2<u32>(0xFFFFFFFFu, 0xFFFFFFFFu);
     var carried = vec2<u32>(f.prim, f.key);
     let base = f.pixel * params.slots;
     for (var i = 0u; i < params.slots; i++) {
         let old = slots[base + i];
-        if before(carried, old) {
+        if word_before(carried, old) {
             slots[base + i] = carried;
             carried = old;
         }
-        if all(carried == empty) {
+        if all(carried == EMPTY_WORD) {
             break;
         }
     }

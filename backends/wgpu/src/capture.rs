@@ -9,6 +9,11 @@
 //! does (Vulkan conventions: upper-left origin, depth in [0, 1], the f32 vertex stage). Depth is
 //! the GPU's own interpolation in both modes (`@builtin(position).z`).
 //!
+//! A scheme is a list of passes ([`Pass`]: draws and compute dispatches) over its storage
+//! buffers, in one submission, read back at its end; the exact A-buffer first runs its counting
+//! passes in a submission of their own and reads back the prefix sum's total, which sizes its
+//! slots (the GPU's count, never the oracle's).
+//!
 //! Guarantee: the dump holds every word the shader left, bit for bit (nothing is repaired on
 //! the way back); bad requests (a replay viewport that is not a power of two, a buffer past the
 //! adapter's limits, a feature the adapter lacks) are errors naming the problem.
@@ -22,7 +27,8 @@ use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{Conventions, View};
 
 use crate::device::{Gpu, GpuError};
-use crate::shaders::{GpuScheme, Storage, COMMON};
+use crate::plant::Plant;
+use crate::shaders::{GpuScheme, Pass, Storage, COMMON, PIXEL_WORKGROUP};
 
 /// How the geometry reaches the GPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,9 +55,10 @@ impl Mode {
 pub struct Captured {
     /// The dump (header and arrays), ready to write or compare.
     pub dump: Dump,
-    /// The render pass on the GPU, from its timestamps (when the adapter has them).
+    /// The passes on the GPU, from the first one's start to the last one's end by timestamps
+    /// (when the adapter has them), summed over the submissions.
     pub gpu_ms: Option<f64>,
-    /// Submit to the end of the read-back, on the host.
+    /// Each submission to the end of its read-back, on the host, summed.
     pub wall_ms: f64,
     /// Triangles drawn (screen triangles in replay mode, mesh triangles in engine mode).
     pub triangles: u32,
@@ -140,39 +147,53 @@ pub fn capture(
     scheme: &GpuScheme,
     mode: Mode,
 ) -> Result<Captured, GpuError> {
+    capture_planted(gpu, view, scene, scheme, mode, None)
+}
+
+/// [`capture`] with a planted bug's shader variant ([`Plant`]); `None` is the correct shader.
+/// The dump names the scheme as the correct one would (its `extra` names the plant), so that
+/// `compare` judges it by what it claims to be.
+///
+/// # Errors
+/// As [`capture`], and a plant that does not apply to the scheme ([`Plant::check`]).
+pub fn capture_planted(
+    gpu: &Gpu,
+    view: &View<'_>,
+    scene: SceneAndCamera,
+    scheme: &GpuScheme,
+    mode: Mode,
+    plant: Option<Plant>,
+) -> Result<Captured, GpuError> {
     gpu.check(scheme.name(), scheme.needs())?;
+    if let Some(plant) = plant {
+        plant.check(scheme)?;
+    }
     let geometry = match mode {
         Mode::Replay => replay_geometry(view)?,
         Mode::Engine => engine_geometry(view),
     };
     let viewport = view.viewport();
     let pixels = viewport.pixels() as u64;
-    let storages = scheme.storages(pixels);
-    let limits = gpu.device.limits();
-    for s in &storages {
-        let bytes = s.words * 4;
-        if bytes > limits.max_storage_buffer_binding_size || bytes > limits.max_buffer_size {
+    if let Some(pool) = scheme.pool(pixels) {
+        if pool >= u64::from(u32::MAX) {
             return Err(GpuError(format!(
-                "{}: buffer {:?} of {bytes} bytes is past adapter {}'s limit ({} bytes per storage binding)",
-                scheme.name(),
-                s.name,
-                gpu.info.name,
-                limits.max_storage_buffer_binding_size
+                "{}: a pool of {pool} nodes does not fit 32-bit node numbers",
+                scheme.name()
             )));
         }
     }
-    let device = &gpu.device;
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let run = encode_and_run(gpu, viewport, &geometry, scheme, &storages, mode)?;
+    let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let run = Run::new(gpu, viewport, &geometry, scheme, mode, plant);
+    let result = run.all(pixels);
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(GpuError(format!(
             "{}: the device refused: {e}",
             scheme.name()
         )));
     }
-    let (words, gpu_ms, wall_ms) = run;
+    let (storages, words, gpu_ms, wall_ms) = result?;
     let dump = to_dump(
-        gpu, view, scene, scheme, mode, &geometry, words, gpu_ms, wall_ms,
+        gpu, view, scene, scheme, mode, plant, &geometry, &storages, words, gpu_ms, wall_ms,
     )?;
     Ok(Captured {
         dump,
@@ -182,185 +203,437 @@ pub fn capture(
     })
 }
 
-type RunResult = (Vec<Vec<u32>>, Option<f64>, f64);
+/// What a capture read back: the storages, their words, GPU and wall milliseconds.
+type RunResult = (Vec<Storage>, Vec<Vec<u32>>, Option<f64>, f64);
 
-fn encode_and_run(
-    gpu: &Gpu,
-    viewport: fragsim_raster::Viewport,
-    geometry: &Geometry,
-    scheme: &GpuScheme,
-    storages: &[Storage],
+/// What one submission read back ([`Run::phase`]).
+struct PhaseOutput {
+    /// The words of each range read, in order.
+    words: Vec<Vec<u32>>,
+    /// The GPU time of its passes, by timestamps.
+    gpu_ms: Option<f64>,
+    /// Submission to the end of the read-back.
+    wall_ms: f64,
+}
+
+/// The objects every pass of one capture shares: the shader module, the parameters, the
+/// geometry and the (never written) colour target.
+struct Run<'a> {
+    gpu: &'a Gpu,
+    scheme: &'a GpuScheme,
     mode: Mode,
-) -> Result<RunResult, GpuError> {
-    use wgpu::util::DeviceExt;
-    let device = &gpu.device;
-    let source = format!("{COMMON}\n{}", scheme.source());
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(scheme.name()),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
+    geometry: &'a Geometry,
+    module: wgpu::ShaderModule,
+    uniform: wgpu::Buffer,
+    vertices: wgpu::Buffer,
+    indices: Option<wgpu::Buffer>,
+    target: wgpu::TextureView,
+    constants: Vec<(&'static str, f64)>,
+    pixels: u64,
+}
 
-    let mut params = Vec::with_capacity(80);
-    for v in geometry.view_projection {
-        params.extend_from_slice(&v.to_le_bytes());
-    }
-    let replay = u32::from(mode == Mode::Replay);
-    for v in [viewport.width, viewport.height, scheme.slots(), replay] {
-        params.extend_from_slice(&v.to_le_bytes());
-    }
-    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("params"),
-        contents: &params,
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let buffers: Vec<wgpu::Buffer> = storages
-        .iter()
-        .map(|s| {
+// A colour target the shader never writes (write mask empty): Vulkan draws need a render
+// area, the schemes write storage buffers only.
+const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+
+impl<'a> Run<'a> {
+    fn new(
+        gpu: &'a Gpu,
+        viewport: fragsim_raster::Viewport,
+        geometry: &'a Geometry,
+        scheme: &'a GpuScheme,
+        mode: Mode,
+        plant: Option<Plant>,
+    ) -> Self {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        let source = format!("{COMMON}\n{}", scheme.source());
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(scheme.name()),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let pixels = viewport.pixels() as u64;
+        let mut params = Vec::with_capacity(96);
+        for v in geometry.view_projection {
+            params.extend_from_slice(&v.to_le_bytes());
+        }
+        let replay = u32::from(mode == Mode::Replay);
+        // `pool` fits: `capture_planted` refused larger pools.
+        let pool = scheme.pool(pixels).unwrap_or(0) as u32;
+        for v in [
+            viewport.width,
+            viewport.height,
+            scheme.slots(),
+            replay,
+            pool,
+            0,
+            0,
+            0,
+        ] {
+            params.extend_from_slice(&v.to_le_bytes());
+        }
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: &params,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertices"),
+            contents: &geometry.vertices,
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let indices = geometry.indices.as_ref().map(|indices| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(s.name),
-                contents: &bytes_of(&vec![s.initial; s.words as usize]),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                label: Some("indices"),
+                contents: &bytes_of(indices),
+                usage: wgpu::BufferUsages::INDEX,
             })
-        })
-        .collect();
+        });
+        let target = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("target"),
+                size: wgpu::Extent3d {
+                    width: viewport.width,
+                    height: viewport.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: TARGET_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        Self {
+            gpu,
+            scheme,
+            mode,
+            geometry,
+            module,
+            uniform,
+            vertices,
+            indices,
+            target,
+            constants: vec![("plant", plant.map_or(0.0, Plant::constant))],
+            pixels,
+        }
+    }
 
-    let mut entries = vec![wgpu::BindGroupLayoutEntry {
-        binding: 0,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }];
-    for s in storages {
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: s.binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
+    /// The counting passes (if any), the size read back, the passes, every storage read back.
+    fn all(&self, pixels: u64) -> Result<RunResult, GpuError> {
+        let counting = self.scheme.counting_storages(pixels);
+        let mut buffers = Vec::new();
+        for s in &counting {
+            buffers.push((s.binding, self.buffer(s)?));
+        }
+        let (mut gpu_ms, mut wall_ms) = (None, 0.0);
+        let mut total = 0;
+        let passes = self.scheme.counting_passes();
+        if !passes.is_empty() {
+            // The storage's size is the GPU's own count: offsets[pixels], the prefix sum's total.
+            let offsets = buffers
+                .iter()
+                .zip(&counting)
+                .find(|(_, s)| s.name == "offsets")
+                .map(|((_, b), _)| b)
+                .ok_or_else(|| GpuError("the counting passes bind no offsets".into()))?;
+            let bound: Vec<(&Storage, &wgpu::Buffer)> = counting
+                .iter()
+                .zip(buffers.iter().map(|(_, b)| b))
+                .collect();
+            let counted = self.phase(&bound, &passes, &[(offsets, pixels * 4, 4)])?;
+            (gpu_ms, wall_ms) = (counted.gpu_ms, counted.wall_ms);
+            total = u64::from(counted.words[0][0]);
+        }
+        let storages = self.scheme.storages(pixels, total);
+        for s in &storages {
+            if !buffers.iter().any(|(b, _)| *b == s.binding) {
+                buffers.push((s.binding, self.buffer(s)?));
+            }
+        }
+        let bound: Vec<(&Storage, &wgpu::Buffer)> = storages
+            .iter()
+            .map(|s| {
+                let buffer = buffers
+                    .iter()
+                    .find(|(b, _)| *b == s.binding)
+                    .map(|(_, buffer)| buffer)
+                    .expect("every storage's buffer was made above");
+                (s, buffer)
+            })
+            .collect();
+        let read: Vec<(&wgpu::Buffer, u64, u64)> =
+            bound.iter().map(|&(s, b)| (b, 0, s.words() * 4)).collect();
+        let PhaseOutput {
+            words,
+            gpu_ms: ms,
+            wall_ms: wall,
+        } = self.phase(&bound, &self.scheme.passes(), &read)?;
+        wall_ms += wall;
+        let gpu_ms = match (gpu_ms, ms) {
+            (Some(a), Some(b)) => Some(a + b),
+            (a, b) => a.or(b),
+        };
+        Ok((storages, words, gpu_ms, wall_ms))
+    }
+
+    /// A storage buffer at its initial words, refused past the adapter's limits. Never empty
+    /// (an empty binding is invalid): at least two words.
+    fn buffer(&self, s: &Storage) -> Result<wgpu::Buffer, GpuError> {
+        use wgpu::util::DeviceExt;
+        let bytes = s.words().max(2) * 4;
+        let limits = self.gpu.device.limits();
+        if bytes > limits.max_storage_buffer_binding_size || bytes > limits.max_buffer_size {
+            return Err(GpuError(format!(
+                "{}: buffer {:?} of {bytes} bytes is past adapter {}'s limit ({} bytes per storage binding)",
+                self.scheme.name(),
+                s.name,
+                self.gpu.info.name,
+                limits.max_storage_buffer_binding_size
+            )));
+        }
+        Ok(self
+            .gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(s.name),
+                contents: &bytes_of(&vec![s.initial; (bytes / 4) as usize]),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            }))
+    }
+
+    /// One submission: `passes` over the `bound` storages, then the `read` ranges (buffer,
+    /// byte offset, bytes) copied back, with the GPU time from the first pass's start to the
+    /// last one's end where the adapter has timestamps, and the wall time from the submission
+    /// to the end of the read-back.
+    fn phase(
+        &self,
+        bound: &[(&Storage, &wgpu::Buffer)],
+        passes: &[Pass],
+        read: &[(&wgpu::Buffer, u64, u64)],
+    ) -> Result<PhaseOutput, GpuError> {
+        let device = &self.gpu.device;
+        let name = self.scheme.name();
+        // Writable storage is not for vertex shaders (no VERTEX_WRITABLE_STORAGE): the
+        // parameters are the vertex stage's only binding.
+        let buffer_entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
             ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                ty,
                 has_dynamic_offset: false,
                 min_binding_size: None,
             },
             count: None,
+        };
+        let mut entries = vec![buffer_entry(
+            0,
+            wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            wgpu::BufferBindingType::Uniform,
+        )];
+        let mut bind = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: self.uniform.as_entire_binding(),
+        }];
+        for &(s, buffer) in bound {
+            entries.push(buffer_entry(
+                s.binding,
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                wgpu::BufferBindingType::Storage { read_only: false },
+            ));
+            bind.push(wgpu::BindGroupEntry {
+                binding: s.binding,
+                resource: buffer.as_entire_binding(),
+            });
+        }
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bindings"),
+            entries: &entries,
         });
-    }
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("bindings"),
-        entries: &entries,
-    });
-    let mut bind = vec![wgpu::BindGroupEntry {
-        binding: 0,
-        resource: uniform.as_entire_binding(),
-    }];
-    for (s, b) in storages.iter().zip(&buffers) {
-        bind.push(wgpu::BindGroupEntry {
-            binding: s.binding,
-            resource: b.as_entire_binding(),
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("bindings"),
+            layout: &layout,
+            entries: &bind,
         });
-    }
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("bindings"),
-        layout: &layout,
-        entries: &bind,
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("layout"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let replay_attributes = wgpu::vertex_attr_array![0 => Float32x4, 1 => Uint32];
-    let engine_attributes = wgpu::vertex_attr_array![0 => Float32x3];
-    let (vs, attributes): (&str, &[wgpu::VertexAttribute]) = match mode {
-        Mode::Replay => ("vs_replay", &replay_attributes),
-        Mode::Engine => ("vs_engine", &engine_attributes),
-    };
-    // A colour target the shader never writes (write mask empty): Vulkan draws need a render
-    // area, the schemes write storage buffers only.
-    let target_format = wgpu::TextureFormat::R8Unorm;
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(scheme.name()),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some(vs),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: geometry.stride,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes,
-            })],
-        },
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some(scheme.entry_point()),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format: target_format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::empty(),
-            })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
-    let target = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("target"),
-        size: wgpu::Extent3d {
-            width: viewport.width,
-            height: viewport.height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: target_format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
-    let target_view = target.create_view(&wgpu::TextureViewDescriptor::default());
-    let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("vertices"),
-        contents: &geometry.vertices,
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let index_buffer = geometry.indices.as_ref().map(|indices| {
-        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("indices"),
-            contents: &bytes_of(indices),
-            usage: wgpu::BufferUsages::INDEX,
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let timestamps = self.gpu.has(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        for (i, &pass) in passes.iter().enumerate() {
+            let begin = (i == 0).then_some(0);
+            let end = (i + 1 == passes.len()).then_some(1);
+            let stamps = timestamps.as_ref().map(|(set, _)| (set, begin, end));
+            match pass {
+                Pass::Draw(entry) => {
+                    let pipeline = self.draw_pipeline(&pipeline_layout, entry);
+                    self.draw(&mut encoder, &pipeline, &bind_group, stamps);
+                }
+                Pass::ComputeOnce(entry) | Pass::ComputePerPixel(entry) => {
+                    let pipeline =
+                        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                            label: Some(entry),
+                            layout: Some(&pipeline_layout),
+                            module: &self.module,
+                            entry_point: Some(entry),
+                            compilation_options: self.options(),
+                            cache: None,
+                        });
+                    let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(entry),
+                        timestamp_writes: stamps.map(|(set, b, e)| {
+                            wgpu::ComputePassTimestampWrites {
+                                query_set: set,
+                                beginning_of_pass_write_index: b,
+                                end_of_pass_write_index: e,
+                            }
+                        }),
+                    });
+                    cpass.set_pipeline(&pipeline);
+                    cpass.set_bind_group(0, &bind_group, &[]);
+                    let (x, y) = match pass {
+                        Pass::ComputePerPixel(_) => per_pixel_groups(
+                            self.pixels,
+                            device.limits().max_compute_workgroups_per_dimension,
+                        ),
+                        _ => (1, 1),
+                    };
+                    cpass.dispatch_workgroups(x, y, 1);
+                }
+            }
+        }
+        let mut sources: Vec<(&wgpu::Buffer, u64, u64)> = read.to_vec();
+        if let Some((set, resolve)) = &timestamps {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+            sources.push((resolve, 0, 16));
+        }
+        let staging: Vec<wgpu::Buffer> = sources
+            .iter()
+            .map(|&(source, offset, size)| {
+                // A mapped buffer is never empty; the words past `size` are not read.
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("read-back"),
+                    size: size.max(8),
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                encoder.copy_buffer_to_buffer(source, offset, &buffer, 0, size);
+                buffer
+            })
+            .collect();
+        let start = Instant::now();
+        self.gpu.queue.submit([encoder.finish()]);
+        for buffer in &staging {
+            buffer.map_async(wgpu::MapMode::Read, .., |_| {});
+        }
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError(format!("{name}: waiting for the GPU: {e}")))?;
+        let mut words = Vec::with_capacity(staging.len());
+        for (buffer, &(_, _, size)) in staging.iter().zip(&sources) {
+            let view = buffer
+                .get_mapped_range(..)
+                .map_err(|e| GpuError(format!("{name}: read-back: {e}")))?;
+            words.push(
+                view[..size as usize]
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect::<Vec<u32>>(),
+            );
+        }
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = timestamps.as_ref().map(|_| {
+            let t = words.pop().unwrap_or_default();
+            let ticks = |i: usize| u64::from(t[2 * i]) | (u64::from(t[2 * i + 1]) << 32);
+            ticks(1).saturating_sub(ticks(0)) as f64
+                * f64::from(self.gpu.queue.get_timestamp_period())
+                / 1e6
+        });
+        Ok(PhaseOutput {
+            words,
+            gpu_ms,
+            wall_ms,
         })
-    });
+    }
 
-    let timestamps = gpu.has(wgpu::Features::TIMESTAMP_QUERY).then(|| {
-        let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("timestamps"),
-            ty: wgpu::QueryType::Timestamp,
-            count: 2,
-        });
-        let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps"),
-            size: 16,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        (set, resolve)
-    });
+    fn options(&self) -> wgpu::PipelineCompilationOptions<'_> {
+        wgpu::PipelineCompilationOptions {
+            constants: &self.constants,
+            ..Default::default()
+        }
+    }
 
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-    {
+    fn draw_pipeline(&self, layout: &wgpu::PipelineLayout, entry: &str) -> wgpu::RenderPipeline {
+        let replay_attributes = wgpu::vertex_attr_array![0 => Float32x4, 1 => Uint32];
+        let engine_attributes = wgpu::vertex_attr_array![0 => Float32x3];
+        let (vs, attributes): (&str, &[wgpu::VertexAttribute]) = match self.mode {
+            Mode::Replay => ("vs_replay", &replay_attributes),
+            Mode::Engine => ("vs_engine", &engine_attributes),
+        };
+        self.gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module: &self.module,
+                    entry_point: Some(vs),
+                    compilation_options: self.options(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: self.geometry.stride,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &self.module,
+                    entry_point: Some(entry),
+                    compilation_options: self.options(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: TARGET_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::empty(),
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+    }
+
+    fn draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::RenderPipeline,
+        bind_group: &wgpu::BindGroup,
+        stamps: Option<(&wgpu::QuerySet, Option<u32>, Option<u32>)>,
+    ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(scheme.name()),
+            label: Some(self.scheme.name()),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target_view,
+                view: &self.target,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
@@ -369,75 +642,33 @@ fn encode_and_run(
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: timestamps
-                .as_ref()
-                .map(|(set, _)| wgpu::RenderPassTimestampWrites {
-                    query_set: set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
+            timestamp_writes: stamps.map(|(set, b, e)| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: b,
+                end_of_pass_write_index: e,
+            }),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.set_vertex_buffer(0, vertex_buffer.slice(..));
-        match &index_buffer {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        match &self.indices {
             Some(indices) => {
                 pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..3 * geometry.count, 0, 0..1);
+                pass.draw_indexed(0..3 * self.geometry.count, 0, 0..1);
             }
-            None => pass.draw(0..3 * geometry.count, 0..1),
+            None => pass.draw(0..3 * self.geometry.count, 0..1),
         }
     }
-    let mut sources: Vec<(&wgpu::Buffer, u64)> = buffers
-        .iter()
-        .zip(storages)
-        .map(|(b, s)| (b, s.words * 4))
-        .collect();
-    if let Some((set, resolve)) = &timestamps {
-        encoder.resolve_query_set(set, 0..2, resolve, 0);
-        sources.push((resolve, 16));
-    }
-    let staging: Vec<wgpu::Buffer> = sources
-        .iter()
-        .map(|&(source, size)| {
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("read-back"),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, size);
-            buffer
-        })
-        .collect();
-    let start = Instant::now();
-    gpu.queue.submit([encoder.finish()]);
-    let mut words = Vec::with_capacity(staging.len());
-    for buffer in &staging {
-        buffer.map_async(wgpu::MapMode::Read, .., |_| {});
-    }
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError(format!("{}: waiting for the GPU: {e}", scheme.name())))?;
-    for buffer in &staging {
-        let view = buffer
-            .get_mapped_range(..)
-            .map_err(|e| GpuError(format!("{}: read-back: {e}", scheme.name())))?;
-        words.push(
-            view.chunks_exact(4)
-                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                .collect::<Vec<u32>>(),
-        );
-    }
-    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let gpu_ms = timestamps.as_ref().map(|_| {
-        let t = words.pop().unwrap_or_default();
-        let ticks = |i: usize| u64::from(t[2 * i]) | (u64::from(t[2 * i + 1]) << 32);
-        ticks(1).saturating_sub(ticks(0)) as f64 * f64::from(gpu.queue.get_timestamp_period()) / 1e6
-    });
-    Ok((words, gpu_ms, wall_ms))
+}
+
+/// Workgroups (x, y) of a per-pixel compute pass: `x` at most the adapter's limit per
+/// dimension, `y` rows of them (the shader's pixel is `id.y · x · 64 + id.x`).
+fn per_pixel_groups(pixels: u64, max_per_dimension: u32) -> (u32, u32) {
+    let groups = pixels.div_ceil(u64::from(PIXEL_WORKGROUP)).max(1);
+    let x = groups.min(u64::from(max_per_dimension.max(1)));
+    (x as u32, groups.div_ceil(x) as u32)
 }
 
 /// The u64 words of an array read back as (low, high) u32 pairs.
@@ -455,38 +686,30 @@ fn to_dump(
     scene: SceneAndCamera,
     scheme: &GpuScheme,
     mode: Mode,
+    plant: Option<Plant>,
     geometry: &Geometry,
+    storages: &[Storage],
     words: Vec<Vec<u32>>,
     gpu_ms: Option<f64>,
     wall_ms: f64,
 ) -> Result<Dump, GpuError> {
     let viewport = view.viewport();
-    let pixels = viewport.pixels() as u64;
-    let slots = u64::from(scheme.slots());
     let mut arrays = BTreeMap::new();
     let mut specs = BTreeMap::new();
-    for (storage, words) in scheme.storages(pixels).iter().zip(words) {
-        let (dtype, shape, data) = match storage.dump_dtype {
-            Dtype::U32 if storage.per_pixel_slots => {
-                (Dtype::U32, vec![pixels, slots], Words::U32(words))
-            }
-            Dtype::U32 => (Dtype::U32, vec![pixels], Words::U32(words)),
-            Dtype::U64 => (
-                Dtype::U64,
-                vec![pixels, slots],
-                Words::U64(pairs_to_u64(&words)),
-            ),
+    for (storage, words) in storages.iter().zip(words) {
+        let (data, ext) = match storage.dtype {
+            Dtype::U32 => (Words::U32(words), "u32"),
+            Dtype::U64 => (Words::U64(pairs_to_u64(&words)), "u64"),
         };
-        let ext = if dtype == Dtype::U32 { "u32" } else { "u64" };
         specs.insert(
-            storage.dump_name.to_string(),
+            storage.name.to_string(),
             ArraySpec {
-                file: format!("{}.{ext}", storage.dump_name),
-                dtype,
-                shape,
+                file: format!("{}.{ext}", storage.name),
+                dtype: storage.dtype,
+                shape: storage.shape.clone(),
             },
         );
-        arrays.insert(storage.dump_name.to_string(), data);
+        arrays.insert(storage.name.to_string(), data);
     }
     // Engine mode draws the mesh with the orbit camera's matrix in f32 and Vulkan's conventions
     // (upper-left origin, depth in [0, 1]): the dump names both, so that compare rebuilds the
@@ -508,10 +731,11 @@ fn to_dump(
         format: FORMAT.into(),
         version: VERSION,
         producer: format!(
-            "fragsim-wgpu {} ({} mode, {})",
+            "fragsim-wgpu {} ({} mode, {}{})",
             env!("CARGO_PKG_VERSION"),
             mode.name(),
-            scheme.name()
+            scheme.name(),
+            plant.map_or(String::new(), |p| format!(", planted bug {}", p.name()))
         ),
         scene,
         width: viewport.width,
@@ -519,21 +743,38 @@ fn to_dump(
         scheme: scheme.layout().into(),
         k: scheme.k(),
         capacity: scheme.capacity(),
-        sorted: false,
-        filled: scheme.capacity().is_some(),
+        sorted: scheme.sorted(),
+        filled: scheme.filled(),
         word: scheme.word().into(),
-        pool: None,
+        pool: scheme.pool(viewport.pixels() as u64),
         layers: None,
-        layout: None,
+        layout: scheme.layout_spec(),
         arrays: specs,
         extra: serde_json::json!({
             "device": gpu.info.name,
             "driver": format!("{} {}", gpu.info.driver, gpu.info.driver_info),
             "mode": mode.name(),
             "shader": scheme.name(),
+            "plant": plant.map(Plant::name),
             "triangles_drawn": geometry.count,
             "timings": {"gpu_ms": gpu_ms, "wall_ms": wall_ms},
         }),
     };
     Ok(Dump { header, arrays })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::per_pixel_groups;
+
+    #[test]
+    fn per_pixel_dispatches_cover_every_pixel_within_the_limit() {
+        assert_eq!(per_pixel_groups(0, 65535), (1, 1));
+        assert_eq!(per_pixel_groups(64, 65535), (1, 1));
+        assert_eq!(per_pixel_groups(65, 65535), (2, 1));
+        // 2048² pixels: 65536 workgroups of 64, past one dimension's 65535.
+        let (x, y) = per_pixel_groups(2048 * 2048, 65535);
+        assert_eq!((x, y), (65535, 2));
+        assert!(u64::from(x) * u64::from(y) * 64 >= 2048 * 2048);
+    }
 }

@@ -4,7 +4,8 @@
 //! Guarantee: [`Gpu::open`] never panics for want of a GPU: no Vulkan driver, no adapter, or an
 //! adapter without `PRIMITIVE_INDEX` is a [`GpuError`] naming the problem. 64-bit atomics and
 //! timestamps are optional: a scheme that needs what the adapter lacks is refused when asked for
-//! ([`Gpu::check`]).
+//! ([`Gpu::check`]). [`adapter_or_skip`] is the tests' way in: the GPU, or one line saying why
+//! the test is skipped (or a failure where CI requires a GPU).
 
 use std::fmt;
 
@@ -139,5 +140,35 @@ impl Gpu {
             self.info.driver_info,
             flags.join(", ")
         )
+    }
+}
+
+/// The GPU for a test, or `None` after one line saying the test is skipped and why. Sets
+/// `XDG_RUNTIME_DIR` to the temporary directory when unset (Mesa warns without it) and prints
+/// the adapter's [`Gpu::report`] when there is one, so a test log names it.
+///
+/// # Panics
+/// With no usable adapter where a GPU is required: `CI=true` (set by CI) or
+/// `FRAGSIM_REQUIRE_GPU=1`, so that CI fails rather than skips.
+#[must_use]
+pub fn adapter_or_skip() -> Option<Gpu> {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    match Gpu::open() {
+        Ok(gpu) => {
+            println!("{}", gpu.report());
+            Some(gpu)
+        }
+        Err(e) => {
+            let required = std::env::var("CI").is_ok_and(|v| v == "true")
+                || std::env::var("FRAGSIM_REQUIRE_GPU").is_ok_and(|v| v == "1");
+            assert!(
+                !required,
+                "a GPU is required (CI=true or FRAGSIM_REQUIRE_GPU=1): {e}"
+            );
+            println!("skipped: {e} (set FRAGSIM_REQUIRE_GPU=1 to fail instead)");
+            None
+        }
     }
 }

@@ -5,10 +5,12 @@
 //! Coverage is what replay mode guarantees by construction (the GPU scans fragsim's own snapped
 //! triangles), while depth is the GPU's f32 interpolation, so a replay capture can be
 //! coverage-identical and still differ in depth keys: the two are reported apart. Coverage is
-//! checked at the pixels where the scheme keeps every fragment (A-buffer: counter within the
-//! capacity; MDTS: at most K fragments in the reference), from the primitive ids stored (or,
-//! for key-only words, the number of fragments).
+//! checked on the lists the dump decodes to (`Dump::capture`, the scheme's own resolve) at the
+//! pixels where the scheme keeps every fragment (at most K, or the capacity, in the reference;
+//! every pixel of the exact A-buffer), from the primitive ids stored (or, for key-only words, the
+//! number of fragments).
 
+use fragsim_capture::{Capacity, Identity, Keeps};
 use fragsim_oracle::compare::{CompareOptions, Comparison};
 use fragsim_oracle::dump::{Dump, DumpError, Words};
 use fragsim_oracle::Oracle;
@@ -67,48 +69,48 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
             "the dump covers {dump_pixels} pixels, the oracle {pixels}"
         )));
     }
+    // The oracle knows every fragment (`complete: None`); any option added later keeps its
+    // default.
     let options = CompareOptions {
         depth_ulps,
         examples: 8,
-        complete: None,
+        ..Default::default()
     };
     let comparison = dump.compare(oracle, &options)?;
-    let slots = dump.header.k.or(dump.header.capacity).unwrap_or(0) as usize;
-    let counters = match dump.arrays.get("counters") {
-        Some(Words::U32(c)) => Some(c.as_slice()),
-        _ => None,
+    let capture = dump.capture()?;
+    // The most fragments of a pixel the scheme keeps.
+    let keeps = match &capture.keeps {
+        Keeps::Nearest(k) | Keeps::Farthest(k) => *k as usize,
+        Keeps::All { capacity, .. } => match capacity {
+            Capacity::Unbounded => usize::MAX,
+            Capacity::PerPixel(c) | Capacity::PerPixelUncounted(c) => *c as usize,
+        },
     };
+    let key_only = capture.identity == Identity::KeyOnly;
     let (mut checked, mut differs) = (0u64, 0u64);
     for p in 0..pixels {
         let reference = oracle.pixel(p);
-        // The fragments a pixel stores: an A-buffer's counted slots, an MDTS pixel's full ones.
-        let stored = match counters {
-            Some(c) => c[p] as usize,
-            None => reference.len(),
-        };
-        if stored > slots || reference.len() > slots {
+        if reference.len() > keeps {
             continue;
         }
         checked += 1;
-        let same = match dump.arrays.get("slots") {
-            Some(Words::U64(words)) => {
-                let row = &words[p * slots..(p + 1) * slots];
-                let full = row.iter().take_while(|&&w| w != u64::MAX).count();
-                let taken = if counters.is_some() { stored } else { full };
-                let mut got: Vec<u32> = row[..taken].iter().map(|&w| w as u32).collect();
-                let mut want: Vec<u32> = reference.iter().map(|&w| w as u32).collect();
-                got.sort_unstable();
-                want.sort_unstable();
-                got == want && (counters.is_some() || full == taken)
-            }
-            Some(Words::U32(keys)) => {
-                let row = &keys[p * slots..(p + 1) * slots];
-                row.iter().take_while(|&&w| w != u32::MAX).count() == reference.len()
-            }
-            None => false,
+        let got = capture.pixel(p);
+        let same = if key_only {
+            got.len() == reference.len()
+        } else {
+            let prims = |list: &[u64]| {
+                let mut ids: Vec<u32> = list.iter().map(|&w| w as u32).collect();
+                ids.sort_unstable();
+                ids
+            };
+            prims(got) == prims(reference)
         };
         differs += u64::from(!same);
     }
+    let counters = match dump.arrays.get("counters") {
+        Some(Words::U32(c)) if dump.header.scheme == "abuffer" => Some(c.as_slice()),
+        _ => None,
+    };
     let counters_differ = counters.map(|c| {
         let n = oracle.depth_complexity();
         c.iter().zip(&n).filter(|(a, b)| a != b).count() as u64

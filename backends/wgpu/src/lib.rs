@@ -3,16 +3,18 @@
 //! NVIDIA driver on the H200), their buffers read back as dumps that `fragsim compare` judges
 //! (`docs/dump-format.md`).
 //!
-//! The parts: the headless device and its adapter report ([`device`]), the shaders and their
-//! buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), one capture in replay or
-//! engine mode ([`mod@capture`]), and the judgement of a capture against fragsim's oracle
-//! ([`judge`]). The command is `fragsim-wgpu` (`src/main.rs`).
+//! The parts: the headless device and its adapter report ([`device`]), the shaders, their passes
+//! and buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), the planted bugs
+//! ([`plant`]), one capture in replay or engine mode ([`mod@capture`]), and the judgement of a
+//! capture against fragsim's oracle ([`judge`]). The command is `fragsim-wgpu` (`src/main.rs`).
 
 pub mod capture;
 pub mod device;
 pub mod judge;
+pub mod plant;
 pub mod shaders;
 
-pub use capture::{capture, Captured, Mode};
-pub use device::{Gpu, GpuError};
+pub use capture::{capture, capture_planted, Captured, Mode};
+pub use device::{adapter_or_skip, Gpu, GpuError};
+pub use plant::Plant;
 pub use shaders::GpuScheme;

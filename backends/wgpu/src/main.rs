@@ -5,6 +5,7 @@
 //! fragsim-wgpu adapter
 //! fragsim-wgpu capture --scheme abuffer,mdts --scene bunny --width 512 --height 512 \
 //!     --view 30 --mode replay --out out/wgpu --judge
+//! fragsim-wgpu capture --scheme linked-list --plant lost-node --scene bunny --out out/wgpu
 //! ```
 //!
 //! Exit status: 0 on success (whatever the verdicts), 2 on an error (no adapter, bad input).
@@ -16,7 +17,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::Viewport;
-use fragsim_wgpu::{capture, judge, Gpu, GpuScheme, Mode};
+use fragsim_wgpu::shaders::NAMES;
+use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
 
 #[derive(Parser)]
 #[command(
@@ -40,7 +42,8 @@ enum Command {
     Adapter,
     /// Capture a scene with one or more schemes; one dump per scheme in OUT/<scheme>/.
     Capture {
-        /// Schemes, comma-separated: abuffer, mdts, mdts32, kbuffer.
+        /// Schemes, comma-separated: abuffer, abuffer-exact, mdts, mdts32, kbuffer,
+        /// linked-list, linked-list-nearest, kbuffer-spinlock-fixed; or all.
         #[arg(long, default_value = "abuffer,mdts,mdts32")]
         scheme: String,
         /// A mesh file (OBJ or PLY, optionally gzipped).
@@ -64,12 +67,21 @@ enum Command {
         /// replay: fragsim's snapped triangles; engine: the mesh and the f32 matrix.
         #[arg(long, value_enum, default_value = "replay")]
         mode: ModeArg,
-        /// MDTS and k-buffer slots per pixel.
+        /// MDTS and k-buffer slots per pixel; linked lists: the nodes the resolve keeps.
         #[arg(long, default_value_t = 8)]
         k: u32,
-        /// A-buffer slots per pixel (FreePipe's 20).
+        /// A-buffer slots per pixel (FreePipe's 20); linked lists: pool nodes per pixel.
         #[arg(long, default_value_t = 20)]
         capacity: u32,
+        /// Planted bugs' shader variants, comma-separated: dropped, wrong-id,
+        /// off-by-one-capacity, unsorted, lost-node, or none (the correct shader); each scheme
+        /// runs once per plant (dumps in OUT/<scheme>-planted-<plant>/). `all`: the correct
+        /// shader and every plant that applies to the scheme, the others skipped.
+        #[arg(long, default_value = "none", value_delimiter = ',')]
+        plant: Vec<String>,
+        /// Judge without writing the dumps (a device run whose dumps would not come back).
+        #[arg(long, requires = "judge")]
+        discard: bool,
         /// Output directory.
         #[arg(long, default_value = "out/wgpu")]
         out: PathBuf,
@@ -111,6 +123,8 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         mode,
         k,
         capacity,
+        plant,
+        discard,
         out,
         judge: judge_it,
         depth_ulps,
@@ -118,10 +132,29 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     else {
         return Ok(());
     };
-    let schemes = scheme
-        .split(',')
-        .map(|s| GpuScheme::parse(s.trim(), k, capacity))
+    let names: Vec<&str> = if scheme == "all" {
+        NAMES.to_vec()
+    } else {
+        scheme.split(',').map(str::trim).collect()
+    };
+    let schemes = names
+        .into_iter()
+        .map(|s| GpuScheme::parse(s, k, capacity))
         .collect::<Result<Vec<_>, _>>()?;
+    // `all` skips the plants a scheme cannot show; a plant named is an error where it does not
+    // apply.
+    let every = plant.iter().any(|p| p == "all");
+    let plants: Vec<Option<Plant>> = if every {
+        std::iter::once(None).chain(Plant::ALL.map(Some)).collect()
+    } else {
+        plant
+            .iter()
+            .map(|p| match p.as_str() {
+                "none" => Ok(None),
+                name => Plant::parse(name).map(Some),
+            })
+            .collect::<Result<Vec<_>, _>>()?
+    };
     let spec = match &mesh {
         Some(path) => SceneAndCamera::hashed_mesh(path, view, elevation)?,
         None => SceneAndCamera::named(&scene, view, elevation),
@@ -135,42 +168,60 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     };
     let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
     let mut failed = 0;
+    let mut runs = 0;
     for scheme in &schemes {
-        // One scheme the adapter cannot run (a buffer past its limits, a missing feature) does
-        // not stop the others: it is reported and the command exits 2 at the end.
-        let captured = match capture(&gpu, &fragsim_view, spec.clone(), scheme, mode) {
-            Ok(captured) => captured,
-            Err(e) => {
-                eprintln!("fragsim-wgpu: {e}");
-                failed += 1;
+        for &plant in &plants {
+            if every && plant.is_some_and(|p| !p.applies_to(scheme)) {
                 continue;
             }
-        };
-        let dir = out.join(scheme.name());
-        captured.dump.write(&dir)?;
-        let gpu_ms = captured
-            .gpu_ms
-            .map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.3} ms"));
-        println!(
-            "{} {} {}x{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
-            scheme.name(),
-            mode.name(),
-            width,
-            height,
-            spec.describe(),
-            captured.triangles,
-            captured.wall_ms,
-            dir.display()
-        );
-        if let Some(oracle) = &oracle {
-            for &ulps in &depth_ulps {
-                let judgement = judge::judge(&captured.dump, oracle, ulps)?;
-                println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
+            runs += 1;
+            // One scheme the adapter cannot run (a buffer past its limits, a missing feature)
+            // does not stop the others: it is reported and the command exits 2 at the end.
+            let captured =
+                match capture_planted(&gpu, &fragsim_view, spec.clone(), scheme, mode, plant) {
+                    Ok(captured) => captured,
+                    Err(e) => {
+                        eprintln!("fragsim-wgpu: {e}");
+                        failed += 1;
+                        continue;
+                    }
+                };
+            let dir = match plant {
+                Some(p) => out.join(format!("{}-planted-{}", scheme.name(), p.name())),
+                None => out.join(scheme.name()),
+            };
+            if !discard {
+                captured.dump.write(&dir)?;
+            }
+            let gpu_ms = captured
+                .gpu_ms
+                .map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.3} ms"));
+            println!(
+                "{}{} {} {}x{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
+                scheme.name(),
+                plant.map_or(String::new(), |p| format!(" (planted: {})", p.name())),
+                mode.name(),
+                width,
+                height,
+                spec.describe(),
+                captured.triangles,
+                captured.wall_ms,
+                if discard {
+                    "(not written)".to_string()
+                } else {
+                    dir.display().to_string()
+                }
+            );
+            if let Some(oracle) = &oracle {
+                for &ulps in &depth_ulps {
+                    let judgement = judge::judge(&captured.dump, oracle, ulps)?;
+                    println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
+                }
             }
         }
     }
     if failed > 0 {
-        return Err(format!("{failed} of {} schemes could not run", schemes.len()).into());
+        return Err(format!("{failed} of {runs} captures could not run").into());
     }
     Ok(())
 }

@@ -1,32 +1,53 @@
-//! The schemes as WGSL fragment shaders (`backends/wgpu/schemes/`, each file named after the
-//! Rust module in `crates/capture/src/schemes/` that it mirrors) and, per scheme, the storage
-//! buffers its shader binds and the dump layout they are read back as.
+//! The schemes as WGSL shaders (`backends/wgpu/schemes/`, each file named after the Rust module
+//! in `crates/capture/src/schemes/` that it mirrors) and, per scheme, its passes, the storage
+//! buffers they bind and the dump layout those are read back as (the catalog's layout for the
+//! scheme, `docs/dump-format.md`).
 //!
 //! Guarantee: each shader is the Rust module's algorithm step for step (its file's comment says
-//! which), on the dump words of `docs/dump-format.md`; every buffer starts at the layout's empty
-//! word, so the dump's empty slots are the layout's empty marker.
+//! which), on the dump words of `docs/dump-format.md`; every buffer starts at the word the Rust
+//! scheme's memory starts at, so the dump's untouched words are the layout's empty markers.
 
-use fragsim_oracle::dump::Dtype;
+use fragsim_capture::schemes::linked_list::Resolve;
+use fragsim_oracle::dump::{Dtype, LayoutSpec};
 
 use crate::device::GpuError;
 
-/// `common.wgsl`: parameters, the two vertex stages and the fragment, prepended to every scheme.
+/// `common.wgsl`: parameters, the planted bugs' constant, the two vertex stages and the
+/// fragment, prepended to every scheme.
 pub const COMMON: &str = include_str!("../schemes/common.wgsl");
 const ABUFFER: &str = include_str!("../schemes/abuffer.wgsl");
 const MDTS: &str = include_str!("../schemes/mdts.wgsl");
 const KBUFFER: &str = include_str!("../schemes/kbuffer.wgsl");
+const LINKED_LIST: &str = include_str!("../schemes/linked_list.wgsl");
+const KBUFFER_SPINLOCK: &str = include_str!("../schemes/kbuffer_spinlock.wgsl");
 
-/// The scheme names [`GpuScheme::parse`] accepts.
-pub const NAMES: [&str; 4] = ["abuffer", "mdts", "mdts32", "kbuffer"];
+/// The scheme names [`GpuScheme::parse`] accepts (the catalog's names).
+pub const NAMES: [&str; 8] = [
+    "abuffer",
+    "abuffer-exact",
+    "mdts",
+    "mdts32",
+    "kbuffer",
+    "linked-list",
+    "linked-list-nearest",
+    "kbuffer-spinlock-fixed",
+];
+
+/// Invocations per workgroup of the per-pixel compute passes (`@workgroup_size(64)`).
+pub const PIXEL_WORKGROUP: u32 = 64;
 
 /// A scheme the GPU runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GpuScheme {
-    /// FreePipe's fixed A-buffer: an `atomicAdd` counter and `capacity` slots per pixel.
+    /// FreePipe's fixed A-buffer: an `atomicAdd` counter and `capacity` slots per pixel, then
+    /// the per-pixel sort in a compute pass.
     ABuffer {
         /// Slots per pixel.
         capacity: u32,
     },
+    /// The exact A-buffer: a counting pass, a prefix sum in a compute pass, the fill pass into
+    /// storage sized from the GPU's own total, then the sort.
+    ABufferExact,
     /// MDTS on u64 fragment words (`atomicMin` walk; 64-bit atomics).
     Mdts {
         /// Slots per pixel.
@@ -42,38 +63,91 @@ pub enum GpuScheme {
         /// Slots per pixel.
         k: u32,
     },
+    /// Per-pixel linked lists: `atomicAdd` node counter, `atomicExchange` heads.
+    LinkedList {
+        /// Nodes the resolve keeps.
+        k: u32,
+        /// Pool nodes per pixel (the pool is this times the pixels, as `fragsim --capacity`).
+        pool_per_pixel: u32,
+        /// Which nodes the resolve keeps (the dump's scheme name).
+        resolve: Resolve,
+    },
+    /// The k-buffer inside a per-pixel spinlock, the holder's path inside the loop body.
+    KbufferSpinlock {
+        /// Slots per pixel.
+        k: u32,
+    },
 }
 
-/// One storage buffer of a scheme: its binding, size, initial word and dump array.
+/// A pass of a scheme, in order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// The geometry drawn through this fragment entry point.
+    Draw(&'static str),
+    /// One workgroup of this compute entry point.
+    ComputeOnce(&'static str),
+    /// This compute entry point once per pixel ([`PIXEL_WORKGROUP`] a workgroup).
+    ComputePerPixel(&'static str),
+}
+
+/// One storage buffer of a scheme: its binding, initial word and the dump array it becomes.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Storage {
     /// The binding in `@group(0)`.
     pub binding: u32,
-    /// Its name (labels, messages).
+    /// The dump array's name (also the buffer's label).
     pub name: &'static str,
-    /// Length in u32 words.
-    pub words: u64,
-    /// Every word's value before the pass.
-    pub initial: u32,
-    /// The dump array it becomes.
-    pub dump_name: &'static str,
     /// The dump array's element type (u64 words are (low, high) u32 pairs on the GPU).
-    pub dump_dtype: Dtype,
-    /// Whether the array's shape is `[pixels, slots]` (else `[pixels]`).
-    pub per_pixel_slots: bool,
+    pub dtype: Dtype,
+    /// The dump array's shape.
+    pub shape: Vec<u64>,
+    /// Every u32 word's value before the first pass.
+    pub initial: u32,
+}
+
+impl Storage {
+    fn new(binding: u32, name: &'static str, dtype: Dtype, shape: Vec<u64>, initial: u32) -> Self {
+        Self {
+            binding,
+            name,
+            dtype,
+            shape,
+            initial,
+        }
+    }
+
+    /// Length in u32 words.
+    #[must_use]
+    pub fn words(&self) -> u64 {
+        let per = match self.dtype {
+            Dtype::U32 => 1,
+            Dtype::U64 => 2,
+        };
+        self.shape.iter().product::<u64>() * per
+    }
 }
 
 impl GpuScheme {
-    /// The scheme called `name`, with `k` MDTS/k-buffer slots or `capacity` A-buffer slots.
+    /// The scheme called `name`, with `k` MDTS/k-buffer slots or linked-list nodes kept, and
+    /// `capacity` A-buffer slots or linked-list pool nodes per pixel.
     ///
     /// # Errors
     /// An unknown name (the message lists [`NAMES`]) or zero slots.
     pub fn parse(name: &str, k: u32, capacity: u32) -> Result<Self, GpuError> {
+        let list = |resolve| Self::LinkedList {
+            k,
+            pool_per_pixel: capacity,
+            resolve,
+        };
         let scheme = match name {
             "abuffer" => Self::ABuffer { capacity },
+            "abuffer-exact" => Self::ABufferExact,
             "mdts" => Self::Mdts { k },
             "mdts32" => Self::Mdts32 { k },
             "kbuffer" => Self::Kbuffer { k },
+            "linked-list" => list(Resolve::KeepFirst),
+            "linked-list-nearest" => list(Resolve::KeepNearest),
+            "kbuffer-spinlock-fixed" => Self::KbufferSpinlock { k },
             _ => {
                 return Err(GpuError(format!(
                     "unknown scheme {name:?}: the wgpu backend has {}",
@@ -81,9 +155,10 @@ impl GpuScheme {
                 )))
             }
         };
-        if scheme.slots() == 0 {
+        let sizes = [scheme.k(), scheme.capacity(), scheme.pool_per_pixel()];
+        if sizes.contains(&Some(0)) {
             return Err(GpuError(format!(
-                "{name}: slots per pixel must be at least 1"
+                "{name}: slots, nodes kept and pool nodes per pixel must be at least 1"
             )));
         }
         Ok(scheme)
@@ -94,41 +169,99 @@ impl GpuScheme {
     pub fn name(&self) -> &'static str {
         match self {
             Self::ABuffer { .. } => "abuffer",
+            Self::ABufferExact => "abuffer-exact",
             Self::Mdts { .. } => "mdts",
             Self::Mdts32 { .. } => "mdts32",
             Self::Kbuffer { .. } => "kbuffer",
+            Self::LinkedList {
+                resolve: Resolve::KeepFirst,
+                ..
+            } => "linked-list",
+            Self::LinkedList {
+                resolve: Resolve::KeepNearest,
+                ..
+            } => "linked-list-nearest",
+            Self::KbufferSpinlock { .. } => "kbuffer-spinlock-fixed",
         }
     }
 
-    /// Slots per pixel.
-    #[must_use]
-    pub fn slots(&self) -> u32 {
-        match *self {
-            Self::ABuffer { capacity } => capacity,
-            Self::Mdts { k } | Self::Mdts32 { k } | Self::Kbuffer { k } => k,
-        }
-    }
-
-    /// The dump's K (MDTS layouts).
+    /// The dump's K: MDTS and k-buffer slots, linked-list nodes kept.
     #[must_use]
     pub fn k(&self) -> Option<u32> {
-        (!matches!(self, Self::ABuffer { .. })).then(|| self.slots())
+        match *self {
+            Self::Mdts { k }
+            | Self::Mdts32 { k }
+            | Self::Kbuffer { k }
+            | Self::KbufferSpinlock { k }
+            | Self::LinkedList { k, .. } => Some(k),
+            Self::ABuffer { .. } | Self::ABufferExact => None,
+        }
     }
 
-    /// The dump's capacity (A-buffer).
+    /// The dump's capacity (the fixed A-buffer).
     #[must_use]
     pub fn capacity(&self) -> Option<u32> {
-        matches!(self, Self::ABuffer { .. }).then(|| self.slots())
+        match *self {
+            Self::ABuffer { capacity } => Some(capacity),
+            _ => None,
+        }
     }
 
-    /// The dump layout (`docs/dump-format.md`): the k-buffer's sorted array is MDTS's.
+    fn pool_per_pixel(&self) -> Option<u32> {
+        match *self {
+            Self::LinkedList { pool_per_pixel, .. } => Some(pool_per_pixel),
+            _ => None,
+        }
+    }
+
+    /// Linked lists: the nodes of the pool over `pixels` pixels.
+    #[must_use]
+    pub fn pool(&self, pixels: u64) -> Option<u64> {
+        self.pool_per_pixel().map(|n| u64::from(n) * pixels)
+    }
+
+    /// The shader's `params.slots`: a pixel's slots (0 where storage is not per pixel).
+    #[must_use]
+    pub fn slots(&self) -> u32 {
+        match self {
+            Self::LinkedList { .. } | Self::ABufferExact => 0,
+            _ => self.k().or(self.capacity()).unwrap_or(0),
+        }
+    }
+
+    /// The dump layout's `scheme` (`docs/dump-format.md`): both A-buffers are `abuffer`, the
+    /// non-atomic k-buffer's sorted slots are MDTS's, the linked lists and the spinlocked
+    /// k-buffer name themselves.
     #[must_use]
     pub fn layout(&self) -> &'static str {
         match self {
-            Self::ABuffer { .. } => "abuffer",
+            Self::ABuffer { .. } | Self::ABufferExact => "abuffer",
             Self::Mdts { .. } | Self::Kbuffer { .. } => "mdts",
             Self::Mdts32 { .. } => "mdts32",
+            Self::LinkedList { .. } | Self::KbufferSpinlock { .. } => self.name(),
         }
+    }
+
+    /// The header's `layout` description, where the layout takes one.
+    #[must_use]
+    pub fn layout_spec(&self) -> Option<LayoutSpec> {
+        match self {
+            Self::LinkedList { .. } => Some(LayoutSpec::FRAGSIM_LISTS),
+            Self::KbufferSpinlock { .. } => Some(LayoutSpec::Memory),
+            _ => None,
+        }
+    }
+
+    /// Whether the dump's lists were sorted on the GPU (the A-buffers' sort pass).
+    #[must_use]
+    pub fn sorted(&self) -> bool {
+        matches!(self, Self::ABuffer { .. } | Self::ABufferExact)
+    }
+
+    /// Whether every slot starts at the empty marker (the A-buffers: the dump's `filled`).
+    #[must_use]
+    pub fn filled(&self) -> bool {
+        matches!(self, Self::ABuffer { .. } | Self::ABufferExact)
     }
 
     /// The dump's `word` field.
@@ -144,19 +277,39 @@ impl GpuScheme {
     #[must_use]
     pub fn source(&self) -> &'static str {
         match self {
-            Self::ABuffer { .. } => ABUFFER,
+            Self::ABuffer { .. } | Self::ABufferExact => ABUFFER,
             Self::Mdts { .. } | Self::Mdts32 { .. } => MDTS,
             Self::Kbuffer { .. } => KBUFFER,
+            Self::LinkedList { .. } => LINKED_LIST,
+            Self::KbufferSpinlock { .. } => KBUFFER_SPINLOCK,
         }
     }
 
-    /// The fragment entry point.
+    /// The passes before the host reads the storage's size back (the exact A-buffer's counting
+    /// pass and prefix sum, over [`GpuScheme::counting_storages`]); empty for the others.
     #[must_use]
-    pub fn entry_point(&self) -> &'static str {
+    pub fn counting_passes(&self) -> Vec<Pass> {
         match self {
-            Self::Mdts { .. } => "fs_u64",
-            Self::Mdts32 { .. } => "fs_u32",
-            _ => "fs_main",
+            Self::ABufferExact => vec![Pass::Draw("fs_count"), Pass::ComputeOnce("cs_prefix")],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The passes that leave the words the dump holds.
+    #[must_use]
+    pub fn passes(&self) -> Vec<Pass> {
+        match self {
+            Self::ABuffer { .. } => vec![
+                Pass::Draw("fs_main"),
+                Pass::ComputePerPixel("cs_sort_fixed"),
+            ],
+            Self::ABufferExact => vec![
+                Pass::Draw("fs_exact"),
+                Pass::ComputePerPixel("cs_sort_exact"),
+            ],
+            Self::Mdts { .. } => vec![Pass::Draw("fs_u64")],
+            Self::Mdts32 { .. } => vec![Pass::Draw("fs_u32")],
+            _ => vec![Pass::Draw("fs_main")],
         }
     }
 
@@ -172,43 +325,97 @@ impl GpuScheme {
         }
     }
 
-    /// The storage buffers over `pixels` pixels, in the order they are read back.
+    /// The exact A-buffer's counters and offsets, bound by the counting passes: the counters
+    /// count, the prefix sum leaves the offsets (the total last) and the counters at 0.
     #[must_use]
-    pub fn storages(&self, pixels: u64) -> Vec<Storage> {
-        let slots = pixels * u64::from(self.slots());
-        let words64 = |binding, name| Storage {
-            binding,
-            name,
-            words: 2 * slots,
-            initial: u32::MAX,
-            dump_name: "slots",
-            dump_dtype: Dtype::U64,
-            per_pixel_slots: true,
-        };
+    pub fn counting_storages(&self, pixels: u64) -> Vec<Storage> {
         match self {
-            Self::ABuffer { .. } => vec![
-                Storage {
-                    binding: 1,
-                    name: "counters",
-                    words: pixels,
-                    initial: 0,
-                    dump_name: "counters",
-                    dump_dtype: Dtype::U32,
-                    per_pixel_slots: false,
-                },
-                words64(2, "slots"),
+            Self::ABufferExact => vec![
+                Storage::new(1, "counters", Dtype::U32, vec![pixels], 0),
+                Storage::new(4, "offsets", Dtype::U32, vec![pixels + 1], 0),
             ],
-            Self::Mdts { .. } => vec![words64(1, "words")],
-            Self::Kbuffer { .. } => vec![words64(2, "slots")],
-            Self::Mdts32 { .. } => vec![Storage {
-                binding: 3,
-                name: "keys",
-                words: slots,
-                initial: u32::MAX,
-                dump_name: "slots",
-                dump_dtype: Dtype::U32,
-                per_pixel_slots: true,
-            }],
+            _ => Vec::new(),
         }
+    }
+
+    /// The storage buffers over `pixels` pixels, in the order they are read back; `total` is
+    /// the exact A-buffer's slot count (read back after [`GpuScheme::counting_passes`]).
+    #[must_use]
+    pub fn storages(&self, pixels: u64, total: u64) -> Vec<Storage> {
+        let per_pixel = |k: u32| vec![pixels, u64::from(k)];
+        let slots64 = |binding, shape| Storage::new(binding, "slots", Dtype::U64, shape, u32::MAX);
+        match *self {
+            Self::ABuffer { capacity } => vec![
+                Storage::new(1, "counters", Dtype::U32, vec![pixels], 0),
+                slots64(2, per_pixel(capacity)),
+            ],
+            Self::ABufferExact => {
+                let mut s = self.counting_storages(pixels);
+                s.push(slots64(2, vec![total]));
+                s
+            }
+            Self::Mdts { k } => vec![slots64(1, per_pixel(k))],
+            Self::Kbuffer { k } => vec![slots64(2, per_pixel(k))],
+            Self::Mdts32 { k } => {
+                vec![Storage::new(3, "slots", Dtype::U32, per_pixel(k), u32::MAX)]
+            }
+            Self::LinkedList { .. } => {
+                let pool = self.pool(pixels).unwrap_or(0);
+                vec![
+                    Storage::new(1, "heads", Dtype::U32, vec![pixels], 0),
+                    Storage::new(2, "counter", Dtype::U32, vec![1], 0),
+                    Storage::new(3, "next", Dtype::U32, vec![pool], 0),
+                    Storage::new(4, "nodes", Dtype::U64, vec![pool], 0),
+                ]
+            }
+            Self::KbufferSpinlock { k } => vec![
+                Storage::new(5, "words32", Dtype::U32, vec![pixels], 0),
+                Storage::new(
+                    6,
+                    "words64",
+                    Dtype::U64,
+                    vec![pixels * u64::from(k)],
+                    u32::MAX,
+                ),
+            ],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_parses_to_its_scheme_and_zero_sizes_are_refused() {
+        for name in NAMES {
+            assert_eq!(GpuScheme::parse(name, 8, 4).unwrap().name(), name);
+        }
+        assert!(GpuScheme::parse("abuffer", 8, 0).is_err());
+        assert!(GpuScheme::parse("linked-list", 0, 4).is_err());
+        let e = GpuScheme::parse("mdts64", 8, 4).unwrap_err();
+        assert!(e.0.contains("abuffer, abuffer-exact"), "{e}");
+    }
+
+    #[test]
+    fn storages_have_the_shapes_of_their_dump_layouts() {
+        let list = GpuScheme::parse("linked-list-nearest", 8, 3).unwrap();
+        let shapes: Vec<(&str, Vec<u64>)> = list
+            .storages(10, 0)
+            .into_iter()
+            .map(|s| (s.name, s.shape))
+            .collect();
+        assert_eq!(
+            shapes,
+            [
+                ("heads", vec![10]),
+                ("counter", vec![1]),
+                ("next", vec![30]),
+                ("nodes", vec![30])
+            ]
+        );
+        let exact = GpuScheme::ABufferExact.storages(10, 17);
+        assert_eq!(exact[1].shape, [11]);
+        assert_eq!((exact[2].shape.clone(), exact[2].words()), (vec![17], 34));
     }
 }

@@ -1,69 +1,96 @@
 //! The wgpu backend on whatever Vulkan adapter this machine has (Mesa's lavapipe in CI): every
 //! scheme on the bunny and a procedural scene, in replay and engine mode, judged by fragsim's
-//! oracle. Without an adapter each test prints one line saying it was skipped and why; with
-//! `CI=true` or `FRAGSIM_REQUIRE_GPU=1` it fails instead.
+//! oracle; every planted bug judged an error where the correct shader is equal. Without an
+//! adapter each test prints one line saying it was skipped and why; with `CI=true` or
+//! `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
 use std::process::Command;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use fragsim_capture::schemes::linked_list::Resolve;
+use fragsim_oracle::dump::Dump;
 
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::{judge, Judgement};
-use fragsim_wgpu::{capture, Gpu, GpuScheme, Mode};
+use fragsim_wgpu::{adapter_or_skip, capture, capture_planted, Gpu, GpuScheme, Mode, Plant};
 
-fn gpu() -> Option<Gpu> {
-    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
-    }
-    match Gpu::open() {
-        Ok(gpu) => {
-            println!("{}", gpu.report());
-            Some(gpu)
-        }
-        Err(e) => {
-            let required = std::env::var("CI").is_ok_and(|v| v == "true")
-                || std::env::var("FRAGSIM_REQUIRE_GPU").is_ok_and(|v| v == "1");
-            assert!(
-                !required,
-                "a GPU is required (CI=true or FRAGSIM_REQUIRE_GPU=1): {e}"
-            );
-            println!("skipped: {e} (set FRAGSIM_REQUIRE_GPU=1 to fail instead)");
-            None
-        }
-    }
-}
-
-/// Captures `scene` with `scheme` in `mode` at `side`² and judges it at 0 ulps.
-fn run(gpu: &Gpu, scene: &str, side: u32, scheme: GpuScheme, mode: Mode) -> (Judgement, Oracle) {
+/// Captures `scene` with `scheme` (planted with `plant`) in `mode` at `side`², writes the dump
+/// and reads it back as `fragsim compare` would, and judges it at `ulps`.
+fn run_planted(
+    gpu: &Gpu,
+    scene: &str,
+    scheme: GpuScheme,
+    mode: Mode,
+    plant: Option<Plant>,
+    ulps: u32,
+) -> (Judgement, Oracle) {
+    let side = 128;
     let spec = SceneAndCamera::named(scene, 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let view = loaded
         .view(Viewport::new(side, side).unwrap(), &spec.orbit())
         .unwrap();
     let oracle = Oracle::build(&view);
-    let captured = capture(gpu, &view, spec, &scheme, mode).unwrap();
-    let judgement = judge(&captured.dump, &oracle, 0).unwrap();
+    let captured = capture_planted(gpu, &view, spec, &scheme, mode, plant).unwrap();
+    // Tests run in parallel: each capture its own directory.
+    static NEXT: AtomicU32 = AtomicU32::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "fragsim-wgpu-test-{}-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    captured.dump.write(&dir).unwrap();
+    let dump = Dump::read(&dir).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(
+        dump, captured.dump,
+        "the dump read back is not the one written"
+    );
+    let judgement = judge(&dump, &oracle, ulps).unwrap();
     println!(
-        "{scene} {side}² {} {}: {}",
+        "{scene} {side}² {}{} {} at {ulps} ulps: {}",
         scheme.name(),
+        plant.map_or(String::new(), |p| format!(" planted {}", p.name())),
         mode.name(),
         judgement.summary()
     );
     (judgement, oracle)
 }
 
+/// [`run_planted`] with the correct shader, judged at 0 ulps.
+fn run(gpu: &Gpu, scene: &str, scheme: GpuScheme, mode: Mode) -> (Judgement, Oracle) {
+    run_planted(gpu, scene, scheme, mode, None, 0)
+}
+
 const SCENES: [&str; 2] = ["bunny", "bunny-spheres:8"];
+
+/// The correct schemes (the non-atomic k-buffer races by design and is judged apart).
+fn correct_schemes() -> [GpuScheme; 8] {
+    let list = |resolve| GpuScheme::LinkedList {
+        k: 8,
+        pool_per_pixel: 16,
+        resolve,
+    };
+    [
+        GpuScheme::ABuffer { capacity: 32 },
+        GpuScheme::ABuffer { capacity: 4 },
+        GpuScheme::ABufferExact,
+        GpuScheme::Mdts { k: 8 },
+        GpuScheme::Mdts32 { k: 8 },
+        list(Resolve::KeepFirst),
+        list(Resolve::KeepNearest),
+        GpuScheme::KbufferSpinlock { k: 8 },
+    ]
+}
 
 #[test]
 fn replay_coverage_is_fragsims_for_every_scheme() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = adapter_or_skip() else { return };
     for scene in SCENES {
-        for scheme in [
-            GpuScheme::ABuffer { capacity: 32 },
-            GpuScheme::Mdts { k: 8 },
-            GpuScheme::Mdts32 { k: 8 },
-        ] {
-            let (j, oracle) = run(&gpu, scene, 128, scheme, Mode::Replay);
+        for scheme in correct_schemes() {
+            let (j, oracle) = run(&gpu, scene, scheme, Mode::Replay);
             assert!(oracle.fragments() > 0, "{scene}: the view is empty");
             assert!(j.coverage_checked > 0);
             assert_eq!(j.coverage_differs, 0, "{scene} {}: coverage", scheme.name());
@@ -75,38 +102,33 @@ fn replay_coverage_is_fragsims_for_every_scheme() {
 
 #[test]
 fn engine_mode_coverage_differs_at_most_at_a_thousandth_of_the_covered_pixels() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = adapter_or_skip() else { return };
     for scene in SCENES {
-        let (j, oracle) = run(
-            &gpu,
-            scene,
-            128,
-            GpuScheme::ABuffer { capacity: 32 },
-            Mode::Engine,
-        );
-        let covered = oracle.depth_complexity().iter().filter(|&&n| n > 0).count() as u64;
-        assert!(covered > 0);
-        // Issue 16's bound for ambiguous pixels: an f32 vertex stage moves a few pixel centres
-        // that lie within a rounding error of a shared edge, no more.
-        assert!(
-            j.counters_differ.unwrap() * 1000 <= covered,
-            "{scene}: {} of {covered} covered pixels have another fragment count",
-            j.counters_differ.unwrap()
-        );
-        assert_eq!(j.comparison.corrupt_words, 0);
+        for scheme in correct_schemes() {
+            let (j, oracle) = run(&gpu, scene, scheme, Mode::Engine);
+            let covered = oracle.depth_complexity().iter().filter(|&&n| n > 0).count() as u64;
+            assert!(covered > 0);
+            // Issue 16's bound for ambiguous pixels: an f32 vertex stage moves a few pixel
+            // centres that lie within a rounding error of a shared edge, no more.
+            for (what, n) in [
+                ("fragment counts", j.counters_differ.unwrap_or(0)),
+                ("primitive ids", j.coverage_differs),
+            ] {
+                assert!(
+                    n * 1000 <= covered,
+                    "{scene} {}: {n} of {covered} covered pixels have other {what}",
+                    scheme.name()
+                );
+            }
+            assert_eq!(j.comparison.corrupt_words, 0, "{scene} {}", scheme.name());
+        }
     }
 }
 
 #[test]
 fn the_kbuffer_race_is_reported_as_it_is() {
-    let Some(gpu) = gpu() else { return };
-    let (j, oracle) = run(
-        &gpu,
-        "bunny",
-        128,
-        GpuScheme::Kbuffer { k: 8 },
-        Mode::Replay,
-    );
+    let Some(gpu) = adapter_or_skip() else { return };
+    let (j, oracle) = run(&gpu, "bunny", GpuScheme::Kbuffer { k: 8 }, Mode::Replay);
     let d = &j.comparison.diff;
     // Whatever the adapter does: a lost fragment is a missing pixel, and the fragments the
     // dump holds plus those lost cover the K nearest of every pixel.
@@ -121,7 +143,7 @@ fn the_kbuffer_race_is_reported_as_it_is() {
 
 #[test]
 fn replay_refuses_a_viewport_that_is_not_a_power_of_two() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = adapter_or_skip() else { return };
     let spec = SceneAndCamera::named("bunny", 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let view = loaded
@@ -142,4 +164,57 @@ fn with_no_vulkan_driver_the_command_says_so_and_exits_2() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("no Vulkan adapter"), "{stderr}");
+}
+
+/// Depth keys within this many ulps of fragsim's count as its (`--depth-ulps`): replay mode's
+/// GPU interpolates the f32-rounded vertex depths where fragsim evaluates the plane in f64 and
+/// rounds once, so a correct replay capture differs in depth by a few ulps.
+const REPLAY_ULPS: u32 = 256;
+
+#[test]
+fn every_planted_bug_is_an_error_where_the_correct_shader_is_equal() {
+    let Some(gpu) = adapter_or_skip() else { return };
+    // At 32 slots no pixel of the bunny at 128² reaches the capacity, so an off-by-one in it
+    // cannot show: the A-buffer is planted at 4 slots.
+    let schemes = correct_schemes()
+        .into_iter()
+        .filter(|s| *s != GpuScheme::ABuffer { capacity: 32 });
+    for scheme in schemes {
+        let plants = std::iter::once(None).chain(
+            Plant::ALL
+                .into_iter()
+                .filter(|p| p.applies_to(&scheme))
+                .map(Some),
+        );
+        for plant in plants {
+            let (j, _) = run_planted(&gpu, "bunny", scheme, Mode::Replay, plant, REPLAY_ULPS);
+            let what = format!(
+                "{} {}: {}",
+                scheme.name(),
+                plant.map_or("correct", Plant::name),
+                j.summary()
+            );
+            match plant {
+                None => assert!(j.comparison.is_equal(), "{what}"),
+                Some(_) => {
+                    assert!(!j.comparison.is_equal(), "{what}");
+                    assert!(j.comparison.diff.mismatched_pixels > 0, "{what}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn the_correct_shaders_are_equal_on_a_procedural_scene() {
+    let Some(gpu) = adapter_or_skip() else { return };
+    for scheme in correct_schemes() {
+        let (j, _) = run_planted(&gpu, SCENES[1], scheme, Mode::Replay, None, REPLAY_ULPS);
+        assert!(
+            j.comparison.is_equal(),
+            "{}: {}",
+            scheme.name(),
+            j.summary()
+        );
+    }
 }
