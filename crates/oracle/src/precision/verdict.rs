@@ -10,14 +10,67 @@
 //! interval, [`verdict::WITHIN_PRECISION`]. With an exact analysis (f64 vertex precision) this is
 //! [`compare_with`], unchanged.
 
-use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use std::path::Path;
 
-use super::{Possible, Precision};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{Conventions, Viewport};
+
+use super::{Bounds, Possible, Precision};
 use crate::compare::{
     compare_with, inferred_counter, verdict, CompareOptions, Comparison, VerdictCounts,
 };
-use crate::dump::WordCheck;
+use crate::dump::{Dump, DumpError, WordCheck};
+use crate::scene::SceneAndCamera;
 use crate::{Diff, Oracle, PixelMismatch};
+
+/// The reference an f32 vertex stage is judged against: the oracle of `scene` on `viewport`
+/// under its declared conventions but with the exact f64 vertex stage, and the analysis of an
+/// f32 one under the same conventions (what `fragsim compare oracle DIR --vertex-precision f32`
+/// builds). The bounds measure an implementation's distance from the exact positions, not from
+/// another f32 evaluation order. `beside` is where a dump's relative mesh path is looked up.
+///
+/// # Errors
+/// A scene that cannot be loaded or rasterized ([`SceneAndCamera::load`],
+/// [`SceneAndCamera::view`]).
+pub fn f32_reference(
+    scene: &SceneAndCamera,
+    viewport: Viewport,
+    beside: Option<&Path>,
+) -> Result<(Oracle, Precision), DumpError> {
+    let mut exact = scene.clone();
+    exact.conventions.vertex_precision = VertexPrecision::F64;
+    let loaded = exact.load(beside)?;
+    let view = exact.view(&loaded, viewport)?;
+    let f32_stage = Conventions {
+        vertex_precision: VertexPrecision::F32,
+        ..exact.conventions
+    };
+    Ok((Oracle::build(&view), Precision::derive(&view, &f32_stage)))
+}
+
+impl Dump {
+    /// The dump judged within the precision of an f32 vertex stage ([`f32_reference`], every
+    /// word read with [`Dump::check_words`], [`compare_within`]), with the bounds derived and the
+    /// reference's covered pixels (what the ambiguous pixels are a share of).
+    ///
+    /// # Errors
+    /// As [`f32_reference`] and [`Dump::capture`].
+    pub fn compare_within(
+        &self,
+        beside: Option<&Path>,
+        options: &CompareOptions<'_>,
+    ) -> Result<(Comparison, Bounds, u64), DumpError> {
+        let (oracle, precision) = f32_reference(&self.header.scene, self.viewport()?, beside)?;
+        let capture = self.capture()?;
+        let words = self.check_words()?;
+        let covered = (0..oracle.pixels())
+            .filter(|&p| !oracle.pixel(p).is_empty())
+            .count() as u64;
+        let comparison = compare_within(&precision, &oracle, &capture, Some(&words), options);
+        Ok((comparison, precision.bounds(), covered))
+    }
+}
 
 /// Compares `candidate` with what `precision` allows, pixel by pixel under the candidate's
 /// promise; `reference` (the oracle of the same view) gives the examples' expected lists. With
