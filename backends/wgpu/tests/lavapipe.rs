@@ -10,28 +10,9 @@ use fragsim_oracle::Oracle;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::{judge, Judgement};
 use fragsim_wgpu::{capture, Gpu, GpuScheme, Mode};
+use support::gpu;
 
-fn gpu() -> Option<Gpu> {
-    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
-    }
-    match Gpu::open() {
-        Ok(gpu) => {
-            println!("{}", gpu.report());
-            Some(gpu)
-        }
-        Err(e) => {
-            let required = std::env::var("CI").is_ok_and(|v| v == "true")
-                || std::env::var("FRAGSIM_REQUIRE_GPU").is_ok_and(|v| v == "1");
-            assert!(
-                !required,
-                "a GPU is required (CI=true or FRAGSIM_REQUIRE_GPU=1): {e}"
-            );
-            println!("skipped: {e} (set FRAGSIM_REQUIRE_GPU=1 to fail instead)");
-            None
-        }
-    }
-}
+mod support;
 
 /// Captures `scene` with `scheme` in `mode` at `side`² and judges it at 0 ulps.
 fn run(gpu: &Gpu, scene: &str, side: u32, scheme: GpuScheme, mode: Mode) -> (Judgement, Oracle) {
