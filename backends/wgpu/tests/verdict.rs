@@ -30,7 +30,9 @@ fn engine_capture(gpu: &Gpu, scheme: &GpuScheme) -> Dump {
     let view = loaded
         .view(Viewport::new(128, 128).unwrap(), &spec.orbit())
         .unwrap();
-    capture(gpu, &view, spec, scheme, Mode::Engine).unwrap().dump
+    capture(gpu, &view, spec, scheme, Mode::Engine)
+        .unwrap()
+        .dump
 }
 
 fn judged(dump: &Dump) -> (Comparison, u64) {
@@ -57,7 +59,10 @@ fn without_first_fragment(dump: &Dump, p: usize) -> Dump {
     let row = &mut slots[8 * p * capacity..8 * (p + 1) * capacity];
     row.copy_within(8.., 0);
     row[8 * (capacity - 1)..].fill(0xFF);
-    Dump::parse("dump.json", header.as_bytes(), |name| Ok(files[name].clone())).unwrap()
+    Dump::parse("dump.json", header.as_bytes(), |name| {
+        Ok(files[name].clone())
+    })
+    .unwrap()
 }
 
 #[test]
@@ -66,7 +71,11 @@ fn a_correct_engine_capture_has_no_error_and_one_dropped_fragment_is_one_error()
     let dump = engine_capture(&gpu, &GpuScheme::ABuffer { capacity: 32 });
     let (comparison, covered) = judged(&dump);
     assert!(covered > 0, "the view is empty");
-    assert_eq!(comparison.diff.mismatched_pixels, 0, "{:?}", comparison.diff);
+    assert_eq!(
+        comparison.diff.mismatched_pixels, 0,
+        "{:?}",
+        comparison.diff
+    );
     // A pixel of two fragments or more whose verdict is neither ambiguous nor within precision:
     // every fragment there is certain and bit-equal, so its loss can be excused by nothing.
     let capture = dump.capture().unwrap();

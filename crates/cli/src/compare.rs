@@ -262,11 +262,14 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         (None, None)
     } else if judged_f32 {
         let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
-        let (oracle, precision) = f32_reference(&header.scene, viewport, Some(&beside))
-            .map_err(|e| e.to_string())?;
+        let (oracle, precision) =
+            f32_reference(&header.scene, viewport, Some(&beside)).map_err(|e| e.to_string())?;
         (Some(oracle), Some(precision))
     } else {
-        let scene = header.scene.load(Some(&beside)).map_err(|e| e.to_string())?;
+        let scene = header
+            .scene
+            .load(Some(&beside))
+            .map_err(|e| e.to_string())?;
         let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
         let view = header
             .scene

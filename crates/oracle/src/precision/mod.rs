@@ -374,9 +374,8 @@ fn origin_form_error(
     let dxy = |i: usize, j: usize, axis: usize| {
         ((v[i].snapped[axis] - v[j].snapped[axis]).abs() + r[i] + r[j]) as f64
     };
-    let dz = |i: usize, j: usize| {
-        (v[i].depth - v[j].depth).abs() + v[i].depth_error + v[j].depth_error
-    };
+    let dz =
+        |i: usize, j: usize| (v[i].depth - v[j].depth).abs() + v[i].depth_error + v[j].depth_error;
     let (dz01, dz20) = (dz(0, 1), dz(2, 0));
     let gradient_x = (dz01 * dxy(2, 0, 1) + dz20 * dxy(0, 1, 1)) / area_lo;
     let gradient_y = (dz01 * dxy(2, 0, 0) + dz20 * dxy(0, 1, 0)) / area_lo;
@@ -384,7 +383,8 @@ fn origin_form_error(
     let side = [viewport.width, viewport.height].map(|s| i64::from(s) << SUBPIXEL_BITS);
     // The largest coordinate from whichever corner the implementation takes as its origin.
     let far = |axis: usize| {
-        let from_corners = |c: i64, slack: i64| (c.abs() + slack).max((side[axis] - c).abs() + slack);
+        let from_corners =
+            |c: i64, slack: i64| (c.abs() + slack).max((side[axis] - c).abs() + slack);
         (0..3)
             .map(|k| from_corners(v[k].snapped[axis], r[k]))
             .fold(from_corners(p[axis], 0), i64::max) as f64

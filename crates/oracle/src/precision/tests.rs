@@ -220,7 +220,11 @@ fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interva
     let viewport = Viewport::new(400, 300).unwrap();
     let (ox, oy) = (380 * 256, 280 * 256);
     let error = 1e-7;
-    let corners = [(ox + 10, oy + 20, 0.2), (ox + 900, oy + 60, 0.9), (ox + 300, oy + 800, 0.5)];
+    let corners = [
+        (ox + 10, oy + 20, 0.2),
+        (ox + 900, oy + 60, 0.9),
+        (ox + 300, oy + 800, 0.5),
+    ];
     let unsnapped = 0.5 + 0.01;
     let analysed = |plane_radius: i64| {
         let verts = corners.map(|(x, y, z)| VertexBound {
@@ -255,7 +259,10 @@ fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interva
     };
     let (checked, escaped) = escapes(&analysed(1));
     assert!(checked > 0);
-    assert_eq!(escaped, 0, "{escaped} of {checked} plane values outside their intervals");
+    assert_eq!(
+        escaped, 0,
+        "{escaped} of {checked} plane values outside their intervals"
+    );
     // Not vacuous: with the snapped radius alone (the bound before) the plane escapes.
     let (_, escaped_before) = escapes(&analysed(0));
     assert!(escaped_before > 0);
