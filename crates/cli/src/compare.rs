@@ -18,7 +18,7 @@ use fragsim_oracle::compare::{
     VerdictCounts,
 };
 use fragsim_oracle::dump::{CorruptWord, Dump, Header};
-use fragsim_oracle::precision::{compare_within, Bounds, Precision};
+use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
@@ -172,6 +172,9 @@ struct WordsReport {
     corrupt: u64,
     /// Words the layout leaves undefined (unfilled A-buffer slots past the counter).
     unchecked: u64,
+    /// Linked lists: nodes the pool counter handed out that no list reaches (each a lost
+    /// fragment, which the lists' comparison counts as missing).
+    unreachable: u64,
 }
 
 /// The whole report (`--json`).
@@ -255,22 +258,27 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         },
         ..header.scene.conventions
     };
-    let mut exact_scene = header.scene.clone();
-    if judged_f32 {
-        exact_scene.conventions.vertex_precision = VertexPrecision::F64;
-    }
-    let (oracle, precision) = if needs_oracle {
-        let scene = exact_scene.load(Some(&beside)).map_err(|e| e.to_string())?;
+    let (oracle, precision) = if !needs_oracle {
+        (None, None)
+    } else if judged_f32 {
         let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
-        let view = exact_scene
+        let (oracle, precision) =
+            f32_reference(&header.scene, viewport, Some(&beside)).map_err(|e| e.to_string())?;
+        (Some(oracle), Some(precision))
+    } else {
+        let scene = header
+            .scene
+            .load(Some(&beside))
+            .map_err(|e| e.to_string())?;
+        let viewport = fragsim_raster::Viewport::new(header.width, header.height)?;
+        let view = header
+            .scene
             .view(&scene, viewport)
             .map_err(|e| e.to_string())?;
         (
             Some(Oracle::build(&view)),
             Some(Precision::derive(&view, &conventions)),
         )
-    } else {
-        (None, None)
     };
     if judged_f32 && !matches!(reference, Side::Oracle) {
         return Err(
@@ -410,6 +418,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             checked: comparison.words_checked,
             corrupt: comparison.corrupt_words,
             unchecked: comparison.unchecked_words,
+            unreachable: words.as_ref().map_or(0, |w| w.unreachable),
         },
         first_differences: examples(&comparison, header.width, candidate_capture.identity),
         image,
@@ -690,9 +699,11 @@ fn print_report(r: &Report) {
     );
     if r.words.checked {
         outln!(
-            "words: every one read; corrupt {}, not defined by the layout {}",
+            "words: every one read; corrupt {}, not defined by the layout {}, nodes no list \
+             reaches {}",
             r.words.corrupt,
-            r.words.unchecked
+            r.words.unchecked,
+            r.words.unreachable
         );
     }
     for note in &r.notes {

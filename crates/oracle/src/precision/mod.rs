@@ -82,7 +82,12 @@ pub struct Precision {
 struct VertexBound {
     snapped: [i64; 2],
     depth: f64,
+    /// Subpixels from `snapped` to any snapped position an implementation may reach.
     radius: i64,
+    /// Subpixels from `snapped` to any position, snapped or not, the implementation's depth plane
+    /// may pass through: `radius`, or the unsnapped f32 position (an interpolator that sets up
+    /// its plane on the float positions, as llvmpipe's `lp_state_setup.c` does), rounded up.
+    plane_radius: i64,
     depth_error: f64,
 }
 
@@ -235,12 +240,16 @@ fn vertex_bound(
     let exact = [(nx * 0.5 + 0.5) * wf, (0.5 - ny * 0.5) * hf];
     let grid = 1i64 << (SUBPIXEL_BITS - conventions.subpixel_bits.min(SUBPIXEL_BITS));
     let mut radius = 0;
+    let mut unsnapped = 0.0f64;
     for (axis, error) in [error_x, error_y].into_iter().enumerate() {
         let step = (1u64 << conventions.subpixel_bits.min(SUBPIXEL_BITS)) as f64;
         // Any round-to-nearest of a value in [X − e, X + e] lies in these grid points.
         let lo = ((exact[axis] - error) * step - 0.5).ceil() as i64 * grid;
         let hi = ((exact[axis] + error) * step + 0.5).floor() as i64 * grid;
         radius = radius.max(snapped[axis] - lo).max(hi - snapped[axis]);
+        // The unsnapped position lies in [X − e, X + e]: at most this far from `snapped`.
+        let one = f64::from(1u32 << SUBPIXEL_BITS);
+        unsnapped = unsnapped.max((snapped[axis] as f64 - exact[axis] * one).abs() + error * one);
         bounds.max_vertex_error_subpixels = bounds
             .max_vertex_error_subpixels
             .max(error * f64::from(1u32 << SUBPIXEL_BITS));
@@ -250,6 +259,7 @@ fn vertex_bound(
         snapped,
         depth,
         radius,
+        plane_radius: radius.max(unsnapped.ceil() as i64),
         depth_error,
     })
 }
@@ -295,6 +305,113 @@ fn round_up(x: f64) -> f32 {
     }
 }
 
+/// The depth keys an implementation may give the fragment of the positively oriented triangle
+/// `v` (doubled area `area`) at pixel centre `p`, where the reference's edge functions are `e`
+/// and its plane value `z`; and whether the whole interval lies in `[0, 1]` (else the fragment
+/// may be dropped). `docs/semantics.md` §10, step 6, derives each term.
+fn depth_interval(
+    viewport: Viewport,
+    v: &[VertexBound; 3],
+    area: i64,
+    p: [i64; 2],
+    e: [i64; 3],
+    z: f64,
+) -> (u32, u32, bool) {
+    const UNBOUNDED: (u32, u32, bool) = (0, KEY_ONE, false);
+    let edges = [(1, 2), (2, 0), (0, 1)];
+    // The plane passes through positions within `plane_radius` of the snapped ones.
+    let r = v.map(|x| x.plane_radius);
+    let area_bound = edge_bound(v[1].snapped, v[2].snapped, v[0].snapped, r[1], r[2], r[0]);
+    let area_f = area as f64;
+    let denominator = area_f - area_bound as f64;
+    if denominator <= 0.0 {
+        return UNBOUNDED;
+    }
+    let eb = edges.map(|(i, j)| edge_bound(v[i].snapped, v[j].snapped, p, r[i], r[j], 0));
+    let z_lo = v.iter().map(|x| x.depth).fold(f64::INFINITY, f64::min);
+    let z_hi = v.iter().map(|x| x.depth).fold(f64::NEG_INFINITY, f64::max);
+    let (mut moved, mut weights, mut magnitude) = (0.0, 0.0, 0.0);
+    for k in 0..3 {
+        let lambda = e[k] as f64 / area_f;
+        let d = (eb[k] as f64 + lambda.abs() * area_bound as f64) / denominator;
+        moved += d;
+        weights += (lambda.abs() + d) * v[k].depth_error;
+        magnitude += (lambda.abs() + d) * (v[k].depth.abs() + v[k].depth_error);
+    }
+    // Σ Δλ = 0, so the plane moves by Σ Δλ_k (Z_k − mid) ≤ Σ|Δλ| · range / 2; the vertex
+    // depths' own errors add, and the plane's evaluation in f32: barycentric (γ_6 on the
+    // weighted magnitudes) or from the window origin (`origin_form_error`).
+    let Some(origin_form) = origin_form_error(viewport, v, &r, denominator, p) else {
+        return UNBOUNDED;
+    };
+    let delta = moved * (z_hi - z_lo) / 2.0 + weights + gamma_both(6.0) * magnitude + origin_form;
+    let (lo, hi) = (round_down(z - delta), round_up(z + delta));
+    let inside = lo >= 0.0 && hi <= 1.0;
+    (
+        depth_key(lo.max(0.0)).unwrap_or(0),
+        depth_key(hi.min(1.0)).unwrap_or(KEY_ONE),
+        inside,
+    )
+}
+
+/// The rounding error of a depth plane set up and evaluated in f32 from the window origin, as
+/// llvmpipe does (`lp_state_setup.c`: `a = a0 + ∂a/∂x·x + ∂a/∂y·y` with
+/// `a0 = a_0 − (∂a/∂x·x_0 + ∂a/∂y·y_0)` and the gradients `(Δa_01·Δy_20 − Δa_20·Δy_01)/A` from f32
+/// differences), for vertices within `r` subpixels of the snapped ones and a doubled area of at
+/// least `area_lo`; `None` when the area's own rounding may reach it. With `G` bounds on the
+/// gradients' magnitudes, `κ` the area's condition number, `c = (1 + γ_6)(1 + 2γ_4 κ) − 1` the
+/// gradients' relative error and `X`, `Y` the largest coordinates from any viewport corner:
+/// `γ_9 (|Z| + 2(1 + c)(G_x X + G_y Y)) + c (G_x |x − x_k| + G_y |y − y_k|)` (`docs/semantics.md`
+/// §10, step 6).
+fn origin_form_error(
+    viewport: Viewport,
+    v: &[VertexBound; 3],
+    r: &[i64; 3],
+    area_lo: f64,
+    p: [i64; 2],
+) -> Option<f64> {
+    // Upper bounds on |differences| of the implementation's coordinates (subpixels) and depths.
+    let dxy = |i: usize, j: usize, axis: usize| {
+        ((v[i].snapped[axis] - v[j].snapped[axis]).abs() + r[i] + r[j]) as f64
+    };
+    let dz =
+        |i: usize, j: usize| (v[i].depth - v[j].depth).abs() + v[i].depth_error + v[j].depth_error;
+    let (dz01, dz20) = (dz(0, 1), dz(2, 0));
+    let gradient_x = (dz01 * dxy(2, 0, 1) + dz20 * dxy(0, 1, 1)) / area_lo;
+    let gradient_y = (dz01 * dxy(2, 0, 0) + dz20 * dxy(0, 1, 0)) / area_lo;
+    let kappa = (dxy(0, 1, 0) * dxy(2, 0, 1) + dxy(2, 0, 0) * dxy(0, 1, 1)) / area_lo;
+    let side = [viewport.width, viewport.height].map(|s| i64::from(s) << SUBPIXEL_BITS);
+    // The largest coordinate from whichever corner the implementation takes as its origin.
+    let far = |axis: usize| {
+        let from_corners =
+            |c: i64, slack: i64| (c.abs() + slack).max((side[axis] - c).abs() + slack);
+        (0..3)
+            .map(|k| from_corners(v[k].snapped[axis], r[k]))
+            .fold(from_corners(p[axis], 0), i64::max) as f64
+    };
+    let near = |axis: usize| {
+        (0..3)
+            .map(|k| (p[axis] - v[k].snapped[axis]).abs() + r[k])
+            .max()
+            .unwrap_or(0) as f64
+    };
+    let z_max = v
+        .iter()
+        .map(|x| x.depth.abs() + x.depth_error)
+        .fold(0.0, f64::max);
+    // The computed area's relative error is at most γ_4 κ, its reciprocal's 2γ_4 κ + u while
+    // that is below one half (1/(1 − ε) ≤ 1 + 2ε).
+    let area_error = gamma_both(4.0) * kappa;
+    if area_error >= 0.5 {
+        return None;
+    }
+    let c = (1.0 + gamma_both(6.0)) * (1.0 + 2.0 * area_error) - 1.0;
+    Some(
+        gamma_both(9.0) * (z_max + 2.0 * (1.0 + c) * (gradient_x * far(0) + gradient_y * far(1)))
+            + c * (gradient_x * near(0) + gradient_y * near(1)),
+    )
+}
+
 /// Lists, for every pixel centre within the grown bounding box of an unclipped triangle, what an
 /// implementation may emit there.
 fn triangle(
@@ -326,8 +443,6 @@ fn triangle(
     let (x0, x1) = span(lo[0], hi[0], viewport.width);
     let (y0, y1) = span(lo[1], hi[1], viewport.height);
     let edges = [(1, 2), (2, 0), (0, 1)];
-    let z_lo = v.iter().map(|x| x.depth).fold(f64::INFINITY, f64::min);
-    let z_hi = v.iter().map(|x| x.depth).fold(f64::NEG_INFINITY, f64::max);
     let area_stable = area > area_bound;
     for y in y0..=y1 {
         for x in x0..=x1 {
@@ -357,31 +472,7 @@ fn triangle(
                 (e[0] as f64 * v[0].depth + e[1] as f64 * v[1].depth + e[2] as f64 * v[2].depth)
                     / area_f;
             let reference = if covered { depth_key(z as f32) } else { None };
-            let (key_lo, key_hi, inside) = if area_stable {
-                let denominator = area_f - area_bound as f64;
-                let mut moved = 0.0;
-                let mut weights = 0.0;
-                let mut magnitude = 0.0;
-                for k in 0..3 {
-                    let lambda = e[k] as f64 / area_f;
-                    let d = (eb[k] as f64 + lambda.abs() * area_bound as f64) / denominator;
-                    moved += d;
-                    weights += (lambda.abs() + d) * v[k].depth_error;
-                    magnitude += (lambda.abs() + d) * (v[k].depth.abs() + v[k].depth_error);
-                }
-                // Σ Δλ = 0, so the plane moves by Σ Δλ_k (Z_k − mid) ≤ Σ|Δλ| · range / 2; the
-                // vertex depths' own errors and the f32 plane evaluation (γ_6) add.
-                let delta = moved * (z_hi - z_lo) / 2.0 + weights + gamma_both(6.0) * magnitude;
-                let (lo, hi) = (round_down(z - delta), round_up(z + delta));
-                let inside = lo >= 0.0 && hi <= 1.0;
-                (
-                    depth_key(lo.max(0.0)).unwrap_or(0),
-                    depth_key(hi.min(1.0)).unwrap_or(KEY_ONE),
-                    inside,
-                )
-            } else {
-                (0, KEY_ONE, false)
-            };
+            let (key_lo, key_hi, inside) = depth_interval(viewport, &v, area, p, e, z);
             found.push((
                 (y * i64::from(viewport.width) + x) as u32,
                 Possible {
@@ -400,4 +491,4 @@ fn triangle(
 mod tests;
 mod verdict;
 
-pub use verdict::compare_within;
+pub use verdict::{compare_within, f32_reference};

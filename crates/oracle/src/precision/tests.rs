@@ -42,8 +42,23 @@ fn vertex(x: i64, y: i64, depth: f64, radius: i64, depth_error: f64) -> VertexBo
         snapped: [x, y],
         depth,
         radius,
+        plane_radius: radius,
         depth_error,
     }
+}
+
+/// The depth llvmpipe gives a pixel (`lp_state_setup.c`): the plane through the f32 window
+/// positions `xy` (pixels, unsnapped) and depths `z`, its gradients and its value at the window
+/// origin set up in f32, evaluated in f32 at pixel `(x, y)` (centre `(x + ½, y + ½)`).
+fn origin_form(xy: [[f32; 2]; 3], z: [f32; 3], x: f32, y: f32) -> f32 {
+    let [[x0, y0], [x1, y1], [x2, y2]] = xy;
+    let (dx01, dy01, dx20, dy20) = (x0 - x1, y0 - y1, x2 - x0, y2 - y0);
+    let ooa = 1.0 / (dx01 * dy20 - dx20 * dy01);
+    let (da01, da20) = (z[0] - z[1], z[2] - z[0]);
+    let dadx = da01 * (dy20 * ooa) - da20 * (dy01 * ooa);
+    let dady = da20 * (dx01 * ooa) - da01 * (dx20 * ooa);
+    let a0 = z[0] - (dadx * (x0 - 0.5) + dady * (y0 - 0.5));
+    a0 + dadx * x + dady * y
 }
 
 #[test]
@@ -193,4 +208,62 @@ fn the_edge_bound_holds_every_perturbation() {
     assert!(largest <= bound, "{largest} > {bound}");
     // Within a factor of two of the worst case: a bound this loose would still flag real edges.
     assert!(2 * largest >= bound, "{largest} ≪ {bound}");
+}
+
+#[test]
+fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interval() {
+    // A steep triangle (depth 0.2 to 0.9 over three pixels) far from the window origin, its
+    // vertices' f32 positions up to ½ subpixel (plus the vertex error) from their snapped ones
+    // while every snap is decided (radius 0): the edge the first derivation missed, where the
+    // plane an interpolator sets up on the unsnapped positions moves by the gradient times
+    // ½ subpixel, hundreds of ulps, with no snapped position moving at all.
+    let viewport = Viewport::new(400, 300).unwrap();
+    let (ox, oy) = (380 * 256, 280 * 256);
+    let error = 1e-7;
+    let corners = [
+        (ox + 10, oy + 20, 0.2),
+        (ox + 900, oy + 60, 0.9),
+        (ox + 300, oy + 800, 0.5),
+    ];
+    let unsnapped = 0.5 + 0.01;
+    let analysed = |plane_radius: i64| {
+        let verts = corners.map(|(x, y, z)| VertexBound {
+            plane_radius,
+            ..vertex(x, y, z, 0, error)
+        });
+        let mut found = Vec::new();
+        triangle(viewport, 0, verts, &mut found);
+        found
+    };
+    let escapes = |found: &[(u32, Possible)]| {
+        let mut checked = 0;
+        let mut escaped = 0;
+        for &(pixel, q) in found.iter().filter(|(_, q)| q.reference.is_some()) {
+            let (x, y) = ((pixel % 400) as f32, (pixel / 400) as f32);
+            for moves in 0..3u32.pow(7) {
+                let step = |i: u32| f64::from((moves / 3u32.pow(i)) % 3) - 1.0;
+                let xy = [0, 1, 2].map(|k| {
+                    let (cx, cy, _) = corners[k];
+                    [0, 1].map(|a| {
+                        let c = [cx, cy][a] as f64 + step(2 * k as u32 + a as u32) * unsnapped;
+                        (c / 256.0) as f32
+                    })
+                });
+                let z = corners.map(|(_, _, z)| (z + step(6) * error) as f32);
+                let key = origin_form(xy, z, x, y).to_bits();
+                checked += 1;
+                escaped += u32::from(!(q.key_lo..=q.key_hi).contains(&key));
+            }
+        }
+        (checked, escaped)
+    };
+    let (checked, escaped) = escapes(&analysed(1));
+    assert!(checked > 0);
+    assert_eq!(
+        escaped, 0,
+        "{escaped} of {checked} plane values outside their intervals"
+    );
+    // Not vacuous: with the snapped radius alone (the bound before) the plane escapes.
+    let (_, escaped_before) = escapes(&analysed(0));
+    assert!(escaped_before > 0);
 }

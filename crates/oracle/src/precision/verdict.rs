@@ -10,14 +10,67 @@
 //! interval, [`verdict::WITHIN_PRECISION`]. With an exact analysis (f64 vertex precision) this is
 //! [`compare_with`], unchanged.
 
-use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use std::path::Path;
 
-use super::{Possible, Precision};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{Conventions, Viewport};
+
+use super::{Bounds, Possible, Precision};
 use crate::compare::{
     compare_with, inferred_counter, verdict, CompareOptions, Comparison, VerdictCounts,
 };
-use crate::dump::WordCheck;
+use crate::dump::{Dump, DumpError, WordCheck};
+use crate::scene::SceneAndCamera;
 use crate::{Diff, Oracle, PixelMismatch};
+
+/// The reference an f32 vertex stage is judged against: the oracle of `scene` on `viewport`
+/// under its declared conventions but with the exact f64 vertex stage, and the analysis of an
+/// f32 one under the same conventions (what `fragsim compare oracle DIR --vertex-precision f32`
+/// builds). The bounds measure an implementation's distance from the exact positions, not from
+/// another f32 evaluation order. `beside` is where a dump's relative mesh path is looked up.
+///
+/// # Errors
+/// A scene that cannot be loaded or rasterized ([`SceneAndCamera::load`],
+/// [`SceneAndCamera::view`]).
+pub fn f32_reference(
+    scene: &SceneAndCamera,
+    viewport: Viewport,
+    beside: Option<&Path>,
+) -> Result<(Oracle, Precision), DumpError> {
+    let mut exact = scene.clone();
+    exact.conventions.vertex_precision = VertexPrecision::F64;
+    let loaded = exact.load(beside)?;
+    let view = exact.view(&loaded, viewport)?;
+    let f32_stage = Conventions {
+        vertex_precision: VertexPrecision::F32,
+        ..exact.conventions
+    };
+    Ok((Oracle::build(&view), Precision::derive(&view, &f32_stage)))
+}
+
+impl Dump {
+    /// The dump judged within the precision of an f32 vertex stage ([`f32_reference`], every
+    /// word read with [`Dump::check_words`], [`compare_within`]), with the bounds derived and the
+    /// reference's covered pixels (what the ambiguous pixels are a share of).
+    ///
+    /// # Errors
+    /// As [`f32_reference`] and [`Dump::capture`].
+    pub fn compare_within(
+        &self,
+        beside: Option<&Path>,
+        options: &CompareOptions<'_>,
+    ) -> Result<(Comparison, Bounds, u64), DumpError> {
+        let (oracle, precision) = f32_reference(&self.header.scene, self.viewport()?, beside)?;
+        let capture = self.capture()?;
+        let words = self.check_words()?;
+        let covered = (0..oracle.pixels())
+            .filter(|&p| !oracle.pixel(p).is_empty())
+            .count() as u64;
+        let comparison = compare_within(&precision, &oracle, &capture, Some(&words), options);
+        Ok((comparison, precision.bounds(), covered))
+    }
+}
 
 /// Compares `candidate` with what `precision` allows, pixel by pixel under the candidate's
 /// promise; `reference` (the oracle of the same view) gives the examples' expected lists. With
@@ -122,45 +175,71 @@ struct Judged {
     claimed_overflow: u64,
 }
 
-/// Assigns candidate fragments to possibilities: each candidate word, in ascending key order, to
-/// the unused admissible possibility whose interval closes first (the earliest-deadline rule, which
-/// matches as many points to intervals as any assignment can), an exact reference match first.
+/// Assigns candidate fragments to possibilities: a maximum matching of candidate words to the
+/// possibilities that admit them (its primitive, its key inside the interval widened by
+/// `widen`), which among the maximum ones matches as many `certain` possibilities as any can.
+/// Kuhn's augmenting paths from the possibility side, the certain ones first: a possibility once
+/// matched stays matched while later ones augment, so the certain ones matched are a maximum set
+/// of them and the whole matching is maximum (a greedy rule is not: with key-only words and
+/// overlapping intervals it left certain fragments unmatched beside a match it could have moved).
+/// Each possibility tries its exact reference key first, so an equal pixel reads equal.
 fn assign(
     possible: &[Possible],
     got: &[u64],
     identity: Identity,
     widen: u32,
 ) -> Vec<Option<usize>> {
-    let mut order: Vec<usize> = (0..got.len()).collect();
-    order.sort_by_key(|&i| got[i]);
-    let mut used = vec![false; possible.len()];
-    let mut assigned = vec![None; got.len()];
-    for i in order {
-        let (key, prim) = ((got[i] >> 32) as u32, got[i] as u32);
-        let admits = |q: &Possible| match identity {
+    let admits = |q: &Possible, word: u64| {
+        let (key, prim) = ((word >> 32) as u32, word as u32);
+        let inside =
+            || key >= q.key_lo.saturating_sub(widen) && key <= q.key_hi.saturating_add(widen);
+        match identity {
             Identity::PrimOnly => q.prim == prim,
-            Identity::KeyOnly => {
-                key >= q.key_lo.saturating_sub(widen) && key <= q.key_hi.saturating_add(widen)
-            }
-            Identity::KeyAndPrim => {
-                q.prim == prim
-                    && key >= q.key_lo.saturating_sub(widen)
-                    && key <= q.key_hi.saturating_add(widen)
-            }
-        };
-        let best = (0..possible.len())
-            .filter(|&j| !used[j] && admits(&possible[j]))
-            .min_by_key(|&j| {
-                let q = &possible[j];
-                let exact = identity != Identity::PrimOnly && q.reference == Some(key);
-                (!exact, q.key_hi, !q.certain)
+            Identity::KeyOnly => inside(),
+            Identity::KeyAndPrim => q.prim == prim && inside(),
+        }
+    };
+    // Per possibility, the candidates it admits, an exact reference match first.
+    let edges: Vec<Vec<usize>> = possible
+        .iter()
+        .map(|q| {
+            let mut admitted: Vec<usize> = (0..got.len()).filter(|&i| admits(q, got[i])).collect();
+            admitted.sort_by_key(|&i| {
+                identity == Identity::PrimOnly || q.reference != Some((got[i] >> 32) as u32)
             });
-        if let Some(j) = best {
-            used[j] = true;
-            assigned[i] = Some(j);
+            admitted
+        })
+        .collect();
+    let mut partner: Vec<Option<usize>> = vec![None; got.len()];
+    let mut order: Vec<usize> = (0..possible.len()).collect();
+    order.sort_by_key(|&j| !possible[j].certain);
+    for j in order {
+        let mut seen = vec![false; got.len()];
+        augment(j, &edges, &mut partner, &mut seen);
+    }
+    partner
+}
+
+/// One augmenting path from possibility `j` (Kuhn): a free candidate it admits, or one whose
+/// possibility can move to another.
+fn augment(
+    j: usize,
+    edges: &[Vec<usize>],
+    partner: &mut [Option<usize>],
+    seen: &mut [bool],
+) -> bool {
+    for &i in &edges[j] {
+        if seen[i] {
+            continue;
+        }
+        seen[i] = true;
+        let current = partner[i];
+        if current.is_none_or(|other| augment(other, edges, partner, seen)) {
+            partner[i] = Some(j);
+            return true;
         }
     }
-    assigned
+    false
 }
 
 fn judge_pixel(
