@@ -41,8 +41,7 @@ fn bench_on(out: &Path, scene: &[&str], schemes: &str, effect: &str) -> Vec<Valu
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    let report: Value = serde_json::from_slice(&output.stdout).unwrap();
-    report["rows"].as_array().unwrap().clone()
+    crate::support::json_lines(&output.stdout)
 }
 
 fn rate(row: &Value) -> f64 {
