@@ -328,40 +328,57 @@ impl Paint for SpeedAccuracy<'_> {
         } else {
             (0.1, 10.0)
         };
-        let top = self
-            .points
-            .iter()
-            .map(|p| p.rate * 100.0)
-            .fold(0.0, f64::max);
-        let top = if top > 0.0 { top * 1.08 } else { 1.0 };
+        // EPR on a log axis too (one scheme near 100 % would squash the rest at 0 on a linear
+        // one); an exact scheme's 0 is drawn on the floor, a decade under the least rate seen.
+        let rates = self.points.iter().map(|p| p.rate * 100.0);
+        let top = rates.clone().fold(0.0, f64::max).max(1e-3) * 2.0;
+        let least = rates.filter(|&r| r > 0.0).fold(f64::INFINITY, f64::min);
+        let floor = if least.is_finite() {
+            10f64.powf(least.log10().floor() - 1.0)
+        } else {
+            1e-3
+        };
+        let y = |rate: f64| (rate * 100.0).max(floor);
         let mut chart = ChartBuilder::on(&left)
             .caption(self.title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(72)
-            .build_cartesian_2d((lo..hi).log_scale(), -top * 0.03..top)?;
+            .build_cartesian_2d((lo..hi).log_scale(), (floor * 0.7..top).log_scale())?;
+        let whole = |v: &f64| format!("{v:.0}");
         chart
             .configure_mesh()
             .x_desc(self.x_label)
-            .y_desc("EPR (% of covered pixels)")
+            .y_desc("EPR (% of covered pixels, log scale)")
+            .x_labels(6)
+            .y_labels(8)
+            .x_label_formatter(&whole)
+            .light_line_style(WHITE)
             .label_style(("sans-serif", 14))
             .draw()?;
+        let bottom = chart.backend_coord(&(lo, floor));
+        root.draw(&Text::new(
+            "EPR 0 (exact) is drawn on this line",
+            (bottom.0 + 6, bottom.1 - 16),
+            ("sans-serif", 12).into_font().color(&BLACK.mix(0.6)),
+        ))?;
+        root.draw(&PathElement::new(
+            vec![bottom, (bottom.0 + (WIDE.0 as i32 - 520), bottom.1)],
+            BLACK.mix(0.3).stroke_width(1),
+        ))?;
         let front = pareto_front(self.points);
         chart
             .draw_series(LineSeries::new(
-                front.iter().map(|&i| {
-                    (
-                        self.points[i].time_ms.max(1e-3),
-                        self.points[i].rate * 100.0,
-                    )
-                }),
+                front
+                    .iter()
+                    .map(|&i| (self.points[i].time_ms.max(1e-3), y(self.points[i].rate))),
                 BLACK.mix(0.5).stroke_width(2),
             ))?
             .label("Pareto front (nothing is both faster and more accurate)")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
         let families = families(self.points);
         for (i, p) in self.points.iter().enumerate() {
-            let at = chart.backend_coord(&(p.time_ms.max(1e-3), p.rate * 100.0));
+            let at = chart.backend_coord(&(p.time_ms.max(1e-3), y(p.rate)));
             let shape = families.iter().position(|&f| f == p.family).unwrap_or(0);
             let colour = palette(i);
             marker(root, at, shape, colour)?;
@@ -376,7 +393,12 @@ impl Paint for SpeedAccuracy<'_> {
                 .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
                 .label(format!("family {family}"))
                 .legend(move |(x, y)| {
-                    let style = BLACK.filled();
+                    // As `marker` draws them: filled for the first four families, hollow after.
+                    let style = if f < 4 {
+                        BLACK.filled()
+                    } else {
+                        BLACK.stroke_width(2)
+                    };
                     match f % 4 {
                         0 => Circle::new((x + 8, y), 5, style).into_dyn(),
                         1 => TriangleMarker::new((x + 8, y), 6, style).into_dyn(),
