@@ -38,16 +38,15 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// `fragsim ARGS`, expecting exit code 0; its records, each checked for the context fields.
-fn records(command: &str, args: &[&str], out: &Path) -> Vec<Value> {
-    let output = Command::cargo_bin("fragsim")
-        .unwrap()
-        .arg(command)
-        .args(args)
-        .args(["--json", "--out"])
-        .arg(out)
-        .output()
-        .unwrap();
+/// `fragsim COMMAND ARGS --json [--out OUT]`, expecting exit code 0; its records, each checked
+/// for the context fields.
+fn records(command: &str, args: &[&str], out: Option<&Path>) -> Vec<Value> {
+    let mut run = Command::cargo_bin("fragsim").unwrap();
+    run.arg(command).args(args).arg("--json");
+    if let Some(out) = out {
+        run.arg("--out").arg(out);
+    }
+    let output = run.output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(
         output.status.code(),
@@ -87,7 +86,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
             ],
         ]
         .concat(),
-        &dir,
+        Some(&dir),
     );
     // One record per scheme and executor, each naming its own executor.
     assert_eq!(render.len(), 6);
@@ -122,7 +121,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
             &["--frames", "1", "--scheme", "mdts,zbuffer", "--no-images"],
         ]
         .concat(),
-        &dir,
+        Some(&dir),
     );
     assert_eq!(bench.len(), 2);
     for r in &bench {
@@ -147,7 +146,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
             &["--angles", "2", "--scheme", "mdts,bdp"],
         ]
         .concat(),
-        &dir,
+        Some(&dir),
     );
     // One record per scheme and angle, the angle in the context.
     assert_eq!(sweep.len(), 4);
@@ -173,7 +172,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
             ],
         ]
         .concat(),
-        &dir.join("hazard"),
+        Some(&dir.join("hazard")),
     );
     // Two policies × two widths; the width in flight is the record's threads.
     assert_eq!(hazard.len(), 4);
@@ -186,7 +185,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
         .iter()
         .all(|r| r["mismatched_pixel_rate"].is_f64() && r["k"] == 8));
 
-    let explain = records("explain", &[], &dir);
+    let explain = records("explain", &[], None);
     assert_eq!(explain.len(), 1);
     assert_eq!(explain[0]["shown"], true);
     assert_eq!(explain[0]["scheme"], "kbuffer");

@@ -320,7 +320,7 @@ fn explain_mdts(scheme: &Mdts<u64>, k: u32, fragments: &[Fragment], seeds: u64) 
     ));
     let _ = writeln!(
         out,
-        "{KEY}; inv: ✓ the invariant holds after the step, ✗ it fails"
+        "{KEY}; inv: ✓ the invariant holds after the step (a cross where it fails)"
     );
     let last: Vec<u64> = memory
         .last()
