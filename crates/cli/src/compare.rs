@@ -653,16 +653,21 @@ fn write_image(
         let p = (y * width + x) as usize;
         image::Rgb(colour(comparison.verdicts[p], reference.pixel(p).len()))
     });
-    let marks: Vec<(u32, u32)> = comparison
+    let differing = comparison
         .verdicts
         .iter()
         .enumerate()
         .filter(|&(_, &v)| v & verdict::DIFFERS != 0)
-        .take(fragsim_shade::legend::MARKS)
-        .map(|(p, _)| ((p % width as usize) as u32, (p / width as usize) as u32))
-        .collect();
-    let figure =
-        fragsim_shade::legend::difference_figure(&image, &legend(comparison, reference), &marks)?;
+        .map(|(p, _)| ((p % width as usize) as u32, (p / width as usize) as u32));
+    // Rings only where differences are sparse: dense ones show alone, and rings would hide some.
+    let ring = differing.clone().count() <= fragsim_shade::legend::MARKS;
+    let marks: Vec<(u32, u32)> = differing.take(fragsim_shade::legend::MARKS).collect();
+    let figure = fragsim_shade::legend::difference_figure(
+        &image,
+        &legend(comparison, reference),
+        &marks,
+        ring,
+    )?;
     fragsim_shade::save_png(&figure, path)
 }
 

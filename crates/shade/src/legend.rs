@@ -174,8 +174,10 @@ const INSET_RADIUS: u32 = 7;
 const INSET_ZOOM: u32 = 8;
 
 /// A difference image with its `legend` (colour, meaning, count) beside it, a ring around each
-/// of `marks` (the first differing pixels, in order) and, below, zoomed insets of the first
-/// [`INSETS`] of them, each with its pixel outlined and its coordinates named.
+/// of `marks` (the first differing pixels, in order) when `ring` (sparse differences, which a
+/// ring makes visible; dense ones are visible alone and a ring would hide some) and, below,
+/// zoomed insets of the first [`INSETS`] of them, each with its pixel outlined and its
+/// coordinates named.
 ///
 /// # Errors
 /// Text cannot be drawn (a font error).
@@ -183,6 +185,7 @@ pub fn difference_figure(
     picture: &RgbImage,
     legend: &[(Rgb<u8>, String)],
     marks: &[(u32, u32)],
+    ring: bool,
 ) -> Result<RgbImage, String> {
     let side = (2 * INSET_RADIUS + 1) * INSET_ZOOM;
     let insets = marks.len().min(INSETS);
@@ -211,10 +214,10 @@ pub fn difference_figure(
         let note_y = 44 + 22 * legend.len() as i32;
         if marks.is_empty() {
             text(area, "no differing pixel", (x0, note_y), 13)?;
-        } else {
+        } else if ring {
             text(area, "rings: first differing pixels", (x0, note_y), 13)?;
         }
-        for &(x, y) in marks {
+        for &(x, y) in marks.iter().filter(|_| ring) {
             area.draw(&Circle::new(
                 (x as i32, y as i32),
                 9,
@@ -302,8 +305,9 @@ pub fn effect_difference_figure(
             "equal (candidate, dimmed)".to_string(),
         ),
     ];
+    let ring = differing.len() <= MARKS;
     let marks: Vec<(u32, u32)> = differing.into_iter().take(MARKS).collect();
-    difference_figure(&picture, &legend, &marks)
+    difference_figure(&picture, &legend, &marks, ring)
 }
 
 #[cfg(test)]
@@ -328,7 +332,7 @@ mod tests {
         let mut picture = RgbImage::from_pixel(64, 64, Rgb([70, 70, 70]));
         picture.put_pixel(40, 30, Rgb([230, 40, 40]));
         let legend = [(Rgb([230, 40, 40]), "missing".to_string())];
-        let figure = difference_figure(&picture, &legend, &[(40, 30)]).unwrap();
+        let figure = difference_figure(&picture, &legend, &[(40, 30)], true).unwrap();
         // The inset's centre block, just inside its outline, is the differing pixel's colour.
         let (left, top) = (4, (64 + 22) + 28);
         let inside = INSET_RADIUS * INSET_ZOOM + 2;
