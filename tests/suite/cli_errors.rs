@@ -185,8 +185,10 @@ fn non_triangular_obj_faces_are_triangulated_not_refused() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    assert!(stdout.contains("\"triangles\": 5"), "{stdout}");
-    assert!(stdout.contains("\"mismatches\": 0"), "{stdout}");
+    for row in crate::support::json_lines(&output.stdout) {
+        assert_eq!(row["triangles"], 5, "{stdout}");
+        assert_eq!(row["mismatched_pixels"], 0, "{stdout}");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -373,11 +375,11 @@ fn assert_loads(path: &std::path::Path, triangles: u32) {
     let output = fragsim(&["--mesh", path.to_str().unwrap(), "--json"]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{}: {stderr}", path.display());
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(
-        stdout.contains(&format!("\"triangles\": {triangles}")),
-        "{stdout}"
-    );
+    let rows = crate::support::json_lines(&output.stdout);
+    assert!(!rows.is_empty(), "{}: no record", path.display());
+    for row in rows {
+        assert_eq!(row["triangles"], triangles, "{row}");
+    }
 }
 
 #[test]

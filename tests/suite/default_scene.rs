@@ -66,7 +66,7 @@ fn render_json(args: &[&str]) -> (i32, Vec<serde_json::Value>, String) {
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
-    let rows = serde_json::from_slice(&output.stdout).unwrap_or_else(|e| panic!("{e}: {stderr}"));
+    let rows = crate::support::json_lines(&output.stdout);
     (output.status.code().unwrap_or(-1), rows, stderr)
 }
 

@@ -416,7 +416,7 @@ fn render_rows(args: &[&str]) -> Vec<(String, String, u64, u64, u64)> {
         .unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
-    let rows: Vec<serde_json::Value> = serde_json::from_slice(&output.stdout).unwrap();
+    let rows = crate::support::json_lines(&output.stdout);
     rows.iter()
         .map(|r| {
             let number = |key: &str| r[key].as_u64().unwrap();
@@ -425,7 +425,7 @@ fn render_rows(args: &[&str]) -> Vec<(String, String, u64, u64, u64)> {
                 r["executor"].as_str().unwrap().into(),
                 number("overflowed"),
                 number("lost"),
-                number("mismatches"),
+                number("mismatched_pixels"),
             )
         })
         .collect()

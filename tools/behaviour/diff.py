@@ -11,8 +11,12 @@ import sys
 
 
 def rows(path):
-    return {(r["scheme"], r["executor"]): {k: v for k, v in r.items() if not k.endswith("_ms")}
-            for r in json.load(open(path))}
+    # JSON Lines: one record per (scheme, executor) (docs/json-schema.md); the version differs
+    # between binaries by design.
+    records = [json.loads(line) for line in open(path) if line.strip()]
+    return {(r["scheme"], r["executor"]): {k: v for k, v in r.items()
+                                           if not k.endswith("_ms") and k != "fragsim_version"}
+            for r in records}
 
 
 old, new = rows(sys.argv[1]), rows(sys.argv[2])

@@ -88,14 +88,16 @@ python3 - "$WORK" "$ROUNDS" "$LP_THREADS" <<'EOF'
 import json, statistics, sys
 work, rounds, lp_threads = sys.argv[1], int(sys.argv[2]), sys.argv[3].split()
 prep = json.load(open(f"{work}/prep.json"))
-fs = {r: json.load(open(f"{work}/fragsim-r{r}/bench.json")) for r in range(1, rounds + 1)}
+# fragsim's bench.jsonl: JSON Lines, one record per scheme and executor (docs/json-schema.md).
+fs = {r: [json.loads(l) for l in open(f"{work}/fragsim-r{r}/bench.jsonl") if l.strip()]
+      for r in range(1, rounds + 1)}
 lp = {(r, t): json.load(open(f"{work}/llvmpipe-r{r}-t{t}.json"))
       for r in range(1, rounds + 1) for t in lp_threads}
-schemes = [(row["scheme"], row["executor"], row["threads"]) for row in fs[1]["rows"]]
+schemes = [(row["scheme"], row["executor"], row["threads"]) for row in fs[1]]
 def row(r, s, e):
-    return next(x for x in fs[r]["rows"] if x["scheme"] == s and x["executor"] == e)
+    return next(x for x in fs[r] if x["scheme"] == s and x["executor"] == e)
 first = next(iter(lp.values()))
-print(f"llvmpipe: {first['renderer']}; fragsim: {fs[1]['scene']}, {fs[1]['triangles']} triangles")
+print(f"llvmpipe: {first['renderer']}; fragsim: {fs[1][0]['scene']}, {fs[1][0]['triangles']} triangles")
 print("ms per frame (each the median of its run's frames; fragsim's includes the vertex stage)")
 head = ["round"] + [f"llvmpipe[{t}]" for t in lp_threads] + [f"{s}/{e}x{n}" for s, e, n in schemes]
 head += [f"ratio {t}/{s}/{e}" for t in lp_threads for s, e, _ in schemes]
@@ -103,10 +105,10 @@ print(" | ".join(head))
 ratios = {(t, s, e): [] for t in lp_threads for s, e, _ in schemes}
 for r in range(1, rounds + 1):
     cells = [str(r)] + [f"{lp[(r, t)]['median_ms']:.1f}" for t in lp_threads]
-    cells += [f"{row(r, s, e)['median_ms']:.1f}" for s, e, _ in schemes]
+    cells += [f"{row(r, s, e)['time_ms']:.1f}" for s, e, _ in schemes]
     for t in lp_threads:
         for s, e, _ in schemes:
-            q = lp[(r, t)]["median_ms"] / row(r, s, e)["median_ms"]
+            q = lp[(r, t)]["median_ms"] / row(r, s, e)["time_ms"]
             ratios[(t, s, e)].append(q)
             cells.append(f"{q:.2f}")
     print(" | ".join(cells))
@@ -115,7 +117,7 @@ for t in lp_threads:
     lp_ms = statistics.median(lp[(r, t)]["median_ms"] for r in range(1, rounds + 1))
     print(f"  llvmpipe[{t}] {lp_ms:.1f} ms")
 for s, e, n in schemes:
-    ms = statistics.median(row(r, s, e)["median_ms"] for r in range(1, rounds + 1))
+    ms = statistics.median(row(r, s, e)["time_ms"] for r in range(1, rounds + 1))
     vertex = statistics.median(row(r, s, e)["vertex_ms"] for r in range(1, rounds + 1))
     bad = max(row(r, s, e)["mismatched_pixels"] for r in range(1, rounds + 1))
     print(f"  fragsim {s} ({e}, {n} threads) {ms:.1f} ms, of which vertex stage {vertex:.1f} ms; "

@@ -8,6 +8,11 @@ import sys
 from pathlib import Path
 
 
+def records(path):
+    """The records of a `--json` output: JSON Lines, one record a line (docs/json-schema.md)."""
+    return [json.loads(line) for line in open(path) if line.strip()]
+
+
 def n(x):
     return f"{x:,}"
 
@@ -27,22 +32,23 @@ def render_table(rows):
         verdict = "kept" if all(e["keeps_guarantee"] for e in ex.values()) else "**BROKEN**"
         out.append(f"| {scheme} | {p['guarantee']} | {passes(p)} | {n(p['memory_bytes'])} | "
                    f"{ex['serial']['time_ms']:.2f} | {p['time_ms']:.2f} | {ex['tiled']['time_ms']:.2f} | "
-                   f"{n(p['overflowed'])} | {n(p['lost'])} | {n(p['mismatches'])} | {verdict} |")
+                   f"{n(p['overflowed'])} | {n(p['lost'])} | {n(p['mismatched_pixels'])} | {verdict} |")
     return "\n".join(out)
 
 
-def bench_table(report):
+def bench_table(rows):
+    report = rows[0]
     head = (f"scene {report['scene']}: {n(report['triangles'])} triangles, {report['width']}×{report['height']}, "
-            f"{n(report['fragments'])} fragments, max depth complexity {report['max_depth_complexity']}, "
+            f"{n(report['oracle_fragments'])} fragments, max depth complexity {report['max_depth_complexity']}, "
             f"{n(report['covered_pixels'])} covered pixels; effect {report['effect']}; {report['frames']} frames per scheme")
     out = [head, "", "| scheme | guarantee | passes | memory B | B/px | captured | overflow | lost | EPR | median ms | min–max ms | vs DP | verdict |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in report["rows"]:
+    for r in rows:
         epr = "—" if r["error_pixel_rate"] is None else f"{100 * r['error_pixel_rate']:.3f} %"
         vs = "—" if r["speedup_vs_depth_peeling"] is None else f"{r['speedup_vs_depth_peeling']:.2f}×"
         verdict = "kept" if r["keeps_guarantee"] else "**BROKEN**"
         out.append(f"| {r['scheme']} | {r['guarantee']} | {passes(r)} | {n(r['memory_bytes'])} | {r['bytes_per_pixel']:.0f} | "
-                   f"{n(r['captured'])} | {n(r['overflowed'])} | {n(r['lost'])} | {epr} | {r['median_ms']:.2f} | "
+                   f"{n(r['captured'])} | {n(r['overflowed'])} | {n(r['lost'])} | {epr} | {r['time_ms']:.2f} | "
                    f"{r['min_ms']:.2f}–{r['max_ms']:.2f} | {vs} | {verdict} |")
     return "\n".join(out)
 
@@ -56,8 +62,7 @@ def shipping_table(d):
         cells = {}
         guarantee = {}
         for k in ks:
-            rep = json.load(open(d / f"ship-{mesh}-{k}.json"))
-            for r in rep["rows"]:
+            for r in records(d / f"ship-{mesh}-{k}.json"):
                 cells.setdefault(r["scheme"], []).append(
                     f"{n(r['overflowed'])} / {n(r['lost'])} / {n(r['mismatched_pixels'])}")
                 guarantee[r["scheme"]] = r["guarantee"].replace(f"({k})", "(K)")
@@ -73,19 +78,22 @@ def shipping_table(d):
 
 
 def sweep_summary(path):
-    s = json.load(open(path))
-    out = [f"{path.name} ({s['effect']}, {len(s['angles'])} angles): mean EPR, max EPR, median time ms"]
-    for series in s["series"]:
-        rates = [r for r in series["error_pixel_rate"] if r is not None]
-        times = sorted(series["time_ms"])
-        out.append(f"- {series['scheme']}: {100 * sum(rates) / len(rates):.3f} %, {100 * max(rates):.3f} %, "
+    rows = records(path)
+    schemes = list(dict.fromkeys(r["scheme"] for r in rows))
+    angles = len({r["view_degrees"] for r in rows})
+    out = [f"{path.name} ({rows[0]['effect']}, {angles} angles): mean EPR, max EPR, median time ms"]
+    for scheme in schemes:
+        mine = [r for r in rows if r["scheme"] == scheme]
+        rates = [r["error_pixel_rate"] for r in mine if r["error_pixel_rate"] is not None]
+        times = sorted(r["time_ms"] for r in mine)
+        out.append(f"- {scheme}: {100 * sum(rates) / len(rates):.3f} %, {100 * max(rates):.3f} %, "
                    f"{times[len(times) // 2]:.2f}")
     return "\n".join(out)
 
 
 def bench_summary(path):
-    rows = json.load(open(path))["rows"]
-    return "\n".join(f"- {path.name} {r['scheme']} ({r['executor']}, {r['threads']} thr): median {r['median_ms']:.2f} ms "
+    rows = records(path)
+    return "\n".join(f"- {path.name} {r['scheme']} ({r['executor']}, {r['threads']} thr): median {r['time_ms']:.2f} ms "
                      f"({r['fps']:.0f} fps), passes {passes(r)}, vertex {r['vertex_ms']:.2f} / passes {r['passes_ms']:.2f} "
                      f"/ post {r['resolve_ms']:.2f}, memory {n(r['memory_bytes'])}, lost {r['lost']}, mismatched {r['mismatched_pixels']}"
                      for r in rows)
@@ -94,9 +102,9 @@ def bench_summary(path):
 def main():
     d = Path(sys.argv[1])
     for name in ["all-bunny.json", "all-bunny-auto.json", "all-dragon.json"]:
-        print(f"### {name}\n\n{render_table(json.load(open(d / name)))}\n")
+        print(f"### {name}\n\n{render_table(records(d / name))}\n")
     for name in ["bench-bunny.json", "bench-dragon.json", "bench-bunny-spheres.json"]:
-        print(f"### {name}\n\n{bench_table(json.load(open(d / name)))}\n")
+        print(f"### {name}\n\n{bench_table(records(d / name))}\n")
     print(f"### shipping\n\n{shipping_table(d)}\n")
     for name in sorted(d.glob("sweep-*.json")):
         print(sweep_summary(name) + "\n")

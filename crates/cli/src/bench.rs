@@ -11,13 +11,13 @@ use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::View;
-use fragsim_shade::effects;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{AttributePass, EffectName, Judge, Judged};
-use crate::schemes::{check_memory_cap_early, Executors, SchemeChoice, SchemeName};
+use crate::record::Context;
+use crate::schemes::{check_memory_cap_early, family, Executors, SchemeChoice, SchemeName};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -37,12 +37,17 @@ pub struct BenchArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for bench.json, bench.md, the images and the speed/accuracy chart.
+    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Print the rows as JSON instead of a table.
+    /// Print JSON Lines instead of the table: one record per scheme and executor
+    /// (`docs/json-schema.md`; bench.jsonl holds the same).
     #[arg(long)]
     pub json: bool,
+    /// Write no images (effect images, difference images, the chart); bench.jsonl and bench.md
+    /// are still written.
+    #[arg(long)]
+    pub no_images: bool,
 }
 
 /// One row of the bench.
@@ -54,9 +59,11 @@ pub struct BenchRow {
     pub guarantee: String,
     /// Whether the first frame kept the guarantee (judged by the oracle, on this executor).
     pub keeps_guarantee: bool,
-    /// `serial` or `parallel`.
+    /// `serial`, `parallel`, `tiled` or `scheduled` (a record's context carries it).
+    #[serde(skip)]
     pub executor: String,
-    /// Threads.
+    /// Threads (a record's context carries them).
+    #[serde(skip)]
     pub threads: usize,
     /// Geometry passes per frame.
     pub passes: u32,
@@ -90,7 +97,7 @@ pub struct BenchRow {
     /// in one extra, untimed frame.
     pub locked_ops_per_fragment: f64,
     /// Median frame time in milliseconds: vertex stage, geometry passes and post pass.
-    pub median_ms: f64,
+    pub time_ms: f64,
     /// Fastest frame.
     pub min_ms: f64,
     /// Slowest frame.
@@ -114,16 +121,22 @@ pub struct BenchRow {
 /// What the whole bench measured.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchReport {
-    /// Scene name.
+    /// The context of every record (scene, viewport, camera, sizes).
+    #[serde(skip)]
+    pub context: Context,
+    /// Scene name, as tables and titles print it (a mesh by its file name).
+    #[serde(skip)]
     pub scene: String,
     /// Triangles.
     pub triangles: u32,
     /// Viewport.
+    #[serde(skip)]
     pub width: u32,
     /// Viewport.
+    #[serde(skip)]
     pub height: u32,
     /// Oracle fragments.
-    pub fragments: usize,
+    pub oracle_fragments: usize,
     /// Largest depth complexity.
     pub max_depth_complexity: u32,
     /// Pixels with at least one fragment.
@@ -136,7 +149,17 @@ pub struct BenchReport {
     /// Frames per row.
     pub frames: u32,
     /// One row per scheme and executor.
+    #[serde(skip)]
     pub rows: Vec<BenchRow>,
+}
+
+/// One line of bench's JSON Lines: a row with what the whole bench measured.
+#[derive(Serialize)]
+struct BenchRecord<'a> {
+    #[serde(flatten)]
+    row: &'a BenchRow,
+    #[serde(flatten)]
+    bench: &'a BenchReport,
 }
 
 fn median(times: &mut [Duration]) -> Duration {
@@ -174,16 +197,24 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
+    crate::oracle_memory::check(&view, sizing.memory_cap)?;
     let oracle = Oracle::build(&view);
     let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
     let covered = judge.covered;
-    if let Some(image) = judge.reference() {
+    let executors = args.schemes.executors();
+    // One step a frame, plus the untimed frame that counts locked operations.
+    let progress = crate::progress::bar(
+        (schemes.len() * executors.len() * (frames + 1)) as u64,
+        "bench",
+    );
+    if let Some(image) = judge.reference().filter(|_| !args.no_images) {
         let name = format!("bench-oracle-{}.png", args.effect.label());
         fragsim_shade::save_png(image, &args.out.join(name))?;
     }
     let mut rows = Vec::new();
     for &name in &schemes {
-        for &executor in args.schemes.executors() {
+        for &executor in executors {
+            progress.set_message(format!("{name} on the {executor} executor"));
             let mut runner = Executors::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial
             // executor's vertex stage runs on one thread too.
@@ -208,9 +239,11 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 pass_times.push(stats.pass_time);
                 resolve_times.push(stats.resolve_time);
                 first.get_or_insert(named);
+                progress.inc(1);
             }
             runner.count_locked_ops = true;
             let counted = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            progress.inc(1);
             let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
             let named = first.expect("at least one frame");
             let diff = oracle.diff(&named.run.capture);
@@ -218,11 +251,11 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let error_pixels = judged.as_ref().map(|j| j.errors);
             if let Some(Judged {
                 image, reference, ..
-            }) = &judged
+            }) = judged.as_ref().filter(|_| !args.no_images)
             {
                 let stem = format!("bench-{}-{executor}", named.name);
                 fragsim_shade::save_png(image, &args.out.join(format!("{stem}.png")))?;
-                let difference = effects::difference_image(reference, image);
+                let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
                 fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
             }
             let median_time = median(&mut times);
@@ -256,7 +289,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                     / stats.counters.fragments.max(1) as f64,
                 locked_ops_per_fragment: locked_ops as f64
                     / counted.run.stats.counters.fragments.max(1) as f64,
-                median_ms: ms(median_time),
+                time_ms: ms(median_time),
                 min_ms: ms(times[0]),
                 max_ms: ms(times[times.len() - 1]),
                 fps: 1.0 / seconds,
@@ -270,13 +303,16 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             });
         }
     }
+    progress.finish_and_clear();
     set_speedups(&mut rows);
+    let context = Context::of_scene("bench", &args.scene)?.sized(&args.schemes);
     let report = BenchReport {
-        scene: scene.name.clone(),
+        scene: context.scene.clone(),
+        context,
         triangles: view.triangle_count(),
         width: viewport.width,
         height: viewport.height,
-        fragments: oracle.fragments(),
+        oracle_fragments: oracle.fragments(),
         max_depth_complexity: oracle.max_depth_complexity(),
         covered_pixels: covered,
         raster_ms: ms(median(&mut raster_times.clone())),
@@ -316,14 +352,14 @@ fn set_speedups(rows: &mut [BenchRow]) {
     let baselines: Vec<(String, f64)> = rows
         .iter()
         .filter(|r| is_baseline(&r.scheme))
-        .map(|r| (r.executor.clone(), r.median_ms))
+        .map(|r| (r.executor.clone(), r.time_ms))
         .collect();
     for row in rows.iter_mut() {
         if let Some((_, base)) = baselines
             .iter()
             .find(|(executor, _)| *executor == row.executor)
         {
-            row.speedup_vs_depth_peeling = Some(base / row.median_ms.max(1e-9));
+            row.speedup_vs_depth_peeling = Some(base / row.time_ms.max(1e-9));
         }
     }
 }
@@ -331,44 +367,73 @@ fn set_speedups(rows: &mut [BenchRow]) {
 fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
-    let json_path = args.out.join("bench.json");
-    std::fs::write(&json_path, &json)
+    let mut lines = String::new();
+    for row in &report.rows {
+        let context = report.context.on(&row.executor, row.threads);
+        let record = BenchRecord { row, bench: report };
+        lines.push_str(&crate::record::line("bench", &context, &record)?);
+        lines.push('\n');
+    }
+    let json_path = args.out.join("bench.jsonl");
+    std::fs::write(&json_path, &lines)
         .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
     let markdown = markdown(report);
     let md_path = args.out.join("bench.md");
     std::fs::write(&md_path, &markdown)
         .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
-    // One point per scheme and executor: the bench's own speed/accuracy scatter.
-    let points: Vec<fragsim_shade::plot::Series> = report
-        .rows
-        .iter()
-        .filter_map(|r| {
-            let rate = r.error_pixel_rate?;
-            Some((
-                format!("{} ({})", r.scheme, r.executor),
-                vec![(r.median_ms, rate * 100.0)],
-            ))
-        })
-        .collect();
-    fragsim_shade::plot::chart(
-        &args.out.join("bench-speed-accuracy.png"),
-        &format!(
-            "{}: speed against accuracy ({})",
-            report.scene, report.effect
-        ),
-        "median frame time (ms)",
-        "EPR (% of covered pixels)",
-        &points,
-        true,
-    )?;
+    if !args.no_images {
+        speed_accuracy_chart(report, &args.out.join("bench-speed-accuracy.png"))?;
+    }
     if args.json {
-        outln!("{json}");
+        out!("{lines}");
     } else {
         out!("{markdown}");
     }
     Ok(())
 }
+
+/// The bench's own speed/accuracy chart: one point per scheme and executor.
+fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<(), String> {
+    let points: Vec<fragsim_shade::plot::Point> = report
+        .rows
+        .iter()
+        .filter_map(|r| {
+            Some(fragsim_shade::plot::Point {
+                label: format!("{} ({})", r.scheme, r.executor),
+                family: family(&r.scheme),
+                time_ms: r.time_ms,
+                rate: r.error_pixel_rate?,
+            })
+        })
+        .collect();
+    fragsim_shade::plot::speed_accuracy(
+        path,
+        &format!(
+            "{}: speed against accuracy ({}, {}x{})",
+            report.scene, report.effect, report.width, report.height
+        ),
+        "median frame time (ms, log scale)",
+        &points,
+    )
+}
+
+/// What bench.md's columns mean, printed under the table.
+const COLUMNS: &str = "
+Columns: **thr** threads; **passes** geometry passes per frame (with the counting pass that \
+sized the storage, where one ran); **memory B**, **B/px** per-pixel storage in bytes, in all and \
+per pixel; **captured** fragments kept; **overflow** fragments with no room by design (beyond K \
+or a fixed capacity: the oracle's prediction); **lost** fragments it should have kept and did \
+not; **mismatched px** pixels whose list differs from the oracle's; **EPR %** error-pixel rate: \
+pixels whose 8-bit colour of the effect differs from the oracle's image, in percent of the \
+covered pixels (JSON holds the fraction, `error_pixel_rate`; n/a: the words cannot resolve the \
+effect); **ops/frag** memory operations per fragment; **locked/frag** read-modify-write \
+operations per fragment (counted in one extra, untimed frame); **vertex ms**, **passes ms**, \
+**post ms** medians of the vertex stage, the geometry passes (storage initialisation, \
+rasterization, capture) and the post pass (resolve, sort); **frame ms** their median sum \
+(`time_ms`), **min**, **max** the fastest and slowest frame; **fps** frames per second at the \
+median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments per second; \
+**vs DP** depth peeling's median time over this row's (above 1: faster than depth peeling).
+";
 
 fn markdown(report: &BenchReport) -> String {
     let mut text = format!(
@@ -378,7 +443,7 @@ fn markdown(report: &BenchReport) -> String {
         report.triangles,
         report.width,
         report.height,
-        report.fragments,
+        report.oracle_fragments,
         report.max_depth_complexity,
         report.covered_pixels,
         report.raster_ms,
@@ -386,7 +451,7 @@ fn markdown(report: &BenchReport) -> String {
         report.effect
     );
     text.push_str(
-        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
+        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR % | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
     );
     text.push_str(
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -407,13 +472,13 @@ fn markdown(report: &BenchReport) -> String {
             r.overflowed,
             r.lost,
             r.mismatched_pixels,
-            r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}%", e * 100.0)),
+            r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
             r.ops_per_fragment,
             r.locked_ops_per_fragment,
             r.vertex_ms,
             r.passes_ms,
             r.resolve_ms,
-            r.median_ms,
+            r.time_ms,
             r.min_ms,
             r.max_ms,
             r.fps,
@@ -422,5 +487,6 @@ fn markdown(report: &BenchReport) -> String {
             option(r.speedup_vs_depth_peeling, 2),
         ));
     }
+    text.push_str(COLUMNS);
     text
 }

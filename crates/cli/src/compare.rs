@@ -25,6 +25,8 @@ use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{depth_from_key, Conventions};
 use serde::Serialize;
 
+use crate::record::{Context, Slots};
+
 /// Options of `fragsim compare`.
 #[derive(Debug, Clone, Args)]
 pub struct CompareArgs {
@@ -34,7 +36,8 @@ pub struct CompareArgs {
     /// The candidate: a dump directory (or its dump.json), or `oracle`.
     #[arg(value_name = "CANDIDATE")]
     pub candidate: String,
-    /// Print the report as JSON.
+    /// Print JSON Lines instead of the report: one `compare` record, then one `difference`
+    /// record per differing pixel shown (`--show`; `docs/json-schema.md`).
     #[arg(long)]
     pub json: bool,
     /// Accept a candidate depth key within N f32 ulps of the reference's (same primitive), for
@@ -193,6 +196,8 @@ struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     precision: Option<Bounds>,
     pixels: u64,
+    /// Pixels with a verdict that is an error (missing, extra, misordered, miscounted, corrupt).
+    mismatched_pixels: u64,
     verdicts: VerdictCounts,
     fragments: Fragments,
     words: WordsReport,
@@ -405,6 +410,11 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         },
         precision: bounds,
         pixels: comparison.verdicts.len() as u64,
+        mismatched_pixels: comparison
+            .verdicts
+            .iter()
+            .filter(|&&v| v & verdict::DIFFERS != 0)
+            .count() as u64,
         verdicts: comparison.counts,
         fragments: Fragments {
             reference: reference_oracle.fragments() as u64,
@@ -425,10 +435,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         notes,
     };
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
+        print_json(&report)?;
     } else {
         print_report(&report);
     }
@@ -616,6 +623,34 @@ fn colour(flags: u8, fragments: usize) -> [u8; 3] {
     }
 }
 
+/// The legend of the difference image: every colour [`colour`] gives, what it means, and how
+/// many pixels have it.
+fn legend(comparison: &Comparison, reference: &Oracle) -> Vec<(image::Rgb<u8>, String)> {
+    let meanings: [(u8, usize, &str); 9] = [
+        (verdict::CORRUPT, 0, "corrupt word"),
+        (verdict::MISSING | verdict::EXTRA, 0, "missing and extra"),
+        (verdict::MISSING, 0, "missing"),
+        (verdict::EXTRA, 0, "extra"),
+        (verdict::MISORDERED, 0, "misordered"),
+        (verdict::MISCOUNTED, 0, "overflow miscounted"),
+        (verdict::OVERFLOWED, 0, "overflowed (by design)"),
+        (0, 1, "equal, covered"),
+        (0, 0, "no fragment"),
+    ];
+    let mut counts = [0u64; 9];
+    for (p, &flags) in comparison.verdicts.iter().enumerate() {
+        let c = colour(flags, reference.pixel(p).len());
+        if let Some(i) = meanings.iter().position(|&(f, n, _)| colour(f, n) == c) {
+            counts[i] += 1;
+        }
+    }
+    meanings
+        .iter()
+        .zip(counts)
+        .map(|(&(f, n, meaning), count)| (image::Rgb(colour(f, n)), format!("{meaning}: {count}")))
+        .collect()
+}
+
 fn write_image(
     comparison: &Comparison,
     width: u32,
@@ -627,7 +662,69 @@ fn write_image(
         let p = (y * width + x) as usize;
         image::Rgb(colour(comparison.verdicts[p], reference.pixel(p).len()))
     });
-    fragsim_shade::save_png(&image, path)
+    let differing = comparison
+        .verdicts
+        .iter()
+        .enumerate()
+        .filter(|&(_, &v)| v & verdict::DIFFERS != 0)
+        .map(|(p, _)| ((p % width as usize) as u32, (p / width as usize) as u32));
+    // Rings only where differences are sparse: dense ones show alone, and rings would hide some.
+    let ring = differing.clone().count() <= fragsim_shade::legend::MARKS;
+    let marks: Vec<(u32, u32)> = differing.take(fragsim_shade::legend::MARKS).collect();
+    let figure = fragsim_shade::legend::difference_figure(
+        &image,
+        &legend(comparison, reference),
+        &marks,
+        ring,
+    )?;
+    fragsim_shade::save_png(&figure, path)
+}
+
+/// The report as JSON Lines: the report's fields flattened into one `compare` record (a group's
+/// fields named as everywhere else: `missing_pixels`, `lost`, `reported_overflow`,
+/// `corrupt_words`, `candidate_k`, `precision_…`), then one `difference` record per example.
+fn print_json(r: &Report) -> Result<(), String> {
+    let mut context = Context::new("compare", &r.scene, r.width, r.height);
+    context.k = r.candidate.k.map(Slots::Fixed);
+    context.capacity = r.candidate.capacity.map(Slots::Fixed);
+    let serde_json::Value::Object(whole) = serde_json::to_value(r).map_err(|e| e.to_string())?
+    else {
+        return Err("the compare report is not a JSON object".into());
+    };
+    let mut flat = serde_json::Map::new();
+    for (key, value) in whole {
+        match (key.as_str(), value) {
+            // The context carries the scene and viewport; the examples are records of their own.
+            ("scene" | "width" | "height" | "first_differences", _) => {}
+            (group, serde_json::Value::Object(fields)) => {
+                for (k, v) in fields {
+                    flat.insert(flat_name(group, &k), v);
+                }
+            }
+            (_, value) => {
+                flat.insert(key, value);
+            }
+        }
+    }
+    crate::record::emit("compare", &context, &flat)?;
+    for example in &r.first_differences {
+        crate::record::emit("difference", &context, example)?;
+    }
+    Ok(())
+}
+
+/// The record's name of field `key` of the report's group `group`.
+fn flat_name(group: &str, key: &str) -> String {
+    let key = key.replace('-', "_");
+    match (group, key.as_str()) {
+        ("verdicts", _) => format!("{key}_pixels"),
+        ("fragments", "reference") => "reference_fragments".into(),
+        ("fragments", "overflow_claimed") => "reported_overflow".into(),
+        ("fragments", _) => key,
+        ("words", "checked") => "words_checked".into(),
+        ("words", _) => format!("{key}_words"),
+        _ => format!("{group}_{key}"),
+    }
 }
 
 fn print_report(r: &Report) {

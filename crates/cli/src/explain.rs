@@ -85,6 +85,28 @@ pub struct ExplainArgs {
     /// default: the scheme's own (`kbuffer`: render targets, `kbuffer-stores`: separate stores).
     #[arg(long, value_enum)]
     pub write_back: Option<WriteBackArg>,
+    /// Print one JSON Lines record (`docs/json-schema.md`): the scheme, the depths, whether the
+    /// property was shown, and the report's lines.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What the symbols of the step table mean, printed under it.
+const KEY: &str = "key: 0.3#1 = a fragment (depth 0.3, primitive 1); ∅ = an empty slot; \
+                   w2 = memory word 2 (the pixel's slot 2); T0 = thread 0; \
+                   ← = the value written; → = the value the operation returned; \
+                   (was …) = what a store overwrote";
+
+/// `explain`'s one JSON Lines record.
+#[derive(serde::Serialize)]
+struct ExplainRecord<'a> {
+    scheme: &'static str,
+    depths: &'a [f32],
+    seeds: u64,
+    /// Whether the property was shown (a hazard for the k-buffer, the invariant for MDTS).
+    shown: bool,
+    /// The printed report, line by line.
+    lines: Vec<&'a str>,
 }
 
 /// The k-buffer's machine, on the command line (`fragsim_capture::schemes::kbuffer::WriteBack`).
@@ -123,7 +145,30 @@ fn machine_label(machine: WriteBack) -> &'static str {
 /// Bad depths or parameters.
 pub fn explain(args: &ExplainArgs) -> Result<bool, String> {
     let (text, shown) = explain_text(args)?;
-    out!("{text}");
+    if args.json {
+        let mut context = crate::record::Context::new(
+            "explain",
+            &fragsim_oracle::scene::SceneAndCamera::named("one-pixel", 0.0, 0.0),
+            1,
+            1,
+        );
+        (context.view_degrees, context.elevation_degrees) = (None, None);
+        context.k = Some(crate::record::Slots::Fixed(
+            args.k.unwrap_or(args.depths.len() as u32),
+        ));
+        context.executor = Some("scheduled".into());
+        context.threads = Some(args.depths.len());
+        let record = ExplainRecord {
+            scheme: args.scheme.0.name(),
+            depths: &args.depths,
+            seeds: args.seeds,
+            shown,
+            lines: text.lines().collect(),
+        };
+        crate::record::emit("explain", &context, &record)?;
+    } else {
+        out!("{text}");
+    }
     Ok(shown)
 }
 
@@ -212,6 +257,7 @@ fn explain_kbuffer(
     );
     let memory = memory_after(&trace, k, EMPTY);
     out.push_str(&table(&fragments, &trace, &memory, &[]));
+    let _ = writeln!(out, "{KEY}");
     let _ = writeln!(out, "expected slots: {}", values(&nearest(&fragments, k)));
     for v in &damage.lost {
         let _ = writeln!(
@@ -272,6 +318,10 @@ fn explain_mdts(scheme: &Mdts<u64>, k: u32, fragments: &[Fragment], seeds: u64) 
         &memory,
         &[("carried (in flight)", in_flight), ("inv", marks)],
     ));
+    let _ = writeln!(
+        out,
+        "{KEY}; inv: ✓ the invariant holds after the step (a cross where it fails)"
+    );
     let last: Vec<u64> = memory
         .last()
         .map(|m| m.iter().copied().filter(|&v| v != EMPTY).collect())

@@ -21,10 +21,24 @@ pub struct ExportArgs {
     /// The triangle file to write.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    /// Print one JSON Lines record (`docs/json-schema.md`) instead of the sentence.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `export-scene`'s one JSON Lines record.
+#[derive(serde::Serialize)]
+struct ExportRecord {
+    /// The file written.
+    out: String,
+    /// Screen triangles written (the pieces of clipped triangles each count).
+    screen_triangles: usize,
+    /// Triangles of the mesh.
+    mesh_triangles: u32,
 }
 
 /// The scene description a dump or an export carries (a mesh file with the hash of its bytes).
-fn scene_spec(args: &SceneArgs) -> Result<SceneAndCamera, String> {
+pub(crate) fn scene_spec(args: &SceneArgs) -> Result<SceneAndCamera, String> {
     match &args.mesh {
         Some(path) => {
             SceneAndCamera::hashed_mesh(path, args.view, args.elevation).map_err(|e| e.to_string())
@@ -49,6 +63,20 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let export = TriangleExport::from_view(&view, spec);
     export.write(&args.out).map_err(|e| e.to_string())?;
+    if args.json {
+        let context = crate::record::Context::new(
+            "export-scene",
+            &export.scene,
+            args.scene.width,
+            args.scene.height,
+        );
+        let record = ExportRecord {
+            out: args.out.display().to_string(),
+            screen_triangles: export.triangles.len(),
+            mesh_triangles: export.mesh_triangles,
+        };
+        return crate::record::emit("export", &context, &record);
+    }
     outln!(
         "wrote {}: {} screen triangles of {} mesh triangles ({}, {}x{})",
         args.out.display(),

@@ -23,10 +23,12 @@ pub use fragsim_explain::{
     hazard::{HazardReport, HazardRow},
 };
 use fragsim_oracle::Oracle;
-use fragsim_shade::plot::{chart, Series};
+use fragsim_shade::plot::{chart, chart_with_ticks, Series};
+use serde::Serialize;
 
 use crate::args::SceneArgs;
 use crate::explain::WriteBackArg;
+use crate::record::{Context, Slots};
 
 /// Options of `fragsim hazard`.
 #[derive(Debug, Clone, Args)]
@@ -59,9 +61,55 @@ pub struct HazardArgs {
     /// Slots per pixel for `--baselines`, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "2,4,8")]
     pub ks: Vec<u32>,
-    /// Directory for hazard.md, hazard.json and the SVG plots (baselines.md, baselines.json).
+    /// Directory for hazard.md, hazard.json and the PNG plots (baselines.md, baselines.json).
     #[arg(long, default_value = "out/hazard")]
     pub out: PathBuf,
+    /// Write the plots as SVG instead of PNG.
+    #[arg(long)]
+    pub svg: bool,
+    /// Print JSON Lines instead of the tables: one record per (machine, policy, width), or per
+    /// baseline row (`docs/json-schema.md`).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One line of hazard's JSON Lines: a row of the rates (the context carries the scheduled
+/// executor and the threads in flight).
+#[derive(Serialize)]
+struct HazardRecord<'a> {
+    scheme: &'static str,
+    write_back: &'a str,
+    policy: &'a str,
+    seeds: u64,
+    /// Fraction of covered pixels whose list differs from the oracle's K nearest, mean over
+    /// the seeds.
+    mismatched_pixel_rate: f64,
+    /// The same, per seed.
+    mismatched_pixel_rate_per_seed: &'a [f64],
+    lost: u64,
+    extra: u64,
+    duplicates: u64,
+    misordered_pixels: u64,
+    /// The rate among the pixels of each depth-complexity bucket (`dc_1`, `dc_2`, `dc_3_4`, …);
+    /// `null` for a bucket without pixels.
+    #[serde(flatten)]
+    by_depth_complexity: std::collections::BTreeMap<String, Option<f64>>,
+}
+
+/// One line of `hazard --baselines`' JSON Lines (the context carries K and the executor).
+#[derive(Serialize)]
+struct BaselineRecord<'a> {
+    scheme: &'a str,
+    passes: u32,
+    overflowed: u64,
+    lost: u64,
+    extra: u64,
+    duplicates: u64,
+    misordered_pixels: u64,
+    error_pixels: u64,
+    /// `error_pixels` over the covered pixels.
+    error_pixel_rate: f64,
+    memory_bytes: u64,
 }
 
 /// Runs `hazard`.
@@ -77,15 +125,15 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
     let view = scene
         .view(viewport, &args.scene.orbit(args.scene.view))
         .map_err(|e| e.to_string())?;
+    crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT)?;
     let oracle = Oracle::build(&view);
     let in_bucket = covered_by_bucket(&oracle);
     let covered: usize = in_bucket.iter().sum();
     let mut report = HazardReport {
-        scene: args
-            .scene
-            .mesh
-            .as_ref()
-            .map_or_else(|| args.scene.scene.clone(), |p| p.display().to_string()),
+        scene: args.scene.mesh.as_ref().map_or_else(
+            || args.scene.scene.clone(),
+            |p| crate::record::file_name(&p.display().to_string()),
+        ),
         size: (args.scene.width, args.scene.height),
         k: args.k,
         covered,
@@ -102,33 +150,40 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
     if args.baselines {
         // The output lists hold every layer (as `render` sizes them).
         let layers = oracle.max_depth_complexity().max(1);
-        for baseline in baselines::table(viewport, &args.ks, &machines, layers)? {
+        let table = baselines::table(viewport, &args.ks, &machines, layers)?;
+        let progress = crate::progress::bar(table.len() as u64, "hazard --baselines");
+        for baseline in table {
+            progress.set_message(format!("{} K = {}", baseline.scheme, baseline.k));
             report
                 .baselines
                 .extend(baselines::rows(&baseline, &view, &oracle)?);
-            eprintln!(
-                "hazard --baselines: {} K = {} done",
-                baseline.scheme, baseline.k
-            );
+            progress.inc(1);
         }
+        progress.finish_and_clear();
         write_baselines(args, &report)?;
         return Ok(report);
     }
+    let progress = crate::progress::bar(
+        (machines.len() * POLICIES.len() * args.widths.len()) as u64,
+        "hazard",
+    );
     for &machine in &machines {
         let scheme = KBuffer::with_write_back(viewport, args.k, machine, MEMORY_CAP_DEFAULT)
             .map_err(|e| e.to_string())?;
         for policy in POLICIES {
             for &width in &args.widths {
-                let row = rate(&view, &oracle, &scheme, machine, policy, width, args.seeds);
-                report.rows.push(row);
-                eprintln!(
-                    "hazard: {} {} W = {width} done",
+                progress.set_message(format!(
+                    "{} {} W = {width}",
                     machine_name(machine),
                     policy.1
-                );
+                ));
+                let row = rate(&view, &oracle, &scheme, machine, policy, width, args.seeds);
+                report.rows.push(row);
+                progress.inc(1);
             }
         }
     }
+    progress.finish_and_clear();
     write(args, &report)?;
     Ok(report)
 }
@@ -168,7 +223,61 @@ fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), Strin
     std::fs::write(out.join("baselines.md"), &md).map_err(|e| e.to_string())?;
     let json = serde_json::to_string_pretty(&report.baselines).map_err(|e| e.to_string())?;
     std::fs::write(out.join("baselines.json"), json).map_err(|e| e.to_string())?;
-    out!("{md}");
+    if !args.json {
+        out!("{md}");
+        return Ok(());
+    }
+    let context = Context::of_scene("hazard", &args.scene)?;
+    for r in &report.baselines {
+        let mut context = context.on(&r.executor, 0);
+        context.threads = None;
+        context.k = Some(Slots::Fixed(r.k));
+        let record = BaselineRecord {
+            scheme: &r.scheme,
+            passes: r.passes,
+            overflowed: r.overflowed,
+            lost: r.lost,
+            extra: r.extra,
+            duplicates: r.duplicates,
+            misordered_pixels: r.misordered_pixels,
+            error_pixels: r.error_pixels,
+            error_pixel_rate: r.error_pixels as f64 / report.covered.max(1) as f64,
+            memory_bytes: r.memory_bytes,
+        };
+        crate::record::emit("baseline", &context, &record)?;
+    }
+    Ok(())
+}
+
+/// Hazard's JSON Lines: one record per row.
+fn print_json(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
+    let mut context = Context::of_scene("hazard", &args.scene)?;
+    context.k = Some(Slots::Fixed(report.k));
+    for r in &report.rows {
+        let by_depth_complexity = report
+            .buckets
+            .iter()
+            .zip(&r.rate_by_depth_complexity)
+            .map(|((label, n), &rate)| {
+                let key = format!("mismatched_pixel_rate_dc_{}", label.replace('–', "_"));
+                (key, (*n > 0).then_some(rate))
+            })
+            .collect();
+        let record = HazardRecord {
+            scheme: "kbuffer",
+            write_back: &r.write_back,
+            policy: &r.policy,
+            seeds: args.seeds,
+            mismatched_pixel_rate: r.rate,
+            mismatched_pixel_rate_per_seed: &r.rate_per_seed,
+            lost: r.lost,
+            extra: r.extra,
+            duplicates: r.duplicates,
+            misordered_pixels: r.misordered_pixels,
+            by_depth_complexity,
+        };
+        crate::record::emit("hazard", &context.on("scheduled", r.width), &record)?;
+    }
     Ok(())
 }
 
@@ -241,7 +350,12 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
     std::fs::write(out.join("hazard.md"), &md).map_err(|e| e.to_string())?;
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
     std::fs::write(out.join("hazard.json"), json).map_err(|e| e.to_string())?;
-    out!("{md}");
+    if args.json {
+        print_json(args, report)?;
+    } else {
+        out!("{md}");
+    }
+    let ext = if args.svg { "svg" } else { "png" };
     let mut by_width: Vec<Series> = Vec::new();
     for &write_back in &args.write_back {
         for (_, p) in POLICIES {
@@ -258,7 +372,7 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         }
     }
     chart(
-        &out.join("hazard_vs_width.svg"),
+        &out.join(format!("hazard_vs_width.{ext}")),
         &format!(
             "k-buffer (K = {}): pixels wrong vs threads in flight",
             report.k
@@ -286,12 +400,23 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
             )
         })
         .collect();
-    chart(
-        &out.join("hazard_vs_depth_complexity.svg"),
-        "k-buffer: pixels wrong vs depth complexity (buckets 1, 2, 3–4, 5–8, 9–16, 17+)",
-        "depth-complexity bucket (0 = dc 1, 1 = dc 2, 2 = 3–4, 3 = 5–8, 4 = 9–16, 5 = 17+)",
-        "fraction of the bucket's pixels wrong",
+    let ticks: Vec<String> = report
+        .buckets
+        .iter()
+        .map(|(label, n)| format!("{label} ({n} px)"))
+        .collect();
+    chart_with_ticks(
+        &out.join(format!("hazard_vs_depth_complexity.{ext}")),
+        (
+            &format!(
+                "k-buffer (K = {}): pixels wrong vs depth complexity",
+                report.k
+            ),
+            "depth complexity of the pixel (bucket, pixels in it)",
+            "fraction of the bucket's pixels wrong",
+        ),
         &by_dc,
         false,
+        Some(&ticks),
     )
 }

@@ -46,6 +46,9 @@ mod explain;
 mod export;
 mod hazard;
 mod judge;
+mod oracle_memory;
+mod progress;
+pub mod record;
 mod render;
 mod schemes;
 mod sweep;
@@ -81,6 +84,9 @@ pub struct Cli {
     /// Options of the default `render`.
     #[command(flatten)]
     pub render: RenderArgs,
+    /// No progress bars on stderr (they are drawn only on a terminal anyway).
+    #[arg(long, global = true)]
+    pub quiet: bool,
 }
 
 /// Subcommands.
@@ -107,6 +113,7 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let matches = Cli::command().get_matches_from(help_flag_dropped(std::env::args_os().collect()));
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    progress::set_quiet(cli.quiet);
     if let Err(message) = check_flags(&cli, &matches) {
         eprintln!("error: {message}");
         return ExitCode::from(2);
@@ -142,7 +149,7 @@ pub fn main() -> ExitCode {
                     run.scheme,
                     run.executor,
                     run.guarantee,
-                    run.mismatches,
+                    run.mismatched_pixels,
                     run.overflow_miscounted_pixels
                 );
             }

@@ -6,7 +6,6 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::{depth_from_key, Viewport};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use crate::args::{ConventionsArgs, SceneArgs, SchemeArgs};
@@ -30,12 +29,17 @@ pub struct RenderArgs {
     /// Directory for the PNG images.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Print the summary as JSON (one object per scheme and executor) instead of a table.
+    /// Print JSON Lines instead of a table: one record per scheme and executor
+    /// (`docs/json-schema.md`).
     #[arg(long)]
     pub json: bool,
     /// Write no images.
     #[arg(long)]
     pub no_images: bool,
+    /// The depth complexity drawn white in depth-complexity.png (and above it, marked `≥`):
+    /// a fixed scale, so that maps of different scenes compare; default: the image's maximum.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub scale_max: Option<u32>,
     /// Also write each scheme's per-pixel words as a dump in `DIR/<scheme>/` (docs/dump-format.md).
     #[arg(long, value_name = "DIR")]
     pub dump: Option<PathBuf>,
@@ -80,16 +84,12 @@ pub struct RunSummary {
     pub guarantee: String,
     /// Whether this run kept its guarantee (judged by the oracle, on this executor).
     pub keeps_guarantee: bool,
-    /// `serial`, `parallel`, `tiled` or `scheduled`.
+    /// `serial`, `parallel`, `tiled` or `scheduled` (a record's context carries it).
+    #[serde(skip)]
     pub executor: String,
-    /// Threads that ran it.
+    /// Threads that ran it (a record's context carries them).
+    #[serde(skip)]
     pub threads: usize,
-    /// Scene name.
-    pub scene: String,
-    /// Viewport width.
-    pub width: u32,
-    /// Viewport height.
-    pub height: u32,
     /// Triangles in the scene.
     pub triangles: u32,
     /// Fragments rasterized and inserted, over all passes.
@@ -114,7 +114,7 @@ pub struct RunSummary {
     /// Fragments the scheme should have kept but did not.
     pub lost: u64,
     /// Pixels that differ from the oracle.
-    pub mismatches: u64,
+    pub mismatched_pixels: u64,
     /// Pass plus post pass, in milliseconds.
     pub time_ms: f64,
     /// The passes (storage initialisation, rasterization, capture), in milliseconds.
@@ -147,7 +147,8 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let sizing = args.schemes.sizing();
     check_memory_cap_early(&schemes, viewport, &sizing)?;
     let executors = args.schemes.executors();
-    let progress = progress_bar(args.json, (schemes.len() * executors.len() + 1) as u64);
+    crate::oracle_memory::check(&view, sizing.memory_cap)?;
+    let progress = crate::progress::bar((schemes.len() * executors.len() + 1) as u64, "render");
     progress.set_message("oracle (serial reference)");
     let oracle_start = Instant::now();
     let oracle = Oracle::build(&view);
@@ -184,7 +185,11 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                     .into_iter()
                     .map(|k| k.map(depth_from_key))
                     .collect();
-                let image = fragsim_shade::nearest_depth(viewport.width, viewport.height, &nearest);
+                let image = fragsim_shade::legend::nearest_depth_with_key(
+                    viewport.width,
+                    viewport.height,
+                    &nearest,
+                )?;
                 fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png"))?;
                 nearest_written = true;
             }
@@ -195,9 +200,6 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 keeps_guarantee,
                 executor: executor.name().into(),
                 threads: run.stats.threads,
-                scene: scene.name.clone(),
-                width: viewport.width,
-                height: viewport.height,
                 triangles: view.triangle_count(),
                 fragments: run.stats.counters.fragments,
                 passes: run.stats.passes,
@@ -209,7 +211,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 reported_overflow: diff.reported_overflow,
                 overflow_miscounted_pixels: diff.overflow_miscounted_pixels,
                 lost: diff.lost,
-                mismatches: diff.mismatched_pixels,
+                mismatched_pixels: diff.mismatched_pixels,
                 time_ms: ms(run.stats.pass_time + run.stats.resolve_time),
                 pass_ms: ms(run.stats.pass_time),
                 resolve_ms: ms(run.stats.resolve_time),
@@ -228,32 +230,23 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     }
     progress.finish_and_clear();
     if !args.no_images {
-        let heat =
-            fragsim_shade::heat_map(viewport.width, viewport.height, &oracle.depth_complexity());
+        let heat = fragsim_shade::legend::heat_map_with_bar(
+            viewport.width,
+            viewport.height,
+            &oracle.depth_complexity(),
+            args.scale_max,
+        )?;
         fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))?;
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?
-        );
+        let context = crate::record::Context::of_scene("render", &args.scene)?.sized(&args.schemes);
+        for row in &rows {
+            crate::record::emit("run", &context.on(&row.executor, row.threads), row)?;
+        }
     } else {
         print_table(&rows, &scene.name, viewport, &oracle, oracle_ms, args);
     }
     Ok(rows)
-}
-
-fn progress_bar(hidden: bool, len: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if hidden {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.enable_steady_tick(std::time::Duration::from_millis(100));
-    bar
 }
 
 fn print_table(
@@ -292,7 +285,7 @@ fn print_table(
         ("captured", 9, |r| r.captured.to_string()),
         ("overflow", 8, |r| r.overflowed.to_string()),
         ("lost", 6, |r| r.lost.to_string()),
-        ("mismatches", 10, |r| r.mismatches.to_string()),
+        ("mismatches", 10, |r| r.mismatched_pixels.to_string()),
         ("verdict", 7, |r| {
             if r.keeps_guarantee { "kept" } else { "BROKEN" }.to_string()
         }),

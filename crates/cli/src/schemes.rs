@@ -59,6 +59,32 @@ impl ValueEnum for SchemeChoice {
     }
 }
 
+/// The family a scheme belongs to, as charts mark it (one marker shape a family): `mdts`,
+/// `a-buffer` (A-buffers, linked lists, the layer counter, the stencil-routed A-buffer),
+/// `peeling` (depth peeling and the z-buffer), `k-buffer` (k-buffers and loop32), `bucket`
+/// (bucket and adaptive depth peeling).
+#[must_use]
+pub fn family(scheme: &str) -> &'static str {
+    const FAMILIES: [(&str, &str); 12] = [
+        ("mdts", "mdts"),
+        ("abuffer", "a-buffer"),
+        ("linked-list", "a-buffer"),
+        ("layer-counter", "a-buffer"),
+        ("srab", "a-buffer"),
+        ("peeling", "peeling"),
+        ("dual-peeling", "peeling"),
+        ("zbuffer", "peeling"),
+        ("kbuffer", "k-buffer"),
+        ("loop32", "k-buffer"),
+        ("bdp", "bucket"),
+        ("adp", "bucket"),
+    ];
+    FAMILIES
+        .iter()
+        .find(|(prefix, _)| scheme.starts_with(prefix))
+        .map_or("other", |&(_, family)| family)
+}
+
 /// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Fault {

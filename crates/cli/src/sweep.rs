@@ -9,7 +9,8 @@ use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{EffectName, Judge};
-use crate::schemes::{Executors, SchemeChoice};
+use crate::record::Context;
+use crate::schemes::{family, Executors, SchemeChoice};
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -33,9 +34,23 @@ pub struct SweepArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for sweep.json and the PNG charts.
+    /// Directory for sweep.jsonl and the PNG charts.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
+    /// Print JSON Lines instead of the table: one record per scheme and angle
+    /// (`docs/json-schema.md`; sweep.jsonl holds the same).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One line of sweep's JSON Lines: a scheme at one angle (the context carries the angle).
+#[derive(Serialize)]
+struct SweepRecord<'a> {
+    scheme: &'a str,
+    effect: &'static str,
+    /// `None` where the scheme's words cannot resolve the effect.
+    error_pixel_rate: Option<f64>,
+    time_ms: f64,
 }
 
 /// One scheme's measurements over the sweep.
@@ -58,14 +73,18 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let scene = args.scene.scene()?;
     let viewport = args.scene.viewport()?;
     let executor = args.schemes.executors()[0];
+    let mut threads = 0;
     let schemes = SchemeChoice::expand(&args.scheme);
     let mut series: Vec<SweepSeries> = Vec::new();
     let mut angles = Vec::new();
+    let progress = crate::progress::bar(u64::from(args.angles), "sweep");
     for step in 0..args.angles {
+        progress.set_message(format!("angle {step}"));
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
         let orbit = args.scene.orbit(angle);
         let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+        crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
         let sizing = args.schemes.sizing();
@@ -86,32 +105,46 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
             series[i].time_ms.push(
                 (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,
             );
+            threads = named.run.stats.threads;
         }
+        progress.inc(1);
     }
-    write_outputs(args, &scene.name, &angles, &series)?;
+    progress.finish_and_clear();
+    let context = Context::of_scene("sweep", &args.scene)?
+        .sized(&args.schemes)
+        .on(executor.name(), threads);
+    write_outputs(args, &context, &angles, &series)?;
     Ok(series)
 }
 
 fn write_outputs(
     args: &SweepArgs,
-    scene: &str,
+    context: &Context,
     angles: &[f64],
     series: &[SweepSeries],
 ) -> Result<(), String> {
-    // A mesh path is named by its file.
-    let scene = std::path::Path::new(scene)
-        .file_name()
-        .map_or(scene.into(), |f| f.to_string_lossy());
+    let scene = &context.scene;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let json =
-        serde_json::json!({ "effect": args.effect.label(), "angles": angles, "series": series });
-    let path = args.out.join("sweep.json");
-    std::fs::write(
-        &path,
-        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
-    )
-    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let mut lines = String::new();
+    for s in series {
+        for ((&angle, &rate), &time_ms) in angles.iter().zip(&s.error_pixel_rate).zip(&s.time_ms) {
+            let record = SweepRecord {
+                scheme: &s.scheme,
+                effect: args.effect.label(),
+                error_pixel_rate: rate,
+                time_ms,
+            };
+            lines.push_str(&crate::record::line(
+                "sweep",
+                &context.at_angle(angle),
+                &record,
+            )?);
+            lines.push('\n');
+        }
+    }
+    let path = args.out.join("sweep.jsonl");
+    std::fs::write(&path, &lines).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     let per_angle: Vec<fragsim_shade::plot::Series> = series
         .iter()
         .map(|s| {
@@ -139,22 +172,27 @@ fn write_outputs(
         let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
         (n > 0).then(|| sum / n as f64)
     };
-    let scatter: Vec<fragsim_shade::plot::Series> = series
+    let scatter: Vec<fragsim_shade::plot::Point> = series
         .iter()
         .filter_map(|s| {
-            let time = mean(&mut s.time_ms.iter().copied())?;
-            let rate = mean(&mut s.error_pixel_rate.iter().flatten().copied())?;
-            Some((s.scheme.clone(), vec![(time, rate * 100.0)]))
+            Some(fragsim_shade::plot::Point {
+                label: s.scheme.clone(),
+                family: family(&s.scheme),
+                time_ms: mean(&mut s.time_ms.iter().copied())?,
+                rate: mean(&mut s.error_pixel_rate.iter().flatten().copied())?,
+            })
         })
         .collect();
-    fragsim_shade::plot::chart(
+    fragsim_shade::plot::speed_accuracy(
         &args.out.join("sweep-speed-accuracy.png"),
         &format!("{scene}: speed against accuracy (means over the sweep)"),
-        "frame time (ms)",
-        "EPR (% of covered pixels)",
+        "mean frame time (ms, log scale)",
         &scatter,
-        true,
     )?;
+    if args.json {
+        out!("{lines}");
+        return Ok(());
+    }
     outln!(
         "{:<20} {:>12} {:>12} {:>12}",
         "scheme",
@@ -186,7 +224,7 @@ fn write_outputs(
         );
     }
     outln!(
-        "wrote {}/sweep.json, sweep-epr.png, sweep-speed-accuracy.png",
+        "wrote {}/sweep.jsonl, sweep-epr.png, sweep-speed-accuracy.png",
         args.out.display()
     );
     Ok(())

@@ -13,6 +13,7 @@ use std::path::Path;
 
 pub mod deferred;
 pub mod effects;
+pub mod legend;
 pub mod plot;
 
 use image::{Rgb, RgbImage};
@@ -31,13 +32,21 @@ const RAMP: [[f32; 3]; 5] = [
 #[must_use]
 pub fn heat_map(width: u32, height: u32, counts: &[u32]) -> RgbImage {
     let max = counts.iter().copied().max().unwrap_or(0).max(1);
+    heat_map_scaled(width, height, counts, max)
+}
+
+/// Depth complexity per pixel as colour on a fixed scale: 0 is black, `max` (and above) white.
+#[must_use]
+pub fn heat_map_scaled(width: u32, height: u32, counts: &[u32], max: u32) -> RgbImage {
+    let max = max.max(1);
     RgbImage::from_fn(width, height, |x, y| {
         let c = counts[(y * width + x) as usize];
         ramp(c as f32 / max as f32)
     })
 }
 
-fn ramp(t: f32) -> Rgb<u8> {
+/// The heat map's colour at `t` in [0, 1] of its scale.
+pub(crate) fn ramp(t: f32) -> Rgb<u8> {
     let scaled = t.clamp(0.0, 1.0) * (RAMP.len() - 1) as f32;
     let i = (scaled.floor() as usize).min(RAMP.len() - 2);
     let f = scaled - i as f32;

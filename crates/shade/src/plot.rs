@@ -17,7 +17,7 @@ const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 /// Chart size in pixels.
 const SIZE: (u32, u32) = (900, 560);
 
-fn register_font() {
+pub(crate) fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
@@ -27,6 +27,41 @@ fn register_font() {
 
 /// A named series of `(x, y)` points.
 pub type Series = (String, Vec<(f64, f64)>);
+
+/// One scheme on a speed/accuracy chart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// What the table beside the chart calls it (`mdts (parallel)`).
+    pub label: String,
+    /// Its family: one marker shape a family.
+    pub family: &'static str,
+    /// Frame time, ms (drawn on a log axis).
+    pub time_ms: f64,
+    /// Error-pixel rate, a fraction (drawn as a percentage).
+    pub rate: f64,
+}
+
+/// The points no other point beats on both time and rate (ties kept), fastest first: the
+/// schemes worth choosing.
+#[must_use]
+pub fn pareto_front(points: &[Point]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| {
+        points[a]
+            .time_ms
+            .total_cmp(&points[b].time_ms)
+            .then(points[a].rate.total_cmp(&points[b].rate))
+    });
+    let mut front = Vec::new();
+    let mut best = f64::INFINITY;
+    for i in order {
+        if points[i].rate < best {
+            best = points[i].rate;
+            front.push(i);
+        }
+    }
+    front
+}
 
 fn palette(i: usize) -> RGBColor {
     const COLOURS: [RGBColor; 10] = [
@@ -70,39 +105,86 @@ pub fn chart(
     series: &[Series],
     scatter: bool,
 ) -> Result<(), String> {
+    chart_with_ticks(path, (title, x_label, y_label), series, scatter, None)
+}
+
+/// [`chart`] with the x axis labelled by `ticks` (`ticks[i]` at `x = i`, only there) instead
+/// of numbers: the axis of discrete buckets.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn chart_with_ticks(
+    path: &Path,
+    labels: (&str, &str, &str),
+    series: &[Series],
+    scatter: bool,
+    ticks: Option<&[String]>,
+) -> Result<(), String> {
+    let lines = Lines {
+        labels,
+        series,
+        scatter,
+        ticks,
+    };
+    render(path, SIZE, &lines)
+}
+
+/// A picture drawn the same on any plotters backend.
+trait Paint {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB>;
+}
+
+/// A line chart or a scatter ([`chart_with_ticks`]).
+struct Lines<'a> {
+    labels: (&'a str, &'a str, &'a str),
+    series: &'a [Series],
+    scatter: bool,
+    ticks: Option<&'a [String]>,
+}
+
+impl Paint for Lines<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        draw(root, self.labels, self.series, self.scatter, self.ticks)
+    }
+}
+
+/// Draws `picture` into a PNG file (a path ending in `.png`) or an SVG file (any other) of
+/// `size` pixels, creating its directory.
+fn render(path: &Path, size: (u32, u32), picture: &impl Paint) -> Result<(), String> {
     register_font();
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     }
     let error = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
-    let labels = (title, x_label, y_label);
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"))
     {
-        let mut bytes = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+        let mut bytes = vec![0u8; size.0 as usize * size.1 as usize * 3];
         {
-            let root = BitMapBackend::with_buffer(&mut bytes, SIZE).into_drawing_area();
-            draw(&root, labels, series, scatter).map_err(|e| error(&e))?;
+            let root = BitMapBackend::with_buffer(&mut bytes, size).into_drawing_area();
+            picture.paint(&root).map_err(|e| error(&e))?;
         }
-        image::RgbImage::from_raw(SIZE.0, SIZE.1, bytes)
+        image::RgbImage::from_raw(size.0, size.1, bytes)
             .expect("the buffer is the chart's size")
             .save(path)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))
     } else {
-        let root = SVGBackend::new(path, SIZE).into_drawing_area();
-        draw(&root, labels, series, scatter).map_err(|e| error(&e))
+        let root = SVGBackend::new(path, size).into_drawing_area();
+        picture.paint(&root).map_err(|e| error(&e))
     }
 }
 
-type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+pub(crate) type DrawResult<DB> =
+    Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     (title, x_label, y_label): (&str, &str, &str),
     series: &[Series],
     scatter: bool,
+    ticks: Option<&[String]>,
 ) -> DrawResult<DB> {
     let points = || series.iter().flat_map(|(_, p)| p.iter().copied());
     let (x0, x1) = range(points().map(|p| p.0));
@@ -121,12 +203,24 @@ fn draw<DB: DrawingBackend>(
         .x_label_area_size(44)
         .y_label_area_size(72)
         .build_cartesian_2d(x0.min(if scatter { 0.0 } else { x0 })..x1, y_start..y_end)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
+    // A bucket's name at its integer position only: the axis is discrete.
+    let tick = |x: &f64| {
+        let i = x.round();
+        match ticks {
+            Some(ticks) if (x - i).abs() < 1e-6 && i >= 0.0 => {
+                ticks.get(i as usize).cloned().unwrap_or_default()
+            }
+            _ => String::new(),
+        }
+    };
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_label)
         .y_desc(y_label)
-        .label_style(("sans-serif", 14))
-        .draw()?;
+        .label_style(("sans-serif", 14));
+    if let Some(ticks) = ticks {
+        mesh.x_label_formatter(&tick).x_labels(ticks.len() * 2 + 1);
+    }
+    mesh.draw()?;
     for (i, (name, data)) in series.iter().enumerate() {
         let colour = palette(i);
         let style = ShapeStyle::from(&colour).stroke_width(2);
@@ -152,6 +246,201 @@ fn draw<DB: DrawingBackend>(
         .label_font(("sans-serif", 13))
         .draw()?;
     root.present()
+}
+
+/// The speed/accuracy chart's size: the chart, and the table of its points beside it.
+const WIDE: (u32, u32) = (1280, 640);
+
+/// The speed/accuracy chart of `points`: frame time on a log axis, the error-pixel rate in
+/// percent, one marker shape a family, each point numbered and listed in a table beside the
+/// chart (labels beside points collide when many schemes are exact), and the Pareto front (the
+/// points nothing beats on both) joined by a line.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn speed_accuracy(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    points: &[Point],
+) -> Result<(), String> {
+    render(
+        path,
+        WIDE,
+        &SpeedAccuracy {
+            title,
+            x_label,
+            points,
+        },
+    )
+}
+
+struct SpeedAccuracy<'a> {
+    title: &'a str,
+    x_label: &'a str,
+    points: &'a [Point],
+}
+
+/// The families in order of first appearance: a family's index picks its marker.
+fn families(points: &[Point]) -> Vec<&'static str> {
+    let mut seen = Vec::new();
+    for p in points {
+        if !seen.contains(&p.family) {
+            seen.push(p.family);
+        }
+    }
+    seen
+}
+
+/// Marker `shape` (0 circle, 1 triangle, 2 square, 3 cross, then filled/hollow variants) at `at`.
+fn marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+    shape: usize,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    let filled = shape < 4;
+    let style = if filled {
+        colour.filled()
+    } else {
+        colour.stroke_width(2)
+    };
+    match shape % 4 {
+        0 => area.draw(&Circle::new(at, 6, style)),
+        1 => area.draw(&TriangleMarker::new(at, 7, style)),
+        2 => area.draw(&Rectangle::new(
+            [(at.0 - 5, at.1 - 5), (at.0 + 5, at.1 + 5)],
+            style,
+        )),
+        _ => area.draw(&Cross::new(at, 6, colour.stroke_width(3))),
+    }
+}
+
+impl Paint for SpeedAccuracy<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        root.fill(&WHITE)?;
+        let (left, right) = root.split_horizontally(WIDE.0 - 400);
+        let times = self.points.iter().map(|p| p.time_ms.max(1e-3));
+        let lo = times.clone().fold(f64::INFINITY, f64::min);
+        let hi = times.fold(f64::NEG_INFINITY, f64::max);
+        let (lo, hi) = if lo.is_finite() {
+            (lo / 1.5, hi * 1.5)
+        } else {
+            (0.1, 10.0)
+        };
+        // EPR on a log axis too (one scheme near 100 % would squash the rest at 0 on a linear
+        // one); an exact scheme's 0 is drawn on the floor, a decade under the least rate seen.
+        let rates = self.points.iter().map(|p| p.rate * 100.0);
+        let top = rates.clone().fold(0.0, f64::max).max(1e-3) * 2.0;
+        let least = rates.filter(|&r| r > 0.0).fold(f64::INFINITY, f64::min);
+        let floor = if least.is_finite() {
+            10f64.powf(least.log10().floor() - 1.0)
+        } else {
+            1e-3
+        };
+        let y = |rate: f64| (rate * 100.0).max(floor);
+        let mut chart = ChartBuilder::on(&left)
+            .caption(self.title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(72)
+            .build_cartesian_2d((lo..hi).log_scale(), (floor * 0.7..top).log_scale())?;
+        let whole = |v: &f64| format!("{v:.0}");
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label)
+            .y_desc("EPR (% of covered pixels, log scale)")
+            .x_labels(6)
+            .y_labels(8)
+            .x_label_formatter(&whole)
+            .light_line_style(WHITE)
+            .label_style(("sans-serif", 14))
+            .draw()?;
+        let bottom = chart.backend_coord(&(lo, floor));
+        root.draw(&Text::new(
+            "EPR 0 (exact) is drawn on this line",
+            (bottom.0 + 6, bottom.1 - 16),
+            ("sans-serif", 12).into_font().color(&BLACK.mix(0.6)),
+        ))?;
+        root.draw(&PathElement::new(
+            vec![bottom, (bottom.0 + (WIDE.0 as i32 - 520), bottom.1)],
+            BLACK.mix(0.3).stroke_width(1),
+        ))?;
+        let front = pareto_front(self.points);
+        chart
+            .draw_series(LineSeries::new(
+                front
+                    .iter()
+                    .map(|&i| (self.points[i].time_ms.max(1e-3), y(self.points[i].rate))),
+                BLACK.mix(0.5).stroke_width(2),
+            ))?
+            .label("Pareto front (nothing is both faster and more accurate)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+        let families = families(self.points);
+        for (i, p) in self.points.iter().enumerate() {
+            let at = chart.backend_coord(&(p.time_ms.max(1e-3), y(p.rate)));
+            let shape = families.iter().position(|&f| f == p.family).unwrap_or(0);
+            let colour = palette(i);
+            marker(root, at, shape, colour)?;
+            root.draw(&Text::new(
+                (i + 1).to_string(),
+                (at.0 + 7, at.1 - 16),
+                ("sans-serif", 12).into_font().color(&colour),
+            ))?;
+        }
+        for (f, family) in families.iter().enumerate() {
+            chart
+                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+                .label(format!("family {family}"))
+                .legend(move |(x, y)| {
+                    // As `marker` draws them: filled for the first four families, hollow after.
+                    let style = if f < 4 {
+                        BLACK.filled()
+                    } else {
+                        BLACK.stroke_width(2)
+                    };
+                    match f % 4 {
+                        0 => Circle::new((x + 8, y), 5, style).into_dyn(),
+                        1 => TriangleMarker::new((x + 8, y), 6, style).into_dyn(),
+                        2 => Rectangle::new([(x + 3, y - 5), (x + 13, y + 5)], style).into_dyn(),
+                        _ => Cross::new((x + 8, y), 5, BLACK.stroke_width(3)).into_dyn(),
+                    }
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()?;
+        // The table: number, scheme, time, EPR; Pareto points starred.
+        let rows = self.points.len().max(1) as i32;
+        let line = ((WIDE.1 as i32 - 40) / (rows + 1)).clamp(8, 20);
+        let size = (line - 4).clamp(8, 14);
+        let font = ("sans-serif", size).into_font();
+        right.draw(&Text::new(
+            "#  scheme  time ms  EPR %  (* Pareto)",
+            (4, 14),
+            font.clone(),
+        ))?;
+        for (i, p) in self.points.iter().enumerate() {
+            let y = 14 + line * (i as i32 + 1);
+            let star = if front.contains(&i) { "*" } else { " " };
+            right.draw(&Text::new(
+                format!(
+                    "{}{star} {}  {:.2}  {:.3}",
+                    i + 1,
+                    p.label,
+                    p.time_ms,
+                    p.rate * 100.0
+                ),
+                (4, y),
+                font.clone().color(&palette(i)),
+            ))?;
+        }
+        root.present()
+    }
 }
 
 #[cfg(test)]

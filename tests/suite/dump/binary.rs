@@ -51,7 +51,11 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
                 .args(["--json", "--no-image"]),
             0,
         );
-        assert!(out.contains("\"equal\": true"), "{out}");
+        assert_eq!(
+            crate::support::json_lines(out.as_bytes())[0]["equal"],
+            true,
+            "{out}"
+        );
     }
     let text = stdout_of(
         fragsim()
@@ -87,7 +91,9 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             .args(["--json", "--no-image"]),
         1,
     );
-    assert!(json.contains("\"equal\": false") && json.contains("\"first_differences\""));
+    let records = crate::support::json_lines(json.as_bytes());
+    assert_eq!(records[0]["equal"], false, "{json}");
+    assert_eq!(records[1]["record"], "difference", "{json}");
     // Nothing to compare, or no dump at all: exit 2.
     stdout_of(fragsim().args(["compare", "oracle", "oracle"]), 2);
     stdout_of(
@@ -98,8 +104,9 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
     );
 }
 
-/// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the report.
-fn json_report(dir: &Path, code: i32) -> serde_json::Value {
+/// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the records
+/// (the `compare` record, then one `difference` record per pixel shown).
+fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
     let out = stdout_of(
         fragsim()
             .args(["compare", "oracle"])
@@ -107,7 +114,7 @@ fn json_report(dir: &Path, code: i32) -> serde_json::Value {
             .args(["--json", "--no-image"]),
         code,
     );
-    serde_json::from_str(&out).unwrap()
+    crate::support::json_lines(out.as_bytes())
 }
 
 #[test]
@@ -136,7 +143,7 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
     ];
     for (scheme, file, width, empty) in layouts {
         let path = dumps.join(scheme);
-        let k = json_report(&path, 0)["candidate"]["k"].as_u64().unwrap() as usize;
+        let k = json_report(&path, 0)[0]["candidate_k"].as_u64().unwrap() as usize;
         let slots = path.join(file);
         let mut bytes = std::fs::read(&slots).unwrap();
         let word = |bytes: &[u8], i: usize| {
@@ -174,11 +181,12 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
             );
         }
         assert!(!text.contains("EQUAL"), "{scheme}: {text}");
-        let report = json_report(&path, 1);
+        let records = json_report(&path, 1);
+        let report = &records[0];
         assert_eq!(report["equal"], false);
-        assert_eq!(report["verdicts"]["corrupt"], 1, "{scheme}");
-        assert_eq!(report["words"]["corrupt"], 1);
-        let first = &report["first_differences"][0];
+        assert_eq!(report["corrupt_pixels"], 1, "{scheme}");
+        assert_eq!(report["corrupt_words"], 1);
+        let first = &records[1];
         assert_eq!(first["pixel"], pixel);
         assert_eq!(first["verdict"], serde_json::json!(["corrupt"]));
         assert_eq!(first["corrupt_words"][0]["slot"], k - 1);
@@ -191,12 +199,12 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
     let pixel = bytes.chunks_exact(4).position(|c| c != [0; 4]).unwrap();
     bytes[pixel * 4..pixel * 4 + 4].copy_from_slice(&u32::MAX.to_le_bytes());
     std::fs::write(&counters, &bytes).unwrap();
-    let report = json_report(&path, 1);
-    assert_eq!(report["verdicts"]["overflow-miscounted"], 1);
-    assert_eq!(report["fragments"]["overflowed"], 0);
-    assert_eq!(report["first_differences"][0]["pixel"], pixel);
+    let records = json_report(&path, 1);
+    assert_eq!(records[0]["overflow_miscounted_pixels"], 1);
+    assert_eq!(records[0]["overflowed"], 0);
+    assert_eq!(records[1]["pixel"], pixel);
     assert_eq!(
-        report["first_differences"][0]["verdict"],
+        records[1]["verdict"],
         // `abuffer` is fixed storage written in full (`filled`): the slots the counter now
         // claims hold the empty marker, which is corrupt too.
         serde_json::json!(["overflow-miscounted", "corrupt"])
@@ -279,7 +287,11 @@ fn render_dumps_every_scheme_or_nothing() {
                 .args(["--json", "--no-image"]),
             0,
         );
-        assert!(out.contains("\"equal\": true"), "{scheme}: {out}");
+        assert_eq!(
+            crate::support::json_lines(out.as_bytes())[0]["equal"],
+            true,
+            "{scheme}: {out}"
+        );
     }
     // A file where one dump goes fails the whole run before anything is moved into place.
     let blocked = dir.join("blocked");

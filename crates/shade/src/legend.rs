@@ -1,0 +1,344 @@
+//! Images read at a glance: a picture with a panel beside it that says what its colours mean
+//! (the heat map's colour bar with units, the nearest depth's near/far key, a difference
+//! image's legend) and, for differences, zoomed insets of the first differing pixels with
+//! their places marked, so that one wrong pixel in 512 × 512 is seen.
+//!
+//! Guarantee: the picture's own pixels are copied unchanged into the top-left corner of the
+//! figure, but for the rings drawn around marked pixels (never on the pixel itself);
+//! everything else is the panel. Text is
+//! drawn with the charts' embedded font ([`crate::plot`]).
+
+use image::{Rgb, RgbImage};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Width of the panel beside the picture, in pixels.
+const PANEL: u32 = 260;
+/// The least height of a figure: a panel's text needs it beside a small picture.
+const MIN_HEIGHT: u32 = 300;
+
+/// `picture` with a panel of [`PANEL`] pixels at its right, filled by `panel` (given the
+/// panel's area and the picture's size), and any `below` height of panel under the picture.
+fn figure(
+    picture: &RgbImage,
+    below: u32,
+    panel: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<RgbImage, String> {
+    crate::plot::register_font();
+    let (w, h) = picture.dimensions();
+    let size = (w + PANEL, (h + below).max(MIN_HEIGHT));
+    let mut out = RgbImage::from_pixel(size.0, size.1, Rgb([255, 255, 255]));
+    for (x, y, p) in picture.enumerate_pixels() {
+        out.put_pixel(x, y, *p);
+    }
+    {
+        let root = BitMapBackend::with_buffer(&mut out, size).into_drawing_area();
+        panel(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(out)
+}
+
+fn text<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: &str,
+    at: (i32, i32),
+    size: i32,
+) -> Result<(), String> {
+    area.draw(&Text::new(
+        s.to_string(),
+        at,
+        ("sans-serif", size).into_font(),
+    ))
+    .map_err(|e| e.to_string())
+}
+
+fn fill<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    corners: [(i32, i32); 2],
+    colour: Rgb<u8>,
+) -> Result<(), String> {
+    let [r, g, b] = colour.0;
+    area.draw(&Rectangle::new(corners, RGBColor(r, g, b).filled()))
+        .map_err(|e| e.to_string())
+}
+
+/// The depth-complexity heat map of `counts` with a colour bar: `scale_max` fixes the count
+/// drawn white (counts above it are white too, the bar says `≥`), so that maps of different
+/// scenes compare; `None` scales to this image's maximum, and the bar says so.
+///
+/// # Errors
+/// Text cannot be drawn (a font error).
+pub fn heat_map_with_bar(
+    width: u32,
+    height: u32,
+    counts: &[u32],
+    scale_max: Option<u32>,
+) -> Result<RgbImage, String> {
+    let max_seen = counts.iter().copied().max().unwrap_or(0);
+    let top = scale_max.unwrap_or(max_seen).max(1);
+    let picture = crate::heat_map_scaled(width, height, counts, top);
+    let x0 = width as i32 + 20;
+    figure(&picture, 0, |area| {
+        text(area, "depth complexity", (x0, 8), 16)?;
+        text(area, "(fragments per pixel)", (x0, 28), 13)?;
+        let (bar_top, bar_bottom) = (56, 256);
+        for y in bar_top..=bar_bottom {
+            let t = (bar_bottom - y) as f32 / (bar_bottom - bar_top) as f32;
+            fill(area, [(x0, y), (x0 + 24, y + 1)], crate::ramp(t))?;
+        }
+        // Ticks at 0, ¼, ½, ¾ and the top of the scale, as whole fragment counts.
+        let mut last = None;
+        for i in 0..=4u32 {
+            let value = (top * i).div_ceil(4);
+            if last == Some(value) {
+                continue;
+            }
+            last = Some(value);
+            let y = bar_bottom - ((bar_bottom - bar_top) as f32 * value as f32 / top as f32) as i32;
+            fill(area, [(x0 + 24, y), (x0 + 30, y + 1)], Rgb([0, 0, 0]))?;
+            let label = if i == 4 && max_seen > top {
+                format!("≥ {value}")
+            } else {
+                value.to_string()
+            };
+            text(area, &label, (x0 + 34, y - 7), 13)?;
+        }
+        let scale = match scale_max {
+            Some(n) => format!("fixed scale: {n} (--scale-max)"),
+            None => "scale: this image's maximum".to_string(),
+        };
+        text(area, &scale, (x0 - 10, bar_bottom + 16), 12)?;
+        text(
+            area,
+            &format!("maximum here: {max_seen}"),
+            (x0 - 10, bar_bottom + 32),
+            12,
+        )
+    })
+}
+
+/// The nearest depth of each pixel (`crate::nearest_depth`) with its key: white is near, dark
+/// is far (the depths at both ends named), black is no fragment.
+///
+/// # Errors
+/// Text cannot be drawn (a font error).
+pub fn nearest_depth_with_key(
+    width: u32,
+    height: u32,
+    nearest: &[Option<f32>],
+) -> Result<RgbImage, String> {
+    let picture = crate::nearest_depth(width, height, nearest);
+    let present = nearest.iter().flatten();
+    let lo = present.clone().copied().fold(f32::INFINITY, f32::min);
+    let hi = present.copied().fold(f32::NEG_INFINITY, f32::max);
+    let x0 = width as i32 + 20;
+    figure(&picture, 0, |area| {
+        text(area, "nearest depth", (x0, 8), 16)?;
+        text(area, "(window z of the first fragment)", (x0 - 10, 28), 12)?;
+        let (bar_top, bar_bottom) = (56, 216);
+        for y in bar_top..=bar_bottom {
+            let t = (y - bar_top) as f32 / (bar_bottom - bar_top) as f32;
+            let v = (255.0 - 215.0 * t).round() as u8;
+            fill(area, [(x0, y), (x0 + 24, y + 1)], Rgb([v, v, v]))?;
+        }
+        area.draw(&Rectangle::new(
+            [(x0, bar_top), (x0 + 24, bar_bottom)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(|e| e.to_string())?;
+        let (near, far) = if lo.is_finite() {
+            (
+                format!("near (white): {lo:.4}"),
+                format!("far (dark): {hi:.4}"),
+            )
+        } else {
+            ("near (white)".into(), "far (dark)".into())
+        };
+        text(area, &near, (x0 + 30, bar_top - 6), 13)?;
+        text(area, &far, (x0 + 30, bar_bottom - 8), 13)?;
+        fill(
+            area,
+            [(x0, bar_bottom + 20), (x0 + 24, bar_bottom + 36)],
+            Rgb([0, 0, 0]),
+        )?;
+        text(area, "no fragment", (x0 + 30, bar_bottom + 21), 13)
+    })
+}
+
+/// How many differing pixels get a zoomed inset.
+pub const INSETS: usize = 4;
+/// Pixels of the picture on each side of an inset's centre.
+const INSET_RADIUS: u32 = 7;
+/// Zoom of an inset.
+const INSET_ZOOM: u32 = 8;
+
+/// A difference image with its `legend` (colour, meaning, count) beside it, a ring around each
+/// of `marks` (the first differing pixels, in order) when `ring` (sparse differences, which a
+/// ring makes visible; dense ones are visible alone and a ring would hide some) and, below,
+/// zoomed insets of the first [`INSETS`] of them, each with its pixel outlined and its
+/// coordinates named.
+///
+/// # Errors
+/// Text cannot be drawn (a font error).
+pub fn difference_figure(
+    picture: &RgbImage,
+    legend: &[(Rgb<u8>, String)],
+    marks: &[(u32, u32)],
+    ring: bool,
+) -> Result<RgbImage, String> {
+    let side = (2 * INSET_RADIUS + 1) * INSET_ZOOM;
+    let insets = marks.len().min(INSETS);
+    let (w, h) = picture.dimensions();
+    // The insets go below the picture and below the legend's text, whichever is lower.
+    let legend_bottom = 64 + 22 * legend.len() as u32;
+    let inset_top = h.max(legend_bottom) + 28;
+    let below = if insets > 0 {
+        inset_top + side + 12 - h
+    } else {
+        0
+    };
+    let mut out = figure(picture, below, |area| {
+        let x0 = w as i32 + 16;
+        text(area, "difference", (x0, 8), 16)?;
+        for (i, (colour, meaning)) in legend.iter().enumerate() {
+            let y = 36 + 22 * i as i32;
+            fill(area, [(x0, y), (x0 + 16, y + 16)], *colour)?;
+            area.draw(&Rectangle::new(
+                [(x0, y), (x0 + 16, y + 16)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+            text(area, meaning, (x0 + 22, y + 1), 13)?;
+        }
+        let note_y = 44 + 22 * legend.len() as i32;
+        if marks.is_empty() {
+            text(area, "no differing pixel", (x0, note_y), 13)?;
+        } else if ring {
+            text(area, "rings: first differing pixels", (x0, note_y), 13)?;
+        }
+        for &(x, y) in marks.iter().filter(|_| ring) {
+            area.draw(&Circle::new(
+                (x as i32, y as i32),
+                9,
+                RGBColor(255, 0, 255).stroke_width(2),
+            ))
+            .map_err(|e| e.to_string())?;
+        }
+        for (i, &(x, y)) in marks.iter().take(INSETS).enumerate() {
+            let left = i as i32 * (side as i32 + 12) + 4;
+            let top = inset_top as i32;
+            text(
+                area,
+                &format!("({x}, {y}) ×{INSET_ZOOM}"),
+                (left, top - 20),
+                13,
+            )?;
+            area.draw(&Rectangle::new(
+                [(left - 1, top - 1), (left + side as i32, top + side as i32)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    })?;
+    // The insets' pixels, copied after the panel so that nothing is drawn over them, then the
+    // centre pixel outlined.
+    for (i, &(cx, cy)) in marks.iter().take(INSETS).enumerate() {
+        let left = i as u32 * (side + 12) + 4;
+        let top = inset_top;
+        for dy in 0..side {
+            for dx in 0..side {
+                let sx = i64::from(cx) + i64::from(dx / INSET_ZOOM) - i64::from(INSET_RADIUS);
+                let sy = i64::from(cy) + i64::from(dy / INSET_ZOOM) - i64::from(INSET_RADIUS);
+                let p = if (0..i64::from(w)).contains(&sx) && (0..i64::from(h)).contains(&sy) {
+                    *picture.get_pixel(sx as u32, sy as u32)
+                } else {
+                    Rgb([255, 255, 255])
+                };
+                if left + dx < out.width() && top + dy < out.height() {
+                    out.put_pixel(left + dx, top + dy, p);
+                }
+            }
+        }
+        let (c0, c1) = (
+            INSET_RADIUS * INSET_ZOOM,
+            (INSET_RADIUS + 1) * INSET_ZOOM - 1,
+        );
+        for t in c0..=c1 {
+            for (x, y) in [(t, c0), (t, c1), (c0, t), (c1, t)] {
+                if left + x < out.width() && top + y < out.height() {
+                    out.put_pixel(left + x, top + y, Rgb([255, 0, 255]));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// How many differing pixels get a ring.
+pub const MARKS: usize = 16;
+
+/// An effect's difference image (`crate::effects::difference_image`: error pixels red) as a
+/// [`difference_figure`]: its legend with the counts, and the first differing pixels (in raster
+/// order) ringed and zoomed.
+///
+/// # Errors
+/// Text cannot be drawn (a font error).
+pub fn effect_difference_figure(
+    reference: &RgbImage,
+    candidate: &RgbImage,
+) -> Result<RgbImage, String> {
+    let picture = crate::effects::difference_image(reference, candidate);
+    let differing: Vec<(u32, u32)> = reference
+        .enumerate_pixels()
+        .filter(|&(x, y, p)| candidate.get_pixel(x, y) != p)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    let legend = [
+        (
+            Rgb([255, 0, 0]),
+            format!("8-bit colour differs: {} px", differing.len()),
+        ),
+        (
+            Rgb([100, 100, 100]),
+            "equal (candidate, dimmed)".to_string(),
+        ),
+    ];
+    let ring = differing.len() <= MARKS;
+    let marks: Vec<(u32, u32)> = differing.into_iter().take(MARKS).collect();
+    difference_figure(&picture, &legend, &marks, ring)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_picture_is_copied_unchanged_and_the_panel_is_drawn() {
+        let counts = [0, 1, 2, 3];
+        let figure = heat_map_with_bar(2, 2, &counts, Some(3)).unwrap();
+        assert_eq!(figure.dimensions(), (2 + PANEL, MIN_HEIGHT));
+        let plain = crate::heat_map_scaled(2, 2, &counts, 3);
+        for (x, y, p) in plain.enumerate_pixels() {
+            assert_eq!(figure.get_pixel(x, y), p);
+        }
+        let inked = figure.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+        assert!(inked > 500, "{inked} pixels of bar and text");
+    }
+
+    #[test]
+    fn an_inset_zooms_the_differing_pixel() {
+        let mut picture = RgbImage::from_pixel(64, 64, Rgb([70, 70, 70]));
+        picture.put_pixel(40, 30, Rgb([230, 40, 40]));
+        let legend = [(Rgb([230, 40, 40]), "missing".to_string())];
+        let figure = difference_figure(&picture, &legend, &[(40, 30)], true).unwrap();
+        // The inset's centre block, just inside its outline, is the differing pixel's colour.
+        let (left, top) = (4, (64 + 22) + 28);
+        let inside = INSET_RADIUS * INSET_ZOOM + 2;
+        assert_eq!(
+            figure.get_pixel(left + inside, top + inside),
+            &Rgb([230, 40, 40])
+        );
+    }
+}
