@@ -9,6 +9,7 @@ pub mod common;
 pub mod dual_peeling;
 pub mod kbuffer;
 pub mod kbuffer_interlock;
+pub mod kbuffer_interlock_ordered;
 pub mod kbuffer_multipass;
 pub mod kbuffer_spinlock;
 pub mod layer_counter;

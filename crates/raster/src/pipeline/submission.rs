@@ -35,7 +35,10 @@ impl View<'_> {
     /// view is [`shuffled`](View::shuffled).
     #[must_use]
     pub fn submitted(&self, index: u32) -> u32 {
-        self.submission.get(index as usize).copied().unwrap_or(index)
+        self.submission
+            .get(index as usize)
+            .copied()
+            .unwrap_or(index)
     }
 
     /// Whether the submission order is a permutation other than primitive id order.
