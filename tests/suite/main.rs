@@ -25,6 +25,7 @@ mod extremes;
 mod interlock_ordered;
 mod kbuffer;
 mod locks;
+mod loop64;
 mod mdts_packed;
 mod meshes;
 mod order_independence;

@@ -308,6 +308,9 @@ catalog! {
     Loop32 "loop32" Fixed(2), K, Some(Memory),
         "nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths merge), then a colour pass; K = `--k`.";
         |b| (Loop32::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+    Loop64 "loop64" Fixed(1), K, Some(Memory),
+        "nvpro-samples' loop64: one pass of 64-bit `atomicMin` on packed (depth, colour) words, here (depth, primitive): exact, K = `--k`.";
+        |b| (crate::schemes::loop64::Loop64::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     LayerCounter "layer-counter" Fixed(1), K, Some(LayerMajor),
         "Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.";
         |b| (LayerCounter::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));

@@ -15,6 +15,7 @@ pub mod kbuffer_spinlock;
 pub mod layer_counter;
 pub mod linked_list;
 pub mod loop32;
+pub mod loop64;
 pub mod mdts;
 pub mod mdts_emulated64;
 pub mod mdts_packed;
