@@ -25,8 +25,7 @@ use super::{explore, fragments, k_best_error, one_pixel, run_spinning, DISTINCT}
 /// not exactly the `k` nearest with the drops counted; keeping the first, not the first `k`
 /// submitted (sorted), or fewer sections run than fragments.
 fn model(name: &str, keep: Keep, ordered: bool, k: u32, list: &[Fragment]) -> (usize, usize) {
-    let order: &'static PrimitiveOrder =
-        Box::leak(Box::new(PrimitiveOrder::of_fragments(1, list)));
+    let order: &'static PrimitiveOrder = Box::leak(Box::new(PrimitiveOrder::of_fragments(1, list)));
     let scheme: &'static KBufferInterlockOrdered<'static> = Box::leak(Box::new(
         KBufferInterlockOrdered::new(
             one_pixel(),
@@ -87,7 +86,10 @@ fn kbuffer_interlock_ordered_2_threads_loses_nothing_and_enters_in_primitive_ord
         later_nearer,
     );
     assert!(explored > 1, "loom explored one interleaving only");
-    assert_eq!(wrong, 0, "an interleaving kept the fragment submitted second");
+    assert_eq!(
+        wrong, 0,
+        "an interleaving kept the fragment submitted second"
+    );
     let (_, missed) = model(
         "kbuffer_interlock_unordered_first_2_threads_k1",
         Keep::First,
@@ -95,5 +97,8 @@ fn kbuffer_interlock_ordered_2_threads_loses_nothing_and_enters_in_primitive_ord
         1,
         later_nearer,
     );
-    assert!(missed > 0, "the unordered control kept the first submitted: the model is vacuous");
+    assert!(
+        missed > 0,
+        "the unordered control kept the first submitted: the model is vacuous"
+    );
 }

@@ -130,13 +130,19 @@ fn keep_first_in_primitive_order_is_the_same_under_every_schedule_where_arrival_
             control_differs |= lists(&control.run.capture) != expected;
         }
     }
-    assert!(control_differs, "the layer counter kept the first submitted on every schedule");
+    assert!(
+        control_differs,
+        "the layer counter kept the first submitted on every schedule"
+    );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(4)
         .build()
         .unwrap();
     let run = pool.install(|| ParallelExecutor::with_task_size(1).run(&view, &ordered));
-    assert!(lists(&run.capture) == expected, "parallel, one triangle a task");
+    assert!(
+        lists(&run.capture) == expected,
+        "parallel, one triangle a task"
+    );
 }
 
 /// A shuffled submission order keeps the first `K` of the new order: draw order matters to

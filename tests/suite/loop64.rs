@@ -36,7 +36,11 @@ fn loop64_is_exact_on_every_executor() {
             assert!(diff.is_exact(), "K = {k}, {executor}");
             let kept = run.run.capture.entries.len() as u64;
             let dropped = run.run.stats.counters.dropped;
-            assert_eq!(kept + dropped, oracle.fragments() as u64, "K = {k}, {executor}");
+            assert_eq!(
+                kept + dropped,
+                oracle.fragments() as u64,
+                "K = {k}, {executor}"
+            );
         }
     }
 }
@@ -61,7 +65,11 @@ fn equal_depths_stay_apart_under_every_schedule() {
     let loop32 = Loop32::new(viewport, 5, MEMORY_CAP_DEFAULT).unwrap();
     for seed in 0..16 {
         let schedule = Schedule {
-            policy: if seed % 2 == 0 { Policy::Random } else { Policy::Warps },
+            policy: if seed % 2 == 0 {
+                Policy::Random
+            } else {
+                Policy::Warps
+            },
             in_flight: 8,
             granularity: Granularity::Fragment,
             seed,

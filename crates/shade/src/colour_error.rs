@@ -93,7 +93,10 @@ mod tests {
         let small = RgbImage::new(1, 1);
         let wide = RgbImage::new(2, 1);
         let refused = colour_error(&small, &wide).unwrap_err();
-        assert!(refused.contains("(2, 1)") && refused.contains("(1, 1)"), "{refused}");
+        assert!(
+            refused.contains("(2, 1)") && refused.contains("(1, 1)"),
+            "{refused}"
+        );
         assert!(colour_error(&RgbImage::new(0, 0), &RgbImage::new(0, 0)).is_err());
     }
 }

@@ -233,9 +233,15 @@ mod tests {
         let scheme = Loop64::new(Viewport::new(1, 1).unwrap(), 1, u64::MAX).unwrap();
         let memory: crate::SerialMemory = scheme.layout().allocate();
         let mut steps = 0;
-        assert_eq!(scheme.insert(fragment(3, 0), &memory, &mut steps), Step::Stored);
+        assert_eq!(
+            scheme.insert(fragment(3, 0), &memory, &mut steps),
+            Step::Stored
+        );
         let before = steps;
-        assert_eq!(scheme.insert(fragment(5, 1), &memory, &mut steps), Step::Dropped);
+        assert_eq!(
+            scheme.insert(fragment(5, 1), &memory, &mut steps),
+            Step::Dropped
+        );
         assert_eq!(steps - before, 1);
         assert_eq!(scheme.resolve(&memory).pixel(0), &[fragment(3, 0).packed()]);
         assert!(Loop64::new(Viewport::new(1, 1).unwrap(), 0, u64::MAX).is_err());
