@@ -6,8 +6,8 @@
 //! one.
 //!
 //! A walk that failed to take the lock yields (`loom::thread::yield_now`) before its retry, as a
-//! spinning GPU thread gives way to the holder under independent thread scheduling; without it
-//! loom would explore a spin without end. `LoomMemory::try_lock` is an acquire compare-exchange
+//! spinning GPU thread gives way to the holder under independent thread scheduling (the shared
+//! driver, `run_spinning`); without it loom would explore a spin without end. `LoomMemory::try_lock` is an acquire compare-exchange
 //! and `unlock` a release store, so loom checks that the slots' `Relaxed` loads see the previous
 //! holder's stores.
 
@@ -15,13 +15,13 @@ use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
 use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Lock, Loop};
+use fragsim::capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Lock, Loop, SpinInsert};
 use fragsim::capture::schemes::mdts::Direction;
-use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
 use loom::sync::atomic::{AtomicU32, Ordering::SeqCst};
 
-use super::{explore, fragments, k_best_error, one_pixel, run_threads, LoomMemory, DISTINCT};
+use super::{explore, fragments, k_best_error, one_pixel, run_spinning, run_threads, DISTINCT};
 
 /// Every interleaving of the spinlocked k-buffer with loop `shape`, one loom thread per fragment
 /// of `list`: panics if two walks are ever inside the critical section together; returns
@@ -35,40 +35,24 @@ fn spinlock_model(name: &str, shape: Loop, k: u32, list: &[Fragment]) -> (usize,
     let wrong_in = Arc::clone(&wrong);
     let list = list.to_vec();
     let explored = explore(name, None, move || {
-        let memory: &'static LoomMemory = Box::leak(Box::new(scheme.layout().allocate()));
         // Walks between their lock and their release, counted by the walks themselves.
         let inside: &'static AtomicU32 = Box::leak(Box::new(AtomicU32::new(0)));
-        let handles: Vec<_> = list
-            .iter()
-            .map(|&f| {
-                loom::thread::spawn(move || {
-                    let mut walk = scheme.begin(f);
-                    loop {
-                        let before = walk.lock;
-                        if let Lock::Release { .. } = before {
-                            // Counted out before the release step frees the lock, so that the
-                            // next holder cannot count itself in while this one still counts.
-                            inside.fetch_sub(1, SeqCst);
-                        }
-                        let outcome = scheme.step(&mut walk, memory);
-                        if let (Lock::Acquire { .. }, Lock::Held { .. }) = (before, walk.lock) {
-                            assert_eq!(inside.fetch_add(1, SeqCst), 0, "two walks hold the lock");
-                        }
-                        match outcome {
-                            Step::Continue if scheme.simt(&walk).spinning => {
-                                loom::thread::yield_now();
-                            }
-                            Step::Continue => {}
-                            done => return done,
-                        }
-                    }
-                })
-            })
-            .collect();
-        let outcomes: Vec<Step> = handles
-            .into_iter()
-            .map(|h| h.join().expect("a walk panicked"))
-            .collect();
+        let (memory, outcomes) = run_spinning(
+            scheme,
+            &list,
+            move |walk: &SpinInsert| {
+                if let Lock::Release { .. } = walk.lock {
+                    // Counted out before the release step frees the lock, so that the next
+                    // holder cannot count itself in while this one still counts.
+                    inside.fetch_sub(1, SeqCst);
+                }
+            },
+            move |was: &SpinInsert, walk: &SpinInsert| {
+                if let (Lock::Acquire { .. }, Lock::Held { .. }) = (was.lock, walk.lock) {
+                    assert_eq!(inside.fetch_add(1, SeqCst), 0, "two walks hold the lock");
+                }
+            },
+        );
         let capture = scheme.resolve(memory);
         if k_best_error(
             Direction::Ascending,

@@ -37,6 +37,7 @@ use loom::sync::atomic::{
 mod abuffer;
 mod kbuffer;
 mod kbuffer_interlock;
+mod kbuffer_interlock_ordered;
 mod kbuffer_spinlock;
 mod mdts;
 mod mdts_emulated64;
@@ -198,6 +199,52 @@ where
         .map(|h| h.join().expect("a walk panicked"))
         .unzip();
     (memory, Walks { outcomes, steps })
+}
+
+/// Inside one model iteration: fresh words for `scheme`, one loom thread per fragment running its
+/// walk step by step, all joined; returns the words and the walks' outcomes. A walk whose step
+/// failed to take a lock or to enter ([`Scheme::simt`]'s `spinning`) yields before its retry, as
+/// a spinning GPU thread gives way under independent thread scheduling (without it loom would
+/// explore a spin without end). `before` sees each step's state before it runs, `after` the state
+/// before and after it and how it ended (the spinlock's mutual-exclusion count).
+fn run_spinning<S, B, A>(
+    scheme: &'static S,
+    fragments: &[Fragment],
+    before: B,
+    after: A,
+) -> (&'static LoomMemory, Vec<Step>)
+where
+    S: Scheme + 'static,
+    B: Fn(&S::State) + Copy + Send + 'static,
+    A: Fn(&S::State, &S::State) + Copy + Send + 'static,
+{
+    let memory: &'static LoomMemory = Box::leak(Box::new(scheme.layout().allocate()));
+    let handles: Vec<_> = fragments
+        .iter()
+        .map(|&f| {
+            loom::thread::spawn(move || {
+                let mut walk = scheme.begin(f);
+                loop {
+                    before(&walk);
+                    let was = walk.clone();
+                    let outcome = scheme.step(&mut walk, memory);
+                    after(&was, &walk);
+                    match outcome {
+                        Step::Continue if scheme.simt(&walk).spinning => {
+                            loom::thread::yield_now();
+                        }
+                        Step::Continue => {}
+                        done => return done,
+                    }
+                }
+            })
+        })
+        .collect();
+    let outcomes = handles
+        .into_iter()
+        .map(|h| h.join().expect("a walk panicked"))
+        .collect();
+    (memory, outcomes)
 }
 
 /// The checker shared by MDTS and the negative control: `kept`, the pixel's list from the post

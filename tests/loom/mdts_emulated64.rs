@@ -4,18 +4,18 @@
 //! a value neither fragment carried, which loom finds; the emulation inside a per-slot lock keeps
 //! exactly the `K` nearest, drops counted, in every interleaving.
 //!
-//! A walk that failed to take a slot's lock yields before its retry (as in
-//! `kbuffer_spinlock.rs`), so that loom schedules the holder.
+//! A walk that failed to take a slot's lock yields before its retry (the shared driver,
+//! `run_spinning`), so that loom schedules the holder.
 
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
-use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
 
-use super::{explore, fragments, k_best_error, one_pixel, LoomMemory, DISTINCT};
+use super::{explore, fragments, k_best_error, one_pixel, run_spinning, DISTINCT};
 
 /// Every interleaving of the emulation, one loom thread per fragment of `list`: (interleavings,
 /// ones that lost a fragment or miscounted, ones that left a torn value in a slot).
@@ -28,28 +28,7 @@ fn model(name: &str, emulation: Emulation, k: u32, list: &[Fragment]) -> (usize,
     let (wrong_in, torn_in) = (Arc::clone(&wrong), Arc::clone(&torn));
     let list = list.to_vec();
     let explored = explore(name, None, move || {
-        let memory: &'static LoomMemory = Box::leak(Box::new(scheme.layout().allocate()));
-        let handles: Vec<_> = list
-            .iter()
-            .map(|&f| {
-                loom::thread::spawn(move || {
-                    let mut walk = scheme.begin(f);
-                    loop {
-                        match scheme.step(&mut walk, memory) {
-                            Step::Continue if scheme.simt(&walk).spinning => {
-                                loom::thread::yield_now();
-                            }
-                            Step::Continue => {}
-                            done => return done,
-                        }
-                    }
-                })
-            })
-            .collect();
-        let outcomes: Vec<Step> = handles
-            .into_iter()
-            .map(|h| h.join().expect("a walk panicked"))
-            .collect();
+        let (memory, outcomes) = run_spinning(scheme, &list, |_| {}, |_, _| {});
         let kept = scheme.resolve(memory);
         if k_best_error(Direction::Ascending, k, &values, kept.pixel(0), &outcomes).is_some() {
             wrong_in.fetch_add(1, StdOrdering::Relaxed);

@@ -143,9 +143,22 @@ pub struct SchemeArgs {
     #[arg(long, default_value_t = MEMORY_CAP_DEFAULT, allow_negative_numbers = true,
           value_parser = parse_bytes)]
     pub memory_cap: u64,
+    /// Submit the triangles in the order of this seed's permutation (primitive ids unchanged):
+    /// order-independent schemes capture the same lists, order-dependent ones may not.
+    #[arg(long, value_name = "SEED")]
+    pub shuffle: Option<u64>,
 }
 
 impl SchemeArgs {
+    /// `view` with its triangles submitted in `--shuffle`'s order, where one is given.
+    #[must_use]
+    pub fn submission<'m>(&self, view: View<'m>) -> View<'m> {
+        match self.shuffle {
+            Some(seed) => view.shuffled(seed),
+            None => view,
+        }
+    }
+
     /// The rayon pool of `--threads`.
     ///
     /// # Errors

@@ -189,7 +189,9 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let mut view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+    let mut view = args
+        .schemes
+        .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);

@@ -142,6 +142,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let view = scene
         .view_under(viewport, &camera, conventions)
         .map_err(|e| e.to_string())?;
+    let view = args.schemes.submission(view);
     crate::args::warn_if_empty(&scene, &view);
     let schemes = SchemeChoice::expand(&args.scheme);
     let sizing = args.schemes.sizing();

@@ -38,6 +38,7 @@ use crate::mesh::Mesh;
 #[cfg(test)]
 mod conventions_tests;
 mod scan;
+mod submission;
 #[cfg(test)]
 mod tests;
 mod vertex;
@@ -103,6 +104,9 @@ pub struct View<'mesh> {
     cull: CullMode,
     guard: [f64; 2],
     conventions: Conventions,
+    /// The submission order (`submission[i]`: the primitive submitted `i`-th); empty: primitive
+    /// id order ([`View::shuffled`]).
+    submission: Vec<u32>,
 }
 
 /// A snapped window position (1/256 pixel, y down) and the window depth `z / w`.
@@ -164,6 +168,7 @@ impl<'mesh> View<'mesh> {
             cull,
             guard,
             conventions,
+            submission: Vec::new(),
         };
         view.set_camera(camera);
         view
@@ -204,7 +209,8 @@ impl<'mesh> View<'mesh> {
         self.mesh
     }
 
-    /// Number of triangles (primitive ids are `0..triangle_count()`).
+    /// Number of triangles (primitive ids are `0..triangle_count()`; the executors submit them in
+    /// [`View::submitted`] order).
     #[must_use]
     pub fn triangle_count(&self) -> u32 {
         self.mesh.triangles.len() as u32

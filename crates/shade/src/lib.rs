@@ -1,5 +1,7 @@
 //! Images of captures: the depth-complexity heat map, the nearest-layer depth, and the
-//! multi-fragment effects ([`effects`]: transparency, translucency) with the error-pixel rate,
+//! multi-fragment effects ([`effects`]: transparency, translucency) with the error-pixel rate
+//! and, for approximate images, the colour error ([`colour_error`]: mean and maximum absolute
+//! error per channel, PSNR),
 //! and the deferred attribute pass that gives captures what shading needs beyond their words
 //! ([`deferred`]: normals, primitive ids of key-only captures).
 //!
@@ -11,6 +13,7 @@
 
 use std::path::Path;
 
+pub mod colour_error;
 pub mod deferred;
 pub mod effects;
 pub mod legend;

@@ -7,6 +7,7 @@
 //! run ([`Executors::run`](super::Executors::run)), the dump recorder and reader, the fuzz
 //! targets' checks and `explain`'s replays are each one visitor, statically dispatched.
 
+use crate::primitive_order::PrimitiveOrder;
 use crate::{CaptureError, Scheme};
 use fragsim_raster::Viewport;
 
@@ -27,6 +28,9 @@ pub struct Build<'a> {
     pub memory_cap: u64,
     /// The per-pixel fragment counts of the scheme's own counting pass, where one ran.
     pub counts: Option<&'a [u32]>,
+    /// The scene's primitive order, for the entries that follow it
+    /// ([`Entry::primitive_order`](super::Entry::primitive_order)); `None`: arrival order.
+    pub order: Option<&'a PrimitiveOrder>,
 }
 
 impl<'a> Build<'a> {
@@ -42,6 +46,7 @@ impl<'a> Build<'a> {
             pool: viewport.pixels() * capacity as usize,
             memory_cap,
             counts: None,
+            order: None,
         }
     }
 

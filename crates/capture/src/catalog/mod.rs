@@ -34,6 +34,7 @@ use crate::schemes::kbuffer::{
     KBuffer, WriteBack,
     WriteBack::{RenderTarget, SeparateStores},
 };
+use crate::schemes::kbuffer_interlock_ordered::{KBufferInterlockOrdered, Keep};
 use crate::schemes::kbuffer_multipass::KBufferMultipass;
 use crate::schemes::layer_counter::LayerCounter;
 use crate::schemes::linked_list::{
@@ -149,11 +150,15 @@ pub struct Entry {
     /// hazard `explain` and `hazard` show); `None` for schemes without a read–modify–write of a
     /// pixel's slots (atomic walks, critical sections).
     pub read_modify_write: Option<WriteBack>,
+    /// Whether its constructor takes the scene's primitive order ([`Build::order`]): the
+    /// ordered interlock's critical sections follow it.
+    pub primitive_order: bool,
 }
 
 macro_rules! catalog {
     ($($scheme:ident $name:literal $passes:expr, $storage:expr, $dump:expr,
-        $description:literal; $(read-modify-write $machine:expr;)? |$build:ident| $construct:expr;)*) => {
+        $description:literal; $(read-modify-write $machine:expr;)? $(in-primitive-order $ordered:literal;)?
+        |$build:ident| $construct:expr;)*) => {
         /// Every scheme the simulator runs by name.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum SchemeName {
@@ -170,6 +175,7 @@ macro_rules! catalog {
                 dump: $dump,
                 description: $description,
                 read_modify_write: catalog!(@optional $($machine)?),
+                primitive_order: catalog!(@flag $($ordered)?),
             },)*
         ];
 
@@ -196,6 +202,8 @@ macro_rules! catalog {
     };
     (@optional) => { None };
     (@optional $value:expr) => { Some($value) };
+    (@flag) => { false };
+    (@flag $value:literal) => { $value };
 }
 
 use DumpLayout::{CountersAndSlots, LayerMajor, LinkedLists, Memory, SlotArray};
@@ -269,6 +277,14 @@ catalog! {
     KbufferInterlock "kbuffer-interlock" Fixed(1), K, Some(Memory),
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
         |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+    KbufferInterlockOrdered "kbuffer-interlock-ordered" Fixed(1), K, Some(Memory),
+        "The interlocked k-buffer with ordered critical sections (a pixel's in primitive order: Vulkan's ordered interlock, D3D's ROVs): exact under any interleaving.";
+        in-primitive-order true;
+        |b| (KBufferInterlockOrdered::new(b.viewport, b.k, Keep::Nearest, b.order, b.memory_cap)?, Some(b.k));
+    KbufferInterlockOrderedFirst "kbuffer-interlock-ordered-first" Fixed(1), K, Some(Memory),
+        "The ordered interlock keeping the first `--k` fragments of each pixel in primitive order (keep-first made deterministic): the same lists under any interleaving.";
+        in-primitive-order true;
+        |b| (KBufferInterlockOrdered::new(b.viewport, b.k, Keep::First, b.order, b.memory_cap)?, Some(b.k));
     KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, Some(Memory),
         "The k-buffer's read–insert–write of K slots under a per-pixel spinlock (compare-and-swap, critical section after the spin loop; nvpro-samples' spinlock mode): exact under independent thread scheduling, deadlocks lockstep warps.";
         |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
@@ -292,6 +308,9 @@ catalog! {
     Loop32 "loop32" Fixed(2), K, Some(Memory),
         "nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths merge), then a colour pass; K = `--k`.";
         |b| (Loop32::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+    Loop64 "loop64" Fixed(1), K, Some(Memory),
+        "nvpro-samples' loop64: one pass of 64-bit `atomicMin` on packed (depth, colour) words, here (depth, primitive): exact, K = `--k`.";
+        |b| (crate::schemes::loop64::Loop64::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     LayerCounter "layer-counter" Fixed(1), K, Some(LayerMajor),
         "Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.";
         |b| (LayerCounter::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));

@@ -8,6 +8,7 @@ use crate::depth_count::{DepthCount, DepthCounts};
 use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
+use crate::primitive_order::PrimitiveOrder;
 use crate::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step};
 use fragsim_raster::{Fragment, View, Viewport};
 
@@ -79,6 +80,11 @@ impl Executors {
             Count::Fixed(n) => n,
         };
         let capacity = resolve(sizing.capacity);
+        // The rasterizer's order, recorded before the frame for the schemes that follow it.
+        let order = name
+            .entry()
+            .primitive_order
+            .then(|| PrimitiveOrder::of_view(view));
         let build = Build {
             viewport,
             k: resolve(sizing.k),
@@ -91,6 +97,7 @@ impl Executors {
             },
             memory_cap: sizing.memory_cap,
             counts: counted.as_ref().map(|c| c.counts.as_slice()),
+            order: order.as_ref(),
         };
         let mut named = name
             .build(
@@ -101,6 +108,7 @@ impl Executors {
                     view,
                     sizes: Build {
                         counts: None,
+                        order: None,
                         ..build
                     },
                 },

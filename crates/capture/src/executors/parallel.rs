@@ -69,8 +69,9 @@ pub(crate) fn parallel_frame<S: Scheme, M: Memory + Sync>(
         (0..view.triangle_count())
             .into_par_iter()
             .with_min_len(triangles_per_task)
-            .fold(Counters::default, |mut counters, prim| {
+            .fold(Counters::default, |mut counters, index| {
                 let rect = view.viewport().rect();
+                let prim = view.submitted(index);
                 rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
                 counters
             })

@@ -511,9 +511,9 @@ pub fn run_scheduled<S: Scheme>(
     schedule: &Schedule,
     record: bool,
 ) -> ScheduledRun {
-    let fragments_of = |prim: u32| {
+    let fragments_of = |index: u32| {
         let mut list = Vec::new();
-        view.rasterize(prim, &mut |f| list.push(f));
+        view.rasterize(view.submitted(index), &mut |f| list.push(f));
         list
     };
     run_stream(

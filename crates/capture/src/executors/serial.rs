@@ -61,7 +61,7 @@ pub fn serial_passes<S: Scheme, M: Memory>(
     })
 }
 
-/// Geometry pass `pass`, triangles in submission order on this thread.
+/// Geometry pass `pass`, triangles in submission order ([`View::submitted`]) on this thread.
 fn serial_pass<S: Scheme, M: Memory>(
     view: &View<'_>,
     scheme: &S,
@@ -70,7 +70,8 @@ fn serial_pass<S: Scheme, M: Memory>(
 ) -> Counters {
     let mut counters = Counters::default();
     let rect = view.viewport().rect();
-    for prim in 0..view.triangle_count() {
+    for index in 0..view.triangle_count() {
+        let prim = view.submitted(index);
         rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
     }
     counters

@@ -97,11 +97,15 @@ impl Tiles {
 }
 
 impl ChunkBins {
-    /// Bins triangles `prims` of `view`, reusing this chunk's buffers.
-    fn bin(&mut self, view: &View<'_>, tiles: Tiles, prims: Range<u32>) {
+    /// Bins the triangles submitted `submitted`-th of `view` ([`View::submitted`]), in submission
+    /// order, reusing this chunk's buffers.
+    fn bin(&mut self, view: &View<'_>, tiles: Tiles, submitted: Range<u32>) {
         self.bounded.clear();
-        self.bounded
-            .extend(prims.filter_map(|prim| view.pixel_bounds(prim).map(|rect| (prim, rect))));
+        self.bounded.extend(
+            submitted
+                .map(|i| view.submitted(i))
+                .filter_map(|prim| view.pixel_bounds(prim).map(|rect| (prim, rect))),
+        );
         // Counting sort: counts into `starts[t + 1]`, prefix sums, then a stable scatter that
         // advances `starts[t]` to where tile `t`'s list ends, and a shift back.
         self.starts.clear();

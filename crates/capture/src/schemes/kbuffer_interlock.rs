@@ -42,14 +42,12 @@
 //! `vk_order_independent_transparency` (NVIDIA, 2020), whose interlock mode wraps the k-buffer
 //! insertion of its spinlock mode in `beginInvocationInterlockARB()` / `endInvocationInterlockARB()`.
 //!
-//! **Departures.** Only the **unordered** mode is modelled (`PixelInterlockUnorderedEXT`: mutual
+//! **Departures.** This is the **unordered** mode (`PixelInterlockUnorderedEXT`: mutual
 //! exclusion, critical sections in any order). The ordered mode (`PixelInterlockOrderedEXT`,
-//! ROVs: a pixel's critical sections in primitive order) is not, because (a) an executor that
-//! runs triangles out of order (parallel, scheduled) would have to wait for fragments not
-//! rasterized yet, which deadlocks it (the reason the k-buffer models "commit in primitive order"
-//! with tickets rather than waiting), and (b) for this scheme it captures nothing more: the `K`
-//! nearest of a pixel are the same in every order, so ordered and unordered keep identical lists;
-//! order only matters to order-dependent policies (keep-first), which this scheme does not have.
+//! ROVs: a pixel's critical sections in primitive order) is
+//! [`kbuffer_interlock_ordered`](crate::schemes::kbuffer_interlock_ordered); for the `K` nearest
+//! both keep identical lists (the `K` nearest of a set do not depend on the order its members
+//! arrive in), order matters only to order-dependent policies (keep-first, [`Keep::First`]).
 //! As in the k-buffer, a slot is one `u64` `depth_key << 32 | prim` rather than the samples'
 //! packed depth and colour, so the capture is compared fragment for fragment with the oracle.
 
@@ -60,6 +58,44 @@ use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
+
+/// What a critical section keeps of a full pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Keep {
+    /// The `K` nearest: the newcomer is inserted and the farthest value falls off.
+    Nearest,
+    /// The first `K` to enter: a newcomer finding the `K` slots full writes nothing and is
+    /// dropped (the policy of the layer counter and of keep-first linked lists).
+    First,
+}
+
+/// The body of a critical section, the pixel's lock held: the `K` loads of the slots, the
+/// insertion in registers under `keep`, the `K` stores unless the fragment is dropped without
+/// one; how the walk ends (`Dropped` also when a value fell off the end).
+pub(crate) fn section<M: Memory>(
+    slots: Slots,
+    keep: Keep,
+    insert: &mut Insert,
+    memory: &M,
+) -> Step {
+    let k = slots.k as usize;
+    insert
+        .local
+        .extend((insert.base..insert.base + k).map(|w| WordMemory::<u64>::load(memory, w)));
+    let full = !insert.local.contains(&EMPTY);
+    let fell_off =
+        (keep == Keep::First && full) || slots.insert_in_registers(insert) == Outcome::FellOff;
+    if !fell_off {
+        for (i, &v) in insert.local.iter().enumerate() {
+            WordMemory::<u64>::store(memory, insert.base + i, v);
+        }
+    }
+    if fell_off || insert.evicted {
+        Step::Dropped
+    } else {
+        Step::Stored
+    }
+}
 
 /// The k-buffer whose read–insert–write-back is one critical section per fragment.
 #[derive(Clone, Debug)]
@@ -141,24 +177,11 @@ impl Scheme for KBufferInterlock {
     /// The whole critical section: lock, `K` loads, the insertion in registers, `K` stores (none
     /// when the fragment falls off), unlock.
     fn step<M: Memory>(&self, insert: &mut Insert, memory: &M) -> Step {
-        let k = self.slots.k as usize;
-        let lock = insert.base / k;
+        let lock = insert.base / self.slots.k as usize;
         memory.lock(lock);
-        insert
-            .local
-            .extend((insert.base..insert.base + k).map(|w| WordMemory::<u64>::load(memory, w)));
-        let fell_off = self.slots.insert_in_registers(insert) == Outcome::FellOff;
-        if !fell_off {
-            for (i, &v) in insert.local.iter().enumerate() {
-                WordMemory::<u64>::store(memory, insert.base + i, v);
-            }
-        }
+        let end = section(self.slots, Keep::Nearest, insert, memory);
         memory.unlock(lock);
-        if fell_off || insert.evicted {
-            Step::Dropped
-        } else {
-            Step::Stored
-        }
+        end
     }
 
     fn pixels(&self) -> usize {
