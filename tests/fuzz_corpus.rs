@@ -1,6 +1,7 @@
 //! Replays the checked-in fuzz corpus (`fuzz/corpus/<target>/`) through the fuzz targets' own
 //! checks (`tests/fuzz_support/`), on stable Rust inside `cargo test`, so CI exercises every
 //! target without a nightly toolchain or cargo-fuzz. A proptest adds fresh random inputs.
+//! `compare` prints its report for each pair of seeds that decode (it is the command's own code).
 
 #[path = "fuzz_support/mod.rs"]
 mod fuzz_support;
@@ -59,6 +60,21 @@ fn dump_parse_corpus_parses_round_trips_or_fails_cleanly() {
     replay("dump_parse", fuzz_support::dump::check);
 }
 
+#[test]
+fn dump_layouts_corpus_decodes_as_the_layout_rules_say_or_fails_naming_the_fault() {
+    replay("dump_layouts", fuzz_support::layouts::check);
+}
+
+#[test]
+fn triangles_corpus_reads_back_its_records_or_fails_cleanly() {
+    replay("triangles", fuzz_support::triangles::check);
+}
+
+#[test]
+fn compare_corpus_keeps_the_exit_codes_meaning() {
+    replay("compare", fuzz_support::compare::check);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 
@@ -68,5 +84,8 @@ proptest! {
         fuzz_support::raster::check(&data);
         fuzz_support::schemes::check(&data);
         fuzz_support::dump::check(&data);
+        fuzz_support::layouts::check(&data);
+        fuzz_support::triangles::check(&data);
+        fuzz_support::compare::check(&data);
     }
 }

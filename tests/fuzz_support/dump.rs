@@ -1,14 +1,14 @@
 //! The `dump_parse` target: arbitrary bytes as a dump (`docs/dump-format.md`) through
-//! [`Dump::parse`], never a panic. The input is the header text up to the first NUL byte; after
-//! it, each array file the parser asks for takes the next chunk (a little-endian `u16` length,
-//! then that many bytes, cut short where the input ends). Checked: the parser only ever asks for
+//! [`Dump::parse`], never a panic. The input is a [`Blob`]: the header text up to the first NUL
+//! byte; after it, each array file the parser asks for takes the next chunk
+//! (`tools/fuzz/seed.py` writes a dump directory so). Checked: the parser only ever asks for
 //! plain file names; a dump it accepts encodes and parses back to itself; decoding its words
 //! ([`Dump::capture`], any layout: slots, A-buffer, linked lists with arbitrary links and
 //! counters, layer-major layers, a scheme's memory), checking them ([`Dump::check_words`]) and
 //! comparing them with an oracle made of them either works, with one list
 //! per pixel of the viewport, or fails with an error.
 
-use fragsim::capture::Keeps;
+use fragsim::capture::{Capture, Keeps};
 use fragsim::oracle::compare::compare;
 use fragsim::oracle::dump::{Dump, DumpError};
 use fragsim::oracle::Oracle;
@@ -18,26 +18,59 @@ use super::input::Input;
 /// The name errors give the header.
 const NAME: &str = "fuzz/dump.json";
 
-/// Parses `data` as a dump and checks the outcome.
-pub fn check(data: &[u8]) {
-    let (header, rest) = match data.iter().position(|&b| b == 0) {
-        Some(nul) => (&data[..nul], &data[nul + 1..]),
-        None => (data, &[][..]),
-    };
-    let mut input = Input::new(rest);
-    let mut remaining = rest.len();
-    let read_file = |file: &str| -> Result<Vec<u8>, DumpError> {
+/// A dump as the fuzzer's bytes hold it: the header text up to the first NUL byte, then one chunk
+/// per array file the parser asks for (a little-endian `u16` length, then that many bytes, cut
+/// short where the input ends).
+pub struct Blob<'a> {
+    /// The header's bytes.
+    pub header: &'a [u8],
+    input: Input<'a>,
+    remaining: usize,
+}
+
+impl<'a> Blob<'a> {
+    /// The dump `data` holds.
+    pub fn new(data: &'a [u8]) -> Self {
+        let (header, rest) = match data.iter().position(|&b| b == 0) {
+            Some(nul) => (&data[..nul], &data[nul + 1..]),
+            None => (data, &[][..]),
+        };
+        Self {
+            header,
+            input: Input::new(rest),
+            remaining: rest.len(),
+        }
+    }
+
+    /// The next chunk, as the bytes of array file `file`, which must be a plain file name.
+    pub fn file(&mut self, file: &str) -> Vec<u8> {
         assert!(
             !file.is_empty() && file != ".." && !file.contains(['/', '\\']),
             "the parser asked for {file:?}, not a plain file name"
         );
-        let len = usize::from(u16::from_le_bytes([input.u8(), input.u8()]));
-        remaining = remaining.saturating_sub(2);
-        let len = len.min(remaining);
-        remaining -= len;
-        Ok((0..len).map(|_| input.u8()).collect())
+        let len = usize::from(u16::from_le_bytes([self.input.u8(), self.input.u8()]));
+        self.remaining = self.remaining.saturating_sub(2);
+        let len = len.min(self.remaining);
+        self.remaining -= len;
+        (0..len).map(|_| self.input.u8()).collect()
+    }
+}
+
+/// Whether a capture is what it promises of itself: lists in canonical order, no overflow (with
+/// overflow it claims fragments that its own lists lack).
+pub fn is_canonical(capture: &Capture) -> bool {
+    let no_overflow = match &capture.keeps {
+        Keeps::All { overflow, .. } => overflow.iter().all(|&o| o == 0),
+        _ => true,
     };
-    let Ok(dump) = Dump::parse(NAME, header, read_file) else {
+    no_overflow && (0..capture.pixels()).all(|p| capture.pixel(p).windows(2).all(|w| w[0] <= w[1]))
+}
+
+/// Parses `data` as a dump and checks the outcome.
+pub fn check(data: &[u8]) {
+    let mut blob = Blob::new(data);
+    let header = blob.header;
+    let Ok(dump) = Dump::parse(NAME, header, |file| Ok(blob.file(file))) else {
         return;
     };
     let (text, files) = dump.encode().expect("a parsed dump encodes");
@@ -63,18 +96,9 @@ pub fn check(data: &[u8]) {
     if let Keeps::All { overflow, .. } = &capture.keeps {
         assert_eq!(overflow.len(), pixels, "one overflow count per pixel");
     }
-    // A capture whose lists are in canonical order, with no overflow, is what it promises of
-    // itself (with overflow it claims fragments that its own lists lack).
-    let reference = Oracle::from_capture(&capture);
-    let comparison = compare(&reference, &capture, 0, 4);
-    let no_overflow = match &capture.keeps {
-        Keeps::All { overflow, .. } => overflow.iter().all(|&o| o == 0),
-        _ => true,
-    };
-    let in_order =
-        no_overflow && (0..pixels).all(|p| capture.pixel(p).windows(2).all(|w| w[0] <= w[1]));
+    let comparison = compare(&Oracle::from_capture(&capture), &capture, 0, 4);
     assert!(
-        !in_order || comparison.is_equal(),
+        !is_canonical(&capture) || comparison.is_equal(),
         "a capture in canonical order differs from itself"
     );
 }

@@ -4,8 +4,11 @@
 //! libFuzzer and to the replay.
 
 pub mod camera;
+pub mod compare;
 pub mod dump;
 pub mod input;
+pub mod layouts;
 pub mod obj_load;
 pub mod raster;
 pub mod schemes;
+pub mod triangles;

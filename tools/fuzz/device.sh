@@ -5,6 +5,9 @@
 # (`-jobs`) sharing one working corpus, seeded from the checked-in `fuzz/corpus/TARGET`, for
 # SECONDS_EACH seconds of wall time; then its working corpus is minimised (`-merge=1`). The
 # workers' logs, any crash and the minimised corpora come back as one archive, $OUT/fuzz.tgz.
+# Every input gets at most 10 s and 2 GiB (`-timeout`, `-rss_limit_mb`: a hang or a runaway
+# allocation is a crash); stdout is closed (`-close_fd_mask=1`), since `compare` prints the
+# command's report for each pair of dumps that decode.
 set -u
 SECONDS_EACH=${SECONDS_EACH:-540}
 WORKERS=${WORKERS:-4}
@@ -16,13 +19,14 @@ for bin in fuzzbin/*; do
   mkdir -p /tmp/fz/$target/run /tmp/fz/$target/corpus /tmp/fz/$target/min
   cp fuzz/corpus/"$target"/* /tmp/fz/$target/corpus/ 2>/dev/null
   (cd /tmp/fz/$target/run && "$root/$bin" -jobs="$WORKERS" -workers="$WORKERS" \
-      -max_total_time="$SECONDS_EACH" -print_final_stats=1 -artifact_prefix=/tmp/fz/$target/run/ \
+      -max_total_time="$SECONDS_EACH" -print_final_stats=1 \
+      -timeout=10 -rss_limit_mb=2048 -close_fd_mask=1 -artifact_prefix=/tmp/fz/$target/run/ \
       /tmp/fz/$target/corpus > driver.log 2>&1) &
 done
 wait
 for bin in fuzzbin/*; do
   target=$(basename "$bin")
-  "$bin" -merge=1 /tmp/fz/$target/min /tmp/fz/$target/corpus > /tmp/fz/$target/merge.log 2>&1
+  "$bin" -merge=1 -close_fd_mask=1 /tmp/fz/$target/min /tmp/fz/$target/corpus > /tmp/fz/$target/merge.log 2>&1
   echo "$target: $(ls /tmp/fz/$target/corpus | wc -l) working, $(ls /tmp/fz/$target/min | wc -l) minimised"
   grep -h "stat::number_of_executed_units\|stat::peak_rss" /tmp/fz/$target/run/fuzz-*.log
   grep -l "SUMMARY\|panicked\|deadly signal" /tmp/fz/$target/run/fuzz-*.log

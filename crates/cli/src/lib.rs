@@ -60,7 +60,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
-pub use compare::CompareArgs;
+pub use compare::{compare, CompareArgs};
 pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
 pub use hazard::{BaselineRow, HazardArgs, HazardReport, HazardRow};

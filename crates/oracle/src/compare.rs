@@ -224,7 +224,8 @@ impl Dump {
 /// of `stored` when it overflowed (storage ran out), unknown (at least `stored`) when not.
 pub(crate) fn inferred_counter(stored: usize, overflow: u32) -> Counter {
     Counter {
-        count: stored as u32 + overflow,
+        // Saturating: a memory dump's words can claim any overflow (found by `dump_layouts`).
+        count: (stored as u32).saturating_add(overflow),
         capacity: if overflow > 0 {
             stored as u32
         } else {

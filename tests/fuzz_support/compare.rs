@@ -1,0 +1,141 @@
+//! The `compare` target: two arbitrary dumps through `fragsim compare REFERENCE CANDIDATE`
+//! ([`fragsim_cli::compare`], the command's own code, run on two dump directories), never a
+//! panic. The input is a little-endian `u32` length, then that many bytes of the reference's
+//! [`Blob`] (as `dump_parse` reads one), then the candidate's; each is written out as a
+//! directory, the header as `dump.json` and each array file the parser asks for beside it, so
+//! that the command reads them as it reads a backend's.
+//!
+//! Checked against what the library makes of each directory ([`Dump::read`], then
+//! [`Dump::capture`] and [`Dump::check_words`]): the command fails (exit code 2) with a message
+//! exactly when a side does not read or decode, or the two cover different viewports or name
+//! different scenes; otherwise it gives a verdict (exit code 0 or 1), and "equal" (0) only when
+//! neither side holds a word its layout says cannot be there. A dump that decodes to lists in
+//! canonical order, with no overflow and no corrupt word, compared with itself is equal.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use clap::{Args, Command, FromArgMatches};
+use fragsim::capture::Capture;
+use fragsim::oracle::dump::{Dump, WordCheck, HEADER_FILE};
+use fragsim_cli::CompareArgs;
+
+use super::dump::{is_canonical, Blob};
+
+/// Splits `data` into the two dumps, writes them out and checks the command on them.
+pub fn check(data: &[u8]) {
+    let (length, rest) = data.split_at(data.len().min(4));
+    let mut word = [0; 4];
+    word[..length.len()].copy_from_slice(length);
+    let (reference, candidate) = rest.split_at((u32::from_le_bytes(word) as usize).min(rest.len()));
+    let scratch = Scratch::new();
+    let (a, b) = (scratch.0.join("reference"), scratch.0.join("candidate"));
+    write_out(reference, &a);
+    write_out(candidate, &b);
+    check_pair(&a, &b);
+    if decoded(&a).is_ok() {
+        check_pair(&a, &a);
+    }
+}
+
+/// A directory of its own for one input, removed afterwards (targets run in parallel threads in
+/// the corpus replay, and in several processes under libFuzzer's `-jobs`).
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new() -> Self {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let n = NEXT.fetch_add(1, Ordering::Relaxed);
+        let dir =
+            std::env::temp_dir().join(format!("fragsim-fuzz-compare-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a scratch directory");
+        Self(dir)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Writes the dump `blob` holds into `dir`: its header, and each array file the parser asks for
+/// (one that the file system refuses, or named as the header, is left out: reading it fails, or
+/// reads the header, as a backend's directory would).
+fn write_out(blob: &[u8], dir: &Path) {
+    std::fs::create_dir_all(dir).expect("a dump directory");
+    let mut blob = Blob::new(blob);
+    let header = blob.header;
+    let mut files = Vec::new();
+    let _ = Dump::parse("fuzz/compare.json", header, |file| {
+        let bytes = blob.file(file);
+        files.push((file.to_string(), bytes.clone()));
+        Ok(bytes)
+    });
+    for (file, bytes) in files.iter().filter(|(file, _)| file != HEADER_FILE) {
+        let _ = std::fs::write(dir.join(file), bytes);
+    }
+    std::fs::write(dir.join(HEADER_FILE), header).expect("the header is written");
+}
+
+/// A dump directory as the library reads and decodes it.
+fn decoded(dir: &Path) -> Result<(Dump, Capture, WordCheck), String> {
+    let dump = Dump::read(dir).map_err(|e| e.0)?;
+    let capture = dump.capture().map_err(|e| e.0)?;
+    let words = dump.check_words().map_err(|e| e.0)?;
+    Ok((dump, capture, words))
+}
+
+/// `fragsim compare REFERENCE CANDIDATE --no-image --show 0`, parsed as the command line parses
+/// it: `Ok(equal)` is exit code 0 or 1, `Err` exit code 2.
+fn run(reference: &Path, candidate: &Path) -> Result<bool, String> {
+    let command = CompareArgs::augment_args(Command::new("compare"));
+    let argv = [
+        "compare".as_ref(),
+        reference.as_os_str(),
+        candidate.as_os_str(),
+        "--no-image".as_ref(),
+        "--show".as_ref(),
+        "0".as_ref(),
+    ];
+    let matches = command
+        .try_get_matches_from(argv)
+        .expect("the arguments parse");
+    let args = CompareArgs::from_arg_matches(&matches).expect("the arguments are compare's");
+    fragsim_cli::compare(&args)
+}
+
+/// Runs the command on one pair and checks its outcome against the library's.
+fn check_pair(reference: &Path, candidate: &Path) {
+    let got = run(reference, candidate);
+    let sides = (decoded(reference), decoded(candidate));
+    let (Ok((a, capture, words_a)), Ok((b, _, words_b))) = &sides else {
+        let error = got.expect_err("compare accepted a dump that does not read or decode");
+        assert!(!error.is_empty(), "an error without a message");
+        return;
+    };
+    let same_viewport = (a.header.width, a.header.height) == (b.header.width, b.header.height);
+    if !same_viewport || a.header.scene != b.header.scene {
+        let error = got.expect_err("compare accepted dumps of different viewports or scenes");
+        assert!(
+            error.contains("different"),
+            "the error does not say the dumps differ: {error}"
+        );
+        return;
+    }
+    let equal = got.unwrap_or_else(|e| panic!("compare refused two dumps that decode: {e}"));
+    if equal {
+        assert_eq!(
+            words_a.corrupt_words() + words_b.corrupt_words(),
+            0,
+            "compare called dumps with corrupt words equal"
+        );
+    }
+    // A memory dump may hold the empty marker in a list, which the comparison takes for no
+    // fragment: no promise is made of such lists.
+    let no_marker = (0..capture.pixels()).all(|p| !capture.pixel(p).contains(&u64::MAX));
+    if reference == candidate && words_a.corrupt_words() == 0 && is_canonical(capture) && no_marker
+    {
+        assert!(equal, "a dump in canonical order differs from itself");
+    }
+}

@@ -1,0 +1,604 @@
+//! The `dump_layouts` target: dumps built from the fuzzer's bytes field by field, so that every
+//! input reaches the layout decoders rather than the JSON parser. Each input is one dump of a
+//! linked-list, layer-major or memory layout (`docs/dump-format.md`) on a viewport of at most
+//! 4 × 3 pixels, with the header's scene fields arbitrary: raw f64 bit patterns for the orbit and
+//! the engine's view-projection matrix (f32 or f64), any conventions, a mesh hash or a string in
+//! its place. Links are drawn from a few node numbers around the pool (so cycles, shared nodes,
+//! links out of the pool and past the node counter are common), counters run past their storage,
+//! and an array may have the wrong size or type.
+//!
+//! Checked, for every input:
+//! - the header encodes, and parses back to the same dump with every number bit for bit, or
+//!   encoding refuses a non-finite number (one of the scene's own checks);
+//! - a dump that breaks its layout (an array of the wrong size or type, `k` of 0, a payload whose
+//!   fields overlap) is refused with an error naming what is wrong, by decoding and by the word
+//!   check alike;
+//! - any other dump decodes, and its word check and lists are what a model of the layout's rules
+//!   written here gives: each linked list walked from its head once, cut at its first link out of
+//!   the pool, to a node the counter never handed out, or to a node already reached (at most
+//!   `pool + pixels` steps in all, so a cycle is found in bounded time); each layer counter past
+//!   its `k` layers named; every impossible depth key named;
+//! - the comparison with an oracle made of the capture itself flags exactly the pixels with
+//!   corrupt words, and calls the rest equal.
+//!
+//! The shape of the memory of a `memory` dump is the scheme's own, from the catalog (or wrong on
+//! purpose); its words are arbitrary, so each scheme's resolve runs on memory no run left.
+
+use fragsim::capture::catalog::{Build, DumpLayout, SchemeName, SchemeVisitor, CATALOG};
+use fragsim::capture::{Capture, Scheme};
+use fragsim::oracle::compare::{compare_with, verdict, CompareOptions};
+use fragsim::oracle::dump::{
+    ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, LayoutSpec, Payload, Words,
+};
+use fragsim::oracle::scene::{mesh_hash, ViewProjection};
+use fragsim::oracle::Oracle;
+use fragsim::raster::{DepthRange, VertexPrecision, Viewport, WindowOrigin};
+
+use super::input::Input;
+
+/// The name errors give the header.
+const NAME: &str = "fuzz/layouts.json";
+
+/// The header every input starts from: its other fields are set from the input.
+const BASE: &str = r#"{"format": "fragsim-dump", "version": 1, "scene": {"name": "quads:1"},
+    "width": 1, "height": 1, "scheme": "mdts", "arrays": {}}"#;
+
+/// Builds a dump from `data` and checks it.
+pub fn check(data: &[u8]) {
+    let mut input = Input::new(data);
+    let built = build(&mut input);
+    let dump = &built.dump;
+    let (text, files) = match dump.encode() {
+        Ok(encoded) => encoded,
+        Err(error) => {
+            assert!(
+                dump.header.scene.check_finite().is_err(),
+                "encoding refused a dump whose scene is finite: {error}"
+            );
+            assert!(error.0.contains("scene"), "{error} does not name the scene");
+            return;
+        }
+    };
+    let again = Dump::parse(NAME, text.as_bytes(), |file| {
+        files
+            .get(file)
+            .cloned()
+            .ok_or_else(|| DumpError(format!("{file} was not encoded")))
+    })
+    .unwrap_or_else(|e| panic!("an encoded dump does not parse: {e}\n{text}"));
+    assert_eq!(&again, dump, "a dump differs after encoding and parsing");
+    // Text equality pins every number to its bits (`==` would let -0.0 pass for 0.0).
+    assert_eq!(
+        again.encode().expect("it encoded once").0,
+        text,
+        "a dump encodes differently after parsing"
+    );
+    let (capture, words) = match (dump.capture(), dump.check_words()) {
+        (Ok(capture), Ok(words)) => (capture, words),
+        (Err(error), Err(_)) => {
+            let fault = built.expected.as_ref().err().unwrap_or_else(|| {
+                panic!("a dump that keeps its layout is refused: {error}\n{text}")
+            });
+            assert!(
+                error.0.contains(fault.as_str()),
+                "the error {error:?} does not name {fault:?}\n{text}"
+            );
+            return;
+        }
+        (capture, words) => panic!(
+            "decoding and the word check disagree: {:?} against {:?}",
+            capture.err(),
+            words.err()
+        ),
+    };
+    if let Err(fault) = &built.expected {
+        panic!("a dump whose {fault} breaks its layout decodes\n{text}");
+    }
+    let pixels = dump.viewport().expect("built valid").pixels();
+    assert_eq!(capture.pixels(), pixels, "one list per pixel");
+    assert_eq!(words.corrupt.len(), pixels, "one word check per pixel");
+    if let Ok(Some(model)) = &built.expected {
+        for p in 0..pixels {
+            let found: Vec<(usize, Corruption)> =
+                words.corrupt[p].iter().map(|c| (c.slot, c.why)).collect();
+            assert_eq!(found, model.corrupt[p], "pixel {p}'s corrupt words\n{text}");
+            assert_eq!(capture.pixel(p), model.lists[p], "pixel {p}'s list\n{text}");
+        }
+        assert_eq!(words.unreachable, model.unreachable, "unreachable nodes");
+    } else {
+        // A memory dump: the rules are the scheme's own, so every word is unchecked.
+        let total: u64 = dump.arrays.values().map(|w| words_len(w) as u64).sum();
+        assert_eq!(
+            words.unchecked, total,
+            "every word of a memory dump is unchecked"
+        );
+    }
+    // The verdict: an oracle made of the capture agrees with it except where a word is corrupt.
+    let comparison = compare_with(
+        &Oracle::from_capture(&capture),
+        &capture,
+        Some(&words),
+        &CompareOptions::default(),
+    );
+    for p in 0..pixels {
+        let corrupt = !words.corrupt[p].is_empty();
+        let flags = comparison.verdicts[p];
+        assert_eq!(
+            flags & verdict::CORRUPT != 0,
+            corrupt,
+            "pixel {p}: verdict {flags:#x}, corrupt words {:?}",
+            words.corrupt[p]
+        );
+        // Lists and layers decode in canonical order with no overflow, so each pixel without a
+        // corrupt word is its own oracle's; a memory dump's words promise nothing.
+        if !corrupt && in_order(&capture, p) && matches!(built.expected, Ok(Some(_))) {
+            assert_eq!(
+                flags & verdict::DIFFERS,
+                0,
+                "pixel {p} differs from itself\n{text}"
+            );
+        }
+    }
+}
+
+fn words_len(words: &Words) -> usize {
+    match words {
+        Words::U32(w) => w.len(),
+        Words::U64(w) => w.len(),
+    }
+}
+
+fn in_order(capture: &Capture, p: usize) -> bool {
+    capture.pixel(p).windows(2).all(|w| w[0] <= w[1])
+}
+
+/// A dump built from the input, with what decoding it must give: `Err(what)` for a dump that
+/// breaks its layout (the error must name `what`), `Ok(Some(model))` for lists and layers,
+/// `Ok(None)` for a memory dump (no model: its words are the scheme's own).
+struct Built {
+    dump: Dump,
+    expected: Result<Option<Model>, String>,
+}
+
+/// What the layout's rules say of a dump's words: per pixel the (slot, reason) of each corrupt
+/// word and the decoded list, and the nodes handed out that no list reaches.
+struct Model {
+    corrupt: Vec<Vec<(usize, Corruption)>>,
+    lists: Vec<Vec<u64>>,
+    unreachable: u64,
+}
+
+fn build(input: &mut Input<'_>) -> Built {
+    let mut header = Dump::parse(NAME, BASE.as_bytes(), |f| {
+        Err(DumpError(format!("{f}: the base header has no arrays")))
+    })
+    .expect("the base header parses")
+    .header;
+    header.width = 1 + u32::from(input.u8() % 4);
+    header.height = 1 + u32::from(input.u8() % 3);
+    scene(input, &mut header);
+    let viewport = Viewport::new(header.width, header.height).expect("at most 4 × 3");
+    let mut arrays = Vec::new();
+    let expected = match input.u8() % 4 {
+        0 => linked_lists(
+            input,
+            &mut header,
+            viewport,
+            SchemeName::LinkedList,
+            &mut arrays,
+        ),
+        1 => linked_lists(
+            input,
+            &mut header,
+            viewport,
+            SchemeName::LinkedListNearest,
+            &mut arrays,
+        ),
+        2 => layer_major(input, &mut header, viewport, &mut arrays),
+        _ => memory(input, &mut header, viewport, &mut arrays).map(|()| None),
+    };
+    header.arrays = arrays
+        .iter()
+        .map(|(name, words)| {
+            let dtype = match words {
+                Words::U32(_) => Dtype::U32,
+                Words::U64(_) => Dtype::U64,
+            };
+            let spec = ArraySpec {
+                file: format!("{name}.bin"),
+                dtype,
+                shape: vec![words_len(words) as u64],
+            };
+            (name.to_string(), spec)
+        })
+        .collect();
+    let arrays = arrays
+        .into_iter()
+        .map(|(name, words)| (name.to_string(), words))
+        .collect();
+    Built {
+        dump: Dump { header, arrays },
+        expected,
+    }
+}
+
+/// The scene fields: a named scene or a mesh file with a hash (or any string in its place), the
+/// orbit and the engine's matrix from raw f64 bits or small values, any conventions.
+fn scene(input: &mut Input<'_>, header: &mut Header) {
+    let flags = input.u8();
+    let scene = &mut header.scene;
+    if flags & 1 != 0 {
+        (scene.name, scene.mesh) = (None, Some("mesh.obj".into()));
+    }
+    scene.mesh_hash = match (flags >> 1) & 3 {
+        0 => None,
+        1 => Some(mesh_hash(&input.u64().to_le_bytes())),
+        _ => Some(
+            String::from_utf8_lossy(&(0..input.u8() % 12).map(|_| input.u8()).collect::<Vec<_>>())
+                .into_owned(),
+        ),
+    };
+    if flags & 8 != 0 {
+        scene.view_degrees = number(input);
+        scene.elevation_degrees = number(input);
+    }
+    if flags & 16 != 0 {
+        let precision = if flags & 32 != 0 {
+            VertexPrecision::F32
+        } else {
+            VertexPrecision::F64
+        };
+        scene.view_projection = Some(ViewProjection {
+            row_major: std::array::from_fn(|_| number(input)),
+            precision,
+        });
+    }
+    if flags & 64 != 0 {
+        let bits = input.u8();
+        let conventions = &mut scene.conventions;
+        conventions.window_origin = if bits & 1 != 0 {
+            WindowOrigin::LowerLeft
+        } else {
+            WindowOrigin::UpperLeft
+        };
+        conventions.depth_range = if bits & 2 != 0 {
+            DepthRange::MinusOneToOne
+        } else {
+            DepthRange::ZeroToOne
+        };
+        conventions.vertex_precision = if bits & 4 != 0 {
+            VertexPrecision::F32
+        } else {
+            VertexPrecision::F64
+        };
+        conventions.subpixel_bits = u32::from(bits >> 3);
+    }
+}
+
+/// A header number: raw f64 bits (NaN, infinities, subnormals, extremes), or a small multiple of
+/// 1/8.
+fn number(input: &mut Input<'_>) -> f64 {
+    match input.u8() {
+        0..=127 => f64::from_bits(input.u64()),
+        b => f64::from(b as i8) / 8.0,
+    }
+}
+
+/// A payload packing: fragsim's, the two unorm packings engines use, or arbitrary fields (which
+/// may overlap or pass the word's top bit: refused).
+fn payload(input: &mut Input<'_>) -> Payload {
+    match input.u8() % 5 {
+        0 | 1 => Payload::FRAGMENT,
+        2 => Payload {
+            dtype: Dtype::U32,
+            depth: DepthFormat::Unorm24,
+            depth_shift: 8,
+            prim_bits: 8,
+        },
+        3 => Payload {
+            dtype: Dtype::U64,
+            depth: DepthFormat::Unorm16,
+            depth_shift: 32,
+            prim_bits: 16,
+        },
+        _ => Payload {
+            dtype: if input.u8() & 1 != 0 {
+                Dtype::U32
+            } else {
+                Dtype::U64
+            },
+            depth: match input.u8() % 3 {
+                0 => DepthFormat::F32,
+                1 => DepthFormat::Unorm24,
+                _ => DepthFormat::Unorm16,
+            },
+            depth_shift: u32::from(input.u8() % 70),
+            prim_bits: u32::from(input.u8() % 40),
+        },
+    }
+}
+
+/// A payload word: under fragsim's packing a fragment word of a depth on a grid over `[0, 1]`
+/// (or above 1.0), else raw bits of the payload's width.
+fn payload_word(input: &mut Input<'_>, payload: &Payload) -> u64 {
+    if *payload == Payload::FRAGMENT {
+        let depth = match input.u8() {
+            255 => 2.0,
+            b => f32::from(b) / 254.0,
+        };
+        u64::from(depth.to_bits()) << 32 | u64::from(input.u8())
+    } else {
+        match payload.dtype {
+            Dtype::U32 => u64::from(input.u32()),
+            Dtype::U64 => input.u64(),
+        }
+    }
+}
+
+/// Payload words in the payload's own dtype, or the other one when `wrong_dtype`.
+fn payload_words(words: Vec<u64>, payload: &Payload, wrong_dtype: bool) -> Words {
+    match (payload.dtype, wrong_dtype) {
+        (Dtype::U32, false) | (Dtype::U64, true) => {
+            Words::U32(words.into_iter().map(|w| w as u32).collect())
+        }
+        _ => Words::U64(words),
+    }
+}
+
+/// `k` of 0 to 3: 0 is refused.
+fn k(input: &mut Input<'_>) -> u32 {
+    u32::from(input.u8() % 4)
+}
+
+/// A length `right`, or, for fault `which` when the input picks it, one off.
+fn length(right: usize, fault: u8, which: u8) -> usize {
+    if fault == which {
+        if right > 1 {
+            right - 1
+        } else {
+            right + 1
+        }
+    } else {
+        right
+    }
+}
+
+/// A linked-list dump (`scheme` is `linked-list` or `linked-list-nearest`) and its model.
+fn linked_lists(
+    input: &mut Input<'_>,
+    header: &mut Header,
+    viewport: Viewport,
+    scheme: SchemeName,
+    arrays: &mut Vec<(&'static str, Words)>,
+) -> Result<Option<Model>, String> {
+    let pixels = viewport.pixels();
+    let k = k(input);
+    let pool = 1 + usize::from(input.u8() % 8);
+    let (null, node_base) = match input.u8() % 3 {
+        0 => (0, 1),
+        1 => (u32::MAX, 0),
+        _ => (u32::from(input.u8()), u32::from(input.u8() % 4)),
+    };
+    let payload = payload(input);
+    // Faults 0 to 4: an array one word off, 5: the nodes in the other dtype, 6: the counter in
+    // two words; any other value: none.
+    let fault = input.u8() % 12;
+    let link = |input: &mut Input<'_>| match input.u8() {
+        255 => u32::MAX,
+        b if b & 3 == 0 => null,
+        b => node_base.wrapping_add(u32::from(b >> 2) % (pool as u32 + 2)),
+    };
+    let heads: Vec<u32> = (0..length(pixels, fault, 0)).map(|_| link(input)).collect();
+    let next: Vec<u32> = (0..length(pool, fault, 1)).map(|_| link(input)).collect();
+    let nodes: Vec<u64> = (0..length(pool, fault, 2))
+        .map(|_| payload_word(input, &payload))
+        .collect();
+    let counter = match input.u8() {
+        255 => u32::MAX,
+        b => u32::from(b) % (pool as u32 + 3),
+    };
+    let counters = if fault == 6 { 2 } else { 1 };
+    arrays.push(("heads", Words::U32(heads.clone())));
+    arrays.push(("next", Words::U32(next.clone())));
+    arrays.push(("nodes", payload_words(nodes.clone(), &payload, fault == 5)));
+    arrays.push(("counter", Words::U32(vec![counter; counters])));
+    header.scheme = scheme.name().into();
+    header.k = Some(k);
+    header.pool = Some(length(pool, fault, 3) as u64);
+    header.layout = Some(LayoutSpec::LinkedList {
+        payload,
+        null,
+        node_base,
+    });
+    // What the reader refuses first: the payload, then `k`, then the arrays (the nodes, whose
+    // count the header's pool sets, before the heads and links).
+    let fault = match fault {
+        _ if payload.check().is_err() => "payload",
+        _ if k == 0 => "\"k\"",
+        0 => "\"heads\"",
+        1 => "\"next\"",
+        2 | 3 | 5 => "\"nodes\"",
+        6 => "\"counter\"",
+        _ => "",
+    };
+    if !fault.is_empty() {
+        return Err(fault.into());
+    }
+    // The model: each list walked once from its head, cut at its first bad link.
+    let allocated = (counter as usize).min(pool);
+    let mut visited = vec![false; pool];
+    let mut steps = 0;
+    let mut model = Model {
+        corrupt: vec![Vec::new(); pixels],
+        lists: Vec::with_capacity(pixels),
+        unreachable: 0,
+    };
+    for (p, &head) in heads.iter().enumerate() {
+        let mut walked = Vec::new();
+        let mut node = head;
+        while node != null {
+            steps += 1;
+            assert!(steps <= pool + pixels, "the model's own walk is bounded");
+            let index = node.checked_sub(node_base).map(|i| i as usize);
+            let why = match index {
+                Some(i) if i >= pool => Some(Corruption::OutOfPool),
+                Some(i) if i >= allocated => Some(Corruption::Unallocated),
+                Some(i) if visited[i] => Some(Corruption::Revisited),
+                Some(_) => None,
+                None => Some(Corruption::OutOfPool),
+            };
+            if let Some(why) = why {
+                model.corrupt[p].push((walked.len(), why));
+                break;
+            }
+            let i = index.expect("checked above");
+            visited[i] = true;
+            let (fragment, possible) = payload.fragment(nodes[i]);
+            if !possible {
+                model.corrupt[p].push((walked.len(), Corruption::ImpossibleKey));
+            }
+            walked.push(fragment);
+            node = next[i];
+        }
+        // `linked-list` keeps the first K nodes of the walk (sorted), `linked-list-nearest` the
+        // K nearest.
+        if scheme == SchemeName::LinkedListNearest {
+            walked.sort_unstable();
+        }
+        walked.truncate(k as usize);
+        walked.sort_unstable();
+        model.lists.push(walked);
+    }
+    model.unreachable = (allocated - visited.iter().filter(|&&v| v).count()) as u64;
+    Ok(Some(model))
+}
+
+/// A layer-major dump (`layer-counter`) and its model.
+fn layer_major(
+    input: &mut Input<'_>,
+    header: &mut Header,
+    viewport: Viewport,
+    arrays: &mut Vec<(&'static str, Words)>,
+) -> Result<Option<Model>, String> {
+    let pixels = viewport.pixels();
+    let k = k(input);
+    let payload = payload(input);
+    // Faults 0 and 1: an array one word off, 2: the layers one layer short, 3: the layers in
+    // the other dtype; any other value: none.
+    let fault = input.u8() % 8;
+    let counters: Vec<u32> = (0..length(pixels, fault, 0))
+        .map(|_| match input.u8() {
+            255 => u32::MAX,
+            b => u32::from(b) % (k + 3),
+        })
+        .collect();
+    let mut layers_len = length(pixels * k as usize, fault, 1);
+    if fault == 2 {
+        layers_len = pixels * (k as usize).saturating_sub(1);
+    }
+    let layers: Vec<u64> = (0..layers_len)
+        .map(|_| payload_word(input, &payload))
+        .collect();
+    arrays.push(("counters", Words::U32(counters.clone())));
+    arrays.push((
+        "layers",
+        payload_words(layers.clone(), &payload, fault == 3),
+    ));
+    header.scheme = SchemeName::LayerCounter.name().into();
+    header.k = Some(k);
+    header.layout = Some(LayoutSpec::LayerMajor { payload });
+    // What the reader refuses first: the payload, then `k`, then the layers, then the counters.
+    let fault = match fault {
+        _ if payload.check().is_err() => "payload",
+        _ if k == 0 => "\"k\"",
+        1..=3 => "\"layers\"",
+        0 => "\"counters\"",
+        _ => "",
+    };
+    if !fault.is_empty() {
+        return Err(fault.into());
+    }
+    let mut model = Model {
+        corrupt: vec![Vec::new(); pixels],
+        lists: Vec::with_capacity(pixels),
+        unreachable: 0,
+    };
+    for (p, &count) in counters.iter().enumerate() {
+        if count > k {
+            model.corrupt[p].push((k as usize, Corruption::CounterPastStorage));
+        }
+        let mut list = Vec::new();
+        for layer in 0..count.min(k) as usize {
+            let (fragment, possible) = payload.fragment(layers[layer * pixels + p]);
+            if !possible {
+                model.corrupt[p].push((layer, Corruption::ImpossibleKey));
+            }
+            list.push(fragment);
+        }
+        list.sort_unstable();
+        model.lists.push(list);
+    }
+    Ok(Some(model))
+}
+
+/// The number of u32 and u64 words a scheme's memory has.
+struct Sizes;
+
+impl SchemeVisitor for Sizes {
+    type Output = (usize, usize);
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> Self::Output {
+        let layout = scheme.layout();
+        (layout.words32, layout.words64)
+    }
+}
+
+/// A memory dump of one of the schemes that dump so, sized as the scheme's memory (or one word
+/// off), with arbitrary words.
+fn memory(
+    input: &mut Input<'_>,
+    header: &mut Header,
+    viewport: Viewport,
+    arrays: &mut Vec<(&'static str, Words)>,
+) -> Result<(), String> {
+    let schemes: Vec<SchemeName> = CATALOG
+        .iter()
+        .filter(|e| e.dump == Some(DumpLayout::Memory))
+        .map(|e| e.scheme)
+        .collect();
+    let scheme = schemes[usize::from(input.u8()) % schemes.len()];
+    let [k, capacity, layers] = [0; 3].map(|_| 1 + u32::from(input.u8() % 4));
+    let Ok((words32, words64)) = scheme.build(
+        &Build::fixed(viewport, k, capacity, layers, u64::MAX),
+        Sizes,
+    ) else {
+        // No such scheme of these sizes: refused, with whatever error the catalog gives.
+        return Err(String::new());
+    };
+    // Faults 0 and 1: an array one word off; any other value: none.
+    let fault = input.u8() % 6;
+    let words32: Vec<u32> = (0..length(words32, fault, 0))
+        .map(|_| input.u32())
+        .collect();
+    let words64: Vec<u64> = (0..length(words64, fault, 1))
+        .map(|_| input.u64())
+        .collect();
+    arrays.push(("words32", Words::U32(words32.clone())));
+    arrays.push(("words64", Words::U64(words64.clone())));
+    header.scheme = scheme.name().into();
+    (header.k, header.capacity, header.layers) = (Some(k), Some(capacity), Some(layers));
+    header.layout = Some(LayoutSpec::Memory);
+    // A size past the dump's words is refused before the scheme is built.
+    let total = (words32.len() + words64.len()).max(1);
+    let sizes = [
+        ("\"k\"", k),
+        ("\"capacity\"", capacity),
+        ("\"layers\"", layers),
+    ];
+    if let Some((field, _)) = sizes.iter().find(|(_, v)| *v as usize > total) {
+        return Err((*field).into());
+    }
+    match fault {
+        0 | 1 => Err(scheme.name().into()),
+        _ => Ok(()),
+    }
+}
