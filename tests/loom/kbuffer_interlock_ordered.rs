@@ -67,6 +67,9 @@ fn model(name: &str, keep: Keep, ordered: bool, k: u32, list: &[Fragment]) -> (u
 /// counted; keeping the first, K = 1, the first submitted in every interleaving, which the
 /// unordered control misses in some.
 #[test]
+#[ignore = "issue 19, open: loom panics with \"Model exceeded maximum number of branches\" on this \
+            model (fresh-clone CI run of 62bbcb4, 2026-12-02): the waiting fragment's retry loop \
+            under an unbounded preemption search; the model needs a bound or a yield-aware wait"]
 fn kbuffer_interlock_ordered_2_threads_loses_nothing_and_enters_in_primitive_order() {
     let list = fragments(&DISTINCT[..2]);
     for k in [1, 2, 3] {
