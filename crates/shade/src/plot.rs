@@ -197,7 +197,11 @@ fn draw<DB: DrawingBackend>(
     };
     let y_end = if y1 > y_start { y1 } else { y_start + 1.0 };
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(root)
+    // The legend in a column of its own beside the plot: drawn inside, it hid the lines it named.
+    let names: Vec<&str> = series.iter().map(|(name, _)| name.as_str()).collect();
+    let (plot_area, legend_area) =
+        root.split_horizontally(root.dim_in_pixel().0 - legend_width(&names));
+    let mut chart = ChartBuilder::on(&plot_area)
         .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(44)
@@ -224,28 +228,48 @@ fn draw<DB: DrawingBackend>(
     for (i, (name, data)) in series.iter().enumerate() {
         let colour = palette(i);
         let style = ShapeStyle::from(&colour).stroke_width(2);
-        let drawn = if scatter {
+        if scatter {
             // The scheme's name beside its point: a scatter of many schemes is read point by point.
             let font = ("sans-serif", 13).into_font().color(&colour);
             chart.draw_series(data.iter().map(|&p| {
                 EmptyElement::at(p)
                     + Circle::new((0, 0), 6, style.filled())
                     + Text::new(name.clone(), (9, -16), font.clone())
-            }))?
+            }))?;
         } else {
-            chart.draw_series(LineSeries::new(data.iter().copied(), style))?
-        };
-        drawn.label(name.clone()).legend(move |(x, y)| {
-            PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(3))
-        });
+            // A dot at every measured point: the lines only join them.
+            chart.draw_series(data.iter().map(|&p| Circle::new(p, 3, style.filled())))?;
+            chart.draw_series(LineSeries::new(data.iter().copied(), style))?;
+        }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()?;
+    draw_legend(&legend_area, &names)?;
     root.present()
+}
+
+/// Pixels the legend column takes: room for the longest name at the legend's font size.
+fn legend_width(names: &[&str]) -> u32 {
+    let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    // About 7 pixels a character at 13 px, plus the colour swatch and margins.
+    (longest as u32 * 7 + 56).min(400)
+}
+
+/// The series' colours and names, one a row, from the top of `area`.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    names: &[&str],
+) -> DrawResult<DB> {
+    let font = ("sans-serif", 13).into_font();
+    for (i, name) in names.iter().enumerate() {
+        let y = 48 + 20 * i as i32;
+        let colour = palette(i);
+        area.draw(&PathElement::new(
+            vec![(8, y), (28, y)],
+            colour.stroke_width(3),
+        ))?;
+        area.draw(&Circle::new((18, y), 3, colour.filled()))?;
+        area.draw(&Text::new(name.to_string(), (34, y - 7), font.clone()))?;
+    }
+    Ok(())
 }
 
 /// The speed/accuracy chart's size: the chart, and the table of its points beside it.
