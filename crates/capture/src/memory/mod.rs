@@ -390,7 +390,10 @@ mod tests {
         WordMemory::<u64>::fetch_min(&memory, BLOCK_WORDS + 1, 3);
         WordMemory::<u64>::fetch_max(&memory, 3 * BLOCK_WORDS, 8);
         WordMemory::<u64>::fetch_or(&memory, 7 * BLOCK_WORDS, 2);
-        assert!(!WordMemory::<u32>::untouched(&memory, 1), "block 0 was written");
+        assert!(
+            !WordMemory::<u32>::untouched(&memory, 1),
+            "block 0 was written"
+        );
         assert!(WordMemory::<u32>::untouched(&memory, BLOCK_WORDS));
         assert!(!WordMemory::<u64>::untouched(&memory, 2 * BLOCK_WORDS - 1));
         assert!(WordMemory::<u64>::untouched(&memory, 0));
