@@ -11,6 +11,7 @@
 #   MESH [../shared/meshes/dragon_vrip.ply.gz, from the repository root]   the dragon
 #   OUT [target/device-scaling]        where the results go (emptied of earlier results first)
 #   THREADS ["1 2 4 8 16"]   EXECUTORS ["parallel tiled"]   SCHEMES [mdts,abuffer]
+#   SCENES ["dragon512 dragon2048 bunny-spheres512"]   which of the three scenes to run
 #   FRAMES_512 [20]   FRAMES_2048 [8]   timed frames per run (bench reports the median)
 #   BUDGET [210]      seconds: a run that would start after this is skipped and named, so that
 #                     the call ends within its 4 minutes; the parallel executor's runs go first
@@ -53,6 +54,10 @@ skipped=()
 for executor in $EXECUTORS; do
     for entry in "${scenes[@]}"; do
         IFS='|' read -r name scene frames <<< "$entry"
+        case " ${SCENES:-dragon512 dragon2048 bunny-spheres512} " in
+            *" $name "*) ;;
+            *) continue ;;
+        esac
         for t in $THREADS; do
             run="$OUT/run-$name-t$t-$executor"
             # shellcheck disable=SC2086 # the scene arguments are words

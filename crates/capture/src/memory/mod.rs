@@ -150,7 +150,7 @@ pub struct SerialMemory {
 }
 
 /// Std atomics with `Relaxed` ordering, shared by the threads of the parallel executor, with a
-/// flag per block of [`BLOCK_WORDS`] words set by the first write to the block (see the module
+/// flag per block of 64 words (`BLOCK_WORDS`) set by the first write to the block (see the module
 /// documentation): what [`AtomicMemory::reset`] re-initialises.
 #[derive(Debug)]
 pub struct AtomicMemory {
@@ -165,7 +165,7 @@ pub struct AtomicMemory {
 /// Words per block of [`AtomicMemory`]'s touched flags: 64 words, four or eight cache lines,
 /// small enough that a sparse frame's blocks are mostly untouched, large enough that the flags
 /// (a byte per block) stay in cache beside the words.
-pub const BLOCK_WORDS: usize = 64;
+const BLOCK_WORDS: usize = 64;
 
 /// One flag per block of `len` words, every one clear.
 fn untouched_blocks(len: usize) -> Vec<AtomicBool> {
