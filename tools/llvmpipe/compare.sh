@@ -16,6 +16,8 @@
 #   MODE [exact]     exact: llvmpipe draws fragsim's snapped vertices (pixel-exact comparison);
 #                    mvp: model-space vertices and fragsim's camera matrix in f32
 #   WORK [target/llvmpipe]   where the binaries, the scene and the results go
+#   FRAGSIM [unset]  a fragsim binary to time instead of building target/release/fragsim (a
+#                    binary kept for a before/after comparison, or one built with other features)
 #
 # Not a test: nothing in cargo test or CI runs it. Exit status 1 when the pictures differ.
 set -euo pipefail
@@ -44,14 +46,17 @@ echo "== mesh $MESH, ${WIDTH}x${HEIGHT}, view $VIEW, elevation $ELEVATION, mode 
 echo "== $ROUNDS rounds x $FRAMES frames; fragsim --threads $THREADS --scheme $SCHEMES --executor $EXECUTOR; llvmpipe: $LP_THREADS"
 
 echo "== building"
-cargo build --release --quiet
-cargo build --release --quiet --manifest-path "$here/prep/Cargo.toml"
+if [ -z "${FRAGSIM:-}" ]; then
+    cargo build --release --quiet
+fi
+# The prep tool's own target directory, whatever CARGO_TARGET_DIR says: its path is used below.
+env -u CARGO_TARGET_DIR cargo build --release --quiet --manifest-path "$here/prep/Cargo.toml"
 if ! cc -O2 -Wall -o "$WORK/draw" "$here/draw.c" -lEGL -lOpenGL; then
     echo "draw.c did not build: install the packages (README.md):" >&2
     echo "  apt-get install -y gcc libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri" >&2
     exit 2
 fi
-fragsim="$root/target/release/fragsim"
+fragsim=${FRAGSIM:-$root/target/release/fragsim}
 prep="$here/prep/target/release/fragsim-llvmpipe-prep"
 
 echo "== fragsim's vertex stage and depth complexity (prep)"
@@ -144,10 +149,11 @@ for key, res in lp.items():
         ok = False
         print(f"  llvmpipe round {key[0]} [{key[1]}]: counts DIFFER from fragsim's")
 totals = {res["fragments"] for res in lp.values()}
-print(f"fragments: fragsim {prep['fragments']} (bench oracle {fs[1]['fragments']}), llvmpipe "
+# Every record of a bench run carries the run's oracle fragment count.
+print(f"fragments: fragsim {prep['fragments']} (bench oracle {fs[1][0]['oracle_fragments']}), llvmpipe "
       f"{sorted(totals)}; covered pixels {prep['covered_pixels']}, max depth complexity "
       f"{prep['max_depth_complexity']}")
-ok = ok and totals == {prep["fragments"]} and fs[1]["fragments"] == prep["fragments"]
+ok = ok and totals == {prep["fragments"]} and fs[1][0]["oracle_fragments"] == prep["fragments"]
 print("pictures: " + ("IDENTICAL, every pixel's fragment count equal" if ok else "DIFFERENT"))
 sys.exit(0 if ok else 1)
 EOF

@@ -31,11 +31,16 @@ print("|---|---|---|" + "---|" * 5)
 for (mesh, executor, scheme), by_threads in sorted(rows.items()):
     if executor == "serial":
         continue
-    base = by_threads[1][0]
+    base = by_threads.get(1, (None,))[0]
     cells = []
     for t in (1, 2, 4, 8, 16):
+        # A sweep cut short (device.sh's time budget) leaves thread counts out: a dash, not a crash.
+        if t not in by_threads:
+            cells.append("–")
+            continue
         ms, fps = by_threads[t]
-        cells.append(f"{ms:.2f} ({fps:.0f}, {base / (t * ms):.0%})")
+        efficiency = f", {base / (t * ms):.0%}" if base else ""
+        cells.append(f"{ms:.2f} ({fps:.0f}{efficiency})")
     print(f"| {mesh} | {executor} | {scheme} | " + " | ".join(cells) + " |")
 
 # The chart: fps against threads (log2 axis), one line per (mesh, executor, scheme).

@@ -114,8 +114,52 @@ pub struct BenchRow {
     pub passes_ms: f64,
     /// Median time of the post pass.
     pub resolve_ms: f64,
+    /// The vertex stage's median over the mesh's vertices, in nanoseconds.
+    pub ns_per_vertex: f64,
+    /// The geometry passes' median over the triangles they ran (triangles × passes), in
+    /// nanoseconds: set-up, scan and capture of a triangle's fragments, storage initialisation
+    /// included.
+    pub ns_per_triangle: f64,
+    /// The geometry passes' and the post pass's medians over the fragments rasterized, in
+    /// nanoseconds: what a fragment costs from rasterization to its resolved list.
+    pub ns_per_fragment: f64,
+    /// Shares of the frame: vertex stage, geometry passes and post pass, each median over the
+    /// sum of the three medians (they add up to 1).
+    pub shares: StageShares,
     /// Depth peeling's median time over this one, when depth peeling ran.
     pub speedup_vs_depth_peeling: Option<f64>,
+}
+
+/// Each stage's share of a frame ([`BenchRow::shares`]).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct StageShares {
+    /// The vertex stage.
+    pub vertex: f64,
+    /// The geometry passes.
+    pub passes: f64,
+    /// The post pass.
+    pub resolve: f64,
+}
+
+impl StageShares {
+    /// The shares of three stage times.
+    fn of(vertex: Duration, passes: Duration, resolve: Duration) -> Self {
+        let total = (vertex + passes + resolve).as_secs_f64().max(1e-12);
+        Self {
+            vertex: vertex.as_secs_f64() / total,
+            passes: passes.as_secs_f64() / total,
+            resolve: resolve.as_secs_f64() / total,
+        }
+    }
+}
+
+/// Nanoseconds per item of a stage that took `time` over `items` items (0 items: 0).
+fn ns_per(time: Duration, items: u64) -> f64 {
+    if items == 0 {
+        0.0
+    } else {
+        time.as_secs_f64() * 1e9 / items as f64
+    }
 }
 
 /// What the whole bench measured.
@@ -262,6 +306,12 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             }
             let median_time = median(&mut times);
             let stats = &named.run.stats;
+            let (vertex_median, pass_median, resolve_median) = (
+                median(&mut vertex_times),
+                median(&mut pass_times),
+                median(&mut resolve_times),
+            );
+            let triangles_run = u64::from(view.triangle_count()) * u64::from(stats.passes);
             let seconds = median_time.as_secs_f64().max(1e-12);
             rows.push(BenchRow {
                 scheme: named.name.clone(),
@@ -298,9 +348,13 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 triangles_per_second: f64::from(view.triangle_count()) * f64::from(stats.passes)
                     / seconds,
                 fragments_per_second: stats.counters.fragments as f64 / seconds,
-                vertex_ms: ms(median(&mut vertex_times)),
-                passes_ms: ms(median(&mut pass_times)),
-                resolve_ms: ms(median(&mut resolve_times)),
+                vertex_ms: ms(vertex_median),
+                passes_ms: ms(pass_median),
+                resolve_ms: ms(resolve_median),
+                ns_per_vertex: ns_per(vertex_median, view.mesh().positions.len() as u64),
+                ns_per_triangle: ns_per(pass_median, triangles_run),
+                ns_per_fragment: ns_per(pass_median + resolve_median, stats.counters.fragments),
+                shares: StageShares::of(vertex_median, pass_median, resolve_median),
                 speedup_vs_depth_peeling: None,
             });
         }

@@ -54,6 +54,9 @@ impl<W: Word, M: WordMemory<W>> WordMemory<W> for CountingMemory<M> {
         // `atomicExch` is a locked instruction too (`xchg` with memory is implicitly locked).
         self.counted().swap(index, value)
     }
+    fn untouched(&self, index: usize) -> bool {
+        self.inner.untouched(index)
+    }
 }
 
 impl<M: Memory> Memory for CountingMemory<M> {

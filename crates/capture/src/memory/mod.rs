@@ -8,10 +8,17 @@
 //! Unlike the GPU, the atomic implementation uses `Relaxed` ordering: the schemes' guarantees need
 //! only per-location atomicity (a total order of the read-modify-writes on each word), and the end
 //! of a pass, a thread join, publishes everything (the proof is in `docs/proof.md`, loom checks it).
+//!
+//! [`AtomicMemory`] also remembers which blocks of [`BLOCK_WORDS`] words any write touched since
+//! its last reset, so that the next frame's reset re-initialises only those (a 2048² MDTS frame
+//! touches a fifth of its 671 MB), and a post pass may skip what no fragment reached
+//! ([`WordMemory::untouched`]). That bookkeeping is no memory operation of the simulated GPU: it
+//! costs a plain load (and once per block a store) beside each write, and the reset it shortens is
+//! still timed as pass time.
 
 use std::cell::Cell;
 use std::fmt::Debug;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering::Relaxed};
 
 mod counting;
 mod layout;
@@ -79,6 +86,14 @@ pub trait WordMemory<W: Word> {
     fn fetch_or(&self, index: usize, value: W) -> W;
     /// `atomicExch` (`imageAtomicExchange`): stores `value`, returns the old value.
     fn swap(&self, index: usize, value: W) -> W;
+    /// Whether word `index` is known to hold its initial value, no write having reached its
+    /// block since the storage was allocated or reset: a hint for post passes, which may skip
+    /// such words. `false` is always a correct answer, and the default; it is no memory
+    /// operation and no step.
+    fn untouched(&self, index: usize) -> bool {
+        let _ = index;
+        false
+    }
 }
 
 /// Per-pixel storage: a `u32` array and a `u64` array.
@@ -134,11 +149,60 @@ pub struct SerialMemory {
     words64: Vec<Cell<u64>>,
 }
 
-/// Std atomics with `Relaxed` ordering, shared by the threads of the parallel executor.
+/// Std atomics with `Relaxed` ordering, shared by the threads of the parallel executor, with a
+/// flag per block of 64 words (`BLOCK_WORDS`) set by the first write to the block (see the module
+/// documentation): what [`AtomicMemory::reset`] re-initialises.
 #[derive(Debug)]
 pub struct AtomicMemory {
     words32: Vec<AtomicU32>,
     words64: Vec<AtomicU64>,
+    touched32: Vec<AtomicBool>,
+    touched64: Vec<AtomicBool>,
+    /// The initial values the words were last set to: a reset to other values writes every word.
+    init: (u32, u64),
+}
+
+/// Words per block of [`AtomicMemory`]'s touched flags: 64 words, four or eight cache lines,
+/// small enough that a sparse frame's blocks are mostly untouched, large enough that the flags
+/// (a byte per block) stay in cache beside the words.
+const BLOCK_WORDS: usize = 64;
+
+/// One flag per block of `len` words, every one clear.
+fn untouched_blocks(len: usize) -> Vec<AtomicBool> {
+    (0..len.div_ceil(BLOCK_WORDS))
+        .map(|_| AtomicBool::new(false))
+        .collect()
+}
+
+/// Marks word `index`'s block touched. The flag is loaded first, so that after the first write
+/// to a block its cache line is only read, never bounced between threads.
+#[inline]
+fn touch(flags: &[AtomicBool], index: usize) {
+    let flag = &flags[index / BLOCK_WORDS];
+    if !flag.load(Relaxed) {
+        flag.store(true, Relaxed);
+    }
+}
+
+/// Sets every word of the touched blocks of `words` to `init` (every block when `all`), in
+/// parallel, and clears the flags.
+fn reset_touched<A: Send>(
+    words: &mut [A],
+    flags: &mut [AtomicBool],
+    all: bool,
+    set: impl Fn(&mut A) + Sync,
+) {
+    use rayon::prelude::*;
+    words
+        .par_chunks_mut(BLOCK_WORDS)
+        .zip(flags.par_iter_mut())
+        .with_min_len(1024)
+        .for_each(|(block, flag)| {
+            if all || *flag.get_mut() {
+                block.iter_mut().for_each(&set);
+                *flag.get_mut() = false;
+            }
+        });
 }
 
 macro_rules! serial_words {
@@ -181,7 +245,7 @@ macro_rules! serial_words {
 }
 
 macro_rules! atomic_words {
-    ($word:ty, $field:ident) => {
+    ($word:ty, $field:ident, $touched:ident) => {
         impl WordMemory<$word> for AtomicMemory {
             fn len(&self) -> usize {
                 self.$field.len()
@@ -191,21 +255,35 @@ macro_rules! atomic_words {
             }
             fn store(&self, i: usize, v: $word) {
                 self.$field[i].store(v, Relaxed);
+                touch(&self.$touched, i);
             }
             fn fetch_min(&self, i: usize, v: $word) -> $word {
-                self.$field[i].fetch_min(v, Relaxed)
+                let old = self.$field[i].fetch_min(v, Relaxed);
+                touch(&self.$touched, i);
+                old
             }
             fn fetch_max(&self, i: usize, v: $word) -> $word {
-                self.$field[i].fetch_max(v, Relaxed)
+                let old = self.$field[i].fetch_max(v, Relaxed);
+                touch(&self.$touched, i);
+                old
             }
             fn fetch_add(&self, i: usize, v: $word) -> $word {
-                self.$field[i].fetch_add(v, Relaxed)
+                let old = self.$field[i].fetch_add(v, Relaxed);
+                touch(&self.$touched, i);
+                old
             }
             fn fetch_or(&self, i: usize, v: $word) -> $word {
-                self.$field[i].fetch_or(v, Relaxed)
+                let old = self.$field[i].fetch_or(v, Relaxed);
+                touch(&self.$touched, i);
+                old
             }
             fn swap(&self, i: usize, v: $word) -> $word {
-                self.$field[i].swap(v, Relaxed)
+                let old = self.$field[i].swap(v, Relaxed);
+                touch(&self.$touched, i);
+                old
+            }
+            fn untouched(&self, i: usize) -> bool {
+                !self.$touched[i / BLOCK_WORDS].load(Relaxed)
             }
         }
     };
@@ -213,8 +291,8 @@ macro_rules! atomic_words {
 
 serial_words!(u32, words32);
 serial_words!(u64, words64);
-atomic_words!(u32, words32);
-atomic_words!(u64, words64);
+atomic_words!(u32, words32, touched32);
+atomic_words!(u64, words64, touched64);
 
 impl SerialMemory {
     /// Whether this storage has exactly the words `layout` asks for.
@@ -242,15 +320,18 @@ impl AtomicMemory {
     }
 
     /// Re-initialises every word to `layout`'s initial values, in parallel (FreePipe's
-    /// initialisation kernel: one GPU thread per word).
+    /// initialisation kernel: one GPU thread per word): the blocks a write touched since the last
+    /// reset, the others holding them already; every block when the initial values change.
     pub fn reset(&mut self, layout: &Layout) {
-        use rayon::prelude::*;
-        self.words32
-            .par_iter_mut()
-            .for_each(|w| *w.get_mut() = layout.init32);
-        self.words64
-            .par_iter_mut()
-            .for_each(|w| *w.get_mut() = layout.init64);
+        let (init32, init64) = (layout.init32, layout.init64);
+        let all = self.init != (init32, init64);
+        reset_touched(&mut self.words32, &mut self.touched32, all, |w| {
+            *w.get_mut() = init32;
+        });
+        reset_touched(&mut self.words64, &mut self.touched64, all, |w| {
+            *w.get_mut() = init64;
+        });
+        self.init = (init32, init64);
     }
 }
 
@@ -275,6 +356,66 @@ impl Memory for AtomicMemory {
             .into_par_iter()
             .map(|_| AtomicU64::new(init64))
             .collect();
-        Self { words32, words64 }
+        Self {
+            words32,
+            words64,
+            touched32: untouched_blocks(len32),
+            touched64: untouched_blocks(len64),
+            init: (init32, init64),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every word of `memory`: the `u32` array widened, then the `u64` array.
+    fn words(memory: &AtomicMemory) -> Vec<u64> {
+        let narrow = (0..WordMemory::<u32>::len(memory))
+            .map(|i| u64::from(WordMemory::<u32>::load(memory, i)));
+        let wide = (0..WordMemory::<u64>::len(memory)).map(|i| WordMemory::<u64>::load(memory, i));
+        narrow.chain(wide).collect()
+    }
+
+    #[test]
+    fn a_reset_re_initialises_every_word_a_write_reached_and_only_their_blocks_read_touched() {
+        let layout = Layout::counters_and_slots(5 * BLOCK_WORDS + 3, 7 * BLOCK_WORDS + 1);
+        let mut memory: AtomicMemory = layout.allocate();
+        let fresh = words(&memory);
+        // One write of each kind, in blocks apart, the last words of both arrays included.
+        WordMemory::<u32>::fetch_add(&memory, 0, 1);
+        WordMemory::<u32>::store(&memory, 5 * BLOCK_WORDS + 2, 9);
+        WordMemory::<u32>::swap(&memory, 2 * BLOCK_WORDS, 4);
+        WordMemory::<u64>::fetch_min(&memory, BLOCK_WORDS + 1, 3);
+        WordMemory::<u64>::fetch_max(&memory, 3 * BLOCK_WORDS, 8);
+        WordMemory::<u64>::fetch_or(&memory, 7 * BLOCK_WORDS, 2);
+        assert!(
+            !WordMemory::<u32>::untouched(&memory, 1),
+            "block 0 was written"
+        );
+        assert!(WordMemory::<u32>::untouched(&memory, BLOCK_WORDS));
+        assert!(!WordMemory::<u64>::untouched(&memory, 2 * BLOCK_WORDS - 1));
+        assert!(WordMemory::<u64>::untouched(&memory, 0));
+        assert_ne!(words(&memory), fresh);
+        memory.reset(&layout);
+        assert_eq!(words(&memory), fresh);
+        assert!((0..7 * BLOCK_WORDS + 1).all(|i| WordMemory::<u64>::untouched(&memory, i)));
+    }
+
+    #[test]
+    fn a_reset_to_other_initial_values_writes_every_word() {
+        let layout = Layout::counters_and_slots(3 * BLOCK_WORDS, 2 * BLOCK_WORDS);
+        let mut memory: AtomicMemory = layout.allocate();
+        let other = Layout {
+            init32: 7,
+            init64: 0,
+            ..layout
+        };
+        memory.reset(&other);
+        assert!((0..3 * BLOCK_WORDS).all(|i| WordMemory::<u32>::load(&memory, i) == 7));
+        assert!((0..2 * BLOCK_WORDS).all(|i| WordMemory::<u64>::load(&memory, i) == 0));
+        memory.reset(&layout);
+        assert_eq!(words(&memory), words(&layout.allocate()));
     }
 }

@@ -253,6 +253,11 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let words = W::words(memory);
         let k = self.k as usize;
+        // Most pixels of a frame are empty: where no write reached the first slot's block, the
+        // slot is empty and so is the list, known without reading the slot's cache line.
+        if words.untouched(pixel * k) {
+            return 0;
+        }
         let stored = (0..k)
             .take_while(|&slot| words.load(pixel * k + slot) != self.empty())
             .count();
