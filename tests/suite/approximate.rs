@@ -38,7 +38,14 @@ fn bench(name: &str, k: &str, seed: &str) -> Vec<Value> {
             "48",
         ])
         .args(["--frames", "1", "--json", "--no-images", "--scheme", "mdts"])
-        .args(["--approximate", "wboit,mlab,tail-blend", "--k", k, "--shuffle", seed])
+        .args([
+            "--approximate",
+            "wboit,mlab,tail-blend",
+            "--k",
+            k,
+            "--shuffle",
+            seed,
+        ])
         .arg("--out")
         .arg(&out)
         .output()
