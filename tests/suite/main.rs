@@ -14,6 +14,7 @@
 
 mod support;
 
+mod approximate;
 mod bucket;
 mod cli_errors;
 mod conventions;

@@ -9,13 +9,15 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use fragsim_capture::executors::Executor;
+use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::View;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::approximate::{ApproximateName, ApproximateRow};
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::judge::{AttributePass, EffectName, Judge, Judged};
+use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
 use crate::record::Context;
 use crate::schemes::{check_memory_cap_early, family, Executors, SchemeChoice, SchemeName};
 
@@ -48,6 +50,10 @@ pub struct BenchArgs {
     /// are still written.
     #[arg(long)]
     pub no_images: bool,
+    /// Approximate OIT schemes to measure beside the catalog's, by their transparency image
+    /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub approximate: Vec<ApproximateName>,
 }
 
 /// One row of the bench.
@@ -88,6 +94,10 @@ pub struct BenchRow {
     pub error_pixels: Option<u64>,
     /// `error_pixels` over the pixels the oracle covers.
     pub error_pixel_rate: Option<f64>,
+    /// The colour error of the effect's image against the oracle's (`mean_abs_error`,
+    /// `max_abs_error`, `psnr_db`; all `null` when the words cannot resolve the effect).
+    #[serde(flatten)]
+    pub colour: ColourColumns,
     /// What the image judge completed from the oracle or recomputed (the deferred attribute
     /// pass), with its count and time; `None` when the image is the scheme's words alone.
     pub attribute_pass: Option<AttributePass>,
@@ -195,6 +205,9 @@ pub struct BenchReport {
     /// One row per scheme and executor.
     #[serde(skip)]
     pub rows: Vec<BenchRow>,
+    /// One row per approximate scheme (`--approximate`).
+    #[serde(skip)]
+    pub approximate: Vec<ApproximateRow>,
 }
 
 /// One line of bench's JSON Lines: a row with what the whole bench measured.
@@ -202,6 +215,16 @@ pub struct BenchReport {
 struct BenchRecord<'a> {
     #[serde(flatten)]
     row: &'a BenchRow,
+    #[serde(flatten)]
+    bench: &'a BenchReport,
+}
+
+/// One line of bench's JSON Lines for an approximate scheme: its row with what the whole bench
+/// measured.
+#[derive(Serialize)]
+struct ApproximateRecord<'a> {
+    #[serde(flatten)]
+    row: &'a ApproximateRow,
     #[serde(flatten)]
     bench: &'a BenchReport,
 }
@@ -246,6 +269,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     crate::oracle_memory::check(&view, sizing.memory_cap)?;
     let oracle = Oracle::build(&view);
     let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+    crate::approximate::check_effect(&judge, &args.approximate)?;
     let covered = judge.covered;
     let executors = args.schemes.executors();
     // One step a frame, plus the untimed frame that counts locked operations.
@@ -295,6 +319,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let diff = oracle.diff(&named.run.capture);
             let judged = judge.judge(&named.run.capture);
             let error_pixels = judged.as_ref().map(|j| j.errors);
+            let colour = ColourColumns::of(judged.as_ref().map(|j| j.colour));
             if let Some(Judged {
                 image, reference, ..
             }) = judged.as_ref().filter(|_| !args.no_images)
@@ -336,6 +361,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 mismatched_pixels: diff.mismatched_pixels,
                 error_pixels,
                 error_pixel_rate: error_pixels.map(|e| e as f64 / covered.max(1) as f64),
+                colour,
                 attribute_pass: judged.and_then(|j| j.pass),
                 ops_per_fragment: stats.counters.steps as f64
                     / stats.counters.fragments.max(1) as f64,
@@ -361,6 +387,27 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     }
     progress.finish_and_clear();
     set_speedups(&mut rows);
+    let raster_ms = ms(median(&mut raster_times.clone()));
+    let order = (!args.approximate.is_empty()).then(|| PrimitiveOrder::of_view(&view));
+    let mut approximate = Vec::new();
+    if let Some(order) = &order {
+        let nodes = crate::approximate::nodes(sizing.k, &oracle);
+        for &scheme in &args.approximate {
+            let (row, image) = pool.install(|| {
+                crate::approximate::measure(
+                    scheme, nodes, &judge, &oracle, order, frames, raster_ms,
+                )
+            })?;
+            if let Some(reference) = judge.reference().filter(|_| !args.no_images) {
+                let stem = format!("bench-{}", row.scheme);
+                fragsim_shade::save_png(&image, &args.out.join(format!("{stem}.png")))?;
+                let difference =
+                    fragsim_shade::legend::effect_difference_figure(reference, &image)?;
+                fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
+            }
+            approximate.push(row);
+        }
+    }
     let context = Context::of_scene("bench", &args.scene)?.sized(&args.schemes);
     let report = BenchReport {
         scene: context.scene.clone(),
@@ -371,17 +418,18 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         oracle_fragments: oracle.fragments(),
         max_depth_complexity: oracle.max_depth_complexity(),
         covered_pixels: covered,
-        raster_ms: ms(median(&mut raster_times.clone())),
+        raster_ms,
         effect: args.effect.label().into(),
         frames: args.frames,
         rows,
+        approximate,
     };
     write_outputs(&report, args)?;
     Ok(report)
 }
 
 /// Rasterizes every triangle on the current pool and discards the fragments.
-fn time_raster_alone(view: &View<'_>) -> Duration {
+pub(crate) fn time_raster_alone(view: &View<'_>) -> Duration {
     let start = Instant::now();
     let fragments: u64 = (0..view.triangle_count())
         .into_par_iter()
@@ -430,6 +478,16 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
         lines.push_str(&crate::record::line("bench", &context, &record)?);
         lines.push('\n');
     }
+    for row in &report.approximate {
+        let context = report.context.on("primitive-order", row.threads);
+        let record = ApproximateRecord { row, bench: report };
+        lines.push_str(&crate::record::line(
+            "bench-approximate",
+            &context,
+            &record,
+        )?);
+        lines.push('\n');
+    }
     let json_path = args.out.join("bench.jsonl");
     std::fs::write(&json_path, &lines)
         .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
@@ -461,6 +519,20 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
                 rate: r.error_pixel_rate?,
             })
         })
+        .chain(
+            report
+                .approximate
+                .iter()
+                .map(|r| fragsim_shade::plot::Point {
+                    label: match r.nodes {
+                        Some(k) => format!("{} (K = {k})", r.scheme),
+                        None => r.scheme.clone(),
+                    },
+                    family: family(&r.scheme),
+                    time_ms: r.time_ms,
+                    rate: r.error_pixel_rate,
+                }),
+        )
         .collect();
     fragsim_shade::plot::speed_accuracy(
         path,
@@ -482,7 +554,10 @@ or a fixed capacity: the oracle's prediction); **lost** fragments it should have
 not; **mismatched px** pixels whose list differs from the oracle's; **EPR %** error-pixel rate: \
 pixels whose 8-bit colour of the effect differs from the oracle's image, in percent of the \
 covered pixels (JSON holds the fraction, `error_pixel_rate`; n/a: the words cannot resolve the \
-effect); **ops/frag** memory operations per fragment; **locked/frag** read-modify-write \
+effect); **mean err**, **max err**, **PSNR dB** the colour error of that image: the mean \
+absolute error of its 8-bit channels (the mean of the three channels'; JSON holds each, \
+`mean_abs_error`), the largest of any channel, and the peak signal-to-noise ratio (inf: equal \
+images); **ops/frag** memory operations per fragment; **locked/frag** read-modify-write \
 operations per fragment (counted in one extra, untimed frame); **vertex ms**, **passes ms**, \
 **post ms** medians of the vertex stage, the geometry passes (storage initialisation, \
 rasterization, capture) and the post pass (resolve, sort); **frame ms** their median sum \
@@ -507,17 +582,18 @@ fn markdown(report: &BenchReport) -> String {
         report.effect
     );
     text.push_str(
-        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR % | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
+        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR % | mean err | max err | PSNR dB | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
     );
     text.push_str(
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let option = |v: Option<f64>, digits: usize| {
         v.map_or_else(|| "n/a".to_string(), |v| format!("{v:.digits$}"))
     };
     for r in &report.rows {
+        let [mean_error, max_error, psnr] = r.colour.cells();
         text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {:.1} | {:.1} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {:.1} | {:.1} | {} |\n",
             r.scheme,
             r.executor,
             r.threads,
@@ -529,6 +605,9 @@ fn markdown(report: &BenchReport) -> String {
             r.lost,
             r.mismatched_pixels,
             r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
+            mean_error,
+            max_error,
+            psnr,
             r.ops_per_fragment,
             r.locked_ops_per_fragment,
             r.vertex_ms,
@@ -544,5 +623,8 @@ fn markdown(report: &BenchReport) -> String {
         ));
     }
     text.push_str(COLUMNS);
+    if !report.approximate.is_empty() {
+        text.push_str(&crate::approximate::markdown(&report.approximate));
+    }
     text
 }

@@ -13,7 +13,10 @@
 //! pixel and primitive id, counted and timed; and the **primitive ids of key-only captures**
 //! (32-bit MDTS, peeling and bucket schemes), completed from the oracle's lists.
 //!
-//! Every capture is then compared with the one reference image, shaded from the oracle's lists.
+//! Every capture is then compared with the one reference image, shaded from the oracle's lists:
+//! the error pixels, and the colour error ([`fragsim_shade::colour_error`]: mean and maximum
+//! absolute error per channel, PSNR), which the approximate OIT schemes' images
+//! ([`crate::approximate`]) are judged by too.
 
 use std::time::Instant;
 
@@ -22,6 +25,7 @@ use fragsim_capture::Capture;
 use fragsim_oracle::Oracle;
 use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
+use fragsim_shade::colour_error::{colour_error, ColourError};
 use fragsim_shade::deferred::{self, PerEntry};
 use fragsim_shade::effects::{self, Effect, Entries, Geometry, Material};
 use image::RgbImage;
@@ -76,6 +80,43 @@ pub struct AttributePass {
     pub ms: f64,
 }
 
+/// The colour error of an image as rows and records carry it (`docs/json-schema.md`): every
+/// field `None` (`null`) where there is no image (the words cannot resolve the effect).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct ColourColumns {
+    /// Mean absolute error per channel (R, G, B), in 8-bit units.
+    pub mean_abs_error: Option<[f64; 3]>,
+    /// Largest absolute error per channel, in 8-bit units.
+    pub max_abs_error: Option<[u8; 3]>,
+    /// Peak signal-to-noise ratio in dB; `None` also for an image equal to the oracle's (its
+    /// PSNR is infinite, which JSON cannot hold: `mean_abs_error` is then zeros, not `null`).
+    pub psnr_db: Option<f64>,
+}
+
+impl ColourColumns {
+    /// The columns of `error`, where there is an image.
+    pub fn of(error: Option<ColourError>) -> Self {
+        error.map_or_else(Self::default, |e| Self {
+            mean_abs_error: Some(e.mean_abs),
+            max_abs_error: Some(e.max_abs),
+            psnr_db: e.psnr_db.is_finite().then_some(e.psnr_db),
+        })
+    }
+
+    /// The table's three cells: the mean over the channels of the mean absolute error, the
+    /// largest error of any channel, the PSNR (`inf` for an equal image); `n/a` without an image.
+    pub fn cells(&self) -> [String; 3] {
+        match (self.mean_abs_error, self.max_abs_error) {
+            (Some(mean), Some(max)) => [
+                format!("{:.3}", mean.iter().sum::<f64>() / 3.0),
+                max.into_iter().max().unwrap_or(0).to_string(),
+                self.psnr_db.map_or("inf".into(), |p| format!("{p:.2}")),
+            ],
+            _ => ["n/a".into(), "n/a".into(), "n/a".into()],
+        }
+    }
+}
+
 /// A capture's image against the oracle's.
 pub(crate) struct Judged<'j> {
     /// The capture's image.
@@ -84,6 +125,8 @@ pub(crate) struct Judged<'j> {
     pub reference: &'j RgbImage,
     /// Pixels whose 8-bit colour differs.
     pub errors: u64,
+    /// How far its colours are from the oracle's.
+    pub colour: ColourError,
     /// What was completed or recomputed, if anything.
     pub pass: Option<AttributePass>,
 }
@@ -146,6 +189,42 @@ impl<'a> Judge<'a> {
         Some(&self.reference)
     }
 
+    /// The effect judged.
+    pub fn effect(&self) -> Effect {
+        self.effect
+    }
+
+    /// The material every image is shaded with.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// The images' width and height.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// `image`, shaded by whatever means at the judge's size, compared with the oracle's;
+    /// `pass`: what was completed or recomputed to shade it.
+    ///
+    /// # Errors
+    /// The image is not the judge's size.
+    pub fn judge_image(
+        &self,
+        image: RgbImage,
+        pass: Option<AttributePass>,
+    ) -> Result<Judged<'_>, String> {
+        let colour = colour_error(&self.reference, &image)?;
+        let errors = effects::error_pixels(&self.reference, &image) as u64;
+        Ok(Judged {
+            image,
+            reference: &self.reference,
+            errors,
+            colour,
+            pass,
+        })
+    }
+
     fn pixels(&self) -> usize {
         self.size.0 as usize * self.size.1 as usize
     }
@@ -192,13 +271,7 @@ impl<'a> Judge<'a> {
             ms,
         });
         let image = self.shade(|p| full.pixel(p), cosines.as_ref());
-        let errors = effects::error_pixels(&self.reference, &image) as u64;
-        Some(Judged {
-            image,
-            reference: &self.reference,
-            errors,
-            pass,
-        })
+        self.judge_image(image, pass).ok()
     }
 }
 

@@ -39,6 +39,7 @@ fn write_stdout(text: std::fmt::Arguments<'_>) {
     }
 }
 
+mod approximate;
 mod args;
 mod bench;
 mod compare;

@@ -62,10 +62,11 @@ impl ValueEnum for SchemeChoice {
 /// The family a scheme belongs to, as charts mark it (one marker shape a family): `mdts`,
 /// `a-buffer` (A-buffers, linked lists, the layer counter, the stencil-routed A-buffer),
 /// `peeling` (depth peeling and the z-buffer), `k-buffer` (k-buffers and loop32), `bucket`
-/// (bucket and adaptive depth peeling).
+/// (bucket and adaptive depth peeling), `approximate` (WBOIT, MLAB, tail blending:
+/// `--approximate`).
 #[must_use]
 pub fn family(scheme: &str) -> &'static str {
-    const FAMILIES: [(&str, &str); 12] = [
+    const FAMILIES: [(&str, &str); 15] = [
         ("mdts", "mdts"),
         ("abuffer", "a-buffer"),
         ("linked-list", "a-buffer"),
@@ -78,6 +79,9 @@ pub fn family(scheme: &str) -> &'static str {
         ("loop32", "k-buffer"),
         ("bdp", "bucket"),
         ("adp", "bucket"),
+        ("wboit", "approximate"),
+        ("mlab", "approximate"),
+        ("tail-blend", "approximate"),
     ];
     FAMILIES
         .iter()

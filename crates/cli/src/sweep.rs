@@ -4,11 +4,13 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::Oracle;
 use serde::Serialize;
 
+use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs};
-use crate::judge::{EffectName, Judge};
+use crate::judge::{ColourColumns, EffectName, Judge};
 use crate::record::Context;
 use crate::schemes::{family, Executors, SchemeChoice};
 
@@ -41,6 +43,10 @@ pub struct SweepArgs {
     /// (`docs/json-schema.md`; sweep.jsonl holds the same).
     #[arg(long)]
     pub json: bool,
+    /// Approximate OIT schemes swept beside the catalog's, judged by their transparency image
+    /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub approximate: Vec<ApproximateName>,
 }
 
 /// One line of sweep's JSON Lines: a scheme at one angle (the context carries the angle).
@@ -50,6 +56,8 @@ struct SweepRecord<'a> {
     effect: &'static str,
     /// `None` where the scheme's words cannot resolve the effect.
     error_pixel_rate: Option<f64>,
+    #[serde(flatten)]
+    colour: ColourColumns,
     time_ms: f64,
 }
 
@@ -60,6 +68,8 @@ pub struct SweepSeries {
     pub scheme: String,
     /// Error-pixel rate (over covered pixels) per angle; `None` where the effect is unresolvable.
     pub error_pixel_rate: Vec<Option<f64>>,
+    /// The colour error against the oracle's image per angle (`None` fields: unresolvable).
+    pub colour: Vec<ColourColumns>,
     /// Frame time per angle, ms.
     pub time_ms: Vec<f64>,
 }
@@ -87,6 +97,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+        crate::approximate::check_effect(&judge, &args.approximate)?;
         let sizing = args.schemes.sizing();
         let mut runner = Executors::default();
         for (i, &name) in schemes.iter().enumerate() {
@@ -95,17 +106,49 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
                 series.push(SweepSeries {
                     scheme: named.name.clone(),
                     error_pixel_rate: Vec::new(),
+                    colour: Vec::new(),
                     time_ms: Vec::new(),
                 });
             }
-            let rate = judge
-                .judge(&named.run.capture)
+            let judged = judge.judge(&named.run.capture);
+            let rate = judged
+                .as_ref()
                 .map(|judged| judged.errors as f64 / judge.covered.max(1) as f64);
             series[i].error_pixel_rate.push(rate);
+            series[i]
+                .colour
+                .push(ColourColumns::of(judged.map(|j| j.colour)));
             series[i].time_ms.push(
                 (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,
             );
             threads = named.run.stats.threads;
+        }
+        if !args.approximate.is_empty() {
+            let order = PrimitiveOrder::of_view(&view);
+            let raster_ms = pool
+                .install(|| crate::bench::time_raster_alone(&view))
+                .as_secs_f64()
+                * 1e3;
+            let nodes = crate::approximate::nodes(args.schemes.k, &oracle);
+            for (j, &scheme) in args.approximate.iter().enumerate() {
+                let (row, _) = pool.install(|| {
+                    crate::approximate::measure(
+                        scheme, nodes, &judge, &oracle, &order, 1, raster_ms,
+                    )
+                })?;
+                let i = schemes.len() + j;
+                if series.len() <= i {
+                    series.push(SweepSeries {
+                        scheme: row.scheme.clone(),
+                        error_pixel_rate: Vec::new(),
+                        colour: Vec::new(),
+                        time_ms: Vec::new(),
+                    });
+                }
+                series[i].error_pixel_rate.push(Some(row.error_pixel_rate));
+                series[i].colour.push(row.colour);
+                series[i].time_ms.push(row.time_ms);
+            }
         }
         progress.inc(1);
     }
@@ -128,11 +171,17 @@ fn write_outputs(
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let mut lines = String::new();
     for s in series {
-        for ((&angle, &rate), &time_ms) in angles.iter().zip(&s.error_pixel_rate).zip(&s.time_ms) {
+        let measured = angles
+            .iter()
+            .zip(&s.error_pixel_rate)
+            .zip(&s.colour)
+            .zip(&s.time_ms);
+        for (((&angle, &rate), &colour), &time_ms) in measured {
             let record = SweepRecord {
                 scheme: &s.scheme,
                 effect: args.effect.label(),
                 error_pixel_rate: rate,
+                colour,
                 time_ms,
             };
             lines.push_str(&crate::record::line(
@@ -194,10 +243,13 @@ fn write_outputs(
         return Ok(());
     }
     outln!(
-        "{:<20} {:>12} {:>12} {:>12}",
+        "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12}",
         "scheme",
         "mean EPR %",
         "max EPR %",
+        "mean err",
+        "max err",
+        "min PSNR dB",
         "mean ms"
     );
     for s in series {
@@ -215,11 +267,15 @@ fn write_outputs(
             .reduce(f64::max)
             .map_or("n/a".into(), |r| format!("{r:.4}"));
         let mean_ms = mean(&mut s.time_ms.iter().copied()).unwrap_or(0.0);
+        let [mean_error, max_error, psnr] = colour_over_angles(&s.colour);
         outln!(
-            "{:<20} {:>12} {:>12} {:>12.2}",
+            "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12.2}",
             s.scheme,
             mean_rate,
             max_rate,
+            mean_error,
+            max_error,
+            psnr,
             mean_ms
         );
     }
@@ -228,4 +284,34 @@ fn write_outputs(
         args.out.display()
     );
     Ok(())
+}
+
+/// The sweep table's colour cells of one scheme: the mean over the angles of the mean absolute
+/// error (the channels' mean), the largest error at any angle, and the lowest PSNR (`inf`: every
+/// angle's image equal to the oracle's); `n/a` where no angle's image resolves.
+fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
+    let means: Vec<f64> = colour
+        .iter()
+        .filter_map(|c| c.mean_abs_error)
+        .map(|m| m.iter().sum::<f64>() / 3.0)
+        .collect();
+    if means.is_empty() {
+        return ["n/a".into(), "n/a".into(), "n/a".into()];
+    }
+    let max = colour
+        .iter()
+        .filter_map(|c| c.max_abs_error)
+        .flatten()
+        .max()
+        .unwrap_or(0);
+    let psnr = colour
+        .iter()
+        .filter_map(|c| c.psnr_db)
+        .reduce(f64::min)
+        .map_or("inf".into(), |p| format!("{p:.2}"));
+    [
+        format!("{:.3}", means.iter().sum::<f64>() / means.len() as f64),
+        max.to_string(),
+        psnr,
+    ]
 }

@@ -1,5 +1,6 @@
-//! Images of captures: the depth-complexity heat map, the nearest-layer depth, and the
-//! multi-fragment effects ([`effects`]: transparency, translucency) with the error-pixel rate
+//! Images of captures: the depth-complexity heat map, the nearest-layer depth, the
+//! multi-fragment effects ([`effects`]: transparency, translucency), the approximate OIT schemes'
+//! transparency ([`approximate`]: WBOIT, MLAB, tail blending), with the error-pixel rate
 //! and, for approximate images, the colour error ([`colour_error`]: mean and maximum absolute
 //! error per channel, PSNR),
 //! and the deferred attribute pass that gives captures what shading needs beyond their words
@@ -13,6 +14,7 @@
 
 use std::path::Path;
 
+pub mod approximate;
 pub mod colour_error;
 pub mod deferred;
 pub mod effects;

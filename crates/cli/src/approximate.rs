@@ -1,0 +1,200 @@
+//! `bench --approximate` and `sweep --approximate`: the approximate OIT schemes (weighted blended
+//! OIT, multi-layer alpha blending, tail blending; [`fragsim_shade::approximate`]) measured beside
+//! the catalog's, by their image alone.
+//!
+//! **What is measured.** These schemes hold colour, not fragment lists, so there is no list for
+//! the oracle to diff: each is judged by its transparency image against the oracle's
+//! ([`Judge::judge_image`]): error pixels, mean and maximum absolute error, PSNR. Its fragments
+//! reach it in primitive order, as a GPU's blending and ordered interlock deliver them
+//! ([`PrimitiveOrder::of_view`]), so its image is the same whatever executor the catalog's
+//! schemes ran on. Its time is the scene's rasterization alone (the bench's `raster_ms`: one
+//! geometry pass, fragments discarded) plus the median time of its blend over every pixel's
+//! fragments on the pool: a CPU model's cost, comparable with the other rows' only as the
+//! schemes' shares of one machine are.
+//!
+//! **Sizes.** MLAB and tail blending take `--k` nodes a pixel (`auto`: the scene's maximum depth
+//! complexity, where both are exact); WBOIT has none. Their storage is what the papers lay out
+//! on a GPU ([`Approximation::bytes_per_pixel`]).
+
+use std::time::{Duration, Instant};
+
+use clap::ValueEnum;
+use fragsim_capture::catalog::Count;
+use fragsim_capture::primitive_order::PrimitiveOrder;
+use fragsim_oracle::Oracle;
+use fragsim_shade::approximate::{in_submission_order, Approximation};
+use fragsim_shade::effects::Effect;
+use image::RgbImage;
+use serde::Serialize;
+
+use crate::judge::{ColourColumns, Judge};
+
+/// An approximate OIT scheme, as `--approximate` spells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ApproximateName {
+    /// Weighted blended OIT (McGuire & Bavoil 2013, the weight of their eq. 10).
+    Wboit,
+    /// Multi-layer alpha blending with `--k` nodes (Salvi & Vaidyanathan 2014).
+    Mlab,
+    /// The `--k` nearest sorted, the rest blended into a tail (nvpro-samples).
+    TailBlend,
+}
+
+impl ApproximateName {
+    /// The scheme with `k` nodes where it takes a number.
+    pub fn with_k(self, k: u32) -> Approximation {
+        match self {
+            ApproximateName::Wboit => Approximation::Wboit,
+            ApproximateName::Mlab => Approximation::Mlab { k },
+            ApproximateName::TailBlend => Approximation::TailBlend { k },
+        }
+    }
+}
+
+/// One approximate scheme's image of one scene against the oracle's.
+#[derive(Debug, Clone, Serialize)]
+pub struct ApproximateRow {
+    /// `wboit`, `mlab` or `tail-blend`.
+    pub scheme: String,
+    /// Always `approximate`: judged by its colour error, never held to the oracle's lists.
+    pub guarantee: &'static str,
+    /// Nodes per pixel (`None`: WBOIT has none).
+    pub nodes: Option<u32>,
+    /// Bytes of per-pixel storage on a GPU, as the paper lays it out.
+    pub memory_bytes: u64,
+    /// Bytes per pixel.
+    pub bytes_per_pixel: f64,
+    /// Pixels with more fragments than `nodes`: the only ones MLAB and tail blending may get
+    /// wrong (WBOIT: pixels with more than one fragment).
+    pub pixels_beyond_nodes: u64,
+    /// Pixels whose 8-bit colour differs from the oracle's image.
+    pub error_pixels: u64,
+    /// `error_pixels` over the pixels the oracle covers.
+    pub error_pixel_rate: f64,
+    /// The colour error against the oracle's image.
+    #[serde(flatten)]
+    pub colour: ColourColumns,
+    /// Median time of the blend over every pixel's fragments, ms.
+    pub blend_ms: f64,
+    /// The rasterization alone plus `blend_ms`: the row's frame time, ms.
+    pub time_ms: f64,
+    /// Threads of the pool that blended (a record's context carries them).
+    #[serde(skip)]
+    pub threads: usize,
+}
+
+/// `--k` resolved for the approximate schemes: `auto` is the scene's maximum depth complexity.
+pub fn nodes(k: Count, oracle: &Oracle) -> u32 {
+    match k {
+        Count::Fixed(n) => n,
+        Count::Auto => oracle.max_depth_complexity().max(1),
+    }
+}
+
+/// Refuses `--approximate` with an effect other than transparency, by name.
+///
+/// # Errors
+/// The judge's effect is not transparency.
+pub(crate) fn check_effect(
+    judge: &Judge<'_>,
+    approximate: &[ApproximateName],
+) -> Result<(), String> {
+    if approximate.is_empty() || judge.effect() == Effect::Transparency {
+        return Ok(());
+    }
+    let name = approximate[0]
+        .to_possible_value()
+        .map(|v| v.get_name().to_string())
+        .unwrap_or_default();
+    Err(format!(
+        "--approximate {name} blends transparency only: run it with --effect transparency"
+    ))
+}
+
+/// Measures `scheme` with `k` nodes on the judge's scene, blending `frames` times on the current
+/// rayon pool (the median is reported); `order` is the view's primitive order and `raster_ms`
+/// its rasterization alone.
+/// Returns the row and the image.
+///
+/// # Errors
+/// The image is not the judge's size (a bug).
+pub(crate) fn measure(
+    scheme: ApproximateName,
+    k: u32,
+    judge: &Judge<'_>,
+    oracle: &Oracle,
+    order: &PrimitiveOrder,
+    frames: usize,
+    raster_ms: f64,
+) -> Result<(ApproximateRow, RgbImage), String> {
+    let approximation = scheme.with_k(k);
+    // The order is the rasterizer's, free on a GPU: arranged once, outside the timed blend.
+    let arrivals: Vec<Vec<u64>> = (0..oracle.pixels())
+        .map(|p| in_submission_order(order, p, oracle.pixel(p)))
+        .collect();
+    let mut times: Vec<Duration> = Vec::with_capacity(frames.max(1));
+    let mut image = RgbImage::new(0, 0);
+    for _ in 0..frames.max(1) {
+        let start = Instant::now();
+        image = approximation.render(judge.material(), judge.size(), |p| &arrivals[p]);
+        times.push(start.elapsed());
+    }
+    times.sort_unstable();
+    let blend_ms = times[times.len() / 2].as_secs_f64() * 1e3;
+    let limit = approximation.k().unwrap_or(1);
+    let pixels_beyond_nodes = oracle
+        .depth_complexity()
+        .iter()
+        .filter(|&&n| n > limit)
+        .count() as u64;
+    let judged = judge.judge_image(image, None)?;
+    let pixels = oracle.pixels() as u64;
+    let memory_bytes = approximation.bytes_per_pixel() * pixels;
+    let row = ApproximateRow {
+        scheme: approximation.name().into(),
+        guarantee: "approximate",
+        nodes: approximation.k(),
+        memory_bytes,
+        bytes_per_pixel: memory_bytes as f64 / pixels.max(1) as f64,
+        pixels_beyond_nodes,
+        error_pixels: judged.errors,
+        error_pixel_rate: judged.errors as f64 / judge.covered.max(1) as f64,
+        colour: ColourColumns::of(Some(judged.colour)),
+        blend_ms,
+        time_ms: raster_ms + blend_ms,
+        threads: rayon::current_num_threads(),
+    };
+    Ok((row, judged.image))
+}
+
+/// bench.md's table of the approximate schemes, with what its columns mean.
+pub fn markdown(rows: &[ApproximateRow]) -> String {
+    let mut text = String::from(
+        "\nApproximate OIT (judged by the image: their storage holds colour, not lists)\n\n\
+         | scheme | nodes | memory B | B/px | px beyond nodes | EPR % | mean err | max err | PSNR dB | blend ms | frame ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let [mean, max, psnr] = r.colour.cells();
+        text.push_str(&format!(
+            "| {} | {} | {} | {:.1} | {} | {:.3} | {mean} | {max} | {psnr} | {:.2} | {:.2} |\n",
+            r.scheme,
+            r.nodes.map_or("-".into(), |k| k.to_string()),
+            r.memory_bytes,
+            r.bytes_per_pixel,
+            r.pixels_beyond_nodes,
+            r.error_pixel_rate * 100.0,
+            r.blend_ms,
+            r.time_ms,
+        ));
+    }
+    text.push_str(
+        "\nColumns: **nodes** per pixel (`--k`; WBOIT none); **memory B**, **B/px** the storage a \
+         GPU needs as the paper lays it out; **px beyond nodes** pixels with more fragments than \
+         nodes (WBOIT: more than one), the only pixels where the scheme may differ from the \
+         exact image; **EPR %**, **mean err**, **max err**, **PSNR dB** as above, of its \
+         transparency image; **blend ms** the median time of the blend over every pixel's \
+         fragments in primitive order; **frame ms** the rasterization alone plus the blend.\n",
+    );
+    text
+}
