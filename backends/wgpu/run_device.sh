@@ -1,52 +1,131 @@
 #!/usr/bin/env bash
-# The wgpu backend on the device machine (docs/results-gpu.md, "wgpu"): one call of the device
-# tool with `carry: ["target/devbin-wgpu"]`, which holds the stripped x86-64 `fragsim-wgpu`, the
-# dragon and the Vulkan loader's .deb (the machine has the NVIDIA driver's ICD but maybe no
-# loader). Every scheme, correct and planted (`--plant all`: the correct shader and each plant
-# that applies to it), and the non-atomic k-buffer, of the bunny, the dragon and bunny-spheres at
-# 512² and 2048², two views each, replay and engine mode, judged in place (--judge) against
-# fragsim's oracle. The three scenes run side by side (the oracle and the verdicts are CPU work);
-# the dumps are not written (--discard: at most 8 files come back, and the 2048² linked lists
-# are a gigabyte each). The spinlocked k-buffer runs on its own under `timeout`: a spinlock in a
-# fragment shader has no forward-progress guarantee, so a hang is reported, not waited out.
+# The wgpu backend on the device machine in one call (docs/results-gpu.md, "wgpu"; issue 17 and
+# issue 16's captures): every scheme, correct and planted, and the non-atomic k-buffer, of the
+# bunny, the dragon and bunny-spheres at 512² and 2048², replay and engine mode, views 30° and
+# 120° (the planted bugs there too), and views 210° and 300° for the schemes issue 16 asks at 4
+# views (abuffer, mdts, mdts32, linked-list-nearest). Each capture is judged in place by
+# `fragsim-wgpu capture --judge --precision`: the coverage check (replay mode: fragsim's
+# (pixel, primitive) pairs at every pixel the scheme keeps whole, the A-buffer's counters against
+# fragsim's depth complexity) and the precision verdict, the library calls of `fragsim compare
+# oracle DIR --vertex-precision f32` with its reference built once per view and shared by that
+# view's captures. The dumps are not written (--discard: the 2048² linked lists are hundreds of
+# megabytes each). The spinlocked k-buffer runs on its own under `timeout` (a spinlock in a
+# fragment shader has no forward-progress guarantee: a hang is reported, not waited out).
 # --capacity 4 (A-buffer slots, linked-list pool nodes per pixel) so that the fixed A-buffer's
-# off-by-one plant has pixels at its capacity to show in (the bunny has none at 20).
-# The logs are the result: $OUT/wgpu-<scene>.log, and everything on stdout.
+# off-by-one plant has pixels at its capacity to show in; K = 8; elevation 15°.
+#
+# Carry `target/devbin-wgpu` (`carry: ["target/devbin-wgpu"]`): the stripped release
+# `fragsim-wgpu`, the dragon, this script and the Vulkan loader's .debs in gl/ (the device has
+# the NVIDIA driver's ICD but maybe no loader); docs/results-gpu.md says how to fill it. Run
+# `bash target/devbin-wgpu/run_device.sh`. Jobs (one per scene, side, view and mode) run side by
+# side (the verdicts are CPU work), the smaller side first so that it is complete whatever
+# happens, then the larger with the dragon first; every job stops at the common deadline BUDGET
+# seconds after the start (a job not started by then says so), so the call ends in time.
+#
+# Knobs (environment): SIZES (default "512 2048"), SCENES ("dragon bunny-spheres bunny"), JOBS
+# (parallel jobs, default the cores / 2), BUDGET (seconds for all the jobs, default 210), BIN
+# (default target/devbin-wgpu), DRAGON (default $BIN/dragon_vrip.ply.gz). A dry run on lavapipe:
+# BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES="32 64" bash
+# backends/wgpu/run_device.sh.
+#
+# Output: every job's log on stdout and in $OUT/wgpu-device.log, then the summary table (scheme,
+# scene, view, size, mode, verdict, error px, ambiguous px, coverage px, ms: GPU timestamps where
+# the adapter has them, else the wall time of submit to read-back) on stdout and in
+# $OUT/wgpu-summary.tsv.
 set -uo pipefail
-bin=target/devbin-wgpu
-for f in "$bin"/gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-export XDG_RUNTIME_DIR=/tmp
-if ! "$bin/fragsim-wgpu" adapter 2>&1 | grep -q NVIDIA; then
-    export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+bin=${BIN:-target/devbin-wgpu}
+sizes=${SIZES:-"512 2048"}
+scenes=${SCENES:-"dragon bunny-spheres bunny"}
+jobs=${JOBS:-$(( $(nproc) / 2 > 0 ? $(nproc) / 2 : 1 ))}
+deadline=$(( $(date +%s) + ${BUDGET:-210} ))
+dragon=${DRAGON:-$bin/dragon_vrip.ply.gz}
+out=${OUT:-/tmp}
+if compgen -G "$bin/gl/*.deb" >/dev/null; then
+    for f in "$bin"/gl/*.deb; do dpkg -x "$f" /; done
+    ldconfig
+fi
+export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
+icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+if ! "$bin/fragsim-wgpu" adapter 2>&1 | grep -q NVIDIA && [ -e "$icd" ]; then
+    export VK_DRIVER_FILES=$icd
 fi
 "$bin/fragsim-wgpu" adapter || exit 1
-nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
-logs=${OUT:-/tmp}
-schemes=abuffer,abuffer-exact,mdts,mdts32,kbuffer,linked-list,linked-list-nearest
+command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
+logs=$(mktemp -d)
+export bin dragon logs deadline
 
-one_scene() {
-    local scene=$1 what
+# One job: the captures of one scene, side, view and mode.
+one() {
+    local scene=$1 side=$2 view=$3 mode=$4 what schemes plant
     case $scene in
-        dragon) what=(--mesh "$bin/dragon_vrip.ply.gz") ;;
+        dragon) what=(--mesh "$dragon") ;;
         *) what=(--scene "$scene") ;;
     esac
-    for side in 512 2048; do
-        for view in 30 120; do
+    local common=("${what[@]}" --width "$side" --height "$side" --view "$view" --mode "$mode"
+        --k 8 --capacity 4 --judge --precision --discard)
+    case $view in
+        30 | 120) schemes=abuffer,abuffer-exact,mdts,mdts32,kbuffer,linked-list,linked-list-nearest plant=all ;;
+        *) schemes=abuffer,mdts,mdts32,linked-list-nearest plant=none ;;
+    esac
+    local log=$logs/$scene-$side-$view-$mode.log start=$SECONDS left
+    {
+        echo "== $scene ${side}x${side} view $view $mode"
+        left=$((deadline - $(date +%s)))
+        if [ "$left" -lt 5 ]; then
+            echo "job $scene $side $view $mode: not run, the budget was spent"
+        else
+            timeout "$left" "$bin/fragsim-wgpu" capture --scheme "$schemes" --plant "$plant" "${common[@]}" \
+                || echo "job $scene $side $view $mode: exit $? (124: stopped at the deadline)"
+        fi
+        left=$((deadline - $(date +%s)))
+        if [ "$plant" = all ] && [ "$left" -ge 5 ]; then
+            timeout "$((left < 60 ? left : 60))" "$bin/fragsim-wgpu" capture --scheme kbuffer-spinlock-fixed "${common[@]}" \
+                || echo "kbuffer-spinlock-fixed $scene $side $view $mode: exit $? (124: timed out, at most 60 s)"
+        fi
+        echo "== $scene ${side}x${side} view $view $mode: $((SECONDS - start)) s"
+    } >"$log" 2>&1
+}
+export -f one
+
+# The smaller sides first; within a side the dragon and the planted views first.
+for side in $(echo "$sizes" | tr ' ' '\n' | sort -n); do
+    for scene in $scenes; do
+        for view in 30 120 210 300; do
             for mode in replay engine; do
-                local common=("${what[@]}" --width "$side" --height "$side" --view "$view"
-                    --mode "$mode" --k 8 --capacity 4 --judge --discard --depth-ulps 0,256)
-                echo "== $scene ${side}x${side} view $view $mode"
-                "$bin/fragsim-wgpu" capture --scheme "$schemes" --plant all "${common[@]}"
-                timeout 60 "$bin/fragsim-wgpu" capture --scheme kbuffer-spinlock-fixed "${common[@]}" \
-                    || echo "kbuffer-spinlock-fixed $mode ${side}x${side}: exit $? (124: timed out after 60 s)"
+                echo "$scene $side $view $mode"
             done
         done
     done
-}
+done | xargs -P "$jobs" -L 1 bash -c 'one "$@"' _
+cat "$logs"/*.log | tee "$out/wgpu-device.log"
 
-for scene in bunny dragon bunny-spheres; do
-    one_scene "$scene" >"$logs/wgpu-$scene.log" 2>&1 &
-done
-wait
-cat "$logs"/wgpu-bunny.log "$logs"/wgpu-dragon.log "$logs"/wgpu-bunny-spheres.log
+# The table: one row per capture, from each job's capture lines and the verdicts below them.
+summary() {
+    printf 'scheme\tscene\tview\tsize\tmode\tverdict\terror_px\tambiguous_px\tcoverage_px\tms\n'
+    for f in "$logs"/*.log; do
+        local base scene side view mode
+        base=$(basename "$f" .log)
+        mode=${base##*-}; base=${base%-*}
+        view=${base##*-}; base=${base%-*}
+        side=${base##*-}; scene=${base%-*}
+        awk -v scene="$scene" -v view="$view" -v side="$side" -v mode="$mode" '
+            / triangles, GPU / {
+                name = $1
+                if ($2 == "(planted:") { p = $3; sub(/\)$/, "", p); name = name "+" p }
+                ms = $0; sub(/.*GPU /, "", ms); sub(/,.*/, "", ms)
+                if (ms ~ /n\/a/) { ms = $0; sub(/.*wall /, "", ms); sub(/ ms.*/, " ms (wall)", ms) }
+                cov = "-"
+            }
+            /^  verdict \(depth ulps/ { cov = $0; sub(/.*coverage: /, "", cov); sub(/ of .*/, "", cov)
+                c = $0; if (sub(/.*counters differ at /, "", c)) { sub(/ pixels.*/, "", c); cov = cov "/" c } }
+            /^  precision verdict/ {
+                v = $6; sub(/:$/, "", v); err = $7
+                amb = $0; sub(/ ambiguous,.*/, "", amb); sub(/.*\), /, "", amb)
+                printf "%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n", name, scene, view, side, mode, v, err, amb, cov, ms
+            }' "$f"
+    done
+}
+echo
+echo "== summary (coverage px: pixels whose primitive ids or counts differ from fragsim's / A-buffer counters that differ; ms: GPU timestamps)"
+summary | tee "$out/wgpu-summary.tsv" | column -t -s $'\t'
+rm -rf "$logs"

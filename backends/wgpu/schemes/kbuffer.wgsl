@@ -2,9 +2,11 @@
 // 2007): a fragment reads its pixel's K sorted slots and writes back the ones its insertion
 // shifts, with plain loads and stores. Two fragments of one pixel that interleave their reads
 // and writes lose one of them: the race this shader exists to show on real hardware. Words are
-// key << 32 | prim as (low, high) u32 pairs, empty = all ones, ascending: the `mdts` layout.
+// key << 32 | prim as (low, high) u32 pairs, empty = all ones, ascending: the catalog's memory
+// layout for the scheme (words64: the slots; words32, the render-target machine's lock and
+// ticket words, are bound by the host and never touched here).
 
-@group(0) @binding(2) var<storage, read_write> slots: array<vec2<u32>>;
+@group(0) @binding(6) var<storage, read_write> slots: array<vec2<u32>>;
 
 @fragment
 fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {

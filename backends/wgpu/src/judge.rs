@@ -9,10 +9,17 @@
 //! pixels where the scheme keeps every fragment (at most K, or the capacity, in the reference;
 //! every pixel of the exact A-buffer), from the primitive ids stored (or, for key-only words, the
 //! number of fragments).
+//!
+//! [`Within`] is the other verdict, issue 16's: the dump judged within the precision of an f32
+//! vertex stage against the exact oracle under the dump's conventions, what `fragsim compare
+//! oracle DIR --vertex-precision f32` prints (the same library calls, [`f32_reference`] and
+//! [`compare_within`]), its reference built once and shared by every capture of one view.
 
 use fragsim_capture::{Capacity, Identity, Keeps};
 use fragsim_oracle::compare::{CompareOptions, Comparison};
 use fragsim_oracle::dump::{Dump, DumpError, Words};
+use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
+use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 
 /// The verdict and the coverage of one capture.
@@ -121,4 +128,115 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
         coverage_differs: differs,
         counters_differ,
     })
+}
+
+/// The reference of the precision verdict for one scene and viewport: the exact oracle under the
+/// scene's conventions and what an f32 vertex stage may produce ([`f32_reference`]).
+pub struct Within {
+    scene: SceneAndCamera,
+    viewport: (u32, u32),
+    oracle: Oracle,
+    precision: Precision,
+    covered: u64,
+}
+
+/// One capture judged by [`Within::judge`].
+#[derive(Debug)]
+pub struct WithinJudgement {
+    /// The verdict: error pixels are `diff.mismatched_pixels`, ambiguous ones `counts.ambiguous`.
+    pub comparison: Comparison,
+    /// The bounds derived for the view.
+    pub bounds: Bounds,
+    /// Pixels the reference covers (what the ambiguous pixels are a share of).
+    pub covered: u64,
+}
+
+impl WithinJudgement {
+    /// One line: the verdict, the error and ambiguous pixels, and the bounds, as `fragsim
+    /// compare` prints them.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let (c, b) = (&self.comparison, &self.bounds);
+        format!(
+            "{}: {} error pixels (missing {}, extra {}, misordered {}, miscounted {}, corrupt {}), {} ambiguous, {} within precision, of {} covered; bounds: vertex error up to {:.3} subpixels, depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs",
+            if c.is_equal() { "EQUAL" } else { "DIFFERENT" },
+            c.diff.mismatched_pixels,
+            c.counts.missing,
+            c.counts.extra,
+            c.counts.misordered,
+            c.counts.miscounted,
+            c.counts.corrupt,
+            c.counts.ambiguous,
+            c.counts.within_precision,
+            self.covered,
+            b.max_vertex_error_subpixels,
+            b.max_depth_interval_ulps,
+            b.ambiguous_pairs
+        )
+    }
+}
+
+impl Within {
+    /// The reference for the scene and viewport `dump` names.
+    ///
+    /// # Errors
+    /// As [`f32_reference`]: a scene that cannot be loaded or rasterized.
+    pub fn of(dump: &Dump) -> Result<Self, DumpError> {
+        let viewport = dump.viewport()?;
+        let scene = dump.header.scene.clone();
+        let (oracle, precision) = f32_reference(&scene, viewport, None)?;
+        let covered = (0..oracle.pixels())
+            .filter(|&p| !oracle.pixel(p).is_empty())
+            .count() as u64;
+        Ok(Self {
+            scene,
+            viewport: (viewport.width, viewport.height),
+            oracle,
+            precision,
+            covered,
+        })
+    }
+
+    /// The exact oracle judged against (for replay dumps, which declare the reference
+    /// conventions, fragsim's own oracle of the view: what [`judge`] takes).
+    #[must_use]
+    pub fn oracle(&self) -> &Oracle {
+        &self.oracle
+    }
+
+    /// Whether `dump` names this reference's scene and viewport.
+    #[must_use]
+    pub fn fits(&self, dump: &Dump) -> bool {
+        dump.header.scene == self.scene && (dump.header.width, dump.header.height) == self.viewport
+    }
+
+    /// `dump` judged within precision, every word read (`Dump::compare_within`'s steps).
+    ///
+    /// # Errors
+    /// A dump of another scene or viewport, or one its layout cannot decode.
+    pub fn judge(&self, dump: &Dump) -> Result<WithinJudgement, DumpError> {
+        if !self.fits(dump) {
+            return Err(DumpError(
+                "the dump names another scene or viewport than the reference's".into(),
+            ));
+        }
+        let options = CompareOptions {
+            examples: 8,
+            ..Default::default()
+        };
+        let capture = dump.capture()?;
+        let words = dump.check_words()?;
+        let comparison = compare_within(
+            &self.precision,
+            &self.oracle,
+            &capture,
+            Some(&words),
+            &options,
+        );
+        Ok(WithinJudgement {
+            comparison,
+            bounds: self.precision.bounds(),
+            covered: self.covered,
+        })
+    }
 }

@@ -17,6 +17,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::Viewport;
+use fragsim_wgpu::judge::Within;
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
 
@@ -41,6 +42,7 @@ enum Command {
     /// Print the adapter and the features the shaders use.
     Adapter,
     /// Capture a scene with one or more schemes; one dump per scheme in OUT/<scheme>/.
+    #[command(group(clap::ArgGroup::new("verdicts").args(["judge", "precision"]).multiple(true)))]
     Capture {
         /// Schemes, comma-separated: abuffer, abuffer-exact, mdts, mdts32, kbuffer,
         /// linked-list, linked-list-nearest, kbuffer-spinlock-fixed; or all.
@@ -80,7 +82,7 @@ enum Command {
         #[arg(long, default_value = "none", value_delimiter = ',')]
         plant: Vec<String>,
         /// Judge without writing the dumps (a device run whose dumps would not come back).
-        #[arg(long, requires = "judge")]
+        #[arg(long, requires = "verdicts")]
         discard: bool,
         /// Output directory.
         #[arg(long, default_value = "out/wgpu")]
@@ -92,6 +94,10 @@ enum Command {
         /// verdict per value.
         #[arg(long, default_value = "0", value_delimiter = ',')]
         depth_ulps: Vec<u32>,
+        /// Also judge each dump within the precision of an f32 vertex stage (issue 16's verdict:
+        /// `fragsim compare oracle DIR --vertex-precision f32`) and print it.
+        #[arg(long)]
+        precision: bool,
     },
 }
 
@@ -128,6 +134,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         out,
         judge: judge_it,
         depth_ulps,
+        precision,
     } = cli.command
     else {
         return Ok(());
@@ -167,6 +174,9 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         ModeArg::Engine => Mode::Engine,
     };
     let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
+    // The precision verdict's reference, built for the first dump and kept while the dumps name
+    // its scene (one view and mode: every dump of this command).
+    let mut within: Option<Within> = None;
     let mut failed = 0;
     let mut runs = 0;
     for scheme in &schemes {
@@ -216,6 +226,18 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 for &ulps in &depth_ulps {
                     let judgement = judge::judge(&captured.dump, oracle, ulps)?;
                     println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
+                }
+            }
+            if precision {
+                if !within.as_ref().is_some_and(|w| w.fits(&captured.dump)) {
+                    within = Some(Within::of(&captured.dump)?);
+                }
+                if let Some(reference) = &within {
+                    let judgement = reference.judge(&captured.dump)?;
+                    println!(
+                        "  precision verdict (f32 vertex stage): {}",
+                        judgement.summary()
+                    );
                 }
             }
         }

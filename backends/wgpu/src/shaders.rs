@@ -229,16 +229,18 @@ impl GpuScheme {
         }
     }
 
-    /// The dump layout's `scheme` (`docs/dump-format.md`): both A-buffers are `abuffer`, the
-    /// non-atomic k-buffer's sorted slots are MDTS's, the linked lists and the spinlocked
-    /// k-buffer name themselves.
+    /// The dump layout's `scheme` (`docs/dump-format.md`), the catalog's for the scheme (what
+    /// `fragsim render --dump` writes): both A-buffers are `abuffer`, the linked lists and the
+    /// two k-buffers (the catalog's memory layout) name themselves.
     #[must_use]
     pub fn layout(&self) -> &'static str {
         match self {
             Self::ABuffer { .. } | Self::ABufferExact => "abuffer",
-            Self::Mdts { .. } | Self::Kbuffer { .. } => "mdts",
+            Self::Mdts { .. } => "mdts",
             Self::Mdts32 { .. } => "mdts32",
-            Self::LinkedList { .. } | Self::KbufferSpinlock { .. } => self.name(),
+            Self::LinkedList { .. } | Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } => {
+                self.name()
+            }
         }
     }
 
@@ -247,7 +249,7 @@ impl GpuScheme {
     pub fn layout_spec(&self) -> Option<LayoutSpec> {
         match self {
             Self::LinkedList { .. } => Some(LayoutSpec::FRAGSIM_LISTS),
-            Self::KbufferSpinlock { .. } => Some(LayoutSpec::Memory),
+            Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } => Some(LayoutSpec::Memory),
             _ => None,
         }
     }
@@ -264,11 +266,13 @@ impl GpuScheme {
         matches!(self, Self::ABuffer { .. } | Self::ABufferExact)
     }
 
-    /// The dump's `word` field.
+    /// The dump's `word` field: empty for the memory layouts, whose words their scheme's module
+    /// documents (as `fragsim render --dump` writes them).
     #[must_use]
     pub fn word(&self) -> &'static str {
         match self {
             Self::Mdts32 { .. } => "key",
+            Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } => "",
             _ => "key<<32|prim",
         }
     }
@@ -344,6 +348,19 @@ impl GpuScheme {
     pub fn storages(&self, pixels: u64, total: u64) -> Vec<Storage> {
         let per_pixel = |k: u32| vec![pixels, u64::from(k)];
         let slots64 = |binding, shape| Storage::new(binding, "slots", Dtype::U64, shape, u32::MAX);
+        // The k-buffers' memory layout: `words32` (zeros), then `k` empty slots per pixel.
+        let memory = |words32, k: u32| {
+            vec![
+                Storage::new(5, "words32", Dtype::U32, vec![words32], 0),
+                Storage::new(
+                    6,
+                    "words64",
+                    Dtype::U64,
+                    vec![pixels * u64::from(k)],
+                    u32::MAX,
+                ),
+            ]
+        };
         match *self {
             Self::ABuffer { capacity } => vec![
                 Storage::new(1, "counters", Dtype::U32, vec![pixels], 0),
@@ -355,7 +372,10 @@ impl GpuScheme {
                 s
             }
             Self::Mdts { k } => vec![slots64(1, per_pixel(k))],
-            Self::Kbuffer { k } => vec![slots64(2, per_pixel(k))],
+            // The catalog's render-target k-buffer: three u32 per pixel (its lock, next ticket
+            // and last committed ticket: the ROP's ordering, which the CPU models and a fragment
+            // shader's plain stores have none of, so the GPU leaves them at 0) before the slots.
+            Self::Kbuffer { k } => memory(3 * pixels, k),
             Self::Mdts32 { k } => {
                 vec![Storage::new(3, "slots", Dtype::U32, per_pixel(k), u32::MAX)]
             }
@@ -368,16 +388,8 @@ impl GpuScheme {
                     Storage::new(4, "nodes", Dtype::U64, vec![pool], 0),
                 ]
             }
-            Self::KbufferSpinlock { k } => vec![
-                Storage::new(5, "words32", Dtype::U32, vec![pixels], 0),
-                Storage::new(
-                    6,
-                    "words64",
-                    Dtype::U64,
-                    vec![pixels * u64::from(k)],
-                    u32::MAX,
-                ),
-            ],
+            // One lock word per pixel before the slots.
+            Self::KbufferSpinlock { k } => memory(pixels, k),
         }
     }
 }
@@ -417,5 +429,47 @@ mod tests {
         let exact = GpuScheme::ABufferExact.storages(10, 17);
         assert_eq!(exact[1].shape, [11]);
         assert_eq!((exact[2].shape.clone(), exact[2].words()), (vec![17], 34));
+    }
+
+    #[test]
+    fn the_kbuffers_dump_the_catalog_schemes_own_memory() {
+        use fragsim_capture::schemes::kbuffer::KBuffer;
+        use fragsim_capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Loop};
+        use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
+        use fragsim_raster::Viewport;
+
+        let viewport = Viewport::new(6, 5).unwrap();
+        let pixels = viewport.pixels() as u64;
+        let words = |s: GpuScheme| -> Vec<(&str, u64, u32)> {
+            s.storages(pixels, 0)
+                .into_iter()
+                .map(|s| (s.name, s.words(), s.initial))
+                .collect()
+        };
+        let catalog = |l: fragsim_capture::Layout| {
+            // u64 words are two u32 on the GPU; their initial word all ones is u64::MAX.
+            assert_eq!((l.init32, l.init64, l.table_bytes), (0, u64::MAX, 0));
+            vec![
+                ("words32", l.words32 as u64, 0),
+                ("words64", 2 * l.words64 as u64, u32::MAX),
+            ]
+        };
+        let kbuffer = KBuffer::new(viewport, 3, MEMORY_CAP_DEFAULT).unwrap();
+        assert_eq!(
+            words(GpuScheme::Kbuffer { k: 3 }),
+            catalog(kbuffer.layout())
+        );
+        let spinlock = KBufferSpinlock::new(viewport, 3, Loop::Fixed, MEMORY_CAP_DEFAULT).unwrap();
+        assert_eq!(
+            words(GpuScheme::KbufferSpinlock { k: 3 }),
+            catalog(spinlock.layout())
+        );
+        for s in [
+            GpuScheme::Kbuffer { k: 3 },
+            GpuScheme::KbufferSpinlock { k: 3 },
+        ] {
+            assert_eq!(s.layout(), s.name());
+            assert_eq!(s.layout_spec(), Some(LayoutSpec::Memory));
+        }
     }
 }
