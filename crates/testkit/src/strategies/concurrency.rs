@@ -1,9 +1,9 @@
 //! Strategies for concurrency: how a run interleaves (task size, schedule).
 
-use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::executors::{ParallelExecutor, Run};
-use fragsim::capture::Scheme;
-use fragsim::raster::View;
+use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim_capture::executors::{ParallelExecutor, Run};
+use fragsim_capture::Scheme;
+use fragsim_raster::View;
 use proptest::prelude::*;
 
 /// How a property's concurrent runs interleave: the parallel executor with a small task size
