@@ -16,6 +16,7 @@ mod support;
 
 mod bucket;
 mod cli_errors;
+mod conform;
 mod conventions;
 mod default_scene;
 mod dump;

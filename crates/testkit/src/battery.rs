@@ -280,6 +280,10 @@ impl<'b> Battery<'b> {
                     comparison: None,
                     fragments: 0,
                 });
+                let mut steps = shrink_steps.get();
+                let (case, found) =
+                    self.crop(case, found, &mut steps, &mut *events.into_inner());
+                shrink_steps.set(steps);
                 Err(Failure::Counterexample(Box::new(Counterexample {
                     case,
                     submitted: found.submitted,
@@ -292,6 +296,35 @@ impl<'b> Battery<'b> {
                 })))
             }
             Err(TestError::Abort(reason)) => Err(Failure::Refused(reason.to_string())),
+        }
+    }
+
+    /// Shrinks a failing case further where proptest's shrinking stops: proptest moves one
+    /// value at a time towards zero, so a failure at pixel (2, 1) keeps a 3×2 viewport; here the
+    /// case is cut to the window around its differing pixels (one pixel, their bounding box, a
+    /// half of the viewport), each under its own schedule and the first few seeds, and its
+    /// triangles are dropped one by one, as long as it still fails.
+    fn crop(
+        &self,
+        mut case: Case,
+        mut found: Found,
+        steps: &mut u32,
+        on_event: &mut dyn FnMut(Event),
+    ) -> (Case, Found) {
+        loop {
+            let mut smaller = None;
+            for candidate in candidates(&case, &found) {
+                *steps += 1;
+                on_event(Event::Shrink(*steps));
+                if let Err(Stop::Found(f)) = self.check(&candidate) {
+                    smaller = Some((candidate, f));
+                    break;
+                }
+            }
+            match smaller {
+                Some((c, f)) => (case, found) = (c, f),
+                None => return (case, found),
+            }
         }
     }
 
@@ -354,6 +387,56 @@ impl<'b> Battery<'b> {
         }
         Ok(())
     }
+}
+
+/// Smaller cases to try after `case` failed with `found`, most promising first: fewer pixels
+/// (crops around the differing pixels, under the case's schedule and seeds 0 to 3), then fewer
+/// triangles.
+fn candidates(case: &Case, found: &Found) -> Vec<Case> {
+    let viewport = case.viewport;
+    let (w, h) = (viewport.width, viewport.height);
+    let differing: Vec<(u32, u32)> = found.comparison.as_ref().map_or(Vec::new(), |c| {
+        c.verdicts
+            .iter()
+            .enumerate()
+            .filter(|(_, &v)| v & verdict::DIFFERS != 0)
+            .map(|(p, _)| (p as u32 % w, p as u32 / w))
+            .collect()
+    });
+    let mut windows: Vec<(u32, u32, u32, u32)> =
+        differing.iter().take(4).map(|&(x, y)| (x, y, 1, 1)).collect();
+    if let (Some(x0), Some(y0)) = (
+        differing.iter().map(|p| p.0).min(),
+        differing.iter().map(|p| p.1).min(),
+    ) {
+        let x1 = differing.iter().map(|p| p.0).max().unwrap_or(x0);
+        let y1 = differing.iter().map(|p| p.1).max().unwrap_or(y0);
+        windows.push((x0, y0, x1 - x0 + 1, y1 - y0 + 1));
+    }
+    let (hw, hh) = (w.div_ceil(2), h.div_ceil(2));
+    windows.extend([(0, 0, hw, h), (w - hw, 0, hw, h), (0, 0, w, hh), (0, h - hh, w, hh)]);
+    let mut out = Vec::new();
+    for (x, y, cw, ch) in windows {
+        if u64::from(cw) * u64::from(ch) >= u64::from(w) * u64::from(h) {
+            continue;
+        }
+        let Some(cropped) = case.cropped(x, y, cw, ch) else {
+            continue;
+        };
+        let seeds = [case.schedule.seed, 0, 1, 2, 3];
+        for (i, &seed) in seeds.iter().enumerate() {
+            if i > 0 && seed == case.schedule.seed {
+                continue;
+            }
+            let mut c = cropped.clone();
+            c.schedule.seed = seed;
+            out.push(c);
+        }
+    }
+    if case.triangles.len() > 1 {
+        out.extend((0..case.triangles.len()).map(|i| case.without(i)));
+    }
+    out
 }
 
 /// One line on a differing verdict: pixels per verdict.

@@ -144,6 +144,39 @@ impl Case {
         }
     }
 
+    /// The window rectangle of `width` × `height` pixels from pixel `(x, y)` as a case of its
+    /// own: the viewport shrunk, every corner moved by whole pixels, so each pixel of the
+    /// rectangle keeps its fragments (coverage and depth move with the grid).
+    #[must_use]
+    pub fn cropped(&self, x: u32, y: u32, width: u32, height: u32) -> Option<Case> {
+        let viewport = Viewport::new(width, height).ok()?;
+        let (dx, dy) = (2 * i32::try_from(x).ok()?, 2 * i32::try_from(y).ok()?);
+        let triangles = self
+            .triangles
+            .iter()
+            .map(|t| CaseTriangle {
+                corners: t.corners.map(|[cx, cy]| [cx - dx, cy - dy]),
+                ..*t
+            })
+            .collect();
+        Some(Case {
+            viewport,
+            triangles,
+            ..self.clone()
+        })
+    }
+
+    /// The case without triangle `index` (and its order key).
+    #[must_use]
+    pub fn without(&self, index: usize) -> Case {
+        let mut case = self.clone();
+        case.triangles.remove(index);
+        if index < case.order_keys.len() {
+            case.order_keys.remove(index);
+        }
+        case
+    }
+
     /// The mesh as OBJ text: every coordinate printed as the shortest decimal that reads back to
     /// the same f32, so a backend (and `compare`) loading the file sees the case's very mesh.
     #[must_use]
