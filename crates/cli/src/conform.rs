@@ -138,7 +138,11 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             .iter()
             .map(|e| e.name)
             .collect();
-        format!("unknown scheme {}: one of {}", args.scheme, names.join(", "))
+        format!(
+            "unknown scheme {}: one of {}",
+            args.scheme,
+            names.join(", ")
+        )
     })?;
     if !args.backend.contains("{out}") {
         return Err(format!(
@@ -300,9 +304,13 @@ fn save(
     let absolute = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let replay = vec![
         backend.command_line(&absolute.join("scene"), &absolute.join("out"), params),
-        format!("fragsim compare oracle '{}'", absolute.join("out").display()),
+        format!(
+            "fragsim compare oracle '{}'",
+            absolute.join("out").display()
+        ),
     ];
-    let mut script = String::from("#!/bin/sh\n# Replays fragsim conform's smallest failing case.\n");
+    let mut script =
+        String::from("#!/bin/sh\n# Replays fragsim conform's smallest failing case.\n");
     if let Err(e) = rerun {
         script.push_str(&format!("# On saving, the backend failed again: {e}\n"));
     }
@@ -361,7 +369,10 @@ fn print_counterexample(
         outln!("    oracle:  [{}]", show(&p.reference));
         outln!("    backend: [{}]", show(&p.candidate));
     }
-    outln!("  saved in {} (scene/, out/, conform.jsonl); replay:", saved.display());
+    outln!(
+        "  saved in {} (scene/, out/, conform.jsonl); replay:",
+        saved.display()
+    );
     for line in replay {
         outln!("    {line}");
     }

@@ -27,9 +27,7 @@ use fragsim_oracle::compare::{verdict, Comparison};
 use fragsim_oracle::{Oracle, PixelMismatch};
 use fragsim_raster::Conventions;
 use proptest::strategy::Strategy;
-use proptest::test_runner::{
-    Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner,
-};
+use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner};
 
 use crate::backend::{Backend, BackendError, Input, Params};
 use crate::case::{case, Case, Limits};
@@ -281,8 +279,7 @@ impl<'b> Battery<'b> {
                     fragments: 0,
                 });
                 let mut steps = shrink_steps.get();
-                let (case, found) =
-                    self.crop(case, found, &mut steps, &mut *events.into_inner());
+                let (case, found) = self.crop(case, found, &mut steps, &mut *events.into_inner());
                 shrink_steps.set(steps);
                 Err(Failure::Counterexample(Box::new(Counterexample {
                     case,
@@ -360,13 +357,10 @@ impl<'b> Battery<'b> {
             view: &view,
             params: &self.params,
         };
-        let output = self
-            .backend
-            .capture(&input)
-            .map_err(|e| match e {
-                BackendError::Setup(message) => Stop::Setup(message),
-                BackendError::Failed(message) => found(Property::Runs, message, None, fragments),
-            })?;
+        let output = self.backend.capture(&input).map_err(|e| match e {
+            BackendError::Setup(message) => Stop::Setup(message),
+            BackendError::Failed(message) => found(Property::Runs, message, None, fragments),
+        })?;
         let comparison = judge(&view, &oracle, &output)
             .map_err(|e| found(Property::Runs, e, None, fragments))?;
         if comparison.claimed_overflow != comparison.diff.overflowed {
@@ -403,8 +397,11 @@ fn candidates(case: &Case, found: &Found) -> Vec<Case> {
             .map(|(p, _)| (p as u32 % w, p as u32 / w))
             .collect()
     });
-    let mut windows: Vec<(u32, u32, u32, u32)> =
-        differing.iter().take(4).map(|&(x, y)| (x, y, 1, 1)).collect();
+    let mut windows: Vec<(u32, u32, u32, u32)> = differing
+        .iter()
+        .take(4)
+        .map(|&(x, y)| (x, y, 1, 1))
+        .collect();
     if let (Some(x0), Some(y0)) = (
         differing.iter().map(|p| p.0).min(),
         differing.iter().map(|p| p.1).min(),
@@ -414,7 +411,12 @@ fn candidates(case: &Case, found: &Found) -> Vec<Case> {
         windows.push((x0, y0, x1 - x0 + 1, y1 - y0 + 1));
     }
     let (hw, hh) = (w.div_ceil(2), h.div_ceil(2));
-    windows.extend([(0, 0, hw, h), (w - hw, 0, hw, h), (0, 0, w, hh), (0, h - hh, w, hh)]);
+    windows.extend([
+        (0, 0, hw, h),
+        (w - hw, 0, hw, h),
+        (0, 0, w, hh),
+        (0, h - hh, w, hh),
+    ]);
     let mut out = Vec::new();
     for (x, y, cw, ch) in windows {
         if u64::from(cw) * u64::from(ch) >= u64::from(w) * u64::from(h) {

@@ -142,7 +142,12 @@ impl CommandBackend {
 
     /// Runs `line` with `sh -c` in a process group of its own, its output into the two files;
     /// kills the group past the timeout.
-    fn run_line(&self, line: &str, stdout: &Path, stderr: &Path) -> Result<ExitStatus, BackendError> {
+    fn run_line(
+        &self,
+        line: &str,
+        stdout: &Path,
+        stderr: &Path,
+    ) -> Result<ExitStatus, BackendError> {
         let file = |path: &Path| {
             fs::File::create(path)
                 .map_err(|e| BackendError::Setup(format!("{}: {e}", path.display())))

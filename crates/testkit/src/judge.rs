@@ -39,9 +39,7 @@ pub fn judge(view: &View<'_>, oracle: &Oracle, output: &Output) -> Result<Compar
                     oracle.pixels()
                 ));
             }
-            Ok(compare_within(
-                &precision, oracle, capture, None, &options,
-            ))
+            Ok(compare_within(&precision, oracle, capture, None, &options))
         }
         Output::Dump(dump) => {
             let viewport = view.viewport();
