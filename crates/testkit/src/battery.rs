@@ -132,8 +132,8 @@ pub struct Battery<'b> {
 enum Stop {
     /// The backend cannot run at all.
     Setup(String),
-    /// A property broke.
-    Found(Found),
+    /// A property broke (boxed: a verdict is large, and `Stop` is every check's error).
+    Found(Box<Found>),
 }
 
 /// A property broken by one case, before shrinking ends.
@@ -255,7 +255,7 @@ impl<'b> Battery<'b> {
                 }
                 Err(Stop::Found(found)) => {
                     let message = format!("{}: {}", found.property, found.message);
-                    *last_found.borrow_mut() = Some(found);
+                    *last_found.borrow_mut() = Some(*found);
                     Err(TestCaseError::fail(message))
                 }
             }
@@ -314,7 +314,7 @@ impl<'b> Battery<'b> {
                 *steps += 1;
                 on_event(Event::Shrink(*steps));
                 if let Err(Stop::Found(f)) = self.check(&candidate) {
-                    smaller = Some((candidate, f));
+                    smaller = Some((candidate, *f));
                     break;
                 }
             }
@@ -339,13 +339,13 @@ impl<'b> Battery<'b> {
     fn check_submitted(&self, submitted: &Case, property: Property) -> Result<(), Stop> {
         let scene = submitted.scene();
         let found = |property, message: String, comparison, fragments| {
-            Stop::Found(Found {
+            Stop::Found(Box::new(Found {
                 submitted: submitted.clone(),
                 property,
                 message,
                 comparison,
                 fragments,
-            })
+            }))
         };
         let view = scene
             .view_under(submitted.viewport, &Case::camera(), Conventions::REFERENCE)
