@@ -17,6 +17,7 @@ mod support;
 mod approximate;
 mod bucket;
 mod cli_errors;
+mod conform;
 mod conventions;
 mod default_scene;
 mod dump;

@@ -43,6 +43,7 @@ mod approximate;
 mod args;
 mod bench;
 mod compare;
+mod conform;
 mod explain;
 mod export;
 mod hazard;
@@ -62,6 +63,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
 pub use compare::{compare, CompareArgs};
+pub use conform::{conform, ConformArgs};
 pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
 pub use hazard::{BaselineRow, HazardArgs, HazardReport, HazardRow};
@@ -101,6 +103,8 @@ pub enum Command {
     Sweep(SweepArgs),
     /// Compare a dump (docs/dump-format.md) with fragsim's oracle or another dump, pixel by pixel.
     Compare(CompareArgs),
+    /// Run the conformance battery against a backend command on generated cases, shrink a failure.
+    Conform(ConformArgs),
     /// Write a view's screen triangles (snapped, clipped, oriented) for a GPU backend.
     ExportScene(ExportArgs),
     /// Find, shrink and print a step-by-step interleaving (k-buffer hazard, MDTS invariant).
@@ -135,6 +139,9 @@ pub fn main() -> ExitCode {
                 compare::compare(&args),
                 "the candidate differs from the reference",
             )
+        }
+        Some(Command::Conform(args)) => {
+            return exit_code(conform::conform(&args), "the backend fails the battery")
         }
         Some(Command::ExportScene(args)) => {
             return exit_code(export::export_scene(&args).map(|()| true), "")

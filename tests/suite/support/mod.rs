@@ -1,10 +1,11 @@
 //! Helpers shared by the suites of this binary (`crate::support`).
 //!
 //! - [`strategies`]: proptest strategies for viewports, orbit cameras, procedural scenes, random
-//!   and closed meshes, planar tilings, capacities `K` and depths.
+//!   and closed meshes, planar tilings, capacities `K` and depths (`fragsim_testkit::strategies`,
+//!   re-exported so that the suites keep their `crate::support::strategies` paths).
 //! - [`json_lines`]: the records of a `--json` output (`docs/json-schema.md`).
 
-pub mod strategies;
+pub use fragsim_testkit::strategies;
 
 /// The records of a `--json` output, one JSON object a line (`docs/json-schema.md`); panics
 /// naming the line that is not one.

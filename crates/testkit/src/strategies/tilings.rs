@@ -1,7 +1,7 @@
 //! Strategies for planar tilings (seen through the identity camera), the depth planes they lie
 //! on and hinges across the near plane.
 
-use fragsim::raster::{Mesh, Viewport, SUBPIXEL_BITS};
+use fragsim_raster::{Mesh, Viewport, SUBPIXEL_BITS};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::select;

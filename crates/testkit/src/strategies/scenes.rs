@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 
-use fragsim::raster::{Mesh, Scene};
+use fragsim_raster::{Mesh, Scene};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::select;

@@ -1,9 +1,9 @@
 //! Strategies for concurrency: how a run interleaves (task size, schedule).
 
-use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::executors::{ParallelExecutor, Run};
-use fragsim::capture::Scheme;
-use fragsim::raster::View;
+use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
+use fragsim_capture::executors::{ParallelExecutor, Run};
+use fragsim_capture::Scheme;
+use fragsim_raster::View;
 use proptest::prelude::*;
 
 /// How a property's concurrent runs interleave: the parallel executor with a small task size
@@ -44,25 +44,29 @@ pub fn policy() -> impl Strategy<Value = Policy> {
     ]
 }
 
-/// A [`Concurrency`]: task sizes 1 to 8, 2 to 64 threads in flight, either granularity, any
-/// seed. Shrinks towards one triangle a task and two fragments in flight under the random policy.
+/// A [`Concurrency`]: task sizes 1 to 8, and a [`schedule`]. Shrinks towards one triangle a task
+/// and two fragments in flight under the random policy.
 pub fn concurrency() -> impl Strategy<Value = Concurrency> {
+    (1usize..=8, schedule()).prop_map(|(task_size, schedule)| Concurrency {
+        task_size,
+        schedule,
+    })
+}
+
+/// A [`Schedule`] of the scheduled executor: any [`policy`], 2 to 64 threads in flight, either
+/// granularity, any seed: a replayable interleaving, so a failure under it reproduces. Shrinks
+/// towards two fragments in flight under the random policy, one fragment a step, seed 0.
+pub fn schedule() -> impl Strategy<Value = Schedule> {
     (
-        1usize..=8,
         policy(),
         2usize..=64,
         prop_oneof![Just(Granularity::Fragment), Just(Granularity::Triangle)],
         any::<u64>(),
     )
-        .prop_map(
-            |(task_size, policy, in_flight, granularity, seed)| Concurrency {
-                task_size,
-                schedule: Schedule {
-                    policy,
-                    in_flight,
-                    granularity,
-                    seed,
-                },
-            },
-        )
+        .prop_map(|(policy, in_flight, granularity, seed)| Schedule {
+            policy,
+            in_flight,
+            granularity,
+            seed,
+        })
 }

@@ -2,7 +2,7 @@
 
 use std::ops::{Range, RangeInclusive};
 
-use fragsim::raster::{Camera, OrbitCamera, Viewport};
+use fragsim_raster::{Camera, OrbitCamera, Viewport};
 use proptest::prelude::*;
 use proptest::sample::select;
 

@@ -1,0 +1,379 @@
+//! `fragsim conform --backend 'COMMAND {scene} {out}' --scheme S`: the conformance battery
+//! (`fragsim_testkit::battery`) against a backend in any language, run as a command on each
+//! generated case's files (`fragsim_testkit::command`).
+//!
+//! Each case is written as files (the triangle export, the mesh OBJ and its camera JSON, the
+//! case's sizes), the command runs on them with a timeout and writes a dump, and the dump is
+//! judged with `compare`'s verdict against the oracle, in the case's submission order and in
+//! another. On a failure proptest shrinks the case by re-running the command on smaller ones
+//! (fewer triangles, a smaller viewport, corners nearer the origin); the smallest failing case is
+//! printed and saved: its scene files, the dump the backend wrote, both lists of the first
+//! differing pixels, and the commands that replay it. Exit code 0 when every case passes, 1 on
+//! a counterexample, 2 on errors (bad arguments, a command that cannot run), as `compare`.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use clap::Args;
+use fragsim_capture::catalog::SchemeName;
+use fragsim_oracle::scene::{mesh_hash, SceneAndCamera};
+use fragsim_oracle::PixelMismatch;
+use fragsim_raster::{depth_from_key, Conventions};
+use fragsim_testkit::{
+    Battery, Case, CommandBackend, Counterexample, Event, Failure, Input, Limits, Params,
+};
+use serde::Serialize;
+
+use crate::record::{self, Context, Slots};
+
+/// Options of `fragsim conform`.
+#[derive(Debug, Clone, Args)]
+pub struct ConformArgs {
+    /// The backend's command line, run by `sh -c` per case: `{scene}` is the case's directory
+    /// (scene.tri, mesh.obj, camera.json, case.json), `{out}` the directory to write the dump
+    /// into; `{scheme}`, `{k}`, `{capacity}` are replaced too.
+    #[arg(long, value_name = "COMMAND")]
+    pub backend: String,
+    /// The catalog scheme the backend runs (the dump's layout).
+    #[arg(long, value_name = "NAME")]
+    pub scheme: String,
+    /// Slots per pixel of K-sized schemes (MDTS, the k-buffers).
+    #[arg(long, value_name = "N", default_value_t = 2,
+          value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub k: u32,
+    /// Slots per pixel of the fixed A-buffer.
+    #[arg(long, value_name = "N", default_value_t = 3,
+          value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub capacity: u32,
+    /// How many cases to generate.
+    #[arg(long, value_name = "N", default_value_t = 100,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    pub cases: u32,
+    /// The seed the cases are generated from (the same seed, the same cases).
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    pub seed: u64,
+    /// Seconds one run of the command may take before it is killed (a failing case).
+    #[arg(long, value_name = "SECONDS", default_value_t = 30.0, value_parser = positive)]
+    pub timeout: f64,
+    /// The largest viewport side of a case, in pixels.
+    #[arg(long, value_name = "N", default_value_t = 8,
+          value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_side: u32,
+    /// The most triangles a case holds.
+    #[arg(long, value_name = "N", default_value_t = 6,
+          value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_triangles: u32,
+    /// Where the smallest failing case is saved (`DIR/case/`, replaced), and the cases are run
+    /// (`DIR/work/`, removed at the end).
+    #[arg(long, value_name = "DIR", default_value = "out/conform")]
+    pub save: PathBuf,
+    /// Print JSON Lines instead of the report: one `conform` record, then one
+    /// `counterexample_pixel` record per differing pixel shown (`docs/json-schema.md`).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A positive, finite number of seconds.
+fn positive(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{text} is not a positive number of seconds")),
+    }
+}
+
+/// A fragment as the report shows it.
+#[derive(Debug, Serialize)]
+struct Entry {
+    key: String,
+    depth: f32,
+    prim: u32,
+}
+
+fn entries(words: &[u64]) -> Vec<Entry> {
+    words
+        .iter()
+        .map(|&w| Entry {
+            key: format!("{:#010x}", w >> 32),
+            depth: depth_from_key((w >> 32) as u32),
+            prim: w as u32,
+        })
+        .collect()
+}
+
+/// The `conform` record.
+#[derive(Debug, Serialize)]
+struct Summary {
+    passed: bool,
+    backend: String,
+    conform_scheme: String,
+    cases: u32,
+    seed: u64,
+    cases_run: u32,
+    shrink_steps: Option<u32>,
+    property: Option<String>,
+    message: Option<String>,
+    triangles: Option<usize>,
+    fragments: Option<usize>,
+    saved: Option<String>,
+    replay: Option<Vec<String>>,
+}
+
+/// One differing pixel of the counterexample, both lists.
+#[derive(Debug, Serialize)]
+struct PixelRecord {
+    pixel: usize,
+    x: u32,
+    y: u32,
+    reference: Vec<Entry>,
+    candidate: Vec<Entry>,
+}
+
+/// Runs `conform`; returns whether every case passed.
+///
+/// # Errors
+/// An unknown scheme, a command that cannot run, files that cannot be written.
+pub fn conform(args: &ConformArgs) -> Result<bool, String> {
+    let scheme = SchemeName::from_name(&args.scheme).ok_or_else(|| {
+        let names: Vec<&str> = fragsim_capture::catalog::CATALOG
+            .iter()
+            .map(|e| e.name)
+            .collect();
+        format!(
+            "unknown scheme {}: one of {}",
+            args.scheme,
+            names.join(", ")
+        )
+    })?;
+    if !args.backend.contains("{out}") {
+        return Err(format!(
+            "--backend `{}` has no {{out}}: the command must be told where to write its dump",
+            args.backend
+        ));
+    }
+    let params = Params {
+        scheme,
+        k: args.k,
+        capacity: args.capacity,
+    };
+    let work = args.save.join("work");
+    std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
+    let backend = CommandBackend {
+        template: args.backend.clone(),
+        timeout: Duration::from_secs_f64(args.timeout),
+        work: work.clone(),
+    };
+    let battery = Battery::new(&backend, params)
+        .cases(args.cases)
+        .seed(args.seed)
+        .limits(Limits {
+            max_side: args.max_side,
+            max_triangles: args.max_triangles as usize,
+        });
+    let bar = crate::progress::bar(u64::from(args.cases), "conform");
+    let result = battery.run_with(&mut |event| match event {
+        Event::Case(n) => bar.set_position(u64::from(n)),
+        Event::Shrink(n) => bar.set_message(format!("failed; shrinking (step {n})")),
+    });
+    bar.finish_and_clear();
+    // The cases' files are scratch; the saved case is written afresh below.
+    let _ = std::fs::remove_dir_all(&work);
+    let mut summary = Summary {
+        passed: true,
+        backend: args.backend.clone(),
+        conform_scheme: scheme.name().to_string(),
+        cases: args.cases,
+        seed: args.seed,
+        cases_run: args.cases,
+        shrink_steps: None,
+        property: None,
+        message: None,
+        triangles: None,
+        fragments: None,
+        saved: None,
+        replay: None,
+    };
+    let found = match result {
+        Ok(_) => {
+            let spec = SceneAndCamera::named("generated", 0.0, 0.0);
+            let context = sized(
+                Context::new("conform", &spec, args.max_side, args.max_side),
+                &params,
+            );
+            if args.json {
+                record::emit("conform", &context, &summary)?;
+            } else {
+                outln!(
+                    "conform: {} passes {} cases of {} (k {}, capacity {}, seed {}): equal to the \
+                     oracle, order-independent, overflow as predicted",
+                    args.backend,
+                    args.cases,
+                    scheme.name(),
+                    args.k,
+                    args.capacity,
+                    args.seed
+                );
+            }
+            return Ok(true);
+        }
+        Err(Failure::Refused(message)) => return Err(message),
+        Err(Failure::Counterexample(found)) => found,
+    };
+    let saved = args.save.join("case");
+    let replay = save(&backend, &found, &params, &saved)?;
+    let spec = Case::scene_and_camera(
+        &saved.join("scene").join("mesh.obj").display().to_string(),
+        mesh_hash(found.submitted.obj().as_bytes()),
+    );
+    let viewport = found.submitted.viewport;
+    let context = sized(
+        Context::new("conform", &spec, viewport.width, viewport.height),
+        &params,
+    );
+    summary = Summary {
+        passed: false,
+        cases_run: found.cases_run,
+        shrink_steps: Some(found.shrink_steps),
+        property: Some(found.property.to_string()),
+        message: Some(found.message.clone()),
+        triangles: Some(found.submitted.triangles.len()),
+        fragments: Some(found.fragments),
+        saved: Some(saved.display().to_string()),
+        replay: Some(replay.clone()),
+        ..summary
+    };
+    let pixels: Vec<PixelRecord> = found
+        .mismatches()
+        .iter()
+        .map(|m| pixel_record(m, viewport.width))
+        .collect();
+    let mut lines = vec![record::line("conform", &context, &summary)?];
+    for p in &pixels {
+        lines.push(record::line("counterexample_pixel", &context, p)?);
+    }
+    let report = saved.join("conform.jsonl");
+    std::fs::write(&report, lines.join("\n") + "\n")
+        .map_err(|e| format!("cannot write {}: {e}", report.display()))?;
+    if args.json {
+        for line in &lines {
+            outln!("{line}");
+        }
+    } else {
+        print_counterexample(args, &found, &pixels, &saved, &replay);
+    }
+    Ok(false)
+}
+
+/// The context with the run's K and capacity.
+fn sized(mut context: Context, params: &Params) -> Context {
+    context.k = Some(Slots::Fixed(params.k));
+    context.capacity = Some(Slots::Fixed(params.capacity));
+    context
+}
+
+fn pixel_record(m: &PixelMismatch, width: u32) -> PixelRecord {
+    PixelRecord {
+        pixel: m.pixel,
+        x: m.pixel as u32 % width,
+        y: m.pixel as u32 / width,
+        reference: entries(&m.expected),
+        candidate: entries(&m.got),
+    }
+}
+
+/// Runs the backend once more on the shrunk case inside `dir` (`dir/scene`, `dir/out`), and
+/// writes `dir/replay.sh`; returns the replay's command lines.
+fn save(
+    backend: &CommandBackend,
+    found: &Counterexample,
+    params: &Params,
+    dir: &Path,
+) -> Result<Vec<String>, String> {
+    let case = &found.submitted;
+    let scene = case.scene();
+    let view = scene
+        .view_under(case.viewport, &Case::camera(), Conventions::REFERENCE)
+        .map_err(|e| e.to_string())?;
+    let input = Input {
+        case,
+        view: &view,
+        params,
+    };
+    // The dump may be missing when the failure is the backend's own (a crash, a timeout):
+    // the scene files are saved all the same.
+    let rerun = backend.run_in(&input, dir);
+    let absolute = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let replay = vec![
+        backend.command_line(&absolute.join("scene"), &absolute.join("out"), params),
+        format!(
+            "fragsim compare oracle '{}'",
+            absolute.join("out").display()
+        ),
+    ];
+    let mut script =
+        String::from("#!/bin/sh\n# Replays fragsim conform's smallest failing case.\n");
+    if let Err(e) = rerun {
+        script.push_str(&format!("# On saving, the backend failed again: {e}\n"));
+    }
+    for line in &replay {
+        script.push_str(line);
+        script.push('\n');
+    }
+    let path = dir.join("replay.sh");
+    std::fs::write(&path, script).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    Ok(replay)
+}
+
+fn print_counterexample(
+    args: &ConformArgs,
+    found: &Counterexample,
+    pixels: &[PixelRecord],
+    saved: &Path,
+    replay: &[String],
+) {
+    let case = &found.submitted;
+    outln!(
+        "conform: {} FAILS `{}` on case {} of {} (seed {}), shrunk in {} steps to:",
+        args.backend,
+        found.property,
+        found.cases_run,
+        args.cases,
+        args.seed,
+        found.shrink_steps
+    );
+    outln!("  {}", found.message);
+    outln!(
+        "  viewport {}x{}, {} triangles, {} fragments (corners in half pixels, y down: (1, 1) is \
+         pixel (0, 0)'s centre):",
+        case.viewport.width,
+        case.viewport.height,
+        case.triangles.len(),
+        found.fragments
+    );
+    for (prim, t) in case.triangles.iter().enumerate() {
+        let corners: Vec<String> = t
+            .corners
+            .iter()
+            .zip(t.depths)
+            .map(|(c, z)| format!("({}, {}, z {z})", c[0], c[1]))
+            .collect();
+        outln!("    prim {prim}: {}", corners.join(" "));
+    }
+    for p in pixels {
+        outln!("  pixel ({}, {}):", p.x, p.y);
+        let show = |list: &[Entry]| {
+            list.iter()
+                .map(|e| format!("{} (prim {}, depth {})", e.key, e.prim, e.depth))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        outln!("    oracle:  [{}]", show(&p.reference));
+        outln!("    backend: [{}]", show(&p.candidate));
+    }
+    outln!(
+        "  saved in {} (scene/, out/, conform.jsonl); replay:",
+        saved.display()
+    );
+    for line in replay {
+        outln!("    {line}");
+    }
+}

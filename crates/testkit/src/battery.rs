@@ -1,0 +1,465 @@
+//! The conformance battery: for a [`Backend`] and the guarantee it claims, the properties the
+//! claim implies, checked on generated [`Case`]s, and on a failure the case shrunk by proptest
+//! to its smallest scene, viewport and schedule.
+//!
+//! The properties, on every case:
+//! - **equal**: the backend's output is equal to the oracle under the scheme's promise (the K
+//!   nearest, every fragment but the predicted overflow), judged by [`crate::judge`] (what
+//!   `fragsim compare oracle DUMP` says); the case's ties (coplanar triangles at equal depths)
+//!   are judged by the canonical order, the primitive id, and its extremes (depths 0 and 1,
+//!   near- and far-plane crossers, guard-band clipping, 1×1 viewports) are in the generator;
+//! - **order-independent**: the same triangles submitted in another order ([`Case::permuted`])
+//!   are equal to that submission's oracle too;
+//! - **overflow**: the overflow the backend's counters claim is exactly what the oracle predicts
+//!   for its capacity (`Σ max(0, n − capacity)`);
+//! - **runs**: the backend returns an output at all (no crash, no timeout, a readable dump).
+//!
+//! Guarantee: a claim that owes exactness ([`Guarantee::owes_exactness`] on the backend's
+//! executor) owes all four. A claim that owes nothing there is refused, as is one judged with
+//! equal depths merged ([`Guarantee::ExactDistinctDepths`]): the battery judges canonical ties.
+//! Source: the suite's properties (`tests/suite/properties/`) and `fragsim compare`.
+
+use std::cell::{Cell, RefCell};
+use std::fmt;
+
+use fragsim_capture::Guarantee;
+use fragsim_oracle::compare::{verdict, Comparison};
+use fragsim_oracle::{Oracle, PixelMismatch};
+use fragsim_raster::Conventions;
+use proptest::strategy::Strategy;
+use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner};
+
+use crate::backend::{Backend, BackendError, Input, Params};
+use crate::case::{case, Case, Limits};
+use crate::judge::judge;
+
+/// A property of the battery.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Property {
+    /// The backend returned an output.
+    Runs,
+    /// Equal to the oracle under the scheme's promise.
+    Equal,
+    /// Equal under another submission order.
+    OrderIndependent,
+    /// The claimed overflow is the predicted one.
+    Overflow,
+}
+
+impl fmt::Display for Property {
+    /// The spelling in reports and JSON: `runs`, `equal`, `order-independent`, `overflow`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Property::Runs => "runs",
+            Property::Equal => "equal",
+            Property::OrderIndependent => "order-independent",
+            Property::Overflow => "overflow",
+        })
+    }
+}
+
+/// A failing case, as the battery found it on the shrunk case.
+#[derive(Clone, Debug)]
+pub struct Counterexample {
+    /// The shrunk case.
+    pub case: Case,
+    /// The case as it was submitted when it failed: `case` itself, or its other order.
+    pub submitted: Case,
+    /// The property broken.
+    pub property: Property,
+    /// What went wrong, in one line.
+    pub message: String,
+    /// The verdict, where the backend's output could be judged.
+    pub comparison: Option<Comparison>,
+    /// The oracle's fragments in the submitted case.
+    pub fragments: usize,
+    /// The cases checked before the failure (the failing one included).
+    pub cases_run: u32,
+    /// The simplifications proptest tried while shrinking.
+    pub shrink_steps: u32,
+}
+
+impl Counterexample {
+    /// The first differing pixels, both lists (the oracle's, the backend's).
+    #[must_use]
+    pub fn mismatches(&self) -> &[PixelMismatch] {
+        self.comparison
+            .as_ref()
+            .map_or(&[], |c| c.diff.first_mismatches.as_slice())
+    }
+}
+
+/// Why a battery did not pass.
+#[derive(Clone, Debug)]
+pub enum Failure {
+    /// Nothing was checked: the claim owes nothing on the backend, the battery cannot judge it,
+    /// or the backend cannot run at all ([`BackendError::Setup`]).
+    Refused(String),
+    /// A case broke a property.
+    Counterexample(Box<Counterexample>),
+}
+
+/// A battery that passed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Passed {
+    /// Cases checked.
+    pub cases: u32,
+    /// The claim checked.
+    pub claim: Guarantee,
+}
+
+/// What the battery is doing, for a progress display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Event {
+    /// Case `n` (from 1) of the run is being checked.
+    Case(u32),
+    /// A failure is being shrunk: simplification `n` (from 1).
+    Shrink(u32),
+}
+
+/// The battery for one backend and scheme.
+pub struct Battery<'b> {
+    backend: &'b dyn Backend,
+    params: Params,
+    claim: Option<Guarantee>,
+    limits: Limits,
+    cases: u32,
+    seed: u64,
+    max_shrink_iters: u32,
+}
+
+/// Why a case stopped the battery.
+enum Stop {
+    /// The backend cannot run at all.
+    Setup(String),
+    /// A property broke (boxed: a verdict is large, and `Stop` is every check's error).
+    Found(Box<Found>),
+}
+
+/// A property broken by one case, before shrinking ends.
+struct Found {
+    submitted: Case,
+    property: Property,
+    message: String,
+    comparison: Option<Comparison>,
+    fragments: usize,
+}
+
+impl<'b> Battery<'b> {
+    /// The battery for `backend` running `params`: 64 cases of [`Limits::default`], seed 0, the
+    /// claim the backend states ([`Backend::guarantee`]).
+    #[must_use]
+    pub fn new(backend: &'b dyn Backend, params: Params) -> Self {
+        Self {
+            backend,
+            params,
+            claim: None,
+            limits: Limits::default(),
+            cases: 64,
+            seed: 0,
+            max_shrink_iters: 2048,
+        }
+    }
+
+    /// Checks `claim` instead of the backend's own (e.g. a k-buffer port that claims exactness).
+    #[must_use]
+    pub fn claiming(mut self, claim: Guarantee) -> Self {
+        self.claim = Some(claim);
+        self
+    }
+
+    /// Checks `cases` cases.
+    #[must_use]
+    pub fn cases(mut self, cases: u32) -> Self {
+        self.cases = cases.max(1);
+        self
+    }
+
+    /// Generates from `seed` (the same seed, the same cases and the same shrinking).
+    #[must_use]
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Generates cases within `limits`.
+    #[must_use]
+    pub fn limits(mut self, limits: Limits) -> Self {
+        self.limits = limits;
+        self
+    }
+
+    /// Runs the battery.
+    ///
+    /// # Errors
+    /// The claim is refused, or a shrunk counterexample.
+    pub fn run(&self) -> Result<Passed, Failure> {
+        self.run_with(&mut |_| {})
+    }
+
+    /// [`Battery::run`], calling `on_event` before each case and each shrinking step.
+    ///
+    /// # Errors
+    /// As [`Battery::run`].
+    pub fn run_with(&self, on_event: &mut dyn FnMut(Event)) -> Result<Passed, Failure> {
+        let claim = match self.claim {
+            Some(claim) => claim,
+            None => self
+                .backend
+                .guarantee(&self.params)
+                .map_err(Failure::Refused)?,
+        };
+        if claim.merges_equal_depths() {
+            return Err(Failure::Refused(format!(
+                "{claim} is judged with equal depths merged; the battery judges ties by primitive id"
+            )));
+        }
+        if !claim.owes_exactness(self.backend.serialises_pixels()) {
+            return Err(Failure::Refused(format!(
+                "{claim} owes no exact capture on {}: nothing to check",
+                self.backend.name()
+            )));
+        }
+        let mut seed = [0u8; 32];
+        seed[..8].copy_from_slice(&self.seed.to_le_bytes());
+        let config = Config {
+            cases: self.cases,
+            failure_persistence: None,
+            max_shrink_iters: self.max_shrink_iters,
+            max_shrink_time: 120_000,
+            ..Config::default()
+        };
+        let mut runner =
+            TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
+        let events = RefCell::new(on_event);
+        let (cases_run, shrink_steps) = (Cell::new(0u32), Cell::new(0u32));
+        let last_found = RefCell::new(None);
+        let setup = RefCell::new(None);
+        let result = runner.run(&case(self.limits).boxed(), |case| {
+            // A backend that cannot run fails every case alike: stop at once, shrink nothing.
+            if setup.borrow().is_some() {
+                return Ok(());
+            }
+            if last_found.borrow().is_none() {
+                cases_run.set(cases_run.get() + 1);
+                (events.borrow_mut())(Event::Case(cases_run.get()));
+            } else {
+                shrink_steps.set(shrink_steps.get() + 1);
+                (events.borrow_mut())(Event::Shrink(shrink_steps.get()));
+            }
+            match self.check(&case) {
+                Ok(()) => Ok(()),
+                Err(Stop::Setup(message)) => {
+                    *setup.borrow_mut() = Some(message.clone());
+                    Err(TestCaseError::fail(message))
+                }
+                Err(Stop::Found(found)) => {
+                    let message = format!("{}: {}", found.property, found.message);
+                    *last_found.borrow_mut() = Some(*found);
+                    Err(TestCaseError::fail(message))
+                }
+            }
+        });
+        if let Some(message) = setup.into_inner() {
+            return Err(Failure::Refused(message));
+        }
+        match result {
+            Ok(()) => Ok(Passed {
+                cases: self.cases,
+                claim,
+            }),
+            Err(TestError::Fail(reason, case)) => {
+                // The last case that failed is the shrunk one: proptest keeps each failing
+                // simplification and reports the last.
+                let found = last_found.into_inner().unwrap_or_else(|| Found {
+                    submitted: case.clone(),
+                    property: Property::Runs,
+                    message: reason.to_string(),
+                    comparison: None,
+                    fragments: 0,
+                });
+                let mut steps = shrink_steps.get();
+                let (case, found) = self.crop(case, found, &mut steps, &mut *events.into_inner());
+                shrink_steps.set(steps);
+                Err(Failure::Counterexample(Box::new(Counterexample {
+                    case,
+                    submitted: found.submitted,
+                    property: found.property,
+                    message: found.message,
+                    comparison: found.comparison,
+                    fragments: found.fragments,
+                    cases_run: cases_run.get(),
+                    shrink_steps: shrink_steps.get(),
+                })))
+            }
+            Err(TestError::Abort(reason)) => Err(Failure::Refused(reason.to_string())),
+        }
+    }
+
+    /// Shrinks a failing case further where proptest's shrinking stops: proptest moves one
+    /// value at a time towards zero, so a failure at pixel (2, 1) keeps a 3×2 viewport; here the
+    /// case is cut to the window around its differing pixels (one pixel, their bounding box, a
+    /// half of the viewport), each under its own schedule and the first few seeds, and its
+    /// triangles are dropped one by one, as long as it still fails.
+    fn crop(
+        &self,
+        mut case: Case,
+        mut found: Found,
+        steps: &mut u32,
+        on_event: &mut dyn FnMut(Event),
+    ) -> (Case, Found) {
+        loop {
+            let mut smaller = None;
+            for candidate in candidates(&case, &found) {
+                *steps += 1;
+                on_event(Event::Shrink(*steps));
+                if let Err(Stop::Found(f)) = self.check(&candidate) {
+                    smaller = Some((candidate, *f));
+                    break;
+                }
+            }
+            match smaller {
+                Some((c, f)) => (case, found) = (c, f),
+                None => return (case, found),
+            }
+        }
+    }
+
+    /// Every property on `case`: as generated, then in its other submission order.
+    fn check(&self, case: &Case) -> Result<(), Stop> {
+        self.check_submitted(case, Property::Equal)?;
+        let permuted = case.permuted();
+        if permuted.triangles != case.triangles {
+            self.check_submitted(&permuted, Property::OrderIndependent)?;
+        }
+        Ok(())
+    }
+
+    /// The backend's output on `submitted` against its oracle; a difference breaks `property`.
+    fn check_submitted(&self, submitted: &Case, property: Property) -> Result<(), Stop> {
+        let scene = submitted.scene();
+        let found = |property, message: String, comparison, fragments| {
+            Stop::Found(Box::new(Found {
+                submitted: submitted.clone(),
+                property,
+                message,
+                comparison,
+                fragments,
+            }))
+        };
+        let view = scene
+            .view_under(submitted.viewport, &Case::camera(), Conventions::REFERENCE)
+            .map_err(|e| found(Property::Runs, e.to_string(), None, 0))?;
+        let oracle = Oracle::build(&view);
+        let fragments = oracle.fragments();
+        let input = Input {
+            case: submitted,
+            view: &view,
+            params: &self.params,
+        };
+        let output = self.backend.capture(&input).map_err(|e| match e {
+            BackendError::Setup(message) => Stop::Setup(message),
+            BackendError::Failed(message) => found(Property::Runs, message, None, fragments),
+        })?;
+        let comparison = judge(&view, &oracle, &output)
+            .map_err(|e| found(Property::Runs, e, None, fragments))?;
+        if comparison.claimed_overflow != comparison.diff.overflowed {
+            let message = format!(
+                "the counters claim {} fragments overflowed, the oracle predicts {}",
+                comparison.claimed_overflow, comparison.diff.overflowed
+            );
+            return Err(found(
+                Property::Overflow,
+                message,
+                Some(comparison),
+                fragments,
+            ));
+        }
+        if !comparison.is_equal() {
+            let message = describe(&comparison, fragments);
+            return Err(found(property, message, Some(comparison), fragments));
+        }
+        Ok(())
+    }
+}
+
+/// Smaller cases to try after `case` failed with `found`, most promising first: fewer pixels
+/// (crops around the differing pixels, under the case's schedule and seeds 0 to 3), then fewer
+/// triangles.
+fn candidates(case: &Case, found: &Found) -> Vec<Case> {
+    let viewport = case.viewport;
+    let (w, h) = (viewport.width, viewport.height);
+    let differing: Vec<(u32, u32)> = found.comparison.as_ref().map_or(Vec::new(), |c| {
+        c.verdicts
+            .iter()
+            .enumerate()
+            .filter(|(_, &v)| v & verdict::DIFFERS != 0)
+            .map(|(p, _)| (p as u32 % w, p as u32 / w))
+            .collect()
+    });
+    let mut windows: Vec<(u32, u32, u32, u32)> = differing
+        .iter()
+        .take(4)
+        .map(|&(x, y)| (x, y, 1, 1))
+        .collect();
+    if let (Some(x0), Some(y0)) = (
+        differing.iter().map(|p| p.0).min(),
+        differing.iter().map(|p| p.1).min(),
+    ) {
+        let x1 = differing.iter().map(|p| p.0).max().unwrap_or(x0);
+        let y1 = differing.iter().map(|p| p.1).max().unwrap_or(y0);
+        windows.push((x0, y0, x1 - x0 + 1, y1 - y0 + 1));
+    }
+    let (hw, hh) = (w.div_ceil(2), h.div_ceil(2));
+    windows.extend([
+        (0, 0, hw, h),
+        (w - hw, 0, hw, h),
+        (0, 0, w, hh),
+        (0, h - hh, w, hh),
+    ]);
+    let mut out = Vec::new();
+    for (x, y, cw, ch) in windows {
+        if u64::from(cw) * u64::from(ch) >= u64::from(w) * u64::from(h) {
+            continue;
+        }
+        let Some(cropped) = case.cropped(x, y, cw, ch) else {
+            continue;
+        };
+        let seeds = [case.schedule.seed, 0, 1, 2, 3];
+        for (i, &seed) in seeds.iter().enumerate() {
+            if i > 0 && seed == case.schedule.seed {
+                continue;
+            }
+            let mut c = cropped.clone();
+            c.schedule.seed = seed;
+            out.push(c);
+        }
+    }
+    if case.triangles.len() > 1 {
+        out.extend((0..case.triangles.len()).map(|i| case.without(i)));
+    }
+    out
+}
+
+/// One line on a differing verdict: pixels per verdict.
+fn describe(comparison: &Comparison, fragments: usize) -> String {
+    let mut per_verdict = [0u64; verdict::NAMES.len()];
+    for &flags in &comparison.verdicts {
+        for (i, (flag, _)) in verdict::NAMES.iter().enumerate() {
+            per_verdict[i] += u64::from(flags & flag != 0);
+        }
+    }
+    let named: Vec<String> = verdict::NAMES
+        .iter()
+        .zip(per_verdict)
+        .filter(|&((flag, _), n)| n > 0 && flag & verdict::DIFFERS != 0)
+        .map(|((_, name), n)| format!("{n} {name}"))
+        .collect();
+    format!(
+        "{} of {} pixels differ from the oracle ({}; {} fragments in the case)",
+        comparison.diff.mismatched_pixels,
+        comparison.verdicts.len(),
+        named.join(", "),
+        fragments
+    )
+}

@@ -1,0 +1,245 @@
+//! A conformance case: a tiny triangle soup drawn straight in window coordinates (the identity
+//! view-projection), a viewport, a submission order and a schedule, and its proptest strategy
+//! ([`case`]).
+//!
+//! Guarantee: a case's corners lie on the half-pixel grid (pixel centres and pixel edges), so a
+//! case makes the rasterizer's hard decisions often: edges exactly through pixel centres (the
+//! top-left rule), triangles sharing edges and vertices, coplanar triangles at equal depths (the
+//! tie policy), depths exactly 0 and 1, triangles crossing the near plane (`z < 0`) and the far
+//! one, and a few corners far beyond the guard band. The snapped corners are exact: a corner at
+//! `h` half pixels is `h / width − 1` in normalised device coordinates, which f32 holds to far
+//! below the 1/256-pixel snapping grid at these viewport sizes, so snapping gives back `128 · h`.
+//!
+//! Source: the rules of `docs/semantics.md` §1–6 (what is hard for a scan and a depth
+//! interpolation) and the case shapes the proptest suite's regressions were found with.
+
+use fragsim_capture::executors::scheduled::Schedule;
+use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
+use fragsim_raster::{Camera, Mesh, Scene, VertexPrecision, Viewport};
+use proptest::collection::vec;
+use proptest::prelude::*;
+use proptest::sample::select;
+
+use crate::strategies::schedule;
+
+/// The identity matrix, row major: model x and y are normalised device coordinates, z the depth.
+const IDENTITY: [f64; 16] = [
+    1.0, 0.0, 0.0, 0.0, //
+    0.0, 1.0, 0.0, 0.0, //
+    0.0, 0.0, 1.0, 0.0, //
+    0.0, 0.0, 0.0, 1.0,
+];
+
+/// A corner far beyond the guard band (16,384 pixels), in half pixels: its triangle is clipped.
+const FAR_OUT: i32 = 100_000;
+
+/// One triangle of a case.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CaseTriangle {
+    /// The corners in half pixels of the window, y down: `(1, 1)` is pixel (0, 0)'s centre,
+    /// `(2, 2)` the corner it shares with pixel (1, 1).
+    pub corners: [[i32; 2]; 3],
+    /// Each corner's depth (`z`; the view-projection is the identity, so `z` is the window
+    /// depth): in `[0, 1]`, or outside it to cross the near or the far plane.
+    pub depths: [f32; 3],
+}
+
+/// A conformance case: what a backend is given to capture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// The viewport.
+    pub viewport: Viewport,
+    /// The triangles, in submission order (primitive `i` is `triangles[i]`).
+    pub triangles: Vec<CaseTriangle>,
+    /// Sort keys of the other submission order the battery checks ([`Case::permuted`]).
+    pub order_keys: Vec<u8>,
+    /// The interleaving, for backends that take one (fragsim's scheduled executor).
+    pub schedule: Schedule,
+}
+
+/// How large cases may be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// The largest viewport side, in pixels (at least 1).
+    pub max_side: u32,
+    /// The most triangles a case holds (at least 1).
+    pub max_triangles: usize,
+}
+
+impl Default for Limits {
+    /// Viewports up to 8×8, up to 6 triangles: enough to overlap several fragments a pixel, small
+    /// enough that a failing case reads at a glance.
+    fn default() -> Self {
+        Self {
+            max_side: 8,
+            max_triangles: 6,
+        }
+    }
+}
+
+impl Case {
+    /// The case's mesh: three vertices of its own per triangle, in submission order.
+    #[must_use]
+    pub fn mesh(&self) -> Mesh {
+        let (w, h) = (
+            f64::from(self.viewport.width),
+            f64::from(self.viewport.height),
+        );
+        let mut positions = Vec::with_capacity(3 * self.triangles.len());
+        for t in &self.triangles {
+            for (corner, &z) in t.corners.iter().zip(&t.depths) {
+                // Window X = (x + 1) / 2 · width in half pixels is h_x: x = h_x / width − 1.
+                let x = f64::from(corner[0]) / w - 1.0;
+                let y = 1.0 - f64::from(corner[1]) / h;
+                positions.push([x as f32, y as f32, z]);
+            }
+        }
+        let triangles = (0..self.triangles.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        Mesh {
+            positions,
+            triangles,
+        }
+    }
+
+    /// The case as a scene (named `case`).
+    #[must_use]
+    pub fn scene(&self) -> Scene {
+        Scene {
+            name: "case".into(),
+            mesh: self.mesh(),
+        }
+    }
+
+    /// The camera every case is seen through: the identity view-projection.
+    #[must_use]
+    pub fn camera() -> Camera {
+        Camera::from_row_major(IDENTITY)
+    }
+
+    /// The scene object of a dump header for this case's mesh stored at `mesh` (an OBJ file)
+    /// whose bytes hash to `mesh_hash`: the identity matrix in f64, the reference conventions.
+    #[must_use]
+    pub fn scene_and_camera(mesh: &str, mesh_hash: String) -> SceneAndCamera {
+        SceneAndCamera {
+            mesh_hash: Some(mesh_hash),
+            view_projection: Some(ViewProjection {
+                row_major: IDENTITY,
+                precision: VertexPrecision::F64,
+            }),
+            ..SceneAndCamera::mesh(std::path::Path::new(mesh), 0.0, 0.0)
+        }
+    }
+
+    /// The same triangles submitted in another order: sorted by their order keys (ties keep
+    /// submission order). Primitive ids follow the new order.
+    #[must_use]
+    pub fn permuted(&self) -> Case {
+        let mut order: Vec<usize> = (0..self.triangles.len()).collect();
+        order.sort_by_key(|&i| self.order_keys.get(i).copied().unwrap_or(0));
+        Case {
+            triangles: order.iter().map(|&i| self.triangles[i]).collect(),
+            ..self.clone()
+        }
+    }
+
+    /// The window rectangle of `width` × `height` pixels from pixel `(x, y)` as a case of its
+    /// own: the viewport shrunk, every corner moved by whole pixels, so each pixel of the
+    /// rectangle keeps its fragments (coverage and depth move with the grid).
+    #[must_use]
+    pub fn cropped(&self, x: u32, y: u32, width: u32, height: u32) -> Option<Case> {
+        let viewport = Viewport::new(width, height).ok()?;
+        let (dx, dy) = (2 * i32::try_from(x).ok()?, 2 * i32::try_from(y).ok()?);
+        let triangles = self
+            .triangles
+            .iter()
+            .map(|t| CaseTriangle {
+                corners: t.corners.map(|[cx, cy]| [cx - dx, cy - dy]),
+                ..*t
+            })
+            .collect();
+        Some(Case {
+            viewport,
+            triangles,
+            ..self.clone()
+        })
+    }
+
+    /// The case without triangle `index` (and its order key).
+    #[must_use]
+    pub fn without(&self, index: usize) -> Case {
+        let mut case = self.clone();
+        case.triangles.remove(index);
+        if index < case.order_keys.len() {
+            case.order_keys.remove(index);
+        }
+        case
+    }
+
+    /// The mesh as OBJ text: every coordinate printed as the shortest decimal that reads back to
+    /// the same f32, so a backend (and `compare`) loading the file sees the case's very mesh.
+    #[must_use]
+    pub fn obj(&self) -> String {
+        let mesh = self.mesh();
+        let mut text = String::from("# a fragsim conformance case (identity view-projection)\n");
+        for [x, y, z] in &mesh.positions {
+            text.push_str(&format!("v {x} {y} {z}\n"));
+        }
+        for [a, b, c] in &mesh.triangles {
+            text.push_str(&format!("f {} {} {}\n", a + 1, b + 1, c + 1));
+        }
+        text
+    }
+}
+
+/// A corner coordinate in half pixels: on the grid from just outside the viewport's top-left
+/// corner to just past its largest side, or (rarely) far beyond the guard band. Shrinks towards 0,
+/// the viewport's top-left corner.
+fn coordinate(max_side: u32) -> impl Strategy<Value = i32> {
+    let side = i32::try_from(max_side).unwrap_or(i32::MAX / 4);
+    prop_oneof![
+        24 => -2..=2 * side + 2,
+        1 => select(vec![-FAR_OUT, FAR_OUT]),
+    ]
+}
+
+/// A corner depth: one of a few exact values (so that coplanar triangles tie and depths 0 and 1
+/// occur), any value in `[0, 1]`, or beyond the near or far plane. Shrinks towards 0.
+fn depth() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        3 => select(vec![0.0f32, 0.25, 0.5, 0.75, 1.0]),
+        2 => 0.0f32..=1.0,
+        1 => select(vec![-0.5f32, 1.5]),
+    ]
+}
+
+/// A [`CaseTriangle`]. Shrinks towards a degenerate triangle at the top-left corner.
+fn triangle(max_side: u32) -> impl Strategy<Value = CaseTriangle> {
+    let corner = || [coordinate(max_side), coordinate(max_side)];
+    ([corner(), corner(), corner()], [depth(), depth(), depth()])
+        .prop_map(|(corners, depths)| CaseTriangle { corners, depths })
+}
+
+/// A [`Case`] within `limits`: a viewport of sides 1 to `max_side`, 1 to `max_triangles`
+/// triangles, another submission order, a [`schedule`]. Shrinks towards fewer triangles, a
+/// 1×1 viewport, corners at the top-left, depth 0, submission order, and the schedule's own
+/// simplest.
+///
+/// # Panics
+/// (When sampled) if `limits.max_side` is 0 or above [`Viewport::MAX_SIDE`].
+pub fn case(limits: Limits) -> impl Strategy<Value = Case> {
+    let max_triangles = limits.max_triangles.max(1);
+    (
+        (1..=limits.max_side, 1..=limits.max_side),
+        vec(triangle(limits.max_side), 1..=max_triangles),
+        vec(any::<u8>(), max_triangles),
+        schedule(),
+    )
+        .prop_map(|((w, h), triangles, order_keys, schedule)| Case {
+            viewport: Viewport::new(w, h).expect("valid viewport side"),
+            triangles,
+            order_keys,
+            schedule,
+        })
+}

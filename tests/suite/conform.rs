@@ -1,0 +1,103 @@
+//! `fragsim conform` against the Python backend of `crates/testkit/python/backend.py` (issue
+//! 21): the correct backend passes, and each of its three planted bugs (a scan missing pixel
+//! centres exactly on a top edge, an A-buffer dropping the 3rd fragment of a pixel, an MDTS walk
+//! stopping one slot early) is found within 200 cases and shrunk to at most 3 triangles and 4×4
+//! pixels, with the smallest case saved and its replay written.
+//!
+//! Each run launches Python once a case and submission order. The correct backend's test is
+//! cheap (24 cases). The planted bugs are found in the first 7 cases of seed 0, but proptest's
+//! shrinking then re-runs the backend until its 120 s limit (measured 2 min 4 s to 2 min 16 s
+//! per bug on this 2-core machine under load, 2026-12-02): that test is ignored in CI's default
+//! run, `cargo test --release --test suite conform:: -- --ignored` runs it.
+
+use std::path::PathBuf;
+
+use assert_cmd::Command;
+
+/// The Python backend's command line, with `extra` arguments.
+fn python(extra: &str) -> String {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("crates/testkit/python/backend.py");
+    format!("python3 '{}' {{scene}} {{out}} {extra}", script.display())
+}
+
+/// `fragsim conform --json` with `backend` on `scheme`; the exit code and the records.
+fn conform(name: &str, backend: &str, scheme: &str, cases: u32) -> (i32, Vec<serde_json::Value>) {
+    let save = std::env::temp_dir().join(format!("fragsim-conform-{name}-{}", std::process::id()));
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args([
+            "conform",
+            "--json",
+            "--scheme",
+            scheme,
+            "--backend",
+            backend,
+        ])
+        .args(["--cases", &cases.to_string(), "--seed", "0"])
+        .arg("--save")
+        .arg(&save)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{name}: {stderr}");
+    let records = crate::support::json_lines(&output.stdout);
+    let code = output.status.code().unwrap_or(-1);
+    if code == 1 {
+        let saved = PathBuf::from(records[0]["saved"].as_str().unwrap());
+        for file in [
+            "scene/scene.tri",
+            "scene/mesh.obj",
+            "scene/camera.json",
+            "replay.sh",
+        ] {
+            assert!(
+                saved.join(file).is_file(),
+                "{name}: no {file} in {}",
+                saved.display()
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&save);
+    (code, records)
+}
+
+#[test]
+fn the_correct_python_backend_passes() {
+    for scheme in ["mdts", "abuffer"] {
+        let (code, records) = conform("correct", &python(""), scheme, 12);
+        assert_eq!(code, 0, "{scheme}: {records:?}");
+        assert_eq!(records[0]["record"], "conform");
+        assert_eq!(records[0]["passed"], true);
+    }
+}
+
+#[test]
+#[ignore = "about 2 minutes per bug: shrinking re-runs the Python backend until proptest's limit"]
+fn each_planted_bug_is_found_and_shrunk_to_three_triangles_and_four_by_four_pixels() {
+    for (bug, scheme) in [
+        ("top-edge", "mdts"),
+        ("third-fragment", "abuffer"),
+        ("early-break", "mdts"),
+    ] {
+        let (code, records) = conform(bug, &python(&format!("--bug {bug}")), scheme, 200);
+        assert_eq!(code, 1, "{bug}: {records:?}");
+        let summary = &records[0];
+        assert_eq!(summary["passed"], false, "{bug}");
+        assert!(
+            summary["cases_run"].as_u64().unwrap() <= 200,
+            "{bug}: {summary}"
+        );
+        assert!(
+            summary["triangles"].as_u64().unwrap() <= 3,
+            "{bug}: {summary}"
+        );
+        let (w, h) = (
+            summary["width"].as_u64().unwrap(),
+            summary["height"].as_u64().unwrap(),
+        );
+        assert!(w <= 4 && h <= 4, "{bug}: {w}x{h}");
+        // The failing pixels with both lists follow (a crash would have none).
+        assert!(records.len() > 1, "{bug}: {records:?}");
+        assert_eq!(records[1]["record"], "counterexample_pixel");
+    }
+}
