@@ -260,3 +260,50 @@ fn with_f64_vertex_precision_the_verdict_is_todays_bit_for_bit() {
         );
     });
 }
+
+#[test]
+fn a_keep_first_list_may_keep_any_arrivals_but_not_lose_more() {
+    with_bunny(|view, oracle| {
+        let precision = Precision::derive(view, &F32);
+        let lists = engine_like(view);
+        let p = (0..lists.len())
+            .find(|&p| {
+                let possible = precision.pixel(p);
+                lists[p].len() >= 3
+                    && possible.iter().all(|q| q.certain)
+                    && possible.len() == lists[p].len()
+            })
+            .expect("a decided pixel of depth complexity 3 or more");
+        // A list that keeps the first `c` arrivals, `c` one less than the pixel's fragments: the
+        // GPU's arrival order kept the farthest ones, not the reference's submission order.
+        let c = lists[p].len() - 1;
+        let kept: Vec<Vec<u64>> = lists
+            .iter()
+            .map(|list| list[list.len().saturating_sub(c)..].to_vec())
+            .collect();
+        let keep_first = |lists: &[Vec<u64>]| {
+            let keeps = Keeps::All {
+                capacity: Capacity::PerPixelUncounted(c as u32),
+                overflow: vec![0; lists.len()],
+            };
+            let mut capture = Capture::with_pixels(lists.len(), Identity::KeyAndPrim, keeps);
+            for list in lists {
+                capture.push_pixel(list.iter().copied());
+            }
+            compare_within(&precision, oracle, &capture, None, &options())
+        };
+        let judged = keep_first(&kept);
+        assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+        assert_eq!(
+            judged.verdicts[p] & verdict::OVERFLOWED,
+            verdict::OVERFLOWED
+        );
+        assert_eq!(judged.diff.lost, 0);
+        // One more fragment gone than the capacity allows is missing, whichever arrived first.
+        let mut planted = kept.clone();
+        planted[p].remove(0);
+        let bugged = keep_first(&planted);
+        assert_eq!(bugged.verdicts[p] & verdict::MISSING, verdict::MISSING);
+        assert_eq!(bugged.diff.lost, 1);
+    });
+}

@@ -4,15 +4,17 @@
 //!
 //! Guarantee: for an implementation whose vertex stage computes in f32 (`VertexPrecision::F32`)
 //! and which otherwise follows `docs/semantics.md` (snapping to the declared subpixel grid with
-//! any round-to-nearest, the top-left rule, depth planes evaluated in f32), every fragment it
-//! emits at a pixel is one of the [`Possible`] entries listed for that pixel, with its depth key
-//! inside that entry's interval; every entry marked `certain` is emitted. With f64 vertex precision
-//! the contract is bit-exactness and the analysis is empty ([`Precision::is_exact`]). Source: the
+//! any round-to-nearest, the window origin's fill rule, depth planes evaluated in f32), every
+//! fragment it emits at a pixel is one of the [`Possible`] entries listed for that pixel, with its
+//! depth key inside that entry's interval; every entry marked `certain` is emitted. Coverage is
+//! enumerated over the snapped triangles its vertices may reach, so it is exact. With f64 vertex
+//! precision the contract is bit-exactness and the analysis is empty ([`Precision::is_exact`]).
+//! Source: the
 //! derivation in `docs/semantics.md`, "Precision of a conforming implementation" (standard
 //! floating-point error analysis, Higham's `γ_n`; the Vulkan CTS rasterization verifier's
 //! "definitely / maybe covered" classification).
 
-use fragsim_raster::conventions::{DepthRange, VertexPrecision};
+use fragsim_raster::conventions::{DepthRange, VertexPrecision, WindowOrigin};
 use fragsim_raster::{depth_key, Conventions, View, Viewport, SUBPIXEL_BITS};
 use serde::Serialize;
 
@@ -22,6 +24,10 @@ const U32: f64 = 1.0 / 16_777_216.0;
 const U64: f64 = f64::EPSILON / 2.0;
 /// The depth key of 1.0, the largest a fragment carries.
 const KEY_ONE: u32 = 0x3F80_0000;
+/// The most snapped triangles (combinations of the vertices' reachable grid points) whose
+/// coverage is enumerated: two points per axis and vertex, `2^6`. Past it the bilinear edge
+/// bound decides (sound, looser).
+const MAX_COMBINATIONS: usize = 64;
 
 /// `γ_n = n·u / (1 − n·u)`: the relative error bound of `n` rounded operations.
 fn gamma(n: f64, u: f64) -> f64 {
@@ -66,6 +72,9 @@ pub struct Bounds {
     /// Triangles the reference clips (near plane or guard band): not analysed, their fragments
     /// taken as ambiguous with any depth.
     pub unanalysed_triangles: u64,
+    /// Triangles whose vertices may reach more than 64 combinations of snapped positions: their
+    /// coverage judged by the bilinear edge bound over the radius instead of by enumeration.
+    pub bounded_triangles: u64,
 }
 
 /// The per-pixel possibilities of a view under an implementation's conventions.
@@ -77,11 +86,17 @@ pub struct Precision {
     bounds: Bounds,
 }
 
-/// A vertex's error bounds: the snapped-position radius (subpixels) and the window-depth error.
+/// A vertex's error bounds: the snapped positions it may reach, their radius (subpixels) and the
+/// window-depth error.
 #[derive(Clone, Copy, Debug)]
 struct VertexBound {
     snapped: [i64; 2],
     depth: f64,
+    /// Per axis, the first and last grid point (subpixels) any round-to-nearest of the vertex's
+    /// f32 window position may give; every grid point between them, `step` apart, is reachable.
+    reach: [[i64; 2]; 2],
+    /// The grid's spacing in subpixels (`2^(8 − subpixel bits)`).
+    step: i64,
     /// Subpixels from `snapped` to any snapped position an implementation may reach.
     radius: i64,
     /// Subpixels from `snapped` to any position, snapped or not, the implementation's depth plane
@@ -113,7 +128,10 @@ impl Precision {
             let tri = view.mesh().triangles[prim as usize].map(|i| vertices[i as usize]);
             match tri {
                 [Some(a), Some(b), Some(c)] => {
-                    triangle(view.viewport(), prim, [a, b, c], &mut found);
+                    let origin = conventions.window_origin;
+                    if !triangle(view.viewport(), origin, prim, [a, b, c], &mut found) {
+                        bounds.bounded_triangles += 1;
+                    }
                 }
                 _ => {
                     bounds.unanalysed_triangles += 1;
@@ -202,10 +220,14 @@ fn vertex_bound(
     let m = view.view_projection().to_cols_array();
     let p = view.mesh().positions[index as usize];
     let v = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0];
-    // |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_5 Σ |M_rj||v_j|: four products and three sums (γ_4) on a
-    // matrix itself rounded to f32 (one more u).
-    let transform_error =
-        |row: usize| gamma_both(5.0) * (0..4).map(|c| (m[c * 4 + row] * v[c]).abs()).sum::<f64>();
+    // |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_4 Σ |M_rj||v_j| (four products and three sums in any
+    // order, an FMA only smaller), on a matrix rounded to f32 (one more u) unless every entry is
+    // an f32 already (an engine's matrix recorded at the precision it used: rounding is exact).
+    let rounded = u8::from(m.iter().any(|&e| f64::from(e as f32) != e));
+    let transform_error = |row: usize| {
+        gamma_both(4.0 + f64::from(rounded))
+            * (0..4).map(|c| (m[c * 4 + row] * v[c]).abs()).sum::<f64>()
+    };
     let [ex, ey, ez, ew] = [0, 1, 2, 3].map(transform_error);
     let w = clip.w;
     if w.abs() <= ew {
@@ -223,11 +245,12 @@ fn vertex_bound(
         ndc_error(clip.y, ey),
         ndc_error(clip.z, ez),
     );
-    // X = (ndc·½ + ½)·width: the error scaled by width/2, and three more roundings.
+    // X = (ndc·½ + ½)·width, or the spec's (width/2)·ndc + width/2: the error scaled by
+    // width/2, and two more roundings (the halving is exact).
     let viewport = view.viewport();
     let window_error = |n: f64, e: f64, side: u32| {
         let side = f64::from(side);
-        side / 2.0 * e + gamma_both(3.0) * ((n.abs() + e) / 2.0 + 0.5) * side
+        side / 2.0 * e + gamma_both(2.0) * ((n.abs() + e) / 2.0 + 0.5) * side
     };
     let error_x = window_error(nx, enx, viewport.width);
     let error_y = window_error(ny, eny, viewport.height);
@@ -241,12 +264,13 @@ fn vertex_bound(
     let grid = 1i64 << (SUBPIXEL_BITS - conventions.subpixel_bits.min(SUBPIXEL_BITS));
     let mut radius = 0;
     let mut unsnapped = 0.0f64;
+    let mut reach = [[0; 2]; 2];
     for (axis, error) in [error_x, error_y].into_iter().enumerate() {
-        let step = (1u64 << conventions.subpixel_bits.min(SUBPIXEL_BITS)) as f64;
-        // Any round-to-nearest of a value in [X − e, X + e] lies in these grid points.
-        let lo = ((exact[axis] - error) * step - 0.5).ceil() as i64 * grid;
-        let hi = ((exact[axis] + error) * step + 0.5).floor() as i64 * grid;
+        let [lo, hi] = snap_reach(exact[axis], error, conventions.subpixel_bits);
         radius = radius.max(snapped[axis] - lo).max(hi - snapped[axis]);
+        // The reference's own snap is one of them (it rounds the centre of the interval); the
+        // bound keeps it so even where the f64 ends above round the other way.
+        reach[axis] = [lo.min(snapped[axis]), hi.max(snapped[axis])];
         // The unsnapped position lies in [X − e, X + e]: at most this far from `snapped`.
         let one = f64::from(1u32 << SUBPIXEL_BITS);
         unsnapped = unsnapped.max((snapped[axis] as f64 - exact[axis] * one).abs() + error * one);
@@ -258,10 +282,25 @@ fn vertex_bound(
     Some(VertexBound {
         snapped,
         depth,
+        reach,
+        step: grid,
         radius,
         plane_radius: radius.max(unsnapped.ceil() as i64),
         depth_error,
     })
+}
+
+/// The first and last grid point, in subpixels, that any round-to-nearest (any tie rule) of a
+/// value in `[x − e, x + e]` (pixels) may give on a grid of `bits` subpixel bits:
+/// `[⌈(x − e)·2^b − ½⌉, ⌊(x + e)·2^b + ½⌋]` grid steps (`docs/semantics.md` §10, step 4). A value
+/// that may reach a half step gives both neighbours, one whose interval holds none gives one.
+fn snap_reach(x: f64, error: f64, bits: u32) -> [i64; 2] {
+    let bits = bits.min(SUBPIXEL_BITS);
+    let (scale, grid) = (f64::from(1u32 << bits), 1i64 << (SUBPIXEL_BITS - bits));
+    [
+        ((x - error) * scale - 0.5).ceil() as i64 * grid,
+        ((x + error) * scale + 0.5).floor() as i64 * grid,
+    ]
 }
 
 /// The doubled signed area of `(a, b, p)` (the pipeline's edge function).
@@ -280,10 +319,17 @@ fn edge_bound(p0: [i64; 2], q: [i64; 2], p: [i64; 2], r0: i64, rq: i64, rp: i64)
     (a + c) * s + (b + d) * alpha + 2 * alpha * s
 }
 
-/// The pipeline's top-left rule for an edge of a positively oriented triangle.
-fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
+/// The pipeline's fill rule for an edge of a positively oriented triangle in fragsim's y-down
+/// rows (`scan.rs`): top-left under an upper-left window origin; under a lower-left one the
+/// window's top edge is fragsim's bottom edge, so a horizontal edge with the interior above.
+fn owns(origin: WindowOrigin, a: [i64; 2], b: [i64; 2]) -> bool {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    dy < 0 || (dy == 0 && dx > 0)
+    dy < 0
+        || (dy == 0
+            && match origin {
+                WindowOrigin::UpperLeft => dx > 0,
+                WindowOrigin::LowerLeft => dx < 0,
+            })
 }
 
 /// The largest f32 not above `x`, and the smallest not below.
@@ -412,14 +458,61 @@ fn origin_form_error(
     )
 }
 
+/// Every snapped triangle an implementation may rasterize for `v`: each vertex at any grid
+/// point it may reach; `None` when there are more than [`MAX_COMBINATIONS`].
+fn combinations(v: &[VertexBound; 3]) -> Option<Vec<[[i64; 2]; 3]>> {
+    let count = |b: &VertexBound, axis: usize| {
+        usize::try_from((b.reach[axis][1] - b.reach[axis][0]) / b.step + 1).unwrap_or(usize::MAX)
+    };
+    let total = v.iter().try_fold(1usize, |n, b| {
+        n.checked_mul(count(b, 0))?.checked_mul(count(b, 1))
+    });
+    if total.is_none_or(|n| n > MAX_COMBINATIONS) {
+        return None;
+    }
+    let points = |b: &VertexBound| -> Vec<[i64; 2]> {
+        let axis = |k: usize| (0..count(b, k) as i64).map(move |i| b.reach[k][0] + i * b.step);
+        axis(0).flat_map(|x| axis(1).map(move |y| [x, y])).collect()
+    };
+    let [a, b, c] = v.map(|x| points(&x));
+    let mut all = Vec::with_capacity(a.len() * b.len() * c.len());
+    for &pa in &a {
+        for &pb in &b {
+            all.extend(c.iter().map(|&pc| [pa, pb, pc]));
+        }
+    }
+    Some(all)
+}
+
+/// Whether the pipeline covers centre `p` with the snapped triangle `xy` (`scan.rs`: the
+/// triangle oriented positively, a degenerate one covering nothing, each edge under the fill
+/// rule of `origin`).
+fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
+    let [a, mut b, mut c] = xy;
+    let area = edge(a, b, c);
+    if area == 0 {
+        return false;
+    }
+    if area < 0 {
+        std::mem::swap(&mut b, &mut c);
+    }
+    [(b, c), (c, a), (a, b)].into_iter().all(|(i, j)| {
+        let e = edge(i, j, p);
+        e > 0 || (e == 0 && owns(origin, i, j))
+    })
+}
+
 /// Lists, for every pixel centre within the grown bounding box of an unclipped triangle, what an
-/// implementation may emit there.
+/// implementation may emit there: coverage enumerated over every snapped triangle the vertices
+/// may reach (step 5 of `docs/semantics.md` §10), or past [`MAX_COMBINATIONS`] decided by the
+/// bilinear edge bound over their radius. Returns whether it enumerated.
 fn triangle(
     viewport: Viewport,
+    origin: WindowOrigin,
     prim: u32,
     verts: [VertexBound; 3],
     found: &mut Vec<(u32, Possible)>,
-) {
+) -> bool {
     let [a, mut b, mut c] = verts;
     let mut area = edge(a.snapped, b.snapped, c.snapped);
     if area < 0 {
@@ -427,6 +520,7 @@ fn triangle(
         area = -area;
     }
     let v = [a, b, c];
+    let reachable = combinations(&v);
     let area_bound = edge_bound(
         b.snapped, c.snapped, a.snapped, b.radius, c.radius, a.radius,
     );
@@ -448,21 +542,32 @@ fn triangle(
         for x in x0..=x1 {
             let p = [x * one + half, y * one + half];
             let e = edges.map(|(i, j)| edge(v[i].snapped, v[j].snapped, p));
-            let eb = edges.map(|(i, j)| {
-                edge_bound(v[i].snapped, v[j].snapped, p, v[i].radius, v[j].radius, 0)
-            });
-            let top_left = edges.map(|(i, j)| is_top_left(v[i].snapped, v[j].snapped));
-            let passes = |k: usize| e[k] > 0 || (e[k] == 0 && top_left[k]);
+            let passes = |k: usize| {
+                let (i, j) = edges[k];
+                e[k] > 0 || (e[k] == 0 && owns(origin, v[i].snapped, v[j].snapped))
+            };
             let covered = area > 0 && (0..3).all(passes);
-            let decided = |k: usize| eb[k] == 0 || e[k].abs() > eb[k];
-            let (certain, possible) = if area_stable {
-                let out = (0..3).any(|k| decided(k) && !passes(k));
-                ((0..3).all(|k| decided(k) && passes(k)), !out)
-            } else {
-                // The orientation itself may flip: either side's coverage may be emitted.
-                let pos = (0..3).all(|k| e[k] >= -eb[k]);
-                let neg = (0..3).all(|k| e[k] <= eb[k]);
-                (false, pos || neg)
+            let (certain, possible) = match &reachable {
+                // The reference's own triangle is one of them: `certain` implies `covered`.
+                Some(all) => {
+                    let split = all.iter().any(|&xy| covers(origin, xy, p) != covered);
+                    (covered && !split, covered || split)
+                }
+                None => {
+                    let eb = edges.map(|(i, j)| {
+                        edge_bound(v[i].snapped, v[j].snapped, p, v[i].radius, v[j].radius, 0)
+                    });
+                    let decided = |k: usize| eb[k] == 0 || e[k].abs() > eb[k];
+                    if area_stable {
+                        let out = (0..3).any(|k| decided(k) && !passes(k));
+                        ((0..3).all(|k| decided(k) && passes(k)), !out)
+                    } else {
+                        // The orientation itself may flip: either side's coverage may be emitted.
+                        let pos = (0..3).all(|k| e[k] >= -eb[k]);
+                        let neg = (0..3).all(|k| e[k] <= eb[k]);
+                        (false, pos || neg)
+                    }
+                }
             };
             if !possible && !covered {
                 continue;
@@ -485,6 +590,7 @@ fn triangle(
             ));
         }
     }
+    reachable.is_some()
 }
 
 #[cfg(test)]

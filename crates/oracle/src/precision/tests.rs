@@ -26,7 +26,10 @@ fn rasterize(viewport: Viewport, xy: [[i64; 2]; 3], z: [f64; 3]) -> Vec<(u32, f6
             let p = [x * 256 + 128, y * 256 + 128];
             let e = [(1, 2), (2, 0), (0, 1)].map(|(i, j)| {
                 let value = edge(v[i], v[j], p);
-                (value, value > 0 || (value == 0 && is_top_left(v[i], v[j])))
+                (
+                    value,
+                    value > 0 || (value == 0 && owns(WindowOrigin::UpperLeft, v[i], v[j])),
+                )
             });
             if e.iter().all(|&(_, pass)| pass) {
                 let depth = (0..3).map(|k| e[k].0 as f64 * zs[k]).sum::<f64>() / area as f64;
@@ -37,10 +40,13 @@ fn rasterize(viewport: Viewport, xy: [[i64; 2]; 3], z: [f64; 3]) -> Vec<(u32, f6
     out
 }
 
+/// A vertex that may reach every grid point within `radius` of `(x, y)` (1/256-pixel grid).
 fn vertex(x: i64, y: i64, depth: f64, radius: i64, depth_error: f64) -> VertexBound {
     VertexBound {
         snapped: [x, y],
         depth,
+        reach: [[x - radius, x + radius], [y - radius, y + radius]],
+        step: 1,
         radius,
         plane_radius: radius,
         depth_error,
@@ -86,7 +92,13 @@ fn every_reachable_fragment_is_listed_and_certain_pairs_are_always_covered() {
     let (mut certain_seen, mut maybe_seen) = (0, 0);
     for (prim, verts) in cases.into_iter().enumerate() {
         let mut found = Vec::new();
-        triangle(viewport, prim as u32, verts, &mut found);
+        triangle(
+            viewport,
+            WindowOrigin::UpperLeft,
+            prim as u32,
+            verts,
+            &mut found,
+        );
         let listed = |pixel: u32| found.iter().find(|(p, _)| *p == pixel).map(|(_, q)| *q);
         let mut always = vec![true; viewport.pixels()];
         let r = verts.map(|v| v.radius);
@@ -160,7 +172,7 @@ fn a_centre_inside_the_edge_margin_is_ambiguous_and_outside_it_decided() {
             vertex(x + 700, 256, 0.5, 0, 0.0),
         ];
         let mut found = Vec::new();
-        triangle(viewport, 0, verts, &mut found);
+        triangle(viewport, WindowOrigin::UpperLeft, 0, verts, &mut found);
         found
             .iter()
             .find(|(p, _)| *p == 0)
@@ -232,7 +244,7 @@ fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interva
             ..vertex(x, y, z, 0, error)
         });
         let mut found = Vec::new();
-        triangle(viewport, 0, verts, &mut found);
+        triangle(viewport, WindowOrigin::UpperLeft, 0, verts, &mut found);
         found
     };
     let escapes = |found: &[(u32, Possible)]| {
@@ -266,4 +278,120 @@ fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interva
     // Not vacuous: with the snapped radius alone (the bound before) the plane escapes.
     let (_, escaped_before) = escapes(&analysed(0));
     assert!(escaped_before > 0);
+}
+
+#[test]
+fn the_snap_reaches_both_neighbours_only_where_its_interval_reaches_a_half_step() {
+    let px = |subpixels: f64| subpixels / 256.0;
+    // Exactly on a rounding boundary with no error: either tie rule, both neighbours.
+    assert_eq!(snap_reach(px(2560.5), 0.0, 8), [2560, 2561]);
+    // No error, off the boundary: the one point.
+    assert_eq!(snap_reach(px(2560.3), 0.0, 8), [2560, 2560]);
+    // An interval that ends on the boundary reaches it; one just short of it does not.
+    assert_eq!(snap_reach(px(2560.25), px(0.25), 8), [2560, 2561]);
+    assert_eq!(snap_reach(px(2560.25), px(0.25 - 1e-6), 8), [2560, 2560]);
+    // An interval spanning two boundaries: three points.
+    assert_eq!(snap_reach(px(2560.0), px(0.6), 8), [2559, 2561]);
+    // On a 4-bit grid the points are 16 subpixels apart.
+    assert_eq!(snap_reach(px(2568.0), 0.0, 4), [2560, 2576]);
+    assert_eq!(snap_reach(px(2570.0), 0.0, 4), [2576, 2576]);
+}
+
+/// A vertex at `(x, y)` that may also snap `dx`, `dy` subpixels away (0 for one point).
+fn reaching(x: i64, y: i64, depth: f64, dx: i64, dy: i64) -> VertexBound {
+    let axis = |c: i64, d: i64| [c.min(c + d), c.max(c + d)];
+    VertexBound {
+        reach: [axis(x, dx), axis(y, dy)],
+        ..vertex(x, y, depth, dx.abs().max(dy.abs()), 0.0)
+    }
+}
+
+#[test]
+fn enumerated_coverage_is_exactly_that_of_the_reachable_snapped_triangles() {
+    let viewport = Viewport::new(6, 6).unwrap();
+    let cases = [
+        // Edges within a subpixel of pixel centres, every vertex with a second point.
+        [
+            reaching(130, 40, 0.2, -1, 1),
+            reaching(1200, 129, 0.5, 1, -1),
+            reaching(385, 1400, 0.9, 0, 1),
+        ],
+        // A horizontal edge through the centres of row 0 and a vertical one through column 1.
+        [
+            reaching(10, 128, 0.3, 0, 1),
+            reaching(1500, 128, 0.3, 0, -1),
+            reaching(384, 1500, 0.6, 1, 0),
+        ],
+        // A sliver whose orientation flips among its reachable triangles.
+        [
+            reaching(100, 100, 0.5, 0, 1),
+            reaching(900, 101, 0.5, 0, -1),
+            reaching(1500, 102, 0.6, 0, 0),
+        ],
+    ];
+    let (mut split, mut decided) = (0, 0);
+    for origin in [WindowOrigin::UpperLeft, WindowOrigin::LowerLeft] {
+        for (prim, verts) in cases.into_iter().enumerate() {
+            let mut found = Vec::new();
+            assert!(triangle(viewport, origin, prim as u32, verts, &mut found));
+            let all = combinations(&verts).unwrap();
+            assert!(all.len() > 1 && all.len() <= MAX_COMBINATIONS);
+            for y in 0..6 {
+                for x in 0..6 {
+                    let p = [x * 256 + 128, y * 256 + 128];
+                    let hits = all.iter().filter(|&&xy| covers(origin, xy, p)).count();
+                    let pixel = (y * 6 + x) as u32;
+                    let listed = found.iter().find(|(q, _)| *q == pixel).map(|(_, q)| *q);
+                    assert_eq!(listed.is_some(), hits > 0, "case {prim} pixel {pixel}");
+                    if let Some(q) = listed.filter(|q| (q.key_lo, q.key_hi) != (0, KEY_ONE)) {
+                        assert_eq!(q.certain, hits == all.len(), "case {prim} pixel {pixel}");
+                    }
+                    split += usize::from(hits > 0 && hits < all.len());
+                    decided += usize::from(hits == all.len());
+                }
+            }
+        }
+    }
+    // Not vacuous: centres of both kinds.
+    assert!(split > 0 && decided > 0, "{split} {decided}");
+}
+
+#[test]
+fn a_snap_that_moves_away_from_a_centre_leaves_it_decided() {
+    // A vertical edge x = 126 beside the centre of pixel 0 (128, 128), the triangle to its right.
+    // Its vertices may snap one subpixel further left only: the centre stays covered, where the
+    // symmetric radius of 1 (the bound before enumeration) calls it ambiguous.
+    let viewport = Viewport::new(4, 2).unwrap();
+    let pixel0 = |verts: [VertexBound; 3]| {
+        let mut found = Vec::new();
+        triangle(viewport, WindowOrigin::UpperLeft, 0, verts, &mut found);
+        found.iter().find(|(p, _)| *p == 0).map(|(_, q)| q.certain)
+    };
+    let third = reaching(826, 256, 0.5, 0, 0);
+    let enumerated = [
+        reaching(126, 0, 0.5, -1, 0),
+        reaching(126, 512, 0.5, -1, 0),
+        third,
+    ];
+    assert_eq!(pixel0(enumerated), Some(true));
+    let symmetric = [
+        vertex(126, 0, 0.5, 1, 0.0),
+        vertex(126, 512, 0.5, 1, 0.0),
+        third,
+    ];
+    assert_eq!(pixel0(symmetric), Some(false));
+}
+
+#[test]
+fn the_fill_rule_follows_the_window_origin() {
+    // A horizontal edge through the centre (128, 128) with the interior below it in fragsim's
+    // y-down rows: a top edge under an upper-left origin (owned), the window's bottom edge
+    // under a lower-left one (not owned).
+    let xy = [[0, 128], [512, 128], [256, 600]];
+    assert!(covers(WindowOrigin::UpperLeft, xy, [128, 128]));
+    assert!(!covers(WindowOrigin::LowerLeft, xy, [128, 128]));
+    // Mirrored, the interior above: owned under a lower-left origin only.
+    let above = [[0, 128], [512, 128], [256, -400]];
+    assert!(!covers(WindowOrigin::UpperLeft, above, [128, 128]));
+    assert!(covers(WindowOrigin::LowerLeft, above, [128, 128]));
 }
