@@ -63,6 +63,11 @@ pub struct ConformArgs {
     #[arg(long, value_name = "N", default_value_t = 6,
           value_parser = clap::value_parser!(u32).range(1..=64))]
     pub max_triangles: u32,
+    /// The most simplifications proptest tries on a failing case before fragsim's own crop to
+    /// the differing pixels and triangle dropping finish the shrinking (each one runs the
+    /// backend once).
+    #[arg(long, value_name = "N", default_value_t = 2048)]
+    pub shrink_steps: u32,
     /// Where the smallest failing case is saved (`DIR/case/`, replaced), and the cases are run
     /// (`DIR/work/`, removed at the end).
     #[arg(long, value_name = "DIR", default_value = "out/conform")]
@@ -165,6 +170,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
     let battery = Battery::new(&backend, params)
         .cases(args.cases)
         .seed(args.seed)
+        .shrink_steps(args.shrink_steps)
         .limits(Limits {
             max_side: args.max_side,
             max_triangles: args.max_triangles as usize,

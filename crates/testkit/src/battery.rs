@@ -182,6 +182,15 @@ impl<'b> Battery<'b> {
         self
     }
 
+    /// Lets proptest try at most `steps` simplifications of a failing case (2048 by default)
+    /// before the battery's own crop and triangle dropping: a cap for backends that are slow to
+    /// start, since each step runs the backend once.
+    #[must_use]
+    pub fn shrink_steps(mut self, steps: u32) -> Self {
+        self.max_shrink_iters = steps;
+        self
+    }
+
     /// Generates cases within `limits`.
     #[must_use]
     pub fn limits(mut self, limits: Limits) -> Self {

@@ -2,7 +2,7 @@
 //! schemes against the serial oracle on the parallel executor, serial against parallel and tiled, fragment
 //! counts, crack-free coverage of closed meshes and planar tilings, and the depth-key order.
 //!
-//! The strategies live in `tests/suite/support/strategies/` for other suites to reuse. Case counts are
+//! The strategies live in `crates/testkit` (`fragsim_testkit::strategies`) for any suite to reuse. Case counts are
 //! sized so the whole file runs in well under a minute in release on two cores. Failures are not
 //! persisted to disk: a failing case found here is recorded below as an explicit regression test.
 
