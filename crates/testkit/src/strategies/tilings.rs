@@ -206,7 +206,7 @@ fn window_interval(side: u32) -> impl Strategy<Value = (f64, f64)> {
 const JITTER: f64 = 0.12;
 
 /// A jittered grid: `nx × ny` cells (1 to 6 each) over a random rectangle, interior vertices moved
-/// by up to [`JITTER`] of a cell (anywhere, or onto pixel centres or corners when that stays within
+/// by up to `JITTER` (0.12) of a cell (anywhere, or onto pixel centres or corners when that stays within
 /// the bound), boundary vertices moved along their side only, each quad split along a random
 /// diagonal.
 pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
