@@ -19,12 +19,22 @@ rows = {}  # (mesh, executor, scheme) -> {threads: (frame_ms, fps)}
 for path in glob.glob(os.path.join(directory, f"{tag}-*-t*-*.md")):
     match = re.match(rf"{re.escape(tag)}-(.+)-t(\d+)-(\w+)\.md$", os.path.basename(path))
     mesh, threads, executor = match.group(1), int(match.group(2)), match.group(3)
+    # Columns by their header names: bench's table gains columns (it did, and this script then
+    # read the vertex stage's time as the frame's), so no position is assumed.
+    column, width = None, 0
     for line in open(path):
         cells = [c.strip() for c in line.split("|")]
-        if len(cells) > 20 and cells[1] in ("mdts", "mdts-probe", "abuffer"):
-            if cells[9] != "0" or cells[10] != "0":
-                sys.exit(f"{path}: {cells[1]} lost {cells[9]}, mismatched {cells[10]}")
-            rows.setdefault((mesh, executor, cells[1]), {})[threads] = (float(cells[17]), float(cells[20]))
+        if len(cells) > 2 and cells[1] == "scheme":
+            column, width = {name: i for i, name in enumerate(cells)}, len(cells)
+            missing = {"lost", "mismatched px", "frame ms", "fps"} - column.keys()
+            if missing:
+                sys.exit(f"{path}: the bench table has no column {sorted(missing)}")
+        elif column and len(cells) == width and cells[1] in ("mdts", "mdts-probe", "abuffer"):
+            lost, mismatched = cells[column["lost"]], cells[column["mismatched px"]]
+            if lost != "0" or mismatched != "0":
+                sys.exit(f"{path}: {cells[1]} lost {lost}, mismatched {mismatched}")
+            rows.setdefault((mesh, executor, cells[1]), {})[threads] = (
+                float(cells[column["frame ms"]]), float(cells[column["fps"]]))
 
 print("| mesh | executor | scheme | " + " | ".join(f"{t} thr ms (fps, eff.)" for t in (1, 2, 4, 8, 16)) + " |")
 print("|---|---|---|" + "---|" * 5)
