@@ -247,13 +247,19 @@ fn vertex_bound(
     let m = view.view_projection().to_cols_array();
     let p = view.mesh().positions[index as usize];
     let v = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0];
-    // |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_4 Σ |M_rj||v_j| (four products and three sums in any
-    // order, an FMA only smaller), on a matrix rounded to f32 (one more u) unless every entry is
-    // an f32 already (an engine's matrix recorded at the precision it used: rounding is exact).
-    let rounded = u8::from(m.iter().any(|&e| f64::from(e as f32) != e));
+    // An engine's matrix recorded at the precision it used (every entry an f32): the rounding
+    // errors of the actual products and partial sums, in any order ([`dot_error`]). A matrix
+    // rounded to f32 first: |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_5 Σ |M_rj||v_j| (the standard
+    // bound of four products and three sums in any order, one more u for the entries).
+    let rounded = m.iter().any(|&e| f64::from(e as f32) != e);
     let transform_error = |row: usize| {
-        gamma_both(4.0 + f64::from(rounded))
-            * (0..4).map(|c| (m[c * 4 + row] * v[c]).abs()).sum::<f64>()
+        let products = [0, 1, 2, 3].map(|c| m[c * 4 + row] * v[c]);
+        let magnitude = products.iter().map(|x| x.abs()).sum::<f64>();
+        if rounded {
+            gamma_both(5.0) * magnitude
+        } else {
+            dot_error(products) + gamma(4.0, U64) * magnitude
+        }
     };
     let [ex, ey, ez, ew] = [0, 1, 2, 3].map(transform_error);
     let w = clip.w;
@@ -264,7 +270,7 @@ fn vertex_bound(
     let ndc_error = |c: f64, e: f64| {
         let q = c / w;
         let e = (e + q.abs() * ew) / (w.abs() - ew);
-        e + gamma_both(1.0) * (q.abs() + e)
+        e + half_ulp(q.abs() + e) + gamma(1.0, U64) * (q.abs() + e)
     };
     let (nx, ny, nz) = (clip.x / w, clip.y / w, clip.z / w);
     let (enx, eny, enz) = (
@@ -273,11 +279,15 @@ fn vertex_bound(
         ndc_error(clip.z, ez),
     );
     // X = (ndc·½ + ½)·width, or the spec's (width/2)·ndc + width/2: the error scaled by
-    // width/2, and two more roundings (the halving is exact).
+    // width/2, and two more roundings of results no larger than these (the halving is exact).
     let viewport = view.viewport();
     let window_error = |n: f64, e: f64, side: u32| {
         let side = f64::from(side);
-        side / 2.0 * e + gamma_both(2.0) * ((n.abs() + e) / 2.0 + 0.5) * side
+        let shifted = (n.abs() + e) / 2.0 + 0.5;
+        let window = shifted * side * (1.0 + 4.0 * U32);
+        let halves_first = side * half_ulp(shifted) + half_ulp(window);
+        let spec_form = half_ulp(side / 2.0 * (n.abs() + e)) + half_ulp(window);
+        side / 2.0 * e + halves_first.max(spec_form) + gamma(2.0, U64) * shifted * side
     };
     let error_x = window_error(nx, enx, viewport.width);
     let error_y = window_error(ny, eny, viewport.height);
@@ -312,6 +322,49 @@ fn vertex_bound(
         error,
         depth_error,
     })
+}
+
+/// Half an f32 ulp at magnitude `x`: the largest error of rounding to f32 (to nearest) a real no
+/// larger than `x` in magnitude (an ulp only grows with the magnitude); at least the smallest
+/// subnormal's half. The exponent is read from the bits, not from a logarithm.
+fn half_ulp(x: f64) -> f64 {
+    let x = x.abs();
+    if x < f64::from(f32::MIN_POSITIVE) {
+        return f64::from(f32::from_bits(1)) / 2.0;
+    }
+    let exponent = ((x.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    2f64.powi(exponent - 24)
+}
+
+/// A bound on the error of an f32 dot product `Σ p_j` of four exact products `p_j = M_rj·v_j`
+/// (`v_3 = 1`, so `p_3` is exact), evaluated in any order, with or without fused multiply-adds:
+/// every rounding of a result `y` errs by at most `½ulp(y)`, and the errors of a sum tree add.
+/// The three products' roundings (none under an FMA) plus, for the worst of the 15 trees on four
+/// addends, the roundings of its three partial sums, each at most `½ulp` of a bound on it
+/// (`|Σ_S p| + γ_4 Σ_S |p|`). Tighter than `γ_4 Σ |p|` by the cancellation in the partial sums
+/// and by the distance to the next power of two (`docs/semantics.md` §10, step 1).
+fn dot_error(p: [f64; 4]) -> f64 {
+    let products: f64 = p[..3].iter().map(|&x| half_ulp(x)).sum();
+    let sum_bound = |set: u32| {
+        let (sum, magnitude) = (0..4)
+            .filter(|j| set >> j & 1 == 1)
+            .fold((0.0, 0.0), |(s, m), j| (s + p[j], m + p[j].abs()));
+        half_ulp(sum.abs() + gamma(4.0, U32) * magnitude)
+    };
+    let pairs = (0u32..16).filter(|s| s.count_ones() == 2);
+    let worst_tree = pairs
+        .flat_map(|pair| {
+            // A pair, then a triple holding it; or the pair and the other pair.
+            let triples = (0..4)
+                .filter(move |j| pair >> j & 1 == 0)
+                .map(move |j| sum_bound(pair | 1 << j));
+            let other = sum_bound(0b1111 & !pair);
+            triples
+                .chain([other])
+                .map(move |next| sum_bound(pair) + next)
+        })
+        .fold(0.0, f64::max);
+    products + worst_tree + sum_bound(0b1111)
 }
 
 /// The first and last grid point, in subpixels, that any round-to-nearest (any tie rule) of a
