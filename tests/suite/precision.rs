@@ -103,7 +103,7 @@ fn certain_pixel(precision: &Precision, lists: &[Vec<u64>]) -> usize {
         .find(|&p| {
             let possible = precision.pixel(p);
             lists[p].len() >= 2
-                && possible.iter().all(|q| q.certain)
+                && possible.iter().all(|q| q.certain())
                 && possible.len() == lists[p].len()
         })
         .expect("a decided pixel of depth complexity 2 or more")
@@ -270,7 +270,7 @@ fn a_keep_first_list_may_keep_any_arrivals_but_not_lose_more() {
             .find(|&p| {
                 let possible = precision.pixel(p);
                 lists[p].len() >= 3
-                    && possible.iter().all(|q| q.certain)
+                    && possible.iter().all(|q| q.certain())
                     && possible.len() == lists[p].len()
             })
             .expect("a decided pixel of depth complexity 3 or more");

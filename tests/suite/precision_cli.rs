@@ -128,4 +128,27 @@ fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
             > 0
     );
     assert!(report["ambiguous_pixels"].is_u64(), "{json}");
+    // The ambiguous pairs split by cause, and the pixels by cause, in the text and the JSON.
+    assert!(
+        out.contains("ambiguous") && out.contains("by cause: coverage"),
+        "{out}"
+    );
+    let field = |key: &str| {
+        report[key]
+            .as_u64()
+            .unwrap_or_else(|| panic!("{key} in {json}"))
+    };
+    assert_eq!(
+        field("precision_ambiguous_pairs"),
+        field("precision_may_be_present_pairs")
+            + field("precision_coverage_undecided_pairs")
+            + field("precision_depth_undecided_pairs")
+            + field("precision_clipped_pairs"),
+        "{json}"
+    );
+    let by_cause: u64 = ["coverage", "depth", "order", "clipped"]
+        .iter()
+        .map(|c| field(&format!("ambiguous_by_cause_{c}")))
+        .sum();
+    assert!(by_cause >= field("ambiguous_pixels"), "{json}");
 }

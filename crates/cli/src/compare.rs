@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use fragsim_oracle::compare::{
-    compare_with, complete_pixels, verdict, with_identity, CompareOptions, Comparison,
-    VerdictCounts,
+    compare_with, complete_pixels, verdict, with_identity, AmbiguityCounts, CompareOptions,
+    Comparison, VerdictCounts,
 };
 use fragsim_oracle::dump::{CorruptWord, Dump, Header};
 use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
@@ -195,6 +195,9 @@ struct Report {
     /// The bounds derived for an f32 vertex stage (absent when every bit is owed).
     #[serde(skip_serializing_if = "Option::is_none")]
     precision: Option<Bounds>,
+    /// The ambiguous pixels by cause (absent when every bit is owed; a pixel may have several).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ambiguous_by_cause: Option<AmbiguityCounts>,
     pixels: u64,
     /// Pixels with a verdict that is an error (missing, extra, misordered, miscounted, corrupt).
     mismatched_pixels: u64,
@@ -433,6 +436,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             VertexPrecision::F32 => "f32".into(),
         },
         precision: bounds,
+        ambiguous_by_cause: bounds.map(|_| comparison.ambiguity),
         pixels: comparison.verdicts.len() as u64,
         mismatched_pixels: comparison
             .verdicts
@@ -790,19 +794,30 @@ fn print_report(r: &Report) {
         outln!(
             "precision (f32 vertex stage): vertex error up to {:.3} subpixels (snapped radius {}), \
              depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs ({} may be \
-             present), {} clipped triangles not analysed, {} judged by the edge bound",
+             present, {} covered with coverage undecided, {} covered with depth leaving [0, 1], \
+             {} of clipped triangles), {} clipped triangles not analysed, {} judged by the edge \
+             bound",
             b.max_vertex_error_subpixels,
             b.max_snap_radius_subpixels,
             b.max_depth_interval_ulps,
             b.ambiguous_pairs,
             b.may_be_present_pairs,
+            b.coverage_undecided_pairs,
+            b.depth_undecided_pairs,
+            b.clipped_pairs,
             b.unanalysed_triangles,
             b.bounded_triangles
         );
+        let why = r.ambiguous_by_cause.unwrap_or_default();
         outln!(
-            "pixels within precision {}, ambiguous {} (counted, never errors)",
+            "pixels within precision {}, ambiguous {} (counted, never errors; by cause: coverage \
+             {}, depth {}, order {}, clipped {})",
             v.within_precision,
-            v.ambiguous
+            v.ambiguous,
+            why.coverage,
+            why.depth,
+            why.order,
+            why.clipped
         );
     }
     let f = &r.fragments;

@@ -143,9 +143,79 @@ pub struct Comparison {
     pub words_checked: bool,
     /// The corrupt words of the pixels in `diff.first_mismatches`.
     pub first_corrupt: Vec<CorruptWord>,
+    /// Of the [`verdict::AMBIGUOUS`] pixels, how many each cause made so (a pixel may have
+    /// several); all 0 outside a verdict within precision.
+    pub ambiguity: AmbiguityCounts,
+}
+
+/// Ambiguous pixels by what left them undecided (`docs/semantics.md` §10, Verdict).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct AmbiguityCounts {
+    /// A fragment whose coverage is decided inside the margin: present though the reference
+    /// does not cover it, or absent though it does.
+    pub coverage: u64,
+    /// A fragment whose coverage is certain but whose depth interval leaves `[0, 1]` (it may be
+    /// clipped away) and which is absent or matched only by that interval.
+    pub depth: u64,
+    /// A K-nearest (K-farthest) cut among overlapping depth intervals.
+    pub order: u64,
+    /// A fragment of a triangle the reference clips (not analysed).
+    pub clipped: u64,
+}
+
+impl AmbiguityCounts {
+    /// Adds `other`'s counts.
+    pub(crate) fn add(&mut self, other: &Self) {
+        self.coverage += other.coverage;
+        self.depth += other.depth;
+        self.order += other.order;
+        self.clipped += other.clipped;
+    }
 }
 
 impl Comparison {
+    /// An empty comparison of `pixels` pixels, with the totals of `words`.
+    pub(crate) fn new(pixels: usize, words: Option<&WordCheck>) -> Self {
+        Self {
+            diff: Diff::default(),
+            verdicts: Vec::with_capacity(pixels),
+            counts: VerdictCounts::default(),
+            claimed_overflow: 0,
+            corrupt_words: words.map_or(0, WordCheck::corrupt_words),
+            unchecked_words: words.map_or(0, |w| w.unchecked),
+            words_checked: words.is_some(),
+            first_corrupt: Vec::new(),
+            ambiguity: AmbiguityCounts::default(),
+        }
+    }
+
+    /// Records pixel `p`'s verdict `flags` (pixels come in order): counted, and where it
+    /// differs kept as one of the first `examples` (`example` builds it, with the pixel's
+    /// corrupt words from `words`).
+    pub(crate) fn record(
+        &mut self,
+        p: usize,
+        flags: u8,
+        examples: usize,
+        words: Option<&WordCheck>,
+        example: impl FnOnce() -> PixelMismatch,
+    ) {
+        self.counts.add(flags);
+        if flags & verdict::DIFFERS != 0 {
+            self.diff.mismatched_pixels += 1;
+            if self.diff.first_mismatches.len() < examples {
+                self.diff.first_mismatches.push(PixelMismatch {
+                    pixel: p,
+                    ..example()
+                });
+                if let Some(words) = words {
+                    self.first_corrupt.extend_from_slice(&words.corrupt[p]);
+                }
+            }
+        }
+        self.verdicts.push(flags);
+    }
+
     /// Whether every pixel is equal (overflow by design allowed).
     #[must_use]
     pub fn is_equal(&self) -> bool {
@@ -277,17 +347,7 @@ pub fn compare_with(
     if let Some(complete) = options.complete {
         assert_eq!(complete.len(), pixels, "completeness of another viewport");
     }
-    let mut comparison = Comparison {
-        diff: Diff::default(),
-        verdicts: Vec::with_capacity(pixels),
-        counts: VerdictCounts::default(),
-        claimed_overflow: 0,
-        corrupt_words: words.map_or(0, WordCheck::corrupt_words),
-        unchecked_words: words.map_or(0, |w| w.unchecked),
-        words_checked: words.is_some(),
-        first_corrupt: Vec::new(),
-    };
-    let total = &mut comparison.diff;
+    let mut comparison = Comparison::new(pixels, words);
     let mut one_ref = Oracle {
         lists: PixelLists {
             offsets: vec![0, 0],
@@ -373,39 +433,26 @@ pub fn compare_with(
         if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 && knows_n {
             flags |= verdict::MISCOUNTED;
         }
-        comparison.counts.add(flags);
         if !counted {
             // MDTS claims nothing: what lies beyond K is its promise.
             comparison.claimed_overflow += d.overflowed;
         }
+        let total = &mut comparison.diff;
         total.captured += d.captured;
         total.overflowed += d.overflowed;
         total.lost += d.lost;
         total.extra += d.extra;
         total.misordered_pixels += d.misordered_pixels;
-        if flags & verdict::DIFFERS != 0 {
-            total.mismatched_pixels += 1;
-            if total.first_mismatches.len() < options.examples {
-                let example = d.first_mismatches.into_iter().next().unwrap_or_else(|| {
-                    // Equal lists, wrong words: both sides are the list the pixel holds.
-                    PixelMismatch {
-                        pixel: p,
-                        expected: one.entries.clone(),
-                        got: one.entries.clone(),
-                    }
-                });
-                total.first_mismatches.push(PixelMismatch {
+        comparison.record(p, flags, options.examples, words, || {
+            d.first_mismatches.into_iter().next().unwrap_or_else(|| {
+                // Equal lists, wrong words: both sides are the list the pixel holds.
+                PixelMismatch {
                     pixel: p,
-                    ..example
-                });
-                if let Some(words) = words {
-                    comparison
-                        .first_corrupt
-                        .extend_from_slice(&words.corrupt[p]);
+                    expected: one.entries.clone(),
+                    got: one.entries.clone(),
                 }
-            }
-        }
-        comparison.verdicts.push(flags);
+            })
+        });
     }
     comparison
 }

@@ -48,11 +48,31 @@ pub struct Possible {
     pub key_lo: u32,
     /// The largest depth key it may carry.
     pub key_hi: u32,
-    /// Whether every conforming implementation emits it (coverage decided outside the margin and
-    /// its depth interval inside `[0, 1]`).
-    pub certain: bool,
+    /// Why not every conforming implementation emits it; `None`: every one does (coverage
+    /// decided outside the margin and its depth interval inside `[0, 1]`).
+    pub doubt: Option<Doubt>,
     /// The reference's depth key where the reference emits it.
     pub reference: Option<u32>,
+}
+
+impl Possible {
+    /// Whether every conforming implementation emits it.
+    #[must_use]
+    pub fn certain(&self) -> bool {
+        self.doubt.is_none()
+    }
+}
+
+/// What leaves a possible fragment undecided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Doubt {
+    /// Some snapped triangle the vertices may reach covers the pixel centre and another does
+    /// not (or the edge bound cannot decide): present or absent, both conform.
+    Coverage,
+    /// Coverage is certain but the depth interval leaves `[0, 1]`: the fragment may be clipped.
+    Depth,
+    /// The reference clips the triangle (near plane or guard band): not analysed.
+    Clipped,
 }
 
 /// The bounds the analysis derived, as `compare` prints them.
@@ -69,6 +89,13 @@ pub struct Bounds {
     pub ambiguous_pairs: u64,
     /// Of those, pairs the reference does not cover (the implementation may emit them).
     pub may_be_present_pairs: u64,
+    /// Of those, pairs the reference covers whose coverage is decided inside the margin (the
+    /// implementation may not emit them).
+    pub coverage_undecided_pairs: u64,
+    /// Of those, pairs whose coverage is certain but whose depth interval leaves `[0, 1]`.
+    pub depth_undecided_pairs: u64,
+    /// Of those, pairs of triangles the reference clips ([`Bounds::unanalysed_triangles`]).
+    pub clipped_pairs: u64,
     /// Triangles the reference clips (near plane or guard band): not analysed, their fragments
     /// taken as ambiguous with any depth.
     pub unanalysed_triangles: u64,
@@ -99,10 +126,11 @@ struct VertexBound {
     step: i64,
     /// Subpixels from `snapped` to any snapped position an implementation may reach.
     radius: i64,
-    /// Subpixels from `snapped` to any position, snapped or not, the implementation's depth plane
-    /// may pass through: `radius`, or the unsnapped f32 position (an interpolator that sets up
-    /// its plane on the float positions, as llvmpipe's `lp_state_setup.c` does), rounded up.
-    plane_radius: i64,
+    /// The reference's unsnapped window position, in subpixels: an interpolator that sets up its
+    /// plane on the float positions (llvmpipe's `lp_state_setup.c`) uses one within `error`.
+    unsnapped: [f64; 2],
+    /// The window-position error bound before snapping, in subpixels (the larger axis).
+    error: f64,
     depth_error: f64,
 }
 
@@ -129,20 +157,23 @@ impl Precision {
             match tri {
                 [Some(a), Some(b), Some(c)] => {
                     let origin = conventions.window_origin;
-                    if !triangle(view.viewport(), origin, prim, [a, b, c], &mut found) {
+                    let tri = [a, b, c];
+                    if !triangle(view.viewport(), origin, prim, tri, &mut found, &mut bounds) {
                         bounds.bounded_triangles += 1;
                     }
                 }
                 _ => {
                     bounds.unanalysed_triangles += 1;
                     view.rasterize(prim, &mut |f| {
+                        bounds.ambiguous_pairs += 1;
+                        bounds.clipped_pairs += 1;
                         found.push((
                             f.pixel,
                             Possible {
                                 prim,
                                 key_lo: 0,
                                 key_hi: KEY_ONE,
-                                certain: false,
+                                doubt: Some(Doubt::Clipped),
                                 reference: Some(f.depth_key),
                             },
                         ));
@@ -161,10 +192,6 @@ impl Precision {
         }
         let entries: Vec<Possible> = found.into_iter().map(|(_, e)| e).collect();
         for e in &entries {
-            if !e.certain {
-                bounds.ambiguous_pairs += 1;
-                bounds.may_be_present_pairs += u64::from(e.reference.is_none());
-            }
             if e.reference.is_some() {
                 bounds.max_depth_interval_ulps =
                     bounds.max_depth_interval_ulps.max(e.key_hi - e.key_lo);
@@ -220,13 +247,19 @@ fn vertex_bound(
     let m = view.view_projection().to_cols_array();
     let p = view.mesh().positions[index as usize];
     let v = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0];
-    // |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_4 Σ |M_rj||v_j| (four products and three sums in any
-    // order, an FMA only smaller), on a matrix rounded to f32 (one more u) unless every entry is
-    // an f32 already (an engine's matrix recorded at the precision it used: rounding is exact).
-    let rounded = u8::from(m.iter().any(|&e| f64::from(e as f32) != e));
+    // An engine's matrix recorded at the precision it used (every entry an f32): the rounding
+    // errors of the actual products and partial sums, in any order ([`dot_error`]). A matrix
+    // rounded to f32 first: |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_5 Σ |M_rj||v_j| (the standard
+    // bound of four products and three sums in any order, one more u for the entries).
+    let rounded = m.iter().any(|&e| f64::from(e as f32) != e);
     let transform_error = |row: usize| {
-        gamma_both(4.0 + f64::from(rounded))
-            * (0..4).map(|c| (m[c * 4 + row] * v[c]).abs()).sum::<f64>()
+        let products = [0, 1, 2, 3].map(|c| m[c * 4 + row] * v[c]);
+        let magnitude = products.iter().map(|x| x.abs()).sum::<f64>();
+        if rounded {
+            gamma_both(5.0) * magnitude
+        } else {
+            dot_error(products) + gamma(4.0, U64) * magnitude
+        }
     };
     let [ex, ey, ez, ew] = [0, 1, 2, 3].map(transform_error);
     let w = clip.w;
@@ -237,7 +270,7 @@ fn vertex_bound(
     let ndc_error = |c: f64, e: f64| {
         let q = c / w;
         let e = (e + q.abs() * ew) / (w.abs() - ew);
-        e + gamma_both(1.0) * (q.abs() + e)
+        e + half_ulp(q.abs() + e) + gamma(1.0, U64) * (q.abs() + e)
     };
     let (nx, ny, nz) = (clip.x / w, clip.y / w, clip.z / w);
     let (enx, eny, enz) = (
@@ -246,11 +279,15 @@ fn vertex_bound(
         ndc_error(clip.z, ez),
     );
     // X = (ndc·½ + ½)·width, or the spec's (width/2)·ndc + width/2: the error scaled by
-    // width/2, and two more roundings (the halving is exact).
+    // width/2, and two more roundings of results no larger than these (the halving is exact).
     let viewport = view.viewport();
     let window_error = |n: f64, e: f64, side: u32| {
         let side = f64::from(side);
-        side / 2.0 * e + gamma_both(2.0) * ((n.abs() + e) / 2.0 + 0.5) * side
+        let shifted = (n.abs() + e) / 2.0 + 0.5;
+        let window = shifted * side * (1.0 + 4.0 * U32);
+        let halves_first = side * half_ulp(shifted) + half_ulp(window);
+        let spec_form = half_ulp(side / 2.0 * (n.abs() + e)) + half_ulp(window);
+        side / 2.0 * e + halves_first.max(spec_form) + gamma(2.0, U64) * shifted * side
     };
     let error_x = window_error(nx, enx, viewport.width);
     let error_y = window_error(ny, eny, viewport.height);
@@ -262,8 +299,8 @@ fn vertex_bound(
     let (wf, hf) = (f64::from(viewport.width), f64::from(viewport.height));
     let exact = [(nx * 0.5 + 0.5) * wf, (0.5 - ny * 0.5) * hf];
     let grid = 1i64 << (SUBPIXEL_BITS - conventions.subpixel_bits.min(SUBPIXEL_BITS));
+    let one = f64::from(1u32 << SUBPIXEL_BITS);
     let mut radius = 0;
-    let mut unsnapped = 0.0f64;
     let mut reach = [[0; 2]; 2];
     for (axis, error) in [error_x, error_y].into_iter().enumerate() {
         let [lo, hi] = snap_reach(exact[axis], error, conventions.subpixel_bits);
@@ -271,13 +308,9 @@ fn vertex_bound(
         // The reference's own snap is one of them (it rounds the centre of the interval); the
         // bound keeps it so even where the f64 ends above round the other way.
         reach[axis] = [lo.min(snapped[axis]), hi.max(snapped[axis])];
-        // The unsnapped position lies in [X − e, X + e]: at most this far from `snapped`.
-        let one = f64::from(1u32 << SUBPIXEL_BITS);
-        unsnapped = unsnapped.max((snapped[axis] as f64 - exact[axis] * one).abs() + error * one);
-        bounds.max_vertex_error_subpixels = bounds
-            .max_vertex_error_subpixels
-            .max(error * f64::from(1u32 << SUBPIXEL_BITS));
     }
+    let error = error_x.max(error_y) * one;
+    bounds.max_vertex_error_subpixels = bounds.max_vertex_error_subpixels.max(error);
     bounds.max_snap_radius_subpixels = bounds.max_snap_radius_subpixels.max(radius);
     Some(VertexBound {
         snapped,
@@ -285,9 +318,53 @@ fn vertex_bound(
         reach,
         step: grid,
         radius,
-        plane_radius: radius.max(unsnapped.ceil() as i64),
+        unsnapped: exact.map(|c| c * one),
+        error,
         depth_error,
     })
+}
+
+/// Half an f32 ulp at magnitude `x`: the largest error of rounding to f32 (to nearest) a real no
+/// larger than `x` in magnitude (an ulp only grows with the magnitude); at least the smallest
+/// subnormal's half. The exponent is read from the bits, not from a logarithm.
+fn half_ulp(x: f64) -> f64 {
+    let x = x.abs();
+    if x < f64::from(f32::MIN_POSITIVE) {
+        return f64::from(f32::from_bits(1)) / 2.0;
+    }
+    let exponent = ((x.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    2f64.powi(exponent - 24)
+}
+
+/// A bound on the error of an f32 dot product `Σ p_j` of four exact products `p_j = M_rj·v_j`
+/// (`v_3 = 1`, so `p_3` is exact), evaluated in any order, with or without fused multiply-adds:
+/// every rounding of a result `y` errs by at most `½ulp(y)`, and the errors of a sum tree add.
+/// The three products' roundings (none under an FMA) plus, for the worst of the 15 trees on four
+/// addends, the roundings of its three partial sums, each at most `½ulp` of a bound on it
+/// (`|Σ_S p| + γ_4 Σ_S |p|`). Tighter than `γ_4 Σ |p|` by the cancellation in the partial sums
+/// and by the distance to the next power of two (`docs/semantics.md` §10, step 1).
+fn dot_error(p: [f64; 4]) -> f64 {
+    let products: f64 = p[..3].iter().map(|&x| half_ulp(x)).sum();
+    let sum_bound = |set: u32| {
+        let (sum, magnitude) = (0..4)
+            .filter(|j| set >> j & 1 == 1)
+            .fold((0.0, 0.0), |(s, m), j| (s + p[j], m + p[j].abs()));
+        half_ulp(sum.abs() + gamma(4.0, U32) * magnitude)
+    };
+    let pairs = (0u32..16).filter(|s| s.count_ones() == 2);
+    let worst_tree = pairs
+        .flat_map(|pair| {
+            // A pair, then a triple holding it; or the pair and the other pair.
+            let triples = (0..4)
+                .filter(move |j| pair >> j & 1 == 0)
+                .map(move |j| sum_bound(pair | 1 << j));
+            let other = sum_bound(0b1111 & !pair);
+            triples
+                .chain([other])
+                .map(move |next| sum_bound(pair) + next)
+        })
+        .fold(0.0, f64::max);
+    products + worst_tree + sum_bound(0b1111)
 }
 
 /// The first and last grid point, in subpixels, that any round-to-nearest (any tie rule) of a
@@ -308,15 +385,32 @@ fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
     (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
 }
 
+/// The edge function of `(a, b, p)` in f64 for real positions, and a bound on its rounding:
+/// two rounded differences per product, the products, the difference (`γ_3` of `|a·b| + |c·d|`;
+/// 0 in effect for integer positions, whose products f64 holds exactly).
+fn edge_value(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> (f64, f64) {
+    let (first, second) = ((b[0] - a[0]) * (p[1] - a[1]), (b[1] - a[1]) * (p[0] - a[0]));
+    (
+        first - second,
+        gamma(3.0, U64) * (first.abs() + second.abs()),
+    )
+}
+
 /// The largest change of `edge(p0, q, p)` when `p0`, `q` and `p` move by at most `r0`, `rq`, `rp`
 /// in each coordinate: the edge function is bilinear, so with `α = r0 + rq` (the edge vector's
 /// change) and `s = rp + r0` (the offset's change) it is
-/// `|Δ| ≤ (|a| + |c|)·s + (|b| + |d|)·α + 2αs`.
-fn edge_bound(p0: [i64; 2], q: [i64; 2], p: [i64; 2], r0: i64, rq: i64, rp: i64) -> i64 {
+/// `|Δ| ≤ (|a| + |c|)·s + (|b| + |d|)·α + 2αs`. Exact for integer arguments (f64 holds every
+/// product of subpixel coordinates).
+fn edge_bound(p0: [f64; 2], q: [f64; 2], p: [f64; 2], r0: f64, rq: f64, rp: f64) -> f64 {
     let (alpha, s) = (r0 + rq, rp + r0);
     let (a, c) = ((q[0] - p0[0]).abs(), (q[1] - p0[1]).abs());
     let (b, d) = ((p[1] - p0[1]).abs(), (p[0] - p0[0]).abs());
-    (a + c) * s + (b + d) * alpha + 2 * alpha * s
+    (a + c) * s + (b + d) * alpha + 2.0 * alpha * s
+}
+
+/// Integer subpixel coordinates as f64 (exact).
+fn real(p: [i64; 2]) -> [f64; 2] {
+    p.map(|c| c as f64)
 }
 
 /// The pipeline's fill rule for an edge of a positively oriented triangle in fragsim's y-down
@@ -351,47 +445,34 @@ fn round_up(x: f64) -> f32 {
     }
 }
 
-/// The depth keys an implementation may give the fragment of the positively oriented triangle
-/// `v` (doubled area `area`) at pixel centre `p`, where the reference's edge functions are `e`
-/// and its plane value `z`; and whether the whole interval lies in `[0, 1]` (else the fragment
-/// may be dropped). `docs/semantics.md` §10, step 6, derives each term.
+/// A plane a conforming implementation may set up for a triangle: through vertex positions
+/// (subpixels, in the triangle's vertex order) each known to within `radius` per coordinate.
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    at: [[f64; 2]; 3],
+    radius: [f64; 3],
+}
+
+/// The depth keys an implementation may give the fragment of triangle `v` at pixel centre `p`
+/// when its plane is one of `planes`, around the reference's plane value `z`; and whether the
+/// whole interval lies in `[0, 1]` (else the fragment may be dropped). The interval is the hull
+/// of each plane's ([`plane_interval`]), with the reference's value in it; one unbounded plane
+/// leaves it the whole range. `docs/semantics.md` §10, step 6, derives each term.
 fn depth_interval(
     viewport: Viewport,
     v: &[VertexBound; 3],
-    area: i64,
+    planes: &[Plane],
     p: [i64; 2],
-    e: [i64; 3],
     z: f64,
 ) -> (u32, u32, bool) {
-    const UNBOUNDED: (u32, u32, bool) = (0, KEY_ONE, false);
-    let edges = [(1, 2), (2, 0), (0, 1)];
-    // The plane passes through positions within `plane_radius` of the snapped ones.
-    let r = v.map(|x| x.plane_radius);
-    let area_bound = edge_bound(v[1].snapped, v[2].snapped, v[0].snapped, r[1], r[2], r[0]);
-    let area_f = area as f64;
-    let denominator = area_f - area_bound as f64;
-    if denominator <= 0.0 {
-        return UNBOUNDED;
+    let mut hull = (z, z);
+    for plane in planes {
+        match plane_interval(viewport, v, plane, p) {
+            Some((lo, hi)) => hull = (hull.0.min(lo), hull.1.max(hi)),
+            None => return (0, KEY_ONE, false),
+        }
     }
-    let eb = edges.map(|(i, j)| edge_bound(v[i].snapped, v[j].snapped, p, r[i], r[j], 0));
-    let z_lo = v.iter().map(|x| x.depth).fold(f64::INFINITY, f64::min);
-    let z_hi = v.iter().map(|x| x.depth).fold(f64::NEG_INFINITY, f64::max);
-    let (mut moved, mut weights, mut magnitude) = (0.0, 0.0, 0.0);
-    for k in 0..3 {
-        let lambda = e[k] as f64 / area_f;
-        let d = (eb[k] as f64 + lambda.abs() * area_bound as f64) / denominator;
-        moved += d;
-        weights += (lambda.abs() + d) * v[k].depth_error;
-        magnitude += (lambda.abs() + d) * (v[k].depth.abs() + v[k].depth_error);
-    }
-    // Σ Δλ = 0, so the plane moves by Σ Δλ_k (Z_k − mid) ≤ Σ|Δλ| · range / 2; the vertex
-    // depths' own errors add, and the plane's evaluation in f32: barycentric (γ_6 on the
-    // weighted magnitudes) or from the window origin (`origin_form_error`).
-    let Some(origin_form) = origin_form_error(viewport, v, &r, denominator, p) else {
-        return UNBOUNDED;
-    };
-    let delta = moved * (z_hi - z_lo) / 2.0 + weights + gamma_both(6.0) * magnitude + origin_form;
-    let (lo, hi) = (round_down(z - delta), round_up(z + delta));
+    let (lo, hi) = (round_down(hull.0), round_up(hull.1));
     let inside = lo >= 0.0 && hi <= 1.0;
     (
         depth_key(lo.max(0.0)).unwrap_or(0),
@@ -400,10 +481,52 @@ fn depth_interval(
     )
 }
 
+/// The real interval of depths at pixel centre `p` of an implementation whose plane passes
+/// through `plane`'s positions (each moved within its radius) and `v`'s vertex depths (each within
+/// its error), evaluated in f32; `None` when the moved triangle's area may reach 0. With
+/// `λ_k = E_k/A` and `B` the edge bounds over the radii, `|Δλ_k| ≤ (B_k + |λ_k|·B_A)/(A − B_A)`
+/// (`docs/semantics.md` §10, step 6).
+fn plane_interval(
+    viewport: Viewport,
+    v: &[VertexBound; 3],
+    plane: &Plane,
+    p: [i64; 2],
+) -> Option<(f64, f64)> {
+    let (at, r) = (plane.at, plane.radius);
+    let centre = real(p);
+    let (signed, area_rounding) = edge_value(at[1], at[2], at[0]);
+    let area = signed.abs();
+    let area_bound = edge_bound(at[1], at[2], at[0], r[1], r[2], r[0]) + area_rounding;
+    let denominator = area - area_bound;
+    if denominator <= 0.0 {
+        return None;
+    }
+    let edges = [(1, 2), (2, 0), (0, 1)];
+    let (mut z, mut moved, mut weights, mut magnitude) = (0.0, 0.0, 0.0, 0.0);
+    let z_lo = v.iter().map(|x| x.depth).fold(f64::INFINITY, f64::min);
+    let z_hi = v.iter().map(|x| x.depth).fold(f64::NEG_INFINITY, f64::max);
+    for (k, (i, j)) in edges.into_iter().enumerate() {
+        let (e, rounding) = edge_value(at[i], at[j], centre);
+        let lambda = e * signed.signum() / area;
+        let bound = edge_bound(at[i], at[j], centre, r[i], r[j], 0.0) + rounding;
+        let d = (bound + lambda.abs() * area_bound) / denominator;
+        z += lambda * v[k].depth;
+        moved += d;
+        weights += (lambda.abs() + d) * v[k].depth_error;
+        magnitude += (lambda.abs() + d) * (v[k].depth.abs() + v[k].depth_error);
+    }
+    // Σ Δλ = 0, so the plane moves by Σ Δλ_k (Z_k − mid) ≤ Σ|Δλ| · range / 2; the vertex
+    // depths' own errors add, and the plane's evaluation in f32: barycentric (γ_6 on the
+    // weighted magnitudes) or from the window origin (`origin_form_error`).
+    let origin_form = origin_form_error(viewport, v, plane, denominator, centre)?;
+    let delta = moved * (z_hi - z_lo) / 2.0 + weights + gamma_both(6.0) * magnitude + origin_form;
+    Some((z - delta, z + delta))
+}
+
 /// The rounding error of a depth plane set up and evaluated in f32 from the window origin, as
 /// llvmpipe does (`lp_state_setup.c`: `a = a0 + ∂a/∂x·x + ∂a/∂y·y` with
 /// `a0 = a_0 − (∂a/∂x·x_0 + ∂a/∂y·y_0)` and the gradients `(Δa_01·Δy_20 − Δa_20·Δy_01)/A` from f32
-/// differences), for vertices within `r` subpixels of the snapped ones and a doubled area of at
+/// differences), for vertices within `plane`'s radii of its positions and a doubled area of at
 /// least `area_lo`; `None` when the area's own rounding may reach it. With `G` bounds on the
 /// gradients' magnitudes, `κ` the area's condition number, `c = (1 + γ_6)(1 + 2γ_4 κ) − 1` the
 /// gradients' relative error and `X`, `Y` the largest coordinates from any viewport corner:
@@ -412,34 +535,32 @@ fn depth_interval(
 fn origin_form_error(
     viewport: Viewport,
     v: &[VertexBound; 3],
-    r: &[i64; 3],
+    plane: &Plane,
     area_lo: f64,
-    p: [i64; 2],
+    p: [f64; 2],
 ) -> Option<f64> {
+    let (at, r) = (plane.at, plane.radius);
     // Upper bounds on |differences| of the implementation's coordinates (subpixels) and depths.
-    let dxy = |i: usize, j: usize, axis: usize| {
-        ((v[i].snapped[axis] - v[j].snapped[axis]).abs() + r[i] + r[j]) as f64
-    };
+    let dxy = |i: usize, j: usize, axis: usize| (at[i][axis] - at[j][axis]).abs() + r[i] + r[j];
     let dz =
         |i: usize, j: usize| (v[i].depth - v[j].depth).abs() + v[i].depth_error + v[j].depth_error;
     let (dz01, dz20) = (dz(0, 1), dz(2, 0));
     let gradient_x = (dz01 * dxy(2, 0, 1) + dz20 * dxy(0, 1, 1)) / area_lo;
     let gradient_y = (dz01 * dxy(2, 0, 0) + dz20 * dxy(0, 1, 0)) / area_lo;
     let kappa = (dxy(0, 1, 0) * dxy(2, 0, 1) + dxy(2, 0, 0) * dxy(0, 1, 1)) / area_lo;
-    let side = [viewport.width, viewport.height].map(|s| i64::from(s) << SUBPIXEL_BITS);
+    let side = [viewport.width, viewport.height].map(|s| f64::from(s << SUBPIXEL_BITS));
     // The largest coordinate from whichever corner the implementation takes as its origin.
     let far = |axis: usize| {
         let from_corners =
-            |c: i64, slack: i64| (c.abs() + slack).max((side[axis] - c).abs() + slack);
+            |c: f64, slack: f64| (c.abs() + slack).max((side[axis] - c).abs() + slack);
         (0..3)
-            .map(|k| from_corners(v[k].snapped[axis], r[k]))
-            .fold(from_corners(p[axis], 0), i64::max) as f64
+            .map(|k| from_corners(at[k][axis], r[k]))
+            .fold(from_corners(p[axis], 0.0), f64::max)
     };
     let near = |axis: usize| {
         (0..3)
-            .map(|k| (p[axis] - v[k].snapped[axis]).abs() + r[k])
-            .max()
-            .unwrap_or(0) as f64
+            .map(|k| (p[axis] - at[k][axis]).abs() + r[k])
+            .fold(0.0, f64::max)
     };
     let z_max = v
         .iter()
@@ -505,13 +626,16 @@ fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
 /// Lists, for every pixel centre within the grown bounding box of an unclipped triangle, what an
 /// implementation may emit there: coverage enumerated over every snapped triangle the vertices
 /// may reach (step 5 of `docs/semantics.md` §10), or past [`MAX_COMBINATIONS`] decided by the
-/// bilinear edge bound over their radius. Returns whether it enumerated.
+/// bilinear edge bound over their radius; depth over the planes of the snapped triangles that
+/// cover the centre and the plane of the unsnapped positions (step 6). Counts the ambiguous
+/// pairs by cause in `bounds`. Returns whether it enumerated.
 fn triangle(
     viewport: Viewport,
     origin: WindowOrigin,
     prim: u32,
     verts: [VertexBound; 3],
     found: &mut Vec<(u32, Possible)>,
+    bounds: &mut Bounds,
 ) -> bool {
     let [a, mut b, mut c] = verts;
     let mut area = edge(a.snapped, b.snapped, c.snapped);
@@ -521,9 +645,25 @@ fn triangle(
     }
     let v = [a, b, c];
     let reachable = combinations(&v);
+    let radius = v.map(|x| x.radius as f64);
     let area_bound = edge_bound(
-        b.snapped, c.snapped, a.snapped, b.radius, c.radius, a.radius,
+        real(b.snapped),
+        real(c.snapped),
+        real(a.snapped),
+        radius[1],
+        radius[2],
+        radius[0],
     );
+    // An interpolator on the float positions: the plane through the unsnapped ones.
+    let unsnapped = Plane {
+        at: v.map(|x| x.unsnapped),
+        radius: v.map(|x| x.error),
+    };
+    // Past enumeration, every snapped plane within the radius.
+    let snapped_within_radius = Plane {
+        at: v.map(|x| real(x.snapped)),
+        radius,
+    };
     let grow = v.iter().map(|x| x.radius).max().unwrap_or(0);
     let one = 1i64 << SUBPIXEL_BITS;
     let half = one / 2;
@@ -537,7 +677,8 @@ fn triangle(
     let (x0, x1) = span(lo[0], hi[0], viewport.width);
     let (y0, y1) = span(lo[1], hi[1], viewport.height);
     let edges = [(1, 2), (2, 0), (0, 1)];
-    let area_stable = area > area_bound;
+    let area_stable = area as f64 > area_bound;
+    let mut planes = Vec::new();
     for y in y0..=y1 {
         for x in x0..=x1 {
             let p = [x * one + half, y * one + half];
@@ -547,24 +688,45 @@ fn triangle(
                 e[k] > 0 || (e[k] == 0 && owns(origin, v[i].snapped, v[j].snapped))
             };
             let covered = area > 0 && (0..3).all(passes);
+            planes.clear();
+            planes.push(unsnapped);
             let (certain, possible) = match &reachable {
                 // The reference's own triangle is one of them: `certain` implies `covered`.
                 Some(all) => {
-                    let split = all.iter().any(|&xy| covers(origin, xy, p) != covered);
+                    let mut split = false;
+                    for &xy in all {
+                        if covers(origin, xy, p) {
+                            planes.push(Plane {
+                                at: xy.map(real),
+                                radius: [0.0; 3],
+                            });
+                            split |= !covered;
+                        } else {
+                            split |= covered;
+                        }
+                    }
                     (covered && !split, covered || split)
                 }
                 None => {
+                    planes.push(snapped_within_radius);
                     let eb = edges.map(|(i, j)| {
-                        edge_bound(v[i].snapped, v[j].snapped, p, v[i].radius, v[j].radius, 0)
+                        edge_bound(
+                            real(v[i].snapped),
+                            real(v[j].snapped),
+                            real(p),
+                            radius[i],
+                            radius[j],
+                            0.0,
+                        )
                     });
-                    let decided = |k: usize| eb[k] == 0 || e[k].abs() > eb[k];
+                    let decided = |k: usize| eb[k] == 0.0 || e[k].abs() as f64 > eb[k];
                     if area_stable {
                         let out = (0..3).any(|k| decided(k) && !passes(k));
                         ((0..3).all(|k| decided(k) && passes(k)), !out)
                     } else {
                         // The orientation itself may flip: either side's coverage may be emitted.
-                        let pos = (0..3).all(|k| e[k] >= -eb[k]);
-                        let neg = (0..3).all(|k| e[k] <= eb[k]);
+                        let pos = (0..3).all(|k| e[k] as f64 >= -eb[k]);
+                        let neg = (0..3).all(|k| e[k] as f64 <= eb[k]);
                         (false, pos || neg)
                     }
                 }
@@ -577,14 +739,31 @@ fn triangle(
                 (e[0] as f64 * v[0].depth + e[1] as f64 * v[1].depth + e[2] as f64 * v[2].depth)
                     / area_f;
             let reference = if covered { depth_key(z as f32) } else { None };
-            let (key_lo, key_hi, inside) = depth_interval(viewport, &v, area, p, e, z);
+            let (key_lo, key_hi, inside) = depth_interval(viewport, &v, &planes, p, z);
+            let doubt = if !certain {
+                Some(Doubt::Coverage)
+            } else if !inside || reference.is_none() {
+                Some(Doubt::Depth)
+            } else {
+                None
+            };
+            if doubt.is_some() {
+                bounds.ambiguous_pairs += 1;
+                if reference.is_none() && !covered {
+                    bounds.may_be_present_pairs += 1;
+                } else if doubt == Some(Doubt::Coverage) {
+                    bounds.coverage_undecided_pairs += 1;
+                } else {
+                    bounds.depth_undecided_pairs += 1;
+                }
+            }
             found.push((
                 (y * i64::from(viewport.width) + x) as u32,
                 Possible {
                     prim,
                     key_lo,
                     key_hi,
-                    certain: certain && inside && reference.is_some(),
+                    doubt,
                     reference,
                 },
             ));

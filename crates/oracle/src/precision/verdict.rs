@@ -16,13 +16,13 @@ use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{Conventions, Viewport};
 
-use super::{Bounds, Possible, Precision};
+use super::{Bounds, Doubt, Possible, Precision};
 use crate::compare::{
-    compare_with, inferred_counter, verdict, CompareOptions, Comparison, VerdictCounts,
+    compare_with, inferred_counter, verdict, AmbiguityCounts, CompareOptions, Comparison,
 };
 use crate::dump::{Dump, DumpError, WordCheck};
 use crate::scene::SceneAndCamera;
-use crate::{Diff, Oracle, PixelMismatch};
+use crate::{Oracle, PixelMismatch};
 
 /// The reference an f32 vertex stage is judged against: the oracle of `scene` on `viewport`
 /// under its declared conventions but with the exact f64 vertex stage, and the analysis of an
@@ -101,16 +101,7 @@ pub fn compare_within(
             "word check of another viewport"
         );
     }
-    let mut comparison = Comparison {
-        diff: Diff::default(),
-        verdicts: Vec::with_capacity(pixels),
-        counts: VerdictCounts::default(),
-        claimed_overflow: 0,
-        corrupt_words: words.map_or(0, WordCheck::corrupt_words),
-        unchecked_words: words.map_or(0, |w| w.unchecked),
-        words_checked: words.is_some(),
-        first_corrupt: Vec::new(),
-    };
+    let mut comparison = Comparison::new(pixels, words);
     let mut got = Vec::new();
     for p in 0..pixels {
         got.clear();
@@ -131,8 +122,8 @@ pub fn compare_within(
         if words.is_some_and(|w| !w.corrupt[p].is_empty()) {
             flags |= verdict::CORRUPT;
         }
-        comparison.counts.add(flags);
         comparison.claimed_overflow += judged.claimed_overflow;
+        comparison.ambiguity.add(&judged.ambiguity);
         let total = &mut comparison.diff;
         total.captured += got.len() as u64;
         total.overflowed += judged.overflowed;
@@ -140,27 +131,18 @@ pub fn compare_within(
         total.extra += judged.extra;
         total.misordered_pixels += u64::from(flags & verdict::MISORDERED != 0);
         total.overflow_miscounted_pixels += u64::from(flags & verdict::MISCOUNTED != 0);
-        if flags & verdict::DIFFERS != 0 {
-            total.mismatched_pixels += 1;
-            if total.first_mismatches.len() < options.examples {
-                let mask = match candidate.identity {
-                    Identity::KeyAndPrim => u64::MAX,
-                    Identity::KeyOnly => u64::MAX << 32,
-                    Identity::PrimOnly => u64::from(u32::MAX),
-                };
-                total.first_mismatches.push(PixelMismatch {
-                    pixel: p,
-                    expected: reference.pixel(p).iter().map(|e| e & mask).collect(),
-                    got: got.clone(),
-                });
-                if let Some(words) = words {
-                    comparison
-                        .first_corrupt
-                        .extend_from_slice(&words.corrupt[p]);
-                }
+        comparison.record(p, flags, options.examples, words, || {
+            let mask = match candidate.identity {
+                Identity::KeyAndPrim => u64::MAX,
+                Identity::KeyOnly => u64::MAX << 32,
+                Identity::PrimOnly => u64::from(u32::MAX),
+            };
+            PixelMismatch {
+                pixel: p,
+                expected: reference.pixel(p).iter().map(|e| e & mask).collect(),
+                got: got.clone(),
             }
-        }
-        comparison.verdicts.push(flags);
+        });
     }
     comparison
 }
@@ -173,6 +155,21 @@ struct Judged {
     extra: u64,
     overflowed: u64,
     claimed_overflow: u64,
+    /// What made the pixel ambiguous: each cause 0 or 1.
+    ambiguity: AmbiguityCounts,
+}
+
+impl Judged {
+    /// Marks the pixel ambiguous because of `doubt`.
+    fn doubt(&mut self, doubt: Doubt) {
+        self.flags |= verdict::AMBIGUOUS;
+        let cause = match doubt {
+            Doubt::Coverage => &mut self.ambiguity.coverage,
+            Doubt::Depth => &mut self.ambiguity.depth,
+            Doubt::Clipped => &mut self.ambiguity.clipped,
+        };
+        *cause = 1;
+    }
 }
 
 /// Assigns candidate fragments to possibilities: a maximum matching of candidate words to the
@@ -222,11 +219,16 @@ fn assign(
     let mut partner: Vec<Option<usize>> = vec![None; got.len()];
     let mut order: Vec<usize> = (0..possible.len()).collect();
     match keeps {
-        Keeps::Nearest(_) => order.sort_by_key(|&j| (!possible[j].certain, possible[j].key_hi)),
+        Keeps::Nearest(_) => order.sort_by_key(|&j| (!possible[j].certain(), possible[j].key_hi)),
         Keeps::Farthest(_) => {
-            order.sort_by_key(|&j| (!possible[j].certain, std::cmp::Reverse(possible[j].key_lo)));
+            order.sort_by_key(|&j| {
+                (
+                    !possible[j].certain(),
+                    std::cmp::Reverse(possible[j].key_lo),
+                )
+            });
         }
-        Keeps::All { .. } => order.sort_by_key(|&j| !possible[j].certain),
+        Keeps::All { .. } => order.sort_by_key(|&j| !possible[j].certain()),
     }
     for j in order {
         let mut seen = vec![false; got.len()];
@@ -275,8 +277,8 @@ fn judge_pixel(
             Some(j) => {
                 matched[*j] = true;
                 let q = &possible[*j];
-                if !q.certain {
-                    judged.flags |= verdict::AMBIGUOUS;
+                if let Some(doubt) = q.doubt {
+                    judged.doubt(doubt);
                 }
                 let key = (got[i] >> 32) as u32;
                 if identity != Identity::PrimOnly && q.reference != Some(key) {
@@ -285,14 +287,14 @@ fn judge_pixel(
             }
         }
     }
-    // A reference fragment that may be absent and is: the coverage went the other way.
-    let absent_maybe = (0..possible.len())
-        .any(|j| !matched[j] && !possible[j].certain && possible[j].reference.is_some());
-    if absent_maybe {
-        judged.flags |= verdict::AMBIGUOUS;
+    // A reference fragment that may be absent and is: the coverage (or a clip) went the other way.
+    for (q, _) in possible.iter().zip(&matched).filter(|(_, &m)| !m) {
+        if let (Some(doubt), Some(_)) = (q.doubt, q.reference) {
+            judged.doubt(doubt);
+        }
     }
     let absent_certain: Vec<usize> = (0..possible.len())
-        .filter(|&j| !matched[j] && possible[j].certain)
+        .filter(|&j| !matched[j] && possible[j].certain())
         .collect();
     let widened = |q: &Possible| {
         (
@@ -321,7 +323,7 @@ fn judge_pixel(
                     } else {
                         (lo > f_hi, hi >= f_lo)
                     };
-                    surely += usize::from(sure && q.certain);
+                    surely += usize::from(sure && q.certain());
                     maybe += usize::from(could);
                 }
                 if maybe < k {
@@ -330,6 +332,7 @@ fn judge_pixel(
                     judged.overflowed += 1;
                 } else {
                     judged.flags |= verdict::AMBIGUOUS;
+                    judged.ambiguity.order = 1;
                 }
             }
             if judged.overflowed > 0 {
@@ -342,7 +345,7 @@ fn judge_pixel(
                 None => inferred_counter(got.len(), overflow[p]),
             };
             judged.claimed_overflow = u64::from(overflow[p]);
-            let certain = possible.iter().filter(|q| q.certain).count();
+            let certain = possible.iter().filter(|q| q.certain()).count();
             let count = counter.count as usize;
             let cap = match capacity {
                 Capacity::Unbounded => usize::MAX,
