@@ -25,7 +25,8 @@
 //! window's y direction with the owner of rule 6's shared edges (lower-left origin).
 //!
 //! The stages live in submodules: `vertex` (rules 1–4: transform, outcodes, clipping, snapping),
-//! `scan` (rules 6–7: bounding box, edge functions, depth) and `viewport` (the render target and
+//! `scan` (rules 6–7: bounding box, edge functions, depth), `sample_scan` (rules 6–7 at each
+//! sample of a multisampled view, `docs/semantics.md` §11) and `viewport` (the render target and
 //! pixel rectangles); this file holds the view that ties them together and rule 5 (facing).
 
 use glam::{DMat4, DVec4};
