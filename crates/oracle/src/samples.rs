@@ -9,7 +9,7 @@
 //! The per-pixel view ([`SampleOracle::per_pixel`]) is what per-pixel storage with coverage masks
 //! can hold at best: each pixel's fragments merged into one node per primitive, with the mask of
 //! the samples it covers and the nearest of their depth keys
-//! ([`merge_samples`](fragsim_capture::schemes::masked_abuffer::merge_samples), the rule the
+//! ([`merge_samples`], the rule the
 //! masked-node A-buffer applies when it captures).
 
 use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
