@@ -31,6 +31,7 @@ mod locks;
 mod loop64;
 mod mdts_packed;
 mod meshes;
+mod multisampling;
 mod order_independence;
 mod peeling;
 mod pictures;

@@ -19,6 +19,7 @@ pub mod compare;
 mod diff;
 pub mod dump;
 pub mod precision;
+pub mod samples;
 pub mod scene;
 pub mod triangles;
 

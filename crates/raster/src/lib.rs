@@ -27,6 +27,7 @@ mod mesh;
 mod pipeline;
 mod ply;
 mod rng;
+pub mod samples;
 mod scenes;
 
 pub use camera::{Camera, OrbitCamera};
@@ -37,4 +38,5 @@ pub use pipeline::{
     CullMode, PixelRect, ScreenTriangle, View, Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS,
 };
 pub use rng::SplitMix64;
+pub use samples::SamplePattern;
 pub use scenes::{Scene, SceneError, DEFAULT_SCENE_NAME};

@@ -25,7 +25,8 @@
 //! window's y direction with the owner of rule 6's shared edges (lower-left origin).
 //!
 //! The stages live in submodules: `vertex` (rules 1–4: transform, outcodes, clipping, snapping),
-//! `scan` (rules 6–7: bounding box, edge functions, depth) and `viewport` (the render target and
+//! `scan` (rules 6–7: bounding box, edge functions, depth), `sample_scan` (rules 6–7 at each
+//! sample of a multisampled view, `docs/semantics.md` §11) and `viewport` (the render target and
 //! pixel rectangles); this file holds the view that ties them together and rule 5 (facing).
 
 use glam::{DMat4, DVec4};
@@ -37,6 +38,7 @@ use crate::mesh::Mesh;
 
 #[cfg(test)]
 mod conventions_tests;
+mod sample_scan;
 mod scan;
 mod submission;
 #[cfg(test)]
@@ -44,6 +46,7 @@ mod tests;
 mod vertex;
 mod viewport;
 
+use sample_scan::Sampling;
 use scan::{bounding_box, edge};
 use vertex::in_front;
 pub use viewport::{PixelRect, Viewport};
@@ -107,6 +110,10 @@ pub struct View<'mesh> {
     /// The submission order (`submission[i]`: the primitive submitted `i`-th); empty: primitive
     /// id order ([`View::shuffled`]).
     submission: Vec<u32>,
+    /// The sample pattern and expanded framebuffer of a view that rasterizes per sample
+    /// ([`View::with_samples`]); `None`: one sample at each pixel centre, through the
+    /// single-sample scan.
+    sampling: Option<Sampling>,
 }
 
 /// A snapped window position (1/256 pixel, y down) and the window depth `z / w`.
@@ -169,6 +176,7 @@ impl<'mesh> View<'mesh> {
             guard,
             conventions,
             submission: Vec::new(),
+            sampling: None,
         };
         view.set_camera(camera);
         view
@@ -191,10 +199,12 @@ impl<'mesh> View<'mesh> {
         self.conventions
     }
 
-    /// The viewport.
+    /// The framebuffer fragments index: the viewport, or the sample-expanded framebuffer of a
+    /// view that rasterizes per sample ([`View::with_samples`]; [`View::pixel_viewport`] is then
+    /// the render target in pixels).
     #[must_use]
     pub fn viewport(&self) -> Viewport {
-        self.viewport
+        self.sampling.map_or(self.viewport, Sampling::framebuffer)
     }
 
     /// The model-to-clip-space matrix of the current camera.
@@ -219,12 +229,15 @@ impl<'mesh> View<'mesh> {
     /// Rasterizes triangle `prim`, calling `emit` for each fragment in scan order (rows top to
     /// bottom, pixels left to right, fan pieces in order).
     pub fn rasterize(&self, prim: u32, emit: &mut impl FnMut(Fragment)) {
-        self.rasterize_in(prim, self.viewport.rect(), emit);
+        self.rasterize_in(prim, self.viewport().rect(), emit);
     }
 
     /// [`View::rasterize`] restricted to the pixels of `rect` (a screen tile): exactly the
     /// fragments of the whole triangle that fall in `rect`, in the same order.
     pub fn rasterize_in(&self, prim: u32, rect: PixelRect, emit: &mut impl FnMut(Fragment)) {
+        if let Some(sampling) = self.sampling {
+            return self.rasterize_samples_in(prim, sampling, rect, emit);
+        }
         let indices = self.mesh.triangles[prim as usize];
         let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
         if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS != 0 {
@@ -250,6 +263,9 @@ impl<'mesh> View<'mesh> {
     /// left to the scan).
     #[must_use]
     pub fn pixel_bounds(&self, prim: u32) -> Option<PixelRect> {
+        if let Some(sampling) = self.sampling {
+            return self.sample_bounds(prim, sampling);
+        }
         let indices = self.mesh.triangles[prim as usize];
         let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
         let full = self.viewport.rect();

@@ -16,6 +16,7 @@ pub mod layer_counter;
 pub mod linked_list;
 pub mod loop32;
 pub mod loop64;
+pub mod masked_abuffer;
 pub mod mdts;
 pub mod mdts_emulated64;
 pub mod mdts_packed;

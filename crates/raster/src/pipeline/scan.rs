@@ -97,7 +97,7 @@ pub(super) fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 
 /// Top edge: horizontal with the interior below; left edge: the interior to its right. For a
 /// positively oriented triangle that is `dy < 0`, or `dy == 0 && dx > 0`.
-fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
+pub(super) fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     dy < 0 || (dy == 0 && dx > 0)
 }
@@ -105,7 +105,7 @@ fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
 /// The top-left rule of a y-up window (OpenGL's lower-left origin) seen in fragsim's y-down rows:
 /// the window's top edge is fragsim's bottom edge, so a horizontal edge with the interior above
 /// (`dy == 0 && dx < 0`) is owned; left edges stay left (`dy < 0`), x is not flipped.
-fn is_bottom_left(a: [i64; 2], b: [i64; 2]) -> bool {
+pub(super) fn is_bottom_left(a: [i64; 2], b: [i64; 2]) -> bool {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     dy < 0 || (dy == 0 && dx < 0)
 }

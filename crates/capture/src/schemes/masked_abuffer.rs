@@ -1,0 +1,382 @@
+//! The masked-node A-buffer: per-pixel storage whose nodes carry a coverage mask, as the
+//! multisampled OIT of Bevy and nvpro-samples does, and its per-sample resolve.
+//!
+//! **Algorithm.** Under multisampling without per-sample shading, a fragment-shader invocation
+//! covers one pixel for one primitive and sees the samples it covers as a mask
+//! (`gl_SampleMaskIn`, WGSL's `sample_mask`). So here each primitive's per-sample fragments in
+//! one pixel (from a view rasterizing per sample, [`fragsim_raster::samples`]) are merged into one
+//! [`MaskedNode`]: the union of their sample bits and the nearest of their depth keys
+//! ([`merge_samples`]; fan pieces of one clipped triangle merge too, since they share the
+//! primitive id). Each node takes a slot of its pixel with a `fetch_add` on the pixel's counter
+//! and writes its packed `(depth key, primitive id)` word and its mask with two plain stores. The
+//! post pass sorts each pixel's nodes by `(depth key, primitive id)` ([`MaskedLists`]); the
+//! resolve that blends per sample ([`MaskedLists::per_sample`]) gives each sample the nodes whose
+//! mask holds it, in that order.
+//!
+//! **Guarantee.** The node lists equal the per-pixel view of the per-sample oracle (its
+//! fragments merged by the same rule) exactly, while every pixel's nodes fit `capacity`: the
+//! slot numbers of `fetch_add` are distinct under any interleaving, as in the A-buffer
+//! (`abuffer.rs`). The per-sample resolve is *approximate*: one depth a node orders a sample by
+//! the node's nearest depth, not the sample's own, so two primitives that cross inside a pixel
+//! may be blended in the wrong order at some samples; the error is measured against the
+//! per-sample oracle (`docs/results.md`, "Multisampling"). Past `capacity` a whole node (every
+//! sample it covers) is dropped and counted.
+//!
+//! **Memory.** One `u32` counter per pixel, and per slot one `u64` word and one `u32` mask:
+//! `4 + 12 × capacity` bytes a pixel, against `n × (4 + 8 × capacity)` for the A-buffer run per
+//! sample over `n` samples.
+//!
+//! **Departures.** It is not a [`Scheme`](crate::Scheme): its walks start from merged nodes, not
+//! from the rasterizer's fragments, so it runs its own serial and parallel loops over the view's
+//! triangles ([`MaskedABuffer::capture`]), on the same [`Memory`] seam, three operations a node.
+
+use fragsim_raster::{Fragment, View, Viewport};
+use rayon::prelude::*;
+
+use crate::capture::PixelLists;
+use crate::memory::{AtomicMemory, Layout, Memory, SerialMemory, WordMemory};
+use crate::scheme::CaptureError;
+
+/// One primitive's coverage of one pixel: its nearest depth key over the samples it covers, and
+/// the mask of those samples (bit `s`: sample `s`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct MaskedNode {
+    /// The smallest depth key of the primitive's samples in the pixel.
+    pub depth_key: u32,
+    /// Primitive id.
+    pub prim: u32,
+    /// Covered samples.
+    pub mask: u32,
+}
+
+impl MaskedNode {
+    /// The node's identity in the canonical packing: depth key high, primitive id low.
+    #[must_use]
+    pub fn packed(self) -> u64 {
+        (u64::from(self.depth_key) << 32) | u64::from(self.prim)
+    }
+}
+
+/// Merges per-sample fragments (their `pixel` a sample index of `samples` samples a pixel) into
+/// one node per pixel and primitive; calls `emit(pixel, node)` in `(pixel, primitive)` order.
+/// Sorts `fragments` in place.
+pub fn merge_samples(
+    samples: u32,
+    fragments: &mut [Fragment],
+    emit: &mut impl FnMut(u32, MaskedNode),
+) {
+    fragments.sort_unstable_by_key(|f| (f.pixel / samples, f.prim, f.depth_key));
+    let mut rest = &*fragments;
+    while let Some(first) = rest.first() {
+        let (pixel, prim) = (first.pixel / samples, first.prim);
+        let same = rest
+            .iter()
+            .take_while(|f| f.pixel / samples == pixel && f.prim == prim)
+            .count();
+        let mask = rest[..same]
+            .iter()
+            .fold(0u32, |mask, f| mask | 1 << (f.pixel % samples));
+        // Sorted by depth key within the group: the first is the nearest.
+        emit(
+            pixel,
+            MaskedNode {
+                depth_key: first.depth_key,
+                prim,
+                mask,
+            },
+        );
+        rest = &rest[same..];
+    }
+}
+
+/// Every pixel's nodes in `(depth key, primitive id)` order, with the nodes each pixel dropped.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MaskedLists {
+    /// Samples a pixel.
+    pub samples: u32,
+    /// `offsets[p]..offsets[p + 1]` are pixel `p`'s nodes.
+    pub offsets: Vec<usize>,
+    /// The nodes of every pixel.
+    pub nodes: Vec<MaskedNode>,
+    /// Nodes each pixel dropped for lack of storage (all 0 for an oracle's view).
+    pub overflow: Vec<u32>,
+}
+
+impl MaskedLists {
+    /// Pixel `p`'s nodes.
+    #[must_use]
+    pub fn pixel(&self, p: usize) -> &[MaskedNode] {
+        &self.nodes[self.offsets[p]..self.offsets[p + 1]]
+    }
+
+    /// Number of pixels.
+    #[must_use]
+    pub fn pixels(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// The lists of `nodes` (pixel, node) in any order over `pixels` pixels, sorted.
+    #[must_use]
+    pub fn from_nodes(samples: u32, pixels: usize, mut nodes: Vec<(u32, MaskedNode)>) -> Self {
+        nodes.sort_unstable_by_key(|&(pixel, node)| (pixel, node.packed()));
+        let mut offsets = Vec::with_capacity(pixels + 1);
+        offsets.push(0);
+        let mut at = 0;
+        for pixel in 0..pixels as u32 {
+            while at < nodes.len() && nodes[at].0 == pixel {
+                at += 1;
+            }
+            offsets.push(at);
+        }
+        Self {
+            samples,
+            offsets,
+            nodes: nodes.into_iter().map(|(_, node)| node).collect(),
+            overflow: vec![0; pixels],
+        }
+    }
+
+    /// The resolve per sample: each sample's list (indexed by sample index, as a per-sample
+    /// oracle's) holds the nodes whose mask covers it, in node order, each packed with the node's
+    /// depth key. What a per-sample blend reads, and what is compared with the per-sample oracle.
+    #[must_use]
+    pub fn per_sample(&self) -> PixelLists {
+        let mut lists = PixelLists::with_pixels(self.pixels() * self.samples as usize);
+        for p in 0..self.pixels() {
+            for s in 0..self.samples {
+                let covering = self.pixel(p).iter().filter(|n| n.mask >> s & 1 == 1);
+                lists.push_pixel(covering.map(|n| n.packed()));
+            }
+        }
+        lists
+    }
+}
+
+/// The masked-node A-buffer: `capacity` masked nodes per pixel.
+#[derive(Clone, Debug)]
+pub struct MaskedABuffer {
+    pixels: usize,
+    samples: u32,
+    capacity: u32,
+}
+
+impl MaskedABuffer {
+    /// `capacity` nodes for each pixel of `pixels`, at `samples` samples a pixel.
+    ///
+    /// # Errors
+    /// `capacity == 0`, a sample count outside 1 to 32 (a mask is one `u32`), or storage beyond
+    /// `memory_cap` bytes.
+    pub fn new(
+        pixels: Viewport,
+        samples: u32,
+        capacity: u32,
+        memory_cap: u64,
+    ) -> Result<Self, CaptureError> {
+        if capacity == 0 {
+            return Err(CaptureError::BadParameter(
+                "the masked-node A-buffer needs a capacity of at least 1 node per pixel".into(),
+            ));
+        }
+        if !(1..=32).contains(&samples) {
+            return Err(CaptureError::BadParameter(format!(
+                "{samples} samples per pixel: a coverage mask holds 1 to 32"
+            )));
+        }
+        let scheme = Self {
+            pixels: pixels.pixels(),
+            samples,
+            capacity,
+        };
+        let needed = scheme.layout().bytes();
+        if needed > memory_cap {
+            return Err(CaptureError::TooMuchMemory {
+                scheme: "abuffer-masked".into(),
+                needed,
+                cap: memory_cap,
+            });
+        }
+        Ok(scheme)
+    }
+
+    /// The words: `u32` counters then masks, `u64` node words.
+    #[must_use]
+    pub fn layout(&self) -> Layout {
+        let slots = self.pixels * self.capacity as usize;
+        Layout::counters_and_slots(self.pixels + slots, slots)
+    }
+
+    /// Inserts `node` into pixel `pixel`: `fetch_add` on the counter, then the word and the mask
+    /// into the slot it handed out. Returns whether the node was stored (else it was dropped,
+    /// and the counter, which keeps counting, says so).
+    pub fn insert<M: Memory>(&self, pixel: u32, node: MaskedNode, memory: &M) -> bool {
+        let pixel = pixel as usize;
+        let slot = WordMemory::<u32>::fetch_add(memory, pixel, 1);
+        if slot >= self.capacity {
+            return false;
+        }
+        let index = pixel * self.capacity as usize + slot as usize;
+        WordMemory::<u64>::store(memory, index, node.packed());
+        WordMemory::<u32>::store(memory, self.pixels + index, node.mask);
+        true
+    }
+
+    /// One frame: every triangle of `view` (rasterizing per sample with this scheme's sample
+    /// count) merged into nodes and inserted, serially in submission order or on the current
+    /// rayon pool with std atomics; then the post pass.
+    ///
+    /// # Errors
+    /// A view that does not rasterize per sample at this scheme's sample count, or on another
+    /// number of pixels.
+    pub fn capture(&self, view: &View<'_>, parallel: bool) -> Result<MaskedLists, String> {
+        if view.samples().map(|p| p.count()) != Some(self.samples)
+            || view.pixel_viewport().pixels() != self.pixels
+        {
+            return Err(format!(
+                "the masked-node A-buffer was built for {} pixels at {} samples, the view is {} \
+                 pixels at {} samples",
+                self.pixels,
+                self.samples,
+                view.pixel_viewport().pixels(),
+                view.samples().map_or(1, |p| p.count())
+            ));
+        }
+        let layout = self.layout();
+        if parallel {
+            let memory: AtomicMemory = layout.allocate();
+            (0..view.triangle_count())
+                .into_par_iter()
+                .for_each_init(Vec::new, |scratch, index| {
+                    self.insert_triangle(view, view.submitted(index), scratch, &memory)
+                });
+            Ok(self.resolve(&memory))
+        } else {
+            let memory: SerialMemory = layout.allocate();
+            let mut scratch = Vec::new();
+            for index in 0..view.triangle_count() {
+                self.insert_triangle(view, view.submitted(index), &mut scratch, &memory);
+            }
+            Ok(self.resolve(&memory))
+        }
+    }
+
+    /// Rasterizes triangle `prim` per sample into `scratch`, merges and inserts its nodes.
+    fn insert_triangle<M: Memory>(
+        &self,
+        view: &View<'_>,
+        prim: u32,
+        scratch: &mut Vec<Fragment>,
+        memory: &M,
+    ) {
+        scratch.clear();
+        view.rasterize(prim, &mut |f| scratch.push(f));
+        merge_samples(self.samples, scratch, &mut |pixel, node| {
+            self.insert(pixel, node, memory);
+        });
+    }
+
+    /// The post pass: each pixel's stored nodes sorted, and its overflow read from its counter.
+    #[must_use]
+    pub fn resolve<M: Memory>(&self, memory: &M) -> MaskedLists {
+        let mut lists = MaskedLists {
+            samples: self.samples,
+            offsets: vec![0],
+            nodes: Vec::new(),
+            overflow: Vec::with_capacity(self.pixels),
+        };
+        for pixel in 0..self.pixels {
+            let count = WordMemory::<u32>::load(memory, pixel);
+            let stored = count.min(self.capacity) as usize;
+            let start = lists.nodes.len();
+            for slot in 0..stored {
+                let index = pixel * self.capacity as usize + slot;
+                let packed = WordMemory::<u64>::load(memory, index);
+                lists.nodes.push(MaskedNode {
+                    depth_key: (packed >> 32) as u32,
+                    prim: packed as u32,
+                    mask: WordMemory::<u32>::load(memory, self.pixels + index),
+                });
+            }
+            lists.nodes[start..].sort_unstable_by_key(|n| n.packed());
+            lists.offsets.push(lists.nodes.len());
+            lists.overflow.push(count - stored as u32);
+        }
+        lists
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(pixel: u32, depth_key: u32, prim: u32) -> Fragment {
+        Fragment {
+            pixel,
+            depth_key,
+            prim,
+        }
+    }
+
+    #[test]
+    fn one_primitives_samples_in_one_pixel_merge_into_one_node_with_the_nearest_key() {
+        // 4 samples a pixel: pixel 0 is samples 0..4, pixel 1 is 4..8.
+        let mut fragments = vec![
+            sample(5, 30, 7),
+            sample(0, 20, 7),
+            sample(2, 10, 7),
+            sample(1, 50, 9),
+        ];
+        let mut nodes = Vec::new();
+        merge_samples(4, &mut fragments, &mut |p, n| nodes.push((p, n)));
+        let node = |depth_key, prim, mask| MaskedNode {
+            depth_key,
+            prim,
+            mask,
+        };
+        assert_eq!(
+            nodes,
+            [
+                (0, node(10, 7, 0b0101)),
+                (0, node(50, 9, 0b0010)),
+                (1, node(30, 7, 0b0010))
+            ]
+        );
+    }
+
+    #[test]
+    fn past_its_capacity_a_pixel_drops_whole_nodes_and_counts_them() {
+        let scheme = MaskedABuffer::new(Viewport::new(1, 1).unwrap(), 4, 2, u64::MAX).unwrap();
+        let memory: SerialMemory = scheme.layout().allocate();
+        for (prim, key) in [(3, 30), (1, 10), (2, 20)] {
+            let node = MaskedNode {
+                depth_key: key,
+                prim,
+                mask: 1 << prim,
+            };
+            assert_eq!(scheme.insert(0, node, &memory), prim != 2);
+        }
+        let lists = scheme.resolve(&memory);
+        assert_eq!(lists.overflow, [1]);
+        let prims: Vec<u32> = lists.pixel(0).iter().map(|n| n.prim).collect();
+        assert_eq!(prims, [1, 3]);
+        let per_sample = lists.per_sample();
+        assert_eq!(per_sample.pixel(1), [10 << 32 | 1]);
+        assert!(per_sample.pixel(2).is_empty());
+    }
+
+    #[test]
+    fn bad_parameters_are_refused_by_name() {
+        let one = Viewport::new(1, 1).unwrap();
+        assert!(MaskedABuffer::new(one, 4, 0, u64::MAX)
+            .unwrap_err()
+            .to_string()
+            .contains("capacity"));
+        assert!(MaskedABuffer::new(one, 64, 1, u64::MAX)
+            .unwrap_err()
+            .to_string()
+            .contains("64 samples"));
+        assert!(matches!(
+            MaskedABuffer::new(one, 4, 8, 10),
+            Err(CaptureError::TooMuchMemory { .. })
+        ));
+    }
+}

@@ -1,0 +1,138 @@
+//! The oracle per sample, and its per-pixel view: what multisampled captures are judged against.
+//!
+//! A view that rasterizes per sample ([`View::with_samples`]) emits one fragment per covered
+//! sample into the sample-expanded framebuffer, so the per-sample oracle is the ordinary
+//! [`Oracle`] of that view: every sample's fragments in canonical order, indexed by sample index
+//! `pixel * n + s`. With one sample at the centre it is today's oracle, bit for bit (the
+//! multisampling suite checks it on the shared meshes).
+//!
+//! The per-pixel view ([`SampleOracle::per_pixel`]) is what per-pixel storage with coverage masks
+//! can hold at best: each pixel's fragments merged into one node per primitive, with the mask of
+//! the samples it covers and the nearest of their depth keys
+//! ([`merge_samples`], the rule the
+//! masked-node A-buffer applies when it captures).
+
+use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
+use fragsim_capture::PixelLists;
+use fragsim_raster::{Fragment, SamplePattern, View, Viewport};
+
+use crate::Oracle;
+
+/// The exact per-sample fragment lists of a view rasterizing per sample.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SampleOracle {
+    pattern: SamplePattern,
+    pixels: Viewport,
+    oracle: Oracle,
+}
+
+impl SampleOracle {
+    /// The per-sample oracle of `view`.
+    ///
+    /// # Errors
+    /// A view that does not rasterize per sample.
+    pub fn build(view: &View<'_>) -> Result<Self, String> {
+        let pattern = view.samples().ok_or(
+            "the per-sample oracle needs a view rasterizing per sample (View::with_samples)",
+        )?;
+        Ok(Self {
+            pattern,
+            pixels: view.pixel_viewport(),
+            oracle: Oracle::build(view),
+        })
+    }
+
+    /// The sample pattern.
+    #[must_use]
+    pub fn pattern(&self) -> SamplePattern {
+        self.pattern
+    }
+
+    /// The render target in pixels.
+    #[must_use]
+    pub fn pixel_viewport(&self) -> Viewport {
+        self.pixels
+    }
+
+    /// The per-sample lists as an [`Oracle`] over the sample-expanded framebuffer: what any
+    /// scheme run on the sampled view is diffed against.
+    #[must_use]
+    pub fn oracle(&self) -> &Oracle {
+        &self.oracle
+    }
+
+    /// Per pixel, the fragments of all its samples: what a per-sample counting pass on a GPU
+    /// (one count per covered sample) adds up.
+    #[must_use]
+    pub fn sample_counts(&self) -> Vec<u32> {
+        let n = self.pattern.count() as usize;
+        let depths = self.oracle.depth_complexity();
+        depths.chunks(n).map(|pixel| pixel.iter().sum()).collect()
+    }
+
+    /// The per-pixel view: every pixel's fragments merged into one node per primitive.
+    #[must_use]
+    pub fn per_pixel(&self) -> MaskedLists {
+        let n = self.pattern.count();
+        let lists = self.oracle.lists();
+        let mut fragments: Vec<Fragment> = (0..lists.pixels())
+            .flat_map(|sample| {
+                lists.pixel(sample).iter().map(move |&packed| Fragment {
+                    pixel: sample as u32,
+                    depth_key: (packed >> 32) as u32,
+                    prim: packed as u32,
+                })
+            })
+            .collect();
+        let mut nodes: Vec<(u32, MaskedNode)> = Vec::new();
+        merge_samples(n, &mut fragments, &mut |pixel, node| {
+            nodes.push((pixel, node))
+        });
+        MaskedLists::from_nodes(n, self.pixels.pixels(), nodes)
+    }
+
+    /// How a per-sample resolve (`candidate`, indexed like [`SampleOracle::oracle`]) departs
+    /// from the per-sample oracle, fragments compared by primitive id in order (a masked node
+    /// carries its nearest depth, not each sample's).
+    ///
+    /// # Panics
+    /// If `candidate` covers another number of samples.
+    #[must_use]
+    pub fn sample_error(&self, candidate: &PixelLists) -> SampleError {
+        assert_eq!(
+            candidate.pixels(),
+            self.oracle.pixels(),
+            "sample counts differ"
+        );
+        let mut error = SampleError::default();
+        for sample in 0..candidate.pixels() {
+            let (want, got) = (self.oracle.pixel(sample), candidate.pixel(sample));
+            error.fragments += want.len() as u64;
+            error.lost += want.len().saturating_sub(got.len()) as u64;
+            let prims = |list: &[u64]| list.iter().map(|&e| e as u32).collect::<Vec<_>>();
+            if prims(want) != prims(got) {
+                error.wrong_samples += 1;
+                if want.len() == got.len() {
+                    error.misordered_samples += 1;
+                }
+            }
+        }
+        error.samples = candidate.pixels() as u64;
+        error
+    }
+}
+
+/// What a per-sample resolve lost or misordered, against the per-sample oracle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SampleError {
+    /// Samples compared.
+    pub samples: u64,
+    /// Sample fragments in the oracle.
+    pub fragments: u64,
+    /// Sample fragments missing from the resolve (storage overflow).
+    pub lost: u64,
+    /// Samples whose list of primitives differs from the oracle's in any way.
+    pub wrong_samples: u64,
+    /// Of those, samples with every fragment present but in another order.
+    pub misordered_samples: u64,
+}

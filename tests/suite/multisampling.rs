@@ -1,0 +1,302 @@
+//! Multisampling (`docs/semantics.md`, "Multisampling"): the per-sample scan against a direct
+//! evaluation of the rules at every sample, one sample at the centre bit-identical to the
+//! single-sample pipeline (the oracle on the shared meshes, every catalog scheme on several
+//! executors), schemes run per sample equal to the per-sample oracle, and the masked-node
+//! A-buffer equal to the per-pixel view of the per-sample oracle within its capacity.
+
+use std::path::PathBuf;
+
+use fragsim::capture::catalog::{Count, Executors, Sizing, CATALOG};
+use fragsim::capture::executors::Executor;
+use fragsim::capture::schemes::masked_abuffer::MaskedABuffer;
+use fragsim::capture::MEMORY_CAP_DEFAULT;
+use fragsim::oracle::samples::SampleOracle;
+use fragsim::oracle::Oracle;
+use fragsim::raster::{Fragment, OrbitCamera, SamplePattern, Scene, View, Viewport};
+
+fn view_of(scene: &Scene, side: u32, angle: f64) -> View<'_> {
+    scene
+        .view(
+            Viewport::new(side, side).unwrap(),
+            &OrbitCamera::default().at_angle(angle),
+        )
+        .unwrap()
+}
+
+/// Every fragment of `view` in its scan order.
+fn fragments(view: &View<'_>) -> Vec<Fragment> {
+    let mut all = Vec::new();
+    for prim in 0..view.triangle_count() {
+        view.rasterize(prim, &mut |f| all.push(f));
+    }
+    all
+}
+
+/// The rules evaluated directly at every sample of every pixel, for every piece of every
+/// triangle: the edge functions in i128 from the vertices, the top-left rule, the depth from
+/// the barycentrics. Sorted.
+fn direct_samples(view: &View<'_>, pattern: SamplePattern) -> Vec<Fragment> {
+    let pixels = view.pixel_viewport();
+    let n = pattern.count();
+    let edge = |a: [i64; 2], b: [i64; 2], p: [i64; 2]| {
+        i128::from(b[0] - a[0]) * i128::from(p[1] - a[1])
+            - i128::from(b[1] - a[1]) * i128::from(p[0] - a[0])
+    };
+    let top_left = |a: [i64; 2], b: [i64; 2]| {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        dy < 0 || (dy == 0 && dx > 0)
+    };
+    let mut out = Vec::new();
+    for prim in 0..view.triangle_count() {
+        view.screen_triangles(prim, &mut |tri| {
+            let [a, b, c] = tri.xy;
+            let area = edge(a, b, c) as f64;
+            for y in 0..pixels.height {
+                for x in 0..pixels.width {
+                    for s in 0..n {
+                        let [ox, oy] = pattern.positions()[s as usize].map(i64::from);
+                        let p = [i64::from(x) * 256 + ox * 16, i64::from(y) * 256 + oy * 16];
+                        let e =
+                            [(b, c), (c, a), (a, b)].map(|(u, v)| (edge(u, v, p), top_left(u, v)));
+                        if e.iter()
+                            .all(|&(value, owned)| value > 0 || (value == 0 && owned))
+                        {
+                            let w = e.map(|(value, _)| value as f64);
+                            let z = (w[0] * tri.z[0] + w[1] * tri.z[1] + w[2] * tri.z[2]) / area;
+                            if let Some(depth_key) = fragsim::raster::depth_key(z as f32) {
+                                let pixel = (y * pixels.width + x) * n + s;
+                                out.push(Fragment {
+                                    pixel,
+                                    depth_key,
+                                    prim,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        });
+    }
+    out.sort_unstable();
+    out
+}
+
+#[test]
+fn every_sample_is_covered_and_its_depth_interpolated_as_the_rules_say_at_its_position() {
+    for (spec, side, angle) in [
+        ("soup:60:3", 20, 0.0),
+        ("spheres:2", 18, 30.0),
+        ("quads:3", 16, 10.0),
+    ] {
+        let scene = Scene::procedural(spec).unwrap();
+        let view = view_of(&scene, side, angle);
+        for count in SamplePattern::COUNTS {
+            let pattern = SamplePattern::standard(count).unwrap();
+            let per_sample = view.clone().with_samples(pattern).unwrap();
+            assert_eq!(per_sample.viewport().width, side * count);
+            let mut scanned = fragments(&per_sample);
+            scanned.sort_unstable();
+            let direct = direct_samples(&per_sample, pattern);
+            assert!(!direct.is_empty(), "{spec}: nothing covered");
+            assert_eq!(scanned, direct, "{spec} at {count} samples");
+        }
+    }
+}
+
+#[test]
+fn one_sample_at_the_centre_rasterizes_the_single_sample_fragments_in_the_same_order() {
+    for spec in ["bunny", "bunny-spheres:60:2", "soup:300:5", "spheres:3"] {
+        let scene = Scene::procedural(spec).unwrap();
+        for angle in [0.0, 75.0] {
+            let view = view_of(&scene, 96, angle);
+            let centre = view.clone().with_samples(SamplePattern::CENTRE).unwrap();
+            assert_eq!(centre.viewport(), view.viewport());
+            assert_eq!(fragments(&centre), fragments(&view), "{spec} at {angle}");
+            // The same bounds, except that the sampled view leaves out the degenerate and
+            // culled triangles the single-sample bounds leave to the scan.
+            for prim in 0..view.triangle_count() {
+                match centre.pixel_bounds(prim) {
+                    Some(bounds) => assert_eq!(Some(bounds), view.pixel_bounds(prim), "{prim}"),
+                    None => view.rasterize(prim, &mut |f| panic!("{spec} {prim}: {f:?}")),
+                }
+            }
+        }
+    }
+}
+
+fn shared_mesh(file: &str) -> Option<PathBuf> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/meshes")
+        .join(file);
+    path.is_file().then_some(path)
+}
+
+#[test]
+fn the_per_sample_oracle_at_one_sample_is_todays_oracle_on_the_bunny_the_dragon_and_bunny_spheres()
+{
+    let mut scenes = vec![
+        ("bunny", Scene::default_scene()),
+        ("bunny-spheres", Scene::procedural("bunny-spheres").unwrap()),
+    ];
+    match shared_mesh("dragon_vrip.ply.gz") {
+        Some(path) => scenes.push(("dragon", Scene::from_file(&path).unwrap())),
+        // A clone without the shared folder beside it: the dragon is not checked (CI has it).
+        None => eprintln!("SKIPPED the dragon: ../shared/meshes/dragon_vrip.ply.gz not found"),
+    }
+    for (name, scene) in &scenes {
+        for angle in [0.0, 120.0] {
+            let view = view_of(scene, 256, angle);
+            let centre = view.clone().with_samples(SamplePattern::CENTRE).unwrap();
+            let today = Oracle::build(&view);
+            let per_sample = SampleOracle::build(&centre).unwrap();
+            assert!(
+                today.fragments() > 10_000,
+                "{name}: {} fragments",
+                today.fragments()
+            );
+            assert_eq!(per_sample.oracle(), &today, "{name} at {angle}");
+            assert_eq!(per_sample.sample_counts(), today.depth_complexity());
+        }
+    }
+}
+
+#[test]
+fn every_scheme_run_at_one_sample_captures_bit_for_bit_what_it_captures_today() {
+    let runs = |spec: &str, side: u32, executors_used: &[Executor]| {
+        let scene = Scene::procedural(spec).unwrap();
+        let view = view_of(&scene, side, 30.0);
+        let centre = view.clone().with_samples(SamplePattern::CENTRE).unwrap();
+        let mut executors = Executors::default();
+        for entry in CATALOG {
+            for count in [Count::Fixed(2), Count::Auto] {
+                let sizing = Sizing {
+                    k: count,
+                    capacity: count,
+                    memory_cap: MEMORY_CAP_DEFAULT,
+                };
+                for &executor in executors_used {
+                    let mut run = |view| {
+                        executors
+                            .run(entry.scheme, executor, view, &sizing)
+                            .unwrap()
+                    };
+                    let (today, sampled) = (run(&view), run(&centre));
+                    assert_eq!(
+                        today.run.capture, sampled.run.capture,
+                        "{spec}: {} ({count:?}) on {executor}",
+                        entry.name
+                    );
+                    assert_eq!(today.run.stats.counters, sampled.run.stats.counters);
+                }
+            }
+        }
+    };
+    runs("bunny", 96, &[Executor::Serial, Executor::Tiled]);
+    runs("spheres:3", 24, &[Executor::Scheduled]);
+}
+
+#[test]
+fn mdts_and_the_abuffer_run_per_sample_equal_the_per_sample_oracle_on_every_executor() {
+    let scene = Scene::procedural("bunny-spheres:80:4").unwrap();
+    let view = view_of(&scene, 64, 40.0);
+    for count in [4, 8] {
+        let sampled = view
+            .clone()
+            .with_samples(SamplePattern::standard(count).unwrap())
+            .unwrap();
+        let oracle = SampleOracle::build(&sampled).unwrap();
+        let mut executors = Executors::default();
+        let sizing = Sizing {
+            k: Count::Auto,
+            capacity: Count::Auto,
+            memory_cap: MEMORY_CAP_DEFAULT,
+        };
+        for name in ["mdts", "abuffer", "abuffer-exact"] {
+            let scheme = fragsim::capture::catalog::SchemeName::from_name(name).unwrap();
+            for executor in [Executor::Serial, Executor::Parallel, Executor::Tiled] {
+                let run = executors.run(scheme, executor, &sampled, &sizing).unwrap();
+                let diff = oracle.oracle().diff(&run.run.capture);
+                assert!(
+                    diff.is_exact(),
+                    "{name} at {count} samples on {executor}: {diff:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_masked_node_abuffer_holds_the_per_pixel_view_within_capacity_and_drops_whole_nodes_past_it()
+{
+    let scene = Scene::procedural("bunny-spheres:80:4").unwrap();
+    let view = view_of(&scene, 64, 40.0);
+    for count in [4, 8] {
+        let sampled = view
+            .clone()
+            .with_samples(SamplePattern::standard(count).unwrap())
+            .unwrap();
+        let oracle = SampleOracle::build(&sampled).unwrap();
+        let per_pixel = oracle.per_pixel();
+        let deepest = (0..per_pixel.pixels())
+            .map(|p| per_pixel.pixel(p).len())
+            .max()
+            .unwrap();
+        assert!(deepest >= 4, "{deepest} nodes at most");
+        // Each node's mask and nearest key come from the per-sample oracle's samples.
+        let covered: u64 = per_pixel
+            .nodes
+            .iter()
+            .map(|n| u64::from(n.mask.count_ones()))
+            .sum();
+        assert_eq!(covered, oracle.oracle().fragments() as u64);
+        for parallel in [false, true] {
+            let full =
+                MaskedABuffer::new(view.viewport(), count, deepest as u32, MEMORY_CAP_DEFAULT)
+                    .unwrap();
+            let captured = full.capture(&sampled, parallel).unwrap();
+            assert_eq!(captured, per_pixel, "{count} samples, parallel {parallel}");
+            let error = oracle.sample_error(&captured.per_sample());
+            assert_eq!(error.lost, 0);
+            assert_eq!(error.wrong_samples, error.misordered_samples);
+            let capacity = 2;
+            let bounded = MaskedABuffer::new(view.viewport(), count, capacity, MEMORY_CAP_DEFAULT)
+                .unwrap()
+                .capture(&sampled, parallel)
+                .unwrap();
+            for p in 0..per_pixel.pixels() {
+                let nodes = per_pixel.pixel(p).len() as u32;
+                assert_eq!(
+                    bounded.overflow[p],
+                    nodes.saturating_sub(capacity),
+                    "pixel {p}"
+                );
+                assert_eq!(bounded.pixel(p).len() as u32, nodes.min(capacity));
+                assert!(bounded
+                    .pixel(p)
+                    .iter()
+                    .all(|n| per_pixel.pixel(p).contains(n)));
+            }
+            assert!(oracle.sample_error(&bounded.per_sample()).lost > 0);
+        }
+    }
+}
+
+#[test]
+fn a_view_refuses_a_framebuffer_too_wide_and_the_masked_abuffer_a_view_of_another_size() {
+    let scene = Scene::procedural("spheres:1").unwrap();
+    let wide = view_of(&scene, 2048, 0.0);
+    let message = wide
+        .with_samples(SamplePattern::standard(16).unwrap())
+        .unwrap_err();
+    assert!(
+        message.contains("2048") && message.contains("16"),
+        "{message}"
+    );
+    let view = view_of(&scene, 8, 0.0);
+    let scheme = MaskedABuffer::new(view.viewport(), 4, 2, MEMORY_CAP_DEFAULT).unwrap();
+    assert!(scheme
+        .capture(&view, false)
+        .unwrap_err()
+        .contains("1 samples"));
+    assert!(SampleOracle::build(&view).is_err());
+}
