@@ -175,6 +175,7 @@ impl<'mesh> View<'mesh> {
     }
 
     /// The vertex stage's snapped position and depth of vertex `index` (no clip bit set).
+    #[inline]
     fn snapped(&self, index: u32) -> Snapped {
         let [x, y] = self.window_xy[index as usize];
         ([x.into(), y.into()], self.window_z[index as usize])
@@ -193,6 +194,7 @@ impl<'mesh> View<'mesh> {
 
     /// The viewport.
     #[must_use]
+    #[inline]
     pub fn viewport(&self) -> Viewport {
         self.viewport
     }
@@ -212,6 +214,7 @@ impl<'mesh> View<'mesh> {
     /// Number of triangles (primitive ids are `0..triangle_count()`; the executors submit them in
     /// [`View::submitted`] order).
     #[must_use]
+    #[inline]
     pub fn triangle_count(&self) -> u32 {
         self.mesh.triangles.len() as u32
     }
