@@ -24,6 +24,7 @@ impl Fragment {
     /// The fragment's identity packed into one 64-bit word whose integer order is the canonical
     /// order: depth key in the high half, primitive id in the low half.
     #[must_use]
+    #[inline]
     pub fn packed(self) -> u64 {
         (u64::from(self.depth_key) << 32) | u64::from(self.prim)
     }
@@ -41,6 +42,7 @@ impl Fragment {
 /// floats do, which is why an integer `atomicMin` sorts depths. Returns `None` for depths outside
 /// `[0, 1]` and for NaN: the pipeline drops those fragments (they lie outside the view volume).
 #[must_use]
+#[inline]
 pub fn depth_key(depth: f32) -> Option<u32> {
     if (0.0..=1.0).contains(&depth) {
         // `-0.0` passes the range test; adding `0.0` turns it into `+0.0`.

@@ -183,6 +183,7 @@ impl<'mesh> View<'mesh> {
     }
 
     /// The vertex stage's snapped position and depth of vertex `index` (no clip bit set).
+    #[inline]
     fn snapped(&self, index: u32) -> Snapped {
         let [x, y] = self.window_xy[index as usize];
         ([x.into(), y.into()], self.window_z[index as usize])
@@ -203,6 +204,7 @@ impl<'mesh> View<'mesh> {
     /// view that rasterizes per sample ([`View::with_samples`]; [`View::pixel_viewport`] is then
     /// the render target in pixels).
     #[must_use]
+    #[inline]
     pub fn viewport(&self) -> Viewport {
         self.sampling.map_or(self.viewport, Sampling::framebuffer)
     }
@@ -222,6 +224,7 @@ impl<'mesh> View<'mesh> {
     /// Number of triangles (primitive ids are `0..triangle_count()`; the executors submit them in
     /// [`View::submitted`] order).
     #[must_use]
+    #[inline]
     pub fn triangle_count(&self) -> u32 {
         self.mesh.triangles.len() as u32
     }

@@ -41,6 +41,7 @@ impl Counters {
     ///
     /// # Panics
     /// If `end` is [`Step::Continue`]: a walk that did not end is not counted.
+    #[inline]
     pub fn record(&mut self, end: Step) {
         self.fragments += 1;
         match end {

@@ -208,35 +208,43 @@ fn reset_touched<A: Send>(
 macro_rules! serial_words {
     ($word:ty, $field:ident) => {
         impl WordMemory<$word> for SerialMemory {
+            #[inline]
             fn len(&self) -> usize {
                 self.$field.len()
             }
+            #[inline]
             fn load(&self, i: usize) -> $word {
                 self.$field[i].get()
             }
+            #[inline]
             fn store(&self, i: usize, v: $word) {
                 self.$field[i].set(v);
             }
+            #[inline]
             fn fetch_min(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].get();
                 self.$field[i].set(old.min(v));
                 old
             }
+            #[inline]
             fn fetch_max(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].get();
                 self.$field[i].set(old.max(v));
                 old
             }
+            #[inline]
             fn fetch_add(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].get();
                 self.$field[i].set(old.wrapping_add(v));
                 old
             }
+            #[inline]
             fn fetch_or(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].get();
                 self.$field[i].set(old | v);
                 old
             }
+            #[inline]
             fn swap(&self, i: usize, v: $word) -> $word {
                 self.$field[i].replace(v)
             }
@@ -247,41 +255,50 @@ macro_rules! serial_words {
 macro_rules! atomic_words {
     ($word:ty, $field:ident, $touched:ident) => {
         impl WordMemory<$word> for AtomicMemory {
+            #[inline]
             fn len(&self) -> usize {
                 self.$field.len()
             }
+            #[inline]
             fn load(&self, i: usize) -> $word {
                 self.$field[i].load(Relaxed)
             }
+            #[inline]
             fn store(&self, i: usize, v: $word) {
                 self.$field[i].store(v, Relaxed);
                 touch(&self.$touched, i);
             }
+            #[inline]
             fn fetch_min(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].fetch_min(v, Relaxed);
                 touch(&self.$touched, i);
                 old
             }
+            #[inline]
             fn fetch_max(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].fetch_max(v, Relaxed);
                 touch(&self.$touched, i);
                 old
             }
+            #[inline]
             fn fetch_add(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].fetch_add(v, Relaxed);
                 touch(&self.$touched, i);
                 old
             }
+            #[inline]
             fn fetch_or(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].fetch_or(v, Relaxed);
                 touch(&self.$touched, i);
                 old
             }
+            #[inline]
             fn swap(&self, i: usize, v: $word) -> $word {
                 let old = self.$field[i].swap(v, Relaxed);
                 touch(&self.$touched, i);
                 old
             }
+            #[inline]
             fn untouched(&self, i: usize) -> bool {
                 !self.$touched[i / BLOCK_WORDS].load(Relaxed)
             }

@@ -139,6 +139,7 @@ impl ABuffer {
     }
 
     /// The first slot of `pixel` and how many it has.
+    #[inline]
     fn slots(&self, pixel: usize) -> (usize, usize) {
         match &self.storage {
             Storage::Fixed { capacity, .. } => (pixel * capacity, *capacity),

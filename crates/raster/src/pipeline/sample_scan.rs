@@ -11,10 +11,9 @@
 //! Fragments index the sample-expanded framebuffer ([`crate::samples`]): sample `s` of pixel
 //! `(x, y)` is column `x * n + s`. A rectangle given to the scan (a tile) is in those columns.
 
-use super::scan::{bounding_box, edge, is_bottom_left, is_top_left};
+use super::scan::{bounding_box, edge, fill_bias, fragment_at};
 use super::{PixelRect, ScreenTriangle, View, Viewport, ONE};
-use crate::conventions::WindowOrigin;
-use crate::fragment::{depth_key, Fragment};
+use crate::fragment::Fragment;
 use crate::samples::SamplePattern;
 
 /// The most samples a pattern has.
@@ -118,11 +117,7 @@ impl View<'_> {
         debug_assert!(area > 0);
         // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
         let edges = [(b, c), (c, a), (a, b)];
-        let owns = match self.conventions.window_origin {
-            WindowOrigin::UpperLeft => is_top_left,
-            WindowOrigin::LowerLeft => is_bottom_left,
-        };
-        let bias = edges.map(|(p, q)| if owns(p, q) { 0 } else { -1 });
+        let bias = fill_bias(edges, self.conventions.window_origin);
         // The gradient of edge (p, q) is (−(q_y − p_y), q_x − p_x) per 1/256 pixel.
         let gradient = edges.map(|(p, q)| [-(q[1] - p[1]), q[0] - p[0]]);
         let mut offsets = [[0i64; 3]; MAX_SAMPLES];
@@ -146,15 +141,8 @@ impl View<'_> {
                     if !columns.contains(&column) || !(0..3).all(|k| e[k] + bias[k] >= 0) {
                         continue;
                     }
-                    let z =
-                        (e[0] as f64 * tri.z[0] + e[1] as f64 * tri.z[1] + e[2] as f64 * tri.z[2])
-                            / area_f;
-                    if let Some(depth_key) = depth_key(z as f32) {
-                        emit(Fragment {
-                            pixel: (y * width + column) as u32,
-                            depth_key,
-                            prim: tri.prim,
-                        });
+                    if let Some(fragment) = fragment_at(tri, e, area_f, y * width + column) {
+                        emit(fragment);
                     }
                 }
                 for k in 0..3 {

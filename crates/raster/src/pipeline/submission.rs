@@ -34,6 +34,7 @@ impl View<'_> {
     /// The primitive submitted `index`-th (`index < triangle_count()`): `index` itself unless the
     /// view is [`shuffled`](View::shuffled).
     #[must_use]
+    #[inline]
     pub fn submitted(&self, index: u32) -> u32 {
         self.submission
             .get(index as usize)

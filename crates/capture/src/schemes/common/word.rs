@@ -21,12 +21,15 @@ pub trait MdtsWord: Word {
 
 impl MdtsWord for u32 {
     const IDENTITY: Identity = Identity::KeyOnly;
+    #[inline]
     fn encode(fragment: Fragment) -> Self {
         fragment.depth_key
     }
+    #[inline]
     fn decode(self) -> u64 {
         u64::from(self) << 32
     }
+    #[inline]
     fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self> {
         memory
     }
@@ -34,12 +37,15 @@ impl MdtsWord for u32 {
 
 impl MdtsWord for u64 {
     const IDENTITY: Identity = Identity::KeyAndPrim;
+    #[inline]
     fn encode(fragment: Fragment) -> Self {
         fragment.packed()
     }
+    #[inline]
     fn decode(self) -> u64 {
         self
     }
+    #[inline]
     fn words<M: Memory>(memory: &M) -> &impl WordMemory<Self> {
         memory
     }
