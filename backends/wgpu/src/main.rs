@@ -6,11 +6,15 @@
 //! fragsim-wgpu capture --scheme abuffer,mdts --scene bunny --width 512 --height 512 \
 //!     --view 30 --mode replay --out out/wgpu --judge
 //! fragsim-wgpu capture --scheme linked-list --plant lost-node --scene bunny --out out/wgpu
+//! fragsim-wgpu capture --case DIR --scheme mdts --k 2 --mode engine --out OUT
 //! ```
+//!
+//! `--case` reads a case directory of `fragsim conform` (its `camera.json` and `case.json`), so
+//! that the command is conform's `--backend` (`docs/testing.md`).
 //!
 //! Exit status: 0 on success (whatever the verdicts), 2 on an error (no adapter, bad input).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -54,6 +58,11 @@ enum Command {
         /// A named scene (bunny, bunny-spheres, spheres:N, soup, quads).
         #[arg(long, default_value = "bunny")]
         scene: String,
+        /// A case directory of `fragsim conform` instead of a scene: the scene object of its
+        /// `camera.json` (the case's mesh, the identity matrix) on the viewport of its
+        /// `case.json`, in place of --mesh, --scene, --width, --height, --view and --elevation.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["mesh", "scene", "width", "height"])]
+        case: Option<PathBuf>,
         /// Viewport width.
         #[arg(long, default_value_t = 512)]
         width: u32,
@@ -122,6 +131,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         scheme,
         mesh,
         scene,
+        case,
         width,
         height,
         view,
@@ -162,13 +172,20 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect::<Result<Vec<_>, _>>()?
     };
-    let spec = match &mesh {
-        Some(path) => SceneAndCamera::hashed_mesh(path, view, elevation)?,
-        None => SceneAndCamera::named(&scene, view, elevation),
+    let (spec, viewport) = match (&case, &mesh) {
+        (Some(dir), _) => conform_case(dir)?,
+        (None, Some(path)) => (
+            SceneAndCamera::hashed_mesh(path, view, elevation)?,
+            Viewport::new(width, height)?,
+        ),
+        (None, None) => (
+            SceneAndCamera::named(&scene, view, elevation),
+            Viewport::new(width, height)?,
+        ),
     };
+    let (width, height) = (viewport.width, viewport.height);
     let loaded = spec.load(None)?;
-    let viewport = Viewport::new(width, height)?;
-    let fragsim_view = loaded.view(viewport, &spec.orbit())?;
+    let fragsim_view = spec.view(&loaded, viewport)?;
     let mode = match mode {
         ModeArg::Replay => Mode::Replay,
         ModeArg::Engine => Mode::Engine,
@@ -246,4 +263,25 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         return Err(format!("{failed} of {runs} captures could not run").into());
     }
     Ok(())
+}
+
+/// The scene object and viewport of a `fragsim conform` case directory: `camera.json` (a dump
+/// header's scene object, naming the case's mesh by its absolute path) and `case.json` (its
+/// `width` and `height`).
+fn conform_case(dir: &Path) -> Result<(SceneAndCamera, Viewport), Box<dyn std::error::Error>> {
+    let read = |name: &str| {
+        let path = dir.join(name);
+        std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    let spec: SceneAndCamera = serde_json::from_str(&read("camera.json")?)
+        .map_err(|e| format!("{}: {e}", dir.join("camera.json").display()))?;
+    let about: serde_json::Value = serde_json::from_str(&read("case.json")?)
+        .map_err(|e| format!("{}: {e}", dir.join("case.json").display()))?;
+    let side = |key: &str| {
+        about[key]
+            .as_u64()
+            .and_then(|v| u32::try_from(v).ok())
+            .ok_or_else(|| format!("{}: no {key}", dir.join("case.json").display()))
+    };
+    Ok((spec, Viewport::new(side("width")?, side("height")?)?))
 }
