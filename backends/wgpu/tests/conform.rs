@@ -92,8 +92,13 @@ fn mdts_and_the_abuffer_conform_in_replay_and_engine_mode_but_for_edge_ties() {
                             .map(|m| (m.pixel as u32 % width, m.pixel as u32 / width))
                             .collect();
                         println!(
-                            "{what}: case {} differs at {pixels:?}, centres on an edge, shrunk to {:?}",
-                            found.cases_run, case.triangles
+                            "{what}: case {} shrunk to {}x{}, differs at {pixels:?} ({}), \
+                             triangles {:?}",
+                            found.cases_run,
+                            width,
+                            case.viewport.height,
+                            found.message,
+                            case.triangles
                         );
                         assert!(!pixels.is_empty(), "{what}: {found:?}");
                         assert!(
