@@ -56,10 +56,11 @@ fn centre_on_an_edge(case: &Case, x: u32, y: u32) -> bool {
 
 /// The correct shaders under the battery, each scheme and mode from three seeds: either every
 /// case passes, or the shrunk counterexample's differing pixels all have their centre exactly on
-/// a triangle's edge. Found by this test on lavapipe (2026-12-02): there lavapipe's fill rule
-/// emits samples on edges that fragsim's top-left rule leaves out (Vulkan leaves the rule to the
-/// implementation, the precision verdict does not yet), so a tie is the one difference allowed
-/// here; any other fails the test. `docs/testing.md` records what each run found.
+/// a triangle's edge. Found by this test on lavapipe (2026-12-02): lavapipe decides samples on
+/// an edge the other way from fragsim's top-left rule (an extra fragment on a right edge, a
+/// missing one on a left edge; Vulkan leaves the rule to the implementation, the precision
+/// verdict does not yet), so a tie is the one difference allowed here; any other fails the test.
+/// `docs/testing.md` records what each run found.
 #[test]
 fn mdts_and_the_abuffer_conform_in_replay_and_engine_mode_but_for_edge_ties() {
     let Some(gpu) = adapter_or_skip() else { return };
