@@ -18,14 +18,19 @@
 # `fragsim-wgpu`, the dragon, this script and the Vulkan loader's .debs in gl/ (the device has
 # the NVIDIA driver's ICD but maybe no loader); docs/results-gpu.md says how to fill it. Run
 # `bash target/devbin-wgpu/run_device.sh`. Jobs (one per scene, side, view and mode) run side by
-# side (the verdicts are CPU work), the smaller side first so that it is complete whatever
-# happens, then the larger with the dragon first; every job stops at the common deadline BUDGET
-# seconds after the start (a job not started by then says so), so the call ends in time.
+# side (the verdicts are CPU work), in the order the knobs give: each side in turn, smallest
+# first, so that it is complete whatever happens; within a side views 30° and 120° (the planted
+# ones) of every scene first, in SCENES's order (the bunny first by default, so that the bunny
+# at 512², both views, both modes, are the first jobs), then the other views. Every job stops at
+# the common deadline BUDGET seconds after the start (a job not started by then says so), so the
+# call ends in time.
 #
-# Knobs (environment): SIZES (default "512 2048"), SCENES ("dragon bunny-spheres bunny"), JOBS
-# (parallel jobs, default the cores / 2), BUDGET (seconds for all the jobs, default 210), BIN
-# (default target/devbin-wgpu), DRAGON (default $BIN/dragon_vrip.ply.gz). A dry run on lavapipe:
-# BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES="32 64" bash
+# Knobs (environment): SIZES (default "512 2048"), SCENES ("bunny dragon bunny-spheres"), VIEWS
+# ("30 120 210 300"), MODES ("replay engine"), JOBS (parallel jobs, default the cores / 2), BUDGET
+# (seconds for all the jobs, default 210), BIN (default target/devbin-wgpu), DRAGON (default
+# $BIN/dragon_vrip.ply.gz). Exactly the bunny at 512², 2 views, both modes (4 jobs):
+# SCENES=bunny SIZES=512 VIEWS="30 120" bash target/devbin-wgpu/run_device.sh. A dry run on
+# lavapipe: BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES="32 64" bash
 # backends/wgpu/run_device.sh.
 #
 # Output: every job's log on stdout and in $OUT/wgpu-device.log, then the summary table (scheme,
@@ -35,7 +40,9 @@
 set -uo pipefail
 bin=${BIN:-target/devbin-wgpu}
 sizes=${SIZES:-"512 2048"}
-scenes=${SCENES:-"dragon bunny-spheres bunny"}
+scenes=${SCENES:-"bunny dragon bunny-spheres"}
+views=${VIEWS:-"30 120 210 300"}
+modes=${MODES:-"replay engine"}
 jobs=${JOBS:-$(( $(nproc) / 2 > 0 ? $(nproc) / 2 : 1 ))}
 deadline=$(( $(date +%s) + ${BUDGET:-210} ))
 dragon=${DRAGON:-$bin/dragon_vrip.ply.gz}
@@ -87,12 +94,16 @@ one() {
 }
 export -f one
 
-# The smaller sides first; within a side the dragon and the planted views first.
+# The jobs in order: the smaller sides first; within a side the planted views (30°, 120°) of
+# every scene, then the other views.
 for side in $(echo "$sizes" | tr ' ' '\n' | sort -n); do
-    for scene in $scenes; do
-        for view in 30 120 210 300; do
-            for mode in replay engine; do
-                echo "$scene $side $view $mode"
+    for planted in yes no; do
+        for scene in $scenes; do
+            for view in $views; do
+                case $view in 30 | 120) [ $planted = yes ] ;; *) [ $planted = no ] ;; esac || continue
+                for mode in $modes; do
+                    echo "$scene $side $view $mode"
+                done
             done
         done
     done

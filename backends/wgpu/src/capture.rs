@@ -650,6 +650,12 @@ impl<'a> Run<'a> {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        // No triangle (every one clipped away, or none given): the pass still runs, so its
+        // timestamps and clear happen, but there is nothing to bind (wgpu refuses an empty
+        // buffer slice).
+        if self.geometry.count == 0 {
+            return;
+        }
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));

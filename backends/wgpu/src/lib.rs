@@ -5,16 +5,19 @@
 //!
 //! The parts: the headless device and its adapter report ([`device`]), the shaders, their passes
 //! and buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), the planted bugs
-//! ([`plant`]), one capture in replay or engine mode ([`mod@capture`]), and the judgement of a
-//! capture against fragsim's oracle ([`judge`]). The command is `fragsim-wgpu` (`src/main.rs`).
+//! ([`plant`]), one capture in replay or engine mode ([`mod@capture`]), the judgement of a
+//! capture against fragsim's oracle ([`judge`]), and the backend as the conformance battery's
+//! [`fragsim_testkit::Backend`] ([`mod@conform`]). The command is `fragsim-wgpu` (`src/main.rs`).
 
 pub mod capture;
+pub mod conform;
 pub mod device;
 pub mod judge;
 pub mod plant;
 pub mod shaders;
 
 pub use capture::{capture, capture_planted, Captured, Mode};
+pub use conform::WgpuBackend;
 pub use device::{adapter_or_skip, Gpu, GpuError};
 pub use plant::Plant;
 pub use shaders::GpuScheme;

@@ -6,14 +6,18 @@
 //! fragsim-wgpu capture --scheme abuffer,mdts --scene bunny --width 512 --height 512 \
 //!     --view 30 --mode replay --out out/wgpu --judge
 //! fragsim-wgpu capture --scheme linked-list --plant lost-node --scene bunny --out out/wgpu
+//! fragsim-wgpu capture --case DIR --scheme mdts --k 2 --mode engine --out OUT
 //! ```
+//!
+//! `--case` reads a case directory of `fragsim conform` (its `camera.json` and `case.json`), so
+//! that the command is conform's `--backend` (`docs/testing.md`).
 //!
 //! Exit status: 0 on success (whatever the verdicts), 2 on an error (no adapter, bad input).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::Viewport;
@@ -42,63 +46,72 @@ enum Command {
     /// Print the adapter and the features the shaders use.
     Adapter,
     /// Capture a scene with one or more schemes; one dump per scheme in OUT/<scheme>/.
-    #[command(group(clap::ArgGroup::new("verdicts").args(["judge", "precision"]).multiple(true)))]
-    Capture {
-        /// Schemes, comma-separated: abuffer, abuffer-exact, mdts, mdts32, kbuffer,
-        /// linked-list, linked-list-nearest, kbuffer-spinlock-fixed; or all.
-        #[arg(long, default_value = "abuffer,mdts,mdts32")]
-        scheme: String,
-        /// A mesh file (OBJ or PLY, optionally gzipped).
-        #[arg(long, conflicts_with = "scene")]
-        mesh: Option<PathBuf>,
-        /// A named scene (bunny, bunny-spheres, spheres:N, soup, quads).
-        #[arg(long, default_value = "bunny")]
-        scene: String,
-        /// Viewport width.
-        #[arg(long, default_value_t = 512)]
-        width: u32,
-        /// Viewport height.
-        #[arg(long, default_value_t = 512)]
-        height: u32,
-        /// Orbit angle, degrees.
-        #[arg(long, default_value_t = 30.0)]
-        view: f64,
-        /// Elevation, degrees.
-        #[arg(long, default_value_t = 15.0)]
-        elevation: f64,
-        /// replay: fragsim's snapped triangles; engine: the mesh and the f32 matrix.
-        #[arg(long, value_enum, default_value = "replay")]
-        mode: ModeArg,
-        /// MDTS and k-buffer slots per pixel; linked lists: the nodes the resolve keeps.
-        #[arg(long, default_value_t = 8)]
-        k: u32,
-        /// A-buffer slots per pixel (FreePipe's 20); linked lists: pool nodes per pixel.
-        #[arg(long, default_value_t = 20)]
-        capacity: u32,
-        /// Planted bugs' shader variants, comma-separated: dropped, wrong-id,
-        /// off-by-one-capacity, unsorted, lost-node, or none (the correct shader); each scheme
-        /// runs once per plant (dumps in OUT/<scheme>-planted-<plant>/). `all`: the correct
-        /// shader and every plant that applies to the scheme, the others skipped.
-        #[arg(long, default_value = "none", value_delimiter = ',')]
-        plant: Vec<String>,
-        /// Judge without writing the dumps (a device run whose dumps would not come back).
-        #[arg(long, requires = "verdicts")]
-        discard: bool,
-        /// Output directory.
-        #[arg(long, default_value = "out/wgpu")]
-        out: PathBuf,
-        /// Also judge each dump against fragsim's oracle here and print the verdict.
-        #[arg(long)]
-        judge: bool,
-        /// With --judge: as `fragsim compare --depth-ulps`; a comma-separated list gives one
-        /// verdict per value.
-        #[arg(long, default_value = "0", value_delimiter = ',')]
-        depth_ulps: Vec<u32>,
-        /// Also judge each dump within the precision of an f32 vertex stage (issue 16's verdict:
-        /// `fragsim compare oracle DIR --vertex-precision f32`) and print it.
-        #[arg(long)]
-        precision: bool,
-    },
+    Capture(Box<CaptureArgs>),
+}
+
+/// Options of `fragsim-wgpu capture`.
+#[derive(Args)]
+#[command(group(clap::ArgGroup::new("verdicts").args(["judge", "precision"]).multiple(true)))]
+struct CaptureArgs {
+    /// Schemes, comma-separated: abuffer, abuffer-exact, mdts, mdts32, kbuffer,
+    /// linked-list, linked-list-nearest, kbuffer-spinlock-fixed; or all.
+    #[arg(long, default_value = "abuffer,mdts,mdts32")]
+    scheme: String,
+    /// A mesh file (OBJ or PLY, optionally gzipped).
+    #[arg(long, conflicts_with = "scene")]
+    mesh: Option<PathBuf>,
+    /// A named scene (bunny, bunny-spheres, spheres:N, soup, quads).
+    #[arg(long, default_value = "bunny")]
+    scene: String,
+    /// A case directory of `fragsim conform` instead of a scene: the scene object of its
+    /// `camera.json` (the case's mesh, the identity matrix) on the viewport of its
+    /// `case.json`, in place of --mesh, --scene, --width, --height, --view and --elevation.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["mesh", "scene", "width", "height"])]
+    case: Option<PathBuf>,
+    /// Viewport width.
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// Viewport height.
+    #[arg(long, default_value_t = 512)]
+    height: u32,
+    /// Orbit angle, degrees.
+    #[arg(long, default_value_t = 30.0)]
+    view: f64,
+    /// Elevation, degrees.
+    #[arg(long, default_value_t = 15.0)]
+    elevation: f64,
+    /// replay: fragsim's snapped triangles; engine: the mesh and the f32 matrix.
+    #[arg(long, value_enum, default_value = "replay")]
+    mode: ModeArg,
+    /// MDTS and k-buffer slots per pixel; linked lists: the nodes the resolve keeps.
+    #[arg(long, default_value_t = 8)]
+    k: u32,
+    /// A-buffer slots per pixel (FreePipe's 20); linked lists: pool nodes per pixel.
+    #[arg(long, default_value_t = 20)]
+    capacity: u32,
+    /// Planted bugs' shader variants, comma-separated: dropped, wrong-id,
+    /// off-by-one-capacity, unsorted, lost-node, or none (the correct shader); each scheme
+    /// runs once per plant (dumps in OUT/<scheme>-planted-<plant>/). `all`: the correct
+    /// shader and every plant that applies to the scheme, the others skipped.
+    #[arg(long, default_value = "none", value_delimiter = ',')]
+    plant: Vec<String>,
+    /// Judge without writing the dumps (a device run whose dumps would not come back).
+    #[arg(long, requires = "verdicts")]
+    discard: bool,
+    /// Output directory.
+    #[arg(long, default_value = "out/wgpu")]
+    out: PathBuf,
+    /// Also judge each dump against fragsim's oracle here and print the verdict.
+    #[arg(long)]
+    judge: bool,
+    /// With --judge: as `fragsim compare --depth-ulps`; a comma-separated list gives one
+    /// verdict per value.
+    #[arg(long, default_value = "0", value_delimiter = ',')]
+    depth_ulps: Vec<u32>,
+    /// Also judge each dump within the precision of an f32 vertex stage (issue 16's verdict:
+    /// `fragsim compare oracle DIR --vertex-precision f32`) and print it.
+    #[arg(long)]
+    precision: bool,
 }
 
 fn main() -> ExitCode {
@@ -118,10 +131,14 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     let gpu = Gpu::open()?;
     println!("{}", gpu.report());
-    let Command::Capture {
+    let Command::Capture(args) = cli.command else {
+        return Ok(());
+    };
+    let CaptureArgs {
         scheme,
         mesh,
         scene,
+        case,
         width,
         height,
         view,
@@ -135,10 +152,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         judge: judge_it,
         depth_ulps,
         precision,
-    } = cli.command
-    else {
-        return Ok(());
-    };
+    } = *args;
     let names: Vec<&str> = if scheme == "all" {
         NAMES.to_vec()
     } else {
@@ -162,13 +176,20 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect::<Result<Vec<_>, _>>()?
     };
-    let spec = match &mesh {
-        Some(path) => SceneAndCamera::hashed_mesh(path, view, elevation)?,
-        None => SceneAndCamera::named(&scene, view, elevation),
+    let (spec, viewport) = match (&case, &mesh) {
+        (Some(dir), _) => conform_case(dir)?,
+        (None, Some(path)) => (
+            SceneAndCamera::hashed_mesh(path, view, elevation)?,
+            Viewport::new(width, height)?,
+        ),
+        (None, None) => (
+            SceneAndCamera::named(&scene, view, elevation),
+            Viewport::new(width, height)?,
+        ),
     };
+    let (width, height) = (viewport.width, viewport.height);
     let loaded = spec.load(None)?;
-    let viewport = Viewport::new(width, height)?;
-    let fragsim_view = loaded.view(viewport, &spec.orbit())?;
+    let fragsim_view = spec.view(&loaded, viewport)?;
     let mode = match mode {
         ModeArg::Replay => Mode::Replay,
         ModeArg::Engine => Mode::Engine,
@@ -246,4 +267,25 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         return Err(format!("{failed} of {runs} captures could not run").into());
     }
     Ok(())
+}
+
+/// The scene object and viewport of a `fragsim conform` case directory: `camera.json` (a dump
+/// header's scene object, naming the case's mesh by its absolute path) and `case.json` (its
+/// `width` and `height`).
+fn conform_case(dir: &Path) -> Result<(SceneAndCamera, Viewport), Box<dyn std::error::Error>> {
+    let read = |name: &str| {
+        let path = dir.join(name);
+        std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    let spec: SceneAndCamera = serde_json::from_str(&read("camera.json")?)
+        .map_err(|e| format!("{}: {e}", dir.join("camera.json").display()))?;
+    let about: serde_json::Value = serde_json::from_str(&read("case.json")?)
+        .map_err(|e| format!("{}: {e}", dir.join("case.json").display()))?;
+    let side = |key: &str| {
+        about[key]
+            .as_u64()
+            .and_then(|v| u32::try_from(v).ok())
+            .ok_or_else(|| format!("{}: no {key}", dir.join("case.json").display()))
+    };
+    Ok((spec, Viewport::new(side("width")?, side("height")?)?))
 }

@@ -18,7 +18,7 @@ use clap::Args;
 use fragsim_capture::catalog::SchemeName;
 use fragsim_oracle::scene::{mesh_hash, SceneAndCamera};
 use fragsim_oracle::PixelMismatch;
-use fragsim_raster::{depth_from_key, Conventions};
+use fragsim_raster::{depth_from_key, Conventions, VertexPrecision};
 use fragsim_testkit::{
     Battery, Case, CommandBackend, Counterexample, Event, Failure, Input, Limits, Params,
 };
@@ -72,6 +72,16 @@ pub struct ConformArgs {
     /// (`DIR/work/`, removed at the end).
     #[arg(long, value_name = "DIR", default_value = "out/conform")]
     pub save: PathBuf,
+    /// How the backend's vertex stage is judged, as `compare --vertex-precision`: `f64` (the
+    /// default) owes the oracle every bit; `f32` (a vertex shader, a GPU's depth interpolation)
+    /// judges each case within the bounds derived for an f32 vertex stage against the exact f64
+    /// one (`docs/semantics.md`, "Precision of a conforming implementation").
+    #[arg(long, value_name = "f64|f32", default_value = "f64", value_parser = ["f64", "f32"])]
+    pub vertex_precision: String,
+    /// Generate (and shrink to) viewports whose sides are powers of two only, for a backend
+    /// that takes no other (the wgpu backend's replay mode).
+    #[arg(long)]
+    pub power_of_two: bool,
     /// Print JSON Lines instead of the report: one `conform` record, then one
     /// `counterexample_pixel` record per differing pixel shown (`docs/json-schema.md`).
     #[arg(long)]
@@ -113,6 +123,7 @@ struct Summary {
     conform_scheme: String,
     cases: u32,
     seed: u64,
+    vertex_precision: String,
     cases_run: u32,
     shrink_steps: Option<u32>,
     property: Option<String>,
@@ -166,6 +177,12 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         template: args.backend.clone(),
         timeout: Duration::from_secs_f64(args.timeout),
         work: work.clone(),
+        vertex_precision: if args.vertex_precision == "f32" {
+            VertexPrecision::F32
+        } else {
+            VertexPrecision::F64
+        },
+        power_of_two: args.power_of_two,
     };
     let battery = Battery::new(&backend, params)
         .cases(args.cases)
@@ -174,6 +191,8 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         .limits(Limits {
             max_side: args.max_side,
             max_triangles: args.max_triangles as usize,
+            power_of_two: args.power_of_two,
+            ..Limits::default()
         });
     let bar = crate::progress::bar(u64::from(args.cases), "conform");
     let result = battery.run_with(&mut |event| match event {
@@ -189,6 +208,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         conform_scheme: scheme.name().to_string(),
         cases: args.cases,
         seed: args.seed,
+        vertex_precision: args.vertex_precision.clone(),
         cases_run: args.cases,
         shrink_steps: None,
         property: None,
@@ -209,14 +229,15 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
                 record::emit("conform", &context, &summary)?;
             } else {
                 outln!(
-                    "conform: {} passes {} cases of {} (k {}, capacity {}, seed {}): equal to the \
-                     oracle, order-independent, overflow as predicted",
+                    "conform: {} passes {} cases of {} (k {}, capacity {}, seed {}, {} vertex \
+                     stage): equal to the oracle, order-independent, overflow as predicted",
                     args.backend,
                     args.cases,
                     scheme.name(),
                     args.k,
                     args.capacity,
-                    args.seed
+                    args.seed,
+                    args.vertex_precision
                 );
             }
             return Ok(true);
@@ -311,8 +332,12 @@ fn save(
     let replay = vec![
         backend.command_line(&absolute.join("scene"), &absolute.join("out"), params),
         format!(
-            "fragsim compare oracle '{}'",
-            absolute.join("out").display()
+            "fragsim compare oracle '{}'{}",
+            absolute.join("out").display(),
+            match backend.vertex_precision {
+                VertexPrecision::F32 => " --vertex-precision f32",
+                VertexPrecision::F64 => "",
+            }
         ),
     ];
     let mut script =

@@ -11,7 +11,7 @@ use fragsim_capture::executors::scheduled::run_scheduled;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::{Capture, Guarantee, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim_oracle::dump::Dump;
-use fragsim_raster::{View, Viewport};
+use fragsim_raster::{VertexPrecision, View, Viewport};
 
 use crate::case::Case;
 
@@ -80,6 +80,21 @@ pub trait Backend {
     /// Whether the backend runs each pixel's fragments one at a time in primitive order (then
     /// the guarantees that exclude hazards are owed). `false` for a GPU.
     fn serialises_pixels(&self) -> bool {
+        false
+    }
+
+    /// The precision of the backend's vertex stage and depth interpolation, as it declares it:
+    /// [`VertexPrecision::F64`] (the default) owes the oracle every bit; [`VertexPrecision::F32`]
+    /// (a GPU's vertex shader and interpolator) is judged within the bounds derived for an f32
+    /// vertex stage (`docs/semantics.md`, "Precision of a conforming implementation").
+    fn vertex_precision(&self) -> VertexPrecision {
+        VertexPrecision::F64
+    }
+
+    /// Whether the backend takes only viewports whose sides are powers of two (a replay of
+    /// fragsim's snapped triangles through clip coordinates that are exact only then): the
+    /// battery then generates and shrinks to such viewports alone.
+    fn power_of_two_viewports(&self) -> bool {
         false
     }
 

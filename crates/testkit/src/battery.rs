@@ -5,7 +5,8 @@
 //! The properties, on every case:
 //! - **equal**: the backend's output is equal to the oracle under the scheme's promise (the K
 //!   nearest, every fragment but the predicted overflow), judged by [`crate::judge`] (what
-//!   `fragsim compare oracle DUMP` says); the case's ties (coplanar triangles at equal depths)
+//!   `fragsim compare oracle DUMP` says, within the precision of an f32 vertex stage where the
+//!   backend declares one: [`Backend::vertex_precision`]); the case's ties (coplanar triangles at equal depths)
 //!   are judged by the canonical order, the primitive id, and its extremes (depths 0 and 1,
 //!   near- and far-plane crossers, guard-band clipping, 1×1 viewports) are in the generator;
 //! - **order-independent**: the same triangles submitted in another order ([`Case::permuted`])
@@ -244,7 +245,7 @@ impl<'b> Battery<'b> {
         let (cases_run, shrink_steps) = (Cell::new(0u32), Cell::new(0u32));
         let last_found = RefCell::new(None);
         let setup = RefCell::new(None);
-        let result = runner.run(&case(self.limits).boxed(), |case| {
+        let result = runner.run(&case(self.case_limits()).boxed(), |case| {
             // A backend that cannot run fails every case alike: stop at once, shrink nothing.
             if setup.borrow().is_some() {
                 return Ok(());
@@ -319,7 +320,8 @@ impl<'b> Battery<'b> {
     ) -> (Case, Found) {
         loop {
             let mut smaller = None;
-            for candidate in candidates(&case, &found) {
+            let power_of_two = self.case_limits().power_of_two;
+            for candidate in candidates(&case, &found, power_of_two) {
                 *steps += 1;
                 on_event(Event::Shrink(*steps));
                 if let Err(Stop::Found(f)) = self.check(&candidate) {
@@ -331,6 +333,15 @@ impl<'b> Battery<'b> {
                 Some((c, f)) => (case, found) = (c, f),
                 None => return (case, found),
             }
+        }
+    }
+
+    /// The limits cases are generated and shrunk within: the battery's, with the backend's
+    /// viewports ([`Backend::power_of_two_viewports`]).
+    fn case_limits(&self) -> Limits {
+        Limits {
+            power_of_two: self.limits.power_of_two || self.backend.power_of_two_viewports(),
+            ..self.limits
         }
     }
 
@@ -370,7 +381,7 @@ impl<'b> Battery<'b> {
             BackendError::Setup(message) => Stop::Setup(message),
             BackendError::Failed(message) => found(Property::Runs, message, None, fragments),
         })?;
-        let comparison = judge(&view, &oracle, &output)
+        let comparison = judge(&view, &oracle, &output, self.backend.vertex_precision())
             .map_err(|e| found(Property::Runs, e, None, fragments))?;
         if comparison.claimed_overflow != comparison.diff.overflowed {
             let message = format!(
@@ -393,9 +404,10 @@ impl<'b> Battery<'b> {
 }
 
 /// Smaller cases to try after `case` failed with `found`, most promising first: fewer pixels
-/// (crops around the differing pixels, under the case's schedule and seeds 0 to 3), then fewer
-/// triangles.
-fn candidates(case: &Case, found: &Found) -> Vec<Case> {
+/// (crops around the differing pixels, under the case's schedule and seeds 0 to 3; with
+/// `power_of_two` each crop's sides rounded up to powers of two, and moved back inside the
+/// viewport), then fewer triangles.
+fn candidates(case: &Case, found: &Found, power_of_two: bool) -> Vec<Case> {
     let viewport = case.viewport;
     let (w, h) = (viewport.width, viewport.height);
     let differing: Vec<(u32, u32)> = found.comparison.as_ref().map_or(Vec::new(), |c| {
@@ -427,7 +439,11 @@ fn candidates(case: &Case, found: &Found) -> Vec<Case> {
         (0, h - hh, w, hh),
     ]);
     let mut out = Vec::new();
-    for (x, y, cw, ch) in windows {
+    for (mut x, mut y, mut cw, mut ch) in windows {
+        if power_of_two {
+            (cw, ch) = (cw.next_power_of_two().min(w), ch.next_power_of_two().min(h));
+            (x, y) = (x.min(w - cw), y.min(h - ch));
+        }
         if u64::from(cw) * u64::from(ch) >= u64::from(w) * u64::from(h) {
             continue;
         }

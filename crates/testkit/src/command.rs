@@ -25,7 +25,7 @@ use fragsim_capture::Guarantee;
 use fragsim_oracle::dump::Dump;
 use fragsim_oracle::scene::mesh_hash;
 use fragsim_oracle::triangles::TriangleExport;
-use fragsim_raster::View;
+use fragsim_raster::{VertexPrecision, View};
 
 use crate::backend::{Backend, BackendError, Input, Output, Params};
 use crate::case::Case;
@@ -43,6 +43,12 @@ pub struct CommandBackend {
     pub timeout: Duration,
     /// Where the cases are written (`current/` inside it, replaced at every case).
     pub work: PathBuf,
+    /// The precision of the command's vertex stage ([`Backend::vertex_precision`]): `F32` for a
+    /// GPU's vertex shader and interpolator, judged within the bounds derived for it.
+    pub vertex_precision: VertexPrecision,
+    /// Whether the command takes only viewports whose sides are powers of two
+    /// ([`Backend::power_of_two_viewports`]).
+    pub power_of_two: bool,
 }
 
 /// A path as one shell word.
@@ -197,6 +203,14 @@ impl Backend for CommandBackend {
     /// Exactness under the scheme's promise: what `fragsim compare` holds a dump to.
     fn guarantee(&self, _: &Params) -> Result<Guarantee, String> {
         Ok(Guarantee::Exact)
+    }
+
+    fn vertex_precision(&self) -> VertexPrecision {
+        self.vertex_precision
+    }
+
+    fn power_of_two_viewports(&self) -> bool {
+        self.power_of_two
     }
 
     fn capture(&self, input: &Input<'_>) -> Result<Output, BackendError> {
