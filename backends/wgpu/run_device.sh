@@ -138,5 +138,11 @@ summary() {
 }
 echo
 echo "== summary (coverage px: pixels whose primitive ids or counts differ from fragsim's / A-buffer counters that differ; ms: GPU timestamps)"
-summary | tee "$out/wgpu-summary.tsv" | column -t -s $'\t'
+# The table aligned where `column` exists (the H200 machine has none: its summary was lost once).
+summary > "$out/wgpu-summary.tsv"
+if command -v column > /dev/null; then
+    column -t -s $'\t' "$out/wgpu-summary.tsv"
+else
+    cat "$out/wgpu-summary.tsv"
+fi
 rm -rf "$logs"
