@@ -19,6 +19,7 @@ pub mod loop64;
 pub mod mdts;
 pub mod mdts_emulated64;
 pub mod mdts_packed;
+pub mod mlab;
 pub mod peeling;
 pub mod stencil_routed;
 pub mod zbuffer;
