@@ -89,9 +89,24 @@ fn the_colour_error_per_depth_complexity_lies_only_past_the_nodes() {
     let out = out_dir("depth");
     let output = Command::cargo_bin("fragsim")
         .unwrap()
-        .args(["bench", "--scene", "spheres:3", "--width", "48", "--height", "48"])
+        .args([
+            "bench",
+            "--scene",
+            "spheres:3",
+            "--width",
+            "48",
+            "--height",
+            "48",
+        ])
         .args(["--frames", "1", "--no-images", "--scheme", "mdts"])
-        .args(["--approximate", "mlab,tail-blend", "--k", "1", "--shuffle", "1"])
+        .args([
+            "--approximate",
+            "mlab,tail-blend",
+            "--k",
+            "1",
+            "--shuffle",
+            "1",
+        ])
         .arg("--out")
         .arg(&out)
         .output()
@@ -118,7 +133,15 @@ fn the_catalogs_mlab_is_judged_exact_on_every_executor() {
     let output = Command::cargo_bin("fragsim")
         .unwrap()
         .args(["--scene", "spheres:3", "--width", "48", "--height", "48"])
-        .args(["--scheme", "mlab", "--k", "2", "--executor", "all", "--no-images"])
+        .args([
+            "--scheme",
+            "mlab",
+            "--k",
+            "2",
+            "--executor",
+            "all",
+            "--no-images",
+        ])
         .args(["--json", "--out"])
         .arg(out_dir("catalog-mlab"))
         .output()
@@ -130,7 +153,11 @@ fn the_catalogs_mlab_is_judged_exact_on_every_executor() {
     );
     let records = crate::support::json_lines(&output.stdout);
     let runs: Vec<&Value> = records.iter().filter(|r| r["scheme"] == "mlab").collect();
-    assert_eq!(runs.len(), 4, "serial, parallel, tiled, scheduled: {records:?}");
+    assert_eq!(
+        runs.len(),
+        4,
+        "serial, parallel, tiled, scheduled: {records:?}"
+    );
     for run in runs {
         assert_eq!(run["guarantee"], "exact", "{run}");
         assert_eq!(run["keeps_guarantee"], true, "{run}");

@@ -616,5 +616,10 @@ fn every_scheme_name_a_run_prints_is_the_name_it_was_given() {
             record["scheme"].as_str().unwrap().to_string()
         })
         .collect();
-    assert_eq!(printed, names, "{}", String::from_utf8_lossy(&output.stderr));
+    assert_eq!(
+        printed,
+        names,
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
 }

@@ -147,10 +147,7 @@ pub(crate) fn measure(
     let blend_ms = times[times.len() / 2].as_secs_f64() * 1e3;
     let limit = approximation.k().unwrap_or(1);
     let depth_complexity = oracle.depth_complexity();
-    let pixels_beyond_nodes = depth_complexity
-        .iter()
-        .filter(|&&n| n > limit)
-        .count() as u64;
+    let pixels_beyond_nodes = depth_complexity.iter().filter(|&&n| n > limit).count() as u64;
     let judged = judge.judge_image(image, None)?;
     let by_depth = colour_error_by_depth(judged.reference, &judged.image, &depth_complexity)?;
     let pixels = oracle.pixels() as u64;

@@ -43,14 +43,8 @@ pub fn colour_error(reference: &RgbImage, candidate: &RgbImage) -> Result<Colour
 
 /// Depth-complexity buckets of [`colour_error_by_depth`]: fragments per pixel from `lo` to `hi`
 /// inclusive (`hi = u32::MAX`: no upper end). Powers of two, as the hazard charts bucket.
-pub const DEPTH_BUCKETS: [(u32, u32); 6] = [
-    (1, 1),
-    (2, 4),
-    (5, 8),
-    (9, 16),
-    (17, 32),
-    (33, u32::MAX),
-];
+pub const DEPTH_BUCKETS: [(u32, u32); 6] =
+    [(1, 1), (2, 4), (5, 8), (9, 16), (17, 32), (33, u32::MAX)];
 
 /// The colour error over the covered pixels of one depth-complexity bucket.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,7 +99,10 @@ pub fn colour_error_by_depth(
         .zip(candidate.pixels())
         .zip(depth_complexity)
     {
-        if let Some(i) = DEPTH_BUCKETS.iter().position(|&(lo, hi)| (lo..=hi).contains(&n)) {
+        if let Some(i) = DEPTH_BUCKETS
+            .iter()
+            .position(|&(lo, hi)| (lo..=hi).contains(&n))
+        {
             sums[i].add(a.0, b.0);
         }
     }
@@ -230,6 +227,9 @@ mod tests {
         assert!(buckets[5].error.unwrap().psnr_db.is_infinite());
         assert!(buckets[2].error.is_none());
         let short = colour_error_by_depth(&reference, &candidate, &[1, 2]).unwrap_err();
-        assert!(short.contains("2 depth-complexity counts for 4 pixels"), "{short}");
+        assert!(
+            short.contains("2 depth-complexity counts for 4 pixels"),
+            "{short}"
+        );
     }
 }

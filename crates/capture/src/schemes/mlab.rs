@@ -184,7 +184,11 @@ impl Scheme for Mlab {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every section leaves the nodes sorted.
-        out.extend(self.nodes(memory, pixel).into_iter().map(|(depth, _)| depth));
+        out.extend(
+            self.nodes(memory, pixel)
+                .into_iter()
+                .map(|(depth, _)| depth),
+        );
         // What was merged is not in the list: the executors count it from the walks.
         0
     }
@@ -235,9 +239,8 @@ mod tests {
                 let mut dropped = 0;
                 for &i in &perm {
                     let mut steps = 0;
-                    dropped += usize::from(
-                        scheme.insert(stream[i], &memory, &mut steps) == Step::Dropped,
-                    );
+                    dropped +=
+                        usize::from(scheme.insert(stream[i], &memory, &mut steps) == Step::Dropped);
                     assert_eq!(steps, 1, "one critical section a fragment");
                 }
                 let kept = (k as usize).min(stream.len());
