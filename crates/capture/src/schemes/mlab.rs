@@ -28,7 +28,7 @@
 //! of the exact image, and it is not a fragment list the oracle could diff: the capture crate
 //! knows no colours. So the catalog entry holds MLAB's node structure to the oracle (where MLAB
 //! promises exactness: the nodes' depths), and its image is measured, never judged, by
-//! [`fragsim_shade::approximate`]'s `Mlab` (the same merge rule, with colour) through
+//! `fragsim_shade::approximate`'s `Mlab` (the same merge rule, with colour) through
 //! `fragsim bench --approximate mlab`: error pixels, mean and maximum colour error, PSNR, per
 //! depth-complexity bucket. The catalog row's own transparency image is that of its node
 //! depths (the `K` nearest, as MDTS's), not MLAB's merged colour.
