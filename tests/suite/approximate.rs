@@ -81,9 +81,9 @@ fn depth_rows(markdown: &str, scheme: &str) -> Vec<(String, u64, f64)> {
         .collect()
 }
 
-/// With one node, the per-depth table of bench.md puts every error past the nodes: the bucket
-/// of one fragment has none, the deeper buckets hold them, and the buckets' pixels are the
-/// covered pixels.
+/// With four nodes, the per-depth table of bench.md puts every error past the nodes: the bucket
+/// of 2–4 fragments (`spheres:3` has no pixel of one) has none, the deeper bucket holds them.
+/// Measured (seed 1): 5–8 fragments, 52 pixels, 13.462 % for both schemes.
 #[test]
 fn the_colour_error_per_depth_complexity_lies_only_past_the_nodes() {
     let out = out_dir("depth");
@@ -103,7 +103,7 @@ fn the_colour_error_per_depth_complexity_lies_only_past_the_nodes() {
             "--approximate",
             "mlab,tail-blend",
             "--k",
-            "1",
+            "4",
             "--shuffle",
             "1",
         ])
@@ -120,7 +120,7 @@ fn the_colour_error_per_depth_complexity_lies_only_past_the_nodes() {
     let _ = std::fs::remove_dir_all(&out);
     for scheme in ["mlab", "tail-blend"] {
         let rows = depth_rows(&markdown, scheme);
-        assert_eq!(rows[0].0, "1", "{markdown}");
+        assert_eq!(rows[0].0, "2–4", "{markdown}");
         assert!(rows[0].1 > 0 && rows[0].2 == 0.0, "{scheme}: {rows:?}");
         assert!(rows[1..].iter().any(|r| r.2 > 0.0), "{scheme}: {rows:?}");
     }
