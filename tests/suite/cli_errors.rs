@@ -583,3 +583,43 @@ fn help_with_help_prints_help() {
         assert!(stdout.contains("Usage: fragsim"), "{args:?}: {stdout}");
     }
 }
+
+/// Issue 20, item 6: every scheme's name, as a run prints it, is the one `--scheme` takes (it
+/// printed `srab-2pass` for `srab`), and `--capacity 1` does not turn `abuffer` into another
+/// scheme (it ran `abuffer-fixed`).
+#[test]
+fn every_scheme_name_a_run_prints_is_the_name_it_was_given() {
+    let names: Vec<&str> = fragsim::capture::catalog::CATALOG
+        .iter()
+        .map(|e| e.name)
+        .collect();
+    let output = fragsim(&[
+        "--scene",
+        "quads:2",
+        "--scheme",
+        &names.join(","),
+        "--capacity",
+        "1",
+        "--k",
+        "2",
+        "--json",
+        "--out",
+        &std::env::temp_dir()
+            .join(format!("fragsim-names-{}", std::process::id()))
+            .to_string_lossy(),
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let printed: Vec<String> = stdout
+        .lines()
+        .map(|line| {
+            let record: serde_json::Value = serde_json::from_str(line).unwrap();
+            record["scheme"].as_str().unwrap().to_string()
+        })
+        .collect();
+    assert_eq!(
+        printed,
+        names,
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}

@@ -524,9 +524,11 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
                 .approximate
                 .iter()
                 .map(|r| fragsim_shade::plot::Point {
+                    // "blend": the approximate image, told apart from the catalog's `mlab`
+                    // row (its node depths, labelled by executor).
                     label: match r.nodes {
-                        Some(k) => format!("{} (K = {k})", r.scheme),
-                        None => r.scheme.clone(),
+                        Some(k) => format!("{} (blend, K = {k})", r.scheme),
+                        None => format!("{} (blend)", r.scheme),
                     },
                     family: family(&r.scheme),
                     time_ms: r.time_ms,

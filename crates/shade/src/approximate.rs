@@ -15,6 +15,18 @@
 //! So on a GPU each is deterministic, whatever the thread schedule, and so it is here: the
 //! caller hands every pixel's fragments in submission order ([`in_submission_order`]).
 //!
+//! **Why these are shading options, and MLAB also a catalog entry.** A catalog entry is judged
+//! by its fragment lists against the oracle's; what is here is judged by its image. WBOIT keeps
+//! no fragment at all (two blend targets), so a catalog entry would capture nothing and its
+//! verdict would say nothing. Tail blending's sorted part is any capture of the `K` nearest
+//! (`mdts`, `kbuffer-interlock`, already in the catalog and judged there); its tail is the
+//! blending hardware's, fragments folded into a colour target in arrival order, with no list
+//! left to judge: so it is a shading option of those bounded captures, applied here to every
+//! pixel's fragments in submission order. MLAB's node structure is a capture with a checkable
+//! promise (its node depths are exactly the `K` nearest, whatever the interleaving), so it is
+//! also the catalog's `mlab` ([`fragsim_capture::schemes::mlab`], judged on every executor);
+//! its colour, the approximation, is measured here.
+//!
 //! **Guarantees.** [`Approximation::Mlab`] and [`Approximation::TailBlend`] with `K` nodes are
 //! the exact image at every pixel with at most `K` fragments (nothing merged, nothing evicted:
 //! the same operations, in the same order, as the exact effect), and may differ only at pixels
@@ -32,9 +44,8 @@
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_raster::Fragment;
 use image::RgbImage;
-use rayon::prelude::*;
 
-use crate::effects::{encode_srgb, primitive_colour, Material};
+use crate::effects::{primitive_colour, shade_image, Material};
 
 /// An approximate OIT scheme and its size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,22 +115,10 @@ impl Approximation {
     pub fn render<'a>(
         self,
         material: &Material,
-        (width, height): (u32, u32),
+        size: (u32, u32),
         arrivals: impl Fn(usize) -> &'a [u64] + Sync,
     ) -> RgbImage {
-        let row = width as usize * 3;
-        let mut bytes = vec![0u8; row * height as usize];
-        bytes
-            .par_chunks_mut(row.max(1))
-            .enumerate()
-            .for_each(|(y, out)| {
-                for (x, rgb) in out.chunks_exact_mut(3).enumerate() {
-                    let p = y * width as usize + x;
-                    let colour = self.shade_pixel(material, arrivals(p));
-                    rgb.copy_from_slice(&colour.map(encode_srgb));
-                }
-            });
-        RgbImage::from_raw(width, height, bytes).expect("the buffer has width × height pixels")
+        shade_image(size, |p| self.shade_pixel(material, arrivals(p)))
     }
 }
 

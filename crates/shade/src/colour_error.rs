@@ -9,7 +9,8 @@
 //! `PSNR = 10 log10(255² / MSE)` dB with `MSE` the mean squared error over all `3 N` values
 //! (the usual definition for 8-bit images; infinite for equal images). The values compared are
 //! the encoded 8-bit ones the error-pixel rate compares, so the two measures speak of the same
-//! images.
+//! images. [`colour_error_by_depth`] gives the same figures per bucket of pixels' depth
+//! complexity, where an approximate scheme's error lives (past its `K` nodes).
 
 use image::RgbImage;
 
@@ -29,32 +30,138 @@ pub struct ColourError {
 /// # Errors
 /// The images differ in size, or are empty.
 pub fn colour_error(reference: &RgbImage, candidate: &RgbImage) -> Result<ColourError, String> {
-    if reference.dimensions() != candidate.dimensions() {
-        return Err(format!(
-            "cannot compare a {:?} image with a {:?} one",
-            candidate.dimensions(),
-            reference.dimensions()
-        ));
-    }
-    let pixels = u64::from(reference.width()) * u64::from(reference.height());
-    if pixels == 0 {
+    check_sizes(reference, candidate)?;
+    if reference.width() == 0 || reference.height() == 0 {
         return Err("cannot compare empty images".into());
     }
-    let (mut sum, mut max, mut squares) = ([0u64; 3], [0u8; 3], 0u64);
+    let mut sums = Sums::default();
     for (a, b) in reference.pixels().zip(candidate.pixels()) {
-        for c in 0..3 {
-            let d = a[c].abs_diff(b[c]);
-            sum[c] += u64::from(d);
-            max[c] = max[c].max(d);
-            squares += u64::from(d) * u64::from(d);
+        sums.add(a.0, b.0);
+    }
+    Ok(sums.error())
+}
+
+/// Depth-complexity buckets of [`colour_error_by_depth`]: fragments per pixel from `lo` to `hi`
+/// inclusive (`hi = u32::MAX`: no upper end). Powers of two, as the hazard charts bucket.
+pub const DEPTH_BUCKETS: [(u32, u32); 6] =
+    [(1, 1), (2, 4), (5, 8), (9, 16), (17, 32), (33, u32::MAX)];
+
+/// The colour error over the covered pixels of one depth-complexity bucket.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BucketError {
+    /// Fewest fragments per pixel of the bucket.
+    pub lo: u32,
+    /// Most fragments per pixel of the bucket (`u32::MAX`: no upper end).
+    pub hi: u32,
+    /// Pixels with that many fragments.
+    pub pixels: u64,
+    /// Of them, those whose 8-bit colour differs.
+    pub error_pixels: u64,
+    /// The colour error over them (`None`: no pixel in the bucket).
+    pub error: Option<ColourError>,
+}
+
+impl BucketError {
+    /// The bucket's name in tables: `1`, `2–4`, `33+`.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match (self.lo, self.hi) {
+            (lo, hi) if lo == hi => lo.to_string(),
+            (lo, u32::MAX) => format!("{lo}+"),
+            (lo, hi) => format!("{lo}–{hi}"),
         }
     }
-    let mse = squares as f64 / (3 * pixels) as f64;
-    Ok(ColourError {
-        mean_abs: sum.map(|s| s as f64 / pixels as f64),
-        max_abs: max,
-        psnr_db: 10.0 * (255.0f64 * 255.0 / mse).log10(),
-    })
+}
+
+/// The colour error of `candidate` against `reference` per bucket of [`DEPTH_BUCKETS`], pixel
+/// `p` (row-major) having `depth_complexity[p]` fragments; pixels without one are left out (both
+/// images show the background there). The approximate schemes' error grows with the fragments a
+/// pixel has, which one figure over the whole image hides.
+///
+/// # Errors
+/// The images differ in size, or `depth_complexity` is not one count a pixel.
+pub fn colour_error_by_depth(
+    reference: &RgbImage,
+    candidate: &RgbImage,
+    depth_complexity: &[u32],
+) -> Result<Vec<BucketError>, String> {
+    check_sizes(reference, candidate)?;
+    let pixels = reference.width() as usize * reference.height() as usize;
+    if depth_complexity.len() != pixels {
+        return Err(format!(
+            "{} depth-complexity counts for {pixels} pixels",
+            depth_complexity.len()
+        ));
+    }
+    let mut sums = [Sums::default(); DEPTH_BUCKETS.len()];
+    for ((a, b), &n) in reference
+        .pixels()
+        .zip(candidate.pixels())
+        .zip(depth_complexity)
+    {
+        if let Some(i) = DEPTH_BUCKETS
+            .iter()
+            .position(|&(lo, hi)| (lo..=hi).contains(&n))
+        {
+            sums[i].add(a.0, b.0);
+        }
+    }
+    Ok(DEPTH_BUCKETS
+        .iter()
+        .zip(sums)
+        .map(|(&(lo, hi), sums)| BucketError {
+            lo,
+            hi,
+            pixels: sums.pixels,
+            error_pixels: sums.differing,
+            error: (sums.pixels > 0).then(|| sums.error()),
+        })
+        .collect())
+}
+
+fn check_sizes(reference: &RgbImage, candidate: &RgbImage) -> Result<(), String> {
+    if reference.dimensions() == candidate.dimensions() {
+        return Ok(());
+    }
+    Err(format!(
+        "cannot compare a {:?} image with a {:?} one",
+        candidate.dimensions(),
+        reference.dimensions()
+    ))
+}
+
+/// The running sums every figure is made of, over the pixels added so far.
+#[derive(Clone, Copy, Debug, Default)]
+struct Sums {
+    pixels: u64,
+    differing: u64,
+    abs: [u64; 3],
+    max: [u8; 3],
+    squares: u64,
+}
+
+impl Sums {
+    fn add(&mut self, a: [u8; 3], b: [u8; 3]) {
+        self.pixels += 1;
+        self.differing += u64::from(a != b);
+        for c in 0..3 {
+            let d = a[c].abs_diff(b[c]);
+            self.abs[c] += u64::from(d);
+            self.max[c] = self.max[c].max(d);
+            self.squares += u64::from(d) * u64::from(d);
+        }
+    }
+
+    /// The figures over at least one pixel.
+    fn error(&self) -> ColourError {
+        let pixels = self.pixels as f64;
+        let mse = self.squares as f64 / (3.0 * pixels);
+        ColourError {
+            mean_abs: self.abs.map(|s| s as f64 / pixels),
+            max_abs: self.max,
+            psnr_db: 10.0 * (255.0f64 * 255.0 / mse).log10(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -98,5 +205,31 @@ mod tests {
             "{refused}"
         );
         assert!(colour_error(&RgbImage::new(0, 0), &RgbImage::new(0, 0)).is_err());
+    }
+
+    /// Four pixels of 0, 1, 3 and 40 fragments, the one of 3 off by 6 in green: the bucket
+    /// `2–4` alone has an error, the empty pixel is in none, the buckets without a pixel have no
+    /// figures.
+    #[test]
+    fn each_bucket_has_the_figures_of_its_own_pixels() {
+        let reference = RgbImage::from_pixel(2, 2, Rgb([50, 50, 50]));
+        let mut candidate = reference.clone();
+        candidate.put_pixel(0, 1, Rgb([50, 56, 50]));
+        let buckets = colour_error_by_depth(&reference, &candidate, &[0, 1, 3, 40]).unwrap();
+        let labels: Vec<String> = buckets.iter().map(BucketError::label).collect();
+        assert_eq!(labels, ["1", "2–4", "5–8", "9–16", "17–32", "33+"]);
+        let pixels: Vec<u64> = buckets.iter().map(|b| b.pixels).collect();
+        assert_eq!(pixels, [1, 1, 0, 0, 0, 1]);
+        let wrong = buckets[1].error.unwrap();
+        assert_eq!((buckets[1].error_pixels, wrong.max_abs), (1, [0, 6, 0]));
+        assert_eq!(wrong.mean_abs, [0.0, 6.0, 0.0]);
+        assert!(buckets[0].error.unwrap().psnr_db.is_infinite());
+        assert!(buckets[5].error.unwrap().psnr_db.is_infinite());
+        assert!(buckets[2].error.is_none());
+        let short = colour_error_by_depth(&reference, &candidate, &[1, 2]).unwrap_err();
+        assert!(
+            short.contains("2 depth-complexity counts for 4 pixels"),
+            "{short}"
+        );
     }
 }

@@ -200,6 +200,20 @@ pub fn render<'a>(
     if !effect.resolvable_from(entries) {
         return None;
     }
+    Some(shade_image((width, height), |p| {
+        shade_pixel(effect, material, entries, p, list(p), geometry)
+            .expect("resolvable entries shade every pixel")
+    }))
+}
+
+/// The image whose pixel `p` (row-major) is `colour(p)`, a linear colour encoded to sRGB; rows
+/// are shaded in parallel, a row per rayon task. Every image of this crate is made here: the
+/// exact effects' ([`render`]) and the approximate schemes'
+/// ([`Approximation::render`](crate::approximate::Approximation::render)).
+pub fn shade_image(
+    (width, height): (u32, u32),
+    colour: impl Fn(usize) -> [f32; 3] + Sync,
+) -> RgbImage {
     let row = width as usize * 3;
     let mut bytes = vec![0u8; row * height as usize];
     bytes
@@ -208,12 +222,10 @@ pub fn render<'a>(
         .for_each(|(y, out)| {
             for (x, rgb) in out.chunks_exact_mut(3).enumerate() {
                 let p = y * width as usize + x;
-                let colour = shade_pixel(effect, material, entries, p, list(p), geometry)
-                    .expect("resolvable entries shade every pixel");
-                rgb.copy_from_slice(&colour.map(encode_srgb));
+                rgb.copy_from_slice(&colour(p).map(encode_srgb));
             }
         });
-    RgbImage::from_raw(width, height, bytes)
+    RgbImage::from_raw(width, height, bytes).expect("the buffer has width × height pixels")
 }
 
 /// The paper's error-pixel count: pixels whose 8-bit colour differs.

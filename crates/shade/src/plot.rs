@@ -380,12 +380,9 @@ impl Paint for SpeedAccuracy<'_> {
             .light_line_style(WHITE)
             .label_style(("sans-serif", 14))
             .draw()?;
+        // The floor line's meaning is written in the table's column, under the table, where no
+        // point's number can land on it (the fastest exact points sit on this line).
         let bottom = chart.backend_coord(&(lo, floor));
-        root.draw(&Text::new(
-            "EPR 0 (exact) is drawn on this line",
-            (bottom.0 + 6, bottom.1 - 16),
-            ("sans-serif", 12).into_font().color(&BLACK.mix(0.6)),
-        ))?;
         root.draw(&PathElement::new(
             vec![bottom, (bottom.0 + (WIDE.0 as i32 - 520), bottom.1)],
             BLACK.mix(0.3).stroke_width(1),
@@ -463,6 +460,11 @@ impl Paint for SpeedAccuracy<'_> {
                 font.clone().color(&palette(i)),
             ))?;
         }
+        right.draw(&Text::new(
+            "EPR 0 (exact) is drawn on the chart's grey floor line",
+            (4, WIDE.1 as i32 - 16),
+            ("sans-serif", 13).into_font().color(&BLACK.mix(0.7)),
+        ))?;
         root.present()
     }
 }

@@ -11,7 +11,7 @@ for scene in bunny dragon bunny-spheres; do
     *) S=(--scene $scene) ;;
   esac
   for k in 8 4; do
-    if [ $k = 8 ]; then C=mdts,bdp,adp,mdts-packed; else C=zbuffer; fi
+    if [ $k = 8 ]; then C=mdts,bdp,adp,mdts-packed,mlab; else C=zbuffer; fi
     /usr/bin/time -f "$scene k$k %e s" $B bench "${S[@]}" --width 512 --height 512 --frames 3 \
       --scheme $C --approximate wboit,mlab,tail-blend --k $k --out $O/$scene-k$k > $O/$scene-k$k.md
   done

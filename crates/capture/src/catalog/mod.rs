@@ -311,6 +311,9 @@ catalog! {
     Loop64 "loop64" Fixed(1), K, Some(Memory),
         "nvpro-samples' loop64: one pass of 64-bit `atomicMin` on packed (depth, colour) words, here (depth, primitive): exact, K = `--k`.";
         |b| (crate::schemes::loop64::Loop64::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+    Mlab "mlab" Fixed(1), K, Some(Memory),
+        "Multi-layer alpha blending's `--k` nodes (Salvi & Vaidyanathan 2014) in a per-pixel interlock, the two farthest merged when full: the node depths are the K nearest (judged); its colour is approximate, measured by `bench --approximate mlab`.";
+        |b| (crate::schemes::mlab::Mlab::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     LayerCounter "layer-counter" Fixed(1), K, Some(LayerMajor),
         "Bevy 0.15's OIT: `atomicAdd` on a per-pixel layer counter, `--k` layers, the rest discarded.";
         |b| (LayerCounter::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));

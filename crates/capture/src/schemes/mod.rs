@@ -20,6 +20,7 @@ pub mod masked_abuffer;
 pub mod mdts;
 pub mod mdts_emulated64;
 pub mod mdts_packed;
+pub mod mlab;
 pub mod peeling;
 pub mod stencil_routed;
 pub mod zbuffer;
