@@ -442,14 +442,7 @@ impl Scheme for KBuffer {
 mod tests {
     use super::*;
     use crate::memory::SerialMemory;
-
-    fn fragment(depth_key: u32, prim: u32) -> Fragment {
-        Fragment {
-            pixel: 0,
-            depth_key,
-            prim,
-        }
-    }
+    use crate::schemes::common::one_pixel::fragment;
 
     #[test]
     fn a_walk_is_k_loads_then_k_stores_or_one_read_and_one_write_back() {

@@ -201,19 +201,8 @@ mod tests {
     use super::*;
     use crate::executors::scheduled::run_fragments_in_order;
     use crate::memory::{AtomicMemory, SerialMemory};
+    use crate::schemes::common::one_pixel::{fragment, one_pixel};
     use crate::schemes::kbuffer::KBuffer;
-
-    fn fragment(depth_key: u32, prim: u32) -> Fragment {
-        Fragment {
-            pixel: 0,
-            depth_key,
-            prim,
-        }
-    }
-
-    fn one_pixel() -> Viewport {
-        Viewport::new(1, 1).unwrap()
-    }
 
     #[test]
     fn a_walk_is_one_step_that_keeps_the_k_nearest_and_drops_what_falls_off() {

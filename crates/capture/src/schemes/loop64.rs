@@ -199,14 +199,7 @@ impl Scheme for Loop64 {
 mod tests {
     use super::*;
     use crate::executors::scheduled::run_fragments_in_order;
-
-    fn fragment(depth_key: u32, prim: u32) -> Fragment {
-        Fragment {
-            pixel: 0,
-            depth_key,
-            prim,
-        }
-    }
+    use crate::schemes::common::one_pixel::fragment;
 
     /// Every interleaving of three walks' first steps (each order of the three fragments,
     /// stepped round-robin), `K` = 2: the two smallest words kept, one drop, and equal depths

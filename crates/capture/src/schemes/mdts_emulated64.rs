@@ -324,18 +324,7 @@ mod tests {
     use super::*;
     use crate::executors::scheduled::run_fragments_in_order;
     use crate::memory::SerialMemory;
-
-    fn fragment(depth_key: u32, prim: u32) -> Fragment {
-        Fragment {
-            pixel: 0,
-            depth_key,
-            prim,
-        }
-    }
-
-    fn one_pixel() -> Viewport {
-        Viewport::new(1, 1).unwrap()
-    }
+    use crate::schemes::common::one_pixel::{fragment, one_pixel};
 
     #[test]
     fn serially_both_keep_the_k_nearest_in_order() {

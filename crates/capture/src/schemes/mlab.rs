@@ -198,18 +198,7 @@ impl Scheme for Mlab {
 mod tests {
     use super::*;
     use crate::memory::SerialMemory;
-
-    fn fragment(depth_key: u32, prim: u32) -> Fragment {
-        Fragment {
-            pixel: 0,
-            depth_key,
-            prim,
-        }
-    }
-
-    fn one_pixel() -> Viewport {
-        Viewport::new(1, 1).unwrap()
-    }
+    use crate::schemes::common::one_pixel::{fragment, one_pixel};
 
     /// Every arrival order of five fragments of one pixel: the nodes are the `K` nearest, their
     /// counts add up to five, and exactly the fragments beyond `K` end a walk dropped.

@@ -5,6 +5,8 @@
 //! only from here, the memory and the `Scheme` trait, never from another scheme.
 
 mod layers;
+#[cfg(test)]
+pub(crate) mod one_pixel;
 pub mod sort;
 mod word;
 
