@@ -143,6 +143,15 @@ impl Gpu {
     }
 }
 
+/// Writes `skipped: WHY` to the process's standard error directly, not through `eprintln!`,
+/// which the test harness captures and shows only for failing tests: a skipped test must say
+/// so in every `cargo test` log.
+pub fn say_skipped(why: &str) {
+    use std::io::Write;
+    // A closed stderr leaves nothing to tell.
+    let _ = writeln!(std::io::stderr(), "skipped: {why}");
+}
+
 /// The GPU for a test, or `None` after one line saying the test is skipped and why. Sets
 /// `XDG_RUNTIME_DIR` to the temporary directory when unset (Mesa warns without it) and prints
 /// the adapter's [`Gpu::report`] when there is one, so a test log names it.
@@ -167,7 +176,7 @@ pub fn adapter_or_skip() -> Option<Gpu> {
                 !required,
                 "a GPU is required (CI=true or FRAGSIM_REQUIRE_GPU=1): {e}"
             );
-            println!("skipped: {e} (set FRAGSIM_REQUIRE_GPU=1 to fail instead)");
+            say_skipped(&format!("{e} (set FRAGSIM_REQUIRE_GPU=1 to fail instead)"));
             None
         }
     }

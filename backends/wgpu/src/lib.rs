@@ -18,6 +18,6 @@ pub mod shaders;
 
 pub use capture::{capture, capture_planted, Captured, Mode};
 pub use conform::WgpuBackend;
-pub use device::{adapter_or_skip, Gpu, GpuError};
+pub use device::{adapter_or_skip, say_skipped, Gpu, GpuError};
 pub use plant::Plant;
 pub use shaders::GpuScheme;

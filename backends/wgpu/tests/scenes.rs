@@ -17,7 +17,7 @@ use fragsim_capture::schemes::linked_list::Resolve;
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::{judge, Within};
-use fragsim_wgpu::{adapter_or_skip, capture, Gpu, GpuScheme, Mode};
+use fragsim_wgpu::{adapter_or_skip, capture, say_skipped, Gpu, GpuScheme, Mode};
 
 fn dragon() -> Option<PathBuf> {
     let path =
@@ -119,7 +119,7 @@ fn bunny_spheres_through_every_correct_scheme_is_equal() {
 #[test]
 fn the_dragon_through_every_correct_scheme_is_equal() {
     let Some(path) = dragon() else {
-        eprintln!("SKIPPED: ../shared/meshes/dragon_vrip.ply.gz not found beside the repository");
+        say_skipped("../shared/meshes/dragon_vrip.ply.gz not found beside the repository");
         return;
     };
     let Some(gpu) = adapter_or_skip() else { return };
