@@ -6,7 +6,7 @@
 
 use fragsim::capture::{Capacity, Capture, Identity, Keeps};
 use fragsim::oracle::compare::{compare_with, verdict, CompareOptions, Comparison};
-use fragsim::oracle::precision::{compare_within, Precision};
+use fragsim::oracle::precision::{compare_within, Doubt, Precision};
 use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
 use fragsim::raster::{Conventions, Fragment, OrbitCamera, Scene, ScreenTriangle, View, Viewport};
@@ -306,4 +306,66 @@ fn a_keep_first_list_may_keep_any_arrivals_but_not_lose_more() {
         assert_eq!(bugged.verdicts[p] & verdict::MISSING, verdict::MISSING);
         assert_eq!(bugged.diff.lost, 1);
     });
+}
+
+/// Pixels where an f32 capture holds a fragment whose coverage the analysis leaves undecided
+/// beside one it leaves out whose coverage is undecided too: a centre beside an edge shared by
+/// the two triangles, which the capture's snap of the edge's vertices gave to one of them.
+fn shared_edge_pixels(precision: &Precision, lists: &[Vec<u64>]) -> Vec<(usize, u32, u32)> {
+    let undecided = |p: usize, present: bool| {
+        precision.pixel(p).iter().find(|q| {
+            q.doubt == Some(Doubt::Coverage)
+                && lists[p].iter().any(|&w| w as u32 == q.prim) == present
+        })
+    };
+    (0..lists.len())
+        .filter_map(|p| Some((p, undecided(p, true)?.prim, undecided(p, false)?.prim)))
+        .collect()
+}
+
+#[test]
+fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragment_through() {
+    let scene = Scene::default_scene();
+    let view = scene
+        .view(Viewport::new(512, 512).unwrap(), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    let precision = Precision::derive(&view, &F32);
+    let lists = engine_like(&view);
+    let judged = judge(&precision, &oracle, &lists);
+    assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+    let snaps = judged.snaps;
+    assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
+    assert!(
+        snaps.pinned_vertices > 0 && snaps.decided_pixels > 0,
+        "{snaps:?}"
+    );
+    assert!(
+        judged.counts.ambiguous <= snaps.joint_pixels - snaps.decided_pixels,
+        "{snaps:?}, {} ambiguous",
+        judged.counts.ambiguous
+    );
+    // Judged one by one, both fragments of each of these pixels may be present or absent, so
+    // a dropped or doubled one would be excused as ambiguous; jointly, either snap of the shared
+    // edge gives the centre to exactly one of them.
+    let shared = shared_edge_pixels(&precision, &lists);
+    assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
+    for &(p, present, absent) in shared.iter().take(8) {
+        assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
+        let mut dropped = lists.to_vec();
+        dropped[p].retain(|&w| w as u32 != present);
+        let flags = judge(&precision, &oracle, &dropped).verdicts[p];
+        assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
+        let key_lo = precision
+            .pixel(p)
+            .iter()
+            .find(|q| q.prim == absent)
+            .unwrap()
+            .key_lo;
+        let mut doubled = lists.to_vec();
+        doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
+        doubled[p].sort_unstable();
+        let flags = judge(&precision, &oracle, &doubled).verdicts[p];
+        assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+    }
 }

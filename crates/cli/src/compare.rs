@@ -15,7 +15,7 @@ use clap::Args;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use fragsim_oracle::compare::{
     compare_with, complete_pixels, verdict, with_identity, AmbiguityCounts, CompareOptions,
-    Comparison, VerdictCounts,
+    Comparison, SnapCounts, VerdictCounts,
 };
 use fragsim_oracle::dump::{CorruptWord, Dump, Header};
 use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
@@ -198,6 +198,9 @@ struct Report {
     /// The ambiguous pixels by cause (absent when every bit is owed; a pixel may have several).
     #[serde(skip_serializing_if = "Option::is_none")]
     ambiguous_by_cause: Option<AmbiguityCounts>,
+    /// What the capture told of the vertices' snaps (absent when every bit is owed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    snaps: Option<SnapCounts>,
     pixels: u64,
     /// Pixels with a verdict that is an error (missing, extra, misordered, miscounted, corrupt).
     mismatched_pixels: u64,
@@ -437,6 +440,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         },
         precision: bounds,
         ambiguous_by_cause: bounds.map(|_| comparison.ambiguity),
+        snaps: bounds.map(|_| comparison.snaps),
         pixels: comparison.verdicts.len() as u64,
         mismatched_pixels: comparison
             .verdicts
@@ -818,6 +822,16 @@ fn print_report(r: &Report) {
             why.depth,
             why.order,
             why.clipped
+        );
+        let s = r.snaps.unwrap_or_default();
+        outln!(
+            "one snap per vertex: {} vertices may snap to more than one grid point where a              centre's coverage hangs on it, {} pinned by the capture; {} pixels judged jointly,              {} of them decided by the pins, {} contradicting every snap (errors), {} past the              enumeration",
+            s.undecided_vertices,
+            s.pinned_vertices,
+            s.joint_pixels,
+            s.decided_pixels,
+            s.contradicting_pixels,
+            s.unjoined_pixels
         );
     }
     let f = &r.fragments;

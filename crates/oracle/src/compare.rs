@@ -146,6 +146,28 @@ pub struct Comparison {
     /// Of the [`verdict::AMBIGUOUS`] pixels, how many each cause made so (a pixel may have
     /// several); all 0 outside a verdict within precision.
     pub ambiguity: AmbiguityCounts,
+    /// What the capture told of the vertices' snaps (`docs/semantics.md` §10, "One snap per
+    /// vertex"); all 0 outside a verdict within precision.
+    pub snaps: SnapCounts,
+}
+
+/// The joint judgement of the pixels whose coverage hangs on a vertex's snap: every triangle
+/// sharing a vertex takes it at the same grid point, so the capture's own pixels tell which.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct SnapCounts {
+    /// Vertices that may snap to more than one grid point and decide some pixel's coverage.
+    pub undecided_vertices: u64,
+    /// Of those, the vertices the capture pins to one grid point.
+    pub pinned_vertices: u64,
+    /// Pixels judged jointly over the snaps of their vertices.
+    pub joint_pixels: u64,
+    /// Of those, pixels whose coverage the pinned snaps decide (no longer ambiguous by coverage).
+    pub decided_pixels: u64,
+    /// Pixels that no snap of their vertices explains together with the rest of the capture:
+    /// judged under the snaps the rest of the capture pins, where they are errors.
+    pub contradicting_pixels: u64,
+    /// Pixels with more joint snaps than are enumerated (judged fragment by fragment).
+    pub unjoined_pixels: u64,
 }
 
 /// Ambiguous pixels by what left them undecided (`docs/semantics.md` §10, Verdict).
@@ -186,6 +208,7 @@ impl Comparison {
             words_checked: words.is_some(),
             first_corrupt: Vec::new(),
             ambiguity: AmbiguityCounts::default(),
+            snaps: SnapCounts::default(),
         }
     }
 

@@ -110,7 +110,41 @@ pub struct Precision {
     exact: bool,
     offsets: Vec<usize>,
     entries: Vec<Possible>,
+    /// Parallel to `entries`: how an entry whose coverage was enumerated depends on its
+    /// vertices' snaps (`None`: decided, clipped, or judged by the edge bound).
+    dependencies: Vec<Option<Dependence>>,
+    /// Per mesh vertex, how many snapped positions it may reach (1: its snap is decided; 0: not
+    /// analysed).
+    vertex_points: Vec<u8>,
     bounds: Bounds,
+}
+
+/// How the coverage of one possible fragment depends on the snaps of its triangle's vertices,
+/// when it was enumerated (`docs/semantics.md` §10, "One snap per vertex"): the verdict uses it
+/// to judge the fragments of a pixel jointly, every triangle that shares a vertex taking that
+/// vertex at the same grid point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Dependence {
+    /// The triangle's vertices (mesh indices), in the order [`combinations`] enumerates them.
+    vertices: [u32; 3],
+    /// How many grid points each may reach: the `i`-th combination takes point
+    /// `i / (n1·n2)` of vertex 0, `(i / n2) mod n1` of vertex 1 and `i mod n2` of vertex 2.
+    points: [u8; 3],
+    /// Bit `i`: the `i`-th combination covers the pixel centre.
+    covering: u64,
+    /// Whether the fragment is certain wherever its triangle covers the centre (its depth
+    /// interval inside `[0, 1]`): else a covering snap may still drop it.
+    depth_certain: bool,
+}
+
+impl Dependence {
+    /// Whether the triangle covers the centre when each of its vertices takes the grid point
+    /// `point(vertex)` (an index into the vertex's reachable points).
+    fn covers_with(&self, point: impl Fn(u32) -> u8) -> bool {
+        let [a, b, c] = self.vertices.map(|v| u64::from(point(v)));
+        let [_, n1, n2] = self.points.map(u64::from);
+        self.covering >> ((a * n1 + b) * n2 + c) & 1 == 1
+    }
 }
 
 /// A vertex's error bounds: the snapped positions it may reach, their radius (subpixels) and the
@@ -144,6 +178,8 @@ impl Precision {
                 exact: true,
                 offsets: Vec::new(),
                 entries: Vec::new(),
+                dependencies: Vec::new(),
+                vertex_points: Vec::new(),
                 bounds: Bounds::default(),
             };
         }
@@ -151,14 +187,31 @@ impl Precision {
         let vertices: Vec<Option<VertexBound>> = (0..view.mesh().positions.len() as u32)
             .map(|i| vertex_bound(view, conventions, i, &mut bounds))
             .collect();
+        let vertex_points: Vec<u8> = vertices
+            .iter()
+            .map(|v| v.map_or(0, |v| u8::try_from(reachable_points(&v)).unwrap_or(0)))
+            .collect();
         let mut found: Vec<(u32, Possible)> = Vec::new();
+        let mut dependent: Vec<(usize, Dependence)> = Vec::new();
         for prim in 0..view.triangle_count() {
-            let tri = view.mesh().triangles[prim as usize].map(|i| vertices[i as usize]);
-            match tri {
+            let ids = view.mesh().triangles[prim as usize];
+            match ids.map(|i| vertices[i as usize]) {
                 [Some(a), Some(b), Some(c)] => {
                     let origin = conventions.window_origin;
-                    let tri = [a, b, c];
-                    if !triangle(view.viewport(), origin, prim, tri, &mut found, &mut bounds) {
+                    let tri = Triangle {
+                        prim,
+                        ids,
+                        verts: [a, b, c],
+                    };
+                    let viewport = view.viewport();
+                    if !triangle(
+                        viewport,
+                        origin,
+                        tri,
+                        &mut found,
+                        &mut dependent,
+                        &mut bounds,
+                    ) {
                         bounds.bounded_triangles += 1;
                     }
                 }
@@ -181,7 +234,12 @@ impl Precision {
                 }
             }
         }
-        found.sort_by_key(|&(p, _)| p);
+        let mut dependency_of: Vec<Option<Dependence>> = vec![None; found.len()];
+        for (entry, dependence) in dependent {
+            dependency_of[entry] = Some(dependence);
+        }
+        let mut order: Vec<usize> = (0..found.len()).collect();
+        order.sort_by_key(|&i| found[i].0);
         let pixels = view.viewport().pixels();
         let mut offsets = vec![0usize; pixels + 1];
         for &(p, _) in &found {
@@ -190,7 +248,9 @@ impl Precision {
         for i in 0..pixels {
             offsets[i + 1] += offsets[i];
         }
-        let entries: Vec<Possible> = found.into_iter().map(|(_, e)| e).collect();
+        let entries: Vec<Possible> = order.iter().map(|&i| found[i].1).collect();
+        let dependencies: Vec<Option<Dependence>> =
+            order.iter().map(|&i| dependency_of[i]).collect();
         for e in &entries {
             if e.reference.is_some() {
                 bounds.max_depth_interval_ulps =
@@ -201,6 +261,8 @@ impl Precision {
             exact: false,
             offsets,
             entries,
+            dependencies,
+            vertex_points,
             bounds,
         }
     }
@@ -231,6 +293,14 @@ impl Precision {
             return &[];
         }
         &self.entries[self.offsets[p]..self.offsets[p + 1]]
+    }
+
+    /// How each of [`Precision::pixel`]`(p)`'s entries depends on its vertices' snaps.
+    fn pixel_dependencies(&self, p: usize) -> &[Option<Dependence>] {
+        if self.exact {
+            return &[];
+        }
+        &self.dependencies[self.offsets[p]..self.offsets[p + 1]]
     }
 }
 
@@ -579,20 +649,29 @@ fn origin_form_error(
     )
 }
 
+/// How many grid points vertex `b` may reach along `axis`.
+fn axis_points(b: &VertexBound, axis: usize) -> usize {
+    usize::try_from((b.reach[axis][1] - b.reach[axis][0]) / b.step + 1).unwrap_or(usize::MAX)
+}
+
+/// How many grid points vertex `b` may snap to (saturating).
+fn reachable_points(b: &VertexBound) -> usize {
+    axis_points(b, 0).saturating_mul(axis_points(b, 1))
+}
+
 /// Every snapped triangle an implementation may rasterize for `v`: each vertex at any grid
 /// point it may reach; `None` when there are more than [`MAX_COMBINATIONS`].
 fn combinations(v: &[VertexBound; 3]) -> Option<Vec<[[i64; 2]; 3]>> {
-    let count = |b: &VertexBound, axis: usize| {
-        usize::try_from((b.reach[axis][1] - b.reach[axis][0]) / b.step + 1).unwrap_or(usize::MAX)
-    };
     let total = v.iter().try_fold(1usize, |n, b| {
-        n.checked_mul(count(b, 0))?.checked_mul(count(b, 1))
+        n.checked_mul(axis_points(b, 0))?
+            .checked_mul(axis_points(b, 1))
     });
     if total.is_none_or(|n| n > MAX_COMBINATIONS) {
         return None;
     }
     let points = |b: &VertexBound| -> Vec<[i64; 2]> {
-        let axis = |k: usize| (0..count(b, k) as i64).map(move |i| b.reach[k][0] + i * b.step);
+        let axis =
+            |k: usize| (0..axis_points(b, k) as i64).map(move |i| b.reach[k][0] + i * b.step);
         axis(0).flat_map(|x| axis(1).map(move |y| [x, y])).collect()
     };
     let [a, b, c] = v.map(|x| points(&x));
@@ -628,23 +707,31 @@ fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
 /// may reach (step 5 of `docs/semantics.md` §10), or past [`MAX_COMBINATIONS`] decided by the
 /// bilinear edge bound over their radius; depth over the planes of the snapped triangles that
 /// cover the centre and the plane of the unsnapped positions (step 6). Counts the ambiguous
-/// pairs by cause in `bounds`. Returns whether it enumerated.
+/// pairs by cause in `bounds`, and records in `dependent` (by index into `found`) how each
+/// enumerated fragment whose coverage is split depends on the vertices' snaps. Returns whether it
+/// enumerated.
 fn triangle(
     viewport: Viewport,
     origin: WindowOrigin,
-    prim: u32,
-    verts: [VertexBound; 3],
+    tri: Triangle,
     found: &mut Vec<(u32, Possible)>,
+    dependent: &mut Vec<(usize, Dependence)>,
     bounds: &mut Bounds,
 ) -> bool {
+    let Triangle { prim, ids, verts } = tri;
     let [a, mut b, mut c] = verts;
+    let [ia, mut ib, mut ic] = ids;
     let mut area = edge(a.snapped, b.snapped, c.snapped);
     if area < 0 {
         std::mem::swap(&mut b, &mut c);
+        std::mem::swap(&mut ib, &mut ic);
         area = -area;
     }
     let v = [a, b, c];
+    let ids = [ia, ib, ic];
     let reachable = combinations(&v);
+    // Each vertex's reachable points (at most 64 while enumerating), for `Dependence`.
+    let points = v.map(|x| u8::try_from(reachable_points(&x)).unwrap_or(u8::MAX));
     let radius = v.map(|x| x.radius as f64);
     let area_bound = edge_bound(
         real(b.snapped),
@@ -690,16 +777,18 @@ fn triangle(
             let covered = area > 0 && (0..3).all(passes);
             planes.clear();
             planes.push(unsnapped);
+            let mut covering = 0u64;
             let (certain, possible) = match &reachable {
                 // The reference's own triangle is one of them: `certain` implies `covered`.
                 Some(all) => {
                     let mut split = false;
-                    for &xy in all {
+                    for (i, &xy) in all.iter().enumerate() {
                         if covers(origin, xy, p) {
                             planes.push(Plane {
                                 at: xy.map(real),
                                 radius: [0.0; 3],
                             });
+                            covering |= 1 << i;
                             split |= !covered;
                         } else {
                             split |= covered;
@@ -740,6 +829,17 @@ fn triangle(
                     / area_f;
             let reference = if covered { depth_key(z as f32) } else { None };
             let (key_lo, key_hi, inside) = depth_interval(viewport, &v, &planes, p, z);
+            if !certain && reachable.is_some() {
+                dependent.push((
+                    found.len(),
+                    Dependence {
+                        vertices: ids,
+                        points,
+                        covering,
+                        depth_certain: inside && (reference.is_some() || !covered),
+                    },
+                ));
+            }
             let doubt = if !certain {
                 Some(Doubt::Coverage)
             } else if !inside || reference.is_none() {
@@ -770,6 +870,14 @@ fn triangle(
         }
     }
     reachable.is_some()
+}
+
+/// A triangle to analyse: its primitive id, its vertices' mesh indices and their bounds.
+#[derive(Clone, Copy, Debug)]
+struct Triangle {
+    prim: u32,
+    ids: [u32; 3],
+    verts: [VertexBound; 3],
 }
 
 #[cfg(test)]
