@@ -40,9 +40,23 @@ SEED=${SEED:-0}
 PART=${PART:-330}
 mkdir -p "$OUT" "$W"
 
+# start_server DIR LOG: starts `$CUDA --serve DIR` in the background, its pid in SERVER; returns
+# once it is ready (it makes its FIFO once its device is up), non-zero if it never was.
+start_server() {
+    rm -rf "$1"
+    "$CUDA" --serve "$1" >"$2" 2>&1 &
+    SERVER=$!
+    for _ in $(seq 6000); do
+        [ -p "$1/requests" ] && return 0
+        kill -0 "$SERVER" 2>/dev/null || return 1
+        sleep 0.01
+    done
+    return 1
+}
+
 # stop_server DIR PID: `quit`, or a kill if it is not read (a server that died holds no FIFO).
 stop_server() {
-    timeout 5 sh -c "echo quit >'$1/requests'" 2>/dev/null
+    [ -p "$1/requests" ] && timeout 5 sh -c "echo quit >'$1/requests'" 2>/dev/null
     for _ in $(seq 50); do
         kill -0 "$2" 2>/dev/null || break
         sleep 0.1
@@ -51,36 +65,52 @@ stop_server() {
     wait "$2" 2>/dev/null
 }
 
+# What the server saves a backend run: one small case run 5 times as a process of its own (a CUDA
+# context each), then 5 times through a server (whose start, a context, is paid once).
+probe_server_saving() {
+    local tri=$W/probe.tri serve=$W/probe.serve t0 t1 t2 t3
+    "$F" export-scene --scene soup:6:1 --width 8 --height 8 --out "$tri" >/dev/null || return
+    t0=$(date +%s%N)
+    for _ in 1 2 3 4 5; do
+        "$CUDA" "$tri" "$W/probe" --schemes mdts --k 4 --reps 1 >/dev/null || return
+    done
+    t1=$(date +%s%N)
+    start_server "$serve" "$W/probe.server.log" || return
+    t2=$(date +%s%N)
+    for _ in 1 2 3 4 5; do
+        "$CUDA" --client "$serve" --timeout 20 "$tri" "$W/probe" --schemes mdts --k 4 --reps 1 || break
+    done
+    t3=$(date +%s%N)
+    stop_server "$serve" "$SERVER"
+    echo "== a backend run of one 8x8 case: $(((t1 - t0) / 5000000)) ms as a process of its own," \
+        "$(((t3 - t2) / 5000000)) ms through a server (whose start took $(((t2 - t1) / 1000000)) ms, once)"
+}
+
 main() {
     echo "== device"
     command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
-    local cuda=${FRAGSIM_CUDA:-}
-    if [ -z "$cuda" ]; then
+    CUDA=${FRAGSIM_CUDA:-}
+    if [ -z "$CUDA" ]; then
         echo "== build"
         timeout 90 make -C backends/cuda OUT="$W" || { echo "== build failed"; return 2; }
-        cuda=$W/fragsim_cuda
+        CUDA=$W/fragsim_cuda
     fi
-    cuda=$(realpath "$cuda")
+    CUDA=$(realpath "$CUDA")
     "$F" --version 2>/dev/null || true
     # run NAME CONFORM_SCHEME CUDA_SCHEME SIZE_PLACEHOLDER [conform options...], in a subshell
     # of its own (the runs go side by side), its server stopped however it ends.
     run() (
-        local name=$1 scheme=$2 cuda_scheme=$3 size=$4 start=$SECONDS code serve=$W/$1.serve server
+        local name=$1 scheme=$2 cuda_scheme=$3 size=$4 start=$SECONDS code serve=$W/$1.serve
         shift 4
-        rm -rf "${OUT:?}/$name" "$serve"
-        "$cuda" --serve "$serve" >"$OUT/$name.server.log" 2>&1 &
-        server=$!
-        trap 'stop_server "$serve" "$server"' EXIT
-        # The server makes its FIFO once its device is up: that is the sign it is ready.
-        for _ in $(seq 600); do
-            [ -p "$serve/requests" ] || ! kill -0 "$server" 2>/dev/null && break
-            sleep 0.1
-        done
-        if [ ! -p "$serve/requests" ]; then
+        rm -rf "${OUT:?}/$name"
+        start_server "$serve" "$OUT/$name.server.log"
+        code=$?
+        trap 'stop_server "$serve" "$SERVER"' EXIT
+        if [ "$code" != 0 ]; then
             echo "== $name: its server did not start: $(tail -2 "$OUT/$name.server.log")" >"$OUT/$name.status"
             return
         fi
-        local backend="'$cuda' --client '$serve' --timeout 20 {scene}/scene.tri {out}/run --schemes $cuda_scheme --k $size --reps 1 && mv {out}/run/$cuda_scheme/* {out}/"
+        local backend="'$CUDA' --client '$serve' --timeout 20 {scene}/scene.tri {out}/run --schemes $cuda_scheme --k $size --reps 1 && mv {out}/run/$cuda_scheme/* {out}/"
         timeout "$PART" "$F" conform --scheme "$scheme" --cases "$CASES" --seed "$SEED" --json \
             --timeout 30 --progress-lines --save "$OUT/$name" --backend "$backend" "$@" \
             >"$OUT/$name.jsonl" 2>"$OUT/$name.stderr"
@@ -107,6 +137,7 @@ main() {
         sed "s| --client '[^']*' --timeout [0-9]*||" "$OUT/kbuffer/case/replay.sh" \
             >"$OUT/kbuffer/case/replay_direct.sh"
     fi
+    probe_server_saving
 }
 
 main 2>&1 | tee "$OUT/conform.log"
