@@ -97,6 +97,10 @@ main() {
     fi
     CUDA=$(realpath "$CUDA")
     "$F" --version 2>/dev/null || true
+    # A fragsim older than --progress-lines still runs the battery, only silent until its end.
+    PROGRESS=--progress-lines
+    "$F" conform --help | grep -q -- --progress-lines ||
+        { PROGRESS=; echo "== $F has no conform --progress-lines: a stopped run will not say how far it got"; }
     # run NAME CONFORM_SCHEME CUDA_SCHEME SIZE_PLACEHOLDER [conform options...], in a subshell
     # of its own (the runs go side by side), its server stopped however it ends.
     run() (
@@ -112,7 +116,7 @@ main() {
         fi
         local backend="'$CUDA' --client '$serve' --timeout 20 {scene}/scene.tri {out}/run --schemes $cuda_scheme --k $size --reps 1 && mv {out}/run/$cuda_scheme/* {out}/"
         timeout "$PART" "$F" conform --scheme "$scheme" --cases "$CASES" --seed "$SEED" --json \
-            --timeout 30 --progress-lines --save "$OUT/$name" --backend "$backend" "$@" \
+            --timeout 30 ${PROGRESS:+"$PROGRESS"} --save "$OUT/$name" --backend "$backend" "$@" \
             >"$OUT/$name.jsonl" 2>"$OUT/$name.stderr"
         code=$?
         echo "== $name: exit $code (0 pass, 1 counterexample, 2 error, 124 timed out), $((SECONDS - start)) s," \
