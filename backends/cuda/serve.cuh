@@ -57,6 +57,12 @@ static void answer_client(const std::string& fifo, std::string answer) {
   for (char& c : answer)
     if (c == '\n') c = ' ';  // one line, whatever the message
   answer = answer.substr(0, PIPE_BUF - 1) + "\n";
+  // Only ever a FIFO: a malformed request must not make the server write into (or remove) a file.
+  struct stat info;
+  if (lstat(fifo.c_str(), &info) != 0 || !S_ISFIFO(info.st_mode)) {
+    fprintf(stderr, "fragsim_cuda --serve: %s is no FIFO, no answer\n", fifo.c_str());
+    return;
+  }
   const int fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
   if (fd < 0) {
     fprintf(stderr, "fragsim_cuda --serve: %s: the client is gone, its answer dropped\n", fifo.c_str());
