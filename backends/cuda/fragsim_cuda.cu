@@ -2,6 +2,8 @@
 // checked against fragsim's oracle through the dump format (docs/dump-format.md). Mirrors the
 // command line's `render` (crates/cli/src/render.rs): read the scene, size K, run each scheme,
 // report; the rest of the backend mirrors the Rust tree file for file (README.md lists the pairs).
+// One case per process, or many in one (`--serve`, serve.cuh: one CUDA context for all of them,
+// `--client` hands it a case); both run a case through run_request.
 //
 // Input: fragsim's triangle export (`fragsim export-scene`): the screen triangles after fragsim's
 // vertex stage, clipping, snapping and orientation. This program is FreePipe's rasterizer from
