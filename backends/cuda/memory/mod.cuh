@@ -14,25 +14,37 @@ static inline unsigned long long atomicMin(unsigned long long* a, unsigned long 
 }
 #endif
 
+// An array in device memory (host memory in the emulation), freed when it goes out of scope, so
+// that a case that fails half-way leaves nothing allocated behind it: the server (serve.cuh) runs
+// case after case in one process, and its memory stays what one case needs.
 template <class T>
-static T* dev_alloc(uint64_t n) {
-  T* p = nullptr;
+class DeviceArray {
+ public:
+  explicit DeviceArray(uint64_t n) {
+    const uint64_t bytes = std::max<uint64_t>(n, 1) * sizeof(T);
 #ifdef __CUDACC__
-  CK(cudaMalloc(&p, std::max<uint64_t>(n, 1) * sizeof(T)));
+    CK(cudaMalloc(&data_, bytes));
 #else
-  p = (T*)malloc(std::max<uint64_t>(n, 1) * sizeof(T));
-  if (!p) { fprintf(stderr, "out of memory\n"); exit(3); }
+    data_ = (T*)malloc(bytes);
+    if (!data_) fail(STATUS_DEVICE, "out of memory (" + std::to_string(bytes) + " bytes)");
 #endif
-  return p;
-}
-template <class T>
-static void dev_free(T* p) {
+  }
+  ~DeviceArray() {
+    // Not checked: a destructor may not throw, and after a device error the server stops anyway.
 #ifdef __CUDACC__
-  CK(cudaFree(p));
+    cudaFree(data_);
 #else
-  free(p);
+    free(data_);
 #endif
-}
+  }
+  DeviceArray(const DeviceArray&) = delete;
+  DeviceArray& operator=(const DeviceArray&) = delete;
+  T* get() const { return data_; }
+
+ private:
+  T* data_ = nullptr;
+};
+
 template <class T>
 static void to_device(T* dst, const T* src, uint64_t n) {
 #ifdef __CUDACC__

@@ -35,7 +35,8 @@ static void run_abuffer(const Job& job) {
   const u32 capacity = job.k;
   const uint64_t pixels = job.pixels, words = pixels * capacity;
   u32* d_counters = job.d_counters;
-  u64* d_slots = dev_alloc<u64>(words);
+  const DeviceArray<u64> slots(words);
+  u64* d_slots = slots.get();
   // Slots need no initialisation (only min(counter, capacity) of them are read); they are
   // filled once so that the dump's unused slots are deterministic.
   LAUNCH(fill_kernel<u64>, words, 512, d_slots, words, EMPTY64);
@@ -60,5 +61,4 @@ static void run_abuffer(const Job& job) {
                    array_json("slots", "slots.u64", "u64", pixels, capacity),
                t, job.device);
   print_result(job, "abuffer", "atomicAdd+insertion-sort", t, words * 8 + pixels * 4);
-  dev_free(d_slots);
 }

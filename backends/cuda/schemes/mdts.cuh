@@ -47,7 +47,8 @@ template <class Op, class W>
 static void run_mdts_layout(const Job& job, const char* name, const char* scheme, const char* variant,
                             const char* word) {
   const uint64_t words = job.pixels * job.k;
-  W* d_slots = dev_alloc<W>(words);
+  const DeviceArray<W> slots(words);
+  W* d_slots = slots.get();
   const Timings t = run_frames(
       job.reps, [&] { LAUNCH(fill_kernel<W>, words, 512, d_slots, words, empty_word<W>()); },
       [&] {
@@ -64,7 +65,6 @@ static void run_mdts_layout(const Job& job, const char* name, const char* scheme
   write_header(dir, *job.scene, scheme, variant, k_param(job.k), word,
                array_json("slots", file, wide ? "u64" : "u32", job.pixels, job.k), t, job.device);
   print_result(job, name, variant, t, words * sizeof(W));
-  dev_free(d_slots);
 }
 
 static void run_mdts(const Job& job) {

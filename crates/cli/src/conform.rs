@@ -86,6 +86,12 @@ pub struct ConformArgs {
     /// `counterexample_pixel` record per differing pixel shown (`docs/json-schema.md`).
     #[arg(long)]
     pub json: bool,
+    /// Write a line to stderr as each case passes (`conform: N of M cases passed`) and at each
+    /// shrinking step (`conform: case N failed; shrinking step S`): for a log, where no bar is
+    /// drawn, so that a run stopped from outside (a `timeout`) still says how far it got. The
+    /// report waits for the end.
+    #[arg(long)]
+    pub progress_lines: bool,
 }
 
 /// A positive, finite number of seconds.
@@ -195,11 +201,27 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             ..Limits::default()
         });
     let bar = crate::progress::bar(u64::from(args.cases), "conform");
+    // Case N starts once case N − 1 has passed; the last case's pass is the run's end.
+    let mut cases_started = 0;
     let result = battery.run_with(&mut |event| match event {
-        Event::Case(n) => bar.set_position(u64::from(n)),
-        Event::Shrink(n) => bar.set_message(format!("failed; shrinking (step {n})")),
+        Event::Case(n) => {
+            bar.set_position(u64::from(n));
+            cases_started = n;
+            if args.progress_lines && n > 1 {
+                eprintln!("conform: {} of {} cases passed", n - 1, args.cases);
+            }
+        }
+        Event::Shrink(step) => {
+            bar.set_message(format!("failed; shrinking (step {step})"));
+            if args.progress_lines {
+                eprintln!("conform: case {cases_started} failed; shrinking step {step}");
+            }
+        }
     });
     bar.finish_and_clear();
+    if args.progress_lines && result.is_ok() {
+        eprintln!("conform: {0} of {0} cases passed", args.cases);
+    }
     // The cases' files are scratch; the saved case is written afresh below.
     let _ = std::fs::remove_dir_all(&work);
     let mut summary = Summary {

@@ -3,16 +3,17 @@
 // word encoding and the array files, plus the raw little-endian arrays themselves.
 #pragma once
 
+#include <filesystem>
+
 #include "device.cuh"
 #include "executors/frame.cuh"
 #include "oracle/triangles.cuh"
 
 static void write_file(const std::string& path, const void* data, size_t bytes) {
   FILE* f = fopen(path.c_str(), "wb");
-  if (!f || fwrite(data, 1, bytes, f) != bytes || fclose(f) != 0) {
-    fprintf(stderr, "cannot write %s\n", path.c_str());
-    exit(2);
-  }
+  if (!f) fail(STATUS_INPUT, "cannot write " + path);
+  const bool written = fwrite(data, 1, bytes, f) == bytes;
+  if (fclose(f) != 0 || !written) fail(STATUS_INPUT, "cannot write " + path);
 }
 
 // The header's "k" parameter line.
@@ -41,6 +42,7 @@ static std::string array_json(const char* name, const char* file, const char* dt
 }
 
 static void make_dir(const std::string& dir) {
-  std::string cmd = "mkdir -p '" + dir + "'";
-  if (system(cmd.c_str()) != 0) { fprintf(stderr, "cannot create %s\n", dir.c_str()); exit(2); }
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) fail(STATUS_INPUT, "cannot create " + dir + ": " + error.message());
 }
