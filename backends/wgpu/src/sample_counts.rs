@@ -1,0 +1,225 @@
+//! The per-sample counting pass on the GPU and its comparison with fragsim's per-sample oracle
+//! (issue 22: per-pixel sample counts identical to the hardware's).
+//!
+//! **The pass** ([`count_samples`]): a single-sample view drawn, in replay or engine mode as
+//! every capture, into a colour target of `n` samples a pixel through
+//! `schemes/sample_counts.wgsl`. Its fragment shader reads `@builtin(sample_index)`, which makes
+//! the pipeline shade per sample (Vulkan: a shader using `SampleId` runs with sample shading at
+//! `minSampleShading` 1.0), so every covered sample of every primitive is one invocation, which
+//! adds 1 at `counts[pixel * n + sample]`. That is per-(pixel, sample) counting by construction,
+//! and the invocation's position is the sample's, so the depth-range test is made at the sample,
+//! as fragsim makes it. A per-pixel invocation counting the bits of `@builtin(sample_mask)` would
+//! cost fewer invocations but sees the pixel centre's depth, which lies outside the primitive
+//! when the centre is not covered.
+//!
+//! **The reference** ([`reference_counts`]): fragsim's per-sample oracle
+//! ([`SampleOracle`]) of the same view with a sample pattern: in replay mode the view itself
+//! (the GPU scans fragsim's own snapped triangles), in engine mode the view of
+//! [`engine_scene`](crate::capture::engine_scene) (the f32 matrix and the f32 vertex stage, where
+//! the GPU's own vertex arithmetic may move an edge past a sample: identity is not owed there).
+//!
+//! **Sample positions.** wgpu neither sets nor reports sample positions (nor Vulkan's
+//! `standardSampleLocations`, which only `unsafe` code could read through its raw handle). The
+//! reference takes Vulkan's standard ones ([`SamplePattern::standard`]), which a driver uses when
+//! `standardSampleLocations` is true. That the GPU uses them is checked by the counts
+//! themselves: [`mirrored`] gives the standard
+//! positions mirrored in y (a y-up rasterizer's `(x, 16 − y)`), and a scene's counts against
+//! that pattern differ at the samples edges pass between the two positions
+//! (`tests/msaa.rs` asserts it), so identity with the standard pattern tells the patterns apart.
+//!
+//! Guarantee: [`count_samples`] returns the words the shader left, bit for bit; a sample count
+//! the adapter's target format lacks, or a view that already rasterizes per sample, is an error
+//! naming it.
+
+use fragsim_oracle::samples::SampleOracle;
+use fragsim_raster::{SamplePattern, View};
+
+use crate::capture::{execute, Mode};
+use crate::device::{Gpu, GpuError};
+use crate::shaders::GpuScheme;
+
+/// The GPU's fragment count at every sample of a view.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleCounts {
+    /// Samples per pixel.
+    pub samples: u32,
+    /// Fragments at sample `s` of pixel `p` at `p * samples + s`, pixels row-major (the
+    /// sample-expanded framebuffer's order, `docs/semantics.md`, "Multisampling").
+    pub counts: Vec<u32>,
+    /// The draw on the GPU, by timestamps where the adapter has them.
+    pub gpu_ms: Option<f64>,
+    /// The submission to the end of the read-back, on the host.
+    pub wall_ms: f64,
+    /// Triangles drawn (screen triangles in replay mode, mesh triangles in engine mode).
+    pub triangles: u32,
+}
+
+/// Draws `view` in `mode` into a target of `samples` samples a pixel and counts the fragments of
+/// every sample.
+///
+/// # Errors
+/// A view that rasterizes per sample (the GPU target is the pixel viewport), a sample count the
+/// adapter cannot render at, and [`capture`](crate::capture)'s errors.
+pub fn count_samples(
+    gpu: &Gpu,
+    view: &View<'_>,
+    mode: Mode,
+    samples: u32,
+) -> Result<SampleCounts, GpuError> {
+    if view.samples().is_some() {
+        return Err(GpuError(
+            "the counting pass draws a single-sample view into a multisampled target".into(),
+        ));
+    }
+    let scheme = GpuScheme::SampleCounts { samples };
+    let ((_, mut words, gpu_ms, wall_ms), triangles) = execute(gpu, view, &scheme, mode, None)?;
+    let counts = words
+        .pop()
+        .ok_or_else(|| GpuError("the counting pass read nothing back".into()))?;
+    Ok(SampleCounts {
+        samples,
+        counts,
+        gpu_ms,
+        wall_ms,
+        triangles,
+    })
+}
+
+/// fragsim's fragment count at every sample of `view` rasterized at `pattern` (the per-sample
+/// oracle's depth complexity), indexed as [`SampleCounts::counts`].
+///
+/// # Errors
+/// An expanded framebuffer past fragsim's largest side.
+pub fn reference_counts(view: &View<'_>, pattern: SamplePattern) -> Result<Vec<u32>, String> {
+    let sampled = view.clone().with_samples(pattern)?;
+    Ok(SampleOracle::build(&sampled)?.oracle().depth_complexity())
+}
+
+/// `pattern`'s positions mirrored in y, `(x, 16 − y)`: where a rasterizer that took the standard
+/// positions in y-up rows would sample. Each call leaks its positions (16 bytes at most for 8
+/// samples; a pattern's positions are `'static`).
+///
+/// # Errors
+/// A pattern with a position at `y = 0`, whose mirror would lie on the next pixel's edge.
+pub fn mirrored(pattern: SamplePattern) -> Result<SamplePattern, String> {
+    let positions: Vec<[u8; 2]> = pattern
+        .positions()
+        .iter()
+        .map(|&[x, y]| [x, 16 - y])
+        .collect();
+    SamplePattern::custom(Box::leak(positions.into_boxed_slice()))
+}
+
+/// Where two per-sample counts of one view differ.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CountDiff {
+    /// Samples compared.
+    pub samples: u64,
+    /// Samples whose counts differ.
+    pub samples_differ: u64,
+    /// Pixels compared.
+    pub pixels: u64,
+    /// Pixels whose sums over their samples differ.
+    pub pixels_differ: u64,
+    /// Sample fragments the GPU counted.
+    pub gpu_fragments: u64,
+    /// Sample fragments of the reference.
+    pub reference_fragments: u64,
+    /// The first differing samples: (x, y, sample, GPU count, reference count).
+    pub examples: Vec<[u32; 5]>,
+}
+
+impl CountDiff {
+    /// `gpu` against `reference` (both indexed as [`SampleCounts::counts`]) over a target
+    /// `width` pixels wide at `samples` a pixel, keeping the first `examples` differing samples.
+    ///
+    /// # Panics
+    /// If the two cover different numbers of samples, or not whole pixels.
+    #[must_use]
+    pub fn of(gpu: &[u32], reference: &[u32], width: u32, samples: u32, examples: usize) -> Self {
+        assert_eq!(gpu.len(), reference.len(), "sample counts differ");
+        let n = samples as usize;
+        assert_eq!(gpu.len() % n, 0, "not whole pixels");
+        let mut diff = Self {
+            samples: gpu.len() as u64,
+            pixels: (gpu.len() / n) as u64,
+            gpu_fragments: gpu.iter().map(|&c| u64::from(c)).sum(),
+            reference_fragments: reference.iter().map(|&c| u64::from(c)).sum(),
+            ..Self::default()
+        };
+        for (pixel, (got, want)) in gpu.chunks(n).zip(reference.chunks(n)).enumerate() {
+            let sum = |c: &[u32]| c.iter().map(|&v| u64::from(v)).sum::<u64>();
+            diff.pixels_differ += u64::from(sum(got) != sum(want));
+            for (s, (&g, &w)) in got.iter().zip(want).enumerate() {
+                if g == w {
+                    continue;
+                }
+                diff.samples_differ += 1;
+                if diff.examples.len() < examples {
+                    let p = pixel as u32;
+                    diff.examples.push([p % width, p / width, s as u32, g, w]);
+                }
+            }
+        }
+        diff
+    }
+
+    /// Whether every sample's count is the same.
+    #[must_use]
+    pub fn is_identical(&self) -> bool {
+        self.samples_differ == 0
+    }
+
+    /// One line: the totals and the differing samples and pixels.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        format!(
+            "{}: {} of {} samples differ, {} of {} pixels' sums differ; sample fragments: GPU {}, fragsim {}",
+            if self.is_identical() {
+                "IDENTICAL"
+            } else {
+                "DIFFERENT"
+            },
+            self.samples_differ,
+            self.samples,
+            self.pixels_differ,
+            self.pixels,
+            self.gpu_fragments,
+            self.reference_fragments
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn differences_are_counted_per_sample_and_per_pixel_sum() {
+        // Two pixels of 4 samples, 2 wide: pixel 1's samples 0 and 1 trade a fragment (its sum
+        // is unchanged), pixel 0's sample 3 loses one.
+        let reference = [1, 1, 1, 1, 2, 0, 1, 1];
+        let gpu = [1, 1, 1, 0, 1, 1, 1, 1];
+        let diff = CountDiff::of(&gpu, &reference, 2, 4, 1);
+        assert_eq!((diff.samples, diff.samples_differ), (8, 3));
+        assert_eq!((diff.pixels, diff.pixels_differ), (2, 1));
+        assert_eq!((diff.gpu_fragments, diff.reference_fragments), (7, 8));
+        assert_eq!(diff.examples, [[0, 0, 3, 0, 1]]);
+        assert!(!diff.is_identical());
+        assert!(CountDiff::of(&gpu, &gpu, 2, 4, 1).is_identical());
+    }
+
+    #[test]
+    fn the_mirrored_patterns_are_other_positions() {
+        for count in [2, 4, 8] {
+            let standard = SamplePattern::standard(count).unwrap();
+            let mirror = mirrored(standard).unwrap();
+            assert_eq!(mirror.count(), count);
+            let mut a = standard.positions().to_vec();
+            let mut b = mirror.positions().to_vec();
+            a.sort_unstable();
+            b.sort_unstable();
+            assert_ne!(a, b, "{count} samples: the mirror is the same set");
+        }
+    }
+}
