@@ -99,7 +99,7 @@ if [ "$msaa" = 1 ]; then
                 --view "$(comma $views)" --mode "$(comma $modes)" --samples "$(comma ${SAMPLES:-1 4 8})" \
                 --mirrored 2>&1 | tee -a "$log"
             rc=${PIPESTATUS[0]}
-            [ "$rc" -ge 2 ] && { echo "$scene $side: exit $rc (124: stopped at the deadline)" | tee -a "$log"; status=2; }
+            [ "$rc" -ge 2 ] && { echo "$scene $side: exit $rc (124: stopped at the deadline; 2: a pass could not run, above)" | tee -a "$log"; status=2; }
         done
     done
     echo

@@ -106,14 +106,15 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| GpuError(format!("adapter {}: cannot open a device: {e}", info.name)))?;
-        let sample_counts = if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
-            adapter
-                .get_texture_format_features(TARGET_FORMAT)
-                .flags
-                .supported_sample_counts()
-        } else {
-            vec![1, 4]
-        };
+        let sample_counts =
+            if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+                adapter
+                    .get_texture_format_features(TARGET_FORMAT)
+                    .flags
+                    .supported_sample_counts()
+            } else {
+                vec![1, 4]
+            };
         Ok(Self {
             device,
             queue,
@@ -183,7 +184,6 @@ impl Gpu {
         )
     }
 }
-
 
 /// Writes `skipped: WHY` to the process's standard error directly, not through `eprintln!`,
 /// which the test harness captures and shows only for failing tests: a skipped test must say

@@ -24,10 +24,13 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
+use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{SamplePattern, Viewport};
 use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::judge::Within;
-use fragsim_wgpu::sample_counts::{count_samples, mirrored, reference_counts, CountDiff};
+use fragsim_wgpu::sample_counts::{
+    count_samples, f32_snap_radius, mirrored, nearest_boundaries, reference_counts, CountDiff,
+};
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
 
@@ -340,6 +343,8 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
     };
     let viewport = Viewport::new(args.width, args.height)?;
     let loaded = base.load(None)?;
+    // Engine mode: the differing samples whose distance to a triangle boundary is measured.
+    const CHECKED: usize = 200;
     let mut rows = Vec::new();
     let (mut identical, mut failed) = (true, 0);
     for &degrees in &args.view {
@@ -348,6 +353,8 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
             ..base.clone()
         };
         let view = spec.view(&loaded, viewport)?;
+        // The f32 vertex stage's snap radius on this view (engine mode, when a count differs).
+        let mut radius: Option<i64> = None;
         for mode in &args.mode {
             let (mode, reference_view) = match mode {
                 ModeArg::Replay => (Mode::Replay, view.clone()),
@@ -378,7 +385,7 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                     &reference,
                     args.width,
                     samples,
-                    args.examples,
+                    CHECKED.max(args.examples),
                 );
                 let ms = counted.gpu_ms.map_or_else(
                     || format!("{:.1} (wall)", counted.wall_ms),
@@ -389,9 +396,61 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                     counted.triangles,
                     diff.summary()
                 );
-                for [x, y, s, got, want] in &diff.examples {
-                    println!("  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}");
+                // Engine mode: each differing sample's nearest triangle boundaries in fragsim's f32
+                // view, against twice the snap radius (src/sample_counts.rs).
+                let near_edges = (mode == Mode::Engine && !diff.is_identical())
+                    .then(|| -> Result<_, Box<dyn std::error::Error>> {
+                        let r = match radius {
+                            Some(r) => r,
+                            None => {
+                                let mut exact = engine_scene(spec.clone(), &view);
+                                exact.conventions.vertex_precision = VertexPrecision::F64;
+                                *radius.insert(f32_snap_radius(&exact.view(&loaded, viewport)?))
+                            }
+                        };
+                        let nearest: Vec<_> = diff
+                            .examples
+                            .iter()
+                            .map(|&[x, y, s, ..]| {
+                                nearest_boundaries(&reference_view, pattern, [x, y], s as usize, 3)
+                            })
+                            .collect();
+                        Ok((r, nearest))
+                    })
+                    .transpose()?;
+                for (i, [x, y, s, got, want]) in
+                    diff.examples.iter().take(args.examples).enumerate()
+                {
+                    let mut line =
+                        format!("  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}");
+                    if let Some((_, nearest)) = &near_edges {
+                        let edges: Vec<String> = nearest[i]
+                            .iter()
+                            .map(|b| {
+                                format!(
+                                    "prim {} at {:.3} ({})",
+                                    b.prim,
+                                    b.subpixels,
+                                    if b.inside { "inside" } else { "outside" }
+                                )
+                            })
+                            .collect();
+                        line += &format!("; nearest boundaries (subpixels): {}", edges.join(", "));
+                    }
+                    println!("{line}");
                 }
+                let explained = near_edges.as_ref().map(|(r, nearest)| {
+                    let bound = 2.0 * *r as f64;
+                    let within = nearest
+                        .iter()
+                        .filter(|n| n.first().is_some_and(|b| b.subpixels <= bound))
+                        .count();
+                    println!(
+                        "  f32 vertex stage: {within} of the {} differing samples checked lie within twice the snap radius ({bound} subpixels) of a triangle boundary (explained by vertex precision)",
+                        nearest.len()
+                    );
+                    format!(" ({within}/{} near an edge)", nearest.len())
+                });
                 let mirror = if args.mirrored && samples > 1 {
                     let other = reference_counts(&reference_view, mirrored(pattern)?)?;
                     let against = CountDiff::of(&counted.counts, &other, args.width, samples, 0);
@@ -405,7 +464,7 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                 };
                 identical &= diff.is_identical();
                 rows.push(format!(
-                    "| {name} | {}x{} | {degrees} | {} | {samples} | {} | {} | {} | {} | {} | {mirror} | {ms} | {} |",
+                    "| {name} | {}x{} | {degrees} | {} | {samples} | {} | {} | {} | {} | {} | {mirror} | {ms} | {}{} |",
                     args.width,
                     args.height,
                     mode.name(),
@@ -414,7 +473,8 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                     diff.reference_fragments,
                     diff.samples_differ,
                     diff.pixels_differ,
-                    if diff.is_identical() { "IDENTICAL" } else { "DIFFERENT" }
+                    if diff.is_identical() { "IDENTICAL" } else { "DIFFERENT" },
+                    explained.unwrap_or_default()
                 ));
             }
         }

@@ -18,6 +18,13 @@
 //! [`engine_scene`](crate::capture::engine_scene) (the f32 matrix and the f32 vertex stage, where
 //! the GPU's own vertex arithmetic may move an edge past a sample: identity is not owed there).
 //!
+//! **Engine mode's differences** ([`nearest_boundaries`]): a sample whose count differs there
+//! must lie near a triangle's boundary, as the GPU's f32 vertex stage and fragsim's place each
+//! vertex within the snap radius of its exact position ([`Precision`]'s bound), so within twice
+//! that radius of each other, and an edge moves no further than its vertices. The command
+//! measures each differing sample's distance to the nearest boundary in fragsim's view and
+//! counts those within twice the radius: explained by vertex precision.
+//!
 //! **Sample positions.** wgpu neither sets nor reports sample positions (nor Vulkan's
 //! `standardSampleLocations`, which only `unsafe` code could read through its raw handle). The
 //! reference takes Vulkan's standard ones ([`SamplePattern::standard`]), which a driver uses when
@@ -31,8 +38,10 @@
 //! the adapter's target format lacks, or a view that already rasterizes per sample, is an error
 //! naming it.
 
+use fragsim_oracle::precision::Precision;
 use fragsim_oracle::samples::SampleOracle;
-use fragsim_raster::{SamplePattern, View};
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{SamplePattern, View, SUBPIXEL_BITS};
 
 use crate::capture::{execute, Mode};
 use crate::device::{Gpu, GpuError};
@@ -108,6 +117,89 @@ pub fn mirrored(pattern: SamplePattern) -> Result<SamplePattern, String> {
         .map(|&[x, y]| [x, 16 - y])
         .collect();
     SamplePattern::custom(Box::leak(positions.into_boxed_slice()))
+}
+
+/// A triangle boundary near a sample ([`nearest_boundaries`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Boundary {
+    /// The triangle's primitive id.
+    pub prim: u32,
+    /// The distance from the sample to the triangle's boundary, in subpixels (1/256 pixel).
+    pub subpixels: f64,
+    /// Whether the sample lies inside the triangle.
+    pub inside: bool,
+}
+
+/// The `count` triangle pieces of `view` whose boundaries pass nearest to sample `sample` of
+/// pixel `(x, y)` at `pattern`'s position, nearest first (every piece, culled ones included:
+/// distance is geometry, not coverage).
+#[must_use]
+pub fn nearest_boundaries(
+    view: &View<'_>,
+    pattern: SamplePattern,
+    [x, y]: [u32; 2],
+    sample: usize,
+    count: usize,
+) -> Vec<Boundary> {
+    let one = f64::from(1u32 << SUBPIXEL_BITS);
+    let [ox, oy] = pattern.fixed_offset(sample);
+    let p = [
+        f64::from(x) * one + ox as f64,
+        f64::from(y) * one + oy as f64,
+    ];
+    let mut near: Vec<Boundary> = Vec::new();
+    for prim in 0..view.triangle_count() {
+        view.screen_triangles(prim, &mut |tri| {
+            let v = tri.xy.map(|[vx, vy]| [vx as f64, vy as f64]);
+            let edges = [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])];
+            let subpixels = edges
+                .iter()
+                .map(|&(a, b)| segment_distance(p, a, b))
+                .fold(f64::INFINITY, f64::min);
+            let sides =
+                edges.map(|(a, b)| (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]));
+            let inside = sides.iter().all(|&e| e >= 0.0) || sides.iter().all(|&e| e <= 0.0);
+            near.push(Boundary {
+                prim: tri.prim,
+                subpixels,
+                inside,
+            });
+        });
+        // Keep the list short: the nearest `count` so far.
+        if near.len() > 4 * count.max(1) {
+            near.sort_by(|a, b| a.subpixels.total_cmp(&b.subpixels));
+            near.truncate(count);
+        }
+    }
+    near.sort_by(|a, b| a.subpixels.total_cmp(&b.subpixels));
+    near.truncate(count);
+    near
+}
+
+/// The distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let length2 = dx * dx + dy * dy;
+    let t = if length2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}
+
+/// The largest snap radius of an f32 vertex stage on `view`'s scene, in subpixels: how far the
+/// GPU's snapped vertices (and fragsim's f32 ones) may lie from the exact ones ([`Precision`]'s
+/// bound). `exact` is the view under the f64 vertex stage.
+#[must_use]
+pub fn f32_snap_radius(exact: &View<'_>) -> i64 {
+    let f32_stage = fragsim_raster::Conventions {
+        vertex_precision: VertexPrecision::F32,
+        ..exact.conventions()
+    };
+    Precision::derive(exact, &f32_stage)
+        .bounds()
+        .max_snap_radius_subpixels
 }
 
 /// Where two per-sample counts of one view differ.
@@ -207,6 +299,14 @@ mod tests {
         assert_eq!(diff.examples, [[0, 0, 3, 0, 1]]);
         assert!(!diff.is_identical());
         assert!(CountDiff::of(&gpu, &gpu, 2, 4, 1).is_identical());
+    }
+
+    #[test]
+    fn distances_to_a_segment_are_to_its_nearest_point() {
+        let (a, b) = ([0.0, 0.0], [4.0, 0.0]);
+        assert_eq!(segment_distance([2.0, 3.0], a, b), 3.0);
+        assert_eq!(segment_distance([7.0, 4.0], a, b), 5.0);
+        assert_eq!(segment_distance([1.0, 1.0], a, a), 2f64.sqrt());
     }
 
     #[test]

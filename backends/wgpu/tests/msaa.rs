@@ -37,7 +37,10 @@ fn the_bunnys_sample_counts_are_fragsims_at_the_standard_positions() {
             if samples > 1 {
                 let other = reference_counts(&view, mirrored(pattern).unwrap()).unwrap();
                 let against = CountDiff::of(&counted.counts, &other, side, samples, 0);
-                println!("{what} against the mirrored positions: {}", against.summary());
+                println!(
+                    "{what} against the mirrored positions: {}",
+                    against.summary()
+                );
                 assert!(against.samples_differ > 0, "{what}: {against:?}");
             }
         }
