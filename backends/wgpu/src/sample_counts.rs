@@ -68,7 +68,7 @@ pub struct SampleCounts {
 ///
 /// # Errors
 /// A view that rasterizes per sample (the GPU target is the pixel viewport), a sample count the
-/// adapter cannot render at, and [`capture`](crate::capture)'s errors.
+/// adapter cannot render at, and [`capture()`](crate::capture())'s errors.
 pub fn count_samples(
     gpu: &Gpu,
     view: &View<'_>,
