@@ -29,7 +29,7 @@ use fragsim_raster::{SamplePattern, Viewport};
 use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::judge::Within;
 use fragsim_wgpu::sample_counts::{
-    count_samples, f32_snap_radius, mirrored, nearest_boundaries, reference_counts, CountDiff,
+    count_samples, f32_snap_radius, mirrored, reference_counts, CountDiff, NearEdges,
 };
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
@@ -326,6 +326,10 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
     Ok(())
 }
 
+/// Engine mode: at most this many differing samples of a comparison are measured against the
+/// nearest triangle boundary (each measure visits every triangle).
+const CHECKED: usize = 200;
+
 /// `fragsim-wgpu msaa-count`: the GPU's per-sample counts against fragsim's per-sample oracle for
 /// every view, mode and sample count, one verdict line each (with the first differing samples),
 /// then a table; `Ok(false)` when any count differs.
@@ -343,8 +347,6 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
     };
     let viewport = Viewport::new(args.width, args.height)?;
     let loaded = base.load(None)?;
-    // Engine mode: the differing samples whose distance to a triangle boundary is measured.
-    const CHECKED: usize = 200;
     let mut rows = Vec::new();
     let (mut identical, mut failed) = (true, 0);
     for &degrees in &args.view {
@@ -408,14 +410,7 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                                 *radius.insert(f32_snap_radius(&exact.view(&loaded, viewport)?))
                             }
                         };
-                        let nearest: Vec<_> = diff
-                            .examples
-                            .iter()
-                            .map(|&[x, y, s, ..]| {
-                                nearest_boundaries(&reference_view, pattern, [x, y], s as usize, 3)
-                            })
-                            .collect();
-                        Ok((r, nearest))
+                        Ok(NearEdges::of(&reference_view, pattern, &diff, r))
                     })
                     .transpose()?;
                 for (i, [x, y, s, got, want]) in
@@ -423,8 +418,8 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                 {
                     let mut line =
                         format!("  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}");
-                    if let Some((_, nearest)) = &near_edges {
-                        let edges: Vec<String> = nearest[i]
+                    if let Some(near) = &near_edges {
+                        let edges: Vec<String> = near.nearest[i]
                             .iter()
                             .map(|b| {
                                 format!(
@@ -439,17 +434,13 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                     }
                     println!("{line}");
                 }
-                let explained = near_edges.as_ref().map(|(r, nearest)| {
-                    let bound = 2.0 * *r as f64;
-                    let within = nearest
-                        .iter()
-                        .filter(|n| n.first().is_some_and(|b| b.subpixels <= bound))
-                        .count();
+                let explained = near_edges.as_ref().map(|near| {
+                    let (within, checked) = (near.within(), near.nearest.len());
                     println!(
-                        "  f32 vertex stage: {within} of the {} differing samples checked lie within twice the snap radius ({bound} subpixels) of a triangle boundary (explained by vertex precision)",
-                        nearest.len()
+                        "  f32 vertex stage: {within} of the {checked} differing samples checked lie within twice the snap radius ({} subpixels) of a triangle boundary (explained by vertex precision)",
+                        near.bound_subpixels
                     );
-                    format!(" ({within}/{} near an edge)", nearest.len())
+                    format!(" ({within}/{checked} near an edge)")
                 });
                 let mirror = if args.mirrored && samples > 1 {
                     let other = reference_counts(&reference_view, mirrored(pattern)?)?;

@@ -176,6 +176,53 @@ pub fn nearest_boundaries(
     near
 }
 
+/// Engine mode's differing samples against vertex precision: each one's nearest triangle
+/// boundaries in fragsim's f32 view and the bound they are held to, twice the f32 snap radius
+/// (the module's documentation says why).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NearEdges {
+    /// Twice the snap radius, in subpixels.
+    pub bound_subpixels: f64,
+    /// Per differing sample of the [`CountDiff`] (its examples, in order), the three nearest
+    /// boundaries, nearest first.
+    pub nearest: Vec<Vec<Boundary>>,
+}
+
+impl NearEdges {
+    /// The examples of `diff` measured in `reference` (fragsim's f32 view, at `pattern`) against
+    /// twice `snap_radius` ([`f32_snap_radius`]).
+    #[must_use]
+    pub fn of(
+        reference: &View<'_>,
+        pattern: SamplePattern,
+        diff: &CountDiff,
+        snap_radius: i64,
+    ) -> Self {
+        let nearest = diff
+            .examples
+            .iter()
+            .map(|&[x, y, s, ..]| nearest_boundaries(reference, pattern, [x, y], s as usize, 3))
+            .collect();
+        Self {
+            bound_subpixels: 2.0 * snap_radius as f64,
+            nearest,
+        }
+    }
+
+    /// The samples measured whose nearest boundary lies within the bound: explained by vertex
+    /// precision.
+    #[must_use]
+    pub fn within(&self) -> usize {
+        self.nearest
+            .iter()
+            .filter(|n| {
+                n.first()
+                    .is_some_and(|b| b.subpixels <= self.bound_subpixels)
+            })
+            .count()
+    }
+}
+
 /// The distance from `p` to the segment `a`–`b`.
 fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
@@ -299,6 +346,22 @@ mod tests {
         assert_eq!(diff.examples, [[0, 0, 3, 0, 1]]);
         assert!(!diff.is_identical());
         assert!(CountDiff::of(&gpu, &gpu, 2, 4, 1).is_identical());
+    }
+
+    #[test]
+    fn near_edges_count_the_samples_within_twice_the_radius() {
+        let at = |subpixels| {
+            vec![Boundary {
+                prim: 0,
+                subpixels,
+                inside: true,
+            }]
+        };
+        let near = NearEdges {
+            bound_subpixels: 2.0,
+            nearest: vec![at(0.5), at(2.0), at(2.5), Vec::new()],
+        };
+        assert_eq!(near.within(), 2);
     }
 
     #[test]
