@@ -37,14 +37,31 @@
 # scene, view, size, mode, verdict, error px, ambiguous px, coverage px, ms: GPU timestamps where
 # the adapter has them, else the wall time of submit to read-back) on stdout and in
 # $OUT/wgpu-summary.tsv.
+#
+# MSAA=1: issue 22's per-sample counting pass instead of the captures (`fragsim-wgpu msaa-count`,
+# src/sample_counts.rs): per scene and side one command over every view, mode and sample count,
+# the GPU's per-sample fragment counts against fragsim's per-sample oracle at the standard
+# positions, and against the positions mirrored in y (which must differ). Defaults then: SIZES
+# "512", SCENES "bunny dragon", VIEWS "30 120", MODES "replay engine", SAMPLES "1 4 8" (1: the
+# control), BUDGET 240 s for all. Output: each command's log on stdout and in
+# $OUT/msaa-device.log, the table of every (scene, side, view, mode, samples) on stdout and in
+# $OUT/msaa-summary.md; exit 0 when every replay count is identical, 1 when one differs, 2 when
+# a command failed (a sample count the GPU lacks, the budget spent). On the H200:
+# MSAA=1 bash target/devbin-wgpu/run_device.sh. A dry run on lavapipe (1 and 4 samples only):
+# MSAA=1 BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES=64 SAMPLES="1 4"
+# bash backends/wgpu/run_device.sh.
 set -uo pipefail
+msaa=${MSAA:-0}
 bin=${BIN:-target/devbin-wgpu}
-sizes=${SIZES:-"512 2048"}
-scenes=${SCENES:-"bunny dragon bunny-spheres"}
-views=${VIEWS:-"30 120 210 300"}
+if [ "$msaa" = 1 ]; then
+    sizes=${SIZES:-512} scenes=${SCENES:-"bunny dragon"} views=${VIEWS:-"30 120"} budget=${BUDGET:-240}
+else
+    sizes=${SIZES:-"512 2048"} scenes=${SCENES:-"bunny dragon bunny-spheres"}
+    views=${VIEWS:-"30 120 210 300"} budget=${BUDGET:-210}
+fi
 modes=${MODES:-"replay engine"}
 jobs=${JOBS:-$(( $(nproc) / 2 > 0 ? $(nproc) / 2 : 1 ))}
-deadline=$(( $(date +%s) + ${BUDGET:-210} ))
+deadline=$(( $(date +%s) + budget ))
 dragon=${DRAGON:-$bin/dragon_vrip.ply.gz}
 out=${OUT:-/tmp}
 if compgen -G "$bin/gl/*.deb" >/dev/null; then
@@ -58,6 +75,45 @@ if ! "$bin/fragsim-wgpu" adapter 2>&1 | grep -q NVIDIA && [ -e "$icd" ]; then
 fi
 "$bin/fragsim-wgpu" adapter || exit 1
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
+
+# MSAA=1: the counting pass, one command per side and scene (see the header), then the table.
+if [ "$msaa" = 1 ]; then
+    # wgpu cannot report the driver's standardSampleLocations; vulkaninfo can, where installed.
+    command -v vulkaninfo >/dev/null && vulkaninfo 2>/dev/null | grep -m1 standardSampleLocations
+    comma() { echo "$*" | tr ' ' ','; }
+    log=$out/msaa-device.log status=0
+    : >"$log"
+    for side in $sizes; do
+        for scene in $scenes; do
+            case $scene in
+                dragon) what=(--mesh "$dragon") ;;
+                *) what=(--scene "$scene") ;;
+            esac
+            left=$((deadline - $(date +%s)))
+            if [ "$left" -lt 5 ]; then
+                echo "$scene $side: not run, the budget was spent" | tee -a "$log"
+                status=2
+                continue
+            fi
+            timeout "$left" "$bin/fragsim-wgpu" msaa-count "${what[@]}" --width "$side" --height "$side" \
+                --view "$(comma $views)" --mode "$(comma $modes)" --samples "$(comma ${SAMPLES:-1 4 8})" \
+                --mirrored 2>&1 | tee -a "$log"
+            rc=${PIPESTATUS[0]}
+            [ "$rc" -ge 2 ] && { echo "$scene $side: exit $rc (124: stopped at the deadline; 2: a pass could not run, above)" | tee -a "$log"; status=2; }
+        done
+    done
+    echo
+    echo "== msaa summary (samples differ: GPU against fragsim's standard positions; mirrored: against (x, 16 - y))"
+    {
+        grep -m1 '^| scene' "$log"
+        grep -m1 '^|---' "$log"
+        grep '^| ' "$log" | grep -v '^| scene'
+    } | tee "$out/msaa-summary.md"
+    if [ "$status" = 0 ] && grep '^| ' "$log" | grep ' replay ' | grep -q DIFFERENT; then
+        status=1
+    fi
+    exit "$status"
+fi
 logs=$(mktemp -d)
 export bin dragon logs deadline
 

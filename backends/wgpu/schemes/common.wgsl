@@ -18,8 +18,9 @@ struct Params {
     replay: u32,
     // Linked lists: nodes in the pool.
     pool: u32,
+    // Samples per pixel of the target (1 but for the counting pass, sample_counts.wgsl).
+    samples: u32,
     // Uniform structs are 16-byte multiples.
-    pad0: u32,
     pad1: u32,
     pad2: u32,
 }

@@ -164,10 +164,44 @@ pub fn capture_planted(
     mode: Mode,
     plant: Option<Plant>,
 ) -> Result<Captured, GpuError> {
-    gpu.check(scheme.name(), scheme.needs())?;
+    if let GpuScheme::SampleCounts { .. } = scheme {
+        return Err(GpuError(format!(
+            "{} is a pass, not a capture scheme: it has no dump layout",
+            scheme.name()
+        )));
+    }
     if let Some(plant) = plant {
         plant.check(scheme)?;
     }
+    let (run, triangles) = execute(gpu, view, scheme, mode, plant)?;
+    let (storages, words, gpu_ms, wall_ms) = run;
+    let dump = to_dump(
+        gpu, view, scene, scheme, mode, plant, triangles, &storages, words, gpu_ms, wall_ms,
+    )?;
+    Ok(Captured {
+        dump,
+        gpu_ms,
+        wall_ms,
+        triangles,
+    })
+}
+
+/// Draws `view` (at one sample a pixel, or the scheme's [`GpuScheme::samples`]) in `mode`
+/// through `scheme`'s passes and reads its storages back; with the triangles drawn.
+///
+/// # Errors
+/// As [`capture`]: a feature or sample count the adapter lacks, a replay viewport that is not a
+/// power of two, a buffer past the adapter's limits, a shader the device refuses, a failed
+/// read-back.
+pub(crate) fn execute(
+    gpu: &Gpu,
+    view: &View<'_>,
+    scheme: &GpuScheme,
+    mode: Mode,
+    plant: Option<Plant>,
+) -> Result<(RunResult, u32), GpuError> {
+    gpu.check(scheme.name(), scheme.needs())?;
+    gpu.check_samples(scheme.samples())?;
     let geometry = match mode {
         Mode::Replay => replay_geometry(view)?,
         Mode::Engine => engine_geometry(view),
@@ -191,20 +225,11 @@ pub fn capture_planted(
             scheme.name()
         )));
     }
-    let (storages, words, gpu_ms, wall_ms) = result?;
-    let dump = to_dump(
-        gpu, view, scene, scheme, mode, plant, &geometry, &storages, words, gpu_ms, wall_ms,
-    )?;
-    Ok(Captured {
-        dump,
-        gpu_ms,
-        wall_ms,
-        triangles: geometry.count,
-    })
+    Ok((result?, geometry.count))
 }
 
 /// What a capture read back: the storages, their words, GPU and wall milliseconds.
-type RunResult = (Vec<Storage>, Vec<Vec<u32>>, Option<f64>, f64);
+pub(crate) type RunResult = (Vec<Storage>, Vec<Vec<u32>>, Option<f64>, f64);
 
 /// What one submission read back ([`Run::phase`]).
 struct PhaseOutput {
@@ -232,9 +257,10 @@ struct Run<'a> {
     pixels: u64,
 }
 
-// A colour target the shader never writes (write mask empty): Vulkan draws need a render
-// area, the schemes write storage buffers only.
-const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+/// The format of the colour target the shaders never write (write mask empty): Vulkan draws
+/// need a render area, the schemes write storage buffers only. Multisampled as the scheme asks
+/// ([`GpuScheme::samples`]: the counting pass).
+pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
 impl<'a> Run<'a> {
     fn new(
@@ -266,7 +292,7 @@ impl<'a> Run<'a> {
             scheme.slots(),
             replay,
             pool,
-            0,
+            scheme.samples(),
             0,
             0,
         ] {
@@ -298,7 +324,7 @@ impl<'a> Run<'a> {
                     depth_or_array_layers: 1,
                 },
                 mip_level_count: 1,
-                sample_count: 1,
+                sample_count: scheme.samples(),
                 dimension: wgpu::TextureDimension::D2,
                 format: TARGET_FORMAT,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -607,7 +633,10 @@ impl<'a> Run<'a> {
                     ..Default::default()
                 },
                 depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
+                multisample: wgpu::MultisampleState {
+                    count: self.scheme.samples(),
+                    ..Default::default()
+                },
                 fragment: Some(wgpu::FragmentState {
                     module: &self.module,
                     entry_point: Some(entry),
@@ -693,7 +722,7 @@ fn to_dump(
     scheme: &GpuScheme,
     mode: Mode,
     plant: Option<Plant>,
-    geometry: &Geometry,
+    triangles: u32,
     storages: &[Storage],
     words: Vec<Vec<u32>>,
     gpu_ms: Option<f64>,
@@ -717,22 +746,12 @@ fn to_dump(
         );
         arrays.insert(storage.name.to_string(), data);
     }
-    // Engine mode draws the mesh with the orbit camera's matrix in f32 and Vulkan's conventions
-    // (upper-left origin, depth in [0, 1]): the dump names both, so that compare rebuilds the
-    // oracle the engine's way. Replay mode draws fragsim's own snapped triangles: reference.
-    let mut scene = scene;
-    if mode == Mode::Engine {
-        // Row-major, as a reader writes a matrix down (glam's arrays are column-major).
-        let m = geometry.view_projection;
-        scene.view_projection = Some(ViewProjection {
-            row_major: std::array::from_fn(|i| f64::from(m[(i % 4) * 4 + i / 4])),
-            precision: VertexPrecision::F32,
-        });
-        scene.conventions = Conventions {
-            vertex_precision: VertexPrecision::F32,
-            ..Conventions::REFERENCE
-        };
-    }
+    // The dump names the engine's matrix and conventions, so that compare rebuilds the oracle
+    // the engine's way. Replay mode draws fragsim's own snapped triangles: reference.
+    let scene = match mode {
+        Mode::Engine => engine_scene(scene, view),
+        Mode::Replay => scene,
+    };
     let header = Header {
         format: FORMAT.into(),
         version: VERSION,
@@ -762,11 +781,29 @@ fn to_dump(
             "mode": mode.name(),
             "shader": scheme.name(),
             "plant": plant.map(Plant::name),
-            "triangles_drawn": geometry.count,
+            "triangles_drawn": triangles,
             "timings": {"gpu_ms": gpu_ms, "wall_ms": wall_ms},
         }),
     };
     Ok(Dump { header, arrays })
+}
+
+/// `scene` as engine mode draws `view`: the orbit camera's matrix rounded to f32 (what
+/// `vs_engine` multiplies by) and Vulkan's conventions with the f32 vertex stage (upper-left
+/// origin, depth in [0, 1]); the scene fragsim rebuilds an engine capture's oracle from.
+#[must_use]
+pub fn engine_scene(mut scene: SceneAndCamera, view: &View<'_>) -> SceneAndCamera {
+    let m = view.view_projection().as_mat4().to_cols_array();
+    // Row-major, as a reader writes a matrix down (glam's arrays are column-major).
+    scene.view_projection = Some(ViewProjection {
+        row_major: std::array::from_fn(|i| f64::from(m[(i % 4) * 4 + i / 4])),
+        precision: VertexPrecision::F32,
+    });
+    scene.conventions = Conventions {
+        vertex_precision: VertexPrecision::F32,
+        ..Conventions::REFERENCE
+    };
+    scene
 }
 
 #[cfg(test)]

@@ -6,8 +6,16 @@
 //! timestamps are optional: a scheme that needs what the adapter lacks is refused when asked for
 //! ([`Gpu::check`]). [`adapter_or_skip`] is the tests' way in: the GPU, or one line saying why
 //! the test is skipped (or a failure where CI requires a GPU).
+//!
+//! For multisampling the report also gives the sample counts the colour target's format renders
+//! at. Where the samples lie it cannot say: wgpu does not expose Vulkan's
+//! `standardSampleLocations`, and reading it through wgpu's raw Vulkan handle takes `unsafe`
+//! code, which the workspace forbids (`crate::sample_counts` says how the positions are checked
+//! instead).
 
 use std::fmt;
+
+use crate::capture::TARGET_FORMAT;
 
 /// Why no GPU could be used, or why a scheme cannot run on this one.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -31,12 +39,16 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// The features this device was opened with (those of [`WANTED`] the adapter has).
     pub features: wgpu::Features,
+    /// The sample counts a colour target of the draws' format renders at (wgpu's guaranteed 1
+    /// and 4, and the adapter's own where it has `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`).
+    pub sample_counts: Vec<u32>,
 }
 
 /// Features the shaders use where the adapter has them, by name: 64-bit integers and their
-/// atomics (MDTS on u64 words), timestamps (GPU timings) and `PRIMITIVE_INDEX`, which is required
-/// (engine mode's primitive id; `common.wgsl` enables it).
-pub const WANTED: [(&str, wgpu::Features); 5] = [
+/// atomics (MDTS on u64 words), timestamps (GPU timings), the adapter's own texture format
+/// features (8 samples a pixel, past WebGPU's guaranteed 4) and `PRIMITIVE_INDEX`, which is
+/// required (engine mode's primitive id; `common.wgsl` enables it).
+pub const WANTED: [(&str, wgpu::Features); 6] = [
     ("SHADER_INT64", wgpu::Features::SHADER_INT64),
     (
         "SHADER_INT64_ATOMIC_MIN_MAX",
@@ -47,6 +59,10 @@ pub const WANTED: [(&str, wgpu::Features); 5] = [
         wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS,
     ),
     ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
+    (
+        "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES",
+        wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES,
+    ),
     ("PRIMITIVE_INDEX", wgpu::Features::PRIMITIVE_INDEX),
 ];
 
@@ -90,12 +106,37 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| GpuError(format!("adapter {}: cannot open a device: {e}", info.name)))?;
+        let sample_counts =
+            if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+                adapter
+                    .get_texture_format_features(TARGET_FORMAT)
+                    .flags
+                    .supported_sample_counts()
+            } else {
+                vec![1, 4]
+            };
         Ok(Self {
             device,
             queue,
             info,
             features,
+            sample_counts,
         })
+    }
+
+    /// Refuses a draw at `samples` a pixel that the colour target's format cannot render at.
+    ///
+    /// # Errors
+    /// The counts the adapter has, with its name.
+    pub fn check_samples(&self, samples: u32) -> Result<(), GpuError> {
+        if self.sample_counts.contains(&samples) {
+            Ok(())
+        } else {
+            Err(GpuError(format!(
+                "adapter {} renders {TARGET_FORMAT:?} targets at {:?} samples a pixel, not {samples}",
+                self.info.name, self.sample_counts
+            )))
+        }
     }
 
     /// Whether the device has `feature`.
@@ -133,12 +174,13 @@ impl Gpu {
             .map(|&(name, f)| format!("{name}: {}", if self.has(f) { "yes" } else { "no" }))
             .collect();
         format!(
-            "adapter {} ({:?}, driver {} {}); {}",
+            "adapter {} ({:?}, driver {} {}); {}; target sample counts {:?}",
             self.info.name,
             self.info.device_type,
             self.info.driver,
             self.info.driver_info,
-            flags.join(", ")
+            flags.join(", "),
+            self.sample_counts
         )
     }
 }

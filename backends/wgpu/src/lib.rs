@@ -6,14 +6,16 @@
 //! The parts: the headless device and its adapter report ([`device`]), the shaders, their passes
 //! and buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), the planted bugs
 //! ([`plant`]), one capture in replay or engine mode ([`mod@capture`]), the judgement of a
-//! capture against fragsim's oracle ([`judge`]), and the backend as the conformance battery's
-//! [`fragsim_testkit::Backend`] ([`mod@conform`]). The command is `fragsim-wgpu` (`src/main.rs`).
+//! capture against fragsim's oracle ([`judge`]), the backend as the conformance battery's
+//! [`fragsim_testkit::Backend`] ([`mod@conform`]), and the per-sample counting pass of a
+//! multisampled target against fragsim's per-sample oracle ([`sample_counts`]). The command is `fragsim-wgpu` (`src/main.rs`).
 
 pub mod capture;
 pub mod conform;
 pub mod device;
 pub mod judge;
 pub mod plant;
+pub mod sample_counts;
 pub mod shaders;
 
 pub use capture::{capture, capture_planted, Captured, Mode};

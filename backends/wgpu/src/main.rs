@@ -7,12 +7,16 @@
 //!     --view 30 --mode replay --out out/wgpu --judge
 //! fragsim-wgpu capture --scheme linked-list --plant lost-node --scene bunny --out out/wgpu
 //! fragsim-wgpu capture --case DIR --scheme mdts --k 2 --mode engine --out OUT
+//! fragsim-wgpu msaa-count --scene bunny --samples 1,4,8 --view 30,120 --width 512 \
+//!     --height 512 --mode replay,engine --mirrored
 //! ```
 //!
 //! `--case` reads a case directory of `fragsim conform` (its `camera.json` and `case.json`), so
 //! that the command is conform's `--backend` (`docs/testing.md`).
 //!
-//! Exit status: 0 on success (whatever the verdicts), 2 on an error (no adapter, bad input).
+//! Exit status: 0 on success (`capture`: whatever the verdicts; `msaa-count`: every count
+//! identical), 1 when `msaa-count` found differing counts, 2 on an error (no adapter, bad input,
+//! a sample count the adapter lacks).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -20,8 +24,13 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
-use fragsim_raster::Viewport;
+use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::{SamplePattern, Viewport};
+use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::judge::Within;
+use fragsim_wgpu::sample_counts::{
+    count_samples, f32_snap_radius, mirrored, reference_counts, CountDiff, NearEdges,
+};
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
 
@@ -47,6 +56,47 @@ enum Command {
     Adapter,
     /// Capture a scene with one or more schemes; one dump per scheme in OUT/<scheme>/.
     Capture(Box<CaptureArgs>),
+    /// Count the GPU's fragments per sample of a multisampled target and compare them with
+    /// fragsim's per-sample oracle; a summary table at the end.
+    MsaaCount(MsaaArgs),
+}
+
+/// Options of `fragsim-wgpu msaa-count`: every combination of views, modes and sample counts.
+#[derive(Args)]
+struct MsaaArgs {
+    /// A mesh file (OBJ or PLY, optionally gzipped).
+    #[arg(long, conflicts_with = "scene")]
+    mesh: Option<PathBuf>,
+    /// A named scene (bunny, bunny-spheres, spheres:N, soup, quads).
+    #[arg(long, default_value = "bunny")]
+    scene: String,
+    /// Viewport width (a power of two in replay mode).
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// Viewport height (a power of two in replay mode).
+    #[arg(long, default_value_t = 512)]
+    height: u32,
+    /// Orbit angles, degrees, comma-separated.
+    #[arg(long, default_value = "30", value_delimiter = ',')]
+    view: Vec<f64>,
+    /// Elevation, degrees.
+    #[arg(long, default_value_t = 15.0)]
+    elevation: f64,
+    /// Samples per pixel, comma-separated: 1 (the control), 2, 4, 8 (Vulkan's standard
+    /// patterns; the adapter's target format must render at the count).
+    #[arg(long, default_value = "4", value_delimiter = ',')]
+    samples: Vec<u32>,
+    /// Modes, comma-separated: replay (fragsim's snapped triangles: identity owed), engine (the
+    /// mesh and the f32 matrix: differences reported).
+    #[arg(long, value_enum, default_value = "replay", value_delimiter = ',')]
+    mode: Vec<ModeArg>,
+    /// Also compare the GPU's counts with fragsim's at the standard positions mirrored in y
+    /// (x, 16 − y): nonzero differences show that the counts tell the positions apart.
+    #[arg(long)]
+    mirrored: bool,
+    /// Differing samples printed per comparison.
+    #[arg(long, default_value_t = 5)]
+    examples: usize,
 }
 
 /// Options of `fragsim-wgpu capture`.
@@ -120,7 +170,8 @@ fn main() -> ExitCode {
         std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
     match run(Cli::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
         Err(e) => {
             eprintln!("fragsim-wgpu: {e}");
             ExitCode::from(2)
@@ -128,12 +179,18 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
+/// The command; `Ok(false)`: `msaa-count` found differing counts.
+fn run(cli: Cli) -> Result<bool, Box<dyn std::error::Error>> {
     let gpu = Gpu::open()?;
     println!("{}", gpu.report());
-    let Command::Capture(args) = cli.command else {
-        return Ok(());
-    };
+    match cli.command {
+        Command::Adapter => Ok(true),
+        Command::Capture(args) => capture_command(&gpu, *args).map(|()| true),
+        Command::MsaaCount(args) => msaa_count(&gpu, &args),
+    }
+}
+
+fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::error::Error>> {
     let CaptureArgs {
         scheme,
         mesh,
@@ -152,7 +209,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         judge: judge_it,
         depth_ulps,
         precision,
-    } = *args;
+    } = args;
     let names: Vec<&str> = if scheme == "all" {
         NAMES.to_vec()
     } else {
@@ -209,7 +266,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             // One scheme the adapter cannot run (a buffer past its limits, a missing feature)
             // does not stop the others: it is reported and the command exits 2 at the end.
             let captured =
-                match capture_planted(&gpu, &fragsim_view, spec.clone(), scheme, mode, plant) {
+                match capture_planted(gpu, &fragsim_view, spec.clone(), scheme, mode, plant) {
                     Ok(captured) => captured,
                     Err(e) => {
                         eprintln!("fragsim-wgpu: {e}");
@@ -267,6 +324,161 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         return Err(format!("{failed} of {runs} captures could not run").into());
     }
     Ok(())
+}
+
+/// Engine mode: at most this many differing samples of a comparison are measured against the
+/// nearest triangle boundary (each measure visits every triangle).
+const CHECKED: usize = 200;
+
+/// `fragsim-wgpu msaa-count`: the GPU's per-sample counts against fragsim's per-sample oracle for
+/// every view, mode and sample count, one verdict line each (with the first differing samples),
+/// then a table; `Ok(false)` when any count differs.
+fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Error>> {
+    let base = match &args.mesh {
+        Some(path) => SceneAndCamera::hashed_mesh(path, 0.0, args.elevation)?,
+        None => SceneAndCamera::named(&args.scene, 0.0, args.elevation),
+    };
+    let name = match &args.mesh {
+        Some(path) => path.file_name().map_or_else(
+            || path.display().to_string(),
+            |f| f.to_string_lossy().into_owned(),
+        ),
+        None => args.scene.clone(),
+    };
+    let viewport = Viewport::new(args.width, args.height)?;
+    let loaded = base.load(None)?;
+    let mut rows = Vec::new();
+    let (mut identical, mut failed) = (true, 0);
+    for &degrees in &args.view {
+        let spec = SceneAndCamera {
+            view_degrees: degrees,
+            ..base.clone()
+        };
+        let view = spec.view(&loaded, viewport)?;
+        // The f32 vertex stage's snap radius on this view (engine mode, when a count differs).
+        let mut radius: Option<i64> = None;
+        for mode in &args.mode {
+            let (mode, reference_view) = match mode {
+                ModeArg::Replay => (Mode::Replay, view.clone()),
+                ModeArg::Engine => (
+                    Mode::Engine,
+                    engine_scene(spec.clone(), &view).view(&loaded, viewport)?,
+                ),
+            };
+            for &samples in &args.samples {
+                let what = format!(
+                    "{name} {}x{} view {degrees} {} {samples}x",
+                    args.width,
+                    args.height,
+                    mode.name()
+                );
+                let pattern = SamplePattern::standard(samples)?;
+                let counted = match count_samples(gpu, &view, mode, samples) {
+                    Ok(counted) => counted,
+                    Err(e) => {
+                        eprintln!("fragsim-wgpu: {what}: {e}");
+                        failed += 1;
+                        continue;
+                    }
+                };
+                let reference = reference_counts(&reference_view, pattern)?;
+                let diff = CountDiff::of(
+                    &counted.counts,
+                    &reference,
+                    args.width,
+                    samples,
+                    CHECKED.max(args.examples),
+                );
+                let ms = counted.gpu_ms.map_or_else(
+                    || format!("{:.1} (wall)", counted.wall_ms),
+                    |ms| format!("{ms:.3}"),
+                );
+                println!(
+                    "{what}: {} triangles, GPU {ms} ms; {}",
+                    counted.triangles,
+                    diff.summary()
+                );
+                // Engine mode: each differing sample's nearest triangle boundaries in fragsim's f32
+                // view, against twice the snap radius (src/sample_counts.rs).
+                let near_edges = (mode == Mode::Engine && !diff.is_identical())
+                    .then(|| -> Result<_, Box<dyn std::error::Error>> {
+                        let r = match radius {
+                            Some(r) => r,
+                            None => {
+                                let mut exact = engine_scene(spec.clone(), &view);
+                                exact.conventions.vertex_precision = VertexPrecision::F64;
+                                *radius.insert(f32_snap_radius(&exact.view(&loaded, viewport)?))
+                            }
+                        };
+                        Ok(NearEdges::of(&reference_view, pattern, &diff, r))
+                    })
+                    .transpose()?;
+                for (i, [x, y, s, got, want]) in
+                    diff.examples.iter().take(args.examples).enumerate()
+                {
+                    let mut line =
+                        format!("  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}");
+                    if let Some(near) = &near_edges {
+                        let edges: Vec<String> = near.nearest[i]
+                            .iter()
+                            .map(|b| {
+                                format!(
+                                    "prim {} at {:.3} ({})",
+                                    b.prim,
+                                    b.subpixels,
+                                    if b.inside { "inside" } else { "outside" }
+                                )
+                            })
+                            .collect();
+                        line += &format!("; nearest boundaries (subpixels): {}", edges.join(", "));
+                    }
+                    println!("{line}");
+                }
+                let explained = near_edges.as_ref().map(|near| {
+                    let (within, checked) = (near.within(), near.nearest.len());
+                    println!(
+                        "  f32 vertex stage: {within} of the {checked} differing samples checked lie within twice the snap radius ({} subpixels) of a triangle boundary (explained by vertex precision)",
+                        near.bound_subpixels
+                    );
+                    format!(" ({within}/{checked} near an edge)")
+                });
+                let mirror = if args.mirrored && samples > 1 {
+                    let other = reference_counts(&reference_view, mirrored(pattern)?)?;
+                    let against = CountDiff::of(&counted.counts, &other, args.width, samples, 0);
+                    println!(
+                        "  against the mirrored positions (x, 16 - y): {} of {} samples, {} pixels' sums differ",
+                        against.samples_differ, against.samples, against.pixels_differ
+                    );
+                    against.samples_differ.to_string()
+                } else {
+                    "-".to_string()
+                };
+                identical &= diff.is_identical();
+                rows.push(format!(
+                    "| {name} | {}x{} | {degrees} | {} | {samples} | {} | {} | {} | {} | {} | {mirror} | {ms} | {}{} |",
+                    args.width,
+                    args.height,
+                    mode.name(),
+                    counted.triangles,
+                    diff.gpu_fragments,
+                    diff.reference_fragments,
+                    diff.samples_differ,
+                    diff.pixels_differ,
+                    if diff.is_identical() { "IDENTICAL" } else { "DIFFERENT" },
+                    explained.unwrap_or_default()
+                ));
+            }
+        }
+    }
+    println!("\n| scene | size | view | mode | samples | triangles | GPU sample fragments | fragsim | samples differ | pixel sums differ | mirrored: samples differ | GPU ms | verdict |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for row in &rows {
+        println!("{row}");
+    }
+    if failed > 0 {
+        return Err(format!("{failed} counting passes could not run").into());
+    }
+    Ok(identical)
 }
 
 /// The scene object and viewport of a `fragsim conform` case directory: `camera.json` (a dump

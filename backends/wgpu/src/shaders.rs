@@ -20,6 +20,7 @@ const MDTS: &str = include_str!("../schemes/mdts.wgsl");
 const KBUFFER: &str = include_str!("../schemes/kbuffer.wgsl");
 const LINKED_LIST: &str = include_str!("../schemes/linked_list.wgsl");
 const KBUFFER_SPINLOCK: &str = include_str!("../schemes/kbuffer_spinlock.wgsl");
+const SAMPLE_COUNTS: &str = include_str!("../schemes/sample_counts.wgsl");
 
 /// The scheme names [`GpuScheme::parse`] accepts (the catalog's names).
 pub const NAMES: [&str; 8] = [
@@ -76,6 +77,13 @@ pub enum GpuScheme {
     KbufferSpinlock {
         /// Slots per pixel.
         k: u32,
+    },
+    /// Not a capture scheme but the counting pass of [`crate::sample_counts`]: one `atomicAdd`
+    /// per covered sample of a multisampled target. It has no dump layout: `capture` refuses it
+    /// and [`GpuScheme::parse`] does not know it.
+    SampleCounts {
+        /// Samples per pixel of the target.
+        samples: u32,
     },
 }
 
@@ -182,6 +190,16 @@ impl GpuScheme {
                 ..
             } => "linked-list-nearest",
             Self::KbufferSpinlock { .. } => "kbuffer-spinlock-fixed",
+            Self::SampleCounts { .. } => "sample-counts",
+        }
+    }
+
+    /// Samples per pixel of the colour target the passes draw into: 1 but for the counting pass.
+    #[must_use]
+    pub fn samples(&self) -> u32 {
+        match *self {
+            Self::SampleCounts { samples } => samples,
+            _ => 1,
         }
     }
 
@@ -194,7 +212,7 @@ impl GpuScheme {
             | Self::Kbuffer { k }
             | Self::KbufferSpinlock { k }
             | Self::LinkedList { k, .. } => Some(k),
-            Self::ABuffer { .. } | Self::ABufferExact => None,
+            Self::ABuffer { .. } | Self::ABufferExact | Self::SampleCounts { .. } => None,
         }
     }
 
@@ -231,16 +249,18 @@ impl GpuScheme {
 
     /// The dump layout's `scheme` (`docs/dump-format.md`), the catalog's for the scheme (what
     /// `fragsim render --dump` writes): both A-buffers are `abuffer`, the linked lists and the
-    /// two k-buffers (the catalog's memory layout) name themselves.
+    /// two k-buffers (the catalog's memory layout) name themselves; the counting pass, which
+    /// writes no dump, its name.
     #[must_use]
     pub fn layout(&self) -> &'static str {
         match self {
             Self::ABuffer { .. } | Self::ABufferExact => "abuffer",
             Self::Mdts { .. } => "mdts",
             Self::Mdts32 { .. } => "mdts32",
-            Self::LinkedList { .. } | Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } => {
-                self.name()
-            }
+            Self::LinkedList { .. }
+            | Self::Kbuffer { .. }
+            | Self::KbufferSpinlock { .. }
+            | Self::SampleCounts { .. } => self.name(),
         }
     }
 
@@ -286,6 +306,7 @@ impl GpuScheme {
             Self::Kbuffer { .. } => KBUFFER,
             Self::LinkedList { .. } => LINKED_LIST,
             Self::KbufferSpinlock { .. } => KBUFFER_SPINLOCK,
+            Self::SampleCounts { .. } => SAMPLE_COUNTS,
         }
     }
 
@@ -390,6 +411,14 @@ impl GpuScheme {
             }
             // One lock word per pixel before the slots.
             Self::KbufferSpinlock { k } => memory(pixels, k),
+            // A count per (pixel, sample), sample-index order within a pixel.
+            Self::SampleCounts { samples } => vec![Storage::new(
+                1,
+                "counts",
+                Dtype::U32,
+                vec![pixels * u64::from(samples)],
+                0,
+            )],
         }
     }
 }

@@ -94,6 +94,33 @@ impl SamplePattern {
         Ok(Self { positions })
     }
 
+    /// A pattern of other positions (1/16 pixel from the pixel's upper-left corner, y down, in
+    /// sample-index order): not a standard pattern, for checks that a rasterizer's coverage
+    /// tells patterns apart (the wgpu backend's counting pass compares the GPU against a
+    /// mirrored pattern too).
+    ///
+    /// # Errors
+    /// No position or more than 16, a coordinate past 15, or a position repeated.
+    pub fn custom(positions: &'static [[u8; 2]]) -> Result<Self, String> {
+        if positions.is_empty() || positions.len() > 16 {
+            return Err(format!(
+                "{} sample positions: a pattern has 1 to 16",
+                positions.len()
+            ));
+        }
+        if let Some(p) = positions.iter().find(|p| p[0] > 15 || p[1] > 15) {
+            return Err(format!(
+                "sample position {p:?}: coordinates are 0 to 15 (1/16 pixel)"
+            ));
+        }
+        let mut sorted = positions.to_vec();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("sample position {:?} is repeated", w[0]));
+        }
+        Ok(Self { positions })
+    }
+
     /// Samples per pixel.
     #[must_use]
     pub fn count(self) -> u32 {
@@ -179,6 +206,15 @@ mod tests {
             let message = SamplePattern::standard(bad).unwrap_err();
             assert!(message.contains(&bad.to_string()), "{message}");
         }
+    }
+
+    #[test]
+    fn custom_patterns_are_checked() {
+        static MIRRORED_4: [[u8; 2]; 4] = [[6, 14], [14, 10], [2, 6], [10, 2]];
+        assert_eq!(SamplePattern::custom(&MIRRORED_4).unwrap().count(), 4);
+        assert!(SamplePattern::custom(&[]).is_err());
+        assert!(SamplePattern::custom(&[[16, 0]]).is_err());
+        assert!(SamplePattern::custom(&[[3, 3], [3, 3]]).is_err());
     }
 
     #[test]
