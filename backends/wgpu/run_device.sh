@@ -25,6 +25,10 @@
 # the common deadline BUDGET seconds after the start (a job not started by then says so), so the
 # call ends in time.
 #
+# SPINLOCK=0 leaves the spinlocked k-buffer out: on the H200 (2026-12-03) its shaders, killed
+# by `timeout`, kept the GPU busy after their processes ended, and every capture started after
+# them stalled until the deadline (docs/results-gpu.md, session 8).
+#
 # Knobs (environment): SIZES (default "512 2048"), SCENES ("bunny dragon bunny-spheres"), VIEWS
 # ("30 120 210 300"), MODES ("replay engine"), JOBS (parallel jobs, default the cores / 2), BUDGET
 # (seconds for all the jobs, default 210), BIN (default target/devbin-wgpu), DRAGON (default
@@ -141,7 +145,7 @@ one() {
                 || echo "job $scene $side $view $mode: exit $? (124: stopped at the deadline)"
         fi
         left=$((deadline - $(date +%s)))
-        if [ "$plant" = all ] && [ "$left" -ge 5 ]; then
+        if [ "$plant" = all ] && [ "${SPINLOCK:-1}" = 1 ] && [ "$left" -ge 5 ]; then
             timeout "$((left < 60 ? left : 60))" "$bin/fragsim-wgpu" capture --scheme kbuffer-spinlock-fixed "${common[@]}" \
                 || echo "kbuffer-spinlock-fixed $scene $side $view $mode: exit $? (124: timed out, at most 60 s)"
         fi
