@@ -520,7 +520,7 @@ fn bench_records_carry_the_colour_error_per_depth_complexity_and_it_adds_up() {
         .args(["bench", "--scene", "spheres:9", "--width", "48"])
         .args(["--height", "48", "--frames", "1", "--json", "--no-images"])
         .args(["--scheme", "abuffer-exact,mdts", "--k", "4"])
-        .args(["--approximate", "wboit,mlab,tail-blend"])
+        .args(["--approximate", "wboit,mlab,tail-blend", "--shuffle", "1"])
         .arg("--out")
         .arg(&out)
         .output()
@@ -570,7 +570,7 @@ fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
         .unwrap()
         .args(["sweep", "--scene", "spheres:9", "--width", "48"])
         .args(["--height", "48", "--angles", "3", "--scheme", "mdts"])
-        .args(["--approximate", "mlab", "--k", "4"])
+        .args(["--approximate", "mlab", "--k", "4", "--shuffle", "1"])
         .arg("--out")
         .arg(&out)
         .output()
@@ -619,12 +619,11 @@ fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
                     .map(|r| r[format!("{name}_{suffix}")].as_u64().unwrap())
                     .sum()
             };
+            let max_field = format!("max_abs_error_{suffix}");
             let largest = of_scheme
                 .iter()
-                .flat_map(|r| {
-                    (0..3).map(move |c| r[format!("max_abs_error_{suffix}")][c].as_u64())
-                })
-                .flatten()
+                .flat_map(|r| r[&max_field].as_array().into_iter().flatten())
+                .filter_map(Value::as_u64)
                 .max()
                 .unwrap();
             let (pixels, errors) = (sum("pixels"), sum("error_pixels"));
@@ -637,4 +636,35 @@ fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
             assert_eq!(cells[5].parse::<u64>().unwrap(), largest, "{cells:?}");
         }
     }
+}
+
+/// `sweep --shuffle` submits the triangles in the shuffled order, as `bench` does (it was
+/// ignored): MLAB with one node on `spheres:3` at 48 × 48, angle 0, has no error pixel in the
+/// scene's own order and some shuffled (measured: 36.5 % of the covered pixels with seed 1).
+#[test]
+fn sweep_submits_in_the_shuffled_order() {
+    let mlab_rate = |shuffle: &[&str]| {
+        let out = out_dir(&format!("sweep-shuffle{}", shuffle.len()));
+        let output = Command::cargo_bin("fragsim")
+            .unwrap()
+            .args(["sweep", "--scene", "spheres:3", "--width", "48"])
+            .args(["--height", "48", "--angles", "1", "--scheme", "zbuffer"])
+            .args(["--approximate", "mlab", "--k", "1", "--json"])
+            .args(shuffle)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let _ = std::fs::remove_dir_all(&out);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let records = crate::support::json_lines(&output.stdout);
+        let mlab = records.iter().find(|r| r["scheme"] == "mlab").unwrap();
+        mlab["error_pixel_rate"].as_f64().unwrap()
+    };
+    assert_eq!(mlab_rate(&[]), 0.0);
+    assert!(mlab_rate(&["--shuffle", "1"]) > 0.0);
 }

@@ -18,7 +18,7 @@ use serde::Serialize;
 use crate::approximate::{ApproximateName, ApproximateRow};
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
-use crate::record::{bucket_cells, ColourByDepth, Context};
+use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{check_memory_cap_early, family, Executors, SchemeChoice, SchemeName};
 
 /// Options of `fragsim bench`.
@@ -527,6 +527,7 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
                 family: family(&r.scheme),
                 time_ms: r.time_ms,
                 rate: r.error_pixel_rate?,
+                mean_error: mean_of_channels(&r.colour),
             })
         })
         .chain(
@@ -538,6 +539,7 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
                     family: family(&r.scheme),
                     time_ms: r.time_ms,
                     rate: r.error_pixel_rate,
+                    mean_error: mean_of_channels(&r.colour),
                 }),
         )
         .collect();
@@ -637,9 +639,9 @@ fn markdown(report: &BenchReport) -> String {
     text
 }
 
-/// bench.md's table of the colour error per depth-complexity bucket, of every image that differs
-/// from the oracle's (catalog rows by scheme and executor, approximate ones as the chart labels
-/// them); empty when every image is exact.
+/// bench.md's table of the colour error per depth-complexity bucket, of every approximate image
+/// (as the chart labels them) and every catalog image that differs from the oracle's (by scheme
+/// and executor); empty when there is none.
 fn depth_markdown(report: &BenchReport) -> String {
     let differing = report
         .rows
@@ -660,8 +662,8 @@ fn depth_markdown(report: &BenchReport) -> String {
         return lines;
     }
     format!(
-        "\nThe colour error per depth-complexity bucket (fragments per pixel), of every image \
-         that differs from the oracle's\n\n\
+        "\nThe colour error per depth-complexity bucket (fragments per pixel), of the approximate \
+         images and of every other image that differs from the oracle's\n\n\
          | row | fragments/px | pixels | EPR % | mean err | max err | PSNR dB |\n\
          |---|---|---|---|---|---|---|\n{lines}\n\
          Columns: **fragments/px** the bucket (the oracle's fragments per pixel; uncovered \

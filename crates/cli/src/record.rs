@@ -253,6 +253,13 @@ impl Serialize for ColourByDepth {
     }
 }
 
+/// The mean absolute error of an image over its three channels, as tables and charts print it
+/// (`None`: no image).
+#[must_use]
+pub fn mean_of_channels(colour: &ColourColumns) -> Option<f64> {
+    colour.mean_abs_error.map(|m| m.iter().sum::<f64>() / 3.0)
+}
+
 /// A table's cells of one bucket: its name, pixels, EPR % of them, and the colour error's mean,
 /// maximum and PSNR cells (as the whole image's: `inf` for a bucket equal to the oracle's).
 #[must_use]

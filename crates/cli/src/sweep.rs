@@ -11,7 +11,7 @@ use serde::Serialize;
 use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{ColourColumns, EffectName, Judge};
-use crate::record::{bucket_cells, ColourByDepth, Context};
+use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 use crate::schemes::{family, Executors, SchemeChoice};
 
@@ -110,7 +110,9 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
         let orbit = args.scene.orbit(angle);
-        let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+        let view = args
+            .schemes
+            .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
@@ -232,18 +234,15 @@ fn write_outputs(
         &per_angle,
         false,
     )?;
-    let mean = |v: &mut dyn Iterator<Item = f64>| {
-        let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
-        (n > 0).then(|| sum / n as f64)
-    };
     let scatter: Vec<fragsim_shade::plot::Point> = series
         .iter()
         .filter_map(|s| {
             Some(fragsim_shade::plot::Point {
                 label: s.scheme.clone(),
                 family: family(&s.scheme),
-                time_ms: mean(&mut s.time_ms.iter().copied())?,
-                rate: mean(&mut s.error_pixel_rate.iter().flatten().copied())?,
+                time_ms: mean(s.time_ms.iter().copied())?,
+                rate: mean(s.error_pixel_rate.iter().flatten().copied())?,
+                mean_error: mean(s.colour.iter().filter_map(mean_of_channels)),
             })
         })
         .collect();
@@ -275,13 +274,13 @@ fn write_outputs(
             .map(|r| r * 100.0)
             .collect();
         let mean_rate =
-            mean(&mut rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
+            mean(rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
         let max_rate = rates
             .iter()
             .copied()
             .reduce(f64::max)
             .map_or("n/a".into(), |r| format!("{r:.4}"));
-        let mean_ms = mean(&mut s.time_ms.iter().copied()).unwrap_or(0.0);
+        let mean_ms = mean(s.time_ms.iter().copied()).unwrap_or(0.0);
         let [mean_error, max_error, psnr] = colour_over_angles(&s.colour);
         outln!(
             "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12.2}",
@@ -302,18 +301,19 @@ fn write_outputs(
     Ok(())
 }
 
+/// The mean of `values` (`None`: there are none).
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
 /// The sweep table's colour cells of one scheme: the mean over the angles of the mean absolute
 /// error (the channels' mean), the largest error at any angle, and the lowest PSNR (`inf`: every
 /// angle's image equal to the oracle's); `n/a` where no angle's image resolves.
 fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
-    let means: Vec<f64> = colour
-        .iter()
-        .filter_map(|c| c.mean_abs_error)
-        .map(|m| m.iter().sum::<f64>() / 3.0)
-        .collect();
-    if means.is_empty() {
+    let Some(mean_error) = mean(colour.iter().filter_map(mean_of_channels)) else {
         return ["n/a".into(), "n/a".into(), "n/a".into()];
-    }
+    };
     let max = colour
         .iter()
         .filter_map(|c| c.max_abs_error)
@@ -326,7 +326,7 @@ fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
         .reduce(f64::min)
         .map_or("inf".into(), |p| format!("{p:.2}"));
     [
-        format!("{:.3}", means.iter().sum::<f64>() / means.len() as f64),
+        format!("{mean_error:.3}"),
         max.to_string(),
         psnr,
     ]

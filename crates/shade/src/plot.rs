@@ -39,6 +39,10 @@ pub struct Point {
     pub time_ms: f64,
     /// Error-pixel rate, a fraction (drawn as a percentage).
     pub rate: f64,
+    /// The image's mean absolute colour error (8-bit units, the mean of the channels'), printed
+    /// in the table beside the chart: EPR counts the pixels that differ, this says by how much
+    /// (`None`: not measured).
+    pub mean_error: Option<f64>,
 }
 
 /// The points no other point beats on both time and rate (ties kept), fastest first: the
@@ -435,13 +439,13 @@ impl Paint for SpeedAccuracy<'_> {
             .border_style(BLACK)
             .label_font(("sans-serif", 13))
             .draw()?;
-        // The table: number, scheme, time, EPR; Pareto points starred.
+        // The table: number, scheme, time, EPR, mean error; Pareto points starred.
         let rows = self.points.len().max(1) as i32;
         let line = ((WIDE.1 as i32 - 40) / (rows + 1)).clamp(8, 20);
         let size = (line - 4).clamp(8, 14);
         let font = ("sans-serif", size).into_font();
         right.draw(&Text::new(
-            "#  scheme  time ms  EPR %  (* Pareto)",
+            "#  scheme  time ms  EPR %  mean err  (* Pareto)",
             (4, 14),
             font.clone(),
         ))?;
@@ -450,11 +454,12 @@ impl Paint for SpeedAccuracy<'_> {
             let star = if front.contains(&i) { "*" } else { " " };
             right.draw(&Text::new(
                 format!(
-                    "{}{star} {}  {:.2}  {:.3}",
+                    "{}{star} {}  {:.2}  {:.3}  {}",
                     i + 1,
                     p.label,
                     p.time_ms,
-                    p.rate * 100.0
+                    p.rate * 100.0,
+                    p.mean_error.map_or("n/a".into(), |e| format!("{e:.3}"))
                 ),
                 (4, y),
                 font.clone().color(&palette(i)),
