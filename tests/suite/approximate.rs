@@ -460,14 +460,22 @@ fn assert_buckets_add_up(record: &Value) -> u64 {
         let pixels = field("pixels", suffix).as_u64().unwrap();
         let mean = field("mean_abs_error", suffix);
         if pixels == 0 {
-            for name in ["error_pixel_rate", "mean_abs_error", "max_abs_error", "psnr_db"] {
+            for name in [
+                "error_pixel_rate",
+                "mean_abs_error",
+                "max_abs_error",
+                "psnr_db",
+            ] {
                 assert!(field(name, suffix).is_null(), "{name}_{suffix}: {record}");
             }
             continue;
         }
         let bucket_errors = field("error_pixels", suffix).as_u64().unwrap();
         let rate = field("error_pixel_rate", suffix).as_f64().unwrap();
-        assert!(close(rate * pixels as f64, bucket_errors as f64), "{record}");
+        assert!(
+            close(rate * pixels as f64, bucket_errors as f64),
+            "{record}"
+        );
         covered += pixels;
         errors += bucket_errors;
         for (c, sum) in abs.iter_mut().enumerate() {
@@ -496,14 +504,16 @@ fn assert_buckets_add_up(record: &Value) -> u64 {
 
 /// The error pixels of the record's buckets of at most `most` fragments, and of the deeper ones.
 fn errors_up_to(record: &Value, most: u64) -> (u64, u64) {
-    BUCKETS.iter().fold((0, 0), |(within, beyond), (suffix, hi)| {
-        let errors = record[format!("error_pixels_{suffix}")].as_u64().unwrap();
-        if *hi <= most {
-            (within + errors, beyond)
-        } else {
-            (within, beyond + errors)
-        }
-    })
+    BUCKETS
+        .iter()
+        .fold((0, 0), |(within, beyond), (suffix, hi)| {
+            let errors = record[format!("error_pixels_{suffix}")].as_u64().unwrap();
+            if *hi <= most {
+                (within + errors, beyond)
+            } else {
+                (within, beyond + errors)
+            }
+        })
 }
 
 /// `bench --json` on nested spheres (depth complexity up to 18) with four nodes: every record,
@@ -541,7 +551,10 @@ fn bench_records_carry_the_colour_error_per_depth_complexity_and_it_adds_up() {
             "{record}"
         );
     }
-    let exact = records.iter().find(|r| r["scheme"] == "abuffer-exact").unwrap();
+    let exact = records
+        .iter()
+        .find(|r| r["scheme"] == "abuffer-exact")
+        .unwrap();
     assert_eq!(errors_up_to(exact, u64::MAX), (0, 0), "{exact}");
     for (suffix, _) in BUCKETS {
         let mean = &exact[format!("mean_abs_error_{suffix}")];
@@ -580,8 +593,7 @@ fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    let records =
-        crate::support::json_lines(&std::fs::read(out.join("sweep.jsonl")).unwrap());
+    let records = crate::support::json_lines(&std::fs::read(out.join("sweep.jsonl")).unwrap());
     let _ = std::fs::remove_dir_all(&out);
     assert_eq!(records.len(), 6, "{records:?}");
     for record in &records {

@@ -655,7 +655,10 @@ fn depth_markdown(report: &BenchReport) -> String {
     let mut lines = String::new();
     for (label, by_depth) in differing.chain(approximate) {
         for bucket in by_depth.covered() {
-            lines.push_str(&format!("| {label} | {} |\n", bucket_cells(bucket).join(" | ")));
+            lines.push_str(&format!(
+                "| {label} | {} |\n",
+                bucket_cells(bucket).join(" | ")
+            ));
         }
     }
     if lines.is_empty() {

@@ -12,8 +12,8 @@ use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{ColourColumns, EffectName, Judge};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
-use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 use crate::schemes::{family, Executors, SchemeChoice};
+use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -273,8 +273,7 @@ fn write_outputs(
             .flatten()
             .map(|r| r * 100.0)
             .collect();
-        let mean_rate =
-            mean(rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
+        let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
         let max_rate = rates
             .iter()
             .copied()
@@ -325,11 +324,7 @@ fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
         .filter_map(|c| c.psnr_db)
         .reduce(f64::min)
         .map_or("inf".into(), |p| format!("{p:.2}"));
-    [
-        format!("{mean_error:.3}"),
-        max.to_string(),
-        psnr,
-    ]
+    [format!("{mean_error:.3}"), max.to_string(), psnr]
 }
 
 /// The sweep's second table: each scheme's colour error per depth-complexity bucket, pooled

@@ -500,10 +500,7 @@ mod tests {
             rate,
             mean_error: Some(rate),
         };
-        let points = [
-            point("fast", "a", 1.0, 0.9),
-            point("slow", "b", 100.0, 0.0),
-        ];
+        let points = [point("fast", "a", 1.0, 0.9), point("slow", "b", 100.0, 0.0)];
         super::speed_accuracy(&path, "title", "x", &points).unwrap();
         let image = image::open(&path).unwrap().to_rgb8();
         std::fs::remove_file(&path).unwrap();
