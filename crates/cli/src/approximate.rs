@@ -4,7 +4,8 @@
 //!
 //! **What is measured.** These schemes hold colour, not fragment lists, so there is no list for
 //! the oracle to diff: each is judged by its transparency image against the oracle's
-//! ([`Judge::judge_image`]): error pixels, mean and maximum absolute error, PSNR. Its fragments
+//! ([`Judge::judge_image`]): error pixels, mean and maximum absolute error, PSNR, over the image
+//! and per depth-complexity bucket ([`ColourByDepth`], where its error lives). Its fragments
 //! reach it in primitive order, as a GPU's blending and ordered interlock deliver them
 //! ([`PrimitiveOrder::of_view`]), so its image is the same whatever executor the catalog's
 //! schemes ran on. Its time is the scene's rasterization alone (the bench's `raster_ms`: one

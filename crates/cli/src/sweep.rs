@@ -1,5 +1,6 @@
 //! `fragsim sweep`: the error-pixel rate of each scheme at many view angles around the model
-//! (the bucket depth peeling paper's Figure 6), and the speed-versus-accuracy scatter.
+//! (the bucket depth peeling paper's Figure 6), the colour error over the image and per
+//! depth-complexity bucket at each angle, and the speed-versus-accuracy scatter.
 
 use std::path::PathBuf;
 
