@@ -4,7 +4,8 @@
 //!
 //! **What is measured.** These schemes hold colour, not fragment lists, so there is no list for
 //! the oracle to diff: each is judged by its transparency image against the oracle's
-//! ([`Judge::judge_image`]): error pixels, mean and maximum absolute error, PSNR. Its fragments
+//! ([`Judge::judge_image`]): error pixels, mean and maximum absolute error, PSNR, over the image
+//! and per depth-complexity bucket ([`ColourByDepth`], where its error lives). Its fragments
 //! reach it in primitive order, as a GPU's blending and ordered interlock deliver them
 //! ([`PrimitiveOrder::of_view`]), so its image is the same whatever executor the catalog's
 //! schemes ran on. Its time is the scene's rasterization alone (the bench's `raster_ms`: one
@@ -23,12 +24,12 @@ use fragsim_capture::catalog::Count;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::Oracle;
 use fragsim_shade::approximate::{in_submission_order, Approximation};
-use fragsim_shade::colour_error::{colour_error_by_depth, BucketError};
 use fragsim_shade::effects::Effect;
 use image::RgbImage;
 use serde::Serialize;
 
 use crate::judge::{ColourColumns, Judge};
+use crate::record::ColourByDepth;
 
 /// An approximate OIT scheme, as `--approximate` spells it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -82,9 +83,21 @@ pub struct ApproximateRow {
     /// Threads of the pool that blended (a record's context carries them).
     #[serde(skip)]
     pub threads: usize,
-    /// The colour error per depth-complexity bucket (bench.md's second table).
-    #[serde(skip)]
-    pub by_depth: Vec<BucketError>,
+    /// The colour error per depth-complexity bucket (`pixels_dc_1`, …; bench.md's per-bucket
+    /// table).
+    #[serde(flatten)]
+    pub colour_by_depth: ColourByDepth,
+}
+
+impl ApproximateRow {
+    /// Its name in charts and tables: `mlab (blend, K = 8)`, told apart from the catalog's
+    /// `mlab` row (its node depths, labelled by executor) by "blend".
+    pub fn label(&self) -> String {
+        match self.nodes {
+            Some(k) => format!("{} (blend, K = {k})", self.scheme),
+            None => format!("{} (blend)", self.scheme),
+        }
+    }
 }
 
 /// `--k` resolved for the approximate schemes: `auto` is the scene's maximum depth complexity.
@@ -149,7 +162,8 @@ pub(crate) fn measure(
     let depth_complexity = oracle.depth_complexity();
     let pixels_beyond_nodes = depth_complexity.iter().filter(|&&n| n > limit).count() as u64;
     let judged = judge.judge_image(image, None)?;
-    let by_depth = colour_error_by_depth(judged.reference, &judged.image, &depth_complexity)?;
+    let colour_by_depth =
+        ColourByDepth::of(Some((judged.reference, &judged.image)), &depth_complexity)?;
     let pixels = oracle.pixels() as u64;
     let memory_bytes = approximation.bytes_per_pixel() * pixels;
     let row = ApproximateRow {
@@ -165,7 +179,7 @@ pub(crate) fn measure(
         blend_ms,
         time_ms: raster_ms + blend_ms,
         threads: rayon::current_num_threads(),
-        by_depth,
+        colour_by_depth,
     };
     Ok((row, judged.image))
 }
@@ -198,29 +212,6 @@ pub fn markdown(rows: &[ApproximateRow]) -> String {
          exact image; **EPR %**, **mean err**, **max err**, **PSNR dB** as above, of its \
          transparency image; **blend ms** the median time of the blend over every pixel's \
          fragments in primitive order; **frame ms** the rasterization alone plus the blend.\n",
-    );
-    text.push_str(
-        "\nThe same images' colour error per depth-complexity bucket (fragments per pixel)\n\n\
-         | scheme | nodes | fragments/px | pixels | EPR % | mean err | max err | PSNR dB |\n\
-         |---|---|---|---|---|---|---|---|\n",
-    );
-    for r in rows {
-        for bucket in r.by_depth.iter().filter(|b| b.pixels > 0) {
-            let [mean, max, psnr] = ColourColumns::of(bucket.error).cells();
-            text.push_str(&format!(
-                "| {} | {} | {} | {} | {:.3} | {mean} | {max} | {psnr} |\n",
-                r.scheme,
-                r.nodes.map_or("-".into(), |k| k.to_string()),
-                bucket.label(),
-                bucket.pixels,
-                bucket.error_pixels as f64 * 100.0 / bucket.pixels as f64,
-            ));
-        }
-    }
-    text.push_str(
-        "\nColumns: **fragments/px** the bucket (the oracle's fragments per pixel; uncovered \
-         pixels in none); **pixels** covered pixels in it; **EPR %** of them, those whose 8-bit \
-         colour differs; the colour error over them alone.\n",
     );
     text
 }

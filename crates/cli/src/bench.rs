@@ -18,7 +18,7 @@ use serde::Serialize;
 use crate::approximate::{ApproximateName, ApproximateRow};
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
-use crate::record::Context;
+use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{check_memory_cap_early, family, Executors, SchemeChoice, SchemeName};
 
 /// Options of `fragsim bench`.
@@ -98,6 +98,10 @@ pub struct BenchRow {
     /// `max_abs_error`, `psnr_db`; all `null` when the words cannot resolve the effect).
     #[serde(flatten)]
     pub colour: ColourColumns,
+    /// The same colour error per depth-complexity bucket (`pixels_dc_1`, …, all `null` when
+    /// the words cannot resolve the effect).
+    #[serde(flatten)]
+    pub colour_by_depth: ColourByDepth,
     /// What the image judge completed from the oracle or recomputed (the deferred attribute
     /// pass), with its count and time; `None` when the image is the scheme's words alone.
     pub attribute_pass: Option<AttributePass>,
@@ -271,6 +275,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
     crate::approximate::check_effect(&judge, &args.approximate)?;
     let covered = judge.covered;
+    let depth_complexity = oracle.depth_complexity();
     let executors = args.schemes.executors();
     // One step a frame, plus the untimed frame that counts locked operations.
     let progress = crate::progress::bar(
@@ -320,6 +325,10 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let judged = judge.judge(&named.run.capture);
             let error_pixels = judged.as_ref().map(|j| j.errors);
             let colour = ColourColumns::of(judged.as_ref().map(|j| j.colour));
+            let colour_by_depth = ColourByDepth::of(
+                judged.as_ref().map(|j| (j.reference, &j.image)),
+                &depth_complexity,
+            )?;
             if let Some(Judged {
                 image, reference, ..
             }) = judged.as_ref().filter(|_| !args.no_images)
@@ -362,6 +371,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 error_pixels,
                 error_pixel_rate: error_pixels.map(|e| e as f64 / covered.max(1) as f64),
                 colour,
+                colour_by_depth,
                 attribute_pass: judged.and_then(|j| j.pass),
                 ops_per_fragment: stats.counters.steps as f64
                     / stats.counters.fragments.max(1) as f64,
@@ -517,6 +527,7 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
                 family: family(&r.scheme),
                 time_ms: r.time_ms,
                 rate: r.error_pixel_rate?,
+                mean_error: mean_of_channels(&r.colour),
             })
         })
         .chain(
@@ -524,15 +535,11 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
                 .approximate
                 .iter()
                 .map(|r| fragsim_shade::plot::Point {
-                    // "blend": the approximate image, told apart from the catalog's `mlab`
-                    // row (its node depths, labelled by executor).
-                    label: match r.nodes {
-                        Some(k) => format!("{} (blend, K = {k})", r.scheme),
-                        None => format!("{} (blend)", r.scheme),
-                    },
+                    label: r.label(),
                     family: family(&r.scheme),
                     time_ms: r.time_ms,
                     rate: r.error_pixel_rate,
+                    mean_error: mean_of_channels(&r.colour),
                 }),
         )
         .collect();
@@ -628,5 +635,44 @@ fn markdown(report: &BenchReport) -> String {
     if !report.approximate.is_empty() {
         text.push_str(&crate::approximate::markdown(&report.approximate));
     }
+    text.push_str(&depth_markdown(report));
     text
+}
+
+/// bench.md's table of the colour error per depth-complexity bucket, of every approximate image
+/// (as the chart labels them) and every catalog image that differs from the oracle's (by scheme
+/// and executor); empty when there is none.
+fn depth_markdown(report: &BenchReport) -> String {
+    let differing = report
+        .rows
+        .iter()
+        .filter(|r| r.error_pixels.is_some_and(|e| e > 0))
+        .map(|r| (format!("{} ({})", r.scheme, r.executor), &r.colour_by_depth));
+    let approximate = report
+        .approximate
+        .iter()
+        .map(|r| (r.label(), &r.colour_by_depth));
+    let mut lines = String::new();
+    for (label, by_depth) in differing.chain(approximate) {
+        for bucket in by_depth.covered() {
+            lines.push_str(&format!(
+                "| {label} | {} |\n",
+                bucket_cells(bucket).join(" | ")
+            ));
+        }
+    }
+    if lines.is_empty() {
+        return lines;
+    }
+    format!(
+        "\nThe colour error per depth-complexity bucket (fragments per pixel), of the approximate \
+         images and of every other image that differs from the oracle's\n\n\
+         | row | fragments/px | pixels | EPR % | mean err | max err | PSNR dB |\n\
+         |---|---|---|---|---|---|---|\n{lines}\n\
+         Columns: **fragments/px** the bucket (the oracle's fragments per pixel; uncovered \
+         pixels are in none); **pixels** the covered pixels in it; **EPR %** of them, those whose \
+         8-bit colour differs; **mean err**, **max err**, **PSNR dB** the colour error over them \
+         alone. JSON: `pixels_dc_5_8`, `error_pixels_dc_5_8`, `error_pixel_rate_dc_5_8`, \
+         `mean_abs_error_dc_5_8`, … for every bucket, on every record.\n"
+    )
 }

@@ -10,7 +10,10 @@
 use serde::Serialize;
 
 use crate::args::{Count, SceneArgs, SchemeArgs};
+use crate::judge::ColourColumns;
 use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_shade::colour_error::{colour_error_by_depth, BucketError, DEPTH_BUCKETS};
+use image::RgbImage;
 
 /// A slot count as a record writes it: a number, or `"auto"` when the scene sized it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -180,4 +183,97 @@ pub fn emit<T: Serialize>(
 ) -> Result<(), String> {
     outln!("{}", line(record, context, fields)?);
     Ok(())
+}
+
+/// The colour error of an effect's image per depth-complexity bucket, as `bench` and `sweep`
+/// records carry it: for each bucket of [`DEPTH_BUCKETS`] (fragments per pixel, from the
+/// oracle), six flat fields named `<quantity>_dc_<bucket>` (`dc_1`, `dc_2_4`, …, `dc_33+`):
+/// `pixels` (covered pixels in the bucket), `error_pixels` (of them, those whose 8-bit colour
+/// differs), `error_pixel_rate` (the fraction; `null` for an empty bucket), `mean_abs_error`,
+/// `max_abs_error`, `psnr_db` (as the whole image's, over the bucket's pixels alone; `null` for
+/// an empty bucket). Every field is `null` where there is no image (the words cannot resolve the
+/// effect), so that every record has every field.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ColourByDepth {
+    /// One entry per bucket of [`DEPTH_BUCKETS`], in order; empty where there is no image.
+    pub buckets: Vec<BucketError>,
+}
+
+impl ColourByDepth {
+    /// The buckets of `candidate` against `reference` (`None`: no image), pixel `p` having
+    /// `depth_complexity[p]` fragments.
+    ///
+    /// # Errors
+    /// The images differ in size, or `depth_complexity` is not one count a pixel (a bug).
+    pub fn of(
+        images: Option<(&RgbImage, &RgbImage)>,
+        depth_complexity: &[u32],
+    ) -> Result<Self, String> {
+        let buckets = match images {
+            Some((reference, candidate)) => {
+                colour_error_by_depth(reference, candidate, depth_complexity)?
+            }
+            None => Vec::new(),
+        };
+        Ok(Self { buckets })
+    }
+
+    /// The buckets with pixels in them.
+    pub fn covered(&self) -> impl Iterator<Item = &BucketError> {
+        self.buckets.iter().filter(|b| b.pixels > 0)
+    }
+}
+
+impl Serialize for ColourByDepth {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(DEPTH_BUCKETS.len() * 6))?;
+        for (i, &(lo, hi)) in DEPTH_BUCKETS.iter().enumerate() {
+            let suffix = match (lo, hi) {
+                (lo, hi) if lo == hi => format!("dc_{lo}"),
+                (lo, u32::MAX) => format!("dc_{lo}+"),
+                (lo, hi) => format!("dc_{lo}_{hi}"),
+            };
+            let bucket = self.buckets.get(i);
+            let colour = ColourColumns::of(bucket.and_then(|b| b.error));
+            let rate = bucket
+                .filter(|b| b.pixels > 0)
+                .map(|b| b.error_pixels as f64 / b.pixels as f64);
+            map.serialize_entry(&format!("pixels_{suffix}"), &bucket.map(|b| b.pixels))?;
+            map.serialize_entry(
+                &format!("error_pixels_{suffix}"),
+                &bucket.map(|b| b.error_pixels),
+            )?;
+            map.serialize_entry(&format!("error_pixel_rate_{suffix}"), &rate)?;
+            map.serialize_entry(&format!("mean_abs_error_{suffix}"), &colour.mean_abs_error)?;
+            map.serialize_entry(&format!("max_abs_error_{suffix}"), &colour.max_abs_error)?;
+            map.serialize_entry(&format!("psnr_db_{suffix}"), &colour.psnr_db)?;
+        }
+        map.end()
+    }
+}
+
+/// The mean absolute error of an image over its three channels, as tables and charts print it
+/// (`None`: no image).
+#[must_use]
+pub fn mean_of_channels(colour: &ColourColumns) -> Option<f64> {
+    colour.mean_abs_error.map(|m| m.iter().sum::<f64>() / 3.0)
+}
+
+/// A table's cells of one bucket: its name, pixels, EPR % of them, and the colour error's mean,
+/// maximum and PSNR cells (as the whole image's: `inf` for a bucket equal to the oracle's).
+#[must_use]
+pub fn bucket_cells(bucket: &BucketError) -> [String; 6] {
+    let [mean, max, psnr] = ColourColumns::of(bucket.error).cells();
+    [
+        bucket.label(),
+        bucket.pixels.to_string(),
+        format!(
+            "{:.3}",
+            bucket.error_pixels as f64 * 100.0 / bucket.pixels.max(1) as f64
+        ),
+        mean,
+        max,
+        psnr,
+    ]
 }

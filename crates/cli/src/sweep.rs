@@ -1,5 +1,6 @@
 //! `fragsim sweep`: the error-pixel rate of each scheme at many view angles around the model
-//! (the bucket depth peeling paper's Figure 6), and the speed-versus-accuracy scatter.
+//! (the bucket depth peeling paper's Figure 6), the colour error over the image and per
+//! depth-complexity bucket at each angle, and the speed-versus-accuracy scatter.
 
 use std::path::PathBuf;
 
@@ -11,8 +12,9 @@ use serde::Serialize;
 use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{ColourColumns, EffectName, Judge};
-use crate::record::Context;
+use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
+use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -58,6 +60,8 @@ struct SweepRecord<'a> {
     error_pixel_rate: Option<f64>,
     #[serde(flatten)]
     colour: ColourColumns,
+    #[serde(flatten)]
+    colour_by_depth: &'a ColourByDepth,
     time_ms: f64,
 }
 
@@ -70,8 +74,22 @@ pub struct SweepSeries {
     pub error_pixel_rate: Vec<Option<f64>>,
     /// The colour error against the oracle's image per angle (`None` fields: unresolvable).
     pub colour: Vec<ColourColumns>,
+    /// The same per depth-complexity bucket, per angle (no buckets: unresolvable).
+    pub colour_by_depth: Vec<ColourByDepth>,
     /// Frame time per angle, ms.
     pub time_ms: Vec<f64>,
+}
+
+impl SweepSeries {
+    fn named(scheme: &str) -> Self {
+        Self {
+            scheme: scheme.into(),
+            error_pixel_rate: Vec::new(),
+            colour: Vec::new(),
+            colour_by_depth: Vec::new(),
+            time_ms: Vec::new(),
+        }
+    }
 }
 
 /// Runs `sweep`.
@@ -93,22 +111,20 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
         let orbit = args.scene.orbit(angle);
-        let view = scene.view(viewport, &orbit).map_err(|e| e.to_string())?;
+        let view = args
+            .schemes
+            .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
         crate::approximate::check_effect(&judge, &args.approximate)?;
+        let depth_complexity = oracle.depth_complexity();
         let sizing = args.schemes.sizing();
         let mut runner = Executors::default();
         for (i, &name) in schemes.iter().enumerate() {
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             if series.len() <= i {
-                series.push(SweepSeries {
-                    scheme: named.name.clone(),
-                    error_pixel_rate: Vec::new(),
-                    colour: Vec::new(),
-                    time_ms: Vec::new(),
-                });
+                series.push(SweepSeries::named(&named.name));
             }
             let judged = judge.judge(&named.run.capture);
             let rate = judged
@@ -117,7 +133,11 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
             series[i].error_pixel_rate.push(rate);
             series[i]
                 .colour
-                .push(ColourColumns::of(judged.map(|j| j.colour)));
+                .push(ColourColumns::of(judged.as_ref().map(|j| j.colour)));
+            series[i].colour_by_depth.push(ColourByDepth::of(
+                judged.as_ref().map(|j| (j.reference, &j.image)),
+                &depth_complexity,
+            )?);
             series[i].time_ms.push(
                 (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,
             );
@@ -138,15 +158,11 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
                 })?;
                 let i = schemes.len() + j;
                 if series.len() <= i {
-                    series.push(SweepSeries {
-                        scheme: row.scheme.clone(),
-                        error_pixel_rate: Vec::new(),
-                        colour: Vec::new(),
-                        time_ms: Vec::new(),
-                    });
+                    series.push(SweepSeries::named(&row.scheme));
                 }
                 series[i].error_pixel_rate.push(Some(row.error_pixel_rate));
                 series[i].colour.push(row.colour);
+                series[i].colour_by_depth.push(row.colour_by_depth);
                 series[i].time_ms.push(row.time_ms);
             }
         }
@@ -175,13 +191,15 @@ fn write_outputs(
             .iter()
             .zip(&s.error_pixel_rate)
             .zip(&s.colour)
+            .zip(&s.colour_by_depth)
             .zip(&s.time_ms);
-        for (((&angle, &rate), &colour), &time_ms) in measured {
+        for ((((&angle, &rate), &colour), colour_by_depth), &time_ms) in measured {
             let record = SweepRecord {
                 scheme: &s.scheme,
                 effect: args.effect.label(),
                 error_pixel_rate: rate,
                 colour,
+                colour_by_depth,
                 time_ms,
             };
             lines.push_str(&crate::record::line(
@@ -217,18 +235,15 @@ fn write_outputs(
         &per_angle,
         false,
     )?;
-    let mean = |v: &mut dyn Iterator<Item = f64>| {
-        let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
-        (n > 0).then(|| sum / n as f64)
-    };
     let scatter: Vec<fragsim_shade::plot::Point> = series
         .iter()
         .filter_map(|s| {
             Some(fragsim_shade::plot::Point {
                 label: s.scheme.clone(),
                 family: family(&s.scheme),
-                time_ms: mean(&mut s.time_ms.iter().copied())?,
-                rate: mean(&mut s.error_pixel_rate.iter().flatten().copied())?,
+                time_ms: mean(s.time_ms.iter().copied())?,
+                rate: mean(s.error_pixel_rate.iter().flatten().copied())?,
+                mean_error: mean(s.colour.iter().filter_map(mean_of_channels)),
             })
         })
         .collect();
@@ -259,14 +274,13 @@ fn write_outputs(
             .flatten()
             .map(|r| r * 100.0)
             .collect();
-        let mean_rate =
-            mean(&mut rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
+        let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
         let max_rate = rates
             .iter()
             .copied()
             .reduce(f64::max)
             .map_or("n/a".into(), |r| format!("{r:.4}"));
-        let mean_ms = mean(&mut s.time_ms.iter().copied()).unwrap_or(0.0);
+        let mean_ms = mean(s.time_ms.iter().copied()).unwrap_or(0.0);
         let [mean_error, max_error, psnr] = colour_over_angles(&s.colour);
         outln!(
             "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12.2}",
@@ -279,6 +293,7 @@ fn write_outputs(
             mean_ms
         );
     }
+    print_depth_table(series);
     outln!(
         "wrote {}/sweep.jsonl, sweep-epr.png, sweep-speed-accuracy.png",
         args.out.display()
@@ -286,18 +301,19 @@ fn write_outputs(
     Ok(())
 }
 
+/// The mean of `values` (`None`: there are none).
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
 /// The sweep table's colour cells of one scheme: the mean over the angles of the mean absolute
 /// error (the channels' mean), the largest error at any angle, and the lowest PSNR (`inf`: every
 /// angle's image equal to the oracle's); `n/a` where no angle's image resolves.
 fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
-    let means: Vec<f64> = colour
-        .iter()
-        .filter_map(|c| c.mean_abs_error)
-        .map(|m| m.iter().sum::<f64>() / 3.0)
-        .collect();
-    if means.is_empty() {
+    let Some(mean_error) = mean(colour.iter().filter_map(mean_of_channels)) else {
         return ["n/a".into(), "n/a".into(), "n/a".into()];
-    }
+    };
     let max = colour
         .iter()
         .filter_map(|c| c.max_abs_error)
@@ -309,9 +325,85 @@ fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
         .filter_map(|c| c.psnr_db)
         .reduce(f64::min)
         .map_or("inf".into(), |p| format!("{p:.2}"));
-    [
-        format!("{:.3}", means.iter().sum::<f64>() / means.len() as f64),
-        max.to_string(),
-        psnr,
-    ]
+    [format!("{mean_error:.3}"), max.to_string(), psnr]
+}
+
+/// The sweep's second table: each scheme's colour error per depth-complexity bucket, pooled
+/// over the angles ([`pooled_over_angles`]); schemes whose images all resolve and all equal the
+/// oracle's are left out, as are empty buckets.
+fn print_depth_table(series: &[SweepSeries]) {
+    let differing = |s: &&SweepSeries| {
+        s.colour_by_depth
+            .iter()
+            .flat_map(ColourByDepth::covered)
+            .any(|b| b.error_pixels > 0)
+    };
+    let mut header = true;
+    for s in series.iter().filter(differing) {
+        if std::mem::take(&mut header) {
+            outln!(
+                "\ncolour error per depth-complexity bucket (fragments per pixel), over every angle"
+            );
+            outln!(
+                "{:<20} {:>12} {:>10} {:>10} {:>10} {:>8} {:>12}",
+                "scheme",
+                "fragments/px",
+                "pixels",
+                "EPR %",
+                "mean err",
+                "max err",
+                "min PSNR dB"
+            );
+        }
+        for bucket in pooled_over_angles(&s.colour_by_depth) {
+            let [label, pixels, rate, mean, max, psnr] = bucket_cells(&bucket);
+            outln!(
+                "{:<20} {label:>12} {pixels:>10} {rate:>10} {mean:>10} {max:>8} {psnr:>12}",
+                s.scheme
+            );
+        }
+    }
+}
+
+/// One scheme's buckets over every angle: pixels and error pixels summed, the mean absolute
+/// error weighted by each angle's pixels (so it is the mean over every pixel of every angle in
+/// the bucket), the largest error, and the lowest PSNR of any angle; buckets without a pixel at
+/// any angle are left out.
+fn pooled_over_angles(angles: &[ColourByDepth]) -> Vec<BucketError> {
+    DEPTH_BUCKETS
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &(lo, hi))| {
+            let at_angles: Vec<(u64, u64, ColourError)> = angles
+                .iter()
+                .filter_map(|a| a.buckets.get(i))
+                .filter_map(|b| Some((b.pixels, b.error_pixels, b.error?)))
+                .collect();
+            let pixels: u64 = at_angles.iter().map(|a| a.0).sum();
+            (pixels > 0).then(|| {
+                let weighted = |c: usize| {
+                    at_angles
+                        .iter()
+                        .map(|(n, _, e)| e.mean_abs[c] * *n as f64)
+                        .sum::<f64>()
+                        / pixels as f64
+                };
+                let largest = |c: usize| at_angles.iter().map(|(_, _, e)| e.max_abs[c]).max();
+                BucketError {
+                    lo,
+                    hi,
+                    pixels,
+                    error_pixels: at_angles.iter().map(|a| a.1).sum(),
+                    error: Some(ColourError {
+                        mean_abs: [0, 1, 2].map(weighted),
+                        max_abs: [0, 1, 2].map(|c| largest(c).unwrap_or(0)),
+                        psnr_db: at_angles
+                            .iter()
+                            .map(|(_, _, e)| e.psnr_db)
+                            .fold(f64::INFINITY, f64::min),
+                    }),
+                }
+            })
+        })
+        .collect()
 }

@@ -39,6 +39,10 @@ pub struct Point {
     pub time_ms: f64,
     /// Error-pixel rate, a fraction (drawn as a percentage).
     pub rate: f64,
+    /// The image's mean absolute colour error (8-bit units, the mean of the channels'), printed
+    /// in the table beside the chart: EPR counts the pixels that differ, this says by how much
+    /// (`None`: not measured).
+    pub mean_error: Option<f64>,
 }
 
 /// The points no other point beats on both time and rate (ties kept), fastest first: the
@@ -275,6 +279,9 @@ fn draw_legend<DB: DrawingBackend>(
 /// The speed/accuracy chart's size: the chart, and the table of its points beside it.
 const WIDE: (u32, u32) = (1280, 640);
 
+/// Pixels between the lines of the speed/accuracy chart's legend.
+const LEGEND_LINE: i32 = 20;
+
 /// The speed/accuracy chart of `points`: frame time on a log axis, the error-pixel rate in
 /// percent, one marker shape a family, each point numbered and listed in a table beside the
 /// chart (labels beside points collide when many schemes are exact), and the Pareto front (the
@@ -388,15 +395,12 @@ impl Paint for SpeedAccuracy<'_> {
             BLACK.mix(0.3).stroke_width(1),
         ))?;
         let front = pareto_front(self.points);
-        chart
-            .draw_series(LineSeries::new(
-                front
-                    .iter()
-                    .map(|&i| (self.points[i].time_ms.max(1e-3), y(self.points[i].rate))),
-                BLACK.mix(0.5).stroke_width(2),
-            ))?
-            .label("Pareto front (nothing is both faster and more accurate)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+        chart.draw_series(LineSeries::new(
+            front
+                .iter()
+                .map(|&i| (self.points[i].time_ms.max(1e-3), y(self.points[i].rate))),
+            BLACK.mix(0.5).stroke_width(2),
+        ))?;
         let families = families(self.points);
         for (i, p) in self.points.iter().enumerate() {
             let at = chart.backend_coord(&(p.time_ms.max(1e-3), y(p.rate)));
@@ -409,39 +413,36 @@ impl Paint for SpeedAccuracy<'_> {
                 ("sans-serif", 12).into_font().color(&colour),
             ))?;
         }
+        // The legend in the column beside the chart, under the table (drawn inside the chart, it
+        // hid the points of slow, inaccurate schemes): the Pareto line, then a marker a family.
+        let legend_top = WIDE.1 as i32 - 40 - LEGEND_LINE * (families.len() as i32 + 1);
+        let legend_font = ("sans-serif", 13).into_font();
+        right.draw(&PathElement::new(
+            vec![(6, legend_top), (22, legend_top)],
+            BLACK.mix(0.5).stroke_width(2),
+        ))?;
+        right.draw(&Text::new(
+            "Pareto front (nothing is both faster and more accurate)",
+            (30, legend_top - 7),
+            legend_font.clone(),
+        ))?;
         for (f, family) in families.iter().enumerate() {
-            chart
-                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
-                .label(format!("family {family}"))
-                .legend(move |(x, y)| {
-                    // As `marker` draws them: filled for the first four families, hollow after.
-                    let style = if f < 4 {
-                        BLACK.filled()
-                    } else {
-                        BLACK.stroke_width(2)
-                    };
-                    match f % 4 {
-                        0 => Circle::new((x + 8, y), 5, style).into_dyn(),
-                        1 => TriangleMarker::new((x + 8, y), 6, style).into_dyn(),
-                        2 => Rectangle::new([(x + 3, y - 5), (x + 13, y + 5)], style).into_dyn(),
-                        _ => Cross::new((x + 8, y), 5, BLACK.stroke_width(3)).into_dyn(),
-                    }
-                });
+            let at = legend_top + LEGEND_LINE * (f as i32 + 1);
+            marker(&right, (14, at), f, BLACK)?;
+            right.draw(&Text::new(
+                format!("family {family}"),
+                (30, at - 7),
+                legend_font.clone(),
+            ))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()?;
-        // The table: number, scheme, time, EPR; Pareto points starred.
+        // The table: number, scheme, time, EPR, mean error; Pareto points starred; above the
+        // legend.
         let rows = self.points.len().max(1) as i32;
-        let line = ((WIDE.1 as i32 - 40) / (rows + 1)).clamp(8, 20);
+        let line = ((legend_top - 40) / (rows + 1)).clamp(8, 20);
         let size = (line - 4).clamp(8, 14);
         let font = ("sans-serif", size).into_font();
         right.draw(&Text::new(
-            "#  scheme  time ms  EPR %  (* Pareto)",
+            "#  scheme  time ms  EPR %  mean err  (* Pareto)",
             (4, 14),
             font.clone(),
         ))?;
@@ -450,11 +451,12 @@ impl Paint for SpeedAccuracy<'_> {
             let star = if front.contains(&i) { "*" } else { " " };
             right.draw(&Text::new(
                 format!(
-                    "{}{star} {}  {:.2}  {:.3}",
+                    "{}{star} {}  {:.2}  {:.3}  {}",
                     i + 1,
                     p.label,
                     p.time_ms,
-                    p.rate * 100.0
+                    p.rate * 100.0,
+                    p.mean_error.map_or("n/a".into(), |e| format!("{e:.3}"))
                 ),
                 (4, y),
                 font.clone().color(&palette(i)),
@@ -482,6 +484,33 @@ mod tests {
         let svg = std::fs::read_to_string(&path).unwrap();
         assert!(svg.contains("<svg") && svg.contains("title"));
         std::fs::remove_file(path).unwrap();
+    }
+
+    /// The legend is drawn in the column beside the chart, under the table, not over the
+    /// plot: with a fast inaccurate point and a slow exact one, the plot's upper right (where
+    /// the legend's box was, and where slow inaccurate schemes land) has no dark pixel, and
+    /// the column's lower part has the legend's.
+    #[test]
+    fn the_speed_accuracy_legend_sits_beside_the_plot() {
+        let path = std::env::temp_dir().join(format!("fragsim-legend-{}.png", std::process::id()));
+        let point = |label: &str, family, time_ms, rate| super::Point {
+            label: label.into(),
+            family,
+            time_ms,
+            rate,
+            mean_error: Some(rate),
+        };
+        let points = [point("fast", "a", 1.0, 0.9), point("slow", "b", 100.0, 0.0)];
+        super::speed_accuracy(&path, "title", "x", &points).unwrap();
+        let image = image::open(&path).unwrap().to_rgb8();
+        std::fs::remove_file(&path).unwrap();
+        let dark = |xs: std::ops::Range<u32>, ys: std::ops::Range<u32>| {
+            xs.flat_map(|x| ys.clone().map(move |y| (x, y)))
+                .filter(|&(x, y)| image.get_pixel(x, y).0.iter().all(|&c| c < 100))
+                .count()
+        };
+        assert_eq!(dark(500..860, 45..130), 0, "something dark over the plot");
+        assert!(dark(880..1280, 500..600) > 50, "no legend under the table");
     }
 
     #[test]

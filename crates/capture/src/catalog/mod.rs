@@ -12,6 +12,18 @@
 //! plus one `catalog!` line here (`kbuffer-interlock` was added so: its module, its `pub mod` line
 //! and its entry).
 //!
+//! **What is not here: weighted blended OIT and tail blending** (issue 19). An entry is a
+//! capture: per-pixel storage of fragments that the oracle judges list by list. WBOIT keeps no
+//! fragment (two blend targets, sums over every fragment), so as an entry it would capture empty
+//! lists and its verdict would say nothing; tail blending's kept part is the `K` nearest, which
+//! `mdts`, `kbuffer-interlock` and `loop64` capture and are judged on, and its tail is blending
+//! hardware folding the rest into a colour target, again no list. Both hold colour alone, so both
+//! are judged by their colour against the oracle's image: they are shading options
+//! (`fragsim_shade::approximate`, `bench --approximate`, `sweep --approximate`), measured with
+//! EPR, colour error and its depth-complexity buckets beside the catalog's rows and charts
+//! (`docs/baselines/wboit.md`, `docs/baselines/tail-blend.md`). MLAB, which keeps `K` nodes with
+//! depths, has both: its node structure is the `mlab` entry, its colour the shading option.
+//!
 //! The catalog's parts: the entries, their columns and constructors here, [`Build`] and
 //! [`SchemeVisitor`] in `build.rs`, [`DumpLayout`] in `dump_layout.rs`, running an entry and the
 //! early memory-cap check in `run.rs`.
