@@ -266,7 +266,7 @@ impl Snaps {
                         *s |= 1 << point;
                     }
                 }
-                if support.iter().any(|&s| s == 0) {
+                if support.contains(&0) {
                     contradicted[i] = true;
                     continue;
                 }
