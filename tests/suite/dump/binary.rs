@@ -7,11 +7,11 @@ use fragsim::oracle::triangles::TriangleExport;
 
 use super::{scratch, spec, with_view, SCENE, WIDTH};
 
-fn fragsim() -> Command {
+pub(super) fn fragsim() -> Command {
     Command::cargo_bin("fragsim").unwrap()
 }
 
-fn stdout_of(cmd: &mut Command, code: i32) -> String {
+pub(super) fn stdout_of(cmd: &mut Command, code: i32) -> String {
     let output = cmd.output().unwrap();
     assert_eq!(
         output.status.code(),
@@ -23,7 +23,7 @@ fn stdout_of(cmd: &mut Command, code: i32) -> String {
     String::from_utf8(output.stdout).unwrap()
 }
 
-const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
+pub(super) const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
 
 #[test]
 fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
