@@ -109,7 +109,10 @@ pub fn check(data: &[u8]) {
             assert_eq!(capture.pixel(p), model.lists[p], "pixel {p}'s list\n{text}");
             if let Some(stored) = &model.stored_words {
                 let named: Vec<u64> = words.corrupt[p].iter().map(|c| c.word).collect();
-                assert_eq!(named, stored[p], "pixel {p}'s corrupt words as stored\n{text}");
+                assert_eq!(
+                    named, stored[p],
+                    "pixel {p}'s corrupt words as stored\n{text}"
+                );
             }
         }
         assert_eq!(words.unreachable, model.unreachable, "unreachable nodes");
@@ -709,7 +712,10 @@ fn slots(
         dtype,
         ..word_payload
     };
-    arrays.push(("slots", payload_words(stored.clone(), &payload_dtype, fault == 1)));
+    arrays.push((
+        "slots",
+        payload_words(stored.clone(), &payload_dtype, fault == 1),
+    ));
     if abuffer {
         let counters = (0..pixels)
             .map(|p| match input.u8() {
@@ -777,9 +783,13 @@ fn slots(
             .collect(),
     };
     fragsims.header.layout = None;
-    fragsims.arrays.insert("slots".into(), words_of(own_dtype, own));
+    fragsims
+        .arrays
+        .insert("slots".into(), words_of(own_dtype, own));
     let capture = fragsims.capture().expect("fragsim's own encoding decodes");
-    let words = fragsims.check_words().expect("fragsim's own encoding is checked");
+    let words = fragsims
+        .check_words()
+        .expect("fragsim's own encoding is checked");
     let first_slot = |p: usize| match scheme {
         SlotScheme::ABufferExact => offsets[p] as usize,
         _ => p * per_pixel,

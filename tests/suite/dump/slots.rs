@@ -68,7 +68,15 @@ fn every_slot_layout_in_either_order_and_payload_round_trips_and_compares_equal(
                         let (p, s) = (at / per_pixel, at % per_pixel);
                         let expected = match (payload, Some(at) == full) {
                             // The first full word, repacked: the key at bit 24, 24 bits of id.
-                            (Some(_), true) if !matches!(scheme, DumpScheme::Mdts { direction: Direction::Descending, .. }) => {
+                            (Some(_), true)
+                                if !matches!(
+                                    scheme,
+                                    DumpScheme::Mdts {
+                                        direction: Direction::Descending,
+                                        ..
+                                    }
+                                ) =>
+                            {
                                 (word >> 32) << 24 | (word & 0xFF_FFFF)
                             }
                             (None, _) => word,
@@ -128,7 +136,8 @@ fn unorm_slot_payloads_hold_the_nearest_step_of_each_depth_and_ids_must_fit() {
             let encoded = own.in_layout(Some(layout)).unwrap();
             let decoded = encoded.capture().unwrap();
             for p in 0..oracle.pixels() {
-                let expected: Vec<u64> = lists.pixel(p).iter().map(|&w| quantised(w, bits)).collect();
+                let expected: Vec<u64> =
+                    lists.pixel(p).iter().map(|&w| quantised(w, bits)).collect();
                 assert_eq!(decoded.pixel(p), expected, "{depth:?}, pixel {p}");
             }
             assert_eq!(encoded.check_words().unwrap().corrupt_words(), 0);
@@ -145,7 +154,10 @@ fn unorm_slot_payloads_hold_the_nearest_step_of_each_depth_and_ids_must_fit() {
             }),
         };
         let error = own.in_layout(Some(narrow)).unwrap_err().0;
-        assert!(error.contains("does not fit the payload's 8 \"prim_bits\""), "{error}");
+        assert!(
+            error.contains("does not fit the payload's 8 \"prim_bits\""),
+            "{error}"
+        );
     });
 }
 
@@ -166,7 +178,10 @@ fn a_mutated_slot_major_word_is_caught_and_named_as_stored() {
             .unwrap()
             .in_layout(Some(layout))
             .unwrap();
-        let deep: Vec<usize> = (0..pixels).filter(|&p| oracle.pixel(p).len() >= 3).take(2).collect();
+        let deep: Vec<usize> = (0..pixels)
+            .filter(|&p| oracle.pixel(p).len() >= 3)
+            .take(2)
+            .collect();
         let [holed, renamed] = [deep[0], deep[1]];
         let mut mutated = dump.clone();
         let Some(Words::U64(slots)) = mutated.arrays.get_mut("slots") else {
@@ -185,7 +200,10 @@ fn a_mutated_slot_major_word_is_caught_and_named_as_stored() {
             comparison.verdicts[holed],
             verdict::MISSING | verdict::CORRUPT
         );
-        assert_eq!(comparison.verdicts[renamed], verdict::MISSING | verdict::EXTRA);
+        assert_eq!(
+            comparison.verdicts[renamed],
+            verdict::MISSING | verdict::EXTRA
+        );
         assert_eq!(comparison.counts.equal, pixels as u64 - 2);
         // An A-buffer's counted slot holding the empty marker, slot-major.
         let abuffer = DumpScheme::ABufferFixed {
@@ -234,9 +252,17 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
         });
         let slot_major = json!({"kind": "slots", "order": "slot-major"});
         let cases: Vec<(&Dump, serde_json::Value, &str)> = vec![
-            (&mdts, json!({"kind": "slots", "order": "diagonal"}), "unknown variant `diagonal`"),
+            (
+                &mdts,
+                json!({"kind": "slots", "order": "diagonal"}),
+                "unknown variant `diagonal`",
+            ),
             (&mdts, json!({"kind": "slots"}), "missing field `order`"),
-            (&mdts, json!({"kind": "slots", "order": "slot-major", "stride": 4}), "unknown field `stride`"),
+            (
+                &mdts,
+                json!({"kind": "slots", "order": "slot-major", "stride": 4}),
+                "unknown field `stride`",
+            ),
             (
                 &mdts,
                 json!({"kind": "slots", "order": "slot-major",
@@ -250,7 +276,11 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
                        "payload": {"dtype": "u32", "depth": "unorm24", "depth_shift": 8, "prim_bits": 8}}),
                 "array \"slots\" must be U32, as its payload",
             ),
-            (&mdts, json!({"kind": "memory"}), "scheme mdts dumps as slots, the header's layout is memory"),
+            (
+                &mdts,
+                json!({"kind": "memory"}),
+                "scheme mdts dumps as slots, the header's layout is memory",
+            ),
         ];
         for (dump, layout, expected) in cases {
             let error = refused(dump, |h| h["layout"] = layout.clone());
@@ -325,22 +355,72 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     assert_eq!(header("mdts")["arrays"]["slots"]["shape"][1], 48 * 36);
     assert_eq!(header("abuffer")["layout"]["payload"]["depth_shift"], 24);
     assert_eq!(header("linked-list")["layout"]["null"], 4_294_967_295u64);
-    assert_eq!(header("layer-counter")["layout"]["payload"]["prim_bits"], 24);
+    assert_eq!(
+        header("layer-counter")["layout"]["payload"]["prim_bits"],
+        24
+    );
     let mut schemes = 0;
     for entry in std::fs::read_dir(&own).unwrap() {
         let name = entry.unwrap().file_name();
         let (theirs, code) = compare_record(&engine.join(&name));
         let (ours, own_code) = compare_record(&own.join(&name));
         assert_eq!(code, own_code, "{name:?}");
-        for field in ["equal", "mismatched_pixels", "captured", "lost", "extra", "corrupt_words"] {
+        for field in [
+            "equal",
+            "mismatched_pixels",
+            "captured",
+            "lost",
+            "extra",
+            "corrupt_words",
+        ] {
             assert_eq!(theirs[field], ours[field], "{name:?}: {field}");
         }
         schemes += 1;
     }
     assert!(schemes > 30, "{schemes} dumps");
-    for scheme in ["mdts", "mdts-desc", "mdts32", "abuffer", "linked-list", "layer-counter"] {
+    for scheme in [
+        "mdts",
+        "mdts-desc",
+        "mdts32",
+        "abuffer",
+        "linked-list",
+        "layer-counter",
+    ] {
         let (record, code) = compare_record(&engine.join(scheme));
         assert_eq!((&record["equal"], code), (&json!(true), 0), "{scheme}");
+    }
+    // Unorm depths compare within the ulps their step spans here (measured: unorm24 needs 1,
+    // unorm16 at most 256 on this scene), never bit for bit.
+    for (payload, ulps) in [("u64:unorm24:32:32", "1"), ("u64:unorm16:32:32", "256")] {
+        let out = dir.join(payload.replace(':', "-"));
+        stdout_of(
+            fragsim()
+                .args([
+                    "render",
+                    "--scene",
+                    SCENE,
+                    "--scheme",
+                    "mdts,abuffer",
+                    "--no-images",
+                ])
+                .args(["--k", "auto", "--capacity", "auto"])
+                .args(SIZE)
+                .arg("--dump")
+                .arg(&out)
+                .args(["--dump-order", "slot-major", "--dump-payload", payload]),
+            0,
+        );
+        for scheme in ["mdts", "abuffer"] {
+            let path = out.join(scheme);
+            assert_eq!(compare_record(&path).1, 1, "{payload} {scheme}");
+            let within = fragsim()
+                .args(["compare", "oracle"])
+                .arg(&path)
+                .args(["--no-image", "--depth-ulps", ulps])
+                .output()
+                .unwrap();
+            assert_eq!(within.status.code(), Some(0), "{payload} {scheme}");
+        }
     }
     // One flipped bit of a slot-major word: exit 1.
     let slots = engine.join("mdts").join("slots.u64");

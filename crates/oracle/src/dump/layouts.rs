@@ -161,7 +161,10 @@ impl DumpScheme {
         };
         let own_lists = match self {
             Self::LinkedLists {
-                spec: LayoutSpec::LinkedList { null, node_base, .. },
+                spec:
+                    LayoutSpec::LinkedList {
+                        null, node_base, ..
+                    },
                 ..
             } => Some(ListNumbering {
                 null: *null,
@@ -174,12 +177,18 @@ impl DumpScheme {
             own_lists.is_none() && encoding.list_numbering.is_some(),
         );
         let spec = match self {
-            Self::Mdts { .. } | Self::Mdts32 { .. } | Self::ABufferFixed { .. } | Self::ABufferExact { .. } => {
+            Self::Mdts { .. }
+            | Self::Mdts32 { .. }
+            | Self::ABufferFixed { .. }
+            | Self::ABufferExact { .. } => {
                 let keys = matches!(self, Self::Mdts32 { .. });
                 ignore("payload", keys && encoding.payload.is_some());
                 let payload = encoding.payload.filter(|_| !keys);
                 let ranges = matches!(self, Self::ABufferExact { .. });
-                ignore("order", ranges && encoding.order == Some(SlotOrder::SlotMajor));
+                ignore(
+                    "order",
+                    ranges && encoding.order == Some(SlotOrder::SlotMajor),
+                );
                 let order = encoding.order.filter(|_| !ranges).unwrap_or_default();
                 (order != SlotOrder::PixelMajor || payload.is_some())
                     .then_some(LayoutSpec::Slots { order, payload })
@@ -712,7 +721,9 @@ pub(super) fn pixel_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usiz
         _ => Vec::new(),
     };
     move |p| match scheme {
-        DumpScheme::ABufferFixed { capacity: slots, .. }
+        DumpScheme::ABufferFixed {
+            capacity: slots, ..
+        }
         | DumpScheme::Mdts { k: slots, .. }
         | DumpScheme::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
         _ => (offsets[p], offsets[p + 1] - offsets[p]),

@@ -91,7 +91,8 @@ pub(super) struct Placement {
 impl Placement {
     /// The `slots` index of fragsim's slot word `own`.
     pub(super) fn stored(self, own: usize) -> usize {
-        self.order.index(own / self.slots, own % self.slots, self.pixels, self.slots)
+        self.order
+            .index(own / self.slots, own % self.slots, self.pixels, self.slots)
     }
 }
 
@@ -136,7 +137,11 @@ impl Dump {
             slots,
         };
         self.check_slot_count(total)?;
-        Ok(Some((placement, SlotCodec::new(scheme, payload), total as usize)))
+        Ok(Some((
+            placement,
+            SlotCodec::new(scheme, payload),
+            total as usize,
+        )))
     }
 
     /// Refuses a `slots` array of other than `total` words.
@@ -172,7 +177,8 @@ impl Dump {
             .collect();
         let mut dump = self.clone();
         dump.header.layout = None;
-        dump.arrays.insert("slots".into(), words_of(own_dtype(scheme), own));
+        dump.arrays
+            .insert("slots".into(), words_of(own_dtype(scheme), own));
         Ok(Some(dump))
     }
 
@@ -186,7 +192,10 @@ impl Dump {
         let Some((placement, codec, _)) = self.slot_layout(scheme)? else {
             return Ok(());
         };
-        let stored = self.widened("slots", codec.payload.map_or(own_dtype(scheme), |p| p.dtype))?;
+        let stored = self.widened(
+            "slots",
+            codec.payload.map_or(own_dtype(scheme), |p| p.dtype),
+        )?;
         let first_slot = pixel_slots(scheme);
         for word in check.corrupt.iter_mut().flatten() {
             // Every corrupt word of a slot layout is a slot word (counters are judged apart).
@@ -228,6 +237,10 @@ impl Dump {
         };
         let mut dump = self.clone();
         dump.header.layout = Some(LayoutSpec::Slots { order, payload });
+        if payload.is_some() {
+            // The informative word is fragsim's; the payload describes this one.
+            dump.header.word = String::new();
+        }
         dump.set_array("slots", words_of(dtype, stored), shape);
         Ok(dump)
     }

@@ -286,6 +286,38 @@ mod tests {
     }
 
     #[test]
+    fn packing_inverts_decoding_for_f32_depths_and_rounds_unorm_ones_to_the_nearest_step() {
+        let word = u64::from(0.75f32.to_bits()) << 32 | 0x12_3456;
+        let over_24 = Payload {
+            depth_shift: 24,
+            prim_bits: 24,
+            ..Payload::FRAGMENT
+        };
+        let packed = over_24.pack(word).unwrap();
+        assert_eq!(packed, u64::from(0.75f32.to_bits()) << 24 | 0x12_3456);
+        assert_eq!(over_24.fragment(packed).0, word);
+        let unorm16 = Payload {
+            depth: DepthFormat::Unorm16,
+            ..Payload::FRAGMENT
+        };
+        // 0.75 · 65535 = 49151.25: the nearest step is 49151.
+        assert_eq!(unorm16.pack(word).unwrap() >> 32, 49_151);
+        // fragsim's empty marker is the payload's, and an id too wide for it is refused.
+        let narrow = Payload {
+            dtype: Dtype::U32,
+            depth: DepthFormat::Unorm24,
+            depth_shift: 8,
+            prim_bits: 8,
+        };
+        assert_eq!(narrow.pack(u64::MAX).unwrap(), u64::from(u32::MAX));
+        assert!(narrow
+            .pack(word)
+            .unwrap_err()
+            .0
+            .contains("1193046 does not fit"));
+    }
+
+    #[test]
     fn f32_keys_above_one_are_flagged_and_bad_packings_refused() {
         let (_, possible) = Payload::FRAGMENT.fragment(u64::from(LARGEST_KEY + 1) << 32);
         assert!(!possible);
