@@ -668,7 +668,11 @@ fn slots(
     } else {
         SlotOrder::PixelMajor
     };
-    let payload = (input.u8() % 3 != 0).then(|| payload(input));
+    // One in three: the scheme's own word, no payload.
+    let payload = match input.u8() % 3 {
+        0 => None,
+        _ => Some(payload(input)),
+    };
     let k = k(input);
     let abuffer = matches!(scheme, SlotScheme::ABufferFixed | SlotScheme::ABufferExact);
     let counts: Vec<u32> = match scheme {
