@@ -11,7 +11,7 @@ use fragsim::oracle::dump::{
 };
 use serde_json::json;
 
-use super::binary::{fragsim, stdout_of, SIZE};
+use super::binary::{fragsim, render_dump, stdout_of};
 use super::{every_layout, judged, scratch, spec, with_view, SCENE};
 
 /// An f32 depth at bit 24 of a u64 word above a 24-bit primitive id: a packing other than
@@ -324,20 +324,10 @@ fn compare_record(dir: &std::path::Path) -> (serde_json::Value, i32) {
 fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_the_same() {
     let dir = scratch("slot-layouts-binary");
     let (own, engine) = (dir.join("own"), dir.join("engine"));
-    let render = |out: &std::path::Path, encoding: &[&str]| {
-        stdout_of(
-            fragsim()
-                .args(["render", "--scene", SCENE, "--scheme", "all", "--no-images"])
-                .args(SIZE)
-                .arg("--dump")
-                .arg(out)
-                .args(encoding),
-            0,
-        )
-    };
-    render(&own, &[]);
-    render(
+    render_dump(&own, "all", &[]);
+    render_dump(
         &engine,
+        "all",
         &[
             "--dump-order",
             "slot-major",
@@ -393,23 +383,9 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     // unorm16 at most 256 on this scene), never bit for bit.
     for (payload, ulps) in [("u64:unorm24:32:32", "1"), ("u64:unorm16:32:32", "256")] {
         let out = dir.join(payload.replace(':', "-"));
-        stdout_of(
-            fragsim()
-                .args([
-                    "render",
-                    "--scene",
-                    SCENE,
-                    "--scheme",
-                    "mdts,abuffer",
-                    "--no-images",
-                ])
-                .args(["--k", "auto", "--capacity", "auto"])
-                .args(SIZE)
-                .arg("--dump")
-                .arg(&out)
-                .args(["--dump-order", "slot-major", "--dump-payload", payload]),
-            0,
-        );
+        let sized = ["--k", "auto", "--capacity", "auto"];
+        let encoding = ["--dump-order", "slot-major", "--dump-payload", payload];
+        render_dump(&out, "mdts,abuffer", &[&sized[..], &encoding[..]].concat());
         for scheme in ["mdts", "abuffer"] {
             let path = out.join(scheme);
             assert_eq!(compare_record(&path).1, 1, "{payload} {scheme}");
