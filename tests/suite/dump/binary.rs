@@ -11,7 +11,7 @@ pub(super) fn fragsim() -> Command {
     Command::cargo_bin("fragsim").unwrap()
 }
 
-pub(super) fn stdout_of(cmd: &mut Command, code: i32) -> String {
+fn stdout_of(cmd: &mut Command, code: i32) -> String {
     let output = cmd.output().unwrap();
     assert_eq!(
         output.status.code(),

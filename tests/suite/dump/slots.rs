@@ -11,7 +11,7 @@ use fragsim::oracle::dump::{
 };
 use serde_json::json;
 
-use super::binary::{fragsim, render_dump, stdout_of};
+use super::binary::{fragsim, render_dump};
 use super::{every_layout, judged, scratch, spec, with_view, SCENE};
 
 /// An f32 depth at bit 24 of a u64 word above a 24-bit primitive id: a packing other than
