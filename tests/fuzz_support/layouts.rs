@@ -774,9 +774,10 @@ fn slots(
         Some(p) => p.fragment(word).0,
     };
     let per_pixel = counts[0] as usize;
-    let stored_at = |own: usize| match scheme {
-        SlotScheme::ABufferExact => own,
-        _ => order.index(own / per_pixel, own % per_pixel, pixels, per_pixel),
+    // The format's formulas, written out rather than asked of the reader.
+    let stored_at = |own: usize| match (scheme, order) {
+        (SlotScheme::ABufferExact, _) | (_, SlotOrder::PixelMajor) => own,
+        (_, SlotOrder::SlotMajor) => (own % per_pixel) * pixels + own / per_pixel,
     };
     let own: Vec<u64> = (0..total).map(|i| own_word(stored[stored_at(i)])).collect();
     let mut fragsims = Dump {

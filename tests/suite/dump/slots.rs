@@ -82,9 +82,11 @@ fn every_slot_layout_in_either_order_and_payload_round_trips_and_compares_equal(
                             (None, _) => word,
                             _ => continue,
                         };
-                        let index = match scheme {
-                            DumpScheme::ABufferExact { .. } => at,
-                            _ => order.index(p, s, pixels, per_pixel),
+                        // The format's formulas, written out rather than asked of the reader.
+                        let index = match (scheme, order) {
+                            (DumpScheme::ABufferExact { .. }, _) => at,
+                            (_, SlotOrder::PixelMajor) => p * per_pixel + s,
+                            (_, SlotOrder::SlotMajor) => s * pixels + p,
                         };
                         assert_eq!(stored[index], expected, "{scheme:?} {layout:?} slot {at}");
                     }
@@ -343,6 +345,25 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     };
     assert_eq!(header("mdts")["layout"]["order"], "slot-major");
     assert_eq!(header("mdts")["arrays"]["slots"]["shape"][1], 48 * 36);
+    // The first full word of fragsim's pixel-major slots (`p · K + s`) lies at `s · pixels + p`,
+    // its f32 key moved to bit 24 above a 24-bit id.
+    let words = |path: std::path::PathBuf| -> Vec<u64> {
+        let bytes = std::fs::read(path).unwrap();
+        bytes
+            .chunks_exact(8)
+            .map(|c| u64::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    };
+    let ours = words(own.join("mdts").join("slots.u64"));
+    let theirs = words(engine.join("mdts").join("slots.u64"));
+    let k = ours.len() / (48 * 36);
+    let full = ours.iter().position(|&w| w != u64::MAX).unwrap();
+    let (p, s) = (full / k, full % k);
+    let word = ours[full];
+    assert_eq!(
+        theirs[s * 48 * 36 + p],
+        (word >> 32) << 24 | (word & 0xFF_FFFF)
+    );
     assert_eq!(header("abuffer")["layout"]["payload"]["depth_shift"], 24);
     assert_eq!(header("linked-list")["layout"]["null"], 4_294_967_295u64);
     assert_eq!(
