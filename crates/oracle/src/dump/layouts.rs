@@ -159,22 +159,9 @@ impl DumpScheme {
                 ignored.push(field);
             }
         };
-        let own_lists = match self {
-            Self::LinkedLists {
-                spec:
-                    LayoutSpec::LinkedList {
-                        null, node_base, ..
-                    },
-                ..
-            } => Some(ListNumbering {
-                null: *null,
-                node_base: *node_base,
-            }),
-            _ => None,
-        };
         ignore(
             "list numbering",
-            own_lists.is_none() && encoding.list_numbering.is_some(),
+            !matches!(self, Self::LinkedLists { .. }) && encoding.list_numbering.is_some(),
         );
         let spec = match self {
             Self::Mdts { .. }
@@ -193,14 +180,25 @@ impl DumpScheme {
                 (order != SlotOrder::PixelMajor || payload.is_some())
                     .then_some(LayoutSpec::Slots { order, payload })
             }
-            Self::LinkedLists { .. } => {
+            Self::LinkedLists { spec, .. } => {
                 ignore("order", encoding.order.is_some());
-                let numbering = encoding.list_numbering.or(own_lists);
-                numbering.map(|n| LayoutSpec::LinkedList {
-                    payload: encoding.payload.unwrap_or(Payload::FRAGMENT),
-                    null: n.null,
-                    node_base: n.node_base,
-                })
+                match *spec {
+                    LayoutSpec::LinkedList {
+                        payload,
+                        null,
+                        node_base,
+                    } => {
+                        let own = ListNumbering { null, node_base };
+                        let numbering = encoding.list_numbering.unwrap_or(own);
+                        Some(LayoutSpec::LinkedList {
+                            payload: encoding.payload.unwrap_or(payload),
+                            null: numbering.null,
+                            node_base: numbering.node_base,
+                        })
+                    }
+                    // Lists always carry a list description (`DumpScheme::from_header`).
+                    other => Some(other),
+                }
             }
             Self::LayerMajor { payload, .. } => {
                 ignore("order", encoding.order.is_some());

@@ -125,6 +125,7 @@ impl Dump {
         };
         let pixels = self.viewport()?.pixels();
         let (slots, total) = match (fixed_slots(scheme), scheme) {
+            // At most 2^28 pixels of 2^32 slots: the product fits.
             (Some(slots), _) => (slots as usize, pixels as u64 * u64::from(slots)),
             (None, DumpScheme::ABufferExact { counts, .. }) => {
                 (1, counts.iter().map(|&c| u64::from(c)).sum())
