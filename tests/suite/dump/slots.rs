@@ -3,6 +3,7 @@
 //! `render --dump` writes them, read back to fragsim's own words and judged by `compare` as
 //! fragsim's own dumps are; a mutated word is named as stored; a bad field is a clear error.
 
+use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::oracle::compare::verdict;
 use fragsim::oracle::dump::{
@@ -448,4 +449,49 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     assert_eq!(output.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("does not fit a 32-bit word"), "{stderr}");
+}
+
+#[test]
+fn the_slot_words_of_loop64_and_the_k_buffers_read_as_mdts_slots() {
+    // Their memory dumps hold fragsim's words undescribed; their slot words alone are MDTS's,
+    // so an engine's port of them can be dumped as `mdts` slots in the order it keeps them.
+    let slot_words = [
+        ("loop64", SlotOrder::SlotMajor),
+        ("kbuffer", SlotOrder::PixelMajor),
+        ("kbuffer-stores", SlotOrder::PixelMajor),
+        ("kbuffer-interlock", SlotOrder::PixelMajor),
+        ("kbuffer-interlock-ordered", SlotOrder::PixelMajor),
+        ("kbuffer-interlock-ordered-first", SlotOrder::PixelMajor),
+        ("kbuffer-spinlock", SlotOrder::PixelMajor),
+        ("kbuffer-spinlock-fixed", SlotOrder::PixelMajor),
+    ];
+    with_view(|view, oracle| {
+        let k = oracle.max_depth_complexity();
+        let pixels = oracle.pixels() as u64;
+        for (name, order) in slot_words {
+            let memory = DumpScheme::Memory {
+                scheme: SchemeName::from_name(name).unwrap(),
+                k,
+                capacity: 1,
+                layers: 1,
+            };
+            let mut dump = Dump::record(view, spec(), &memory, "test").unwrap();
+            let words = dump.arrays.remove("words64").unwrap();
+            dump.arrays.clear();
+            dump.header.arrays.clear();
+            dump.header.scheme = "mdts".into();
+            (dump.header.k, dump.header.capacity, dump.header.layers) = (Some(k), None, None);
+            dump.header.layout = Some(LayoutSpec::Slots {
+                order,
+                payload: None,
+            });
+            let shape = match order {
+                SlotOrder::PixelMajor => vec![pixels, u64::from(k)],
+                SlotOrder::SlotMajor => vec![u64::from(k), pixels],
+            };
+            dump.set_array("slots", words, shape);
+            let comparison = judged(&dump, oracle);
+            assert!(comparison.is_equal() && comparison.words_checked, "{name}");
+        }
+    });
 }

@@ -216,7 +216,7 @@ impl Dump {
 
     /// Puts array `name` in the dump: its words, and in the header its file (`name.u32` or
     /// `name.u64`), dtype and shape.
-    pub(super) fn set_array(&mut self, name: &str, words: Words, shape: Vec<u64>) {
+    pub fn set_array(&mut self, name: &str, words: Words, shape: Vec<u64>) {
         let spec = array_spec(name, words.dtype(), shape);
         self.header.arrays.insert(name.into(), spec);
         self.arrays.insert(name.into(), words);
