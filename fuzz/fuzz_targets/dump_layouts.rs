@@ -1,4 +1,4 @@
-//! Dumps built field by field (linked lists, layer-major layers, scheme memory; the header's scene fields) through encoding, parsing, decoding, the word rules and the comparison; the checks are in `tests/fuzz_support/layouts.rs`, shared with the corpus replay
+//! Dumps built field by field (slot arrays slot-major or pixel-major with any payload, linked lists, layer-major layers, scheme memory; the header's scene fields) through encoding, parsing, decoding, the word rules and the comparison; the checks are in `tests/fuzz_support/layouts.rs`, shared with the corpus replay
 //! `tests/fuzz_corpus.rs`.
 #![no_main]
 

@@ -1,6 +1,6 @@
 //! The `dump_layouts` target: dumps built from the fuzzer's bytes field by field, so that every
 //! input reaches the layout decoders rather than the JSON parser. Each input is one dump of a
-//! linked-list, layer-major or memory layout (`docs/dump-format.md`) on a viewport of at most
+//! slot (slot-major or pixel-major, any payload), linked-list, layer-major or memory layout (`docs/dump-format.md`) on a viewport of at most
 //! 4 × 3 pixels, with the header's scene fields arbitrary: raw f64 bit patterns for the orbit and
 //! the engine's view-projection matrix (f32 or f64), any conventions, a mesh hash or a string in
 //! its place. Links are drawn from a few node numbers around the pool (so cycles, shared nodes,
@@ -17,9 +17,12 @@
 //!   written here gives: each linked list walked from its head once, cut at its first link out of
 //!   the pool, to a node the counter never handed out, or to a node already reached (at most
 //!   `pool + pixels` steps in all, so a cycle is found in bounded time); each layer counter past
-//!   its `k` layers named; every impossible depth key named;
+//!   its `k` layers named; every impossible depth key named; a slot dump decodes and checks as
+//!   the same words in fragsim's own encoding (pixel-major, unpacked) do, each corrupt word named
+//!   as the dump stores it;
 //! - the comparison with an oracle made of the capture itself flags exactly the pixels with
-//!   corrupt words, and calls the rest equal.
+//!   corrupt words, and calls the rest equal (an A-buffer's pixels may differ: its counters may
+//!   claim fragments its slots lack).
 //!
 //! The shape of the memory of a `memory` dump is the scheme's own, from the catalog (or wrong on
 //! purpose); its words are arbitrary, so each scheme's resolve runs on memory no run left.
@@ -28,7 +31,8 @@ use fragsim::capture::catalog::{Build, DumpLayout, SchemeName, SchemeVisitor, CA
 use fragsim::capture::{Capture, Scheme};
 use fragsim::oracle::compare::{compare_with, verdict, CompareOptions};
 use fragsim::oracle::dump::{
-    ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, LayoutSpec, Payload, Words,
+    ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, LayoutSpec, Payload,
+    SlotOrder, Words,
 };
 use fragsim::oracle::scene::{mesh_hash, ViewProjection};
 use fragsim::oracle::Oracle;
@@ -103,6 +107,13 @@ pub fn check(data: &[u8]) {
                 words.corrupt[p].iter().map(|c| (c.slot, c.why)).collect();
             assert_eq!(found, model.corrupt[p], "pixel {p}'s corrupt words\n{text}");
             assert_eq!(capture.pixel(p), model.lists[p], "pixel {p}'s list\n{text}");
+            if let Some(stored) = &model.stored_words {
+                let named: Vec<u64> = words.corrupt[p].iter().map(|c| c.word).collect();
+                assert_eq!(
+                    named, stored[p],
+                    "pixel {p}'s corrupt words as stored\n{text}"
+                );
+            }
         }
         assert_eq!(words.unreachable, model.unreachable, "unreachable nodes");
     } else {
@@ -129,9 +140,12 @@ pub fn check(data: &[u8]) {
             "pixel {p}: verdict {flags:#x}, corrupt words {:?}",
             words.corrupt[p]
         );
-        // Lists and layers decode in canonical order with no overflow, so each pixel without a
-        // corrupt word is its own oracle's; a memory dump's words promise nothing.
-        if !corrupt && in_order(&capture, p) && matches!(built.expected, Ok(Some(_))) {
+        // Lists, layers and MDTS slots decode with no overflow, so each pixel in canonical
+        // order without a corrupt word is its own oracle's; a memory dump's words promise
+        // nothing, an A-buffer's counters may claim fragments its slots lack.
+        let judged_against_itself =
+            matches!(&built.expected, Ok(Some(model)) if model.judged_against_itself);
+        if !corrupt && in_order(&capture, p) && judged_against_itself {
             assert_eq!(
                 flags & verdict::DIFFERS,
                 0,
@@ -166,6 +180,11 @@ struct Model {
     corrupt: Vec<Vec<(usize, Corruption)>>,
     lists: Vec<Vec<u64>>,
     unreachable: u64,
+    /// Slot layouts: per pixel each corrupt word as the dump stores it.
+    stored_words: Option<Vec<Vec<u64>>>,
+    /// Whether each pixel in canonical order without a corrupt word equals an oracle made of the
+    /// capture (not so for an A-buffer, whose counters may claim fragments its slots lack).
+    judged_against_itself: bool,
 }
 
 fn build(input: &mut Input<'_>) -> Built {
@@ -179,22 +198,25 @@ fn build(input: &mut Input<'_>) -> Built {
     scene(input, &mut header);
     let viewport = Viewport::new(header.width, header.height).expect("at most 4 × 3");
     let mut arrays = Vec::new();
-    let expected = match input.u8() % 4 {
-        0 => linked_lists(
+    // A kind byte of 7 modulo 8 picks the slot layouts, added after the corpus was grown: the
+    // other values keep the kind they had modulo 4.
+    let expected = match input.u8() % 8 {
+        7 => slots(input, &mut header, viewport, &mut arrays),
+        0 | 4 => linked_lists(
             input,
             &mut header,
             viewport,
             SchemeName::LinkedList,
             &mut arrays,
         ),
-        1 => linked_lists(
+        1 | 5 => linked_lists(
             input,
             &mut header,
             viewport,
             SchemeName::LinkedListNearest,
             &mut arrays,
         ),
-        2 => layer_major(input, &mut header, viewport, &mut arrays),
+        2 | 6 => layer_major(input, &mut header, viewport, &mut arrays),
         _ => memory(input, &mut header, viewport, &mut arrays).map(|()| None),
     };
     header.arrays = arrays
@@ -338,10 +360,16 @@ fn payload_word(input: &mut Input<'_>, payload: &Payload) -> u64 {
 /// Payload words in the payload's own dtype, or the other one when `wrong_dtype`.
 fn payload_words(words: Vec<u64>, payload: &Payload, wrong_dtype: bool) -> Words {
     match (payload.dtype, wrong_dtype) {
-        (Dtype::U32, false) | (Dtype::U64, true) => {
-            Words::U32(words.into_iter().map(|w| w as u32).collect())
-        }
-        _ => Words::U64(words),
+        (Dtype::U32, false) | (Dtype::U64, true) => words_of(Dtype::U32, words),
+        _ => words_of(Dtype::U64, words),
+    }
+}
+
+/// Words of `dtype` (u32 words narrowed).
+fn words_of(dtype: Dtype, words: Vec<u64>) -> Words {
+    match dtype {
+        Dtype::U32 => Words::U32(words.into_iter().map(|w| w as u32).collect()),
+        Dtype::U64 => Words::U64(words),
     }
 }
 
@@ -432,6 +460,8 @@ fn linked_lists(
         corrupt: vec![Vec::new(); pixels],
         lists: Vec::with_capacity(pixels),
         unreachable: 0,
+        stored_words: None,
+        judged_against_itself: true,
     };
     for (p, &head) in heads.iter().enumerate() {
         let mut walked = Vec::new();
@@ -522,6 +552,8 @@ fn layer_major(
         corrupt: vec![Vec::new(); pixels],
         lists: Vec::with_capacity(pixels),
         unreachable: 0,
+        stored_words: None,
+        judged_against_itself: true,
     };
     for (p, &count) in counters.iter().enumerate() {
         if count > k {
@@ -601,4 +633,191 @@ fn memory(
         0 | 1 => Err(scheme.name().into()),
         _ => Ok(()),
     }
+}
+
+/// The slot schemes a slot dump may name, and whether the A-buffer's storage is exact.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum SlotScheme {
+    Mdts,
+    MdtsDesc,
+    Mdts32,
+    ABufferFixed,
+    ABufferExact,
+}
+
+/// A slot dump (`mdts`, `mdts-desc`, `mdts32`, `abuffer`) in a described layout (slot-major or
+/// pixel-major, any payload) and its model: the same words in fragsim's own encoding, placed
+/// pixel-major and decoded as the format says, read and checked by the reader's own-encoding
+/// path. The described dump must decode and check the same, naming each corrupt word as stored.
+fn slots(
+    input: &mut Input<'_>,
+    header: &mut Header,
+    viewport: Viewport,
+    arrays: &mut Vec<(&'static str, Words)>,
+) -> Result<Option<Model>, String> {
+    let pixels = viewport.pixels();
+    let scheme = match input.u8() % 5 {
+        0 => SlotScheme::Mdts,
+        1 => SlotScheme::MdtsDesc,
+        2 => SlotScheme::Mdts32,
+        3 => SlotScheme::ABufferFixed,
+        _ => SlotScheme::ABufferExact,
+    };
+    let order = if input.u8() & 1 != 0 {
+        SlotOrder::SlotMajor
+    } else {
+        SlotOrder::PixelMajor
+    };
+    // One in three: the scheme's own word, no payload.
+    let payload = match input.u8() % 3 {
+        0 => None,
+        _ => Some(payload(input)),
+    };
+    let k = k(input);
+    let abuffer = matches!(scheme, SlotScheme::ABufferFixed | SlotScheme::ABufferExact);
+    let counts: Vec<u32> = match scheme {
+        SlotScheme::ABufferExact => (0..pixels).map(|_| u32::from(input.u8() % 4)).collect(),
+        _ => vec![k; pixels],
+    };
+    // Faults 0: the slots one word off, 1: the slots in the other dtype; any other value: none.
+    let fault = input.u8() % 8;
+    let own_dtype = if scheme == SlotScheme::Mdts32 {
+        Dtype::U32
+    } else {
+        Dtype::U64
+    };
+    let dtype = payload.map_or(own_dtype, |p| p.dtype);
+    let all_ones = u64::MAX >> (64 - dtype.bits());
+    let empty = if scheme == SlotScheme::MdtsDesc {
+        0
+    } else {
+        all_ones
+    };
+    let word_payload = payload.unwrap_or(Payload::FRAGMENT);
+    let total: usize = counts.iter().map(|&c| c as usize).sum();
+    let stored: Vec<u64> = (0..length(total, fault, 0))
+        .map(|_| match input.u8() % 4 {
+            0 => empty,
+            _ => {
+                let word = payload_word(input, &word_payload);
+                let word = match (scheme, payload) {
+                    (SlotScheme::Mdts32, None) => word >> 32,
+                    _ => word,
+                };
+                if scheme == SlotScheme::MdtsDesc {
+                    word.wrapping_add(1) & all_ones
+                } else {
+                    word
+                }
+            }
+        })
+        .collect();
+    let payload_dtype = Payload {
+        dtype,
+        ..word_payload
+    };
+    arrays.push((
+        "slots",
+        payload_words(stored.clone(), &payload_dtype, fault == 1),
+    ));
+    if abuffer {
+        let counters = (0..pixels)
+            .map(|p| match input.u8() {
+                255 => u32::MAX,
+                b => u32::from(b) % (counts[p] + 3),
+            })
+            .collect();
+        arrays.push(("counters", Words::U32(counters)));
+        header.filled = input.u8() & 1 != 0;
+        header.sorted = input.u8() & 1 != 0;
+    }
+    let mut offsets = vec![0u32];
+    if scheme == SlotScheme::ABufferExact {
+        for &c in &counts {
+            offsets.push(offsets[offsets.len() - 1] + c);
+        }
+        arrays.push(("offsets", Words::U32(offsets.clone())));
+    }
+    header.scheme = match scheme {
+        SlotScheme::Mdts => "mdts",
+        SlotScheme::MdtsDesc => "mdts-desc",
+        SlotScheme::Mdts32 => "mdts32",
+        SlotScheme::ABufferFixed | SlotScheme::ABufferExact => "abuffer",
+    }
+    .into();
+    match scheme {
+        SlotScheme::ABufferFixed => header.capacity = Some(k),
+        SlotScheme::ABufferExact => {}
+        _ => header.k = Some(k),
+    }
+    header.layout = Some(LayoutSpec::Slots { order, payload });
+    // What the reader refuses first: `k` or the capacity, the payload, the order, then the
+    // slots array.
+    let fault = match fault {
+        _ if k == 0 && scheme == SlotScheme::ABufferFixed => "\"capacity\"",
+        _ if k == 0 && !abuffer => "\"k\"",
+        _ if payload.is_some() && scheme == SlotScheme::Mdts32 => "payload",
+        _ if payload.is_some_and(|p| p.check().is_err()) => "payload",
+        _ if scheme == SlotScheme::ABufferExact && order == SlotOrder::SlotMajor => "\"order\"",
+        0 | 1 => "\"slots\"",
+        _ => "",
+    };
+    if !fault.is_empty() {
+        return Err(fault.into());
+    }
+    // The model: fragsim's word of each stored word, placed pixel-major.
+    let own_word = |word: u64| match payload {
+        None => word,
+        Some(_) if scheme == SlotScheme::MdtsDesc && word == 0 => 0,
+        Some(p) if scheme == SlotScheme::MdtsDesc => p.fragment(word - 1).0 + 1,
+        Some(_) if word == all_ones => u64::MAX,
+        Some(p) => p.fragment(word).0,
+    };
+    let per_pixel = counts[0] as usize;
+    // The format's formulas, written out rather than asked of the reader.
+    let stored_at = |own: usize| match (scheme, order) {
+        (SlotScheme::ABufferExact, _) | (_, SlotOrder::PixelMajor) => own,
+        (_, SlotOrder::SlotMajor) => (own % per_pixel) * pixels + own / per_pixel,
+    };
+    let own: Vec<u64> = (0..total).map(|i| own_word(stored[stored_at(i)])).collect();
+    let mut fragsims = Dump {
+        header: header.clone(),
+        arrays: arrays
+            .iter()
+            .map(|(name, words)| (name.to_string(), words.clone()))
+            .collect(),
+    };
+    fragsims.header.layout = None;
+    fragsims
+        .arrays
+        .insert("slots".into(), words_of(own_dtype, own));
+    let capture = fragsims.capture().expect("fragsim's own encoding decodes");
+    let words = fragsims
+        .check_words()
+        .expect("fragsim's own encoding is checked");
+    let first_slot = |p: usize| match scheme {
+        SlotScheme::ABufferExact => offsets[p] as usize,
+        _ => p * per_pixel,
+    };
+    Ok(Some(Model {
+        corrupt: words
+            .corrupt
+            .iter()
+            .map(|c| c.iter().map(|w| (w.slot, w.why)).collect())
+            .collect(),
+        lists: (0..pixels).map(|p| capture.pixel(p).to_vec()).collect(),
+        unreachable: 0,
+        stored_words: Some(
+            words
+                .corrupt
+                .iter()
+                .map(|c| {
+                    c.iter()
+                        .map(|w| stored[stored_at(first_slot(w.pixel) + w.slot)])
+                        .collect()
+                })
+                .collect(),
+        ),
+        judged_against_itself: !abuffer,
+    }))
 }

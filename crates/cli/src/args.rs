@@ -13,6 +13,7 @@ use fragsim_raster::{
 
 pub use fragsim_capture::catalog::Count;
 use fragsim_capture::catalog::Sizing;
+use fragsim_oracle::dump::{Encoding, ListNumbering, Payload, SlotOrder};
 
 /// The scene and the camera.
 #[derive(Debug, Clone, Args)]
@@ -104,6 +105,78 @@ impl ConventionsArgs {
             vertex_precision: self.vertex_precision,
         }
     }
+}
+
+/// `render --dump` and the encoding of its dumps (`docs/dump-format.md`, "Layouts described by
+/// the header"): each option goes to the layouts that have its field, the others are written
+/// without it (stderr says so).
+#[derive(Debug, Clone, Args)]
+pub struct DumpArgs {
+    /// Also write each scheme's per-pixel words as a dump in `DIR/<scheme>/`.
+    #[arg(long = "dump", value_name = "DIR")]
+    pub dir: Option<PathBuf>,
+    /// The slot layouts' order (`mdts`, `mdts32`, `mdts-desc`, `abuffer` with `--capacity`):
+    /// `pixel-major` (slot s of pixel p at p·K + s, fragsim's) or `slot-major` (at s·pixels + p,
+    /// one image layer per slot).
+    #[arg(long, value_name = "ORDER", requires = "dir", value_parser = kebab::<SlotOrder>)]
+    pub dump_order: Option<SlotOrder>,
+    /// The payload word of slots, list nodes and layers, `DTYPE:DEPTH:SHIFT:PRIM_BITS`: `u64` or
+    /// `u32`; `f32`, `unorm24` or `unorm16` depth from bit SHIFT; the primitive id in the low
+    /// PRIM_BITS bits (fragsim's: `u64:f32:32:32`; a D24 depth over an 8-bit id: `u32:unorm24:8:8`).
+    #[arg(long, value_name = "PAYLOAD", requires = "dir", value_parser = parse_payload)]
+    pub dump_payload: Option<Payload>,
+    /// Linked lists' node numbering `NULL:NODE_BASE`: `0:1` (fragsim, nvpro-samples) or
+    /// `4294967295:0` (Vulkan-Samples).
+    #[arg(long, value_name = "NULL:NODE_BASE", requires = "dir", value_parser = parse_list_numbering)]
+    pub dump_list_numbering: Option<ListNumbering>,
+}
+
+impl DumpArgs {
+    /// The encoding asked.
+    #[must_use]
+    pub fn encoding(&self) -> Encoding {
+        Encoding {
+            order: self.dump_order,
+            payload: self.dump_payload,
+            list_numbering: self.dump_list_numbering,
+        }
+    }
+}
+
+/// `--dump-payload`: `DTYPE:DEPTH:SHIFT:PRIM_BITS`, checked as a header's payload is.
+fn parse_payload(text: &str) -> Result<Payload, String> {
+    let [dtype, depth, shift, prim_bits] = fields(text, "DTYPE:DEPTH:SHIFT:PRIM_BITS")?;
+    let number = |field: &str, name: &str| {
+        field
+            .parse::<u32>()
+            .map_err(|e| format!("{name} {field:?}: {e}"))
+    };
+    let payload = Payload {
+        dtype: kebab(dtype)?,
+        depth: kebab(depth)?,
+        depth_shift: number(shift, "SHIFT")?,
+        prim_bits: number(prim_bits, "PRIM_BITS")?,
+    };
+    payload.check().map_err(|e| e.to_string())?;
+    Ok(payload)
+}
+
+/// `--dump-list-numbering`: `NULL:NODE_BASE`.
+fn parse_list_numbering(text: &str) -> Result<ListNumbering, String> {
+    let [null, node_base] = fields(text, "NULL:NODE_BASE")?;
+    let number = |field: &str| field.parse::<u32>().map_err(|e| format!("{field:?}: {e}"));
+    Ok(ListNumbering {
+        null: number(null)?,
+        node_base: number(node_base)?,
+    })
+}
+
+/// The `N` colon-separated fields of `text`, which must have the form `form`.
+fn fields<'a, const N: usize>(text: &'a str, form: &str) -> Result<[&'a str; N], String> {
+    let parts: Vec<&str> = text.split(':').collect();
+    parts
+        .try_into()
+        .map_err(|_| format!("{text:?} is not {form}"))
 }
 
 /// A conventions value by its kebab-case name, as a dump header spells it.

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_oracle::dump::{Dump, DumpScheme};
+use fragsim_oracle::dump::{Dump, DumpScheme, Encoding};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::triangles::TriangleExport;
 use fragsim_raster::View;
@@ -95,15 +95,16 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
 pub(crate) struct DumpStage {
     dir: PathBuf,
     staging: PathBuf,
+    encoding: Encoding,
     written: Vec<&'static str>,
 }
 
 impl DumpStage {
-    /// Creates `dir` and its staging directory.
+    /// Creates `dir` and its staging directory, for dumps written in `encoding`.
     ///
     /// # Errors
     /// A directory that cannot be created.
-    pub(crate) fn new(dir: &Path) -> Result<Self, String> {
+    pub(crate) fn new(dir: &Path, encoding: Encoding) -> Result<Self, String> {
         let staging = dir.join(format!(".fragsim-partial-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir_all(&staging)
@@ -111,6 +112,7 @@ impl DumpStage {
         Ok(Self {
             dir: dir.to_path_buf(),
             staging,
+            encoding,
             written: Vec::new(),
         })
     }
@@ -144,7 +146,16 @@ impl DumpStage {
             conventions: view.conventions(),
             ..scene_spec(scene)?
         };
-        let dump = Dump::record(view, spec, &scheme, &producer).map_err(|e| e.to_string())?;
+        let (layout, ignored) = scheme.spec_in(&self.encoding);
+        if !ignored.is_empty() {
+            eprintln!(
+                "render --dump: {name}'s layout has no {}: written without",
+                ignored.join(" or ")
+            );
+        }
+        let dump = Dump::record(view, spec, &scheme, &producer)
+            .and_then(|dump| dump.in_layout(layout))
+            .map_err(|e| format!("render --dump: {name}: {e}"))?;
         dump.write(&self.staging.join(name.name()))
             .map_err(|e| e.to_string())?;
         self.written.push(name.name());

@@ -8,7 +8,7 @@ use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::{depth_from_key, Viewport};
 use serde::Serialize;
 
-use crate::args::{ConventionsArgs, SceneArgs, SchemeArgs};
+use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
 use crate::schemes::{check_memory_cap_early, Executors, Fault, SchemeChoice};
 
 /// Options of `fragsim render`.
@@ -40,9 +40,11 @@ pub struct RenderArgs {
     /// a fixed scale, so that maps of different scenes compare; default: the image's maximum.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub scale_max: Option<u32>,
-    /// Also write each scheme's per-pixel words as a dump in `DIR/<scheme>/` (docs/dump-format.md).
-    #[arg(long, value_name = "DIR")]
-    pub dump: Option<PathBuf>,
+    /// Also write each scheme's per-pixel words as a dump in `DIR/<scheme>/` (docs/dump-format.md),
+    /// in fragsim's encoding or the one `--dump-order`, `--dump-payload` and
+    /// `--dump-list-numbering` ask.
+    #[command(flatten)]
+    pub dump: DumpArgs,
     /// The oracle's tie policy for fragments of one pixel at one depth: `by-primitive` (the
     /// canonical order), `keep-duplicates` (compared by depth key) or `merge-equal-depths`
     /// (compared by distinct depth key, as loop32 and 32-bit peeling keep them).
@@ -162,8 +164,9 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let mut nearest_written = false;
     let mut dumps = args
         .dump
+        .dir
         .as_deref()
-        .map(crate::export::DumpStage::new)
+        .map(|dir| crate::export::DumpStage::new(dir, args.dump.encoding()))
         .transpose()?;
     for &name in &schemes {
         let mut last = None;

@@ -7,7 +7,7 @@ use fragsim::oracle::triangles::TriangleExport;
 
 use super::{scratch, spec, with_view, SCENE, WIDTH};
 
-fn fragsim() -> Command {
+pub(super) fn fragsim() -> Command {
     Command::cargo_bin("fragsim").unwrap()
 }
 
@@ -25,10 +25,8 @@ fn stdout_of(cmd: &mut Command, code: i32) -> String {
 
 const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
 
-#[test]
-fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
-    let dir = scratch("binary");
-    let dumps = dir.join("dumps");
+/// `fragsim render` of the test scene running `schemes`, their dumps in `out`, with `options`.
+pub(super) fn render_dump(out: &Path, schemes: &str, options: &[&str]) {
     stdout_of(
         fragsim()
             .args([
@@ -36,13 +34,22 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
                 "--scene",
                 SCENE,
                 "--scheme",
-                "mdts,mdts32,abuffer",
+                schemes,
+                "--no-images",
             ])
             .args(SIZE)
-            .args(["--no-images", "--dump"])
-            .arg(&dumps),
+            .arg("--dump")
+            .arg(out)
+            .args(options),
         0,
     );
+}
+
+#[test]
+fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
+    let dir = scratch("binary");
+    let dumps = dir.join("dumps");
+    render_dump(&dumps, "mdts,mdts32,abuffer", &[]);
     for scheme in ["mdts", "mdts32", "abuffer"] {
         let out = stdout_of(
             fragsim()
@@ -121,20 +128,7 @@ fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
 fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
     let dir = scratch("binary-corrupt");
     let dumps = dir.join("dumps");
-    stdout_of(
-        fragsim()
-            .args([
-                "render",
-                "--scene",
-                SCENE,
-                "--scheme",
-                "mdts,mdts-desc,mdts32,abuffer",
-            ])
-            .args(SIZE)
-            .args(["--no-images", "--dump"])
-            .arg(&dumps),
-        0,
-    );
+    render_dump(&dumps, "mdts,mdts-desc,mdts32,abuffer", &[]);
     // (layout, slots file, bytes a word, the empty slot's word)
     let layouts = [
         ("mdts", "slots.u64", 8, u64::MAX),

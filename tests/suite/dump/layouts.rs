@@ -163,6 +163,16 @@ fn a_vulkan_samples_linked_list_reads_as_fragsims() {
         });
         assert_eq!(vulkan.capture().unwrap(), dump.capture().unwrap());
         assert!(judged(&vulkan, oracle).is_equal());
+        // `render --dump-list-numbering 4294967295:0` writes exactly these lists, and refuses a
+        // terminator that is some node's number.
+        assert_eq!(dump.in_layout(vulkan.header.layout).unwrap(), vulkan);
+        let colliding = LayoutSpec::LinkedList {
+            payload: Payload::FRAGMENT,
+            null: 1,
+            node_base: 1,
+        };
+        let error = dump.in_layout(Some(colliding)).unwrap_err().0;
+        assert!(error.contains("\"null\" 1 is a node's number"), "{error}");
         // The same lists with u32 nodes of a unorm24 depth over an 8-bit id: the depths are the
         // unorm's, each within its quantum of the f32 depth.
         let mut packed = dump.clone();

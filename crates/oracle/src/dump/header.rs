@@ -19,6 +19,17 @@ pub enum Dtype {
     U64,
 }
 
+impl Dtype {
+    /// The element's width in bits.
+    #[must_use]
+    pub fn bits(self) -> u32 {
+        match self {
+            Self::U32 => 32,
+            Self::U64 => 64,
+        }
+    }
+}
+
 /// Where an array lives and what it holds.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ArraySpec {

@@ -16,7 +16,7 @@ use fragsim_raster::Viewport;
 use serde::Serialize;
 
 use super::lists::{layer_major, linked_lists, ListArrays, Translated};
-use super::spec::{LayoutSpec, Payload, LARGEST_KEY};
+use super::spec::{Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder, LARGEST_KEY};
 use super::{err, Dtype, Dump, DumpError, Header, Words};
 
 /// Which scheme's memory a dump holds, with its parameters.
@@ -146,6 +146,73 @@ impl DumpScheme {
             Self::Memory { .. } => Some(LayoutSpec::Memory),
             _ => None,
         }
+    }
+
+    /// The header layout that writes this scheme's words in `encoding` (`None`: fragsim's own
+    /// slot encoding), and the fields of `encoding` its layout has no place for (`order`,
+    /// `payload`, `list numbering`), which it leaves out.
+    #[must_use]
+    pub fn spec_in(&self, encoding: &Encoding) -> (Option<LayoutSpec>, Vec<&'static str>) {
+        let mut ignored = Vec::new();
+        let mut ignore = |field: &'static str, given: bool| {
+            if given {
+                ignored.push(field);
+            }
+        };
+        ignore(
+            "list numbering",
+            !matches!(self, Self::LinkedLists { .. }) && encoding.list_numbering.is_some(),
+        );
+        let spec = match self {
+            Self::Mdts { .. }
+            | Self::Mdts32 { .. }
+            | Self::ABufferFixed { .. }
+            | Self::ABufferExact { .. } => {
+                let keys = matches!(self, Self::Mdts32 { .. });
+                ignore("payload", keys && encoding.payload.is_some());
+                let payload = encoding.payload.filter(|_| !keys);
+                let ranges = matches!(self, Self::ABufferExact { .. });
+                ignore(
+                    "order",
+                    ranges && encoding.order == Some(SlotOrder::SlotMajor),
+                );
+                let order = encoding.order.filter(|_| !ranges).unwrap_or_default();
+                (order != SlotOrder::PixelMajor || payload.is_some())
+                    .then_some(LayoutSpec::Slots { order, payload })
+            }
+            Self::LinkedLists { spec, .. } => {
+                ignore("order", encoding.order.is_some());
+                match *spec {
+                    LayoutSpec::LinkedList {
+                        payload,
+                        null,
+                        node_base,
+                    } => {
+                        let own = ListNumbering { null, node_base };
+                        let numbering = encoding.list_numbering.unwrap_or(own);
+                        Some(LayoutSpec::LinkedList {
+                            payload: encoding.payload.unwrap_or(payload),
+                            null: numbering.null,
+                            node_base: numbering.node_base,
+                        })
+                    }
+                    // Lists always carry a list description (`DumpScheme::from_header`).
+                    other => Some(other),
+                }
+            }
+            Self::LayerMajor { payload, .. } => {
+                ignore("order", encoding.order.is_some());
+                Some(LayoutSpec::LayerMajor {
+                    payload: encoding.payload.unwrap_or(*payload),
+                })
+            }
+            Self::Memory { .. } => {
+                ignore("order", encoding.order.is_some());
+                ignore("payload", encoding.payload.is_some());
+                Some(LayoutSpec::Memory)
+            }
+        };
+        (spec, ignored)
     }
 
     /// The layout scheme `name`'s memory has after a run of it built with `sizes`, with `slots`
@@ -312,7 +379,7 @@ impl DumpScheme {
                     DumpLayout::LinkedLists => "linked-list",
                     DumpLayout::LayerMajor => "layer-major",
                     DumpLayout::Memory => "memory",
-                    _ => "no \"layout\" (its name fixes it)",
+                    DumpLayout::SlotArray(_) | DumpLayout::CountersAndSlots => "slots",
                 };
                 if spec.kind() != expected {
                     return err(format!(
@@ -368,37 +435,64 @@ impl DumpScheme {
             }
             _ => {}
         }
-        match layout {
-            DumpLayout::SlotArray(SlotWord::Fragment) => Ok(Self::Mdts {
+        let slots = match layout {
+            DumpLayout::SlotArray(SlotWord::Fragment) => Self::Mdts {
                 k: k()?,
                 direction: Direction::Ascending,
-            }),
-            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => Ok(Self::Mdts {
+            },
+            DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => Self::Mdts {
                 k: k()?,
                 direction: Direction::Descending,
-            }),
-            DumpLayout::SlotArray(SlotWord::Key) => Ok(Self::Mdts32 { k: k()? }),
+            },
+            DumpLayout::SlotArray(SlotWord::Key) => Self::Mdts32 { k: k()? },
             DumpLayout::CountersAndSlots => match (header.capacity, offsets) {
-                (Some(0), _) => err(format!("{name} \"capacity\" must be at least 1")),
-                (Some(capacity), _) => Ok(Self::ABufferFixed {
+                (Some(0), _) => return err(format!("{name} \"capacity\" must be at least 1")),
+                (Some(capacity), _) => Self::ABufferFixed {
                     capacity,
                     sorted: header.sorted,
-                }),
+                },
                 (None, Some(offsets)) => {
                     if offsets.first() != Some(&0) || offsets.windows(2).any(|w| w[0] > w[1]) {
                         return err(format!("{name} offsets must start at 0 and never decrease"));
                     }
-                    Ok(Self::ABufferExact {
+                    Self::ABufferExact {
                         counts: offsets.windows(2).map(|w| w[1] - w[0]).collect(),
                         sorted: header.sorted,
-                    })
+                    }
                 }
-                (None, None) => err(format!("{name} needs \"capacity\" or an \"offsets\" array")),
+                (None, None) => {
+                    return err(format!("{name} needs \"capacity\" or an \"offsets\" array"))
+                }
             },
             DumpLayout::LinkedLists | DumpLayout::LayerMajor | DumpLayout::Memory => {
                 unreachable!("handled above")
             }
+        };
+        if let Some(LayoutSpec::Slots { order, payload }) = spec {
+            slots.check_slot_spec(order, payload)?;
         }
+        Ok(slots)
+    }
+
+    /// Refuses a slot layout description that this slot scheme cannot have.
+    fn check_slot_spec(&self, order: SlotOrder, payload: Option<Payload>) -> Result<(), DumpError> {
+        let name = self.name();
+        match (self, payload) {
+            (Self::Mdts32 { .. }, Some(_)) => {
+                return err(format!(
+                    "{name} slots hold bare depth keys: its layout takes no \"payload\""
+                ))
+            }
+            (_, Some(payload)) => payload.check()?,
+            (_, None) => {}
+        }
+        if order == SlotOrder::SlotMajor && matches!(self, Self::ABufferExact { .. }) {
+            return err(format!(
+                "{name} with \"offsets\" keeps each pixel's slots together: \"order\" must be \
+                 pixel-major"
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -515,10 +609,17 @@ impl Dump {
     /// # Errors
     /// As [`Dump::capture`]: an unknown scheme, or arrays missing or of the wrong size or type.
     pub fn check_words(&self) -> Result<WordCheck, DumpError> {
+        let scheme = self.scheme()?;
+        // A slot layout of the engine's: the rules hold of fragsim's encoding of its words,
+        // each corrupt word named as stored.
+        if let Some(own) = self.own_slots(&scheme)? {
+            let mut check = own.check_words()?;
+            self.name_stored_words(&scheme, &mut check)?;
+            return Ok(check);
+        }
         // Decoding validates the arrays against the scheme's layout; the check then indexes them
         // freely.
         self.capture()?;
-        let scheme = self.scheme()?;
         let pixels = self.viewport()?.pixels();
         let mut check = WordCheck {
             corrupt: vec![Vec::new(); pixels],
@@ -544,7 +645,7 @@ impl Dump {
             DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. } => {
                 let counters = self.u32s("counters")?.ok_or_else(|| missing("counters"))?;
                 let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
-                let at = abuffer_slots(&scheme);
+                let at = pixel_slots(&scheme);
                 let mut all = Vec::with_capacity(pixels);
                 for (p, &count) in counters.iter().enumerate() {
                     let (first, capacity) = at(p);
@@ -605,8 +706,9 @@ fn check_mdts(check: &mut WordCheck, slots: &[u64], k: usize, empty: u64, key: f
     }
 }
 
-/// Pixel `p`'s slot range in an A-buffer's flat slot array.
-fn abuffer_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
+/// Pixel `p`'s first slot and slot count in fragsim's pixel-major slot array of an MDTS or
+/// A-buffer dump.
+pub(super) fn pixel_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
     let offsets: Vec<usize> = match scheme {
         DumpScheme::ABufferExact { counts, .. } => std::iter::once(0)
             .chain(counts.iter().scan(0usize, |sum, &c| {
@@ -617,14 +719,18 @@ fn abuffer_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
         _ => Vec::new(),
     };
     move |p| match scheme {
-        DumpScheme::ABufferFixed { capacity, .. } => (p * *capacity as usize, *capacity as usize),
+        DumpScheme::ABufferFixed {
+            capacity: slots, ..
+        }
+        | DumpScheme::Mdts { k: slots, .. }
+        | DumpScheme::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
         _ => (offsets[p], offsets[p + 1] - offsets[p]),
     }
 }
 
 /// A-buffer lists as the GPU's sort kernel left them: `min(counter, capacity)` slots, unsorted.
 pub(super) fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture {
-    let at = abuffer_slots(scheme);
+    let at = pixel_slots(scheme);
     let capacity = match scheme {
         DumpScheme::ABufferFixed { capacity, .. } => Capacity::PerPixel(*capacity),
         _ => Capacity::Unbounded,
@@ -654,7 +760,7 @@ pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme
         Some(Words::U32(c)) => c.clone(),
         _ => return,
     };
-    let at = abuffer_slots(scheme);
+    let at = pixel_slots(scheme);
     if let Some(Words::U64(slots)) = arrays.get_mut("slots") {
         for (p, &count) in counters.iter().enumerate() {
             let (first, capacity) = at(p);
@@ -665,7 +771,7 @@ pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme
 
 impl Dump {
     /// An array's words widened to u64, which must have `dtype`.
-    fn widened(&self, name: &str, dtype: Dtype) -> Result<Vec<u64>, DumpError> {
+    pub(super) fn widened(&self, name: &str, dtype: Dtype) -> Result<Vec<u64>, DumpError> {
         match (self.arrays.get(name), dtype) {
             (Some(Words::U32(w)), Dtype::U32) => Ok(w.iter().map(|&w| u64::from(w)).collect()),
             (Some(Words::U64(w)), Dtype::U64) => Ok(w.clone()),
@@ -675,7 +781,7 @@ impl Dump {
     }
 
     /// A u32 array of `len` words.
-    fn u32s_of(&self, name: &str, len: usize) -> Result<&[u32], DumpError> {
+    pub(super) fn u32s_of(&self, name: &str, len: usize) -> Result<&[u32], DumpError> {
         let words = self
             .u32s(name)?
             .ok_or_else(|| DumpError(format!("missing array {name:?}")))?;

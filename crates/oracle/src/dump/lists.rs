@@ -10,7 +10,9 @@
 //! lists sharing a node) is cut there and named a [`CorruptWord`] of its pixel.
 
 use super::layouts::{CorruptWord, Corruption};
-use super::spec::Payload;
+use super::slots::words_of;
+use super::spec::{LayoutSpec, ListNumbering, Payload};
+use super::{err, Dump, DumpError, Words};
 
 /// Fragsim's memory of a scheme built from a dump's arrays, and what the translation found.
 #[derive(Debug, Default)]
@@ -144,6 +146,79 @@ pub(super) fn layer_major(
         out.unchecked += u64::from(k) - stored as u64;
     }
     out
+}
+
+impl Dump {
+    /// This linked-list dump (fragsim's numbering and words, as [`Dump::record`] writes it) with
+    /// its nodes numbered as `numbering` and packed as `payload`.
+    ///
+    /// # Errors
+    /// A terminator that is some node's number, node numbers past 2^32, or a primitive id that
+    /// does not fit the payload.
+    pub(super) fn lists_as(
+        &self,
+        payload: Payload,
+        numbering: ListNumbering,
+    ) -> Result<Dump, DumpError> {
+        let ListNumbering { null, node_base } = numbering;
+        let pool = self.header.pool.unwrap_or_default();
+        let numbers = u64::from(node_base)..u64::from(node_base) + pool;
+        if numbers.end > 1 << 32 {
+            return err(format!(
+                "list numbering: {pool} nodes from \"node_base\" {node_base} pass 2^32"
+            ));
+        }
+        if numbers.contains(&u64::from(null)) {
+            return err(format!(
+                "list numbering: \"null\" {null} is a node's number ({node_base} to {})",
+                numbers.end - 1
+            ));
+        }
+        // fragsim's link 0 ends a list and link `n` is node `n − 1`.
+        let renumber = |links: &[u32]| -> Words {
+            Words::U32(
+                links
+                    .iter()
+                    .map(|&link| link.checked_sub(1).map_or(null, |i| i + node_base))
+                    .collect(),
+            )
+        };
+        let pixels = self.viewport()?.pixels();
+        let heads = renumber(self.u32s_of("heads", pixels)?);
+        let next = renumber(self.u32s_of("next", pool as usize)?);
+        let nodes = self
+            .widened("nodes", Payload::FRAGMENT.dtype)?
+            .into_iter()
+            .map(|word| payload.pack(word))
+            .collect::<Result<Vec<u64>, DumpError>>()?;
+        let mut dump = self.clone();
+        dump.header.layout = Some(LayoutSpec::LinkedList {
+            payload,
+            null,
+            node_base,
+        });
+        dump.set_array("heads", heads, vec![pixels as u64]);
+        dump.set_array("next", next, vec![pool]);
+        dump.set_array("nodes", words_of(payload.dtype, nodes), vec![pool]);
+        Ok(dump)
+    }
+
+    /// This layer-major dump (fragsim's words) with its layers packed as `payload`.
+    ///
+    /// # Errors
+    /// A primitive id that does not fit the payload.
+    pub(super) fn layers_as(&self, payload: Payload) -> Result<Dump, DumpError> {
+        let layers = self
+            .widened("layers", Payload::FRAGMENT.dtype)?
+            .into_iter()
+            .map(|word| payload.pack(word))
+            .collect::<Result<Vec<u64>, DumpError>>()?;
+        let shape = self.shape_of("layers");
+        let mut dump = self.clone();
+        dump.header.layout = Some(LayoutSpec::LayerMajor { payload });
+        dump.set_array("layers", words_of(payload.dtype, layers), shape);
+        Ok(dump)
+    }
 }
 
 #[cfg(test)]

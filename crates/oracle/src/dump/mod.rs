@@ -38,15 +38,17 @@
 //!
 //! Every catalog scheme has a layout: MDTS slots, the A-buffer's counters and slots, linked lists
 //! (heads, next, nodes, the pool counter), Bevy's layer-major layers, or, for schemes whose memory
-//! is no list per pixel, the scheme's own memory words. Linked-list and layer-major dumps carry a
-//! description ([`LayoutSpec`]: the terminator, the node numbering, the payload's u32 or u64 word,
-//! f32, unorm24 or unorm16 depth and id bits), so an engine's own buffers can be dumped as they
-//! are.
+//! is no list per pixel, the scheme's own memory words. Any of them may carry a description
+//! ([`LayoutSpec`]: slot arrays pixel-major or slot-major, a list's terminator and node numbering,
+//! the payload's u32 or u64 word, f32, unorm24 or unorm16 depth and id bits), so an engine's own
+//! buffers can be dumped as they are; [`Dump::in_layout`] writes fragsim's words so
+//! (`render --dump-order`, `--dump-payload`, `--dump-list-numbering`).
 //!
 //! The parts: the header and its words (`header.rs`), the layout description (`spec.rs`), the
 //! layouts and their word rules (`layouts.rs`, from the catalog's
 //! [`DumpLayout`](fragsim_capture::catalog::DumpLayout)), linked lists and layers turned into
-//! fragsim's memory with their links checked (`lists.rs`), parsing and decoding (`read.rs`),
+//! fragsim's memory with their links checked (`lists.rs`), slot arrays in an engine's order and
+//! payload turned into fragsim's (`slots.rs`), parsing and decoding (`read.rs`),
 //! recording and writing (`write.rs`); the scene a dump names is
 //! [`crate::scene`], the comparison [`crate::compare`], the triangle export [`crate::triangles`].
 //!
@@ -59,6 +61,7 @@ mod header;
 mod layouts;
 mod lists;
 mod read;
+mod slots;
 mod spec;
 mod write;
 
@@ -75,7 +78,7 @@ use crate::Oracle;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{CorruptWord, Corruption, Counter, DumpScheme, WordCheck};
-pub use spec::{DepthFormat, LayoutSpec, Payload};
+pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
 
 /// The `format` field of every dump header.
 pub const FORMAT: &str = "fragsim-dump";

@@ -170,6 +170,9 @@ impl Dump {
     /// A header that names no known scheme, or arrays missing or of the wrong size or type.
     pub fn capture(&self) -> Result<Capture, DumpError> {
         let scheme = self.scheme()?;
+        if let Some(own) = self.own_slots(&scheme)? {
+            return own.capture();
+        }
         let translated;
         let (words32, words64) = match scheme {
             DumpScheme::LinkedLists { .. } | DumpScheme::LayerMajor { .. } => {

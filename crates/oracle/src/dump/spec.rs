@@ -1,5 +1,5 @@
 //! The layout description a dump header carries (`"layout"`, `docs/dump-format.md`): how the
-//! arrays of a linked-list, layer-major or memory dump hold the scheme's memory, and how a
+//! arrays of a slot, linked-list, layer-major or memory dump hold the scheme's memory, and how a
 //! payload word packs a fragment's depth and primitive id.
 //!
 //! The description is what lets a dump carry the engine's own buffers rather than fragsim's: a
@@ -7,9 +7,10 @@
 //! and number them from 1 (nvpro-samples, fragsim); a node may hold a u32 word of a unorm24
 //! depth above an 8-bit primitive id. The reader converts each payload word to fragsim's
 //! fragment word (`depth_key << 32 | prim`, [`Payload::fragment`]) and each node number to
-//! fragsim's before the scheme's own resolve runs. A header without the description (a dump
-//! written before it existed, or one of the slot and A-buffer layouts) has the layout its
-//! `scheme` names, with fragsim's own encoding ([`Payload::FRAGMENT`]).
+//! fragsim's before the scheme's own resolve runs; a slot array may hold each pixel's slots
+//! together or one image layer per slot ([`SlotOrder`]). A header without the description (a
+//! dump written before it existed) has the layout its `scheme` names, with fragsim's own
+//! encoding ([`Payload::FRAGMENT`], pixel-major slots).
 
 use serde::{Deserialize, Serialize};
 
@@ -73,10 +74,7 @@ impl Payload {
     /// A primitive id of no bits or more than 32, above the depth field, or a depth field past
     /// the word's top bit.
     pub fn check(&self) -> Result<(), DumpError> {
-        let word_bits = match self.dtype {
-            Dtype::U32 => 32,
-            Dtype::U64 => 64,
-        };
+        let word_bits = u64::from(self.dtype.bits());
         if self.prim_bits == 0 || self.prim_bits > 32 {
             return err(format!(
                 "payload \"prim_bits\" {} must be 1 to 32: fragments are told apart by their \
@@ -114,6 +112,62 @@ impl Payload {
         let prim = word & mask(self.prim_bits);
         ((u64::from(key) << 32) | prim, key <= LARGEST_KEY)
     }
+
+    /// The payload word of fragsim's fragment word `fragment` (`depth_key << 32 | prim`), as an
+    /// engine's shader packs it: the f32 depth's bits, or its nearest unorm step
+    /// (`round(depth · (2^bits − 1))`, a D24 or D16 conversion), with the id in the low bits.
+    /// fragsim's empty marker (all ones) packs to the payload's (all ones of its word), so that
+    /// storage never written reads as empty in either encoding. [`Payload::fragment`] gives an
+    /// f32 word back bit for bit. Needs a [`Payload::check`]ed payload.
+    ///
+    /// # Errors
+    /// A primitive id that needs more than `prim_bits` bits: the word would name another
+    /// primitive.
+    pub fn pack(&self, fragment: u64) -> Result<u64, DumpError> {
+        if fragment == u64::MAX {
+            return Ok(mask(self.dtype.bits()));
+        }
+        let (key, prim) = ((fragment >> 32) as u32, fragment & 0xFFFF_FFFF);
+        if prim > mask(self.prim_bits) {
+            return err(format!(
+                "primitive id {prim} does not fit the payload's {} \"prim_bits\"",
+                self.prim_bits
+            ));
+        }
+        let field = match self.depth {
+            DepthFormat::F32 => u64::from(key),
+            DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
+                let steps = mask(self.depth.bits());
+                let depth = f64::from(f32::from_bits(key)).clamp(0.0, 1.0);
+                (depth * steps as f64).round() as u64
+            }
+        };
+        Ok(field << self.depth_shift | prim)
+    }
+}
+
+/// How a slot array places the `slots` slots of its `pixels` pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SlotOrder {
+    /// Each pixel's slots together: slot `s` of pixel `p` at `p · slots + s` (fragsim,
+    /// FreePipe, a CUDA kernel's `slots[p * K + s]`).
+    #[default]
+    PixelMajor,
+    /// One image layer per slot: slot `s` of pixel `p` at `s · pixels + p` (an engine that
+    /// allocates a texture array or `K` render targets, nvpro-samples' loop32).
+    SlotMajor,
+}
+
+impl SlotOrder {
+    /// The array index of slot `slot` of pixel `pixel`.
+    #[must_use]
+    pub fn index(self, pixel: usize, slot: usize, pixels: usize, slots: usize) -> usize {
+        match self {
+            Self::PixelMajor => pixel * slots + slot,
+            Self::SlotMajor => slot * pixels + pixel,
+        }
+    }
 }
 
 fn mask(bits: u32) -> u64 {
@@ -148,6 +202,16 @@ pub enum LayoutSpec {
     /// The scheme's own memory after its last pass: `words32` and `words64`, in the order its
     /// module documents.
     Memory,
+    /// The slot layouts (`mdts`, `mdts32`, `mdts-desc`, `abuffer`): the `slots` array in
+    /// `order`, each word packed as `payload` (absent: the scheme's own word). The empty marker
+    /// is all ones of the word (`0` for `mdts-desc`, whose words are the payload plus one).
+    Slots {
+        /// How the slots of the pixels are placed.
+        order: SlotOrder,
+        /// The slot payload; absent: fragsim's own word (`mdts32`'s depth keys take none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        payload: Option<Payload>,
+    },
 }
 
 impl LayoutSpec {
@@ -170,8 +234,32 @@ impl LayoutSpec {
             Self::LinkedList { .. } => "linked-list",
             Self::LayerMajor { .. } => "layer-major",
             Self::Memory => "memory",
+            Self::Slots { .. } => "slots",
         }
     }
+}
+
+/// How linked lists number their nodes: `null` ends a list, node number `n` is array index
+/// `n − node_base`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ListNumbering {
+    /// The terminator.
+    pub null: u32,
+    /// The first node's number.
+    pub node_base: u32,
+}
+
+/// An encoding asked of every dump written at once (`render --dump-order`, `--dump-payload`,
+/// `--dump-list-numbering`): each field goes to the layouts that have it, and an absent field
+/// leaves fragsim's own ([`DumpScheme::spec_in`](super::DumpScheme::spec_in)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Encoding {
+    /// Slot layouts: how the `slots` array places each pixel's slots.
+    pub order: Option<SlotOrder>,
+    /// Slot layouts (but `mdts32`'s bare keys), linked lists and layer-major layers: the payload.
+    pub payload: Option<Payload>,
+    /// Linked lists: the terminator and the node numbering.
+    pub list_numbering: Option<ListNumbering>,
 }
 
 #[cfg(test)]
@@ -195,6 +283,38 @@ mod tests {
             (half >> 32) as u32,
             ((8_388_608.0 / 16_777_215.0) as f32).to_bits()
         );
+    }
+
+    #[test]
+    fn packing_inverts_decoding_for_f32_depths_and_rounds_unorm_ones_to_the_nearest_step() {
+        let word = u64::from(0.75f32.to_bits()) << 32 | 0x12_3456;
+        let over_24 = Payload {
+            depth_shift: 24,
+            prim_bits: 24,
+            ..Payload::FRAGMENT
+        };
+        let packed = over_24.pack(word).unwrap();
+        assert_eq!(packed, u64::from(0.75f32.to_bits()) << 24 | 0x12_3456);
+        assert_eq!(over_24.fragment(packed).0, word);
+        let unorm16 = Payload {
+            depth: DepthFormat::Unorm16,
+            ..Payload::FRAGMENT
+        };
+        // 0.75 · 65535 = 49151.25: the nearest step is 49151.
+        assert_eq!(unorm16.pack(word).unwrap() >> 32, 49_151);
+        // fragsim's empty marker is the payload's, and an id too wide for it is refused.
+        let narrow = Payload {
+            dtype: Dtype::U32,
+            depth: DepthFormat::Unorm24,
+            depth_shift: 8,
+            prim_bits: 8,
+        };
+        assert_eq!(narrow.pack(u64::MAX).unwrap(), u64::from(u32::MAX));
+        assert!(narrow
+            .pack(word)
+            .unwrap_err()
+            .0
+            .contains("1193046 does not fit"));
     }
 
     #[test]

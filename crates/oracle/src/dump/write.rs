@@ -10,7 +10,8 @@ use fragsim_raster::View;
 
 use super::header::{check_array, check_distinct_files, check_file_name};
 use super::layouts::sort_abuffer_in_place;
-use super::{io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
+use super::{err, io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
+use super::{LayoutSpec, ListNumbering};
 use super::{FORMAT, HEADER_FILE, VERSION};
 use crate::scene::SceneAndCamera;
 use fragsim_capture::catalog::SchemeVisitor;
@@ -26,6 +27,19 @@ impl SchemeVisitor for Record<'_, '_> {
         let memory: SerialMemory = scheme.layout().allocate();
         fragsim_capture::executors::serial_passes(self.view, scheme, &memory);
         (read_all(&memory), read_all(&memory))
+    }
+}
+
+/// The spec of array `name` as fragsim writes it: file `name.u32` or `name.u64`.
+fn array_spec(name: &str, dtype: Dtype, shape: Vec<u64>) -> ArraySpec {
+    let suffix = match dtype {
+        Dtype::U32 => "u32",
+        Dtype::U64 => "u64",
+    };
+    ArraySpec {
+        file: format!("{name}.{suffix}"),
+        dtype,
+        shape,
     }
 }
 
@@ -133,15 +147,7 @@ impl Dump {
         let specs = arrays
             .iter()
             .map(|(name, words)| {
-                let suffix = match words.dtype() {
-                    Dtype::U32 => "u32",
-                    Dtype::U64 => "u64",
-                };
-                let spec = ArraySpec {
-                    file: format!("{name}.{suffix}"),
-                    dtype: words.dtype(),
-                    shape: shapes[name.as_str()].clone(),
-                };
+                let spec = array_spec(name, words.dtype(), shapes[name.as_str()].clone());
                 (name.clone(), spec)
             })
             .collect();
@@ -167,6 +173,53 @@ impl Dump {
             },
             arrays,
         })
+    }
+
+    /// This dump, as [`Dump::record`] writes it (fragsim's own encoding), with its words as
+    /// `spec` describes (`None`: fragsim's own slot encoding, unchanged): what `render --dump`
+    /// writes for an engine's layout ([`DumpScheme::spec_in`]).
+    ///
+    /// # Errors
+    /// A dump in another encoding than fragsim's, a description its scheme cannot have (the
+    /// reader's own checks), a primitive id that does not fit the payload, or a list numbering
+    /// whose terminator is a node's number.
+    pub fn in_layout(&self, spec: Option<LayoutSpec>) -> Result<Dump, DumpError> {
+        let scheme = self.scheme()?;
+        if self.header.layout != scheme.spec() {
+            return err(format!(
+                "only fragsim's own encoding is re-encoded; this dump's layout is {:?}",
+                self.header.layout
+            ));
+        }
+        let mut described = self.header.clone();
+        described.layout = spec;
+        DumpScheme::from_header(&described, self.u32s("offsets")?)?;
+        match spec {
+            Some(LayoutSpec::Slots { order, payload }) => self.slots_as(&scheme, order, payload),
+            Some(LayoutSpec::LinkedList {
+                payload,
+                null,
+                node_base,
+            }) => self.lists_as(payload, ListNumbering { null, node_base }),
+            Some(LayoutSpec::LayerMajor { payload }) => self.layers_as(payload),
+            Some(LayoutSpec::Memory) | None => Ok(self.clone()),
+        }
+    }
+
+    /// The shape of array `name`: the header's, or its length where the header has none.
+    pub(super) fn shape_of(&self, name: &str) -> Vec<u64> {
+        match self.header.arrays.get(name) {
+            Some(spec) => spec.shape.clone(),
+            None => vec![self.arrays.get(name).map_or(0, |w| w.len() as u64)],
+        }
+    }
+
+    /// Puts array `name` in the dump: its words, and in the header its file (`name.u32` or
+    /// `name.u64`), dtype and shape.
+    pub fn set_array(&mut self, name: &str, words: Words, shape: Vec<u64>) {
+        let spec = array_spec(name, words.dtype(), shape);
+        self.header.arrays.insert(name.into(), spec);
+        self.arrays.insert(name.into(), words);
     }
 
     /// The header as `dump.json` text and each array file's bytes, by file name: what
