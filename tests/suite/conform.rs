@@ -108,3 +108,27 @@ fn each_planted_bug_is_found_and_shrunk_to_three_triangles_and_four_by_four_pixe
         assert_eq!(records[1]["record"], "counterexample_pixel");
     }
 }
+
+#[test]
+fn progress_lines_count_every_passed_case_on_stderr() {
+    let save = std::env::temp_dir().join(format!("fragsim-conform-progress-{}", std::process::id()));
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(["conform", "--scheme", "mdts", "--backend", &python("")])
+        .args(["--cases", "4", "--seed", "0", "--progress-lines", "--save"])
+        .arg(&save)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&save);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("conform: "))
+        .collect();
+    // One line as each case after the first starts (the one before it passed), one at the end.
+    let expected: Vec<String> = (1..=4)
+        .map(|n| format!("conform: {n} of 4 cases passed"))
+        .collect();
+    assert_eq!(lines, expected, "{stderr}");
+}
