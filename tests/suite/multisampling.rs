@@ -340,6 +340,7 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
     assert_eq!(record["msaa"]["samples"], 1, "{record}");
     assert_eq!(record["msaa"]["differing_pixels"], 0, "{record}");
     assert_eq!(record["msaa"]["mixed_pixels"], 0, "{record}");
+    assert_eq!(record["msaa"]["layer_edge_pixels"], 0, "{record}");
     assert_eq!(record["msaa"]["sample_fragments"], record["oracle_fragments"]);
     assert_eq!(png(&out.join("bench-oracle-transparency-msaa1.png")), today(&out));
 
@@ -355,7 +356,8 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
     assert!(differing > 100, "{differing} pixels changed");
     assert_eq!(record["msaa"]["differing_pixels"], differing, "{record}");
     let mixed = record["msaa"]["mixed_pixels"].as_u64().unwrap();
-    assert!(mixed as usize >= differing / 2, "{mixed} mixed, {differing} differing");
+    let layer_edges = record["msaa"]["layer_edge_pixels"].as_u64().unwrap();
+    assert!(0 < layer_edges && layer_edges < mixed, "{record}");
     let fragments = record["msaa"]["sample_fragments"].as_u64().unwrap();
     let single_fragments = record["oracle_fragments"].as_u64().unwrap();
     assert!(fragments > 3 * single_fragments && fragments < 5 * single_fragments);

@@ -232,9 +232,12 @@ pub struct MsaaReport {
     pub samples: u32,
     /// Fragments of the per-sample oracle (one per covered sample).
     pub sample_fragments: usize,
-    /// Pixels whose samples do not all hold the same primitives in the same order: the edges
-    /// multisampling sees.
+    /// Pixels whose samples do not all hold the same primitives in the same order: every edge
+    /// multisampling sees, between two triangles of one surface too.
     pub mixed_pixels: usize,
+    /// Of those, pixels whose samples hold different numbers of fragments: where a layer begins
+    /// or ends inside the pixel (silhouettes and folds).
+    pub layer_edge_pixels: usize,
     /// Pixels whose resolved 8-bit colour differs from the single-sample image's.
     pub differing_pixels: usize,
 }
@@ -515,9 +518,13 @@ fn multisampled(
     let reference = judge.reference().ok_or("the judge has the oracle's image")?;
     let n = samples as usize;
     let prims = |sample: usize| lists.pixel(sample).iter().map(|&e| e as u32);
-    let mixed_pixels = (0..oracle.pixel_viewport().pixels() as usize)
-        .filter(|&p| (p * n + 1..(p + 1) * n).any(|s| !prims(s).eq(prims(p * n))))
-        .count();
+    let (mut mixed_pixels, mut layer_edge_pixels) = (0, 0);
+    for first in (0..lists.pixels()).step_by(n) {
+        let others = first + 1..first + n;
+        let layers = lists.pixel(first).len();
+        layer_edge_pixels += usize::from(others.clone().any(|s| lists.pixel(s).len() != layers));
+        mixed_pixels += usize::from(others.into_iter().any(|s| !prims(s).eq(prims(first))));
+    }
     if !args.no_images {
         let stem = format!("bench-oracle-{}-msaa{samples}", args.effect.label());
         fragsim_shade::save_png(&image, &args.out.join(format!("{stem}.png")))?;
@@ -528,6 +535,7 @@ fn multisampled(
         samples,
         sample_fragments: lists.fragments(),
         mixed_pixels,
+        layer_edge_pixels,
         differing_pixels: error_pixels(reference, &image),
     })
 }
@@ -688,10 +696,12 @@ fn markdown(report: &BenchReport) -> String {
         text.push_str(&format!(
             "The oracle's image at {n} samples a pixel (standard pattern), shaded per sample and \
              resolved per pixel (bench-oracle-{effect}-msaa{n}.png): {} sample fragments; {} \
-             mixed pixels (samples holding different primitives); {} pixels whose 8-bit colour \
+             mixed pixels (samples holding different primitives), {} of them layer edges \
+             (samples holding different numbers of fragments); {} pixels whose 8-bit colour \
              differs from the single-sample image (bench-oracle-{effect}-msaa{n}-diff.png).\n\n",
             msaa.sample_fragments,
             msaa.mixed_pixels,
+            msaa.layer_edge_pixels,
             msaa.differing_pixels,
             n = msaa.samples,
             effect = report.effect,
