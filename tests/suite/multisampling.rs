@@ -307,8 +307,18 @@ fn a_view_refuses_a_framebuffer_too_wide_and_the_masked_abuffer_a_view_of_anothe
 fn bench_with(out: &std::path::Path, extra: &[&str]) -> (Option<i32>, serde_json::Value, String) {
     let output = assert_cmd::Command::cargo_bin("fragsim")
         .unwrap()
-        .args(["bench", "--scene", "bunny", "--width", "64", "--height", "64"])
-        .args(["--scheme", "mdts", "--executor", "serial", "--frames", "1", "--json"])
+        .args([
+            "bench", "--scene", "bunny", "--width", "64", "--height", "64",
+        ])
+        .args([
+            "--scheme",
+            "mdts",
+            "--executor",
+            "serial",
+            "--frames",
+            "1",
+            "--json",
+        ])
         .arg("--out")
         .arg(out)
         .args(extra)
@@ -341,8 +351,14 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
     assert_eq!(record["msaa"]["differing_pixels"], 0, "{record}");
     assert_eq!(record["msaa"]["mixed_pixels"], 0, "{record}");
     assert_eq!(record["msaa"]["layer_edge_pixels"], 0, "{record}");
-    assert_eq!(record["msaa"]["sample_fragments"], record["oracle_fragments"]);
-    assert_eq!(png(&out.join("bench-oracle-transparency-msaa1.png")), today(&out));
+    assert_eq!(
+        record["msaa"]["sample_fragments"],
+        record["oracle_fragments"]
+    );
+    assert_eq!(
+        png(&out.join("bench-oracle-transparency-msaa1.png")),
+        today(&out)
+    );
 
     let (code, record, stderr) = bench_with(&out, &["--samples", "4"]);
     assert_eq!(code, Some(0), "{stderr}");
@@ -377,7 +393,10 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
     for (extra, says) in [
         (&["--samples", "3"][..], "--samples 3"),
         (&["--samples", "32"][..], "1, 2, 4, 8 or 16"),
-        (&["--samples", "4", "--effect", "fresnel"][..], "transparency"),
+        (
+            &["--samples", "4", "--effect", "fresnel"][..],
+            "transparency",
+        ),
     ] {
         let (code, _, stderr) = bench_with(&out, extra);
         assert_eq!(code, Some(2), "{extra:?}: {stderr}");

@@ -493,12 +493,11 @@ fn multisampled(
     args: &BenchArgs,
 ) -> Result<MsaaReport, String> {
     let samples = pattern.count();
-    let sampled = view.clone().with_samples(pattern)?;
     // The per-sample oracle is about `samples` single-sample oracles (one per sample index,
-    // each a shifted pixel grid): the single-sample bound against that share of the cap.
+    // each on a shifted pixel grid): the single-sample bound against that share of the cap.
     let cap = args.schemes.sizing().memory_cap / u64::from(samples);
     crate::oracle_memory::check(view, cap)?;
-    let oracle = SampleOracle::build(&sampled)?;
+    let oracle = SampleOracle::build(&view.clone().with_samples(pattern)?)?;
     let lists = oracle.oracle();
     // Transparency reads neither distances nor normals.
     let geometry = Geometry {
@@ -514,16 +513,18 @@ fn multisampled(
         |s| lists.pixel(s),
         geometry,
     )
-    .ok_or("the oracle's lists resolve every effect")?;
-    let reference = judge.reference().ok_or("the judge has the oracle's image")?;
+    .expect("full identities resolve every effect");
+    let reference = judge
+        .reference()
+        .expect("the judge shades the oracle's image");
     let n = samples as usize;
     let prims = |sample: usize| lists.pixel(sample).iter().map(|&e| e as u32);
     let (mut mixed_pixels, mut layer_edge_pixels) = (0, 0);
     for first in (0..lists.pixels()).step_by(n) {
-        let others = first + 1..first + n;
+        let others = || first + 1..first + n;
         let layers = lists.pixel(first).len();
-        layer_edge_pixels += usize::from(others.clone().any(|s| lists.pixel(s).len() != layers));
-        mixed_pixels += usize::from(others.into_iter().any(|s| !prims(s).eq(prims(first))));
+        layer_edge_pixels += usize::from(others().any(|s| lists.pixel(s).len() != layers));
+        mixed_pixels += usize::from(others().any(|s| !prims(s).eq(prims(first))));
     }
     if !args.no_images {
         let stem = format!("bench-oracle-{}-msaa{samples}", args.effect.label());

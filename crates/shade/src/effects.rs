@@ -431,7 +431,10 @@ mod tests {
                 changed += 1;
             }
         }
-        assert!(uniform > 1000 && changed > 100, "{uniform} uniform, {changed} changed");
+        assert!(
+            uniform > 1000 && changed > 100,
+            "{uniform} uniform, {changed} changed"
+        );
     }
 
     #[test]
