@@ -2,7 +2,8 @@
 //! evaluation of the rules at every sample, one sample at the centre bit-identical to the
 //! single-sample pipeline (the oracle on the shared meshes, every catalog scheme on several
 //! executors), schemes run per sample equal to the per-sample oracle, and the masked-node
-//! A-buffer equal to the per-pixel view of the per-sample oracle within its capacity.
+//! A-buffer equal to the per-pixel view of the per-sample oracle within its capacity; `bench
+//! --samples`'s resolved transparency image, the single-sample image at one sample.
 
 use std::path::PathBuf;
 
@@ -299,4 +300,107 @@ fn a_view_refuses_a_framebuffer_too_wide_and_the_masked_abuffer_a_view_of_anothe
         .unwrap_err()
         .contains("1 samples"));
     assert!(SampleOracle::build(&view).is_err());
+}
+
+/// `fragsim bench` of mdts on the bunny at 64 × 64 with `extra` arguments into `out`: its exit
+/// code, its one JSON record (when it succeeded) and its stderr.
+fn bench_with(out: &std::path::Path, extra: &[&str]) -> (Option<i32>, serde_json::Value, String) {
+    let output = assert_cmd::Command::cargo_bin("fragsim")
+        .unwrap()
+        .args([
+            "bench", "--scene", "bunny", "--width", "64", "--height", "64",
+        ])
+        .args([
+            "--scheme",
+            "mdts",
+            "--executor",
+            "serial",
+            "--frames",
+            "1",
+            "--json",
+        ])
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    let record = crate::support::json_lines(&output.stdout)
+        .into_iter()
+        .next()
+        .unwrap_or_default();
+    (output.status.code(), record, stderr)
+}
+
+fn png(path: &std::path::Path) -> image::RgbImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8()
+}
+
+#[test]
+fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_refuses_other_counts()
+{
+    let out = std::env::temp_dir().join(format!("fragsim-msaa-bench-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let today = |out: &std::path::Path| png(&out.join("bench-oracle-transparency.png"));
+
+    let (code, record, stderr) = bench_with(&out, &["--samples", "1"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(record["msaa"]["samples"], 1, "{record}");
+    assert_eq!(record["msaa"]["differing_pixels"], 0, "{record}");
+    assert_eq!(record["msaa"]["mixed_pixels"], 0, "{record}");
+    assert_eq!(record["msaa"]["layer_edge_pixels"], 0, "{record}");
+    assert_eq!(
+        record["msaa"]["sample_fragments"],
+        record["oracle_fragments"]
+    );
+    assert_eq!(
+        png(&out.join("bench-oracle-transparency-msaa1.png")),
+        today(&out)
+    );
+
+    let (code, record, stderr) = bench_with(&out, &["--samples", "4"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let resolved = png(&out.join("bench-oracle-transparency-msaa4.png"));
+    let single = today(&out);
+    let differing = resolved
+        .pixels()
+        .zip(single.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(differing > 100, "{differing} pixels changed");
+    assert_eq!(record["msaa"]["differing_pixels"], differing, "{record}");
+    let mixed = record["msaa"]["mixed_pixels"].as_u64().unwrap();
+    let layer_edges = record["msaa"]["layer_edge_pixels"].as_u64().unwrap();
+    assert!(0 < layer_edges && layer_edges < mixed, "{record}");
+    let fragments = record["msaa"]["sample_fragments"].as_u64().unwrap();
+    let single_fragments = record["oracle_fragments"].as_u64().unwrap();
+    assert!(fragments > 3 * single_fragments && fragments < 5 * single_fragments);
+    // The difference figure's picture (its top-left 64 × 64) paints each differing pixel red.
+    let figure = png(&out.join("bench-oracle-transparency-msaa4-diff.png"));
+    let red = figure
+        .enumerate_pixels()
+        .filter(|&(x, y, p)| x < 64 && y < 64 && p.0 == [255, 0, 0])
+        .count();
+    assert_eq!(red, differing);
+    let markdown = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    assert!(
+        markdown.contains(&format!("{differing} pixels whose 8-bit colour differs")),
+        "{markdown}"
+    );
+
+    for (extra, says) in [
+        (&["--samples", "3"][..], "--samples 3"),
+        (&["--samples", "32"][..], "1, 2, 4, 8 or 16"),
+        (
+            &["--samples", "4", "--effect", "fresnel"][..],
+            "transparency",
+        ),
+    ] {
+        let (code, _, stderr) = bench_with(&out, extra);
+        assert_eq!(code, Some(2), "{extra:?}: {stderr}");
+        assert!(stderr.contains(says), "{extra:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(out).unwrap();
 }

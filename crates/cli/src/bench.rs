@@ -10,8 +10,10 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
+use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::View;
+use fragsim_raster::{SamplePattern, View};
+use fragsim_shade::effects::{error_pixels, render_resolved, Entries, Geometry};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -50,6 +52,12 @@ pub struct BenchArgs {
     /// are still written.
     #[arg(long)]
     pub no_images: bool,
+    /// Also resolve the oracle's transparency image from this many samples a pixel (1, 2, 4, 8
+    /// or 16: the standard patterns, `docs/semantics.md` §11) and compare it with the
+    /// single-sample image: `bench-oracle-transparency-msaa<N>.png`, its difference image
+    /// (`…-diff.png`) and the `msaa` fields. The schemes still run at one sample.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u32>,
     /// Approximate OIT schemes to measure beside the catalog's, by their transparency image
     /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
     #[arg(long, value_delimiter = ',')]
@@ -206,12 +214,32 @@ pub struct BenchReport {
     pub effect: String,
     /// Frames per row.
     pub frames: u32,
+    /// The multisampled oracle image against the single-sample one (`--samples`).
+    pub msaa: Option<MsaaReport>,
     /// One row per scheme and executor.
     #[serde(skip)]
     pub rows: Vec<BenchRow>,
     /// One row per approximate scheme (`--approximate`).
     #[serde(skip)]
     pub approximate: Vec<ApproximateRow>,
+}
+
+/// The oracle's transparency image resolved from several samples a pixel, against the
+/// single-sample image (`--samples`).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct MsaaReport {
+    /// Samples a pixel.
+    pub samples: u32,
+    /// Fragments of the per-sample oracle (one per covered sample).
+    pub sample_fragments: usize,
+    /// Pixels whose samples do not all hold the same primitives in the same order: every edge
+    /// multisampling sees, between two triangles of one surface too.
+    pub mixed_pixels: usize,
+    /// Of those, pixels whose samples hold different numbers of fragments: where a layer begins
+    /// or ends inside the pixel (silhouettes and folds).
+    pub layer_edge_pixels: usize,
+    /// Pixels whose resolved 8-bit colour differs from the single-sample image's.
+    pub differing_pixels: usize,
 }
 
 /// One line of bench's JSON Lines: a row with what the whole bench measured.
@@ -247,6 +275,18 @@ fn ms(d: Duration) -> f64 {
 /// # Errors
 /// Scene, parameter or output errors.
 pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
+    let pattern = args
+        .samples
+        .map(|count| {
+            if args.effect != EffectName::Transparency {
+                return Err(format!(
+                    "--samples resolves the transparency image only, not {}",
+                    args.effect.label()
+                ));
+            }
+            SamplePattern::standard(count).map_err(|e| format!("--samples {count}: {e}"))
+        })
+        .transpose()?;
     let pool = args.schemes.pool()?;
     let scene = args.scene.scene()?;
     let viewport = args.scene.viewport()?;
@@ -286,6 +326,9 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         let name = format!("bench-oracle-{}.png", args.effect.label());
         fragsim_shade::save_png(image, &args.out.join(name))?;
     }
+    let msaa = pattern
+        .map(|pattern| multisampled(&view, pattern, &judge, args))
+        .transpose()?;
     let mut rows = Vec::new();
     for &name in &schemes {
         for &executor in executors {
@@ -431,11 +474,71 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         raster_ms,
         effect: args.effect.label().into(),
         frames: args.frames,
+        msaa,
         rows,
         approximate,
     };
     write_outputs(&report, args)?;
     Ok(report)
+}
+
+/// The oracle's image of `judge`'s effect (transparency) resolved from `pattern`'s samples
+/// (`fragsim_shade::effects::render_resolved`), compared with the judge's single-sample image;
+/// unless `--no-images`, both written to `--out`: `bench-oracle-<effect>-msaa<N>.png` and its
+/// difference image.
+fn multisampled(
+    view: &View<'_>,
+    pattern: SamplePattern,
+    judge: &Judge<'_>,
+    args: &BenchArgs,
+) -> Result<MsaaReport, String> {
+    let samples = pattern.count();
+    // The per-sample oracle is about `samples` single-sample oracles (one per sample index,
+    // each on a shifted pixel grid): the single-sample bound against that share of the cap.
+    let cap = args.schemes.sizing().memory_cap / u64::from(samples);
+    crate::oracle_memory::check(view, cap)?;
+    let oracle = SampleOracle::build(&view.clone().with_samples(pattern)?)?;
+    let lists = oracle.oracle();
+    // Transparency reads neither distances nor normals.
+    let geometry = Geometry {
+        distance: &|_| 0.0,
+        cosine: &|_, _| 1.0,
+    };
+    let image = render_resolved(
+        judge.effect(),
+        judge.material(),
+        Entries::KeyAndPrim,
+        judge.size(),
+        samples,
+        |s| lists.pixel(s),
+        geometry,
+    )
+    .expect("full identities resolve every effect");
+    let reference = judge
+        .reference()
+        .expect("the judge shades the oracle's image");
+    let n = samples as usize;
+    let prims = |sample: usize| lists.pixel(sample).iter().map(|&e| e as u32);
+    let (mut mixed_pixels, mut layer_edge_pixels) = (0, 0);
+    for first in (0..lists.pixels()).step_by(n) {
+        let others = || first + 1..first + n;
+        let layers = lists.pixel(first).len();
+        layer_edge_pixels += usize::from(others().any(|s| lists.pixel(s).len() != layers));
+        mixed_pixels += usize::from(others().any(|s| !prims(s).eq(prims(first))));
+    }
+    if !args.no_images {
+        let stem = format!("bench-oracle-{}-msaa{samples}", args.effect.label());
+        fragsim_shade::save_png(&image, &args.out.join(format!("{stem}.png")))?;
+        let difference = fragsim_shade::legend::effect_difference_figure(reference, &image)?;
+        fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
+    }
+    Ok(MsaaReport {
+        samples,
+        sample_fragments: lists.fragments(),
+        mixed_pixels,
+        layer_edge_pixels,
+        differing_pixels: error_pixels(reference, &image),
+    })
 }
 
 /// Rasterizes every triangle on the current pool and discards the fragments.
@@ -590,6 +693,21 @@ fn markdown(report: &BenchReport) -> String {
         report.frames,
         report.effect
     );
+    if let Some(msaa) = &report.msaa {
+        text.push_str(&format!(
+            "The oracle's image at {n} samples a pixel (standard pattern), shaded per sample and \
+             resolved per pixel (bench-oracle-{effect}-msaa{n}.png): {} sample fragments; {} \
+             mixed pixels (samples holding different primitives), {} of them layer edges \
+             (samples holding different numbers of fragments); {} pixels whose 8-bit colour \
+             differs from the single-sample image (bench-oracle-{effect}-msaa{n}-diff.png).\n\n",
+            msaa.sample_fragments,
+            msaa.mixed_pixels,
+            msaa.layer_edge_pixels,
+            msaa.differing_pixels,
+            n = msaa.samples,
+            effect = report.effect,
+        ));
+    }
     text.push_str(
         "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR % | mean err | max err | PSNR dB | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
     );

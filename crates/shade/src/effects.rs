@@ -187,22 +187,64 @@ pub fn shade_pixel(
 }
 
 /// Resolves every pixel, rows in parallel; `list(p)` gives pixel `p`'s entries. `None` when the
-/// effect cannot be resolved from these entries.
+/// effect cannot be resolved from these entries. The one-sample case of [`render_resolved`].
 #[must_use]
 pub fn render<'a>(
     effect: Effect,
     material: &Material,
     entries: Entries,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     list: impl Fn(usize) -> &'a [u64] + Sync,
     geometry: Geometry<'_>,
 ) -> Option<RgbImage> {
+    render_resolved(effect, material, entries, size, 1, list, geometry)
+}
+
+/// The multisample resolve of an effect: every sample shaded from its own list, then each
+/// pixel's `samples` linear colours averaged, then encoded once ([`shade_image`]).
+///
+/// `list(i)` gives the entries of sample index `i = p * samples + s`, sample `s` of pixel `p`
+/// (row-major): the sample-expanded framebuffer a sampled view rasterizes into
+/// (`fragsim_raster::samples`, `docs/semantics.md` §11), whose per-sample oracle
+/// (`fragsim_oracle::samples::SampleOracle::oracle`) is indexed the same way; `geometry`'s
+/// `cosine` is called with the sample index too.
+///
+/// The filter is the standard MSAA box resolve: the unweighted mean of the pixel's samples (the
+/// filter of GPUs' fixed-function colour resolve; Vulkan's `vkCmdResolveImage` leaves it to the
+/// implementation). It is taken in linear light, before the sRGB encoding, like the blending
+/// itself: averaging encoded bytes would darken every edge between a bright and a dark sample.
+/// The sum runs in f64, where equal f32 colours add exactly, so a pixel whose samples all shade
+/// alike resolves to exactly that colour, and one sample is the single-sample image bit for bit.
+///
+/// `None` when the effect cannot be resolved from these entries.
+///
+/// # Panics
+/// If `samples` is 0.
+#[must_use]
+pub fn render_resolved<'a>(
+    effect: Effect,
+    material: &Material,
+    entries: Entries,
+    size: (u32, u32),
+    samples: u32,
+    list: impl Fn(usize) -> &'a [u64] + Sync,
+    geometry: Geometry<'_>,
+) -> Option<RgbImage> {
+    assert!(samples > 0, "a pixel has at least one sample");
     if !effect.resolvable_from(entries) {
         return None;
     }
-    Some(shade_image((width, height), |p| {
-        shade_pixel(effect, material, entries, p, list(p), geometry)
-            .expect("resolvable entries shade every pixel")
+    let n = samples as usize;
+    Some(shade_image(size, |p| {
+        let mut sum = [0.0f64; 3];
+        for sample in p * n..(p + 1) * n {
+            let colour = shade_pixel(effect, material, entries, sample, list(sample), geometry)
+                .expect("resolvable entries shade every sample");
+            for ch in 0..3 {
+                sum[ch] += f64::from(colour[ch]);
+            }
+        }
+        sum.map(|c| (c / n as f64) as f32)
     }))
 }
 
@@ -299,6 +341,99 @@ mod tests {
         assert_ne!(
             shade(&[1 << 32, (2 << 32) | 1]),
             shade(&[(2 << 32) | 1, 1 << 32])
+        );
+    }
+
+    #[test]
+    fn a_half_covered_pixel_resolves_to_the_mean_of_its_two_samples_in_linear_light() {
+        let m = Material {
+            opacity: 0.9,
+            ..Material::default()
+        };
+        // Sample 0 holds one nearly opaque fragment (primitive 0: red), sample 1 nothing.
+        let lists: [&[u64]; 2] = [&[0], &[]];
+        let image = render_resolved(
+            Effect::Transparency,
+            &m,
+            Entries::KeyAndPrim,
+            (1, 1),
+            2,
+            |s| lists[s],
+            FLAT,
+        )
+        .unwrap();
+        let covered =
+            shade_pixel(Effect::Transparency, &m, Entries::KeyAndPrim, 0, &[0], FLAT).unwrap();
+        let linear_mean = [0, 1, 2].map(|ch| {
+            let sum = f64::from(covered[ch]) + f64::from(m.background[ch]);
+            encode_srgb((sum / 2.0) as f32)
+        });
+        assert_eq!(image.get_pixel(0, 0).0, linear_mean);
+        // The mean of the encoded bytes is far darker in red: the resolve is not that.
+        let encoded_mean =
+            (u16::from(encode_srgb(covered[0])) + u16::from(encode_srgb(m.background[0]))) / 2;
+        assert!(
+            u16::from(linear_mean[0]) > encoded_mean + 20,
+            "{linear_mean:?} against {encoded_mean}"
+        );
+    }
+
+    #[test]
+    fn one_sample_resolves_to_the_single_sample_image_and_four_change_only_mixed_pixels() {
+        use fragsim_oracle::samples::SampleOracle;
+        use fragsim_oracle::Oracle;
+        use fragsim_raster::{OrbitCamera, SamplePattern, Scene, Viewport};
+
+        let scene = Scene::procedural("bunny").unwrap();
+        let side = 64;
+        let view = scene
+            .view(Viewport::new(side, side).unwrap(), &OrbitCamera::default())
+            .unwrap();
+        let m = Material {
+            primitives: view.triangle_count(),
+            ..Material::default()
+        };
+        let today = Oracle::build(&view);
+        let shade = |p: usize, list: &[u64]| {
+            shade_pixel(Effect::Transparency, &m, Entries::KeyAndPrim, p, list, FLAT).unwrap()
+        };
+        let single = shade_image((side, side), |p| shade(p, today.pixel(p)));
+        let resolve = |count: u32| {
+            let pattern = SamplePattern::standard(count).unwrap();
+            let sampled =
+                SampleOracle::build(&view.clone().with_samples(pattern).unwrap()).unwrap();
+            let lists = sampled.oracle();
+            let image = render_resolved(
+                Effect::Transparency,
+                &m,
+                Entries::KeyAndPrim,
+                (side, side),
+                count,
+                |s| lists.pixel(s),
+                FLAT,
+            )
+            .unwrap();
+            (image, sampled)
+        };
+        assert_eq!(resolve(1).0, single);
+        let (four, sampled) = resolve(4);
+        let sampled = sampled.oracle();
+        let prims = |list: &[u64]| list.iter().map(|&e| e as u32).collect::<Vec<_>>();
+        let (mut uniform, mut changed) = (0, 0);
+        for p in 0..(side * side) as usize {
+            let centre = prims(today.pixel(p));
+            let (x, y) = ((p % side as usize) as u32, (p / side as usize) as u32);
+            if (0..4).all(|s| prims(sampled.pixel(p * 4 + s)) == centre) {
+                // Every sample shades as the centre does: the resolve keeps the colour exactly.
+                uniform += 1;
+                assert_eq!(four.get_pixel(x, y), single.get_pixel(x, y), "pixel {p}");
+            } else if four.get_pixel(x, y) != single.get_pixel(x, y) {
+                changed += 1;
+            }
+        }
+        assert!(
+            uniform > 1000 && changed > 100,
+            "{uniform} uniform, {changed} changed"
         );
     }
 

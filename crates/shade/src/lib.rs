@@ -1,5 +1,6 @@
 //! Images of captures: the depth-complexity heat map, the nearest-layer depth, the
-//! multi-fragment effects ([`effects`]: transparency, translucency), the approximate OIT schemes'
+//! multi-fragment effects ([`effects`]: transparency, translucency, Fresnel, and their
+//! multisample resolve), the approximate OIT schemes'
 //! transparency ([`approximate`]: WBOIT, MLAB, tail blending), with the error-pixel rate
 //! and, for approximate images, the colour error ([`colour_error`]: mean and maximum absolute
 //! error per channel, PSNR),
