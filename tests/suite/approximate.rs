@@ -12,7 +12,7 @@
 //! of six fragments), MLAB's one failure (a fragment landing inside a merged node), WBOIT exact
 //! for one fragment only, and submission order as recorded.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 use fragsim::capture::primitive_order::PrimitiveOrder;
@@ -25,43 +25,53 @@ fn out_dir(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("fragsim-approximate-{name}-{}", std::process::id()))
 }
 
-/// `fragsim bench` on nested spheres (depth complexity 6 at the centre) at 48 × 48, one frame,
-/// MDTS and every approximate scheme with `--k k`, the submission order shuffled with `seed`;
-/// the JSON records.
-fn bench(name: &str, k: &str, seed: &str) -> Vec<Value> {
+/// Runs `fragsim ARGS --out DIR` (DIR a fresh temporary directory named after `name`), which
+/// must succeed; `read` takes what it needs from its stdout and DIR before DIR is removed.
+fn run_ok<T>(name: &str, args: &[&str], read: impl FnOnce(&[u8], &Path) -> T) -> T {
     let out = out_dir(name);
     let output = Command::cargo_bin("fragsim")
         .unwrap()
-        .args([
-            "bench",
-            "--scene",
-            "spheres:3",
-            "--width",
-            "48",
-            "--height",
-            "48",
-        ])
-        .args(["--frames", "1", "--json", "--no-images", "--scheme", "mdts"])
-        .args([
-            "--approximate",
-            "wboit,mlab,tail-blend",
-            "--k",
-            k,
-            "--shuffle",
-            seed,
-        ])
+        .args(args)
         .arg("--out")
         .arg(&out)
         .output()
         .unwrap();
     assert!(
         output.status.success(),
-        "{}",
+        "{args:?}: {}",
         String::from_utf8_lossy(&output.stderr)
     );
-    let records = crate::support::json_lines(&output.stdout);
+    let value = read(&output.stdout, &out);
     let _ = std::fs::remove_dir_all(&out);
-    records
+    value
+}
+
+/// `fragsim bench` on nested spheres (depth complexity 6 at the centre) at 48 × 48, one frame,
+/// MDTS and every approximate scheme with `--k k`, the submission order shuffled with `seed`;
+/// the JSON records.
+fn bench(name: &str, k: &str, seed: &str) -> Vec<Value> {
+    let args = [
+        "bench",
+        "--scene",
+        "spheres:3",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--frames",
+        "1",
+        "--json",
+        "--no-images",
+        "--scheme",
+        "mdts",
+        "--approximate",
+        "wboit,mlab,tail-blend",
+        "--k",
+        k,
+        "--shuffle",
+        seed,
+    ];
+    run_ok(name, &args, |stdout, _| crate::support::json_lines(stdout))
 }
 
 /// bench.md's per-depth-complexity rows of the row labelled `label`: (bucket, pixels, EPR %).
@@ -90,38 +100,29 @@ fn depth_rows(markdown: &str, label: &str) -> Vec<(String, u64, f64)> {
 /// Measured (seed 1): 5–8 fragments, 52 pixels, 13.462 % for both schemes.
 #[test]
 fn the_colour_error_per_depth_complexity_lies_only_past_the_nodes() {
-    let out = out_dir("depth");
-    let output = Command::cargo_bin("fragsim")
-        .unwrap()
-        .args([
-            "bench",
-            "--scene",
-            "spheres:3",
-            "--width",
-            "48",
-            "--height",
-            "48",
-        ])
-        .args(["--frames", "1", "--no-images", "--scheme", "mdts"])
-        .args([
-            "--approximate",
-            "mlab,tail-blend",
-            "--k",
-            "4",
-            "--shuffle",
-            "1",
-        ])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let markdown = std::fs::read_to_string(out.join("bench.md")).unwrap();
-    let _ = std::fs::remove_dir_all(&out);
+    let args = [
+        "bench",
+        "--scene",
+        "spheres:3",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--frames",
+        "1",
+        "--no-images",
+        "--scheme",
+        "mdts",
+        "--approximate",
+        "mlab,tail-blend",
+        "--k",
+        "4",
+        "--shuffle",
+        "1",
+    ];
+    let markdown = run_ok("depth", &args, |_, out| {
+        std::fs::read_to_string(out.join("bench.md")).unwrap()
+    });
     for label in ["mlab (blend, K = 4)", "tail-blend (blend, K = 4)"] {
         let rows = depth_rows(&markdown, label);
         assert_eq!(rows[0].0, "2–4", "{markdown}");
@@ -524,24 +525,30 @@ fn errors_up_to(record: &Value, most: u64) -> (u64, u64) {
 /// where a pixel has one fragment.
 #[test]
 fn bench_records_carry_the_colour_error_per_depth_complexity_and_it_adds_up() {
-    let out = out_dir("buckets");
-    let output = Command::cargo_bin("fragsim")
-        .unwrap()
-        .args(["bench", "--scene", "spheres:9", "--width", "48"])
-        .args(["--height", "48", "--frames", "1", "--json", "--no-images"])
-        .args(["--scheme", "abuffer-exact,mdts", "--k", "4"])
-        .args(["--approximate", "wboit,mlab,tail-blend", "--shuffle", "1"])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let _ = std::fs::remove_dir_all(&out);
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let records = crate::support::json_lines(&output.stdout);
+    let args = [
+        "bench",
+        "--scene",
+        "spheres:9",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--frames",
+        "1",
+        "--json",
+        "--no-images",
+        "--scheme",
+        "abuffer-exact,mdts",
+        "--k",
+        "4",
+        "--approximate",
+        "wboit,mlab,tail-blend",
+        "--shuffle",
+        "1",
+    ];
+    let records = run_ok("buckets", &args, |stdout, _| {
+        crate::support::json_lines(stdout)
+    });
     assert_eq!(records.len(), 5, "{records:?}");
     assert!(records[0]["max_depth_complexity"].as_u64() > Some(16));
     for record in &records {
@@ -578,23 +585,32 @@ fn bench_records_carry_the_colour_error_per_depth_complexity_and_it_adds_up() {
 /// the angles: its pixels and error pixels the records' sums, its largest error their largest.
 #[test]
 fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
-    let out = out_dir("sweep-buckets");
-    let output = Command::cargo_bin("fragsim")
-        .unwrap()
-        .args(["sweep", "--scene", "spheres:9", "--width", "48"])
-        .args(["--height", "48", "--angles", "3", "--scheme", "mdts"])
-        .args(["--approximate", "mlab", "--k", "4", "--shuffle", "1"])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let records = crate::support::json_lines(&std::fs::read(out.join("sweep.jsonl")).unwrap());
-    let _ = std::fs::remove_dir_all(&out);
+    let args = [
+        "sweep",
+        "--scene",
+        "spheres:9",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--angles",
+        "3",
+        "--scheme",
+        "mdts",
+        "--approximate",
+        "mlab",
+        "--k",
+        "4",
+        "--shuffle",
+        "1",
+    ];
+    let (records, table) = run_ok("sweep-buckets", &args, |stdout, out| {
+        let records = std::fs::read(out.join("sweep.jsonl")).unwrap();
+        (
+            crate::support::json_lines(&records),
+            String::from_utf8(stdout.to_vec()).unwrap(),
+        )
+    });
     assert_eq!(records.len(), 6, "{records:?}");
     for record in &records {
         let covered = assert_buckets_add_up(record);
@@ -606,7 +622,6 @@ fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
         assert!(close(rate * covered as f64, errors as f64), "{record}");
         assert_eq!(errors_up_to(record, 4).0, 0, "{record}");
     }
-    let table = String::from_utf8(output.stdout).unwrap();
     let pooled = table
         .split("colour error per depth-complexity bucket")
         .nth(1)
@@ -656,24 +671,27 @@ fn sweep_records_and_table_carry_the_colour_error_per_depth_complexity() {
 #[test]
 fn sweep_submits_in_the_shuffled_order() {
     let mlab_rate = |shuffle: &[&str]| {
-        let out = out_dir(&format!("sweep-shuffle{}", shuffle.len()));
-        let output = Command::cargo_bin("fragsim")
-            .unwrap()
-            .args(["sweep", "--scene", "spheres:3", "--width", "48"])
-            .args(["--height", "48", "--angles", "1", "--scheme", "zbuffer"])
-            .args(["--approximate", "mlab", "--k", "1", "--json"])
-            .args(shuffle)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        let _ = std::fs::remove_dir_all(&out);
-        assert!(
-            output.status.success(),
-            "{}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        let records = crate::support::json_lines(&output.stdout);
+        let mut args = vec![
+            "sweep",
+            "--scene",
+            "spheres:3",
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--angles",
+            "1",
+            "--scheme",
+            "zbuffer",
+            "--approximate",
+            "mlab",
+            "--k",
+            "1",
+            "--json",
+        ];
+        args.extend(shuffle);
+        let name = format!("sweep-shuffle{}", shuffle.len());
+        let records = run_ok(&name, &args, |stdout, _| crate::support::json_lines(stdout));
         let mlab = records.iter().find(|r| r["scheme"] == "mlab").unwrap();
         mlab["error_pixel_rate"].as_f64().unwrap()
     };

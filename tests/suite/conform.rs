@@ -111,7 +111,8 @@ fn each_planted_bug_is_found_and_shrunk_to_three_triangles_and_four_by_four_pixe
 
 #[test]
 fn progress_lines_count_every_passed_case_on_stderr() {
-    let save = std::env::temp_dir().join(format!("fragsim-conform-progress-{}", std::process::id()));
+    let save =
+        std::env::temp_dir().join(format!("fragsim-conform-progress-{}", std::process::id()));
     let output = Command::cargo_bin("fragsim")
         .unwrap()
         .args(["conform", "--scheme", "mdts", "--backend", &python("")])
