@@ -50,7 +50,9 @@
 # control), BUDGET 240 s for all. Output: each command's log on stdout and in
 # $OUT/msaa-device.log, the table of every (scene, side, view, mode, samples) on stdout and in
 # $OUT/msaa-summary.md; exit 0 when every replay count is identical, 1 when one differs, 2 when
-# a command failed (a sample count the GPU lacks, the budget spent). On the H200:
+# a command failed (a sample count the GPU lacks, the budget spent). MSAA_ARGS: more options of
+# msaa-count (e.g. "--alone --examples 8": each differing replay sample's triangles drawn alone).
+# On the H200:
 # MSAA=1 bash target/devbin-wgpu/run_device.sh. A dry run on lavapipe (1 and 4 samples only):
 # MSAA=1 BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES=64 SAMPLES="1 4"
 # bash backends/wgpu/run_device.sh.
@@ -101,7 +103,7 @@ if [ "$msaa" = 1 ]; then
             fi
             timeout "$left" "$bin/fragsim-wgpu" msaa-count "${what[@]}" --width "$side" --height "$side" \
                 --view "$(comma $views)" --mode "$(comma $modes)" --samples "$(comma ${SAMPLES:-1 4 8})" \
-                --mirrored 2>&1 | tee -a "$log"
+                --mirrored ${MSAA_ARGS:-} 2>&1 | tee -a "$log"
             rc=${PIPESTATUS[0]}
             [ "$rc" -ge 2 ] && { echo "$scene $side: exit $rc (124: stopped at the deadline; 2: a pass could not run, above)" | tee -a "$log"; status=2; }
         done

@@ -77,6 +77,15 @@ struct Geometry {
 /// id). With `W` and `H` powers of two and `|X|, |Y| ≤ 2^23` both coordinates are exact in f32
 /// and the viewport transform `(x + 1) W / 2` gives `X / 256` back exactly.
 fn replay_geometry(view: &View<'_>) -> Result<Geometry, GpuError> {
+    replay_geometry_of(view, 0..view.triangle_count())
+}
+
+/// [`replay_geometry`] of the primitives `prims` of `view` alone (each with all its screen
+/// triangles).
+fn replay_geometry_of(
+    view: &View<'_>,
+    prims: impl IntoIterator<Item = u32>,
+) -> Result<Geometry, GpuError> {
     let viewport = view.viewport();
     if !viewport.width.is_power_of_two() || !viewport.height.is_power_of_two() {
         return Err(GpuError(format!(
@@ -90,7 +99,7 @@ fn replay_geometry(view: &View<'_>) -> Result<Geometry, GpuError> {
     );
     let mut vertices = Vec::new();
     let mut count = 0u32;
-    for prim in 0..view.triangle_count() {
+    for prim in prims {
         view.screen_triangles(prim, &mut |t| {
             for (xy, z) in t.xy.iter().zip(t.z) {
                 let x = (xy[0] as f64 / sx - 1.0) as f32;
@@ -200,12 +209,42 @@ pub(crate) fn execute(
     mode: Mode,
     plant: Option<Plant>,
 ) -> Result<(RunResult, u32), GpuError> {
-    gpu.check(scheme.name(), scheme.needs())?;
-    gpu.check_samples(scheme.samples())?;
     let geometry = match mode {
         Mode::Replay => replay_geometry(view)?,
         Mode::Engine => engine_geometry(view),
     };
+    Ok((
+        execute_geometry(gpu, view, &geometry, scheme, mode, plant)?,
+        geometry.count,
+    ))
+}
+
+/// [`execute`] in replay mode with only the primitives `prims` of `view` drawn (what the
+/// counting pass's diagnosis draws alone, `crate::sample_counts::count_samples_of`).
+///
+/// # Errors
+/// As [`execute`].
+pub(crate) fn execute_replay_of(
+    gpu: &Gpu,
+    view: &View<'_>,
+    prims: &[u32],
+    scheme: &GpuScheme,
+) -> Result<RunResult, GpuError> {
+    let geometry = replay_geometry_of(view, prims.iter().copied())?;
+    execute_geometry(gpu, view, &geometry, scheme, Mode::Replay, None)
+}
+
+/// Draws `geometry` over `view`'s viewport through `scheme`'s passes and reads its storages back.
+fn execute_geometry(
+    gpu: &Gpu,
+    view: &View<'_>,
+    geometry: &Geometry,
+    scheme: &GpuScheme,
+    mode: Mode,
+    plant: Option<Plant>,
+) -> Result<RunResult, GpuError> {
+    gpu.check(scheme.name(), scheme.needs())?;
+    gpu.check_samples(scheme.samples())?;
     let viewport = view.viewport();
     let pixels = viewport.pixels() as u64;
     if let Some(pool) = scheme.pool(pixels) {
@@ -217,7 +256,7 @@ pub(crate) fn execute(
         }
     }
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let run = Run::new(gpu, viewport, &geometry, scheme, mode, plant);
+    let run = Run::new(gpu, viewport, geometry, scheme, mode, plant);
     let result = run.all(pixels);
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(GpuError(format!(
@@ -225,7 +264,7 @@ pub(crate) fn execute(
             scheme.name()
         )));
     }
-    Ok((result?, geometry.count))
+    result
 }
 
 /// What a capture read back: the storages, their words, GPU and wall milliseconds.

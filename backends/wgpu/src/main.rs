@@ -25,11 +25,12 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
-use fragsim_raster::{SamplePattern, Viewport};
+use fragsim_raster::{SamplePattern, View, Viewport};
 use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::judge::Within;
 use fragsim_wgpu::sample_counts::{
-    count_samples, f32_snap_radius, mirrored, reference_counts, CountDiff, NearEdges,
+    count_samples, count_samples_of, covering_prims, f32_snap_radius, mirrored, reference_counts,
+    CountDiff, NearEdges,
 };
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
@@ -97,6 +98,11 @@ struct MsaaArgs {
     /// Differing samples printed per comparison.
     #[arg(long, default_value_t = 5)]
     examples: usize,
+    /// Diagnose each printed differing sample of a replay comparison: draw each triangle that
+    /// covers it in fragsim's oracle alone, then all of them together, and print the GPU's count
+    /// there (does the rasterizer miss the sample by itself, or only beside the rest?).
+    #[arg(long)]
+    alone: bool,
 }
 
 /// Options of `fragsim-wgpu capture`.
@@ -413,11 +419,21 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                         Ok(NearEdges::of(&reference_view, pattern, &diff, r))
                     })
                     .transpose()?;
-                for (i, [x, y, s, got, want]) in
-                    diff.examples.iter().take(args.examples).enumerate()
-                {
-                    let mut line =
-                        format!("  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}");
+                let index =
+                    |&[x, y, s, ..]: &[u32; 5]| ((y * args.width + x) * samples + s) as usize;
+                for (i, example) in diff.examples.iter().take(args.examples).enumerate() {
+                    let [x, y, s, got, want] = *example;
+                    let at = index(example);
+                    let mut line = format!(
+                        "  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}; dropped by the depth-range test there: {}",
+                        counted.depth_dropped[at]
+                    );
+                    if counted.depth_dropped[at] > 0 {
+                        line += &format!(
+                            " (a depth {:e})",
+                            f32::from_bits(counted.dropped_depth_bits[at])
+                        );
+                    }
                     if let Some(near) = &near_edges {
                         let edges: Vec<String> = near.nearest[i]
                             .iter()
@@ -433,6 +449,19 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                         line += &format!("; nearest boundaries (subpixels): {}", edges.join(", "));
                     }
                     println!("{line}");
+                }
+                if args.alone && mode == Mode::Replay {
+                    let shown: Vec<usize> = diff
+                        .examples
+                        .iter()
+                        .take(args.examples)
+                        .map(index)
+                        .collect();
+                    alone(gpu, &view, pattern, &shown)?;
+                }
+                let dropped: u64 = counted.depth_dropped.iter().map(|&c| u64::from(c)).sum();
+                if dropped > 0 {
+                    println!("  invocations dropped by the depth-range test: {dropped}");
                 }
                 let explained = near_edges.as_ref().map(|near| {
                     let (within, checked) = (near.within(), near.nearest.len());
@@ -479,6 +508,35 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
         return Err(format!("{failed} counting passes could not run").into());
     }
     Ok(identical)
+}
+
+/// `msaa-count --alone`: at each of the samples `shown` (indices into the counts), the GPU's
+/// count with each triangle fragsim finds there drawn alone, then with all of them together.
+fn alone(
+    gpu: &Gpu,
+    view: &View<'_>,
+    pattern: SamplePattern,
+    shown: &[usize],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let samples = pattern.count();
+    for (&at, prims) in shown.iter().zip(covering_prims(view, pattern, shown)?) {
+        let mut parts = Vec::new();
+        for &prim in &prims {
+            let one = count_samples_of(gpu, view, &[prim], samples)?;
+            parts.push(format!(
+                "prim {prim}: {} (depth-range drops {})",
+                one.counts[at], one.depth_dropped[at]
+            ));
+        }
+        let together = count_samples_of(gpu, view, &prims, samples)?;
+        println!(
+            "  sample #{at} drawn alone: {}; all {} together: {}",
+            parts.join(", "),
+            prims.len(),
+            together.counts[at]
+        );
+    }
+    Ok(())
 }
 
 /// The scene object and viewport of a `fragsim conform` case directory: `camera.json` (a dump

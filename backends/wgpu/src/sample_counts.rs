@@ -43,7 +43,7 @@ use fragsim_oracle::samples::SampleOracle;
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{SamplePattern, View, SUBPIXEL_BITS};
 
-use crate::capture::{execute, Mode};
+use crate::capture::{execute, execute_replay_of, Mode};
 use crate::device::{Gpu, GpuError};
 use crate::shaders::GpuScheme;
 
@@ -55,6 +55,11 @@ pub struct SampleCounts {
     /// Fragments at sample `s` of pixel `p` at `p * samples + s`, pixels row-major (the
     /// sample-expanded framebuffer's order, `docs/semantics.md`, "Multisampling").
     pub counts: Vec<u32>,
+    /// Per sample as `counts`, the invocations the depth-range test dropped: the GPU's
+    /// rasterizer covered the sample but the depth it interpolated there left `[0, 1]`.
+    pub depth_dropped: Vec<u32>,
+    /// Per sample as `counts`, the bits of the largest such depth (0 where none).
+    pub dropped_depth_bits: Vec<u32>,
     /// The draw on the GPU, by timestamps where the adapter has them.
     pub gpu_ms: Option<f64>,
     /// The submission to the end of the read-back, on the host.
@@ -81,17 +86,53 @@ pub fn count_samples(
         ));
     }
     let scheme = GpuScheme::SampleCounts { samples };
-    let ((_, mut words, gpu_ms, wall_ms), triangles) = execute(gpu, view, &scheme, mode, None)?;
-    let counts = words
-        .pop()
-        .ok_or_else(|| GpuError("the counting pass read nothing back".into()))?;
-    Ok(SampleCounts {
-        samples,
-        counts,
-        gpu_ms,
-        wall_ms,
-        triangles,
-    })
+    let ((_, words, gpu_ms, wall_ms), triangles) = execute(gpu, view, &scheme, mode, None)?;
+    SampleCounts::read(samples, words, gpu_ms, wall_ms, triangles)
+}
+
+/// [`count_samples`] in replay mode with only the primitives `prims` of `view` drawn: the
+/// diagnosis of a differing sample, whose covering triangles are drawn alone, each by itself,
+/// to tell a rasterizer that misses the sample from one whose result depends on the rest of
+/// the scene.
+///
+/// # Errors
+/// As [`count_samples`].
+pub fn count_samples_of(
+    gpu: &Gpu,
+    view: &View<'_>,
+    prims: &[u32],
+    samples: u32,
+) -> Result<SampleCounts, GpuError> {
+    let scheme = GpuScheme::SampleCounts { samples };
+    let (_, words, gpu_ms, wall_ms) = execute_replay_of(gpu, view, prims, &scheme)?;
+    SampleCounts::read(samples, words, gpu_ms, wall_ms, prims.len() as u32)
+}
+
+impl SampleCounts {
+    /// The counting pass's one storage (three arrays of samples, `sample_counts.wgsl`) split.
+    fn read(
+        samples: u32,
+        mut words: Vec<Vec<u32>>,
+        gpu_ms: Option<f64>,
+        wall_ms: f64,
+        triangles: u32,
+    ) -> Result<Self, GpuError> {
+        let mut counts = words
+            .pop()
+            .ok_or_else(|| GpuError("the counting pass read nothing back".into()))?;
+        let n = counts.len() / 3;
+        let dropped_depth_bits = counts.split_off(2 * n);
+        let depth_dropped = counts.split_off(n);
+        Ok(Self {
+            samples,
+            counts,
+            depth_dropped,
+            dropped_depth_bits,
+            gpu_ms,
+            wall_ms,
+            triangles,
+        })
+    }
 }
 
 /// fragsim's fragment count at every sample of `view` rasterized at `pattern` (the per-sample
@@ -102,6 +143,23 @@ pub fn count_samples(
 pub fn reference_counts(view: &View<'_>, pattern: SamplePattern) -> Result<Vec<u32>, String> {
     let sampled = view.clone().with_samples(pattern)?;
     Ok(SampleOracle::build(&sampled)?.oracle().depth_complexity())
+}
+
+/// The primitives whose fragments fragsim's per-sample oracle of `view` at `pattern` holds at
+/// each of `samples` (indices as [`SampleCounts::counts`]), nearest first.
+///
+/// # Errors
+/// As [`reference_counts`].
+pub fn covering_prims(
+    view: &View<'_>,
+    pattern: SamplePattern,
+    samples: &[usize],
+) -> Result<Vec<Vec<u32>>, String> {
+    let oracle = SampleOracle::build(&view.clone().with_samples(pattern)?)?;
+    Ok(samples
+        .iter()
+        .map(|&i| oracle.oracle().pixel(i).iter().map(|&w| w as u32).collect())
+        .collect())
 }
 
 /// `pattern`'s positions mirrored in y, `(x, 16 − y)`: where a rasterizer that took the standard

@@ -411,12 +411,13 @@ impl GpuScheme {
             }
             // One lock word per pixel before the slots.
             Self::KbufferSpinlock { k } => memory(pixels, k),
-            // A count per (pixel, sample), sample-index order within a pixel.
+            // A count per (pixel, sample), sample-index order within a pixel; then as many
+            // counts of depth-range drops, and as many example depths (sample_counts.wgsl).
             Self::SampleCounts { samples } => vec![Storage::new(
                 1,
                 "counts",
                 Dtype::U32,
-                vec![pixels * u64::from(samples)],
+                vec![3 * pixels * u64::from(samples)],
                 0,
             )],
         }

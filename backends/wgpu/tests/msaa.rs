@@ -8,7 +8,9 @@
 
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_raster::{SamplePattern, Viewport};
-use fragsim_wgpu::sample_counts::{count_samples, mirrored, reference_counts, CountDiff};
+use fragsim_wgpu::sample_counts::{
+    count_samples, count_samples_of, covering_prims, mirrored, reference_counts, CountDiff,
+};
 use fragsim_wgpu::{adapter_or_skip, say_skipped, Mode};
 
 #[test]
@@ -45,4 +47,37 @@ fn the_bunnys_sample_counts_are_fragsims_at_the_standard_positions() {
             }
         }
     }
+}
+
+/// The diagnosis of `msaa-count --alone`: at the deepest sample of the bunny, each triangle the
+/// oracle finds there, drawn alone, is one fragment there; all of them together are the
+/// oracle's count; the whole view's pass drops nothing by the depth-range test (every replay
+/// depth is inside [0, 1]).
+#[test]
+fn triangles_drawn_alone_cover_the_samples_the_oracle_gives_them() {
+    let Some(gpu) = adapter_or_skip() else { return };
+    let samples = 4;
+    if let Err(e) = gpu.check_samples(samples) {
+        say_skipped(&format!("{samples} samples: {e}"));
+        return;
+    }
+    let pattern = SamplePattern::standard(samples).unwrap();
+    let spec = SceneAndCamera::named("bunny", 30.0, 15.0);
+    let loaded = spec.load(None).unwrap();
+    let view = spec.view(&loaded, Viewport::new(64, 64).unwrap()).unwrap();
+    let reference = reference_counts(&view, pattern).unwrap();
+    let deepest = (0..reference.len()).max_by_key(|&i| reference[i]).unwrap();
+    let prims = &covering_prims(&view, pattern, &[deepest]).unwrap()[0];
+    assert_eq!(prims.len(), reference[deepest] as usize);
+    assert!(prims.len() > 1, "the deepest sample holds one fragment");
+    for &prim in prims {
+        let one = count_samples_of(&gpu, &view, &[prim], samples).unwrap();
+        assert_eq!(one.counts[deepest], 1, "prim {prim} alone");
+        assert_eq!(one.triangles, 1);
+    }
+    let together = count_samples_of(&gpu, &view, prims, samples).unwrap();
+    assert_eq!(together.counts[deepest], reference[deepest]);
+    let whole = count_samples(&gpu, &view, Mode::Replay, samples).unwrap();
+    assert!(whole.depth_dropped.iter().all(|&c| c == 0));
+    assert_eq!(whole.counts.len(), reference.len());
 }
