@@ -62,18 +62,24 @@ const EMPTY_WORD: vec2<u32> = vec2<u32>(0xFFFFFFFFu, 0xFFFFFFFFu);
 struct Varyings {
     @builtin(position) position: vec4<f32>,
     @location(0) @interpolate(flat) prim: u32,
+    // The window depth interpolated at the sample (screen-linear, as window depth is): what a
+    // per-sample depth test sees. Under sample shading position.z need not be it: the H200's is
+    // the depth at the pixel centre (docs/semantics.md, "Multisampling"). At one sample a pixel
+    // the sample is the centre.
+    @location(1) @interpolate(linear, sample) sample_depth: f32,
 }
 
 // Replay: fragsim's snapped screen triangles, already in clip space with w = 1.
 @vertex
 fn vs_replay(@location(0) clip: vec4<f32>, @location(1) prim: u32) -> Varyings {
-    return Varyings(clip, prim);
+    return Varyings(clip, prim, clip.z);
 }
 
 // Engine: the mesh's model-space vertex times the view-projection matrix, in f32.
 @vertex
 fn vs_engine(@location(0) model: vec3<f32>) -> Varyings {
-    return Varyings(params.view_projection * vec4<f32>(model, 1.0), 0u);
+    let clip = params.view_projection * vec4<f32>(model, 1.0);
+    return Varyings(clip, 0u, clip.z / clip.w);
 }
 
 struct Fragment {

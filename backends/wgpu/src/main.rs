@@ -425,13 +425,13 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                     let [x, y, s, got, want] = *example;
                     let at = index(example);
                     let mut line = format!(
-                        "  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}; dropped by the depth-range test there: {}",
-                        counted.depth_dropped[at]
+                        "  pixel ({x}, {y}) sample {s}: GPU {got}, fragsim {want}; shader depth outside [0, 1] there: {}",
+                        counted.shader_depth_outside[at]
                     );
-                    if counted.depth_dropped[at] > 0 {
+                    if counted.shader_depth_outside[at] > 0 {
                         line += &format!(
-                            " (a depth {:e})",
-                            f32::from_bits(counted.dropped_depth_bits[at])
+                            " (position.z {:e})",
+                            f32::from_bits(counted.shader_depth_bits[at])
                         );
                     }
                     if let Some(near) = &near_edges {
@@ -459,9 +459,13 @@ fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Er
                         .collect();
                     alone(gpu, &view, pattern, &shown)?;
                 }
-                let dropped: u64 = counted.depth_dropped.iter().map(|&c| u64::from(c)).sum();
-                if dropped > 0 {
-                    println!("  invocations dropped by the depth-range test: {dropped}");
+                let outside: u64 = counted
+                    .shader_depth_outside
+                    .iter()
+                    .map(|&c| u64::from(c))
+                    .sum();
+                if outside > 0 {
+                    println!("  counted samples whose shader depth (position.z) lies outside [0, 1] (the depth of another point than the sample): {outside}");
                 }
                 let explained = near_edges.as_ref().map(|near| {
                     let (within, checked) = (near.within(), near.nearest.len());
@@ -523,10 +527,7 @@ fn alone(
         let mut parts = Vec::new();
         for &prim in &prims {
             let one = count_samples_of(gpu, view, &[prim], samples)?;
-            parts.push(format!(
-                "prim {prim}: {} (depth-range drops {})",
-                one.counts[at], one.depth_dropped[at]
-            ));
+            parts.push(format!("prim {prim}: {}", one.counts[at]));
         }
         let together = count_samples_of(gpu, view, &prims, samples)?;
         println!(

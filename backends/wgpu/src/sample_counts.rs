@@ -6,11 +6,14 @@
 //! `schemes/sample_counts.wgsl`. Its fragment shader reads `@builtin(sample_index)`, which makes
 //! the pipeline shade per sample (Vulkan: a shader using `SampleId` runs with sample shading at
 //! `minSampleShading` 1.0), so every covered sample of every primitive is one invocation, which
-//! adds 1 at `counts[pixel * n + sample]`. That is per-(pixel, sample) counting by construction,
-//! and the invocation's position is the sample's, so the depth-range test is made at the sample,
-//! as fragsim makes it. A per-pixel invocation counting the bits of `@builtin(sample_mask)` would
-//! cost fewer invocations but sees the pixel centre's depth, which lies outside the primitive
-//! when the centre is not covered.
+//! adds 1 at `counts[pixel * n + sample]`. That is per-(pixel, sample) counting by construction.
+//! The depth-range test is made on the depth interpolated at the sample (a varying with sample
+//! interpolation), as fragsim makes it, not on `@builtin(position).z`: under sample shading the
+//! H200 gives the shader the depth at the pixel centre, which for a sliver triangle beside the
+//! centre lies far outside `[0, 1]` (measured: `docs/results-gpu.md`, "MSAA"), so a test on it
+//! dropped covered samples. The pass counts those (`shader_depth_outside`), the evidence of that
+//! convention. A per-pixel invocation counting the bits of `@builtin(sample_mask)` would cost
+//! fewer invocations but sees the centre's depth too.
 //!
 //! **The reference** ([`reference_counts`]): fragsim's per-sample oracle
 //! ([`SampleOracle`]) of the same view with a sample pattern: in replay mode the view itself
@@ -55,11 +58,13 @@ pub struct SampleCounts {
     /// Fragments at sample `s` of pixel `p` at `p * samples + s`, pixels row-major (the
     /// sample-expanded framebuffer's order, `docs/semantics.md`, "Multisampling").
     pub counts: Vec<u32>,
-    /// Per sample as `counts`, the invocations the depth-range test dropped: the GPU's
-    /// rasterizer covered the sample but the depth it interpolated there left `[0, 1]`.
-    pub depth_dropped: Vec<u32>,
-    /// Per sample as `counts`, the bits of the largest such depth (0 where none).
-    pub dropped_depth_bits: Vec<u32>,
+    /// Per sample as `counts`, the counted fragments whose shader-visible depth
+    /// (`@builtin(position).z`) lies outside `[0, 1]` though the depth interpolated at the
+    /// sample is inside: the GPU gives the shader the depth of another point than the sample
+    /// (the H200: the pixel centre's).
+    pub shader_depth_outside: Vec<u32>,
+    /// Per sample as `counts`, the bits of the largest such shader-visible depth (0 where none).
+    pub shader_depth_bits: Vec<u32>,
     /// The draw on the GPU, by timestamps where the adapter has them.
     pub gpu_ms: Option<f64>,
     /// The submission to the end of the read-back, on the host.
@@ -121,13 +126,13 @@ impl SampleCounts {
             .pop()
             .ok_or_else(|| GpuError("the counting pass read nothing back".into()))?;
         let n = counts.len() / 3;
-        let dropped_depth_bits = counts.split_off(2 * n);
-        let depth_dropped = counts.split_off(n);
+        let shader_depth_bits = counts.split_off(2 * n);
+        let shader_depth_outside = counts.split_off(n);
         Ok(Self {
             samples,
             counts,
-            depth_dropped,
-            dropped_depth_bits,
+            shader_depth_outside,
+            shader_depth_bits,
             gpu_ms,
             wall_ms,
             triangles,

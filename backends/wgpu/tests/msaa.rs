@@ -51,8 +51,7 @@ fn the_bunnys_sample_counts_are_fragsims_at_the_standard_positions() {
 
 /// The diagnosis of `msaa-count --alone`: at the deepest sample of the bunny, each triangle the
 /// oracle finds there, drawn alone, is one fragment there; all of them together are the
-/// oracle's count; the whole view's pass drops nothing by the depth-range test (every replay
-/// depth is inside [0, 1]).
+/// oracle's count.
 #[test]
 fn triangles_drawn_alone_cover_the_samples_the_oracle_gives_them() {
     let Some(gpu) = adapter_or_skip() else { return };
@@ -77,7 +76,4 @@ fn triangles_drawn_alone_cover_the_samples_the_oracle_gives_them() {
     }
     let together = count_samples_of(&gpu, &view, prims, samples).unwrap();
     assert_eq!(together.counts[deepest], reference[deepest]);
-    let whole = count_samples(&gpu, &view, Mode::Replay, samples).unwrap();
-    assert!(whole.depth_dropped.iter().all(|&c| c == 0));
-    assert_eq!(whole.counts.len(), reference.len());
 }
