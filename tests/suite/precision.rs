@@ -74,13 +74,23 @@ fn engine_like(view: &View<'_>) -> Vec<Vec<u64>> {
 }
 
 fn capture_of(lists: &[Vec<u64>]) -> Capture {
+    capture_as(lists, Identity::KeyAndPrim)
+}
+
+/// The lists as a capture of `identity`: with [`Identity::KeyOnly`] the primitive ids are
+/// dropped from the words, as an `mdts32` dump stores them.
+fn capture_as(lists: &[Vec<u64>], identity: Identity) -> Capture {
     let keeps = Keeps::All {
         capacity: Capacity::Unbounded,
         overflow: vec![0; lists.len()],
     };
-    let mut capture = Capture::with_pixels(lists.len(), Identity::KeyAndPrim, keeps);
+    let mut capture = Capture::with_pixels(lists.len(), identity, keeps);
+    let mask = match identity {
+        Identity::KeyOnly => u64::MAX << 32,
+        _ => u64::MAX,
+    };
     for list in lists {
-        capture.push_pixel(list.iter().copied());
+        capture.push_pixel(list.iter().map(|&w| w & mask));
     }
     capture
 }
@@ -366,6 +376,47 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
         doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
         doubled[p].sort_unstable();
         let flags = judge(&precision, &oracle, &doubled).verdicts[p];
+        assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+    }
+}
+
+/// Key-only words (`mdts32`) name no triangle: at a centre beside a shared edge the one stored
+/// key lies in both triangles' intervals, so both snaps of the edge explain the pixel with one
+/// fragment. The pixel is then decided in all the dump records (unnamed, not ambiguous), and a
+/// dropped or doubled fragment there is still an error: no snap explains a count of 0 or 2.
+#[test]
+fn key_only_words_leave_the_triangle_unnamed_and_still_catch_a_dropped_or_doubled_fragment() {
+    let scene = Scene::default_scene();
+    let view = scene
+        .view(Viewport::new(512, 512).unwrap(), &OrbitCamera::default())
+        .unwrap();
+    let oracle = Oracle::build(&view);
+    let precision = Precision::derive(&view, &F32);
+    let lists = engine_like(&view);
+    let key_only = |lists: &[Vec<u64>]| {
+        let capture = capture_as(lists, Identity::KeyOnly);
+        compare_within(&precision, &oracle, &capture, None, &options())
+    };
+    let judged = key_only(&lists);
+    assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+    let snaps = judged.snaps;
+    assert!(snaps.unnamed_pixels > 0, "{snaps:?}");
+    assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
+    // The same capture with ids pins the snaps instead: nothing is left unnamed.
+    assert_eq!(judge(&precision, &oracle, &lists).snaps.unnamed_pixels, 0);
+    let shared = shared_edge_pixels(&precision, &lists);
+    assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
+    for &(p, present, _) in shared.iter().take(8) {
+        assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
+        let mut dropped = lists.to_vec();
+        dropped[p].retain(|&w| w as u32 != present);
+        let flags = key_only(&dropped).verdicts[p];
+        assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
+        let mut doubled = lists.to_vec();
+        let kept = *doubled[p].iter().find(|&&w| w as u32 == present).unwrap();
+        doubled[p].push(kept);
+        doubled[p].sort_unstable();
+        let flags = key_only(&doubled).verdicts[p];
         assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
     }
 }

@@ -158,7 +158,7 @@ impl WithinJudgement {
     pub fn summary(&self) -> String {
         let (c, b) = (&self.comparison, &self.bounds);
         format!(
-            "{}: {} error pixels (missing {}, extra {}, misordered {}, miscounted {}, corrupt {}), {} ambiguous, {} within precision, of {} covered; bounds: vertex error up to {:.3} subpixels, depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs; one snap per vertex: {} of {} jointly judged pixels decided by the pins, {} contradicting",
+            "{}: {} error pixels (missing {}, extra {}, misordered {}, miscounted {}, corrupt {}), {} ambiguous, {} within precision, of {} covered; bounds: vertex error up to {:.3} subpixels, depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs; one snap per vertex: {} of {} jointly judged pixels decided by the pins, {} but for the triangle of a key-only word, {} contradicting",
             if c.is_equal() { "EQUAL" } else { "DIFFERENT" },
             c.diff.mismatched_pixels,
             c.counts.missing,
@@ -174,6 +174,7 @@ impl WithinJudgement {
             b.ambiguous_pairs,
             c.snaps.decided_pixels,
             c.snaps.joint_pixels,
+            c.snaps.unnamed_pixels,
             c.snaps.contradicting_pixels
         )
     }

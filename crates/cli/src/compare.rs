@@ -825,11 +825,12 @@ fn print_report(r: &Report) {
         );
         let s = r.snaps.unwrap_or_default();
         outln!(
-            "one snap per vertex: {} vertices may snap to more than one grid point where a              centre's coverage hangs on it, {} pinned by the capture; {} pixels judged jointly,              {} of them decided by the pins, {} contradicting every snap (errors), {} past the              enumeration",
+            "one snap per vertex: {} vertices may snap to more than one grid point where a              centre's coverage hangs on it, {} pinned by the capture; {} pixels judged jointly,              {} of them decided by the pins, {} decided but for which triangle a key-only word came              from (the dump names none), {} contradicting every snap (errors), {} past the              enumeration",
             s.undecided_vertices,
             s.pinned_vertices,
             s.joint_pixels,
             s.decided_pixels,
+            s.unnamed_pixels,
             s.contradicting_pixels,
             s.unjoined_pixels
         );

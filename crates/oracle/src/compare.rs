@@ -163,6 +163,12 @@ pub struct SnapCounts {
     pub joint_pixels: u64,
     /// Of those, pixels whose coverage the pinned snaps decide (no longer ambiguous by coverage).
     pub decided_pixels: u64,
+    /// Of those, pixels of a capture without primitive ids (key-only words) that more than one
+    /// snap explains, all with the same number of fragments: the snaps differ only in which
+    /// triangle a stored key came from, which the dump does not record. Every key lies in the
+    /// interval of the fragment each snap matches it to, so the pixel is decided in all the dump
+    /// records (`docs/semantics.md` §10, "One snap per vertex"), and not ambiguous.
+    pub unnamed_pixels: u64,
     /// Pixels that no snap of their vertices explains together with the rest of the capture:
     /// judged under the snaps the rest of the capture pins, where they are errors.
     pub contradicting_pixels: u64,

@@ -194,7 +194,8 @@ const MAX_JOINT: usize = 256;
 /// vertex may still take are those that explain, without an error, every pixel that depends on
 /// it (arc consistency over the pixels' joint snaps). A pixel is then judged under the snaps
 /// left; it is ambiguous by coverage only while they leave more than one fitting set of its
-/// fragments.
+/// fragments that the dump can tell apart (with key-only words, sets of one size cannot be:
+/// [`SnapCounts::unnamed_pixels`]).
 struct Snaps {
     /// Per mesh vertex, a bit per reachable grid point it may still take.
     domain: Vec<u64>,
@@ -314,9 +315,14 @@ impl Snaps {
             }
         }
         let mut judged = best.unwrap_or_default();
+        // Key-only words name no triangle: snaps that explain the pixel with as many fragments
+        // each agree on everything it stores (its count, and keys inside every interval matched).
+        let unnamed = pixel.candidate.identity == Identity::KeyOnly
+            && fitting_sets.windows(2).all(|w| w[0].len() == w[1].len());
         match fitting_sets.len() {
             0 => counts.contradicting_pixels += 1,
             1 => counts.decided_pixels += 1,
+            _ if unnamed => counts.unnamed_pixels += 1,
             _ => judged.doubt(Doubt::Coverage),
         }
         judged
