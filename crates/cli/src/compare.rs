@@ -18,8 +18,8 @@ use fragsim_oracle::compare::{
     Comparison, SnapCounts, VerdictCounts,
 };
 use fragsim_oracle::dump::{node_capture, CorruptWord, Dump, Header, MASKED_SCHEME};
-use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
+use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
@@ -691,12 +691,7 @@ fn entry(word: u64, identity: Identity) -> Entry {
 }
 
 /// The examples of `comparison`, whose lists are `samples` a pixel of a `width`-pixel row.
-fn examples(
-    comparison: &Comparison,
-    width: u32,
-    samples: u32,
-    identity: Identity,
-) -> Vec<Example> {
+fn examples(comparison: &Comparison, width: u32, samples: u32, identity: Identity) -> Vec<Example> {
     let n = samples as usize;
     comparison
         .diff

@@ -315,7 +315,11 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
 /// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample) and
 /// says, unless `json`, whether it holds the per-pixel view of the per-sample oracle; returns its
 /// capacity: `--capacity`, or under `auto` the most nodes a pixel of that view has.
-fn masked(view: &View<'_>, sizing: &fragsim_capture::catalog::Sizing, json: bool) -> Result<u32, String> {
+fn masked(
+    view: &View<'_>,
+    sizing: &fragsim_capture::catalog::Sizing,
+    json: bool,
+) -> Result<u32, String> {
     let Some(pattern) = view.samples() else {
         return Err(format!(
             "--scheme {MASKED_SCHEME} runs per sample: it needs --samples 2, 4, 8 or 16"

@@ -126,14 +126,12 @@ impl Conventions {
     pub fn pattern(&self) -> Result<Option<SamplePattern>, String> {
         match self.samples {
             1 => Ok(None),
-            n => SamplePattern::standard(n)
-                .map(Some)
-                .map_err(|_| {
-                    format!(
-                        "conventions \"samples\" {n}: the standard sample patterns have 1, 2, 4, \
+            n => SamplePattern::standard(n).map(Some).map_err(|_| {
+                format!(
+                    "conventions \"samples\" {n}: the standard sample patterns have 1, 2, 4, \
                          8 or 16 samples a pixel"
-                    )
-                }),
+                )
+            }),
         }
     }
 }

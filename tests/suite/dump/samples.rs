@@ -11,8 +11,24 @@ use super::scratch;
 fn render_4x(out: &Path, schemes: &str, options: &[&str]) {
     stdout_of(
         fragsim()
-            .args(["render", "--scene", "spheres:3", "--width", "24", "--height", "18"])
-            .args(["--samples", "4", "--k", "auto", "--capacity", "auto", "--no-images"])
+            .args([
+                "render",
+                "--scene",
+                "spheres:3",
+                "--width",
+                "24",
+                "--height",
+                "18",
+            ])
+            .args([
+                "--samples",
+                "4",
+                "--k",
+                "auto",
+                "--capacity",
+                "auto",
+                "--no-images",
+            ])
             .args(["--scheme", schemes, "--dump"])
             .arg(out)
             .args(options),
@@ -57,10 +73,19 @@ fn per_sample_and_masked_dumps_round_trip_equal_at_4_samples() {
     render_4x(
         &engine,
         "mdts,abuffer-masked",
-        &["--dump-order", "slot-major", "--dump-payload", "u64:f32:24:24"],
+        &[
+            "--dump-order",
+            "slot-major",
+            "--dump-payload",
+            "u64:f32:24:24",
+        ],
     );
     for scheme in ["mdts", "abuffer-masked"] {
-        assert_eq!(json_report(&engine.join(scheme), 0)[0]["equal"], true, "{scheme}");
+        assert_eq!(
+            json_report(&engine.join(scheme), 0)[0]["equal"],
+            true,
+            "{scheme}"
+        );
     }
 }
 
@@ -98,7 +123,10 @@ fn a_dropped_sample_fragment_a_wrong_mask_bit_and_a_dropped_node_are_different()
         read_words::<8>(&nodes_path),
     );
     let capacity = masks.len() / counters.len();
-    let pixel = counters.iter().position(|c| u32::from_le_bytes(*c) > 0).unwrap();
+    let pixel = counters
+        .iter()
+        .position(|c| u32::from_le_bytes(*c) > 0)
+        .unwrap();
     // A wrong mask bit: sample 0 and 1 swapped in the pixel's first node (a mask of one bit
     // moves, of two or more changes, never empties).
     let mut wrong = masks.clone();
@@ -153,7 +181,15 @@ fn a_header_with_a_sample_count_without_a_standard_pattern_is_refused_naming_the
     }
     // The masked-node A-buffer runs per sample only.
     let output = fragsim()
-        .args(["render", "--scene", "spheres:3", "--width", "8", "--height", "8"])
+        .args([
+            "render",
+            "--scene",
+            "spheres:3",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
         .args(["--scheme", "abuffer-masked", "--no-images"])
         .output()
         .unwrap();

@@ -26,9 +26,9 @@ use super::spec::{Encoding, LayoutSpec, SlotOrder, LARGEST_KEY};
 use super::{err, Dtype, Dump, DumpError, Header, Words};
 use super::{FORMAT, VERSION};
 use crate::compare::{compare_with, verdict, CompareOptions, Comparison};
+use crate::diff::PixelMismatch;
 use crate::scene::SceneAndCamera;
 use crate::Oracle;
-use crate::diff::PixelMismatch;
 
 /// The header `scheme` of a masked-node dump.
 pub const MASKED_SCHEME: &str = "abuffer-masked";
@@ -159,12 +159,8 @@ impl Dump {
     pub fn masked_lists(&self) -> Result<MaskedLists, DumpError> {
         let masked = self.masked_checked()?;
         let (counters, nodes, masks) = self.masked_words(&masked)?;
-        let scheme = MaskedABuffer::new(
-            self.viewport()?,
-            masked.samples,
-            masked.capacity,
-            u64::MAX,
-        )?;
+        let scheme =
+            MaskedABuffer::new(self.viewport()?, masked.samples, masked.capacity, u64::MAX)?;
         let memory: SerialMemory = scheme.layout().allocate();
         // The scheme's u32 words are the counters, then the masks (`MaskedABuffer::layout`).
         for (i, &w) in counters.iter().chain(&masks).enumerate() {
@@ -396,10 +392,9 @@ impl Dump {
         }
         let shape = match order {
             SlotOrder::PixelMajor => self.shape_of("nodes"),
-            SlotOrder::SlotMajor => vec![
-                u64::from(masked.capacity),
-                masked.placement.pixels() as u64,
-            ],
+            SlotOrder::SlotMajor => {
+                vec![u64::from(masked.capacity), masked.placement.pixels() as u64]
+            }
         };
         let mut dump = self.clone();
         dump.header.layout = Some(LayoutSpec::Slots { order, payload });
