@@ -85,9 +85,16 @@ pub fn check(data: &[u8]) {
     assert_eq!(again, dump, "a dump differs after encoding and parsing");
     // The sample count (`scene.conventions.samples`): a parsed header's is a standard one, and
     // its lists are one a pixel (masked nodes) or one a sample (every other layout).
-    let samples = dump.header.samples().expect("parse refuses other sample counts");
+    let samples = dump
+        .header
+        .samples()
+        .expect("parse refuses other sample counts");
     assert!(fragsim::raster::SamplePattern::COUNTS.contains(&samples));
-    let pixels = dump.header.pixel_viewport().expect("parse checked it").pixels();
+    let pixels = dump
+        .header
+        .pixel_viewport()
+        .expect("parse checked it")
+        .pixels();
     let lists = if dump.is_masked() {
         pixels
     } else {

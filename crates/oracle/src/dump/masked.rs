@@ -44,6 +44,10 @@ struct Masked {
     dtype: Dtype,
 }
 
+/// A masked-node dump's words in fragsim's pixel-major order: the counters, the nodes
+/// (fragsim's words) and the masks.
+type OwnWords = (Vec<u32>, Vec<u64>, Vec<u32>);
+
 /// One stored node whose coverage mask differs from the reference node of its primitive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WrongMask {
@@ -124,7 +128,7 @@ impl Dump {
     }
 
     /// The counters, and the nodes (fragsim's words) and masks in fragsim's pixel-major order.
-    fn masked_words(&self, masked: &Masked) -> Result<(Vec<u32>, Vec<u64>, Vec<u32>), DumpError> {
+    fn masked_words(&self, masked: &Masked) -> Result<OwnWords, DumpError> {
         let pixels = self.viewport()?.pixels();
         // At most 2^28 pixels of 2^32 slots: the product fits.
         let slots = pixels as u64 * u64::from(masked.capacity);
