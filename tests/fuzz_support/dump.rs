@@ -4,7 +4,8 @@
 //! (`tools/fuzz/seed.py` writes a dump directory so). Checked: the parser only ever asks for
 //! plain file names; a dump it accepts encodes and parses back to itself; decoding its words
 //! ([`Dump::capture`], any layout: slots, A-buffer, linked lists with arbitrary links and
-//! counters, layer-major layers, a scheme's memory), checking them ([`Dump::check_words`]) and
+//! counters, layer-major layers, a scheme's memory, masked nodes; at any sample count the header
+//! may name, one list a sample, or a pixel for masked nodes), checking them ([`Dump::check_words`]) and
 //! comparing them with an oracle made of them either works, with one list
 //! per pixel of the viewport, or fails with an error.
 
@@ -82,6 +83,28 @@ pub fn check(data: &[u8]) {
     })
     .expect("an encoded dump parses");
     assert_eq!(again, dump, "a dump differs after encoding and parsing");
+    // The sample count (`scene.conventions.samples`): a parsed header's is a standard one, and
+    // its lists are one a pixel (masked nodes) or one a sample (every other layout).
+    let samples = dump
+        .header
+        .samples()
+        .expect("parse refuses other sample counts");
+    assert!(fragsim::raster::SamplePattern::COUNTS.contains(&samples));
+    let pixels = dump
+        .header
+        .pixel_viewport()
+        .expect("parse checked it")
+        .pixels();
+    let lists = if dump.is_masked() {
+        pixels
+    } else {
+        pixels * samples as usize
+    };
+    assert_eq!(
+        dump.viewport().expect("parse checked it").pixels(),
+        lists,
+        "lists per pixel and sample"
+    );
     let Ok(capture) = dump.capture() else {
         return;
     };

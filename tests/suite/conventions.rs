@@ -25,12 +25,14 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// OpenGL's conventions with an f32 vertex stage: every field away from the reference.
+/// OpenGL's conventions with an f32 vertex stage: every field away from the reference but the
+/// sample count (one sample: these tests judge pixel centres).
 const GL_F32: Conventions = Conventions {
     window_origin: WindowOrigin::LowerLeft,
     subpixel_bits: 4,
     depth_range: DepthRange::MinusOneToOne,
     vertex_precision: VertexPrecision::F32,
+    samples: 1,
 };
 
 const VIEWPORT: (u32, u32) = (40, 28);

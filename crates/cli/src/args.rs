@@ -92,6 +92,11 @@ pub struct ConventionsArgs {
     /// Vertex-stage arithmetic: `f64` (fragsim's reference) or `f32` (as a vertex shader).
     #[arg(long, value_name = "PRECISION", default_value = "f64", value_parser = kebab::<VertexPrecision>)]
     pub vertex_precision: VertexPrecision,
+    /// Samples a pixel at the standard pattern (1, 2, 4, 8 or 16): above 1 every scheme runs per
+    /// sample over the sample-expanded framebuffer (`docs/semantics.md`, "Multisampling"), and a
+    /// dump records the count in `scene.conventions.samples`.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub samples: u32,
 }
 
 impl ConventionsArgs {
@@ -103,6 +108,7 @@ impl ConventionsArgs {
             subpixel_bits: self.subpixel_bits,
             depth_range: self.depth_range,
             vertex_precision: self.vertex_precision,
+            samples: self.samples,
         }
     }
 }

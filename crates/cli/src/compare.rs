@@ -17,8 +17,9 @@ use fragsim_oracle::compare::{
     compare_with, complete_pixels, verdict, with_identity, AmbiguityCounts, CompareOptions,
     Comparison, SnapCounts, VerdictCounts,
 };
-use fragsim_oracle::dump::{CorruptWord, Dump, Header};
+use fragsim_oracle::dump::{node_capture, CorruptWord, Dump, Header, MASKED_SCHEME};
 use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
+use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
@@ -140,12 +141,15 @@ struct Corrupt {
     why: &'static str,
 }
 
-/// One differing pixel, both lists.
+/// One differing pixel (or sample of a per-sample layout), both lists.
 #[derive(Debug, Serialize)]
 struct Example {
     pixel: usize,
     x: u32,
     y: u32,
+    /// The sample index within the pixel, for a per-sample layout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sample: Option<u32>,
     verdict: Vec<&'static str>,
     reference: Vec<Entry>,
     candidate: Vec<Entry>,
@@ -180,6 +184,20 @@ struct WordsReport {
     unreachable: u64,
 }
 
+/// A per-sample layout's differences counted both ways: by sample (what each list covers) and by
+/// pixel (a pixel differs when any of its samples does).
+#[derive(Debug, Serialize)]
+struct SampleCounts {
+    /// Samples a pixel.
+    samples: u32,
+    /// Samples compared.
+    compared: u64,
+    /// Samples with a verdict that is an error.
+    differing_samples: u64,
+    /// Pixels with at least one such sample.
+    differing_pixels: u64,
+}
+
 /// The whole report (`--json`).
 #[derive(Debug, Serialize)]
 struct Report {
@@ -201,9 +219,17 @@ struct Report {
     /// What the capture told of the vertices' snaps (absent when every bit is owed).
     #[serde(skip_serializing_if = "Option::is_none")]
     snaps: Option<SnapCounts>,
+    /// Lists compared: pixels, or the samples of a per-sample layout.
     pixels: u64,
-    /// Pixels with a verdict that is an error (missing, extra, misordered, miscounted, corrupt).
+    /// Lists with a verdict that is an error (missing, extra, misordered, miscounted, corrupt).
     mismatched_pixels: u64,
+    /// A per-sample layout (`scene.conventions.samples` above 1): differing samples and pixels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    per_sample: Option<SampleCounts>,
+    /// A masked-node dump: stored nodes whose coverage mask differs from the reference's (each
+    /// also a missing and an extra node of its pixel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    wrong_masks: Option<u64>,
     verdicts: VerdictCounts,
     fragments: Fragments,
     words: WordsReport,
@@ -261,6 +287,24 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     // conventions, and the candidate is judged within the bounds derived for an f32 one: they
     // measure an implementation's distance from the exact positions, not from another f32 order.
     let judged_f32 = args.vertex_precision.as_deref() == Some("f32");
+    let samples = header.samples().map_err(|e| e.to_string())?;
+    if judged_f32 && samples > 1 {
+        return Err(format!(
+            "--vertex-precision f32 derives its bounds at pixel centres: the dump has {samples} \
+             samples a pixel"
+        ));
+    }
+    // A masked-node dump is judged against the per-pixel view of the per-sample oracle, which
+    // only the oracle side can give.
+    let is_masked = |side: &Side| matches!(side, Side::Dump(dump, _) if dump.is_masked());
+    let masked = is_masked(&candidate);
+    if is_masked(&reference) || (masked && !matches!(reference, Side::Oracle)) {
+        return Err(format!(
+            "a masked-node dump ({MASKED_SCHEME}) is compared as the candidate against the \
+             oracle: `fragsim compare oracle DUMP`"
+        ));
+    }
+    let mut per_pixel = None;
     let conventions = Conventions {
         vertex_precision: if judged_f32 {
             VertexPrecision::F32
@@ -286,10 +330,15 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             .scene
             .view(&scene, viewport)
             .map_err(|e| e.to_string())?;
-        (
-            Some(Oracle::build(&view)),
-            Some(Precision::derive(&view, &conventions)),
-        )
+        let oracle = if masked {
+            let nodes = SampleOracle::build(&view)?.per_pixel();
+            let oracle = Oracle::from_capture(&node_capture(&nodes, Capacity::Unbounded));
+            per_pixel = Some(nodes);
+            oracle
+        } else {
+            Oracle::build(&view)
+        };
+        (Some(oracle), Some(Precision::derive(&view, &conventions)))
     };
     if judged_f32 && !matches!(reference, Side::Oracle) {
         return Err(
@@ -364,21 +413,45 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         examples: args.show,
         complete: complete.as_deref(),
     };
-    let comparison = match &precision {
-        Some(precision) => compare_within(
+    let mut wrong_masks = None;
+    let comparison = match (&precision, &candidate, &per_pixel) {
+        (_, Side::Dump(dump, _), Some(per_pixel)) => {
+            let masked = dump
+                .compare_masked(per_pixel, &options)
+                .map_err(|e| e.to_string())?;
+            wrong_masks = Some(masked.wrong_masks.len() as u64);
+            masked.nodes
+        }
+        (Some(precision), _, _) => compare_within(
             precision,
             reference_oracle,
             &candidate_capture,
             words.as_ref(),
             &options,
         ),
-        None => compare_with(
+        (None, _, _) => compare_with(
             reference_oracle,
             &candidate_capture,
             words.as_ref(),
             &options,
         ),
     };
+    // A per-sample layout's lists are samples: `n` consecutive ones make a pixel.
+    let per_sample = (samples > 1 && !masked).then(|| {
+        let n = samples as usize;
+        let differs = |v: &u8| v & verdict::DIFFERS != 0;
+        SampleCounts {
+            samples,
+            compared: comparison.verdicts.len() as u64,
+            differing_samples: comparison.verdicts.iter().filter(|v| differs(v)).count() as u64,
+            differing_pixels: comparison
+                .verdicts
+                .chunks(n)
+                .filter(|pixel| pixel.iter().any(differs))
+                .count() as u64,
+        }
+    });
+    let lists_per_pixel = if per_sample.is_some() { samples } else { 1 };
     let bounds = precision
         .as_ref()
         .filter(|p| !p.is_exact())
@@ -418,7 +491,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     } else {
         write_image(
             &comparison,
-            header.width,
+            header.width * lists_per_pixel,
             header.height,
             reference_oracle,
             &args.image,
@@ -447,6 +520,8 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             .iter()
             .filter(|&&v| v & verdict::DIFFERS != 0)
             .count() as u64,
+        per_sample,
+        wrong_masks,
         verdicts: comparison.counts,
         fragments: Fragments {
             reference: reference_oracle.fragments() as u64,
@@ -462,7 +537,12 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
             unchecked: comparison.unchecked_words,
             unreachable: words.as_ref().map_or(0, |w| w.unreachable),
         },
-        first_differences: examples(&comparison, header.width, candidate_capture.identity),
+        first_differences: examples(
+            &comparison,
+            header.width,
+            lists_per_pixel,
+            candidate_capture.identity,
+        ),
         image,
         notes,
     };
@@ -610,15 +690,18 @@ fn entry(word: u64, identity: Identity) -> Entry {
     }
 }
 
-fn examples(comparison: &Comparison, width: u32, identity: Identity) -> Vec<Example> {
+/// The examples of `comparison`, whose lists are `samples` a pixel of a `width`-pixel row.
+fn examples(comparison: &Comparison, width: u32, samples: u32, identity: Identity) -> Vec<Example> {
+    let n = samples as usize;
     comparison
         .diff
         .first_mismatches
         .iter()
         .map(|m| Example {
-            pixel: m.pixel,
-            x: (m.pixel % width as usize) as u32,
-            y: (m.pixel / width as usize) as u32,
+            pixel: m.pixel / n,
+            x: (m.pixel / n % width as usize) as u32,
+            y: (m.pixel / n / width as usize) as u32,
+            sample: (n > 1).then_some((m.pixel % n) as u32),
             verdict: verdict::names(comparison.verdicts[m.pixel]),
             reference: m.expected.iter().map(|&w| entry(w, identity)).collect(),
             candidate: m.got.iter().map(|&w| entry(w, identity)).collect(),
@@ -794,6 +877,19 @@ fn print_report(r: &Report) {
         v.miscounted,
         v.corrupt
     );
+    if let Some(s) = &r.per_sample {
+        outln!(
+            "per sample ({} a pixel): {} of {} samples differ, in {} of {} pixels",
+            s.samples,
+            s.differing_samples,
+            s.compared,
+            s.differing_pixels,
+            s.compared / u64::from(s.samples)
+        );
+    }
+    if let Some(wrong) = r.wrong_masks {
+        outln!("masked nodes: {wrong} stored with another coverage mask than the reference's");
+    }
     if let Some(b) = &r.precision {
         outln!(
             "precision (f32 vertex stage): vertex error up to {:.3} subpixels (snapped radius {}), \
@@ -862,8 +958,9 @@ fn print_report(r: &Report) {
         outln!("note: {note}");
     }
     for e in &r.first_differences {
+        let sample = e.sample.map_or(String::new(), |s| format!(", sample {s}"));
         outln!(
-            "pixel {} (x {}, y {}): {}",
+            "pixel {} (x {}, y {}{sample}): {}",
             e.pixel,
             e.x,
             e.y,

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_oracle::dump::{Dump, DumpScheme, Encoding};
+use fragsim_oracle::dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::triangles::TriangleExport;
 use fragsim_raster::View;
@@ -159,6 +159,38 @@ impl DumpStage {
         dump.write(&self.staging.join(name.name()))
             .map_err(|e| e.to_string())?;
         self.written.push(name.name());
+        Ok(())
+    }
+
+    /// Stages the masked-node A-buffer's memory of `capacity` nodes a pixel after a serial run
+    /// over `view` (which rasterizes per sample).
+    ///
+    /// # Errors
+    /// A dump that cannot be recorded or written.
+    pub(crate) fn add_masked(
+        &mut self,
+        view: &View<'_>,
+        scene: &SceneArgs,
+        capacity: u32,
+    ) -> Result<(), String> {
+        let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
+        let spec = SceneAndCamera {
+            conventions: view.conventions(),
+            ..scene_spec(scene)?
+        };
+        let (layout, ignored) = masked_spec(&self.encoding);
+        if !ignored.is_empty() {
+            eprintln!(
+                "render --dump: {MASKED_SCHEME}'s layout has no {}: written without",
+                ignored.join(" or ")
+            );
+        }
+        let dump = Dump::record_masked(view, spec, capacity, &producer)
+            .and_then(|dump| dump.in_layout(layout))
+            .map_err(|e| format!("render --dump: {MASKED_SCHEME}: {e}"))?;
+        dump.write(&self.staging.join(MASKED_SCHEME))
+            .map_err(|e| e.to_string())?;
+        self.written.push(MASKED_SCHEME);
         Ok(())
     }
 

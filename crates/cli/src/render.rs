@@ -3,9 +3,16 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use std::sync::OnceLock;
+
+use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
+use fragsim_capture::catalog::Count;
+use fragsim_capture::schemes::masked_abuffer::MaskedABuffer;
+use fragsim_oracle::dump::MASKED_SCHEME;
+use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{depth_from_key, Viewport};
+use fragsim_raster::{depth_from_key, View, Viewport};
 use serde::Serialize;
 
 use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
@@ -23,9 +30,11 @@ pub struct RenderArgs {
     /// Scheme sizing and executors.
     #[command(flatten)]
     pub schemes: SchemeArgs,
-    /// Schemes to run, comma-separated, or `all`.
+    /// Schemes to run, comma-separated, or `all`; with `--samples` 2 or more also
+    /// `abuffer-masked`, the masked-node A-buffer (per-pixel nodes with coverage masks, judged
+    /// against the per-pixel view of the per-sample oracle).
     #[arg(long, value_delimiter = ',', default_value = "mdts,abuffer")]
-    pub scheme: Vec<SchemeChoice>,
+    pub scheme: Vec<RenderScheme>,
     /// Directory for the PNG images.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -53,6 +62,39 @@ pub struct RenderArgs {
     /// Inject a fault into every scheme (to show that a verdict can fail; tests only).
     #[arg(long, hide = true)]
     pub inject_fault: Option<Fault>,
+}
+
+/// A `render --scheme` value: a catalog scheme (or `all`), or the masked-node A-buffer, which is
+/// no catalog scheme (its walks start from merged nodes, not fragments) and runs only per sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RenderScheme {
+    /// A catalog scheme, or `all`.
+    Catalog(SchemeChoice),
+    /// The masked-node A-buffer ([`MASKED_SCHEME`]).
+    Masked,
+}
+
+impl ValueEnum for RenderScheme {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: OnceLock<Vec<RenderScheme>> = OnceLock::new();
+        VARIANTS.get_or_init(|| {
+            SchemeChoice::value_variants()
+                .iter()
+                .map(|&c| RenderScheme::Catalog(c))
+                .chain([RenderScheme::Masked])
+                .collect()
+        })
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        match self {
+            Self::Catalog(choice) => choice.to_possible_value(),
+            Self::Masked => Some(PossibleValue::new(MASKED_SCHEME).help(
+                "The masked-node A-buffer: per-pixel nodes with coverage masks (--samples 2 or \
+                 more; --capacity nodes a pixel).",
+            )),
+        }
+    }
 }
 
 /// `--ties`: [`Ties`] on the command line.
@@ -146,7 +188,18 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         .map_err(|e| e.to_string())?;
     let view = args.schemes.submission(view);
     crate::args::warn_if_empty(&scene, &view);
-    let schemes = SchemeChoice::expand(&args.scheme);
+    // At more than one sample every scheme, the oracle and the images cover the sample-expanded
+    // framebuffer (`docs/semantics.md`, "Multisampling").
+    let viewport = view.viewport();
+    let catalog: Vec<SchemeChoice> = args
+        .scheme
+        .iter()
+        .filter_map(|s| match s {
+            RenderScheme::Catalog(choice) => Some(*choice),
+            RenderScheme::Masked => None,
+        })
+        .collect();
+    let schemes = SchemeChoice::expand(&catalog);
     let sizing = args.schemes.sizing();
     check_memory_cap_early(&schemes, viewport, &sizing)?;
     let executors = args.schemes.executors();
@@ -229,6 +282,12 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             stage.add(name, run, &view, &args.scene)?;
         }
     }
+    if args.scheme.contains(&RenderScheme::Masked) {
+        let capacity = masked(&view, &sizing, args.json)?;
+        if let Some(stage) = &mut dumps {
+            stage.add_masked(&view, &args.scene, capacity)?;
+        }
+    }
     if let Some(stage) = dumps {
         stage.finish()?;
     }
@@ -251,6 +310,54 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         print_table(&rows, &scene.name, viewport, &oracle, oracle_ms, args);
     }
     Ok(rows)
+}
+
+/// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample) and
+/// says, unless `json`, whether it holds the per-pixel view of the per-sample oracle; returns its
+/// capacity: `--capacity`, or under `auto` the most nodes a pixel of that view has.
+fn masked(
+    view: &View<'_>,
+    sizing: &fragsim_capture::catalog::Sizing,
+    json: bool,
+) -> Result<u32, String> {
+    let Some(pattern) = view.samples() else {
+        return Err(format!(
+            "--scheme {MASKED_SCHEME} runs per sample: it needs --samples 2, 4, 8 or 16"
+        ));
+    };
+    let oracle = SampleOracle::build(view)?;
+    let per_pixel = oracle.per_pixel();
+    let capacity = match sizing.capacity {
+        Count::Fixed(c) => c,
+        Count::Auto => (0..per_pixel.pixels())
+            .map(|p| per_pixel.pixel(p).len() as u32)
+            .max()
+            .unwrap_or(0)
+            .max(1),
+    };
+    let scheme = MaskedABuffer::new(
+        view.pixel_viewport(),
+        pattern.count(),
+        capacity,
+        sizing.memory_cap,
+    )
+    .map_err(|e| e.to_string())?;
+    let lists = scheme.capture(view, false)?;
+    if !json {
+        let overflowed: u64 = lists.overflow.iter().map(|&o| u64::from(o)).sum();
+        let holds = if lists == per_pixel {
+            "equal to"
+        } else {
+            "differs from"
+        };
+        outln!(
+            "{MASKED_SCHEME} (serial): {} samples, capacity {capacity}, {} nodes stored, {overflowed} \
+             overflowed: {holds} the per-pixel view of the per-sample oracle",
+            pattern.count(),
+            lists.nodes.len()
+        );
+    }
+    Ok(capacity)
 }
 
 fn print_table(

@@ -245,6 +245,37 @@ impl Comparison {
         self.verdicts.push(flags);
     }
 
+    /// Adds `flags` to the verdicts of the pixels in `flagged` after every pixel was recorded:
+    /// what the lists cannot show (a masked node's coverage mask). The counts are taken again,
+    /// and each pixel that now differs joins the examples (`example` builds it) when it is among
+    /// the first `examples` differing pixels.
+    pub(crate) fn add_flags(
+        &mut self,
+        flagged: &[(usize, u8)],
+        examples: usize,
+        example: impl Fn(usize) -> PixelMismatch,
+    ) {
+        for &(p, flags) in flagged {
+            let before = self.verdicts[p];
+            self.verdicts[p] |= flags;
+            let shown = self.diff.first_mismatches.iter().any(|m| m.pixel == p);
+            if before & verdict::DIFFERS == 0 && flags & verdict::DIFFERS != 0 && !shown {
+                self.diff.first_mismatches.push(example(p));
+            }
+        }
+        self.diff.first_mismatches.sort_by_key(|m| m.pixel);
+        self.diff.first_mismatches.truncate(examples);
+        self.counts = VerdictCounts::default();
+        for &v in &self.verdicts {
+            self.counts.add(v);
+        }
+        self.diff.mismatched_pixels = self
+            .verdicts
+            .iter()
+            .filter(|&&v| v & verdict::DIFFERS != 0)
+            .count() as u64;
+    }
+
     /// Whether every pixel is equal (overflow by design allowed).
     #[must_use]
     pub fn is_equal(&self) -> bool {

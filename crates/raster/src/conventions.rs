@@ -13,8 +13,16 @@
 //! fragsim had before conventions existed. In JSON (a dump header's `scene.conventions`) each
 //! field is optional and defaults to the reference's, the enums are spelled in kebab case
 //! (`"lower-left"`, `"minus-one-to-one"`, `"f32"`) and an unknown field is refused.
+//!
+//! The sample count ([`Conventions::samples`]) is one of them: an implementation that renders
+//! with N samples a pixel at the standard pattern ([`SamplePattern::standard`]) declares N, and
+//! [`View::with_conventions`](crate::View::with_conventions) then rasterizes per sample into the
+//! sample-expanded framebuffer (`docs/semantics.md`, "Multisampling"). One sample, the default,
+//! is the single-sample pipeline, and a header without the field is written and read as before.
 
 use serde::{Deserialize, Serialize};
+
+use crate::samples::SamplePattern;
 
 /// Where window row 0 lies, which decides which edge the fill rule gives a shared pixel centre.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -63,6 +71,17 @@ pub struct Conventions {
     pub depth_range: DepthRange,
     /// The vertex stage's arithmetic.
     pub vertex_precision: VertexPrecision,
+    /// Samples a pixel at the standard pattern ([`SamplePattern::COUNTS`]: 1, 2, 4, 8 or 16);
+    /// 1: one sample at the pixel centre, the single-sample pipeline. Left out of JSON at 1, so
+    /// that a header written without it reads, and is written back, as before.
+    #[serde(skip_serializing_if = "is_one")]
+    pub samples: u32,
+}
+
+// serde's `skip_serializing_if` takes a reference.
+#[allow(clippy::trivially_copy_pass_by_ref)]
+fn is_one(samples: &u32) -> bool {
+    *samples == 1
 }
 
 /// The most subpixel bits fragsim's fixed-point grid holds ([`crate::SUBPIXEL_BITS`]).
@@ -75,6 +94,7 @@ impl Conventions {
         subpixel_bits: MAX_SUBPIXEL_BITS,
         depth_range: DepthRange::ZeroToOne,
         vertex_precision: VertexPrecision::F64,
+        samples: 1,
     };
 
     /// Whether these are the reference conventions (a header then leaves them out).
@@ -86,15 +106,32 @@ impl Conventions {
     /// Refuses conventions fragsim cannot rasterize under.
     ///
     /// # Errors
-    /// Subpixel bits outside `1..=MAX_SUBPIXEL_BITS`, by value.
+    /// Subpixel bits outside `1..=MAX_SUBPIXEL_BITS`, or a sample count without a standard
+    /// pattern, by value and field name.
     pub fn check(&self) -> Result<(), String> {
-        if (1..=MAX_SUBPIXEL_BITS).contains(&self.subpixel_bits) {
-            Ok(())
-        } else {
-            Err(format!(
+        if !(1..=MAX_SUBPIXEL_BITS).contains(&self.subpixel_bits) {
+            return Err(format!(
                 "{} subpixel bits: fragsim rasterizes with 1 to {MAX_SUBPIXEL_BITS}",
                 self.subpixel_bits
-            ))
+            ));
+        }
+        self.pattern().map(|_| ())
+    }
+
+    /// The sample pattern of [`Conventions::samples`]: `None` for one sample (the single-sample
+    /// scan at pixel centres), else the standard pattern of that count.
+    ///
+    /// # Errors
+    /// A count other than 1, 2, 4, 8 or 16, naming the field `samples`.
+    pub fn pattern(&self) -> Result<Option<SamplePattern>, String> {
+        match self.samples {
+            1 => Ok(None),
+            n => SamplePattern::standard(n).map(Some).map_err(|_| {
+                format!(
+                    "conventions \"samples\" {n}: the standard sample patterns have 1, 2, 4, \
+                         8 or 16 samples a pixel"
+                )
+            }),
         }
     }
 }

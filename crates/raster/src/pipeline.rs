@@ -139,10 +139,13 @@ impl<'mesh> View<'mesh> {
     }
 
     /// Transforms every vertex of `mesh` once under `conventions` (`docs/semantics.md`,
-    /// "Conventions"): what an implementation that declares them rasterizes.
+    /// "Conventions"): what an implementation that declares them rasterizes. Conventions of more
+    /// than one sample a pixel give a view rasterizing per sample at the standard pattern
+    /// ([`View::with_samples`]), whose [`View::viewport`] is the sample-expanded framebuffer.
     ///
     /// # Errors
-    /// Conventions fragsim cannot rasterize under ([`Conventions::check`]).
+    /// Conventions fragsim cannot rasterize under ([`Conventions::check`]), or a
+    /// sample-expanded framebuffer too wide.
     pub fn with_conventions(
         mesh: &'mesh Mesh,
         camera: &Camera,
@@ -151,7 +154,11 @@ impl<'mesh> View<'mesh> {
         conventions: Conventions,
     ) -> Result<Self, String> {
         conventions.check()?;
-        Ok(Self::build(mesh, camera, viewport, cull, conventions))
+        let view = Self::build(mesh, camera, viewport, cull, conventions);
+        match conventions.pattern()? {
+            Some(pattern) => view.with_samples(pattern),
+            None => Ok(view),
+        }
     }
 
     fn build(

@@ -11,7 +11,7 @@ pub(super) fn fragsim() -> Command {
     Command::cargo_bin("fragsim").unwrap()
 }
 
-fn stdout_of(cmd: &mut Command, code: i32) -> String {
+pub(super) fn stdout_of(cmd: &mut Command, code: i32) -> String {
     let output = cmd.output().unwrap();
     assert_eq!(
         output.status.code(),
@@ -113,7 +113,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
 
 /// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the records
 /// (the `compare` record, then one `difference` record per pixel shown).
-fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
+pub(super) fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
     let out = stdout_of(
         fragsim()
             .args(["compare", "oracle"])

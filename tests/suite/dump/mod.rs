@@ -18,6 +18,7 @@ mod files;
 mod layouts;
 mod numbers;
 mod parse;
+mod samples;
 mod slots;
 
 /// A fresh directory under cargo's per-test-target temporary directory.

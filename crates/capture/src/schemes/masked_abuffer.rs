@@ -228,6 +228,25 @@ impl MaskedABuffer {
     /// A view that does not rasterize per sample at this scheme's sample count, or on another
     /// number of pixels.
     pub fn capture(&self, view: &View<'_>, parallel: bool) -> Result<MaskedLists, String> {
+        self.check_view(view)?;
+        let layout = self.layout();
+        if parallel {
+            let memory: AtomicMemory = layout.allocate();
+            (0..view.triangle_count())
+                .into_par_iter()
+                .for_each_init(Vec::new, |scratch, index| {
+                    self.insert_triangle(view, view.submitted(index), scratch, &memory)
+                });
+            Ok(self.resolve(&memory))
+        } else {
+            let memory: SerialMemory = layout.allocate();
+            self.insert_all(view, &memory)?;
+            Ok(self.resolve(&memory))
+        }
+    }
+
+    /// Refuses a view of another pixel count or sample count than this scheme's.
+    fn check_view(&self, view: &View<'_>) -> Result<(), String> {
         if view.samples().map(|p| p.count()) != Some(self.samples)
             || view.pixel_viewport().pixels() != self.pixels
         {
@@ -240,23 +259,21 @@ impl MaskedABuffer {
                 view.samples().map_or(1, |p| p.count())
             ));
         }
-        let layout = self.layout();
-        if parallel {
-            let memory: AtomicMemory = layout.allocate();
-            (0..view.triangle_count())
-                .into_par_iter()
-                .for_each_init(Vec::new, |scratch, index| {
-                    self.insert_triangle(view, view.submitted(index), scratch, &memory)
-                });
-            Ok(self.resolve(&memory))
-        } else {
-            let memory: SerialMemory = layout.allocate();
-            let mut scratch = Vec::new();
-            for index in 0..view.triangle_count() {
-                self.insert_triangle(view, view.submitted(index), &mut scratch, &memory);
-            }
-            Ok(self.resolve(&memory))
+        Ok(())
+    }
+
+    /// The pass alone, serially in submission order, into `memory` (of [`MaskedABuffer::layout`]):
+    /// the words a dump records (`fragsim_oracle::dump`), before the post pass.
+    ///
+    /// # Errors
+    /// As [`MaskedABuffer::capture`].
+    pub fn insert_all<M: Memory>(&self, view: &View<'_>, memory: &M) -> Result<(), String> {
+        self.check_view(view)?;
+        let mut scratch = Vec::new();
+        for index in 0..view.triangle_count() {
+            self.insert_triangle(view, view.submitted(index), &mut scratch, memory);
         }
+        Ok(())
     }
 
     /// Rasterizes triangle `prim` per sample into `scratch`, merges and inserts its nodes.

@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use fragsim_raster::Viewport;
 use serde::{Deserialize, Serialize};
 
 use super::{err, DumpError, LayoutSpec};
@@ -94,6 +95,46 @@ pub struct Header {
     /// Anything else the producer wants to keep (timings, device): ignored by the reader.
     #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
     pub extra: serde_json::Value,
+}
+
+impl Header {
+    /// The render target in pixels: `width` × `height`.
+    ///
+    /// # Errors
+    /// A zero or oversized side.
+    pub fn pixel_viewport(&self) -> Result<Viewport, DumpError> {
+        Viewport::new(self.width, self.height).map_err(DumpError)
+    }
+
+    /// Samples a pixel (`scene.conventions.samples`, 1 when absent).
+    ///
+    /// # Errors
+    /// A count other than 1, 2, 4, 8 or 16, naming the field.
+    pub fn samples(&self) -> Result<u32, DumpError> {
+        self.scene.conventions.pattern().map_err(DumpError)?;
+        Ok(self.scene.conventions.samples)
+    }
+
+    /// The sample-expanded framebuffer a per-sample layout indexes (`docs/semantics.md`,
+    /// "Multisampling"): `width · samples` columns, sample `s` of pixel `p` at `p · samples + s`;
+    /// at one sample, the viewport itself.
+    ///
+    /// # Errors
+    /// A bad viewport or sample count, or an expanded width past the largest side.
+    pub fn framebuffer(&self) -> Result<Viewport, DumpError> {
+        Self::framebuffer_of(&self.scene, self.pixel_viewport()?)
+    }
+
+    /// The sample-expanded framebuffer of `pixels` at `scene`'s sample count.
+    pub(super) fn framebuffer_of(
+        scene: &SceneAndCamera,
+        pixels: Viewport,
+    ) -> Result<Viewport, DumpError> {
+        match scene.conventions.pattern().map_err(DumpError)? {
+            Some(pattern) => pattern.expand(pixels).map_err(DumpError),
+            None => Ok(pixels),
+        }
+    }
 }
 
 /// The contents of one array file.

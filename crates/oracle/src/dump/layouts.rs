@@ -522,6 +522,9 @@ pub enum Corruption {
     /// A counter above the layers it counts, which no run leaves (Bevy's clamp stores the layer
     /// count back over any counter that passed it).
     CounterPastStorage,
+    /// A masked node's coverage mask (below its pixel's counter) that is empty or holds a bit
+    /// at or past the sample count: a node is stored for at least one covered sample.
+    ImpossibleMask,
 }
 
 impl Corruption {
@@ -537,6 +540,7 @@ impl Corruption {
             Self::Unallocated => "link to a node never allocated",
             Self::Revisited => "link to a node already in a list (a cycle)",
             Self::CounterPastStorage => "counter past its storage",
+            Self::ImpossibleMask => "coverage mask empty or past the sample count",
         }
     }
 }
@@ -589,7 +593,7 @@ impl WordCheck {
     }
 
     /// Records `word` in `slot` of pixel `pixel` as corrupt, when a rule gave a reason.
-    fn flag(&mut self, pixel: usize, slot: usize, word: u64, why: Option<Corruption>) {
+    pub(super) fn flag(&mut self, pixel: usize, slot: usize, word: u64, why: Option<Corruption>) {
         if let Some(why) = why {
             self.corrupt[pixel].push(CorruptWord {
                 pixel,
@@ -609,6 +613,9 @@ impl Dump {
     /// # Errors
     /// As [`Dump::capture`]: an unknown scheme, or arrays missing or of the wrong size or type.
     pub fn check_words(&self) -> Result<WordCheck, DumpError> {
+        if self.is_masked() {
+            return self.check_masked_words();
+        }
         let scheme = self.scheme()?;
         // A slot layout of the engine's: the rules hold of fragsim's encoding of its words,
         // each corrupt word named as stored.

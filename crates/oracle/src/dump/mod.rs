@@ -60,6 +60,7 @@
 mod header;
 mod layouts;
 mod lists;
+mod masked;
 mod read;
 mod slots;
 mod spec;
@@ -78,6 +79,7 @@ use crate::Oracle;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{CorruptWord, Corruption, Counter, DumpScheme, WordCheck};
+pub use masked::{masked_spec, node_capture, MaskedComparison, WrongMask, MASKED_SCHEME};
 pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
 
 /// The `format` field of every dump header.

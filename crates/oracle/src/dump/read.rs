@@ -107,7 +107,7 @@ impl Dump {
                 header.version
             ));
         }
-        Viewport::new(header.width, header.height).map_err(DumpError)?;
+        header.framebuffer()?;
         check_distinct_files(&header.arrays)?;
         let mut arrays = BTreeMap::new();
         for (name, spec) in &header.arrays {
@@ -131,12 +131,18 @@ impl Dump {
         Ok(Self { header, arrays })
     }
 
-    /// The viewport.
+    /// The framebuffer the arrays index, one list each: the pixels of the masked-node layout
+    /// ([`Dump::is_masked`]), else the sample-expanded framebuffer ([`Header::framebuffer`]),
+    /// which at one sample is the viewport.
     ///
     /// # Errors
-    /// A zero or oversized side.
+    /// A zero or oversized side, or a sample count without a standard pattern.
     pub fn viewport(&self) -> Result<Viewport, DumpError> {
-        Viewport::new(self.header.width, self.header.height).map_err(DumpError)
+        if self.is_masked() {
+            self.header.pixel_viewport()
+        } else {
+            self.header.framebuffer()
+        }
     }
 
     pub(super) fn u32s(&self, name: &str) -> Result<Option<&[u32]>, DumpError> {
@@ -169,6 +175,9 @@ impl Dump {
     /// # Errors
     /// A header that names no known scheme, or arrays missing or of the wrong size or type.
     pub fn capture(&self) -> Result<Capture, DumpError> {
+        if self.is_masked() {
+            return self.masked_capture();
+        }
         let scheme = self.scheme()?;
         if let Some(own) = self.own_slots(&scheme)? {
             return own.capture();

@@ -16,8 +16,8 @@ use super::{err, Dtype, Dump, DumpError, DumpScheme, Words};
 use fragsim_capture::schemes::mdts::Direction;
 
 /// How one slot word of a layout maps to fragsim's.
-#[derive(Clone, Copy)]
-struct SlotCodec {
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SlotCodec {
     /// The payload (`None`: fragsim's own word, which only moves).
     payload: Option<Payload>,
     /// `mdts-desc`: the word is the payload plus one, and 0 is empty.
@@ -38,8 +38,16 @@ impl SlotCodec {
         }
     }
 
+    /// The codec of a plain slot word (no plus one) packed as `payload` (`None`: fragsim's).
+    pub(super) fn plain(payload: Option<Payload>) -> Self {
+        Self {
+            payload,
+            plus_one: false,
+        }
+    }
+
     /// fragsim's word for a stored word.
-    fn own(self, stored: u64) -> u64 {
+    pub(super) fn own(self, stored: u64) -> u64 {
         let Some(payload) = self.payload else {
             return stored;
         };
@@ -57,7 +65,7 @@ impl SlotCodec {
     }
 
     /// The stored word for fragsim's word.
-    fn stored(self, own: u64) -> Result<u64, DumpError> {
+    pub(super) fn stored(self, own: u64) -> Result<u64, DumpError> {
         let Some(payload) = self.payload else {
             return Ok(own);
         };
@@ -80,7 +88,7 @@ fn all_ones(dtype: Dtype) -> u64 {
 }
 
 /// Where fragsim's pixel-major slot words lie in a dump's `slots` array.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 pub(super) struct Placement {
     order: SlotOrder,
     pixels: usize,
@@ -89,6 +97,20 @@ pub(super) struct Placement {
 }
 
 impl Placement {
+    /// `slots` slots for each of `pixels` pixels, placed in `order`.
+    pub(super) fn new(order: SlotOrder, pixels: usize, slots: usize) -> Self {
+        Self {
+            order,
+            pixels,
+            slots,
+        }
+    }
+
+    /// The pixels.
+    pub(super) fn pixels(self) -> usize {
+        self.pixels
+    }
+
     /// The `slots` index of fragsim's slot word `own`.
     pub(super) fn stored(self, own: usize) -> usize {
         self.order

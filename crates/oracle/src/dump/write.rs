@@ -58,7 +58,21 @@ impl Dump {
         scheme: &DumpScheme,
         producer: &str,
     ) -> Result<Self, DumpError> {
+        // The arrays index the view's framebuffer (sample-expanded at more than one sample), the
+        // header names the pixels and the sample count.
         let viewport = view.viewport();
+        let declared = Header::framebuffer_of(&scene, view.pixel_viewport())?;
+        if declared != viewport {
+            return err(format!(
+                "the view rasterizes a {}x{} framebuffer, the scene's conventions ({} samples) \
+                 declare {}x{}",
+                viewport.width,
+                viewport.height,
+                scene.conventions.samples,
+                declared.width,
+                declared.height
+            ));
+        }
         let (words32, words64) = scheme.with_scheme(viewport, Record { view })?;
         let pixels = viewport.pixels() as u64;
         let mut arrays = BTreeMap::new();
@@ -157,8 +171,8 @@ impl Dump {
                 version: VERSION,
                 producer: producer.into(),
                 scene,
-                width: viewport.width,
-                height: viewport.height,
+                width: view.pixel_viewport().width,
+                height: view.pixel_viewport().height,
                 scheme: scheme.name().into(),
                 k,
                 capacity,
@@ -184,6 +198,9 @@ impl Dump {
     /// reader's own checks), a primitive id that does not fit the payload, or a list numbering
     /// whose terminator is a node's number.
     pub fn in_layout(&self, spec: Option<LayoutSpec>) -> Result<Dump, DumpError> {
+        if self.is_masked() {
+            return self.masked_as(spec);
+        }
         let scheme = self.scheme()?;
         if self.header.layout != scheme.spec() {
             return err(format!(

@@ -1,0 +1,432 @@
+//! The masked-node A-buffer's dump (`abuffer-masked`, `docs/dump-format.md`): per-pixel storage
+//! whose nodes carry a coverage mask ([`MaskedABuffer`]), judged against the per-pixel view of
+//! the per-sample oracle ([`SampleOracle::per_pixel`](crate::samples::SampleOracle::per_pixel)).
+//!
+//! Arrays: `counters` u32 `[pixels]` (the `fetch_add` counts, never wrapped), `nodes`
+//! `[pixels, capacity]` node words (fragsim's `key << 32 | prim`, or the header's payload) and
+//! `masks` u32 `[pixels, capacity]` (bit `s`: sample `s`), slot `i` of pixel `p` at
+//! `p · capacity + i` (or `i · pixels + p` slot-major, both arrays alike). The header gives
+//! `capacity`, the sample count in `scene.conventions.samples`, and optionally a slot layout
+//! description (`"layout": {"kind": "slots", …}`) whose order and payload the reader turns into
+//! fragsim's words before the scheme's own post pass ([`MaskedABuffer::resolve`]) runs, so that a
+//! dump is decoded exactly as fragsim decodes its own runs.
+//!
+//! The nodes are compared as an A-buffer's fragments are ([`compare_with`]: missing, extra,
+//! overflow allowed past `capacity` and counted, counters checked), and each stored node's mask
+//! against the reference node of its primitive: a mask that differs makes the reference's node
+//! missing and the stored one extra ([`Dump::compare_masked`]).
+
+use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists, MaskedNode};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, SerialMemory, WordMemory};
+use fragsim_raster::View;
+
+use super::layouts::{Corruption, Counter, WordCheck};
+use super::slots::{words_of, Placement, SlotCodec};
+use super::spec::{Encoding, LayoutSpec, SlotOrder, LARGEST_KEY};
+use super::{err, Dtype, Dump, DumpError, Header, Words};
+use super::{FORMAT, VERSION};
+use crate::compare::{compare_with, verdict, CompareOptions, Comparison};
+use crate::diff::PixelMismatch;
+use crate::scene::SceneAndCamera;
+use crate::Oracle;
+
+/// The header `scheme` of a masked-node dump.
+pub const MASKED_SCHEME: &str = "abuffer-masked";
+
+/// A masked-node dump's parameters, read from its header.
+#[derive(Clone, Copy, Debug)]
+struct Masked {
+    capacity: u32,
+    samples: u32,
+    placement: Placement,
+    codec: SlotCodec,
+    /// The `nodes` array's dtype (the payload's).
+    dtype: Dtype,
+}
+
+/// A masked-node dump's words in fragsim's pixel-major order: the counters, the nodes
+/// (fragsim's words) and the masks.
+type OwnWords = (Vec<u32>, Vec<u64>, Vec<u32>);
+
+/// One stored node whose coverage mask differs from the reference node of its primitive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WrongMask {
+    /// Row-major pixel index.
+    pub pixel: usize,
+    /// The node's primitive id.
+    pub prim: u32,
+    /// The reference node's mask.
+    pub expected: u32,
+    /// The stored node's mask.
+    pub got: u32,
+}
+
+/// A masked-node dump against the per-pixel view of the per-sample oracle.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MaskedComparison {
+    /// The nodes compared as fragments (`key << 32 | prim`), each wrong mask folded in as a
+    /// missing and an extra node of its pixel.
+    pub nodes: Comparison,
+    /// Every stored node whose mask differs from the reference's, in pixel order.
+    pub wrong_masks: Vec<WrongMask>,
+}
+
+/// The capture of masked lists' nodes as words `key << 32 | prim`, with `capacity` nodes a pixel
+/// and each pixel's overflow: what an A-buffer of the nodes would hold.
+#[must_use]
+pub fn node_capture(lists: &MaskedLists, capacity: Capacity) -> Capture {
+    let mut capture = Capture::with_pixels(
+        lists.pixels(),
+        Identity::KeyAndPrim,
+        Keeps::All {
+            capacity,
+            overflow: lists.overflow.clone(),
+        },
+    );
+    for p in 0..lists.pixels() {
+        capture
+            .lists
+            .push_pixel(lists.pixel(p).iter().map(|n| n.packed()));
+    }
+    capture
+}
+
+impl Dump {
+    /// Whether this is a masked-node dump ([`MASKED_SCHEME`]).
+    #[must_use]
+    pub fn is_masked(&self) -> bool {
+        self.header.scheme == MASKED_SCHEME
+    }
+
+    /// The masked-node parameters of the header.
+    fn masked(&self) -> Result<Masked, DumpError> {
+        let capacity = match self.header.capacity {
+            Some(c) if c > 0 => c,
+            _ => return err(format!("{MASKED_SCHEME} needs \"capacity\" ≥ 1")),
+        };
+        let samples = self.header.samples()?;
+        let (order, payload) = match self.header.layout {
+            None => (SlotOrder::PixelMajor, None),
+            Some(LayoutSpec::Slots { order, payload }) => (order, payload),
+            Some(other) => {
+                return err(format!(
+                    "scheme {MASKED_SCHEME} dumps as slots, the header's layout is {}",
+                    other.kind()
+                ))
+            }
+        };
+        if let Some(payload) = payload {
+            payload.check()?;
+        }
+        Ok(Masked {
+            capacity,
+            samples,
+            placement: Placement::new(order, self.viewport()?.pixels(), capacity as usize),
+            codec: SlotCodec::plain(payload),
+            dtype: payload.map_or(Dtype::U64, |p| p.dtype),
+        })
+    }
+
+    /// The counters, and the nodes (fragsim's words) and masks in fragsim's pixel-major order.
+    fn masked_words(&self, masked: &Masked) -> Result<OwnWords, DumpError> {
+        let pixels = self.viewport()?.pixels();
+        // At most 2^28 pixels of 2^32 slots: the product fits.
+        let slots = pixels as u64 * u64::from(masked.capacity);
+        let counters = self.u32s_of("counters", pixels)?.to_vec();
+        let nodes = self.widened("nodes", masked.dtype)?;
+        let masks = self
+            .u32s("masks")?
+            .ok_or_else(|| DumpError("missing array \"masks\"".into()))?;
+        for (name, len) in [("nodes", nodes.len()), ("masks", masks.len())] {
+            if len as u64 != slots {
+                return err(format!(
+                    "array {name:?} has {len} words, {} nodes of {pixels} pixels expected",
+                    masked.capacity
+                ));
+            }
+        }
+        let at = |i| masked.placement.stored(i);
+        let own_nodes = (0..nodes.len())
+            .map(|i| masked.codec.own(nodes[at(i)]))
+            .collect();
+        let own_masks = (0..masks.len()).map(|i| masks[at(i)]).collect();
+        Ok((counters, own_nodes, own_masks))
+    }
+
+    /// The masked-node A-buffer's lists: the words loaded into its memory and resolved by its own
+    /// post pass (each pixel's `min(counter, capacity)` nodes, sorted; the rest counted as
+    /// overflow).
+    ///
+    /// # Errors
+    /// Not a masked-node dump, a bad `capacity`, sample count or layout description, arrays
+    /// missing or of the wrong size or type.
+    pub fn masked_lists(&self) -> Result<MaskedLists, DumpError> {
+        let masked = self.masked_checked()?;
+        let (counters, nodes, masks) = self.masked_words(&masked)?;
+        let scheme =
+            MaskedABuffer::new(self.viewport()?, masked.samples, masked.capacity, u64::MAX)?;
+        let memory: SerialMemory = scheme.layout().allocate();
+        // The scheme's u32 words are the counters, then the masks (`MaskedABuffer::layout`).
+        for (i, &w) in counters.iter().chain(&masks).enumerate() {
+            WordMemory::<u32>::store(&memory, i, w);
+        }
+        for (i, &w) in nodes.iter().enumerate() {
+            WordMemory::<u64>::store(&memory, i, w);
+        }
+        Ok(scheme.resolve(&memory))
+    }
+
+    fn masked_checked(&self) -> Result<Masked, DumpError> {
+        if !self.is_masked() {
+            return err(format!(
+                "scheme {}: not a masked-node dump ({MASKED_SCHEME})",
+                self.header.scheme
+            ));
+        }
+        self.masked()
+    }
+
+    /// The nodes as a capture ([`node_capture`]): what [`Dump::capture`] gives of a masked-node
+    /// dump.
+    pub(super) fn masked_capture(&self) -> Result<Capture, DumpError> {
+        let capacity = self.masked_checked()?.capacity;
+        Ok(node_capture(
+            &self.masked_lists()?,
+            Capacity::PerPixel(capacity),
+        ))
+    }
+
+    /// The word rules of the masked-node layout: the A-buffer's on the nodes (no empty marker
+    /// below the counter, no key above 1.0, with `filled` nothing past it), and each counted
+    /// node's mask within the pixel's samples and not empty; with `filled`, a mask past the
+    /// counter is 0.
+    pub(super) fn check_masked_words(&self) -> Result<WordCheck, DumpError> {
+        let masked = self.masked_checked()?;
+        // Decoding validates the arrays; the check then indexes them freely.
+        self.masked_lists()?;
+        let (counters, nodes, masks) = self.masked_words(&masked)?;
+        let stored_nodes = self.widened("nodes", masked.dtype)?;
+        let stored_masks = self.u32s("masks")?.unwrap_or_default();
+        let capacity = masked.capacity as usize;
+        let samples_mask = (1u64 << masked.samples) - 1;
+        let mut check = WordCheck {
+            corrupt: vec![Vec::new(); counters.len()],
+            ..WordCheck::default()
+        };
+        let mut all = Vec::with_capacity(counters.len());
+        for (p, &count) in counters.iter().enumerate() {
+            let stored = (count as usize).min(capacity);
+            for slot in 0..capacity {
+                let own = p * capacity + slot;
+                let (node, mask) = (nodes[own], masks[own]);
+                let (node_why, mask_why) = if slot < stored {
+                    let node_why = if node == u64::MAX {
+                        Some(Corruption::EmptyCounted)
+                    } else {
+                        ((node >> 32) as u32 > LARGEST_KEY).then_some(Corruption::ImpossibleKey)
+                    };
+                    let outside = mask == 0 || u64::from(mask) & !samples_mask != 0;
+                    (node_why, outside.then_some(Corruption::ImpossibleMask))
+                } else if self.header.filled {
+                    (
+                        (node != u64::MAX).then_some(Corruption::BeyondCounter),
+                        (mask != 0).then_some(Corruption::BeyondCounter),
+                    )
+                } else {
+                    check.unchecked += 2;
+                    (None, None)
+                };
+                let at = masked.placement.stored(own);
+                check.flag(p, slot, stored_nodes[at], node_why);
+                check.flag(p, slot, u64::from(stored_masks[at]), mask_why);
+            }
+            all.push(Counter {
+                count,
+                capacity: masked.capacity,
+            });
+        }
+        check.counters = Some(all);
+        Ok(check)
+    }
+
+    /// Compares this masked-node dump with `reference` (the per-pixel view of the per-sample
+    /// oracle, [`SampleOracle::per_pixel`](crate::samples::SampleOracle::per_pixel)): the nodes as
+    /// an A-buffer's fragments with every word checked ([`compare_with`]), then each stored
+    /// node's mask against the reference node of its primitive in the pixel. A wrong mask makes
+    /// the reference node missing and the stored one extra: the pixel is
+    /// [`verdict::MISSING`] and [`verdict::EXTRA`], and each such node counts one lost and one
+    /// extra fragment.
+    ///
+    /// # Errors
+    /// As [`Dump::masked_lists`], or a reference of another number of pixels or samples.
+    pub fn compare_masked(
+        &self,
+        reference: &MaskedLists,
+        options: &CompareOptions<'_>,
+    ) -> Result<MaskedComparison, DumpError> {
+        let lists = self.masked_lists()?;
+        if (reference.pixels(), reference.samples) != (lists.pixels(), lists.samples) {
+            return err(format!(
+                "the reference has {} pixels at {} samples, the dump {} at {}",
+                reference.pixels(),
+                reference.samples,
+                lists.pixels(),
+                lists.samples
+            ));
+        }
+        let capture = self.masked_capture()?;
+        let words = self.check_words()?;
+        let oracle = Oracle::from_capture(&node_capture(reference, Capacity::Unbounded));
+        let mut nodes = compare_with(&oracle, &capture, Some(&words), options);
+        let mut wrong_masks = Vec::new();
+        for p in 0..lists.pixels() {
+            for node in lists.pixel(p) {
+                let expected = reference.pixel(p).iter().find(|r| r.prim == node.prim);
+                if let Some(&MaskedNode { mask, .. }) = expected.filter(|r| r.mask != node.mask) {
+                    wrong_masks.push(WrongMask {
+                        pixel: p,
+                        prim: node.prim,
+                        expected: mask,
+                        got: node.mask,
+                    });
+                }
+            }
+        }
+        let flagged: Vec<(usize, u8)> = wrong_masks
+            .iter()
+            .map(|w| (w.pixel, verdict::MISSING | verdict::EXTRA))
+            .collect();
+        let wrong = wrong_masks.len() as u64;
+        nodes.diff.lost += wrong;
+        nodes.diff.extra += wrong;
+        nodes.add_flags(&flagged, options.examples, |p| PixelMismatch {
+            pixel: p,
+            expected: oracle.pixel(p).to_vec(),
+            got: capture.pixel(p).to_vec(),
+        });
+        Ok(MaskedComparison { nodes, wrong_masks })
+    }
+
+    /// Runs the masked-node A-buffer of `capacity` nodes a pixel serially over `view` (which
+    /// rasterizes per sample, at the sample count `scene`'s conventions declare) and records its
+    /// memory as a dump, `filled` (fragsim's storage starts empty).
+    ///
+    /// # Errors
+    /// A view that does not rasterize per sample at the conventions' count, a capacity of 0.
+    pub fn record_masked(
+        view: &View<'_>,
+        scene: SceneAndCamera,
+        capacity: u32,
+        producer: &str,
+    ) -> Result<Self, DumpError> {
+        let pixels = view.pixel_viewport();
+        let samples = scene.conventions.samples;
+        if view.samples().map(|p| p.count()) != Some(samples) {
+            return err(format!(
+                "the masked-node A-buffer needs a view rasterizing per sample at the \
+                 conventions' {samples} samples"
+            ));
+        }
+        let scheme = MaskedABuffer::new(pixels, samples, capacity, u64::MAX)?;
+        let memory: SerialMemory = scheme.layout().allocate();
+        scheme.insert_all(view, &memory).map_err(DumpError)?;
+        let n = pixels.pixels();
+        let u32s: Vec<u32> = (0..WordMemory::<u32>::len(&memory))
+            .map(|i| WordMemory::<u32>::load(&memory, i))
+            .collect();
+        let u64s: Vec<u64> = (0..WordMemory::<u64>::len(&memory))
+            .map(|i| WordMemory::<u64>::load(&memory, i))
+            .collect();
+        let (counters, masks) = u32s.split_at(n);
+        let slots = vec![n as u64, u64::from(capacity)];
+        let mut dump = Self {
+            header: Header {
+                format: FORMAT.into(),
+                version: VERSION,
+                producer: producer.into(),
+                scene,
+                width: pixels.width,
+                height: pixels.height,
+                scheme: MASKED_SCHEME.into(),
+                k: None,
+                capacity: Some(capacity),
+                sorted: false,
+                filled: true,
+                pool: None,
+                layers: None,
+                layout: None,
+                word: "key<<32|prim".into(),
+                arrays: std::collections::BTreeMap::new(),
+                extra: serde_json::Value::Null,
+            },
+            arrays: std::collections::BTreeMap::new(),
+        };
+        dump.set_array("counters", Words::U32(counters.to_vec()), vec![n as u64]);
+        dump.set_array("masks", Words::U32(masks.to_vec()), slots.clone());
+        dump.set_array("nodes", Words::U64(u64s), slots);
+        Ok(dump)
+    }
+
+    /// This masked-node dump (in fragsim's own encoding, as [`Dump::record_masked`] writes it)
+    /// with both slot arrays placed in `order` and the nodes packed as `payload`.
+    ///
+    /// # Errors
+    /// A primitive id that does not fit the payload.
+    pub(super) fn masked_as(&self, spec: Option<LayoutSpec>) -> Result<Dump, DumpError> {
+        let masked = self.masked_checked()?;
+        if self.header.layout.is_some() {
+            return err("only fragsim's own encoding is re-encoded");
+        }
+        let Some(LayoutSpec::Slots { order, payload }) = spec else {
+            return match spec {
+                None => Ok(self.clone()),
+                Some(other) => err(format!(
+                    "scheme {MASKED_SCHEME} dumps as slots, not {}",
+                    other.kind()
+                )),
+            };
+        };
+        let (_, nodes, masks) = self.masked_words(&masked)?;
+        let placement = Placement::new(order, masked.placement.pixels(), masked.capacity as usize);
+        let codec = SlotCodec::plain(payload);
+        let (mut stored_nodes, mut stored_masks) = (vec![0; nodes.len()], vec![0; masks.len()]);
+        for (i, (&node, &mask)) in nodes.iter().zip(&masks).enumerate() {
+            stored_nodes[placement.stored(i)] = codec.stored(node)?;
+            stored_masks[placement.stored(i)] = mask;
+        }
+        let shape = match order {
+            SlotOrder::PixelMajor => self.shape_of("nodes"),
+            SlotOrder::SlotMajor => {
+                vec![u64::from(masked.capacity), masked.placement.pixels() as u64]
+            }
+        };
+        let mut dump = self.clone();
+        dump.header.layout = Some(LayoutSpec::Slots { order, payload });
+        if payload.is_some() {
+            dump.header.word = String::new();
+        }
+        let dtype = payload.map_or(Dtype::U64, |p| p.dtype);
+        dump.set_array("nodes", words_of(dtype, stored_nodes), shape.clone());
+        dump.set_array("masks", Words::U32(stored_masks), shape);
+        Ok(dump)
+    }
+}
+
+/// The header layout that writes a masked-node dump in `encoding` (`None`: fragsim's own), and
+/// the fields of `encoding` its layout has no place for (`list numbering`).
+#[must_use]
+pub fn masked_spec(encoding: &Encoding) -> (Option<LayoutSpec>, Vec<&'static str>) {
+    let ignored = if encoding.list_numbering.is_some() {
+        vec!["list numbering"]
+    } else {
+        Vec::new()
+    };
+    let order = encoding.order.unwrap_or_default();
+    let spec = (order != SlotOrder::PixelMajor || encoding.payload.is_some()).then_some(
+        LayoutSpec::Slots {
+            order,
+            payload: encoding.payload,
+        },
+    );
+    (spec, ignored)
+}

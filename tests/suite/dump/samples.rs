@@ -1,0 +1,198 @@
+//! Multisampled dumps (issue 22): the sample count in `scene.conventions.samples`, per-sample
+//! MDTS and A-buffer dumps over the sample-expanded framebuffer, and the masked-node A-buffer's
+//! dump, through the binary: written by `render --samples 4 --dump`, judged by `compare`.
+
+use std::path::Path;
+
+use super::binary::{fragsim, json_report, stdout_of};
+use super::scratch;
+
+/// `render --samples 4` of a small scene, with the dumps of `schemes` in `out` and `options`.
+fn render_4x(out: &Path, schemes: &str, options: &[&str]) {
+    stdout_of(
+        fragsim()
+            .args([
+                "render",
+                "--scene",
+                "spheres:3",
+                "--width",
+                "24",
+                "--height",
+                "18",
+            ])
+            .args([
+                "--samples",
+                "4",
+                "--k",
+                "auto",
+                "--capacity",
+                "auto",
+                "--no-images",
+            ])
+            .args(["--scheme", schemes, "--dump"])
+            .arg(out)
+            .args(options),
+        0,
+    );
+}
+
+fn read_words<const N: usize>(path: &Path) -> Vec<[u8; N]> {
+    std::fs::read(path)
+        .unwrap()
+        .chunks_exact(N)
+        .map(|c| c.try_into().unwrap())
+        .collect()
+}
+
+fn write_words<const N: usize>(path: &Path, words: &[[u8; N]]) {
+    std::fs::write(path, words.concat()).unwrap();
+}
+
+#[test]
+fn per_sample_and_masked_dumps_round_trip_equal_at_4_samples() {
+    let dir = scratch("samples-round-trip");
+    render_4x(&dir, "mdts,abuffer,abuffer-masked", &[]);
+    for scheme in ["mdts", "abuffer", "abuffer-masked"] {
+        let header = std::fs::read_to_string(dir.join(scheme).join("dump.json")).unwrap();
+        assert!(header.contains("\"samples\": 4"), "{header}");
+        let report = &json_report(&dir.join(scheme), 0)[0];
+        assert_eq!(report["equal"], true, "{scheme}: {report}");
+        assert_eq!(report["corrupt_words"], 0, "{scheme}");
+        assert_eq!(report["unchecked_words"], 0, "{scheme}");
+        if scheme == "abuffer-masked" {
+            // One list per pixel: 24 × 18.
+            assert_eq!(report["pixels"], 432, "{scheme}");
+            assert_eq!(report["wrong_masks"], 0, "{scheme}");
+        } else {
+            assert_eq!(report["pixels"], 432 * 4, "{scheme}");
+            assert_eq!(report["per_sample_differing_samples"], 0, "{scheme}");
+        }
+    }
+    // The engine's encodings read back as fragsim's own.
+    let engine = dir.join("engine");
+    render_4x(
+        &engine,
+        "mdts,abuffer-masked",
+        &[
+            "--dump-order",
+            "slot-major",
+            "--dump-payload",
+            "u64:f32:24:24",
+        ],
+    );
+    for scheme in ["mdts", "abuffer-masked"] {
+        assert_eq!(
+            json_report(&engine.join(scheme), 0)[0]["equal"],
+            true,
+            "{scheme}"
+        );
+    }
+}
+
+#[test]
+fn a_dropped_sample_fragment_a_wrong_mask_bit_and_a_dropped_node_are_different() {
+    let dir = scratch("samples-planted");
+    render_4x(&dir, "mdts,abuffer-masked", &[]);
+    // MDTS per sample: the nearest fragment of the first covered sample dropped (its slots
+    // shift down, as if it never arrived: no word rule is broken).
+    let k = 6;
+    let slots = dir.join("mdts").join("slots.u64");
+    let mut words = read_words::<8>(&slots);
+    let header: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("mdts/dump.json")).unwrap())
+            .unwrap();
+    assert_eq!(header["k"], k);
+    let first = words.iter().position(|w| w != &[0xff; 8]).unwrap();
+    let sample = first / k;
+    let row = &mut words[sample * k..(sample + 1) * k];
+    row.rotate_left(1);
+    row[k - 1] = [0xff; 8];
+    write_words(&slots, &words);
+    let report = &json_report(&dir.join("mdts"), 1)[0];
+    assert_eq!(report["per_sample_differing_samples"], 1, "{report}");
+    assert_eq!(report["per_sample_differing_pixels"], 1, "{report}");
+    assert_eq!(report["lost"], 1, "{report}");
+
+    let masked = dir.join("abuffer-masked");
+    let counters_path = masked.join("counters.u32");
+    let masks_path = masked.join("masks.u32");
+    let nodes_path = masked.join("nodes.u64");
+    let (counters, masks, nodes) = (
+        read_words::<4>(&counters_path),
+        read_words::<4>(&masks_path),
+        read_words::<8>(&nodes_path),
+    );
+    let capacity = masks.len() / counters.len();
+    let pixel = counters
+        .iter()
+        .position(|c| u32::from_le_bytes(*c) > 0)
+        .unwrap();
+    // A wrong mask bit: sample 0 and 1 swapped in the pixel's first node (a mask of one bit
+    // moves, of two or more changes, never empties).
+    let mut wrong = masks.clone();
+    let mask = u32::from_le_bytes(wrong[pixel * capacity]);
+    let flipped = if mask == 0b11 { 0b01 } else { mask ^ 0b11 };
+    wrong[pixel * capacity] = flipped.to_le_bytes();
+    write_words(&masks_path, &wrong);
+    let records = json_report(&masked, 1);
+    assert_eq!(records[0]["wrong_masks"], 1, "{:?}", records[0]);
+    assert_eq!(records[0]["corrupt_words"], 0, "{:?}", records[0]);
+    assert_eq!(records[1]["pixel"], pixel, "{:?}", records[1]);
+    write_words(&masks_path, &masks);
+    // A dropped node: the pixel's last node and mask cleared and its counter one less.
+    let count = u32::from_le_bytes(counters[pixel]);
+    let last = pixel * capacity + count as usize - 1;
+    let (mut fewer, mut cleared, mut gone) = (counters.clone(), masks.clone(), nodes.clone());
+    fewer[pixel] = (count - 1).to_le_bytes();
+    cleared[last] = [0; 4];
+    gone[last] = [0xff; 8];
+    write_words(&counters_path, &fewer);
+    write_words(&masks_path, &cleared);
+    write_words(&nodes_path, &gone);
+    let report = &json_report(&masked, 1)[0];
+    assert_eq!(report["lost"], 1, "{report}");
+    assert_eq!(report["missing_pixels"], 1, "{report}");
+}
+
+#[test]
+fn a_header_with_a_sample_count_without_a_standard_pattern_is_refused_naming_the_field() {
+    let dir = scratch("samples-bad-count");
+    render_4x(&dir, "mdts", &[]);
+    let header_path = dir.join("mdts").join("dump.json");
+    let header = std::fs::read_to_string(&header_path).unwrap();
+    for bad in ["3", "0", "32"] {
+        std::fs::write(
+            &header_path,
+            header.replace("\"samples\": 4", &format!("\"samples\": {bad}")),
+        )
+        .unwrap();
+        let output = fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join("mdts"))
+            .arg("--no-image")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(
+            stderr.contains(&format!("conventions \"samples\" {bad}")),
+            "{bad}: {stderr}"
+        );
+    }
+    // The masked-node A-buffer runs per sample only.
+    let output = fragsim()
+        .args([
+            "render",
+            "--scene",
+            "spheres:3",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .args(["--scheme", "abuffer-masked", "--no-images"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("--samples 2, 4, 8 or 16"));
+}
