@@ -17,7 +17,7 @@ use fragsim_oracle::compare::{
     compare_with, complete_pixels, verdict, with_identity, AmbiguityCounts, CompareOptions,
     Comparison, SnapCounts, VerdictCounts,
 };
-use fragsim_oracle::dump::{node_capture, CorruptWord, Dump, Header, MASKED_SCHEME};
+use fragsim_oracle::dump::{node_capture, CorruptWord, DepthFormat, Dump, Header, MASKED_SCHEME};
 use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
 use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::scene::SceneAndCamera;
@@ -210,7 +210,11 @@ struct Report {
     compared: String,
     depth_ulps: u32,
     vertex_precision: String,
-    /// The bounds derived for an f32 vertex stage (absent when every bit is owed).
+    /// How the candidate dump stores depth (`f32`, `unorm24`, `unorm16`): a unorm depth is
+    /// judged by the steps its conversion may land on.
+    stored_depth: &'static str,
+    /// The bounds derived for an f32 vertex stage or a unorm depth (absent when every bit is
+    /// owed).
     #[serde(skip_serializing_if = "Option::is_none")]
     precision: Option<Bounds>,
     /// The ambiguous pixels by cause (absent when every bit is owed; a pixel may have several).
@@ -340,6 +344,25 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         };
         (Some(oracle), Some(Precision::derive(&view, &conventions)))
     };
+    // A unorm payload cannot owe the f32 bits: the oracle's fragments are judged as the dump
+    // stores depth, each interval the steps the conversion may land on.
+    let stored = match &candidate {
+        Side::Dump(dump, _) if matches!(reference, Side::Oracle) && !masked => dump.depth_format(),
+        _ => DepthFormat::F32,
+    };
+    let precision = match (precision, &oracle) {
+        (Some(precision), Some(oracle)) => Some(precision.stored_as(stored, oracle)),
+        (precision, _) => precision,
+    };
+    if stored != DepthFormat::F32 {
+        notes.push(format!(
+            "depth stored as {}: each reference depth z is owed as any step from \
+             floor(z·s − 1/2) to ceil(z·s + 1/2), s = 2^{} − 1 (a rounding or truncating \
+             conversion of the f32 product)",
+            stored.name(),
+            stored.bits()
+        ));
+    }
     if judged_f32 && !matches!(reference, Side::Oracle) {
         return Err(
             "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
@@ -505,12 +528,13 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         scene: header.scene.clone(),
         width: header.width,
         height: header.height,
-        compared: what_is_compared(&candidate_capture, args.depth_ulps, bounds.is_some()),
+        compared: what_is_compared(&candidate_capture, args.depth_ulps, judged_f32, stored),
         depth_ulps: args.depth_ulps,
         vertex_precision: match conventions.vertex_precision {
             VertexPrecision::F64 => "f64".into(),
             VertexPrecision::F32 => "f32".into(),
         },
+        stored_depth: stored.name(),
         precision: bounds,
         ambiguous_by_cause: bounds.map(|_| comparison.ambiguity),
         snaps: bounds.map(|_| comparison.snaps),
@@ -655,7 +679,12 @@ fn reference_caveats(capture: &Capture) -> Vec<String> {
     }
 }
 
-fn what_is_compared(candidate: &Capture, ulps: u32, within_precision: bool) -> String {
+fn what_is_compared(
+    candidate: &Capture,
+    ulps: u32,
+    f32_vertex_stage: bool,
+    stored: DepthFormat,
+) -> String {
     let words = match candidate.identity {
         Identity::KeyAndPrim => "depth key (f32 bits) and primitive id of every fragment",
         Identity::KeyOnly => "depth keys (f32 bits) of every fragment",
@@ -666,19 +695,25 @@ fn what_is_compared(candidate: &Capture, ulps: u32, within_precision: bool) -> S
         Keeps::Farthest(k) => format!("the {k} farthest per pixel"),
         Keeps::All { .. } => "all per pixel, less the overflow the reference predicts".into(),
     };
-    let tolerance = if within_precision {
-        let widened = if ulps == 0 {
-            String::new()
-        } else {
-            format!(" widened by {ulps} ulps")
-        };
-        format!("within the precision of an f32 vertex stage{widened}")
-    } else if ulps == 0 {
-        "bit for bit".to_string()
-    } else {
-        format!("depth keys within {ulps} ulps")
+    let tolerance = match (precision_of(f32_vertex_stage, stored), ulps) {
+        (None, 0) => "bit for bit".to_string(),
+        (None, _) => format!("depth keys within {ulps} ulps"),
+        (Some(what), 0) => format!("within the precision of {what}"),
+        (Some(what), _) => format!("within the precision of {what} widened by {ulps} ulps"),
     };
     format!("{words}, {promise}, in stored order, {tolerance}")
+}
+
+/// What the bounds are derived for: an f32 vertex stage, a unorm depth, or both (`None`: every
+/// bit is owed).
+fn precision_of(f32_vertex_stage: bool, stored: DepthFormat) -> Option<String> {
+    let unorm = (stored != DepthFormat::F32).then(|| format!("a {} depth", stored.name()));
+    match (f32_vertex_stage, unorm) {
+        (false, None) => None,
+        (false, Some(unorm)) => Some(unorm),
+        (true, None) => Some("an f32 vertex stage".into()),
+        (true, Some(unorm)) => Some(format!("an f32 vertex stage and {unorm}")),
+    }
 }
 
 fn entry(word: u64, identity: Identity) -> Entry {
@@ -892,11 +927,16 @@ fn print_report(r: &Report) {
     }
     if let Some(b) = &r.precision {
         outln!(
-            "precision (f32 vertex stage): vertex error up to {:.3} subpixels (snapped radius {}), \
+            "precision ({}): vertex error up to {:.3} subpixels (snapped radius {}), \
              depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs ({} may be \
              present, {} covered with coverage undecided, {} covered with depth leaving [0, 1], \
              {} of clipped triangles), {} clipped triangles not analysed, {} judged by the edge \
              bound",
+            match (r.vertex_precision.as_str(), r.stored_depth) {
+                ("f32", "f32") => "f32 vertex stage".to_string(),
+                ("f32", stored) => format!("f32 vertex stage, {stored} depth"),
+                (_, stored) => format!("{stored} depth"),
+            },
             b.max_vertex_error_subpixels,
             b.max_snap_radius_subpixels,
             b.max_depth_interval_ulps,
@@ -921,7 +961,11 @@ fn print_report(r: &Report) {
         );
         let s = r.snaps.unwrap_or_default();
         outln!(
-            "one snap per vertex: {} vertices may snap to more than one grid point where a              centre's coverage hangs on it, {} pinned by the capture; {} pixels judged jointly,              {} of them decided by the pins, {} decided but for which triangle a key-only word came              from (the dump names none), {} contradicting every snap (errors), {} past the              enumeration",
+            "one snap per vertex: {} vertices may snap to more than one grid point where a \
+             centre's coverage hangs on it, {} pinned by the capture; {} pixels judged jointly, \
+             {} of them decided by the pins, {} decided but for which triangle a key-only word \
+             came from (the dump names none), {} contradicting every snap (errors), {} past the \
+             enumeration",
             s.undecided_vertices,
             s.pinned_vertices,
             s.joint_pixels,

@@ -401,24 +401,47 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
         let (record, code) = compare_record(&engine.join(scheme));
         assert_eq!((&record["equal"], code), (&json!(true), 0), "{scheme}");
     }
-    // Unorm depths compare within the ulps their step spans here (measured: unorm24 needs 1,
-    // unorm16 at most 256 on this scene), never bit for bit.
-    for (payload, ulps) in [("u64:unorm24:32:32", "1"), ("u64:unorm16:32:32", "256")] {
+    // Unorm depths are judged by the steps their conversion may land on, derived, with no
+    // tolerance to give: EQUAL as written, bit for bit never (`stored_depth` says why).
+    for (payload, stored) in [
+        ("u64:unorm24:32:32", "unorm24"),
+        ("u64:unorm16:32:32", "unorm16"),
+    ] {
         let out = dir.join(payload.replace(':', "-"));
         let sized = ["--k", "auto", "--capacity", "auto"];
         let encoding = ["--dump-order", "slot-major", "--dump-payload", payload];
         render_dump(&out, "mdts,abuffer", &[&sized[..], &encoding[..]].concat());
         for scheme in ["mdts", "abuffer"] {
-            let path = out.join(scheme);
-            assert_eq!(compare_record(&path).1, 1, "{payload} {scheme}");
-            let within = fragsim()
-                .args(["compare", "oracle"])
-                .arg(&path)
-                .args(["--no-image", "--depth-ulps", ulps])
-                .output()
-                .unwrap();
-            assert_eq!(within.status.code(), Some(0), "{payload} {scheme}");
+            let (record, code) = compare_record(&out.join(scheme));
+            assert_eq!(code, 0, "{payload} {scheme}: {record}");
+            assert_eq!(record["stored_depth"], json!(stored), "{payload} {scheme}");
+            assert!(
+                record["compared"]
+                    .as_str()
+                    .unwrap()
+                    .ends_with(&format!("a {stored} depth")),
+                "{record}"
+            );
         }
+    }
+    // The bound is the conversion's: a unorm16 step one above the nearest is a truncating or
+    // rounding conversion's (EQUAL), two above is no conversion's (DIFFERENT). The farthest
+    // fragment of a pixel (slot 1 of slot-major slots, slot 2 empty), so that no order changes.
+    let unorm16 = dir.join("u64-unorm16-32-32").join("mdts");
+    let slots = unorm16.join("slots.u64");
+    let written = std::fs::read(&slots).unwrap();
+    let word = |i: usize| u64::from_le_bytes(written[i * 8..i * 8 + 8].try_into().unwrap());
+    let pixels = 48 * 36;
+    let farthest = (0..pixels)
+        .map(|p| pixels + p)
+        .find(|&i| word(i) != u64::MAX && word(i + pixels) == u64::MAX && word(i) >> 32 < 0xFFF0)
+        .expect("a pixel holding two fragments");
+    for (steps, code) in [(1, 0), (2, 1)] {
+        let mut bytes = written.clone();
+        let moved = word(farthest) + (steps << 32);
+        bytes[farthest * 8..farthest * 8 + 8].copy_from_slice(&moved.to_le_bytes());
+        std::fs::write(&slots, bytes).unwrap();
+        assert_eq!(compare_record(&unorm16).1, code, "{steps} steps deeper");
     }
     // One flipped bit of a slot-major word: exit 1.
     let slots = engine.join("mdts").join("slots.u64");

@@ -16,7 +16,9 @@ use fragsim_raster::Viewport;
 use serde::Serialize;
 
 use super::lists::{layer_major, linked_lists, ListArrays, Translated};
-use super::spec::{Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder, LARGEST_KEY};
+use super::spec::{
+    DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder, LARGEST_KEY,
+};
 use super::{err, Dtype, Dump, DumpError, Header, Words};
 
 /// Which scheme's memory a dump holds, with its parameters.
@@ -777,6 +779,16 @@ pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme
 }
 
 impl Dump {
+    /// How the dump's words store depth: its layout's payload's format, f32 keys where the
+    /// layout has no payload (fragsim's own words, `mdts32`'s keys, a scheme's memory).
+    #[must_use]
+    pub fn depth_format(&self) -> DepthFormat {
+        self.header
+            .layout
+            .and_then(|layout| layout.payload())
+            .map_or(DepthFormat::F32, |payload| payload.depth)
+    }
+
     /// An array's words widened to u64, which must have `dtype`.
     pub(super) fn widened(&self, name: &str, dtype: Dtype) -> Result<Vec<u64>, DumpError> {
         match (self.arrays.get(name), dtype) {

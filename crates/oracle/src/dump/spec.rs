@@ -38,6 +38,68 @@ impl DepthFormat {
             Self::Unorm16 => 16,
         }
     }
+
+    /// Its name in a header and on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::F32 => "f32",
+            Self::Unorm24 => "unorm24",
+            Self::Unorm16 => "unorm16",
+        }
+    }
+
+    /// The depth key a stored field reads back as: the f32 bits themselves, or the nearest f32
+    /// to a unorm field's value `field / (2^bits − 1)` (what the GPU's depth was rounded from).
+    #[must_use]
+    pub fn key_of_field(self, field: u64) -> u32 {
+        match self {
+            Self::F32 => field as u32,
+            Self::Unorm24 | Self::Unorm16 => {
+                ((field as f64 / mask(self.bits()) as f64) as f32).to_bits()
+            }
+        }
+    }
+
+    /// The field that stores depth key `key` as fragsim writes it: the bits, or the nearest
+    /// unorm step `round(depth · (2^bits − 1))` (a D24 or D16 conversion).
+    #[must_use]
+    pub fn field_of_key(self, key: u32) -> u64 {
+        match self {
+            Self::F32 => u64::from(key),
+            Self::Unorm24 | Self::Unorm16 => {
+                let steps = mask(self.bits()) as f64;
+                (Self::depth(key) * steps).round() as u64
+            }
+        }
+    }
+
+    /// The keys a field of this format may read back as for a depth between keys `lo` and `hi`
+    /// (`lo ≤ hi`), whatever conversion an implementation used (`docs/semantics.md` §10,
+    /// "Stored depth"): the f32 keys unchanged; for a unorm field of `s = 2^bits − 1` steps, the
+    /// steps from `⌊lo · s − ½⌋` to `⌈hi · s + ½⌉`. A shader computes `z · s` in f32, within
+    /// half a step below `2^24`, then rounds (a depth buffer's conversion) or truncates
+    /// (`uint(z * s)`): either lands in that range, and no other step can.
+    #[must_use]
+    pub fn stored_keys(self, lo: u32, hi: u32) -> (u32, u32) {
+        match self {
+            Self::F32 => (lo, hi),
+            Self::Unorm24 | Self::Unorm16 => {
+                let steps = mask(self.bits()) as f64;
+                let first = (Self::depth(lo) * steps - 0.5).floor().clamp(0.0, steps);
+                let last = (Self::depth(hi) * steps + 0.5).ceil().clamp(0.0, steps);
+                (
+                    self.key_of_field(first as u64),
+                    self.key_of_field(last as u64),
+                )
+            }
+        }
+    }
+
+    /// A depth key's value clamped to `[0, 1]`.
+    fn depth(key: u32) -> f64 {
+        f64::from(f32::from_bits(key)).clamp(0.0, 1.0)
+    }
 }
 
 /// Where a payload word keeps the depth and the primitive id: the depth field of
@@ -102,13 +164,7 @@ impl Payload {
     #[must_use]
     pub fn fragment(&self, word: u64) -> (u64, bool) {
         let field = (word >> self.depth_shift) & mask(self.depth.bits());
-        let key = match self.depth {
-            DepthFormat::F32 => field as u32,
-            // The nearest f32 to the normalised value: what the GPU's depth was rounded from.
-            DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
-                ((field as f64 / mask(self.depth.bits()) as f64) as f32).to_bits()
-            }
-        };
+        let key = self.depth.key_of_field(field);
         let prim = word & mask(self.prim_bits);
         ((u64::from(key) << 32) | prim, key <= LARGEST_KEY)
     }
@@ -134,14 +190,7 @@ impl Payload {
                 self.prim_bits
             ));
         }
-        let field = match self.depth {
-            DepthFormat::F32 => u64::from(key),
-            DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
-                let steps = mask(self.depth.bits());
-                let depth = f64::from(f32::from_bits(key)).clamp(0.0, 1.0);
-                (depth * steps as f64).round() as u64
-            }
-        };
+        let field = self.depth.field_of_key(key);
         Ok(field << self.depth_shift | prim)
     }
 }
@@ -215,6 +264,16 @@ pub enum LayoutSpec {
 }
 
 impl LayoutSpec {
+    /// The payload its words are packed in, where the description gives one.
+    #[must_use]
+    pub fn payload(&self) -> Option<Payload> {
+        match *self {
+            Self::LinkedList { payload, .. } | Self::LayerMajor { payload } => Some(payload),
+            Self::Slots { payload, .. } => payload,
+            Self::Memory => None,
+        }
+    }
+
     /// fragsim's own linked lists: node 0 ends a list, nodes numbered from 1.
     pub const FRAGSIM_LISTS: LayoutSpec = LayoutSpec::LinkedList {
         payload: Payload::FRAGMENT,

@@ -18,6 +18,9 @@ use fragsim_raster::conventions::{DepthRange, VertexPrecision, WindowOrigin};
 use fragsim_raster::{depth_key, Conventions, View, Viewport, SUBPIXEL_BITS};
 use serde::Serialize;
 
+use crate::dump::DepthFormat;
+use crate::Oracle;
+
 /// f32's unit roundoff, `2^-24`.
 const U32: f64 = 1.0 / 16_777_216.0;
 /// f64's unit roundoff, `2^-53`: the reference's own rounding, added to every term.
@@ -264,6 +267,61 @@ impl Precision {
             dependencies,
             vertex_points,
             bounds,
+        }
+    }
+
+    /// The analysis as a dump whose words store depth in `format` reads back
+    /// ([`DepthFormat::stored_keys`], `docs/semantics.md` §10, "Stored depth"): every interval
+    /// becomes the keys the stored field may read back as, and every reference key the one
+    /// fragsim's own conversion gives. An exact analysis (f64 vertex precision) first becomes
+    /// `reference`'s fragments, each certain at its own key: a unorm field cannot owe the f32
+    /// bits, only the steps the conversion may land on. f32 words leave the analysis as it is.
+    #[must_use]
+    pub fn stored_as(self, format: DepthFormat, reference: &Oracle) -> Self {
+        if format == DepthFormat::F32 {
+            return self;
+        }
+        let mut stored = if self.exact {
+            Self::certain(reference)
+        } else {
+            self
+        };
+        let mut widest = 0;
+        for e in &mut stored.entries {
+            (e.key_lo, e.key_hi) = format.stored_keys(e.key_lo, e.key_hi);
+            if let Some(key) = &mut e.reference {
+                *key = format.key_of_field(format.field_of_key(*key));
+                widest = widest.max(e.key_hi - e.key_lo);
+            }
+        }
+        stored.bounds.max_depth_interval_ulps = widest;
+        stored
+    }
+
+    /// `reference`'s fragments as an analysis in which each is certain at its own key.
+    fn certain(reference: &Oracle) -> Self {
+        let mut offsets = vec![0];
+        let mut entries = Vec::with_capacity(reference.fragments());
+        for p in 0..reference.pixels() {
+            entries.extend(reference.pixel(p).iter().map(|&word| {
+                let key = (word >> 32) as u32;
+                Possible {
+                    prim: word as u32,
+                    key_lo: key,
+                    key_hi: key,
+                    doubt: None,
+                    reference: Some(key),
+                }
+            }));
+            offsets.push(entries.len());
+        }
+        Self {
+            exact: false,
+            offsets,
+            dependencies: vec![None; entries.len()],
+            entries,
+            vertex_points: Vec::new(),
+            bounds: Bounds::default(),
         }
     }
 

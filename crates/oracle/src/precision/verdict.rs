@@ -51,8 +51,9 @@ pub fn f32_reference(
 }
 
 impl Dump {
-    /// The dump judged within the precision of an f32 vertex stage ([`f32_reference`], every
-    /// word read with [`Dump::check_words`], [`compare_within`]), with the bounds derived and the
+    /// The dump judged within the precision of an f32 vertex stage ([`f32_reference`] as the
+    /// dump stores depth, [`Precision::stored_as`]; every word read with [`Dump::check_words`],
+    /// [`compare_within`]), with the bounds derived and the
     /// reference's covered pixels (what the ambiguous pixels are a share of).
     ///
     /// # Errors
@@ -63,6 +64,7 @@ impl Dump {
         options: &CompareOptions<'_>,
     ) -> Result<(Comparison, Bounds, u64), DumpError> {
         let (oracle, precision) = f32_reference(&self.header.scene, self.viewport()?, beside)?;
+        let precision = precision.stored_as(self.depth_format(), &oracle);
         let capture = self.capture()?;
         let words = self.check_words()?;
         let covered = (0..oracle.pixels())
