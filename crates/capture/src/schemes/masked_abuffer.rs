@@ -30,6 +30,8 @@
 //! from the rasterizer's fragments, so it runs its own serial and parallel loops over the view's
 //! triangles ([`MaskedABuffer::capture`]), on the same [`Memory`] seam, three operations a node.
 
+use std::time::{Duration, Instant};
+
 use fragsim_raster::{Fragment, View, Viewport};
 use rayon::prelude::*;
 
@@ -152,6 +154,19 @@ impl MaskedLists {
     }
 }
 
+/// One timed frame of a [`MaskedABuffer`].
+#[derive(Clone, Debug)]
+pub struct MaskedFrame {
+    /// The sorted node lists, with each pixel's dropped nodes.
+    pub lists: MaskedLists,
+    /// Sample fragments rasterized (before merging).
+    pub fragments: u64,
+    /// The geometry pass: storage allocation, rasterization per sample, merging, insertion.
+    pub pass_time: Duration,
+    /// The post pass: every pixel's stored nodes read back and sorted.
+    pub resolve_time: Duration,
+}
+
 /// The masked-node A-buffer: `capacity` masked nodes per pixel.
 #[derive(Clone, Debug)]
 pub struct MaskedABuffer {
@@ -228,6 +243,15 @@ impl MaskedABuffer {
     /// A view that does not rasterize per sample at this scheme's sample count, or on another
     /// number of pixels.
     pub fn capture(&self, view: &View<'_>, parallel: bool) -> Result<MaskedLists, String> {
+        self.frame(view, parallel).map(|frame| frame.lists)
+    }
+
+    /// [`MaskedABuffer::capture`], timed: the geometry pass (storage allocation, rasterization,
+    /// merging, insertion) and the post pass apart, as `bench --samples` reports them.
+    ///
+    /// # Errors
+    /// As [`MaskedABuffer::capture`].
+    pub fn frame(&self, view: &View<'_>, parallel: bool) -> Result<MaskedFrame, String> {
         if view.samples().map(|p| p.count()) != Some(self.samples)
             || view.pixel_viewport().pixels() != self.pixels
         {
@@ -241,37 +265,73 @@ impl MaskedABuffer {
             ));
         }
         let layout = self.layout();
-        if parallel {
+        let start = Instant::now();
+        // The two memories are two types (std atomics, plain cells): one timed body each.
+        let (lists, fragments, pass_time, resolve_time) = if parallel {
             let memory: AtomicMemory = layout.allocate();
-            (0..view.triangle_count())
+            let fragments = (0..view.triangle_count())
                 .into_par_iter()
-                .for_each_init(Vec::new, |scratch, index| {
+                .map_init(Vec::new, |scratch, index| {
                     self.insert_triangle(view, view.submitted(index), scratch, &memory)
-                });
-            Ok(self.resolve(&memory))
+                })
+                .sum();
+            let pass_time = start.elapsed();
+            let lists = self.resolve(&memory);
+            (lists, fragments, pass_time, start.elapsed() - pass_time)
         } else {
             let memory: SerialMemory = layout.allocate();
             let mut scratch = Vec::new();
-            for index in 0..view.triangle_count() {
-                self.insert_triangle(view, view.submitted(index), &mut scratch, &memory);
-            }
-            Ok(self.resolve(&memory))
-        }
+            let fragments = (0..view.triangle_count())
+                .map(|index| {
+                    self.insert_triangle(view, view.submitted(index), &mut scratch, &memory)
+                })
+                .sum();
+            let pass_time = start.elapsed();
+            let lists = self.resolve(&memory);
+            (lists, fragments, pass_time, start.elapsed() - pass_time)
+        };
+        Ok(MaskedFrame {
+            lists,
+            fragments,
+            pass_time,
+            resolve_time,
+        })
     }
 
-    /// Rasterizes triangle `prim` per sample into `scratch`, merges and inserts its nodes.
+    /// The counting pass that sizes a masked-node A-buffer to the scene (`--capacity auto`): one
+    /// geometry pass that merges nodes as [`MaskedABuffer::frame`] does and only counts them, a
+    /// `fetch_add` each; the frame's [`MaskedLists::overflow`] holds every pixel's node count
+    /// (no node is stored). Its memory is one `u32` counter a pixel.
+    ///
+    /// # Errors
+    /// As [`MaskedABuffer::capture`], or a sample count outside 1 to 32.
+    pub fn count_nodes(
+        pixels: Viewport,
+        samples: u32,
+        view: &View<'_>,
+        parallel: bool,
+    ) -> Result<MaskedFrame, String> {
+        let mut counter = Self::new(pixels, samples, 1, u64::MAX).map_err(|e| e.to_string())?;
+        // Capacity 0, which `new` refuses for a capture: every insertion only counts.
+        counter.capacity = 0;
+        counter.frame(view, parallel)
+    }
+
+    /// Rasterizes triangle `prim` per sample into `scratch`, merges and inserts its nodes;
+    /// returns the sample fragments rasterized.
     fn insert_triangle<M: Memory>(
         &self,
         view: &View<'_>,
         prim: u32,
         scratch: &mut Vec<Fragment>,
         memory: &M,
-    ) {
+    ) -> u64 {
         scratch.clear();
         view.rasterize(prim, &mut |f| scratch.push(f));
         merge_samples(self.samples, scratch, &mut |pixel, node| {
             self.insert(pixel, node, memory);
         });
+        scratch.len() as u64
     }
 
     /// The post pass: each pixel's stored nodes sorted, and its overflow read from its counter.
