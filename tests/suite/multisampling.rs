@@ -3,7 +3,8 @@
 //! single-sample pipeline (the oracle on the shared meshes, every catalog scheme on several
 //! executors), schemes run per sample equal to the per-sample oracle, and the masked-node
 //! A-buffer equal to the per-pixel view of the per-sample oracle within its capacity; `bench
-//! --samples`'s resolved transparency image, the single-sample image at one sample.
+//! --samples`'s resolved transparency image, the single-sample image at one sample, and its
+//! multisampled rows (exact with room, whole masked nodes overflowing without).
 
 use std::path::PathBuf;
 
@@ -401,6 +402,110 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
         let (code, _, stderr) = bench_with(&out, extra);
         assert_eq!(code, Some(2), "{extra:?}: {stderr}");
         assert!(stderr.contains(says), "{extra:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// `fragsim bench --samples 4` of the A-buffer on the bunny at 64 × 64 on every executor, with
+/// `--capacity capacity`: its `bench-msaa` records.
+fn sampled_rows(out: &std::path::Path, capacity: &str) -> Vec<serde_json::Value> {
+    let output = assert_cmd::Command::cargo_bin("fragsim")
+        .unwrap()
+        .args([
+            "bench", "--scene", "bunny", "--width", "64", "--height", "64",
+        ])
+        .args(["--scheme", "abuffer", "--executor", "all", "--frames", "1"])
+        .args([
+            "--samples",
+            "4",
+            "--capacity",
+            capacity,
+            "--json",
+            "--no-images",
+        ])
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "--capacity {capacity}: {stderr}");
+    crate::support::json_lines(&output.stdout)
+        .into_iter()
+        .filter(|r| r["record"] == "bench-msaa")
+        .collect()
+}
+
+#[test]
+fn bench_samples_rows_hold_the_masked_abuffer_exact_with_room_and_count_its_overflow_without() {
+    let out = std::env::temp_dir().join(format!("fragsim-msaa-rows-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let pixels = 64 * 64;
+    let field = |r: &serde_json::Value, name: &str| {
+        r[name].as_u64().unwrap_or_else(|| panic!("{name} in {r}"))
+    };
+    // The bunny has no intersecting triangles: with room for every node, nothing is lost or
+    // misordered, per sample or masked, and the resolved images equal the oracle's.
+    let ample = sampled_rows(&out, "64");
+    let rows: Vec<(&str, &str, &str)> = ample
+        .iter()
+        .map(|r| {
+            (
+                r["scheme"].as_str().unwrap(),
+                r["storage"].as_str().unwrap(),
+                r["executor"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            ("abuffer", "per-sample", "serial"),
+            ("abuffer", "per-sample", "parallel"),
+            ("abuffer", "per-sample", "tiled"),
+            ("abuffer-masked", "masked", "serial"),
+            ("abuffer-masked", "masked", "parallel"),
+        ]
+    );
+    let sample_fragments = field(&ample[0], "sample_fragments");
+    for r in &ample {
+        assert_eq!(r["samples"], 4, "{r}");
+        assert_eq!(field(r, "sample_fragments"), sample_fragments, "{r}");
+        for zero in [
+            "overflowed",
+            "lost",
+            "wrong_samples",
+            "misordered_samples",
+            "error_pixels",
+        ] {
+            assert_eq!(field(r, zero), 0, "{zero} in {r}");
+        }
+        // Storage as allocated: 4 + 8 × 64 bytes a sample, 4 + 12 × 64 a masked pixel.
+        let bytes = if r["storage"] == "masked" {
+            pixels * (4 + 12 * 64)
+        } else {
+            pixels * 4 * (4 + 8 * 64)
+        };
+        assert_eq!(field(r, "memory_bytes"), bytes, "{r}");
+    }
+    // Two nodes a pixel: whole nodes overflow, counted by the pixels' counters, and each takes
+    // at least one sample fragment with it.
+    let tight = sampled_rows(&out, "2");
+    assert_eq!(tight.len(), 5);
+    for r in tight.iter().filter(|r| r["storage"] == "masked") {
+        let overflowed = field(r, "overflowed");
+        assert_eq!(r["overflow_unit"], "nodes");
+        assert!(overflowed > 100, "{r}");
+        assert!(field(r, "lost") >= overflowed, "{r}");
+        assert!(field(r, "wrong_samples") > 0, "{r}");
+        assert!(field(r, "error_pixels") > 0, "{r}");
+        assert_eq!(field(r, "memory_bytes"), pixels * (4 + 12 * 2), "{r}");
+    }
+    // `auto`: the masked A-buffer's own counting pass of nodes sizes it to the deepest pixel.
+    let auto = sampled_rows(&out, "auto");
+    for r in auto.iter().filter(|r| r["storage"] == "masked") {
+        assert_eq!(r["passes"], 2, "{r}");
+        assert_eq!(r["slots"], r["msaa"]["max_nodes_per_pixel"], "{r}");
+        assert_eq!(field(r, "lost"), 0, "{r}");
     }
     std::fs::remove_dir_all(out).unwrap();
 }
