@@ -436,12 +436,20 @@ fn sampled_rows(out: &std::path::Path, capacity: &str) -> Vec<serde_json::Value>
 }
 
 #[test]
-fn bench_samples_rows_hold_the_masked_abuffer_exact_with_room_and_count_its_overflow_without() {
+fn bench_samples_rows_hold_masked_nodes_exact_with_room_and_count_their_overflow_without() {
     let out = std::env::temp_dir().join(format!("fragsim-msaa-rows-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let pixels = 64 * 64;
     let field = |r: &serde_json::Value, name: &str| {
         r[name].as_u64().unwrap_or_else(|| panic!("{name} in {r}"))
+    };
+    // Storage as allocated at `n` slots: 4 + 8n bytes a sample (the A-buffer per sample), 4 + 12n
+    // a pixel (masked slots), 4 + 16n a pixel and the pool's counter (masked linked list).
+    let bytes_of = |r: &serde_json::Value, n: u64| match r["scheme"].as_str().unwrap() {
+        "abuffer" => pixels * 4 * (4 + 8 * n),
+        "abuffer-masked" => pixels * (4 + 12 * n),
+        "linked-list-masked" => pixels * (4 + 16 * n) + 4,
+        other => panic!("{other}"),
     };
     // The bunny has no intersecting triangles: with room for every node, nothing is lost or
     // misordered, per sample or masked, and the resolved images equal the oracle's.
@@ -464,6 +472,8 @@ fn bench_samples_rows_hold_the_masked_abuffer_exact_with_room_and_count_its_over
             ("abuffer", "per-sample", "tiled"),
             ("abuffer-masked", "masked", "serial"),
             ("abuffer-masked", "masked", "parallel"),
+            ("linked-list-masked", "masked", "serial"),
+            ("linked-list-masked", "masked", "parallel"),
         ]
     );
     let sample_fragments = field(&ample[0], "sample_fragments");
@@ -479,18 +489,12 @@ fn bench_samples_rows_hold_the_masked_abuffer_exact_with_room_and_count_its_over
         ] {
             assert_eq!(field(r, zero), 0, "{zero} in {r}");
         }
-        // Storage as allocated: 4 + 8 × 64 bytes a sample, 4 + 12 × 64 a masked pixel.
-        let bytes = if r["storage"] == "masked" {
-            pixels * (4 + 12 * 64)
-        } else {
-            pixels * 4 * (4 + 8 * 64)
-        };
-        assert_eq!(field(r, "memory_bytes"), bytes, "{r}");
+        assert_eq!(field(r, "memory_bytes"), bytes_of(r, 64), "{r}");
     }
-    // Two nodes a pixel: whole nodes overflow, counted by the pixels' counters, and each takes
-    // at least one sample fragment with it.
-    let tight = sampled_rows(&out, "2");
-    assert_eq!(tight.len(), 5);
+    // One node a pixel: whole nodes overflow, counted by the pixels' counters (the pool's one
+    // counter), and each takes at least one sample fragment with it.
+    let tight = sampled_rows(&out, "1");
+    assert_eq!(tight.len(), 7);
     for r in tight.iter().filter(|r| r["storage"] == "masked") {
         let overflowed = field(r, "overflowed");
         assert_eq!(r["overflow_unit"], "nodes");
@@ -498,14 +502,16 @@ fn bench_samples_rows_hold_the_masked_abuffer_exact_with_room_and_count_its_over
         assert!(field(r, "lost") >= overflowed, "{r}");
         assert!(field(r, "wrong_samples") > 0, "{r}");
         assert!(field(r, "error_pixels") > 0, "{r}");
-        assert_eq!(field(r, "memory_bytes"), pixels * (4 + 12 * 2), "{r}");
+        assert_eq!(field(r, "memory_bytes"), bytes_of(r, 1), "{r}");
     }
-    // `auto`: the masked A-buffer's own counting pass of nodes sizes it to the deepest pixel.
+    // `auto`: the masked schemes' own counting pass of nodes sizes the A-buffer to the deepest
+    // pixel and the pool to every node.
     let auto = sampled_rows(&out, "auto");
     for r in auto.iter().filter(|r| r["storage"] == "masked") {
         assert_eq!(r["passes"], 2, "{r}");
-        assert_eq!(r["slots"], r["msaa"]["max_nodes_per_pixel"], "{r}");
         assert_eq!(field(r, "lost"), 0, "{r}");
     }
+    assert_eq!(auto[3]["slots"], auto[3]["msaa"]["max_nodes_per_pixel"]);
+    assert_eq!(auto[5]["slots"], serde_json::Value::Null);
     std::fs::remove_dir_all(out).unwrap();
 }

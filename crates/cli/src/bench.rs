@@ -58,8 +58,9 @@ pub struct BenchArgs {
     /// against the single-sample image (`bench-oracle-transparency-msaa<N>.png`, its difference
     /// image and the `msaa` fields), and after the single-sample rows, one `bench-msaa` row per
     /// multisampled scheme against the per-sample oracle: every `--scheme` run per sample
-    /// (storage × N) and the masked-node A-buffer (`--capacity` nodes a pixel, each carrying a
-    /// coverage mask; serial and parallel executors).
+    /// (storage × N), the masked-node A-buffer (`--capacity` nodes a pixel, each carrying a
+    /// coverage mask) and the masked-node linked list (a pool of `--capacity` nodes a pixel),
+    /// these two on the serial and parallel executors.
     #[arg(long, value_name = "N")]
     pub samples: Option<u32>,
     /// Approximate OIT schemes to measure beside the catalog's, by their transparency image

@@ -6,11 +6,13 @@
 //! - *per sample*: every scheme of `--scheme` run on the view rasterizing per sample
 //!   ([`View::with_samples`]), whose sample-expanded framebuffer makes it the per-sample scheme
 //!   (MDTS, the A-buffer, …, their storage × samples), by the catalog's own runner and sizing;
-//! - *masked*: the masked-node A-buffer ([`MaskedABuffer`]): per-pixel storage whose nodes carry
-//!   a coverage mask, a primitive's samples in one pixel merged into one node, `--capacity` nodes
-//!   a pixel (`auto`: its own counting pass of nodes, a second geometry pass, reported). It runs
-//!   on the serial and parallel executors only (it has its own two loops, not the catalog's
-//!   executors): with `--executor tiled` or `scheduled` it has no row.
+//! - *masked*: per-pixel storage whose nodes carry a coverage mask, a primitive's samples in one
+//!   pixel merged into one node ([`MaskedABuffer`]): the masked-node A-buffer, `--capacity`
+//!   nodes a pixel, and the masked-node linked list, a pool of `--capacity` nodes a pixel shared
+//!   by all (`auto`: their own counting pass of nodes, a second geometry pass, reported, sizes
+//!   the A-buffer to the deepest pixel and the pool to every node). They run on the serial and
+//!   parallel executors only (they have their own two loops, not the catalog's executors): with
+//!   `--executor tiled` or `scheduled` they have no row.
 //!
 //! **The error** of every row is against the per-sample oracle, whatever the storage: the sample
 //! fragments missing from the scheme's per-sample resolve, the samples whose list differs, and of
@@ -23,7 +25,7 @@ use std::path::Path;
 
 use fragsim_capture::catalog::{check_memory_cap_early, Count, Executors, SchemeName, Sizing};
 use fragsim_capture::executors::Executor;
-use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame};
+use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
 use fragsim_oracle::samples::{SampleError, SampleOracle};
 use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
@@ -60,7 +62,7 @@ pub struct MsaaReport {
 /// One multisampled scheme on one executor, against the per-sample oracle.
 #[derive(Debug, Clone, Serialize)]
 pub struct SampledRow {
-    /// The catalog's name of a scheme run per sample, or `abuffer-masked`.
+    /// The catalog's name of a scheme run per sample, `abuffer-masked` or `linked-list-masked`.
     pub scheme: String,
     /// `per-sample` (a catalog scheme on the sample-expanded framebuffer) or `masked` (per-pixel
     /// nodes carrying a coverage mask).
@@ -77,8 +79,9 @@ pub struct SampledRow {
     pub passes: u32,
     /// That counting pass, where one ran (inside `passes_ms`).
     pub count_pass_ms: Option<f64>,
-    /// Slots a sample (per-sample storage with a fixed count) or nodes a pixel (masked) the
-    /// storage had; `None` for schemes sized per pixel by their counts.
+    /// Slots a sample (per-sample storage with a fixed count), nodes a pixel (the masked
+    /// A-buffer) or pool nodes a pixel (linked lists) the storage had; `None` where it was sized
+    /// by counts beyond one number (a pool of the scene's nodes, per-pixel exact storage).
     pub slots: Option<u32>,
     /// Bytes the scheme allocated.
     pub memory_bytes: u64,
@@ -155,7 +158,7 @@ pub(crate) struct Bench<'b, 'v> {
 
 /// Refuses, before any pass, storage of the multisampled rows beyond the memory cap: every scheme
 /// of `schemes` at its smallest over the sample-expanded framebuffer, and the masked-node
-/// A-buffer at a fixed `--capacity`.
+/// A-buffer and linked list at a fixed `--capacity`.
 ///
 /// # Errors
 /// The first refusal, by name.
@@ -168,13 +171,16 @@ pub(crate) fn check_early(
     check_memory_cap_early(schemes, pattern.expand(view.viewport())?, sizing)
         .map_err(|e| format!("at {} samples a pixel: {e}", pattern.count()))?;
     if let Count::Fixed(capacity) = sizing.capacity {
-        MaskedABuffer::new(
-            view.viewport(),
-            pattern.count(),
-            capacity,
-            sizing.memory_cap,
-        )
-        .map_err(|e| e.to_string())?;
+        for linked in [false, true] {
+            let storage = masked_storage(linked, capacity, view.viewport().pixels());
+            MaskedABuffer::with_storage(
+                view.viewport(),
+                pattern.count(),
+                storage,
+                sizing.memory_cap,
+            )
+            .map_err(|e| e.to_string())?;
+        }
     }
     Ok(())
 }
@@ -254,7 +260,7 @@ fn rows(
         .filter(|&e| matches!(e, Executor::Serial | Executor::Parallel))
         .collect();
     let progress = crate::progress::bar(
-        ((bench.schemes.len() * bench.executors.len() + masked_executors.len()) * bench.frames)
+        ((bench.schemes.len() * bench.executors.len() + 2 * masked_executors.len()) * bench.frames)
             as u64,
         "bench --samples",
     );
@@ -341,55 +347,52 @@ fn rows(
             )?;
         }
     }
-    for executor in masked_executors {
-        progress.set_message(format!("abuffer-masked on the {executor} executor"));
-        let parallel = executor == Executor::Parallel;
-        let (masked, times) = time_frames(
-            view,
-            bench.camera,
-            bench.vertex_pool(executor),
-            bench.frames,
-            &progress,
-            |view| {
-                let masked = bench
-                    .pool
-                    .install(|| masked_frame(view, bench.sizing, parallel))?;
-                let (pass_time, resolve_time) = (masked.pass_time(), masked.frame.resolve_time);
-                Ok((masked, pass_time, resolve_time))
-            },
-        )?;
-        let per_sample = masked.frame.lists.per_sample();
-        row(
-            Common {
-                scheme: "abuffer-masked".into(),
-                storage: "masked",
-                executor,
-                threads: if parallel {
-                    bench.pool.current_num_threads()
-                } else {
-                    1
+    for linked in [false, true] {
+        for &executor in &masked_executors {
+            let parallel = executor == Executor::Parallel;
+            let kind = if linked { "linked list" } else { "A-buffer" };
+            progress.set_message(format!("masked {kind} on the {executor} executor"));
+            let (masked, times) = time_frames(
+                view,
+                bench.camera,
+                bench.vertex_pool(executor),
+                bench.frames,
+                &progress,
+                |view| {
+                    let masked = bench
+                        .pool
+                        .install(|| masked_frame(view, bench.sizing, linked, parallel))?;
+                    let (pass_time, resolve_time) = (masked.pass_time(), masked.frame.resolve_time);
+                    Ok((masked, pass_time, resolve_time))
                 },
-                passes: if masked.count.is_some() { 2 } else { 1 },
-                count_pass_ms: masked
-                    .count
-                    .as_ref()
-                    .map(|c| ms(c.pass_time + c.resolve_time)),
-                slots: Some(masked.capacity),
-                memory_bytes: masked.memory_bytes,
-                fragments: masked.fragments,
-                overflowed: masked
-                    .frame
-                    .lists
-                    .overflow
-                    .iter()
-                    .map(|&o| u64::from(o))
-                    .sum(),
-                overflow_unit: "nodes",
-                times,
-            },
-            oracle.sample_error(&per_sample),
-            judge.judge_lists(&per_sample),
-        )?;
+            )?;
+            let per_sample = masked.frame.lists.per_sample();
+            row(
+                Common {
+                    scheme: masked.name.into(),
+                    storage: "masked",
+                    executor,
+                    threads: if parallel {
+                        bench.pool.current_num_threads()
+                    } else {
+                        1
+                    },
+                    passes: if masked.count.is_some() { 2 } else { 1 },
+                    count_pass_ms: masked
+                        .count
+                        .as_ref()
+                        .map(|c| ms(c.pass_time + c.resolve_time)),
+                    slots: masked.slots,
+                    memory_bytes: masked.memory_bytes,
+                    fragments: masked.fragments,
+                    overflowed: masked.frame.dropped,
+                    overflow_unit: "nodes",
+                    times,
+                },
+                oracle.sample_error(&per_sample),
+                judge.judge_lists(&per_sample),
+            )?;
+        }
     }
     progress.finish_and_clear();
     Ok(rows)
@@ -422,14 +425,16 @@ impl Bench<'_, '_> {
     }
 }
 
-/// One frame of the masked-node A-buffer, with its counting pass where `--capacity auto`.
+/// One frame of masked-node storage, with its counting pass where `--capacity auto`.
 struct MaskedRun {
+    /// `abuffer-masked` or `linked-list-masked`.
+    name: &'static str,
     /// The counting pass of nodes, where one sized the storage.
     count: Option<MaskedFrame>,
     /// The capture.
     frame: MaskedFrame,
-    /// Nodes a pixel.
-    capacity: u32,
+    /// Nodes a pixel (the A-buffer) or pool nodes a pixel (the linked list, a fixed pool).
+    slots: Option<u32>,
     /// Bytes of the capture's storage (the counting pass needs one counter a pixel, which a GPU
     /// clears and reuses as the capture's).
     memory_bytes: u64,
@@ -448,24 +453,51 @@ impl MaskedRun {
     }
 }
 
-/// A frame of the masked-node A-buffer on `view` (rasterizing per sample), `sizing.capacity`
-/// nodes a pixel; `auto`: as many as its counting pass found in the deepest pixel.
-fn masked_frame(view: &View<'_>, sizing: Sizing, parallel: bool) -> Result<MaskedRun, String> {
+/// The storage of `--capacity N`: `N` slots a pixel, or a pool of `N` nodes for each of `pixels`
+/// (as the catalog's linked lists size theirs).
+fn masked_storage(linked: bool, capacity: u32, pixels: usize) -> MaskedStorage {
+    if linked {
+        MaskedStorage::Pool(pixels * capacity as usize)
+    } else {
+        MaskedStorage::Slots(capacity)
+    }
+}
+
+/// A frame of the masked-node A-buffer (`linked`: linked list) on `view` (rasterizing per
+/// sample), sized by `sizing.capacity`; `auto`: by its counting pass, the A-buffer to the
+/// deepest pixel's nodes, the pool to all of them.
+fn masked_frame(
+    view: &View<'_>,
+    sizing: Sizing,
+    linked: bool,
+    parallel: bool,
+) -> Result<MaskedRun, String> {
     let pixels = view.pixel_viewport();
     let samples = view.samples().map_or(1, |p| p.count());
-    let (count, capacity) = match sizing.capacity {
-        Count::Fixed(capacity) => (None, capacity),
+    let (count, storage) = match sizing.capacity {
+        Count::Fixed(capacity) => (None, masked_storage(linked, capacity, pixels.pixels())),
         Count::Auto => {
             let counted = MaskedABuffer::count_nodes(pixels, samples, view, parallel)?;
-            let deepest = counted.lists.overflow.iter().copied().max().unwrap_or(0);
-            (Some(counted), deepest.max(1))
+            let nodes = counted.lists.overflow.iter();
+            let storage = if linked {
+                MaskedStorage::Pool(nodes.map(|&n| n as usize).sum::<usize>().max(1))
+            } else {
+                MaskedStorage::Slots(nodes.copied().max().unwrap_or(0).max(1))
+            };
+            (Some(counted), storage)
         }
     };
-    let scheme = MaskedABuffer::new(pixels, samples, capacity, sizing.memory_cap)
+    let scheme = MaskedABuffer::with_storage(pixels, samples, storage, sizing.memory_cap)
         .map_err(|e| e.to_string())?;
     let frame = scheme.frame(view, parallel)?;
+    let slots = match (storage, sizing.capacity) {
+        (MaskedStorage::Slots(capacity), _) => Some(capacity),
+        (MaskedStorage::Pool(_), Count::Fixed(capacity)) => Some(capacity),
+        (MaskedStorage::Pool(_), Count::Auto) => None,
+    };
     Ok(MaskedRun {
-        capacity,
+        name: scheme.name(),
+        slots,
         memory_bytes: scheme.layout().bytes(),
         fragments: frame.fragments + count.as_ref().map_or(0, |c| c.fragments),
         count,
@@ -518,12 +550,15 @@ pub(crate) fn markdown(msaa: &MsaaReport) -> String {
         "
 Columns: **storage** `per-sample`: the scheme run on the sample-expanded framebuffer (its storage \
 × samples); `masked`: per-pixel nodes, one per primitive and pixel, each carrying the mask of the \
-samples it covers and the nearest of their depths; **passes** geometry passes, its own counting \
-pass included; **slots** slots a sample (per-sample) or nodes a pixel (masked) the storage had \
-(`--k`, `--capacity`, or its counting pass's deepest pixel under `auto`); **memory B**, **B/px** \
+samples it covers and the nearest of their depths, in `--capacity` slots a pixel \
+(`abuffer-masked`) or a pool of `--capacity` nodes a pixel shared by all (`linked-list-masked`); \
+**passes** geometry passes, its own counting pass included; **slots** slots a sample \
+(per-sample), nodes a pixel (masked A-buffer) or pool nodes a pixel (linked lists) the storage \
+had (`--k`, `--capacity`, or its counting pass's deepest pixel under `auto`; counted: a pool of \
+every node, storage sized per pixel); **memory B**, **B/px** \
 bytes allocated, in all and per pixel (all its samples); **overflow** what found no room: sample \
 fragments (per-sample storage, the oracle's prediction as above) or whole nodes (masked storage, \
-its counters' count); **lost** sample fragments of the per-sample oracle missing from the \
+its counters' count: per pixel, or the pool's one counter); **lost** sample fragments of the per-sample oracle missing from the \
 scheme's per-sample resolve, with their share; **wrong samples** samples whose list differs from \
 the per-sample oracle's, with their share of all samples; **misordered** of those, samples with \
 every fragment present in another order (a masked node orders all its samples by its nearest \
