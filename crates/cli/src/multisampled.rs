@@ -245,8 +245,8 @@ pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<M
     })
 }
 
-/// The rows: every scheme per sample on every executor, then the masked-node A-buffer on the
-/// serial and parallel executors among them.
+/// The rows: every scheme per sample on every executor, then the masked-node A-buffer and
+/// linked list on the serial and parallel executors among them.
 fn rows(
     bench: &Bench<'_, '_>,
     view: &mut View<'_>,
