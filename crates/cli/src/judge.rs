@@ -153,7 +153,8 @@ pub(crate) struct Judge<'a> {
 }
 
 impl<'a> Judge<'a> {
-    /// The judge of `effect` for `view` of `scene` through `orbit`, at one sample a pixel.
+    /// The judge of `effect` for `view` of `scene` through `orbit` (a view rasterizing per
+    /// sample through [`Judge::per_sample`], which refuses what is not resolved per sample).
     pub fn new(
         effect: EffectName,
         scene: &Scene,
