@@ -3,7 +3,8 @@
 //! single-sample pipeline (the oracle on the shared meshes, every catalog scheme on several
 //! executors), schemes run per sample equal to the per-sample oracle, and the masked-node
 //! A-buffer equal to the per-pixel view of the per-sample oracle within its capacity; `bench
-//! --samples`'s resolved transparency image, the single-sample image at one sample.
+//! --samples`'s resolved transparency image, the single-sample image at one sample, and its
+//! multisampled rows (exact with room, whole masked nodes overflowing without).
 
 use std::path::PathBuf;
 
@@ -402,5 +403,115 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
         assert_eq!(code, Some(2), "{extra:?}: {stderr}");
         assert!(stderr.contains(says), "{extra:?}: {stderr}");
     }
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// `fragsim bench --samples 4` of the A-buffer on the bunny at 64 × 64 on every executor, with
+/// `--capacity capacity`: its `bench-msaa` records.
+fn sampled_rows(out: &std::path::Path, capacity: &str) -> Vec<serde_json::Value> {
+    let output = assert_cmd::Command::cargo_bin("fragsim")
+        .unwrap()
+        .args([
+            "bench", "--scene", "bunny", "--width", "64", "--height", "64",
+        ])
+        .args(["--scheme", "abuffer", "--executor", "all", "--frames", "1"])
+        .args([
+            "--samples",
+            "4",
+            "--capacity",
+            capacity,
+            "--json",
+            "--no-images",
+        ])
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "--capacity {capacity}: {stderr}");
+    crate::support::json_lines(&output.stdout)
+        .into_iter()
+        .filter(|r| r["record"] == "bench-msaa")
+        .collect()
+}
+
+#[test]
+fn bench_samples_rows_hold_masked_nodes_exact_with_room_and_count_their_overflow_without() {
+    let out = std::env::temp_dir().join(format!("fragsim-msaa-rows-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let pixels = 64 * 64;
+    let field = |r: &serde_json::Value, name: &str| {
+        r[name].as_u64().unwrap_or_else(|| panic!("{name} in {r}"))
+    };
+    // Storage as allocated at `n` slots: 4 + 8n bytes a sample (the A-buffer per sample), 4 + 12n
+    // a pixel (masked slots), 4 + 16n a pixel and the pool's counter (masked linked list).
+    let bytes_of = |r: &serde_json::Value, n: u64| match r["scheme"].as_str().unwrap() {
+        "abuffer" => pixels * 4 * (4 + 8 * n),
+        "abuffer-masked" => pixels * (4 + 12 * n),
+        "linked-list-masked" => pixels * (4 + 16 * n) + 4,
+        other => panic!("{other}"),
+    };
+    // The bunny has no intersecting triangles: with room for every node, nothing is lost or
+    // misordered, per sample or masked, and the resolved images equal the oracle's.
+    let ample = sampled_rows(&out, "64");
+    let rows: Vec<(&str, &str, &str)> = ample
+        .iter()
+        .map(|r| {
+            (
+                r["scheme"].as_str().unwrap(),
+                r["storage"].as_str().unwrap(),
+                r["executor"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            ("abuffer", "per-sample", "serial"),
+            ("abuffer", "per-sample", "parallel"),
+            ("abuffer", "per-sample", "tiled"),
+            ("abuffer-masked", "masked", "serial"),
+            ("abuffer-masked", "masked", "parallel"),
+            ("linked-list-masked", "masked", "serial"),
+            ("linked-list-masked", "masked", "parallel"),
+        ]
+    );
+    let sample_fragments = field(&ample[0], "sample_fragments");
+    for r in &ample {
+        assert_eq!(r["samples"], 4, "{r}");
+        assert_eq!(field(r, "sample_fragments"), sample_fragments, "{r}");
+        for zero in [
+            "overflowed",
+            "lost",
+            "wrong_samples",
+            "misordered_samples",
+            "error_pixels",
+        ] {
+            assert_eq!(field(r, zero), 0, "{zero} in {r}");
+        }
+        assert_eq!(field(r, "memory_bytes"), bytes_of(r, 64), "{r}");
+    }
+    // One node a pixel: whole nodes overflow, counted by the pixels' counters (the pool's one
+    // counter), and each takes at least one sample fragment with it.
+    let tight = sampled_rows(&out, "1");
+    assert_eq!(tight.len(), 7);
+    for r in tight.iter().filter(|r| r["storage"] == "masked") {
+        let overflowed = field(r, "overflowed");
+        assert_eq!(r["overflow_unit"], "nodes");
+        assert!(overflowed > 100, "{r}");
+        assert!(field(r, "lost") >= overflowed, "{r}");
+        assert!(field(r, "wrong_samples") > 0, "{r}");
+        assert!(field(r, "error_pixels") > 0, "{r}");
+        assert_eq!(field(r, "memory_bytes"), bytes_of(r, 1), "{r}");
+    }
+    // `auto`: the masked schemes' own counting pass of nodes sizes the A-buffer to the deepest
+    // pixel and the pool to every node.
+    let auto = sampled_rows(&out, "auto");
+    for r in auto.iter().filter(|r| r["storage"] == "masked") {
+        assert_eq!(r["passes"], 2, "{r}");
+        assert_eq!(field(r, "lost"), 0, "{r}");
+    }
+    assert_eq!(auto[3]["slots"], auto[3]["msaa"]["max_nodes_per_pixel"]);
+    assert_eq!(auto[5]["slots"], serde_json::Value::Null);
     std::fs::remove_dir_all(out).unwrap();
 }

@@ -4,22 +4,23 @@
 //! frame (median, min, max over `--frames`), with the split between vertex stage, rasterization
 //! and capture.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
-use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{SamplePattern, View};
-use fragsim_shade::effects::{error_pixels, render_resolved, Entries, Geometry};
+use fragsim_raster::{Camera, SamplePattern, View};
+use image::RgbImage;
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::approximate::{ApproximateName, ApproximateRow};
 use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
+use crate::multisampled::{MsaaReport, SampledRow};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{check_memory_cap_early, family, Executors, SchemeChoice, SchemeName};
 
@@ -52,10 +53,14 @@ pub struct BenchArgs {
     /// are still written.
     #[arg(long)]
     pub no_images: bool,
-    /// Also resolve the oracle's transparency image from this many samples a pixel (1, 2, 4, 8
-    /// or 16: the standard patterns, `docs/semantics.md` §11) and compare it with the
-    /// single-sample image: `bench-oracle-transparency-msaa<N>.png`, its difference image
-    /// (`…-diff.png`) and the `msaa` fields. The schemes still run at one sample.
+    /// Also measure multisampling at this many samples a pixel (1, 2, 4, 8 or 16: the standard
+    /// patterns, `docs/semantics.md` §11): the oracle's transparency image resolved from them
+    /// against the single-sample image (`bench-oracle-transparency-msaa<N>.png`, its difference
+    /// image and the `msaa` fields), and after the single-sample rows, one `bench-msaa` row per
+    /// multisampled scheme against the per-sample oracle: every `--scheme` run per sample
+    /// (storage × N), the masked-node A-buffer (`--capacity` nodes a pixel, each carrying a
+    /// coverage mask) and the masked-node linked list (a pool of `--capacity` nodes a pixel),
+    /// these two on the serial and parallel executors.
     #[arg(long, value_name = "N")]
     pub samples: Option<u32>,
     /// Approximate OIT schemes to measure beside the catalog's, by their transparency image
@@ -214,7 +219,8 @@ pub struct BenchReport {
     pub effect: String,
     /// Frames per row.
     pub frames: u32,
-    /// The multisampled oracle image against the single-sample one (`--samples`).
+    /// The multisampled oracle image against the single-sample one, and the multisampled rows
+    /// (`--samples`).
     pub msaa: Option<MsaaReport>,
     /// One row per scheme and executor.
     #[serde(skip)]
@@ -222,24 +228,6 @@ pub struct BenchReport {
     /// One row per approximate scheme (`--approximate`).
     #[serde(skip)]
     pub approximate: Vec<ApproximateRow>,
-}
-
-/// The oracle's transparency image resolved from several samples a pixel, against the
-/// single-sample image (`--samples`).
-#[derive(Debug, Clone, Copy, Serialize)]
-pub struct MsaaReport {
-    /// Samples a pixel.
-    pub samples: u32,
-    /// Fragments of the per-sample oracle (one per covered sample).
-    pub sample_fragments: usize,
-    /// Pixels whose samples do not all hold the same primitives in the same order: every edge
-    /// multisampling sees, between two triangles of one surface too.
-    pub mixed_pixels: usize,
-    /// Of those, pixels whose samples hold different numbers of fragments: where a layer begins
-    /// or ends inside the pixel (silhouettes and folds).
-    pub layer_edge_pixels: usize,
-    /// Pixels whose resolved 8-bit colour differs from the single-sample image's.
-    pub differing_pixels: usize,
 }
 
 /// One line of bench's JSON Lines: a row with what the whole bench measured.
@@ -261,13 +249,98 @@ struct ApproximateRecord<'a> {
     bench: &'a BenchReport,
 }
 
+/// One line of bench's JSON Lines for a multisampled scheme (`--samples`): its row with what the
+/// whole bench measured.
+#[derive(Serialize)]
+struct SampledRecord<'a> {
+    #[serde(flatten)]
+    row: &'a SampledRow,
+    #[serde(flatten)]
+    bench: &'a BenchReport,
+}
+
 fn median(times: &mut [Duration]) -> Duration {
     times.sort_unstable();
     times[times.len() / 2]
 }
 
-fn ms(d: Duration) -> f64 {
+pub(crate) fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
+}
+
+/// The times of one scheme's frames on one executor ([`time_frames`]).
+pub(crate) struct FrameTimes {
+    /// Every frame: vertex stage, geometry passes and post pass, fastest first.
+    pub frames: Vec<Duration>,
+    /// The vertex stage's median.
+    pub vertex: Duration,
+    /// The geometry passes' median.
+    pub passes: Duration,
+    /// The post pass's median.
+    pub resolve: Duration,
+}
+
+impl FrameTimes {
+    /// The median frame.
+    pub fn median(&self) -> Duration {
+        self.frames[self.frames.len() / 2]
+    }
+}
+
+/// Times `frames` frames of one scheme (at least one): each is the vertex stage (the camera set
+/// on `view`, on `vertex_pool`) and then `frame(view)`, which runs the geometry passes and the
+/// post pass and returns what it made with the two times. One progress step a frame. Returns
+/// the first frame's result and the times.
+///
+/// # Errors
+/// The first error of `frame`.
+pub(crate) fn time_frames<T>(
+    view: &mut View<'_>,
+    camera: &Camera,
+    vertex_pool: &rayon::ThreadPool,
+    frames: usize,
+    progress: &ProgressBar,
+    mut frame: impl FnMut(&View<'_>) -> Result<(T, Duration, Duration), String>,
+) -> Result<(T, FrameTimes), String> {
+    let mut totals = Vec::with_capacity(frames);
+    let (mut vertex, mut passes, mut resolve) = (Vec::new(), Vec::new(), Vec::new());
+    let mut first = None;
+    for _ in 0..frames.max(1) {
+        let start = Instant::now();
+        vertex_pool.install(|| view.set_camera(camera));
+        let vertex_time = start.elapsed();
+        let (made, pass_time, resolve_time) = frame(view)?;
+        totals.push(vertex_time + pass_time + resolve_time);
+        vertex.push(vertex_time);
+        passes.push(pass_time);
+        resolve.push(resolve_time);
+        first.get_or_insert(made);
+        progress.inc(1);
+    }
+    totals.sort_unstable();
+    let times = FrameTimes {
+        frames: totals,
+        vertex: median(&mut vertex),
+        passes: median(&mut passes),
+        resolve: median(&mut resolve),
+    };
+    Ok((first.expect("at least one frame"), times))
+}
+
+/// Writes `image` to `out/<stem>.png` and its difference from `reference` to
+/// `out/<stem>-diff.png`.
+///
+/// # Errors
+/// Images of different sizes, or a file that cannot be written.
+pub(crate) fn save_with_difference(
+    image: &RgbImage,
+    reference: &RgbImage,
+    out: &Path,
+    stem: &str,
+) -> Result<(), String> {
+    fragsim_shade::save_png(image, &out.join(format!("{stem}.png")))?;
+    let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
+    fragsim_shade::save_png(&difference, &out.join(format!("{stem}-diff.png")))
 }
 
 /// Runs `bench`.
@@ -307,6 +380,9 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);
     check_memory_cap_early(&schemes, viewport, &sizing)?;
+    if let Some(pattern) = pattern {
+        crate::multisampled::check_early(&view, pattern, &schemes, &sizing)?;
+    }
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
@@ -326,9 +402,6 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         let name = format!("bench-oracle-{}.png", args.effect.label());
         fragsim_shade::save_png(image, &args.out.join(name))?;
     }
-    let msaa = pattern
-        .map(|pattern| multisampled(&view, pattern, &judge, args))
-        .transpose()?;
     let mut rows = Vec::new();
     for &name in &schemes {
         for &executor in executors {
@@ -341,29 +414,17 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             } else {
                 &pool
             };
-            let mut times = Vec::with_capacity(frames);
-            let mut vertex_times = Vec::with_capacity(frames);
-            let mut pass_times = Vec::with_capacity(frames);
-            let mut resolve_times = Vec::with_capacity(frames);
-            let mut first = None;
-            for _ in 0..frames {
-                let start = Instant::now();
-                frame_pool.install(|| view.set_camera(&camera));
-                let vertex_time = start.elapsed();
-                let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
-                let stats = &named.run.stats;
-                times.push(vertex_time + stats.pass_time + stats.resolve_time);
-                vertex_times.push(vertex_time);
-                pass_times.push(stats.pass_time);
-                resolve_times.push(stats.resolve_time);
-                first.get_or_insert(named);
-                progress.inc(1);
-            }
+            let (named, times) =
+                time_frames(&mut view, &camera, frame_pool, frames, &progress, |view| {
+                    let named = pool.install(|| runner.run(name, executor, view, &sizing))?;
+                    let stats = &named.run.stats;
+                    let (pass_time, resolve_time) = (stats.pass_time, stats.resolve_time);
+                    Ok((named, pass_time, resolve_time))
+                })?;
             runner.count_locked_ops = true;
             let counted = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             progress.inc(1);
             let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
-            let named = first.expect("at least one frame");
             let diff = oracle.diff(&named.run.capture);
             let judged = judge.judge(&named.run.capture);
             let error_pixels = judged.as_ref().map(|j| j.errors);
@@ -377,17 +438,12 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             }) = judged.as_ref().filter(|_| !args.no_images)
             {
                 let stem = format!("bench-{}-{executor}", named.name);
-                fragsim_shade::save_png(image, &args.out.join(format!("{stem}.png")))?;
-                let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
-                fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
+                save_with_difference(image, reference, &args.out, &stem)?;
             }
-            let median_time = median(&mut times);
+            let median_time = times.median();
             let stats = &named.run.stats;
-            let (vertex_median, pass_median, resolve_median) = (
-                median(&mut vertex_times),
-                median(&mut pass_times),
-                median(&mut resolve_times),
-            );
+            let (vertex_median, pass_median, resolve_median) =
+                (times.vertex, times.passes, times.resolve);
             let triangles_run = u64::from(view.triangle_count()) * u64::from(stats.passes);
             let seconds = median_time.as_secs_f64().max(1e-12);
             rows.push(BenchRow {
@@ -421,8 +477,8 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 locked_ops_per_fragment: locked_ops as f64
                     / counted.run.stats.counters.fragments.max(1) as f64,
                 time_ms: ms(median_time),
-                min_ms: ms(times[0]),
-                max_ms: ms(times[times.len() - 1]),
+                min_ms: ms(times.frames[0]),
+                max_ms: ms(times.frames[times.frames.len() - 1]),
                 fps: 1.0 / seconds,
                 triangles_per_second: f64::from(view.triangle_count()) * f64::from(stats.passes)
                     / seconds,
@@ -440,6 +496,25 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     }
     progress.finish_and_clear();
     set_speedups(&mut rows);
+    let msaa = pattern
+        .map(|pattern| {
+            let bench = crate::multisampled::Bench {
+                view: &view,
+                scene: &scene,
+                orbit,
+                camera: &camera,
+                judge: &judge,
+                schemes: &schemes,
+                executors,
+                sizing,
+                frames,
+                pool: &pool,
+                serial_pool: &serial_pool,
+                out: (!args.no_images).then_some(args.out.as_path()),
+            };
+            crate::multisampled::measure(&bench, pattern)
+        })
+        .transpose()?;
     let raster_ms = ms(median(&mut raster_times.clone()));
     let order = (!args.approximate.is_empty()).then(|| PrimitiveOrder::of_view(&view));
     let mut approximate = Vec::new();
@@ -452,11 +527,12 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 )
             })?;
             if let Some(reference) = judge.reference().filter(|_| !args.no_images) {
-                let stem = format!("bench-{}", row.scheme);
-                fragsim_shade::save_png(&image, &args.out.join(format!("{stem}.png")))?;
-                let difference =
-                    fragsim_shade::legend::effect_difference_figure(reference, &image)?;
-                fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
+                save_with_difference(
+                    &image,
+                    reference,
+                    &args.out,
+                    &format!("bench-{}", row.scheme),
+                )?;
             }
             approximate.push(row);
         }
@@ -480,65 +556,6 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     };
     write_outputs(&report, args)?;
     Ok(report)
-}
-
-/// The oracle's image of `judge`'s effect (transparency) resolved from `pattern`'s samples
-/// (`fragsim_shade::effects::render_resolved`), compared with the judge's single-sample image;
-/// unless `--no-images`, both written to `--out`: `bench-oracle-<effect>-msaa<N>.png` and its
-/// difference image.
-fn multisampled(
-    view: &View<'_>,
-    pattern: SamplePattern,
-    judge: &Judge<'_>,
-    args: &BenchArgs,
-) -> Result<MsaaReport, String> {
-    let samples = pattern.count();
-    // The per-sample oracle is about `samples` single-sample oracles (one per sample index,
-    // each on a shifted pixel grid): the single-sample bound against that share of the cap.
-    let cap = args.schemes.sizing().memory_cap / u64::from(samples);
-    crate::oracle_memory::check(view, cap)?;
-    let oracle = SampleOracle::build(&view.clone().with_samples(pattern)?)?;
-    let lists = oracle.oracle();
-    // Transparency reads neither distances nor normals.
-    let geometry = Geometry {
-        distance: &|_| 0.0,
-        cosine: &|_, _| 1.0,
-    };
-    let image = render_resolved(
-        judge.effect(),
-        judge.material(),
-        Entries::KeyAndPrim,
-        judge.size(),
-        samples,
-        |s| lists.pixel(s),
-        geometry,
-    )
-    .expect("full identities resolve every effect");
-    let reference = judge
-        .reference()
-        .expect("the judge shades the oracle's image");
-    let n = samples as usize;
-    let prims = |sample: usize| lists.pixel(sample).iter().map(|&e| e as u32);
-    let (mut mixed_pixels, mut layer_edge_pixels) = (0, 0);
-    for first in (0..lists.pixels()).step_by(n) {
-        let others = || first + 1..first + n;
-        let layers = lists.pixel(first).len();
-        layer_edge_pixels += usize::from(others().any(|s| lists.pixel(s).len() != layers));
-        mixed_pixels += usize::from(others().any(|s| !prims(s).eq(prims(first))));
-    }
-    if !args.no_images {
-        let stem = format!("bench-oracle-{}-msaa{samples}", args.effect.label());
-        fragsim_shade::save_png(&image, &args.out.join(format!("{stem}.png")))?;
-        let difference = fragsim_shade::legend::effect_difference_figure(reference, &image)?;
-        fragsim_shade::save_png(&difference, &args.out.join(format!("{stem}-diff.png")))?;
-    }
-    Ok(MsaaReport {
-        samples,
-        sample_fragments: lists.fragments(),
-        mixed_pixels,
-        layer_edge_pixels,
-        differing_pixels: error_pixels(reference, &image),
-    })
 }
 
 /// Rasterizes every triangle on the current pool and discards the fragments.
@@ -599,6 +616,12 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
             &context,
             &record,
         )?);
+        lines.push('\n');
+    }
+    for row in report.msaa.iter().flat_map(|m| &m.rows) {
+        let context = report.context.on(&row.executor, row.threads);
+        let record = SampledRecord { row, bench: report };
+        lines.push_str(&crate::record::line("bench-msaa", &context, &record)?);
         lines.push('\n');
     }
     let json_path = args.out.join("bench.jsonl");
@@ -754,6 +777,9 @@ fn markdown(report: &BenchReport) -> String {
         text.push_str(&crate::approximate::markdown(&report.approximate));
     }
     text.push_str(&depth_markdown(report));
+    if let Some(msaa) = &report.msaa {
+        text.push_str(&crate::multisampled::markdown(msaa));
+    }
     text
 }
 

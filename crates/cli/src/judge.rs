@@ -21,7 +21,7 @@
 use std::time::Instant;
 
 use clap::ValueEnum;
-use fragsim_capture::Capture;
+use fragsim_capture::{Capture, PixelLists};
 use fragsim_oracle::Oracle;
 use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
@@ -132,21 +132,29 @@ pub(crate) struct Judged<'j> {
 }
 
 /// Shades captures and compares them with the oracle's image.
+///
+/// A judge of a view rasterizing per sample ([`Judge::per_sample`]) shades every sample of the
+/// sample-expanded lists and resolves each pixel from its samples
+/// ([`effects::render_resolved`], `docs/semantics.md` §11): its images are the render target's
+/// size, its reference the per-sample oracle's resolved image.
 pub(crate) struct Judge<'a> {
     effect: Effect,
     material: Material,
     size: (u32, u32),
+    /// Samples a pixel (1: the view does not rasterize per sample).
+    samples: u32,
     distance: Distance<'a>,
     /// The deferred attribute pass of the view: only when the effect needs normals.
     attributes: Option<Attributes<'a>>,
     oracle: &'a Oracle,
     reference: RgbImage,
-    /// Pixels the oracle covers: the rate's denominator.
+    /// Pixels the oracle covers (at any of their samples): the rate's denominator.
     pub covered: usize,
 }
 
 impl<'a> Judge<'a> {
-    /// The judge of `effect` for `view` of `scene` through `orbit`.
+    /// The judge of `effect` for `view` of `scene` through `orbit` (a view rasterizing per
+    /// sample through [`Judge::per_sample`], which refuses what is not resolved per sample).
     pub fn new(
         effect: EffectName,
         scene: &Scene,
@@ -154,7 +162,7 @@ impl<'a> Judge<'a> {
         orbit: OrbitCamera,
         oracle: &'a Oracle,
     ) -> Self {
-        let viewport = view.viewport();
+        let viewport = view.pixel_viewport();
         let aspect = f64::from(viewport.width) / f64::from(viewport.height);
         let bounds = scene.mesh.bounds();
         let (lo, hi) = bounds;
@@ -168,11 +176,17 @@ impl<'a> Judge<'a> {
         };
         let effect = effect.effect();
         let attributes = (effect == Effect::Fresnel).then(|| Attributes::new(view));
-        let covered = oracle.depth_complexity().iter().filter(|&&c| c > 0).count();
+        let samples = view.samples().map_or(1, |pattern| pattern.count());
+        let covered = oracle
+            .depth_complexity()
+            .chunks(samples as usize)
+            .filter(|pixel| pixel.iter().any(|&c| c > 0))
+            .count();
         let mut judge = Self {
             effect,
             material,
             size: (viewport.width, viewport.height),
+            samples,
             distance,
             attributes,
             oracle,
@@ -182,6 +196,31 @@ impl<'a> Judge<'a> {
         let cosines = judge.recompute(|p| oracle.pixel(p));
         judge.reference = judge.shade(|p| oracle.pixel(p), cosines.as_ref());
         judge
+    }
+
+    /// The judge of `effect` for `view` rasterizing per sample, against `oracle`, the per-sample
+    /// oracle's lists ([`fragsim_oracle::samples::SampleOracle::oracle`]).
+    ///
+    /// # Errors
+    /// A view at one sample, or Fresnel: its normals are recomputed per pixel centre, not per
+    /// sample.
+    pub fn per_sample(
+        effect: EffectName,
+        scene: &Scene,
+        view: &View<'a>,
+        orbit: OrbitCamera,
+        oracle: &'a Oracle,
+    ) -> Result<Self, String> {
+        if view.samples().is_none() {
+            return Err("a per-sample judge needs a view rasterizing per sample".into());
+        }
+        if effect.effect() == Effect::Fresnel {
+            return Err(format!(
+                "{} is not resolved per sample (its normals are a pixel centre's)",
+                effect.label()
+            ));
+        }
+        Ok(Self::new(effect, scene, view, orbit, oracle))
     }
 
     /// The oracle's image.
@@ -247,11 +286,13 @@ impl<'a> Judge<'a> {
             distance: &*self.distance,
             cosine: &cosine,
         };
-        effects::render(
+        // At one sample the resolve is the single-sample image bit for bit (§11).
+        effects::render_resolved(
             self.effect,
             &self.material,
             Entries::KeyAndPrim,
             self.size,
+            self.samples,
             &list,
             geometry,
         )
@@ -262,6 +303,22 @@ impl<'a> Judge<'a> {
     pub fn judge(&self, capture: &Capture) -> Option<Judged<'_>> {
         let start = Instant::now();
         let (full, completed) = deferred::complete(capture, self.oracle);
+        self.judge_full(&full.lists, completed, start)
+    }
+
+    /// The image of `lists` of full identities (depth key and primitive id, indexed like the
+    /// oracle's), compared with the oracle's: the masked nodes' per-sample resolve.
+    pub fn judge_lists(&self, lists: &PixelLists) -> Option<Judged<'_>> {
+        self.judge_full(lists, None, Instant::now())
+    }
+
+    /// The image of `full`, `completed` from the oracle (what, if anything) since `start`.
+    fn judge_full(
+        &self,
+        full: &PixelLists,
+        completed: Option<&'static str>,
+        start: Instant,
+    ) -> Option<Judged<'_>> {
         let cosines = self.recompute(|p| full.pixel(p));
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let recomputed_entries = cosines.as_ref().map_or(0, |c| c.len() as u64);

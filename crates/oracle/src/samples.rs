@@ -13,7 +13,7 @@
 //! masked-node A-buffer applies when it captures).
 
 use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
-use fragsim_capture::PixelLists;
+use fragsim_capture::{Capture, Identity, PixelLists};
 use fragsim_raster::{Fragment, SamplePattern, View, Viewport};
 
 use crate::Oracle;
@@ -99,6 +99,27 @@ impl SampleOracle {
     /// If `candidate` covers another number of samples.
     #[must_use]
     pub fn sample_error(&self, candidate: &PixelLists) -> SampleError {
+        self.error_by(candidate, primitive_id)
+    }
+
+    /// [`SampleOracle::sample_error`] of a capture of any identity, from a scheme run on the
+    /// sampled view: entries compared by what its words identify, primitive ids (full and
+    /// primitive-only words) or depth keys (key-only words hold no primitive id, and comparing
+    /// their zero low halves would call every reordering right).
+    ///
+    /// # Panics
+    /// If `capture` covers another number of samples.
+    #[must_use]
+    pub fn capture_error(&self, capture: &Capture) -> SampleError {
+        let identify = match capture.identity {
+            Identity::KeyOnly => depth_key,
+            Identity::KeyAndPrim | Identity::PrimOnly => primitive_id,
+        };
+        self.error_by(&capture.lists, identify)
+    }
+
+    /// The error of `candidate`, each entry reduced to what `identify` compares.
+    fn error_by(&self, candidate: &PixelLists, identify: fn(u64) -> u32) -> SampleError {
         assert_eq!(
             candidate.pixels(),
             self.oracle.pixels(),
@@ -109,8 +130,8 @@ impl SampleOracle {
             let (want, got) = (self.oracle.pixel(sample), candidate.pixel(sample));
             error.fragments += want.len() as u64;
             error.lost += want.len().saturating_sub(got.len()) as u64;
-            let prims = |list: &[u64]| list.iter().map(|&e| e as u32).collect::<Vec<_>>();
-            if prims(want) != prims(got) {
+            let ids = |list: &[u64]| list.iter().map(|&e| identify(e)).collect::<Vec<_>>();
+            if ids(want) != ids(got) {
                 error.wrong_samples += 1;
                 if want.len() == got.len() {
                     error.misordered_samples += 1;
@@ -120,6 +141,16 @@ impl SampleOracle {
         error.samples = candidate.pixels() as u64;
         error
     }
+}
+
+/// The primitive id of a packed entry (its low half).
+fn primitive_id(entry: u64) -> u32 {
+    entry as u32
+}
+
+/// The depth key of a packed entry (its high half).
+fn depth_key(entry: u64) -> u32 {
+    (entry >> 32) as u32
 }
 
 /// What a per-sample resolve lost or misordered, against the per-sample oracle.
