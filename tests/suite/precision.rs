@@ -20,12 +20,27 @@ const F32: Conventions = Conventions {
 };
 
 fn with_bunny(test: impl FnOnce(&View<'_>, &Oracle)) {
+    with_bunny_at(96, 80, test);
+}
+
+fn with_bunny_at(width: u32, height: u32, test: impl FnOnce(&View<'_>, &Oracle)) {
     let scene = Scene::default_scene();
     let view = scene
-        .view(Viewport::new(96, 80).unwrap(), &OrbitCamera::default())
+        .view(
+            Viewport::new(width, height).unwrap(),
+            &OrbitCamera::default(),
+        )
         .unwrap();
     let oracle = Oracle::build(&view);
     test(&view, &oracle);
+}
+
+/// The bunny at 512², its f32 analysis and an engine-like capture's lists: enough shared-edge
+/// pixels for the one-snap tests.
+fn with_f32_bunny_512(test: impl FnOnce(&Oracle, &Precision, &[Vec<u64>])) {
+    with_bunny_at(512, 512, |view, oracle| {
+        test(oracle, &Precision::derive(view, &F32), &engine_like(view));
+    });
 }
 
 /// Vertex `index` through an f32 vertex shader: the matrix rounded to f32, `M·v`, the divide
@@ -335,49 +350,44 @@ fn shared_edge_pixels(precision: &Precision, lists: &[Vec<u64>]) -> Vec<(usize, 
 
 #[test]
 fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragment_through() {
-    let scene = Scene::default_scene();
-    let view = scene
-        .view(Viewport::new(512, 512).unwrap(), &OrbitCamera::default())
-        .unwrap();
-    let oracle = Oracle::build(&view);
-    let precision = Precision::derive(&view, &F32);
-    let lists = engine_like(&view);
-    let judged = judge(&precision, &oracle, &lists);
-    assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
-    let snaps = judged.snaps;
-    assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
-    assert!(
-        snaps.pinned_vertices > 0 && snaps.decided_pixels > 0,
-        "{snaps:?}"
-    );
-    assert!(
-        judged.counts.ambiguous <= snaps.joint_pixels - snaps.decided_pixels,
-        "{snaps:?}, {} ambiguous",
-        judged.counts.ambiguous
-    );
-    // Judged one by one, both fragments of each of these pixels may be present or absent, so
-    // a dropped or doubled one would be excused as ambiguous; jointly, either snap of the shared
-    // edge gives the centre to exactly one of them.
-    let shared = shared_edge_pixels(&precision, &lists);
-    assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
-    for &(p, present, absent) in shared.iter().take(8) {
-        assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
-        let mut dropped = lists.to_vec();
-        dropped[p].retain(|&w| w as u32 != present);
-        let flags = judge(&precision, &oracle, &dropped).verdicts[p];
-        assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
-        let key_lo = precision
-            .pixel(p)
-            .iter()
-            .find(|q| q.prim == absent)
-            .unwrap()
-            .key_lo;
-        let mut doubled = lists.to_vec();
-        doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
-        doubled[p].sort_unstable();
-        let flags = judge(&precision, &oracle, &doubled).verdicts[p];
-        assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
-    }
+    with_f32_bunny_512(|oracle, precision, lists| {
+        let judged = judge(precision, oracle, lists);
+        assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+        let snaps = judged.snaps;
+        assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
+        assert!(
+            snaps.pinned_vertices > 0 && snaps.decided_pixels > 0,
+            "{snaps:?}"
+        );
+        assert!(
+            judged.counts.ambiguous <= snaps.joint_pixels - snaps.decided_pixels,
+            "{snaps:?}, {} ambiguous",
+            judged.counts.ambiguous
+        );
+        // Judged one by one, both fragments of each of these pixels may be present or absent, so
+        // a dropped or doubled one would be excused as ambiguous; jointly, either snap of the shared
+        // edge gives the centre to exactly one of them.
+        let shared = shared_edge_pixels(precision, lists);
+        assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
+        for &(p, present, absent) in shared.iter().take(8) {
+            assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
+            let mut dropped = lists.to_vec();
+            dropped[p].retain(|&w| w as u32 != present);
+            let flags = judge(precision, oracle, &dropped).verdicts[p];
+            assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
+            let key_lo = precision
+                .pixel(p)
+                .iter()
+                .find(|q| q.prim == absent)
+                .unwrap()
+                .key_lo;
+            let mut doubled = lists.to_vec();
+            doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
+            doubled[p].sort_unstable();
+            let flags = judge(precision, oracle, &doubled).verdicts[p];
+            assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+        }
+    });
 }
 
 /// Key-only words (`mdts32`) name no triangle: at a centre beside a shared edge the one stored
@@ -386,37 +396,32 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
 /// dropped or doubled fragment there is still an error: no snap explains a count of 0 or 2.
 #[test]
 fn key_only_words_leave_the_triangle_unnamed_and_still_catch_a_dropped_or_doubled_fragment() {
-    let scene = Scene::default_scene();
-    let view = scene
-        .view(Viewport::new(512, 512).unwrap(), &OrbitCamera::default())
-        .unwrap();
-    let oracle = Oracle::build(&view);
-    let precision = Precision::derive(&view, &F32);
-    let lists = engine_like(&view);
-    let key_only = |lists: &[Vec<u64>]| {
-        let capture = capture_as(lists, Identity::KeyOnly);
-        compare_within(&precision, &oracle, &capture, None, &options())
-    };
-    let judged = key_only(&lists);
-    assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
-    let snaps = judged.snaps;
-    assert!(snaps.unnamed_pixels > 0, "{snaps:?}");
-    assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
-    // The same capture with ids pins the snaps instead: nothing is left unnamed.
-    assert_eq!(judge(&precision, &oracle, &lists).snaps.unnamed_pixels, 0);
-    let shared = shared_edge_pixels(&precision, &lists);
-    assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
-    for &(p, present, _) in shared.iter().take(8) {
-        assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
-        let mut dropped = lists.to_vec();
-        dropped[p].retain(|&w| w as u32 != present);
-        let flags = key_only(&dropped).verdicts[p];
-        assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
-        let mut doubled = lists.to_vec();
-        let kept = *doubled[p].iter().find(|&&w| w as u32 == present).unwrap();
-        doubled[p].push(kept);
-        doubled[p].sort_unstable();
-        let flags = key_only(&doubled).verdicts[p];
-        assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
-    }
+    with_f32_bunny_512(|oracle, precision, lists| {
+        let key_only = |lists: &[Vec<u64>]| {
+            let capture = capture_as(lists, Identity::KeyOnly);
+            compare_within(precision, oracle, &capture, None, &options())
+        };
+        let judged = key_only(lists);
+        assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+        let snaps = judged.snaps;
+        assert!(snaps.unnamed_pixels > 0, "{snaps:?}");
+        assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
+        // The same capture with ids pins the snaps instead: nothing is left unnamed.
+        assert_eq!(judge(precision, oracle, lists).snaps.unnamed_pixels, 0);
+        let shared = shared_edge_pixels(precision, lists);
+        assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
+        for &(p, present, _) in shared.iter().take(8) {
+            assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
+            let mut dropped = lists.to_vec();
+            dropped[p].retain(|&w| w as u32 != present);
+            let flags = key_only(&dropped).verdicts[p];
+            assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
+            let mut doubled = lists.to_vec();
+            let kept = *doubled[p].iter().find(|&&w| w as u32 == present).unwrap();
+            doubled[p].push(kept);
+            doubled[p].sort_unstable();
+            let flags = key_only(&doubled).verdicts[p];
+            assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+        }
+    });
 }
