@@ -128,12 +128,13 @@ pub(super) fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
 fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
     let dir = scratch("binary-corrupt");
     let dumps = dir.join("dumps");
-    render_dump(&dumps, "mdts,mdts-desc,mdts32,abuffer", &[]);
+    render_dump(&dumps, "mdts,mdts-desc,mdts32,kbuffer,abuffer", &[]);
     // (layout, slots file, bytes a word, the empty slot's word)
     let layouts = [
         ("mdts", "slots.u64", 8, u64::MAX),
         ("mdts-desc", "slots.u64", 8, 0),
         ("mdts32", "slots.u32", 4, u64::from(u32::MAX)),
+        ("kbuffer", "slots.u64", 8, u64::MAX),
     ];
     for (scheme, file, width, empty) in layouts {
         let path = dumps.join(scheme);
