@@ -440,7 +440,7 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
         let k = json_header(&path)["k"].as_u64().unwrap() as usize;
         let slots = path.join("slots.u64");
         let mut bytes = std::fs::read(&slots).unwrap();
-        let word = |bytes: &[u8], i: usize| &bytes[i * 8..i * 8 + 8] == [0xff; 8];
+        let word = |bytes: &[u8], i: usize| bytes[i * 8..i * 8 + 8] == [0xff; 8];
         let p = (0..bytes.len() / 8 / k)
             .find(|&p| !word(&bytes, p * k))
             .unwrap();
