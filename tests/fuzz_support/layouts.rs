@@ -635,7 +635,8 @@ fn memory(
     }
 }
 
-/// The slot schemes a slot dump may name, and whether the A-buffer's storage is exact.
+/// The slot schemes a slot dump may name, whether the A-buffer's storage is exact, and which
+/// k-buffer's slots (under its own name: its promise and resolve).
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum SlotScheme {
     Mdts,
@@ -643,9 +644,10 @@ enum SlotScheme {
     Mdts32,
     ABufferFixed,
     ABufferExact,
+    KBuffer(SchemeName),
 }
 
-/// A slot dump (`mdts`, `mdts-desc`, `mdts32`, `abuffer`) in a described layout (slot-major or
+/// A slot dump (`mdts`, `mdts-desc`, `mdts32`, `abuffer`, a k-buffer) in a described layout (slot-major or
 /// pixel-major, any payload) and its model: the same words in fragsim's own encoding, placed
 /// pixel-major and decoded as the format says, read and checked by the reader's own-encoding
 /// path. The described dump must decode and check the same, naming each corrupt word as stored.
@@ -656,12 +658,18 @@ fn slots(
     arrays: &mut Vec<(&'static str, Words)>,
 ) -> Result<Option<Model>, String> {
     let pixels = viewport.pixels();
-    let scheme = match input.u8() % 5 {
+    let kbuffers: Vec<SchemeName> = CATALOG
+        .iter()
+        .filter(|e| e.dump == Some(DumpLayout::KBufferSlots))
+        .map(|e| e.scheme)
+        .collect();
+    let scheme = match input.u8() % 6 {
         0 => SlotScheme::Mdts,
         1 => SlotScheme::MdtsDesc,
         2 => SlotScheme::Mdts32,
         3 => SlotScheme::ABufferFixed,
-        _ => SlotScheme::ABufferExact,
+        4 => SlotScheme::ABufferExact,
+        _ => SlotScheme::KBuffer(kbuffers[usize::from(input.u8()) % kbuffers.len()]),
     };
     let order = if input.u8() & 1 != 0 {
         SlotOrder::SlotMajor
@@ -743,6 +751,7 @@ fn slots(
         SlotScheme::MdtsDesc => "mdts-desc",
         SlotScheme::Mdts32 => "mdts32",
         SlotScheme::ABufferFixed | SlotScheme::ABufferExact => "abuffer",
+        SlotScheme::KBuffer(kbuffer) => kbuffer.name(),
     }
     .into();
     match scheme {

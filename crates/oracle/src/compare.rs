@@ -427,10 +427,20 @@ pub fn compare_with(
         one.entries.clear();
         let mut flags = 0;
         one.keeps = match &candidate.keeps {
-            Keeps::All { overflow, .. } => {
-                let counter = match words.and_then(|w| w.counters.as_ref()) {
-                    Some(counters) => counters[p],
-                    None => inferred_counter(got.len(), overflow[p]),
+            Keeps::All {
+                overflow,
+                capacity: kept,
+            } => {
+                let counter = match (words.and_then(|w| w.counters.as_ref()), kept) {
+                    (Some(counters), _) => counters[p],
+                    // Storage that discards its overflow uncounted (Bevy's clamp, a list resolve
+                    // stopping at `C` nodes, the ordered interlock keeping the first `C`): its
+                    // count is the reference's, and its capacity is known.
+                    (None, Capacity::PerPixelUncounted(c)) if knows_n => Counter {
+                        count: n as u32,
+                        capacity: *c,
+                    },
+                    (None, _) => inferred_counter(got.len(), overflow[p]),
                 };
                 comparison.claimed_overflow += u64::from(overflow[p]);
                 // The marker is no fragment: its word check calls it corrupt.

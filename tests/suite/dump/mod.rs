@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::oracle::compare::{CompareOptions, Comparison};
 use fragsim::oracle::dump::{Dump, DumpScheme, Words};
@@ -62,6 +63,16 @@ fn every_layout(oracle: &Oracle) -> Vec<DumpScheme> {
             direction: Direction::Descending,
         },
         DumpScheme::Mdts32 { k: 3 },
+        // The k-buffers' slots: the K nearest, and the first K in primitive order (fewer than
+        // the scene's layers, so that the promise differs from MDTS's).
+        DumpScheme::KBuffer {
+            scheme: SchemeName::Kbuffer,
+            k,
+        },
+        DumpScheme::KBuffer {
+            scheme: SchemeName::KbufferInterlockOrderedFirst,
+            k: 2,
+        },
         DumpScheme::ABufferFixed {
             capacity: k,
             sorted: true,

@@ -34,7 +34,9 @@ fn widened(dump: &Dump, name: &str) -> Vec<u64> {
 /// Slots per pixel of a fixed-storage slot scheme.
 fn slots_per_pixel(scheme: &DumpScheme) -> Option<usize> {
     match scheme {
-        DumpScheme::Mdts { k, .. } | DumpScheme::Mdts32 { k } => Some(*k as usize),
+        DumpScheme::Mdts { k, .. } | DumpScheme::Mdts32 { k } | DumpScheme::KBuffer { k, .. } => {
+            Some(*k as usize)
+        }
         DumpScheme::ABufferFixed { capacity, .. } => Some(*capacity as usize),
         _ => None,
     }
@@ -253,6 +255,10 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
             k,
             direction: Direction::Ascending,
         });
+        let kbuffer = record(&DumpScheme::KBuffer {
+            scheme: SchemeName::Kbuffer,
+            k,
+        });
         let slot_major = json!({"kind": "slots", "order": "slot-major"});
         let cases: Vec<(&Dump, serde_json::Value, &str)> = vec![
             (
@@ -284,6 +290,18 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
                 json!({"kind": "memory"}),
                 "scheme mdts dumps as slots, the header's layout is memory",
             ),
+            // A k-buffer's slots are no longer read as its memory of old.
+            (
+                &kbuffer,
+                json!({"kind": "memory"}),
+                "scheme kbuffer dumps as slots, the header's layout is memory",
+            ),
+            (
+                &kbuffer,
+                json!({"kind": "slots", "order": "pixel-major",
+                       "payload": {"dtype": "u32", "depth": "unorm24", "depth_shift": 8, "prim_bits": 0}}),
+                "payload \"prim_bits\" 0 must be 1 to 32",
+            ),
         ];
         for (dump, layout, expected) in cases {
             let error = refused(dump, |h| h["layout"] = layout.clone());
@@ -307,7 +325,14 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
             h["k"] = json!(k + 1);
         });
         assert!(error.contains("array \"slots\" has"), "{error}");
+        let error = refused(&kbuffer, |h| h["k"] = json!(0));
+        assert!(error.contains("scheme kbuffer needs \"k\" ≥ 1"), "{error}");
     });
+}
+
+/// The header of the dump in `dir`.
+fn json_header(dir: &std::path::Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("dump.json")).unwrap()).unwrap()
 }
 
 /// The `compare` record of `fragsim compare oracle DIR --json`, and the exit code.
@@ -397,9 +422,37 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
         "abuffer",
         "linked-list",
         "layer-counter",
+        "kbuffer",
+        "kbuffer-interlock-ordered-first",
+        "loop64",
     ] {
         let (record, code) = compare_record(&engine.join(scheme));
         assert_eq!((&record["equal"], code), (&json!(true), 0), "{scheme}");
+    }
+    // The k-buffers keep their name (their promise) and take the slot encoding; loop64 is mdts.
+    assert_eq!(header("kbuffer")["scheme"], "kbuffer");
+    assert_eq!(header("kbuffer-spinlock")["layout"]["order"], "slot-major");
+    assert_eq!(header("loop64")["scheme"], "mdts");
+    // A k-buffer that lost a fragment (a race's lost write-back: a pixel's last full slot never
+    // written) is DIFFERENT under either promise, never excused as overflow.
+    for scheme in ["kbuffer", "kbuffer-interlock-ordered-first"] {
+        let path = own.join(scheme);
+        let k = json_header(&path)["k"].as_u64().unwrap() as usize;
+        let slots = path.join("slots.u64");
+        let mut bytes = std::fs::read(&slots).unwrap();
+        let word = |bytes: &[u8], i: usize| bytes[i * 8..i * 8 + 8] == [0xff; 8];
+        let p = (0..bytes.len() / 8 / k)
+            .find(|&p| !word(&bytes, p * k))
+            .unwrap();
+        let last = (p * k..(p + 1) * k).rfind(|&i| !word(&bytes, i)).unwrap();
+        bytes[last * 8..last * 8 + 8].copy_from_slice(&[0xff; 8]);
+        std::fs::write(&slots, bytes).unwrap();
+        let (record, code) = compare_record(&path);
+        assert_eq!(
+            (code, &record["lost"]),
+            (1, &json!(1)),
+            "{scheme}: {record}"
+        );
     }
     // Unorm depths are judged by the steps their conversion may land on, derived, with no
     // tolerance to give: EQUAL as written, bit for bit never (`stored_depth` says why).
@@ -475,44 +528,49 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
 }
 
 #[test]
-fn the_slot_words_of_loop64_and_the_k_buffers_read_as_mdts_slots() {
-    // Their memory dumps hold fragsim's words undescribed; their slot words alone are MDTS's,
-    // so an engine's port of them can be dumped as `mdts` slots in the order it keeps them.
-    let slot_words = [
-        ("loop64", SlotOrder::SlotMajor),
-        ("kbuffer", SlotOrder::PixelMajor),
-        ("kbuffer-stores", SlotOrder::PixelMajor),
-        ("kbuffer-interlock", SlotOrder::PixelMajor),
-        ("kbuffer-interlock-ordered", SlotOrder::PixelMajor),
-        ("kbuffer-interlock-ordered-first", SlotOrder::PixelMajor),
-        ("kbuffer-spinlock", SlotOrder::PixelMajor),
-        ("kbuffer-spinlock-fixed", SlotOrder::PixelMajor),
+fn the_k_buffers_and_loop64_dump_their_own_slot_words() {
+    // A k-buffer's dump is its memory's u64 words, its K slots a pixel, under its own name;
+    // loop64's memory is the `mdts` dump it writes, placed slot-major.
+    let schemes = [
+        "loop64",
+        "kbuffer",
+        "kbuffer-stores",
+        "kbuffer-interlock",
+        "kbuffer-interlock-ordered",
+        "kbuffer-interlock-ordered-first",
+        "kbuffer-spinlock",
+        "kbuffer-spinlock-fixed",
     ];
     with_view(|view, oracle| {
         let k = oracle.max_depth_complexity();
-        let pixels = oracle.pixels() as u64;
-        for (name, order) in slot_words {
+        let sizes = fragsim::capture::catalog::Build::fixed(view.viewport(), k, 1, 1, u64::MAX);
+        for name in schemes {
+            let scheme = SchemeName::from_name(name).unwrap();
             let memory = DumpScheme::Memory {
-                scheme: SchemeName::from_name(name).unwrap(),
+                scheme,
                 k,
                 capacity: 1,
                 layers: 1,
             };
-            let mut dump = Dump::record(view, spec(), &memory, "test").unwrap();
-            let words = dump.arrays.remove("words64").unwrap();
-            dump.arrays.clear();
-            dump.header.arrays.clear();
-            dump.header.scheme = "mdts".into();
-            (dump.header.k, dump.header.capacity, dump.header.layers) = (Some(k), None, None);
-            dump.header.layout = Some(LayoutSpec::Slots {
-                order,
-                payload: None,
-            });
-            let shape = match order {
-                SlotOrder::PixelMajor => vec![pixels, u64::from(k)],
-                SlotOrder::SlotMajor => vec![u64::from(k), pixels],
-            };
-            dump.set_array("slots", words, shape);
+            let memory = Dump::record(view, spec(), &memory, "test").unwrap();
+            let layout = DumpScheme::for_run(scheme, k, &sizes, None).unwrap();
+            let mut dump = Dump::record(view, spec(), &layout, "test").unwrap();
+            let own_name = name != "loop64";
+            assert_eq!(dump.header.scheme, if own_name { name } else { "mdts" });
+            if !own_name {
+                let order = SlotOrder::SlotMajor;
+                let spec = LayoutSpec::Slots {
+                    order,
+                    payload: None,
+                };
+                dump = dump.in_layout(Some(spec)).unwrap();
+            }
+            assert_eq!(
+                widened(&dump, "slots"),
+                widened(&memory, "words64"),
+                "{name}"
+            );
+            assert_eq!(dump.arrays.len(), 1, "{name}: no locks");
             let comparison = judged(&dump, oracle);
             assert!(comparison.is_equal() && comparison.words_checked, "{name}");
         }

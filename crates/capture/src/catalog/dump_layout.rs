@@ -8,7 +8,8 @@ use super::{SchemeName, CATALOG};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DumpLayout {
     /// `slots` `[pixels, k]`: each pixel's `k` slots of one word each, pixel-major, full slots
-    /// first (MDTS; the z-buffer is its `k` = 1).
+    /// first (MDTS; the z-buffer is its `k` = 1; loop64 keeps the same array slot-major, the
+    /// order a header may describe, with the same promise, the K nearest).
     SlotArray(SlotWord),
     /// The A-buffer's `counters` `[pixels]` (fetch-and-add counts, u32) and `slots` of fragment
     /// words (u64): `[pixels, capacity]` for fixed storage, or `[total]` beside `offsets`
@@ -20,9 +21,17 @@ pub enum DumpLayout {
     LinkedLists,
     /// Layer-major layers (Bevy's `layers[layer * pixels + pixel]`) beside per-pixel `counters`.
     LayerMajor,
+    /// A k-buffer's `slots` `[pixels, k]`: MDTS's slot array of fragment words
+    /// ([`SlotWord::Fragment`]), which is what its K render targets or slot arrays hold, without
+    /// the scheme's u32 words (locks, tickets, sections done), which its resolve never reads.
+    /// Each entry dumps under its own name, so that the reader holds the words to the scheme's
+    /// own promise (the K nearest; `kbuffer-interlock-ordered-first` the first K in primitive
+    /// order) and decodes them with its own resolve (which keeps the gaps, duplicates and
+    /// disorder a hazard leaves, for the diff to see).
+    KBufferSlots,
     /// The scheme's own words as they are after its last pass (`words32`, `words64`), decoded by
     /// its own resolve: schemes whose memory is no list per pixel (bucket histograms, peeling's
-    /// layer records, the k-buffer's slots beside its locks). Each entry dumps under its own name.
+    /// layer records, stencil-routed samples). Each entry dumps under its own name.
     Memory,
 }
 
@@ -42,14 +51,17 @@ impl DumpLayout {
     /// need that scheme's own resolve) rather than the name of the layout's first entry.
     #[must_use]
     pub fn names_its_scheme(self) -> bool {
-        matches!(self, DumpLayout::LinkedLists | DumpLayout::Memory)
+        matches!(
+            self,
+            DumpLayout::LinkedLists | DumpLayout::KBufferSlots | DumpLayout::Memory
+        )
     }
 
     /// The scheme whose name a dump of this layout carries in its header, for a layout that
     /// does not name its scheme ([`DumpLayout::names_its_scheme`]): the first catalog entry with
     /// the layout. Other entries with it leave the same words (`abuffer-bitonic` and
-    /// `abuffer-exact` dump as `abuffer`, `mdts-probe` and `zbuffer` as `mdts`), so a reader
-    /// rebuilds them as that one.
+    /// `abuffer-exact` dump as `abuffer`, `mdts-probe`, `zbuffer` and `loop64` as `mdts`), so a
+    /// reader rebuilds them as that one.
     ///
     /// # Panics
     /// If no catalog entry has the layout (a unit test checks that every layout has one).
@@ -103,6 +115,7 @@ mod tests {
             DumpLayout::CountersAndSlots,
             DumpLayout::LinkedLists,
             DumpLayout::LayerMajor,
+            DumpLayout::KBufferSlots,
             DumpLayout::Memory,
         ];
         for layout in layouts {

@@ -218,7 +218,7 @@ macro_rules! catalog {
     (@flag $value:literal) => { $value };
 }
 
-use DumpLayout::{CountersAndSlots, LayerMajor, LinkedLists, Memory, SlotArray};
+use DumpLayout::{CountersAndSlots, KBufferSlots, LayerMajor, LinkedLists, Memory, SlotArray};
 use Passes::{Fixed, PerLayers, UntilConfirmed, UpTo};
 use SlotWord::{Fragment, FragmentPlusOne, Key};
 use Storage::{Capacity, Counted, KAndPool, Slots, K};
@@ -278,29 +278,29 @@ catalog! {
     Adp "adp" PerLayers { before: 2, per: 32, after: 0 }, Counted, Some(Memory),
         "Adaptive bucket depth peeling (§3.3).";
         |b| (Adp::<u32>::new(b.viewport, b.layers, b.memory_cap)?, Some(b.layers));
-    Kbuffer "kbuffer" Fixed(1), K, Some(Memory),
+    Kbuffer "kbuffer" Fixed(1), K, Some(KBufferSlots),
         "The k-buffer: read–insert–write of K slots, exact only without concurrent hazards; render-target write-backs (one step each, committed in primitive order).";
         read-modify-write RenderTarget;
         |b| (KBuffer::with_write_back(b.viewport, b.k, RenderTarget, b.memory_cap)?, Some(b.k));
-    KbufferStores "kbuffer-stores" Fixed(1), K, Some(Memory),
+    KbufferStores "kbuffer-stores" Fixed(1), K, Some(KBufferSlots),
         "The k-buffer with K separate loads and stores (CUDA's): torn write-backs too.";
         read-modify-write SeparateStores;
         |b| (KBuffer::with_write_back(b.viewport, b.k, SeparateStores, b.memory_cap)?, Some(b.k));
-    KbufferInterlock "kbuffer-interlock" Fixed(1), K, Some(Memory),
+    KbufferInterlock "kbuffer-interlock" Fixed(1), K, Some(KBufferSlots),
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
         |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
-    KbufferInterlockOrdered "kbuffer-interlock-ordered" Fixed(1), K, Some(Memory),
+    KbufferInterlockOrdered "kbuffer-interlock-ordered" Fixed(1), K, Some(KBufferSlots),
         "The interlocked k-buffer with ordered critical sections (a pixel's in primitive order: Vulkan's ordered interlock, D3D's ROVs): exact under any interleaving.";
         in-primitive-order true;
         |b| (KBufferInterlockOrdered::new(b.viewport, b.k, Keep::Nearest, b.order, b.memory_cap)?, Some(b.k));
-    KbufferInterlockOrderedFirst "kbuffer-interlock-ordered-first" Fixed(1), K, Some(Memory),
+    KbufferInterlockOrderedFirst "kbuffer-interlock-ordered-first" Fixed(1), K, Some(KBufferSlots),
         "The ordered interlock keeping the first `--k` fragments of each pixel in primitive order (keep-first made deterministic): the same lists under any interleaving.";
         in-primitive-order true;
         |b| (KBufferInterlockOrdered::new(b.viewport, b.k, Keep::First, b.order, b.memory_cap)?, Some(b.k));
-    KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, Some(Memory),
+    KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, Some(KBufferSlots),
         "The k-buffer's read–insert–write of K slots under a per-pixel spinlock (compare-and-swap, critical section after the spin loop; nvpro-samples' spinlock mode): exact under independent thread scheduling, deadlocks lockstep warps.";
         |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
-    KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, Some(Memory),
+    KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, Some(KBufferSlots),
         "The spinlocked k-buffer with the critical section and release inside the lock loop's body: exact, and terminates under lockstep warps too.";
         |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Fixed, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, Some(Memory),
@@ -320,7 +320,7 @@ catalog! {
     Loop32 "loop32" Fixed(2), K, Some(Memory),
         "nvpro-samples' loop32: MDTS's `atomicMin` loop stopping on an equal depth (equal depths merge), then a colour pass; K = `--k`.";
         |b| (Loop32::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
-    Loop64 "loop64" Fixed(1), K, Some(Memory),
+    Loop64 "loop64" Fixed(1), K, Some(SlotArray(Fragment)),
         "nvpro-samples' loop64: one pass of 64-bit `atomicMin` on packed (depth, colour) words, here (depth, primitive): exact, K = `--k`.";
         |b| (crate::schemes::loop64::Loop64::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     Mlab "mlab" Fixed(1), K, Some(Memory),

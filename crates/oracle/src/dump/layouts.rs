@@ -72,6 +72,16 @@ pub enum DumpScheme {
         /// The payload.
         payload: Payload,
     },
+    /// A k-buffer's slots (`kbuffer`, `kbuffer-stores`, `kbuffer-interlock*`,
+    /// `kbuffer-spinlock*`): `slots` `[pixels, k]` as MDTS's, under the scheme's own name, rebuilt
+    /// and resolved as `scheme` (its promise, its resolve), its u32 words left at their initial
+    /// values ([`DumpLayout::KBufferSlots`]).
+    KBuffer {
+        /// The k-buffer.
+        scheme: SchemeName,
+        /// Slots per pixel.
+        k: u32,
+    },
     /// Any other scheme's own memory after its last pass: `words32`, `words64`
     /// ([`LayoutSpec::Memory`]), rebuilt and resolved as `scheme` sized so.
     Memory {
@@ -119,6 +129,7 @@ impl DumpScheme {
             Self::ABufferFixed { .. } | Self::ABufferExact { .. } => DumpLayout::CountersAndSlots,
             Self::LinkedLists { .. } => DumpLayout::LinkedLists,
             Self::LayerMajor { .. } => DumpLayout::LayerMajor,
+            Self::KBuffer { .. } => DumpLayout::KBufferSlots,
             Self::Memory { .. } => DumpLayout::Memory,
         }
     }
@@ -133,7 +144,9 @@ impl DumpScheme {
     /// The catalog scheme the dump's words are rebuilt as.
     fn scheme_name(&self) -> SchemeName {
         match self {
-            Self::LinkedLists { scheme, .. } | Self::Memory { scheme, .. } => *scheme,
+            Self::LinkedLists { scheme, .. }
+            | Self::KBuffer { scheme, .. }
+            | Self::Memory { scheme, .. } => *scheme,
             _ => self.layout().scheme(),
         }
     }
@@ -168,6 +181,7 @@ impl DumpScheme {
         let spec = match self {
             Self::Mdts { .. }
             | Self::Mdts32 { .. }
+            | Self::KBuffer { .. }
             | Self::ABufferFixed { .. }
             | Self::ABufferExact { .. } => {
                 let keys = matches!(self, Self::Mdts32 { .. });
@@ -271,6 +285,10 @@ impl DumpScheme {
                 k: slots,
                 payload: Payload::FRAGMENT,
             },
+            DumpLayout::KBufferSlots => Self::KBuffer {
+                scheme: name,
+                k: slots,
+            },
             DumpLayout::Memory => Self::Memory {
                 scheme: name,
                 k: sizes.k,
@@ -285,9 +303,9 @@ impl DumpScheme {
         match self.layout() {
             DumpLayout::SlotArray(SlotWord::FragmentPlusOne) => "(key<<32|prim)+1",
             DumpLayout::SlotArray(SlotWord::Key) => "key",
-            DumpLayout::SlotArray(SlotWord::Fragment) | DumpLayout::CountersAndSlots => {
-                "key<<32|prim"
-            }
+            DumpLayout::SlotArray(SlotWord::Fragment)
+            | DumpLayout::KBufferSlots
+            | DumpLayout::CountersAndSlots => "key<<32|prim",
             // The description is in `"layout"`.
             DumpLayout::LinkedLists | DumpLayout::LayerMajor | DumpLayout::Memory => "",
         }
@@ -299,7 +317,8 @@ impl DumpScheme {
                 words32: Some("slots"),
                 words64: None,
             },
-            DumpLayout::SlotArray(_) => ArrayNames {
+            // A k-buffer's u32 words are its locks, which are not dumped (`Resolve`).
+            DumpLayout::SlotArray(_) | DumpLayout::KBufferSlots => ArrayNames {
                 words32: None,
                 words64: Some("slots"),
             },
@@ -327,7 +346,10 @@ impl DumpScheme {
         visitor: V,
     ) -> Result<V::Output, DumpError> {
         let slots = match self {
-            Self::Mdts { k, .. } | Self::Mdts32 { k } | Self::LayerMajor { k, .. } => *k,
+            Self::Mdts { k, .. }
+            | Self::Mdts32 { k }
+            | Self::LayerMajor { k, .. }
+            | Self::KBuffer { k, .. } => *k,
             Self::ABufferFixed { capacity, .. } => *capacity,
             Self::ABufferExact { .. } => 0,
             Self::LinkedLists { k, .. } => *k,
@@ -381,7 +403,9 @@ impl DumpScheme {
                     DumpLayout::LinkedLists => "linked-list",
                     DumpLayout::LayerMajor => "layer-major",
                     DumpLayout::Memory => "memory",
-                    DumpLayout::SlotArray(_) | DumpLayout::CountersAndSlots => "slots",
+                    DumpLayout::SlotArray(_)
+                    | DumpLayout::KBufferSlots
+                    | DumpLayout::CountersAndSlots => "slots",
                 };
                 if spec.kind() != expected {
                     return err(format!(
@@ -447,6 +471,7 @@ impl DumpScheme {
                 direction: Direction::Descending,
             },
             DumpLayout::SlotArray(SlotWord::Key) => Self::Mdts32 { k: k()? },
+            DumpLayout::KBufferSlots => Self::KBuffer { scheme, k: k()? },
             DumpLayout::CountersAndSlots => match (header.capacity, offsets) {
                 (Some(0), _) => return err(format!("{name} \"capacity\" must be at least 1")),
                 (Some(capacity), _) => Self::ABufferFixed {
@@ -636,8 +661,14 @@ impl Dump {
         };
         let missing = |n: &str| DumpError(format!("missing array {n:?}"));
         match &scheme {
-            DumpScheme::Mdts { k, direction } => {
+            DumpScheme::Mdts { k, .. } | DumpScheme::KBuffer { k, .. } => {
                 let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
+                // A k-buffer's slots obey MDTS's rules: every write-back leaves them sorted, full
+                // slots first, so a gap is a hazard's (or a stray write's).
+                let direction = match &scheme {
+                    DumpScheme::Mdts { direction, .. } => *direction,
+                    _ => Direction::Ascending,
+                };
                 let (empty, key): (u64, fn(u64) -> u32) = match direction {
                     Direction::Ascending => (u64::MAX, |w| (w >> 32) as u32),
                     Direction::Descending => (0, |w| (w.wrapping_sub(1) >> 32) as u32),
@@ -732,6 +763,7 @@ pub(super) fn pixel_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usiz
             capacity: slots, ..
         }
         | DumpScheme::Mdts { k: slots, .. }
+        | DumpScheme::KBuffer { k: slots, .. }
         | DumpScheme::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
         _ => (offsets[p], offsets[p + 1] - offsets[p]),
     }

@@ -36,9 +36,10 @@
 //! assert!(comparison.is_equal() && comparison.words_checked);
 //! ```
 //!
-//! Every catalog scheme has a layout: MDTS slots, the A-buffer's counters and slots, linked lists
-//! (heads, next, nodes, the pool counter), Bevy's layer-major layers, or, for schemes whose memory
-//! is no list per pixel, the scheme's own memory words. Any of them may carry a description
+//! Every catalog scheme has a layout: MDTS slots, the A-buffer's counters and slots, a k-buffer's
+//! slots (MDTS's, under its own name), linked lists (heads, next, nodes, the pool counter), Bevy's
+//! layer-major layers, or, for schemes whose memory is no list per pixel, the scheme's own memory
+//! words. Any of them may carry a description
 //! ([`LayoutSpec`]: slot arrays pixel-major or slot-major, a list's terminator and node numbering,
 //! the payload's u32 or u64 word, f32, unorm24 or unorm16 depth and id bits), so an engine's own
 //! buffers can be dumped as they are; [`Dump::in_layout`] writes fragsim's words so

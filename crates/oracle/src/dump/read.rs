@@ -23,7 +23,9 @@ fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W])
 /// are taken as stored instead.
 struct Resolve<'a> {
     scheme: &'a DumpScheme,
-    words32: &'a [u32],
+    /// `None`: the dump has none of the scheme's u32 words (a k-buffer's locks and tickets, which
+    /// its resolve never reads), so they keep their initial values.
+    words32: Option<&'a [u32]>,
     words64: &'a [u64],
 }
 
@@ -31,23 +33,27 @@ impl SchemeVisitor for Resolve<'_> {
     type Output = Result<Capture, DumpError>;
     fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> Self::Output {
         let layout = scheme.layout();
-        if layout.words32 != self.words32.len() || layout.words64 != self.words64.len() {
+        let words32 = self.words32.map_or(layout.words32, <[u32]>::len);
+        if layout.words32 != words32 || layout.words64 != self.words64.len() {
             return err(format!(
-                "{} over this viewport holds {} u32 and {} u64 words; the dump has {} and {}",
+                "{} over this viewport holds {} u32 and {} u64 words; the dump has {words32} and {}",
                 scheme.name(),
                 layout.words32,
                 layout.words64,
-                self.words32.len(),
                 self.words64.len()
             ));
         }
         if let DumpScheme::ABufferFixed { sorted: true, .. }
         | DumpScheme::ABufferExact { sorted: true, .. } = self.scheme
         {
-            return Ok(stored_lists(self.scheme, self.words32, self.words64));
+            return Ok(stored_lists(
+                self.scheme,
+                self.words32.unwrap_or_default(),
+                self.words64,
+            ));
         }
         let memory: SerialMemory = layout.allocate();
-        write_all(&memory, self.words32);
+        write_all(&memory, self.words32.unwrap_or_default());
         write_all(&memory, self.words64);
         Ok(scheme.resolve(&memory))
     }
@@ -186,12 +192,16 @@ impl Dump {
         let (words32, words64) = match scheme {
             DumpScheme::LinkedLists { .. } | DumpScheme::LayerMajor { .. } => {
                 translated = self.translate(&scheme)?;
-                (&translated.words32[..], &translated.words64[..])
+                (Some(&translated.words32[..]), &translated.words64[..])
             }
+            DumpScheme::KBuffer { .. } => (None, required(Some("slots"), self.u64s("slots"))?),
             _ => {
                 let names = scheme.names();
                 (
-                    required(names.words32, self.u32s(names.words32.unwrap_or_default()))?,
+                    Some(required(
+                        names.words32,
+                        self.u32s(names.words32.unwrap_or_default()),
+                    )?),
                     required(names.words64, self.u64s(names.words64.unwrap_or_default()))?,
                 )
             }

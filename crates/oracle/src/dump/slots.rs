@@ -1,4 +1,4 @@
-//! Slot dumps (`mdts`, `mdts32`, `mdts-desc`, `abuffer`) in an engine's layout
+//! Slot dumps (`mdts`, `mdts32`, `mdts-desc`, `abuffer`, the k-buffers) in an engine's layout
 //! ([`LayoutSpec::Slots`]): the `slots` array slot-major or pixel-major, each word packed as the
 //! header's payload. Reading turns them into fragsim's own encoding (pixel-major, fragsim's
 //! words) before the scheme's resolve and word rules run, so every rule holds of either; writing
@@ -121,7 +121,9 @@ impl Placement {
 /// The slots per pixel of a slot scheme with fixed storage (`None`: exact storage).
 fn fixed_slots(scheme: &DumpScheme) -> Option<u32> {
     match scheme {
-        DumpScheme::Mdts { k, .. } | DumpScheme::Mdts32 { k } => Some(*k),
+        DumpScheme::Mdts { k, .. } | DumpScheme::Mdts32 { k } | DumpScheme::KBuffer { k, .. } => {
+            Some(*k)
+        }
         DumpScheme::ABufferFixed { capacity, .. } => Some(*capacity),
         _ => None,
     }

@@ -251,7 +251,7 @@ pub enum LayoutSpec {
     /// The scheme's own memory after its last pass: `words32` and `words64`, in the order its
     /// module documents.
     Memory,
-    /// The slot layouts (`mdts`, `mdts32`, `mdts-desc`, `abuffer`): the `slots` array in
+    /// The slot layouts (`mdts`, `mdts32`, `mdts-desc`, `abuffer`, the k-buffers): the `slots` array in
     /// `order`, each word packed as `payload` (absent: the scheme's own word). The empty marker
     /// is all ones of the word (`0` for `mdts-desc`, whose words are the payload plus one).
     Slots {

@@ -141,8 +141,10 @@ impl Dump {
                         arrays.insert("offsets".into(), Words::U32(offsets));
                         vec![total]
                     }
-                    // The slot layouts: MDTS on either word.
-                    DumpScheme::Mdts { k: n, .. } | DumpScheme::Mdts32 { k: n } => {
+                    // The slot layouts: MDTS on either word, a k-buffer's slots.
+                    DumpScheme::Mdts { k: n, .. }
+                    | DumpScheme::Mdts32 { k: n }
+                    | DumpScheme::KBuffer { k: n, .. } => {
                         k = Some(*n);
                         vec![pixels, u64::from(*n)]
                     }
