@@ -2,9 +2,9 @@
 // 2007): a fragment reads its pixel's K sorted slots and writes back the ones its insertion
 // shifts, with plain loads and stores. Two fragments of one pixel that interleave their reads
 // and writes lose one of them: the race this shader exists to show on real hardware. Words are
-// key << 32 | prim as (low, high) u32 pairs, empty = all ones, ascending: the catalog's memory
-// layout for the scheme (words64: the slots; words32, the render-target machine's lock and
-// ticket words, are bound by the host and never touched here).
+// key << 32 | prim as (low, high) u32 pairs, empty = all ones, ascending: the catalog's k-buffer
+// slot layout, slots[pixel * K + slot] (the render-target machine's lock and ticket words, which
+// the CPU model keeps beside them, are bound by the host at binding 5 and never touched here).
 
 @group(0) @binding(6) var<storage, read_write> slots: array<vec2<u32>>;
 

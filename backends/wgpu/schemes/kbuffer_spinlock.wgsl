@@ -10,8 +10,8 @@
 // are relaxed, so the lock orders the slot accesses for no formal memory model: the slots are
 // atomics too (each access reaches the device's coherent memory, none is cached in registers
 // across the lock), and the capture shows what the hardware did. Words are key << 32 | prim as
-// (low, high) u32 pairs, empty = all ones, ascending, after the lock words: the catalog's memory
-// layout for the scheme (words32: the locks; words64: the slots).
+// (low, high) u32 pairs, empty = all ones, ascending: the catalog's k-buffer slot layout,
+// slots[pixel * K + slot] (the locks, one a pixel, are not dumped).
 
 @group(0) @binding(5) var<storage, read_write> locks: array<atomic<u32>>;
 @group(0) @binding(6) var<storage, read_write> slot_words: array<atomic<u32>>;

@@ -770,7 +770,7 @@ fn to_dump(
     let viewport = view.viewport();
     let mut arrays = BTreeMap::new();
     let mut specs = BTreeMap::new();
-    for (storage, words) in storages.iter().zip(words) {
+    for (storage, words) in storages.iter().zip(words).filter(|(s, _)| s.dumped) {
         let (data, ext) = match storage.dtype {
             Dtype::U32 => (Words::U32(words), "u32"),
             Dtype::U64 => (Words::U64(pairs_to_u64(&words)), "u64"),

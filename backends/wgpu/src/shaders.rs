@@ -111,6 +111,9 @@ pub struct Storage {
     pub shape: Vec<u64>,
     /// Every u32 word's value before the first pass.
     pub initial: u32,
+    /// Whether the dump holds it: a k-buffer's lock words are the shader's own business, not
+    /// part of the slot layout a dump records.
+    pub dumped: bool,
 }
 
 impl Storage {
@@ -121,6 +124,15 @@ impl Storage {
             dtype,
             shape,
             initial,
+            dumped: true,
+        }
+    }
+
+    /// The storage as working memory the dump leaves out.
+    fn working(self) -> Self {
+        Self {
+            dumped: false,
+            ..self
         }
     }
 
@@ -249,8 +261,8 @@ impl GpuScheme {
 
     /// The dump layout's `scheme` (`docs/dump-format.md`), the catalog's for the scheme (what
     /// `fragsim render --dump` writes): both A-buffers are `abuffer`, the linked lists and the
-    /// two k-buffers (the catalog's memory layout) name themselves; the counting pass, which
-    /// writes no dump, its name.
+    /// two k-buffers (the catalog's k-buffer slot layout) name themselves; the counting pass,
+    /// which writes no dump, its name.
     #[must_use]
     pub fn layout(&self) -> &'static str {
         match self {
@@ -269,7 +281,6 @@ impl GpuScheme {
     pub fn layout_spec(&self) -> Option<LayoutSpec> {
         match self {
             Self::LinkedList { .. } => Some(LayoutSpec::FRAGSIM_LISTS),
-            Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } => Some(LayoutSpec::Memory),
             _ => None,
         }
     }
@@ -286,13 +297,11 @@ impl GpuScheme {
         matches!(self, Self::ABuffer { .. } | Self::ABufferExact)
     }
 
-    /// The dump's `word` field: empty for the memory layouts, whose words their scheme's module
-    /// documents (as `fragsim render --dump` writes them).
+    /// The dump's `word` field (as `fragsim render --dump` writes it).
     #[must_use]
     pub fn word(&self) -> &'static str {
         match self {
             Self::Mdts32 { .. } => "key",
-            Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } => "",
             _ => "key<<32|prim",
         }
     }
@@ -369,17 +378,12 @@ impl GpuScheme {
     pub fn storages(&self, pixels: u64, total: u64) -> Vec<Storage> {
         let per_pixel = |k: u32| vec![pixels, u64::from(k)];
         let slots64 = |binding, shape| Storage::new(binding, "slots", Dtype::U64, shape, u32::MAX);
-        // The k-buffers' memory layout: `words32` (zeros), then `k` empty slots per pixel.
-        let memory = |words32, k: u32| {
+        // The k-buffers: their lock words (zeros; not dumped), then `k` empty slots per pixel,
+        // the catalog's k-buffer slot layout.
+        let kbuffer = |locks, k: u32| {
             vec![
-                Storage::new(5, "words32", Dtype::U32, vec![words32], 0),
-                Storage::new(
-                    6,
-                    "words64",
-                    Dtype::U64,
-                    vec![pixels * u64::from(k)],
-                    u32::MAX,
-                ),
+                Storage::new(5, "locks", Dtype::U32, vec![locks], 0).working(),
+                slots64(6, per_pixel(k)),
             ]
         };
         match *self {
@@ -396,7 +400,7 @@ impl GpuScheme {
             // The catalog's render-target k-buffer: three u32 per pixel (its lock, next ticket
             // and last committed ticket: the ROP's ordering, which the CPU models and a fragment
             // shader's plain stores have none of, so the GPU leaves them at 0) before the slots.
-            Self::Kbuffer { k } => memory(3 * pixels, k),
+            Self::Kbuffer { k } => kbuffer(3 * pixels, k),
             Self::Mdts32 { k } => {
                 vec![Storage::new(3, "slots", Dtype::U32, per_pixel(k), u32::MAX)]
             }
@@ -410,7 +414,7 @@ impl GpuScheme {
                 ]
             }
             // One lock word per pixel before the slots.
-            Self::KbufferSpinlock { k } => memory(pixels, k),
+            Self::KbufferSpinlock { k } => kbuffer(pixels, k),
             // A count per (pixel, sample), sample-index order within a pixel; then as many
             // counts of depth-range drops, and as many example depths (sample_counts.wgsl).
             Self::SampleCounts { samples } => vec![Storage::new(
@@ -462,7 +466,8 @@ mod tests {
     }
 
     #[test]
-    fn the_kbuffers_dump_the_catalog_schemes_own_memory() {
+    fn the_kbuffers_bind_the_catalog_schemes_words_and_dump_its_slot_layout() {
+        use fragsim_capture::catalog::DumpLayout;
         use fragsim_capture::schemes::kbuffer::KBuffer;
         use fragsim_capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Loop};
         use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
@@ -470,18 +475,19 @@ mod tests {
 
         let viewport = Viewport::new(6, 5).unwrap();
         let pixels = viewport.pixels() as u64;
-        let words = |s: GpuScheme| -> Vec<(&str, u64, u32)> {
+        let words = |s: GpuScheme| -> Vec<(&str, u64, u32, bool)> {
             s.storages(pixels, 0)
                 .into_iter()
-                .map(|s| (s.name, s.words(), s.initial))
+                .map(|s| (s.name, s.words(), s.initial, s.dumped))
                 .collect()
         };
+        // The catalog scheme's lock words (zeros, left out of the dump) and its slots (u64 words
+        // are two u32 on the GPU; their initial word all ones is u64::MAX).
         let catalog = |l: fragsim_capture::Layout| {
-            // u64 words are two u32 on the GPU; their initial word all ones is u64::MAX.
             assert_eq!((l.init32, l.init64, l.table_bytes), (0, u64::MAX, 0));
             vec![
-                ("words32", l.words32 as u64, 0),
-                ("words64", 2 * l.words64 as u64, u32::MAX),
+                ("locks", l.words32 as u64, 0, false),
+                ("slots", 2 * l.words64 as u64, u32::MAX, true),
             ]
         };
         let kbuffer = KBuffer::new(viewport, 3, MEMORY_CAP_DEFAULT).unwrap();
@@ -499,7 +505,12 @@ mod tests {
             GpuScheme::KbufferSpinlock { k: 3 },
         ] {
             assert_eq!(s.layout(), s.name());
-            assert_eq!(s.layout_spec(), Some(LayoutSpec::Memory));
+            assert_eq!(
+                DumpLayout::named(s.layout()),
+                Some(DumpLayout::KBufferSlots)
+            );
+            assert_eq!(s.layout_spec(), None);
+            assert_eq!(s.storages(pixels, 0)[1].shape, [pixels, 3]);
         }
     }
 }

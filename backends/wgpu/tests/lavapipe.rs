@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_capture::schemes::linked_list::Resolve;
-use fragsim_oracle::dump::{Dump, LayoutSpec, Words};
+use fragsim_oracle::dump::{Dump, Words};
 
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
@@ -234,27 +234,29 @@ fn the_correct_shaders_are_equal_on_a_procedural_scene() {
 }
 
 #[test]
-fn the_kbuffers_dump_the_catalogs_memory_and_are_judged_as_any_scheme() {
+fn the_kbuffers_dump_the_catalogs_slots_and_are_judged_as_any_scheme() {
     let Some(gpu) = adapter_or_skip() else { return };
     for scheme in [
         GpuScheme::KbufferSpinlock { k: 8 },
         GpuScheme::Kbuffer { k: 8 },
     ] {
         let (dump, _) = captured(&gpu, "bunny", scheme, Mode::Replay, None);
-        // What `fragsim render --dump` writes for the scheme: its catalog name, the memory
-        // layout, the scheme's own words (the GPU has no use for the lock and ticket words of
-        // the non-atomic k-buffer's render-target machine: they stay at 0; the spinlock's are
-        // all released).
+        // What `fragsim render --dump` writes for the scheme: its catalog name, the k-buffer
+        // slot layout, the K slots of each pixel and nothing else (the lock words stay on the
+        // GPU).
         assert_eq!(dump.header.scheme, scheme.name());
         assert_eq!(
             DumpLayout::named(&dump.header.scheme),
-            Some(DumpLayout::Memory)
+            Some(DumpLayout::KBufferSlots)
         );
-        assert_eq!(dump.header.layout, Some(LayoutSpec::Memory));
-        match dump.arrays.get("words32") {
-            Some(Words::U32(w)) => assert!(w.iter().all(|&w| w == 0), "{}", scheme.name()),
-            other => panic!("{}: words32 is {other:?}", scheme.name()),
-        }
+        assert_eq!(dump.header.layout, None);
+        let arrays: Vec<&String> = dump.arrays.keys().collect();
+        assert_eq!(arrays, ["slots"], "{}", scheme.name());
+        assert!(
+            matches!(dump.arrays.get("slots"), Some(Words::U64(_))),
+            "{}",
+            scheme.name()
+        );
         let verdict = Within::of(&dump).unwrap().judge(&dump).unwrap();
         println!(
             "bunny 128² {} replay, precision verdict: {}",
