@@ -175,7 +175,7 @@ impl DumpStage {
             (_, false) => Dump::record(view, spec, &scheme, &producer),
         }
         .and_then(|dump| dump.in_layout(layout))
-            .map_err(|e| format!("render --dump: {name}: {e}"))?;
+        .map_err(|e| format!("render --dump: {name}: {e}"))?;
         dump.write(&self.staging.join(name.name()))
             .map_err(|e| e.to_string())?;
         self.written.push(name.name());

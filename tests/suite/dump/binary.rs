@@ -313,3 +313,81 @@ fn render_dumps_every_scheme_or_nothing() {
     let left: Vec<_> = std::fs::read_dir(&blocked).unwrap().collect();
     assert_eq!(left.len(), 1, "only the file that was there");
 }
+
+#[test]
+fn a_header_that_disagrees_with_its_arrays_names_the_field_at_fault() {
+    // Issue 36: `k: 9` over slots of shape [pixels, 8], or a width one short, was reported as a
+    // total of words that named neither `k`, `width` nor `shape`.
+    let dir = scratch("binary-header-fields");
+    render_dump(
+        &dir,
+        "mdts,abuffer,linked-list,layer-counter",
+        &["--k", "4"],
+    );
+    let pixels = WIDTH * 36;
+    let cases: [(&str, &str, serde_json::Value, &[&str]); 6] = [
+        (
+            "mdts",
+            "k",
+            serde_json::json!(5),
+            &["\"slots\"", "\"k\" 5", "[1728, 5]"],
+        ),
+        (
+            "mdts",
+            "width",
+            serde_json::json!(WIDTH - 1),
+            &["\"slots\"", "\"width\" 47 × \"height\" 36", "[1692, 4]"],
+        ),
+        (
+            "abuffer",
+            "capacity",
+            serde_json::json!(3),
+            &["\"slots\"", "\"capacity\" 3"],
+        ),
+        (
+            "abuffer",
+            "height",
+            serde_json::json!(35),
+            &["\"counters\"", "\"height\" 35"],
+        ),
+        (
+            "linked-list",
+            "pool",
+            serde_json::json!(7),
+            &["\"next\"", "\"pool\" 7"],
+        ),
+        (
+            "layer-counter",
+            "k",
+            serde_json::json!(3),
+            &["\"layers\"", "\"k\" 3", "[3, 1728]"],
+        ),
+    ];
+    assert_eq!(pixels, 1728);
+    for (scheme, field, value, reasons) in cases {
+        let header_file = dir.join(scheme).join("dump.json");
+        let original = std::fs::read(&header_file).unwrap();
+        json_report(&dir.join(scheme), 0);
+        let mut header: serde_json::Value = serde_json::from_slice(&original).unwrap();
+        header[field] = value;
+        std::fs::write(&header_file, header.to_string()).unwrap();
+        let output = fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join(scheme))
+            .arg("--no-image")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{scheme} {field}: {stderr}");
+        for reason in reasons
+            .iter()
+            .chain(&["shape", "disagrees with the header"])
+        {
+            assert!(
+                stderr.contains(reason),
+                "{scheme} {field}: {reason:?} not in {stderr}"
+            );
+        }
+        std::fs::write(&header_file, original).unwrap();
+    }
+}

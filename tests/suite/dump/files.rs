@@ -124,7 +124,7 @@ fn malformed_dumps_are_clear_errors() {
                 Box::new(|d: &Path| edit_header(d, &format!("\"k\": {k}"), "\"k\": 0")),
             ),
             (
-                "holds",
+                "\"width\" 24 × \"height\" 36",
                 Box::new(|d: &Path| edit_header(d, "\"width\": 48", "\"width\": 24")),
             ),
         ];

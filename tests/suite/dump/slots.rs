@@ -324,7 +324,8 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
             h["layout"] = slot_major.clone();
             h["k"] = json!(k + 1);
         });
-        assert!(error.contains("array \"slots\" has"), "{error}");
+        let named = format!("array \"slots\": shape [1728, {k}] disagrees with the header's \"k\" {}, which makes it [{}, 1728]", k + 1, k + 1);
+        assert!(error.contains(&named), "{error}");
         let error = refused(&kbuffer, |h| h["k"] = json!(0));
         assert!(error.contains("scheme kbuffer needs \"k\" ≥ 1"), "{error}");
     });

@@ -108,7 +108,13 @@ fn a_k_nearest_list_short_of_k_is_different_under_f32_precision() {
     // K = 2 of a scene several layers deep, the second slot of every pixel emptied: each pixel of
     // two fragments or more holds one where every conforming list holds two.
     let dir = scratch("sound-short-list");
-    render(&dir, &["--scene", SCENE], 48, "mdts,mdts-desc", &["--k", "2"]);
+    render(
+        &dir,
+        &["--scene", SCENE],
+        48,
+        "mdts,mdts-desc",
+        &["--k", "2"],
+    );
     let f32_stage = ["--vertex-precision", "f32"];
     for scheme in ["mdts", "mdts-desc"] {
         let path = dir.join(scheme);
@@ -120,7 +126,10 @@ fn a_k_nearest_list_short_of_k_is_different_under_f32_precision() {
         assert!(deep > 100, "{scheme}: {after}");
         // One fragment lost at each such pixel, the others beyond K as before.
         assert_eq!(after["lost"], deep, "{scheme}: {after}");
-        assert_eq!(after["overflowed"], before["overflowed"], "{scheme}: {after}");
+        assert_eq!(
+            after["overflowed"], before["overflowed"],
+            "{scheme}: {after}"
+        );
         assert_eq!(after["ambiguous_pixels"], 0, "{scheme}: {after}");
     }
 }
@@ -252,7 +261,9 @@ fn render_dump_of_a_racy_kbuffer_run_holds_that_runs_words() {
     let dir = scratch("sound-racy-dump");
     let out = stdout_of(
         fragsim()
-            .args(["render", "--scene", SCENE, "--width", "48", "--height", "36"])
+            .args([
+                "render", "--scene", SCENE, "--width", "48", "--height", "36",
+            ])
             .args(["--scheme", "kbuffer", "--executor", "scheduled"])
             .args(["--no-images", "--json", "--dump"])
             .arg(&dir),
@@ -279,7 +290,11 @@ fn a_misspelt_header_field_is_refused_by_name() {
     let mut kept = original.clone();
     kept["extra"] = serde_json::json!({"capacty": 3, "anything": [1, 2]});
     std::fs::write(&header_file, kept.to_string()).unwrap();
-    assert_eq!(compared(&path, &[], 0)["equal"], true, "extra holds anything");
+    assert_eq!(
+        compared(&path, &[], 0)["equal"],
+        true,
+        "extra holds anything"
+    );
     let misspelt: [(&[&str], &str); 4] = [
         (&[], "capacty"),
         (&["scene"], "fov_y_degres"),
@@ -304,7 +319,10 @@ fn a_misspelt_header_field_is_refused_by_name() {
             .unwrap();
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(2), "{field}: {stderr}");
-        assert!(stderr.contains(&format!("unknown field `{field}`")), "{stderr}");
+        assert!(
+            stderr.contains(&format!("unknown field `{field}`")),
+            "{stderr}"
+        );
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }

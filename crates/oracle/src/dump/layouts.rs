@@ -644,6 +644,7 @@ impl Dump {
             return self.check_masked_words();
         }
         let scheme = self.scheme()?;
+        self.check_shapes(&scheme)?;
         // A slot layout of the engine's: the rules hold of fragsim's encoding of its words,
         // each corrupt word named as stored.
         if let Some(own) = self.own_slots(&scheme)? {

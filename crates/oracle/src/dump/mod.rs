@@ -63,6 +63,7 @@ mod layouts;
 mod lists;
 mod masked;
 mod read;
+mod shapes;
 mod slots;
 mod spec;
 mod write;

@@ -186,6 +186,7 @@ impl Dump {
             return self.masked_capture();
         }
         let scheme = Self::judged_lists(self.scheme()?);
+        self.check_shapes(&scheme)?;
         if let Some(own) = self.own_slots(&scheme)? {
             return own.capture();
         }

@@ -1,0 +1,128 @@
+//! The arrays' sizes checked against the header fields that fix them, before any word is
+//! decoded, so that a mismatch names the field at fault (`k`, `width`, `capacity`, `pool`, the
+//! array's `shape`) instead of a total of words (issue 36).
+
+use super::spec::{LayoutSpec, SlotOrder};
+use super::{err, Dump, DumpError, DumpScheme};
+
+/// One dimension of an array as the header fixes it: its size, and the fields that make it.
+struct Dim {
+    size: u64,
+    from: String,
+}
+
+impl Dump {
+    /// Checks that each array the layout of `scheme` sizes from the header holds as many words
+    /// as the header's fields say. A shape of another rank with the same number of words (a flat
+    /// `[pixels · k]`) is accepted, as the reader takes the words row-major.
+    ///
+    /// # Errors
+    /// An array of another number of words, naming the array, its `shape` and the header fields
+    /// whose dimension it contradicts.
+    pub(super) fn check_shapes(&self, scheme: &DumpScheme) -> Result<(), DumpError> {
+        for (name, dims) in self.expected_shapes(scheme)? {
+            let Some(spec) = self.header.arrays.get(name) else {
+                continue; // Decoding names a missing array.
+            };
+            let wanted: Vec<u64> = dims.iter().map(|d| d.size).collect();
+            let words = |shape: &[u64]| shape.iter().try_fold(1u64, |n, &d| n.checked_mul(d));
+            if words(&spec.shape) == words(&wanted) {
+                continue;
+            }
+            // The fields whose dimension the shape has nowhere (a shape in the other slot order
+            // still has the pixels); every field when each dimension is there in another rank.
+            let mut at_fault: Vec<&str> = dims
+                .iter()
+                .filter(|d| !spec.shape.contains(&d.size))
+                .map(|d| d.from.as_str())
+                .collect();
+            if at_fault.is_empty() {
+                at_fault = dims.iter().map(|d| d.from.as_str()).collect();
+            }
+            let verb = if at_fault.len() == 1 { "makes" } else { "make" };
+            return err(format!(
+                "array {name:?}: shape {:?} disagrees with the header's {}, which {verb} it \
+                 {wanted:?}",
+                spec.shape,
+                at_fault.join(" and ")
+            ));
+        }
+        Ok(())
+    }
+
+    /// The arrays whose sizes the header fixes, each with its dimensions.
+    fn expected_shapes(
+        &self,
+        scheme: &DumpScheme,
+    ) -> Result<Vec<(&'static str, Vec<Dim>)>, DumpError> {
+        let header = &self.header;
+        let pixels = self.viewport()?.pixels() as u64;
+        let samples = header.samples()?;
+        let mut of_pixels = format!("\"width\" {} × \"height\" {}", header.width, header.height);
+        if samples > 1 {
+            of_pixels += &format!(" × {samples} samples");
+        }
+        let pixel_dim = || Dim {
+            size: pixels,
+            from: format!("{of_pixels} = {pixels} lists"),
+        };
+        let field = |name: &str, size: u32| Dim {
+            size: u64::from(size),
+            from: format!("{name:?} {size}"),
+        };
+        // A slot array's two dimensions in the header's slot order.
+        let slots = |per_pixel: Dim| {
+            let slot_major = matches!(
+                header.layout,
+                Some(LayoutSpec::Slots {
+                    order: SlotOrder::SlotMajor,
+                    ..
+                })
+            );
+            if slot_major {
+                vec![per_pixel, pixel_dim()]
+            } else {
+                vec![pixel_dim(), per_pixel]
+            }
+        };
+        Ok(match scheme {
+            DumpScheme::Mdts { k, .. }
+            | DumpScheme::Mdts32 { k }
+            | DumpScheme::KBuffer { k, .. } => {
+                vec![("slots", slots(field("k", *k)))]
+            }
+            DumpScheme::ABufferFixed { capacity, .. } => vec![
+                ("counters", vec![pixel_dim()]),
+                ("slots", slots(field("capacity", *capacity))),
+            ],
+            DumpScheme::ABufferExact { counts, .. } => vec![
+                ("counters", vec![pixel_dim()]),
+                (
+                    "slots",
+                    vec![Dim {
+                        size: counts.iter().map(|&c| u64::from(c)).sum(),
+                        from: "the last of \"offsets\"".into(),
+                    }],
+                ),
+            ],
+            DumpScheme::LinkedLists { pool, .. } => vec![
+                ("heads", vec![pixel_dim()]),
+                ("next", vec![field("pool", *pool)]),
+                ("nodes", vec![field("pool", *pool)]),
+                (
+                    "counter",
+                    vec![Dim {
+                        size: 1,
+                        from: "one counter".into(),
+                    }],
+                ),
+            ],
+            DumpScheme::LayerMajor { k, .. } => vec![
+                ("counters", vec![pixel_dim()]),
+                ("layers", vec![field("k", *k), pixel_dim()]),
+            ],
+            // The scheme's own memory, sized by its constructor: decoding names the sizes.
+            DumpScheme::Memory { .. } => Vec::new(),
+        })
+    }
+}
