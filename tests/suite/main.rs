@@ -24,6 +24,7 @@ mod dump;
 mod effects;
 mod explain;
 mod extremes;
+mod honest_reports;
 mod interlock_ordered;
 mod json_lines;
 mod kbuffer;

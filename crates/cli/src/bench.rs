@@ -118,10 +118,11 @@ pub struct BenchRow {
     /// What the image judge completed from the oracle or recomputed (the deferred attribute
     /// pass), with its count and time; `None` when the image is the scheme's words alone.
     pub attribute_pass: Option<AttributePass>,
-    /// Memory operations per fragment.
+    /// Memory operations per fragment, of the untimed frame that counts locked operations.
     pub ops_per_fragment: f64,
     /// Read-modify-write operations (`lock`-prefixed instructions on x86) per fragment, counted
-    /// in one extra, untimed frame.
+    /// in one extra, untimed frame: the frame `ops_per_fragment` counts too, so that the two
+    /// describe one interleaving (a spinlock's spins vary from frame to frame).
     pub locked_ops_per_fragment: f64,
     /// Median frame time in milliseconds: vertex stage, geometry passes and post pass.
     pub time_ms: f64,
@@ -472,8 +473,8 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 colour,
                 colour_by_depth,
                 attribute_pass: judged.and_then(|j| j.pass),
-                ops_per_fragment: stats.counters.steps as f64
-                    / stats.counters.fragments.max(1) as f64,
+                ops_per_fragment: counted.run.stats.counters.steps as f64
+                    / counted.run.stats.counters.fragments.max(1) as f64,
                 locked_ops_per_fragment: locked_ops as f64
                     / counted.run.stats.counters.fragments.max(1) as f64,
                 time_ms: ms(median_time),
