@@ -56,7 +56,11 @@
 //! Unlike the GPU, which leaves its words in device memory, [`Dump::record`] runs fragsim's scheme
 //! serially on [`SerialMemory`] and copies every word out; for MDTS the words are the same under
 //! any interleaving (the sortedness proof), for the A-buffer the slot order within a pixel is the
-//! serial one.
+//! serial one. [`Dump::of_memory`] records the words another run left instead (`render --dump`
+//! writes the memory of the run it reports, on whatever executor, a racy one's included).
+//!
+//! A header field this format does not name is refused by name (`extra` holds anything else), and
+//! an array whose size the header's fields contradict is refused naming the fields at fault.
 
 mod header;
 mod layouts;

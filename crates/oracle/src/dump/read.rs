@@ -177,7 +177,8 @@ impl Dump {
 
     /// Decodes the words into the per-pixel lists the verdict judges, with the scheme's own post
     /// pass (sorted A-buffer dumps: in stored order). Linked lists are decoded whole: every node
-    /// a pixel's list reaches, sorted, all of them owed ([`Dump::judged_lists`]).
+    /// a pixel's list reaches, sorted, all of them owed (the resolve's `k` limits what shading
+    /// reads, not what is judged).
     ///
     /// # Errors
     /// A header that names no known scheme, or arrays missing or of the wrong size or type.
