@@ -17,6 +17,7 @@ mod binary;
 mod compare;
 mod files;
 mod layouts;
+mod mutations;
 mod numbers;
 mod parse;
 mod samples;
