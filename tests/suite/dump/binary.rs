@@ -354,7 +354,7 @@ fn a_header_that_disagrees_with_its_arrays_names_the_field_at_fault() {
             "linked-list",
             "pool",
             serde_json::json!(7),
-            &["\"next\"", "\"pool\" 7"],
+            &["\"nodes\"", "\"pool\" 7"],
         ),
         (
             "layer-counter",

@@ -105,10 +105,11 @@ impl Dump {
                     }],
                 ),
             ],
+            // The nodes first: a wrong `pool` is named by them, before the links.
             DumpScheme::LinkedLists { pool, .. } => vec![
+                ("nodes", vec![field("pool", *pool)]),
                 ("heads", vec![pixel_dim()]),
                 ("next", vec![field("pool", *pool)]),
-                ("nodes", vec![field("pool", *pool)]),
                 (
                     "counter",
                     vec![Dim {
