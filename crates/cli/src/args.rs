@@ -7,8 +7,8 @@ use fragsim_capture::executors::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::conventions::MAX_SUBPIXEL_BITS;
 use fragsim_raster::{
-    Conventions, DepthRange, OrbitCamera, Scene, VertexPrecision, View, Viewport, WindowOrigin,
-    DEFAULT_SCENE_NAME,
+    Camera, Conventions, DepthRange, OrbitCamera, Scene, UpAxis, VertexPrecision, View, Viewport,
+    WindowOrigin, DEFAULT_SCENE_NAME,
 };
 
 pub use fragsim_capture::catalog::Count;
@@ -40,6 +40,13 @@ pub struct SceneArgs {
     /// look straight down its up axis).
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = elevation)]
     pub elevation: f64,
+    /// The model's up axis in its file: `y` (OBJ's custom), `z` (most scanner and CAD files: a
+    /// z-up model otherwise lies on its side), `x`, `-y`, `-z` or `-x`. The camera orbits that
+    /// axis; the mesh and its primitive ids stay as they are (a dump records the turned camera as
+    /// its `view_projection`).
+    #[arg(long, value_name = "AXIS", default_value = "y", allow_hyphen_values = true,
+          value_parser = UpAxis::parse)]
+    pub up: UpAxis,
 }
 
 impl SceneArgs {
@@ -71,6 +78,38 @@ impl SceneArgs {
             elevation_degrees: self.elevation,
             ..OrbitCamera::default()
         }
+    }
+
+    /// The camera at orbit `angle` around `scene` stood on its `--up` axis, with the projection
+    /// of `depth_range`.
+    ///
+    /// # Errors
+    /// A side out of range.
+    pub fn camera(
+        &self,
+        scene: &Scene,
+        angle: f64,
+        depth_range: DepthRange,
+    ) -> Result<Camera, String> {
+        Ok(scene.orbit_camera_up(self.viewport()?, &self.orbit(angle), depth_range, self.up))
+    }
+
+    /// `scene` at orbit `angle` under `conventions`: what `render` captures and `export-scene`
+    /// writes (at more than one sample, a view rasterizing per sample whose
+    /// [`View::pixel_viewport`] is the render target).
+    ///
+    /// # Errors
+    /// A bad viewport, or conventions fragsim cannot rasterize under.
+    pub fn view_at<'s>(
+        &self,
+        scene: &'s Scene,
+        angle: f64,
+        conventions: Conventions,
+    ) -> Result<View<'s>, String> {
+        let camera = self.camera(scene, angle, conventions.depth_range)?;
+        scene
+            .view_under(self.viewport()?, &camera, conventions)
+            .map_err(|e| e.to_string())
     }
 }
 

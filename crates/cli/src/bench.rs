@@ -11,7 +11,7 @@ use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{Camera, SamplePattern, View};
+use fragsim_raster::{Camera, Conventions, DepthRange, SamplePattern, View};
 use image::RgbImage;
 use indicatif::ProgressBar;
 use rayon::prelude::*;
@@ -367,15 +367,16 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let frames = args.frames as usize;
     // The camera depends on the model's bounds, a per-scene constant (a GPU application computes
     // it at load); the vertex stage proper is timed per frame, on the pool.
-    let aspect = f64::from(viewport.width) / f64::from(viewport.height);
-    let camera = orbit.camera(scene.mesh.bounds(), aspect);
+    let camera = args
+        .scene
+        .camera(&scene, args.scene.view, DepthRange::ZeroToOne)?;
     let serial_pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
     let mut view = args
         .schemes
-        .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
+        .submission(args.scene.view_at(&scene, args.scene.view, Conventions::REFERENCE)?);
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);

@@ -29,6 +29,7 @@ use serde::Serialize;
 use crate::args::SceneArgs;
 use crate::explain::WriteBackArg;
 use crate::record::{Context, Slots};
+use fragsim_raster::Conventions;
 
 /// Options of `fragsim hazard`.
 #[derive(Debug, Clone, Args)]
@@ -122,9 +123,9 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
     }
     let scene = args.scene.scene()?;
     let viewport = args.scene.viewport()?;
-    let view = scene
-        .view(viewport, &args.scene.orbit(args.scene.view))
-        .map_err(|e| e.to_string())?;
+    let view = args
+        .scene
+        .view_at(&scene, args.scene.view, Conventions::REFERENCE)?;
     crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT)?;
     let oracle = Oracle::build(&view);
     let in_bucket = covered_by_bucket(&oracle);

@@ -179,14 +179,11 @@ pub struct RunSummary {
 pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let pool = args.schemes.pool()?;
     let scene = args.scene.scene()?;
-    let viewport = args.scene.viewport()?;
-    let conventions = args.conventions.conventions();
-    let orbit = args.scene.orbit(args.scene.view);
-    let camera = scene.orbit_camera(viewport, &orbit, conventions.depth_range);
-    let view = scene
-        .view_under(viewport, &camera, conventions)
-        .map_err(|e| e.to_string())?;
-    let view = args.schemes.submission(view);
+    let view = args.schemes.submission(args.scene.view_at(
+        &scene,
+        args.scene.view,
+        args.conventions.conventions(),
+    )?);
     crate::args::warn_if_empty(&scene, &view);
     // At more than one sample every scheme, the oracle and the images cover the sample-expanded
     // framebuffer (`docs/semantics.md`, "Multisampling").

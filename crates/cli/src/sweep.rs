@@ -14,6 +14,7 @@ use crate::args::{SceneArgs, SchemeArgs};
 use crate::judge::{ColourColumns, EffectName, Judge};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
+use fragsim_raster::Conventions;
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
 /// Options of `fragsim sweep`.
@@ -99,7 +100,6 @@ impl SweepSeries {
 pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let pool = args.schemes.pool()?;
     let scene = args.scene.scene()?;
-    let viewport = args.scene.viewport()?;
     let executor = args.schemes.executors()[0];
     let mut threads = 0;
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -113,7 +113,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let orbit = args.scene.orbit(angle);
         let view = args
             .schemes
-            .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
+            .submission(args.scene.view_at(&scene, angle, Conventions::REFERENCE)?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);

@@ -251,6 +251,57 @@ fn the_binary_exports_the_triangles_of_the_view_it_names() {
     with_view(|view, _| assert_eq!(read, TriangleExport::from_view(view, spec())));
 }
 
+/// Issue 36: `export-scene` takes `render`'s convention flags, records them in its scene, and
+/// writes the view a backend under them rasterizes (its size in pixels at several samples).
+#[test]
+fn the_export_takes_renders_conventions() {
+    let dir = scratch("export-conventions");
+    let export = |name: &str, conventions: &[&str]| {
+        let file = dir.join(name);
+        let text = stdout_of(
+            fragsim()
+                .args(["export-scene", "--scene", SCENE])
+                .args(SIZE)
+                .args(conventions)
+                .arg("--out")
+                .arg(&file),
+            0,
+        );
+        assert!(text.contains("binary FRAGTRI1"), "{text}");
+        TriangleExport::read(&file).unwrap()
+    };
+    let reference = export("reference.tri", &[]);
+    let gl = export(
+        "gl.tri",
+        &[
+            "--window-origin",
+            "lower-left",
+            "--depth-range",
+            "minus-one-to-one",
+            "--subpixel-bits",
+            "4",
+            "--vertex-precision",
+            "f32",
+            "--samples",
+            "4",
+        ],
+    );
+    let declared = gl.scene.conventions;
+    assert_eq!(
+        serde_json::to_value(declared).unwrap(),
+        serde_json::json!({"window_origin": "lower-left", "subpixel_bits": 4,
+            "depth_range": "minus-one-to-one", "vertex_precision": "f32", "samples": 4})
+    );
+    assert_eq!((gl.width, gl.height), (WIDTH, super::HEIGHT));
+    let scene = fragsim::raster::Scene::procedural(SCENE).unwrap();
+    let view = gl
+        .scene
+        .view(&scene, fragsim::raster::Viewport::new(WIDTH, super::HEIGHT).unwrap())
+        .unwrap();
+    assert_eq!(gl.triangles, TriangleExport::from_view(&view, gl.scene.clone()).triangles);
+    assert_ne!(gl.triangles, reference.triangles, "the conventions changed nothing");
+}
+
 #[test]
 fn render_dumps_every_scheme_or_nothing() {
     let dir = scratch("binary-all");
