@@ -30,6 +30,7 @@ mod kbuffer;
 mod locks;
 mod loop64;
 mod mdts_packed;
+mod mesh_files;
 mod meshes;
 mod multisampling;
 mod order_independence;
