@@ -23,6 +23,7 @@ mod default_scene;
 mod dump;
 mod effects;
 mod explain;
+mod flag_dialect;
 mod extremes;
 mod interlock_ordered;
 mod json_lines;

@@ -212,7 +212,7 @@ fn up_z_stands_a_z_up_model_as_its_y_up_twin() {
         .unwrap()
         .args(["compare", "oracle"])
         .arg(dumps.join("mdts"))
-        .arg("--no-image")
+        .arg("--no-images")
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&compare.stdout);

@@ -42,8 +42,9 @@ pub struct BenchArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart.
-    #[arg(long, default_value = "out")]
+    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart (its own,
+    /// so that the sweep's files do not mix with the bench's).
+    #[arg(long, default_value = "out/bench")]
     pub out: PathBuf,
     /// Print JSON Lines instead of the table: one record per scheme and executor
     /// (`docs/json-schema.md`; bench.jsonl holds the same).
@@ -632,13 +633,23 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
     let md_path = args.out.join("bench.md");
     std::fs::write(&md_path, &markdown)
         .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
-    if !args.no_images {
+    let wrote = if args.no_images {
+        format!("wrote {}: bench.jsonl, bench.md", args.out.display())
+    } else {
         speed_accuracy_chart(report, &args.out.join("bench-speed-accuracy.png"))?;
-    }
+        format!(
+            "wrote {}: bench.jsonl, bench.md, bench-speed-accuracy.png and the effect and \
+             difference images",
+            args.out.display()
+        )
+    };
+    // Under `--json` stdout stays JSON Lines: where the files went goes to stderr.
     if args.json {
         out!("{lines}");
+        eprintln!("{wrote}");
     } else {
         out!("{markdown}");
+        outln!("{wrote}");
     }
     Ok(())
 }

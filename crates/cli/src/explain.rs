@@ -72,7 +72,7 @@ pub struct ExplainArgs {
         allow_hyphen_values = true
     )]
     pub depths: Vec<f32>,
-    /// Slots per pixel (default: the number of fragments, so nothing falls off by design).
+    /// Slots per pixel [default: one per depth of --depths, so nothing falls off by design].
     #[arg(long)]
     pub k: Option<u32>,
     /// Seeds of the scheduled executor to search.

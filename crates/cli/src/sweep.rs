@@ -39,9 +39,13 @@ pub struct SweepArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for sweep.jsonl and the PNG charts.
-    #[arg(long, default_value = "out")]
+    /// Directory for sweep.jsonl and the PNG charts (its own, so that bench's files do not mix
+    /// with the sweep's).
+    #[arg(long, default_value = "out/sweep")]
     pub out: PathBuf,
+    /// Write no charts; sweep.jsonl is still written.
+    #[arg(long)]
+    pub no_images: bool,
     /// Print JSON Lines instead of the table: one record per scheme and angle
     /// (`docs/json-schema.md`; sweep.jsonl holds the same).
     #[arg(long)]
@@ -227,6 +231,9 @@ fn write_outputs(
         "{scene}: error pixels of {} per view angle",
         args.effect.label()
     );
+    if args.no_images {
+        return print_summary(args, series, &lines, &["sweep.jsonl"]);
+    }
     fragsim_shade::plot::chart(
         &args.out.join("sweep-epr.png"),
         &title,
@@ -253,8 +260,26 @@ fn write_outputs(
         "mean frame time (ms, log scale)",
         &scatter,
     )?;
+    print_summary(
+        args,
+        series,
+        &lines,
+        &["sweep.jsonl", "sweep-epr.png", "sweep-speed-accuracy.png"],
+    )
+}
+
+/// Prints the JSON Lines or the table, then the files written (on stderr under `--json`, so
+/// that stdout stays JSON Lines).
+fn print_summary(
+    args: &SweepArgs,
+    series: &[SweepSeries],
+    lines: &str,
+    written: &[&str],
+) -> Result<(), String> {
+    let wrote = format!("wrote {}: {}", args.out.display(), written.join(", "));
     if args.json {
         out!("{lines}");
+        eprintln!("{wrote}");
         return Ok(());
     }
     outln!(
@@ -294,10 +319,7 @@ fn write_outputs(
         );
     }
     print_depth_table(series);
-    outln!(
-        "wrote {}/sweep.jsonl, sweep-epr.png, sweep-speed-accuracy.png",
-        args.out.display()
-    );
+    outln!("{wrote}");
     Ok(())
 }
 

@@ -55,7 +55,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             fragsim()
                 .args(["compare", "oracle"])
                 .arg(dumps.join(scheme))
-                .args(["--json", "--no-image"]),
+                .args(["--json", "--no-images"]),
             0,
         );
         assert_eq!(
@@ -69,7 +69,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             .arg("compare")
             .arg(dumps.join("abuffer"))
             .arg(dumps.join("mdts"))
-            .arg("--no-image"),
+            .arg("--no-images"),
         0,
     );
     assert!(text.contains("EQUAL (bit-identical)"), "{text}");
@@ -95,7 +95,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(dumps.join("mdts"))
-            .args(["--json", "--no-image"]),
+            .args(["--json", "--no-images"]),
         1,
     );
     let records = crate::support::json_lines(json.as_bytes());
@@ -111,14 +111,14 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
     );
 }
 
-/// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the records
+/// Runs `fragsim compare oracle DIR --json --no-images` expecting exit code `code`; the records
 /// (the `compare` record, then one `difference` record per pixel shown).
 pub(super) fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
     let out = stdout_of(
         fragsim()
             .args(["compare", "oracle"])
             .arg(dir)
-            .args(["--json", "--no-image"]),
+            .args(["--json", "--no-images"]),
         code,
     );
     crate::support::json_lines(out.as_bytes())
@@ -166,7 +166,7 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
             fragsim()
                 .args(["compare", "oracle"])
                 .arg(&path)
-                .arg("--no-image"),
+                .arg("--no-images"),
             1,
         );
         let x = pixel % WIDTH as usize;
@@ -216,7 +216,7 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(&path)
-            .arg("--no-image"),
+            .arg("--no-images"),
         1,
     );
     assert!(
@@ -338,7 +338,7 @@ fn render_dumps_every_scheme_or_nothing() {
             fragsim()
                 .args(["compare", "oracle"])
                 .arg(dumps.join(scheme))
-                .args(["--json", "--no-image"]),
+                .args(["--json", "--no-images"]),
             0,
         );
         assert_eq!(

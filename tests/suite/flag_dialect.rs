@@ -1,0 +1,115 @@
+//! One dialect of flags across commands (issue 36): `--no-images` is spelled so everywhere (the
+//! older `compare --no-image` still parses), sweep takes it, `sweep --help` lists no flag sweep
+//! refuses, every `--help` that offers `--k` shows its default, and bench and sweep write into
+//! their own folders and say where.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use assert_cmd::Command;
+
+/// A fresh directory under cargo's per-test-target temporary directory.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("flag-dialect")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `fragsim args` run in `dir`.
+fn fragsim_in(dir: &Path, args: &[&str]) -> Output {
+    Command::cargo_bin("fragsim")
+        .unwrap()
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn help(command: &str) -> String {
+    let output = fragsim_in(Path::new("."), &[command, "--help"]);
+    assert!(output.status.success());
+    String::from_utf8(output.stdout).unwrap()
+}
+
+/// The files directly in `dir`, sorted.
+fn files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn every_command_that_writes_images_takes_no_images_and_help_shows_defaults() {
+    for command in ["render", "bench", "sweep", "compare"] {
+        let text = help(command);
+        assert!(text.contains("--no-images"), "{command} --help:\n{text}");
+        assert!(!text.contains("--no-image "), "{command} --help:\n{text}");
+    }
+    for command in ["render", "bench", "sweep", "hazard", "conform", "explain"] {
+        let text = help(command);
+        let k = text
+            .split("\n\n")
+            .chain(text.lines())
+            .find(|block| block.trim_start().starts_with("--k "))
+            .unwrap_or_else(|| panic!("{command} --help has no --k:\n{text}"));
+        assert!(k.contains("default"), "{command}'s --k hides its default: {k}");
+    }
+    // sweep sets the angle itself: --view is not offered, and still refused with the reason.
+    let sweep = help("sweep");
+    assert!(!sweep.contains("--view"), "{sweep}");
+    let refused = fragsim_in(Path::new("."), &["sweep", "--view", "10"]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("sweep sets the view angle"));
+}
+
+#[test]
+fn bench_and_sweep_write_their_own_folders_and_say_where() {
+    let dir = scratch("defaults");
+    let tiny = ["--scene", "spheres:2", "--width", "24", "--height", "16", "--scheme", "mdts"];
+    let bench = fragsim_in(&dir, &[&["bench", "--frames", "1"], &tiny[..]].concat());
+    let sweep = fragsim_in(&dir, &[&["sweep", "--angles", "2"], &tiny[..]].concat());
+    for (name, output) in [("bench", &bench), ("sweep", &sweep)] {
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{name}: {}", String::from_utf8_lossy(&output.stderr));
+        let wrote = format!("wrote {}", Path::new("out").join(name).display());
+        assert!(stdout.contains(&wrote), "{name} does not say where it wrote:\n{stdout}");
+    }
+    assert!(files(&dir.join("out/bench")).contains(&"bench.jsonl".to_string()));
+    assert_eq!(
+        files(&dir.join("out/sweep")),
+        ["sweep-epr.png", "sweep-speed-accuracy.png", "sweep.jsonl"]
+    );
+    // sweep --no-images writes its JSON Lines only; under --json the path goes to stderr.
+    let bare = dir.join("bare");
+    let output = fragsim_in(
+        &dir,
+        &[&["sweep", "--angles", "2", "--no-images", "--json", "--out", "bare"], &tiny[..]].concat(),
+    );
+    assert!(output.status.success());
+    assert_eq!(files(&bare), ["sweep.jsonl"]);
+    assert!(String::from_utf8_lossy(&output.stderr).contains("wrote bare: sweep.jsonl"));
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    assert_eq!(crate::support::json_lines(stdout.as_bytes()).len(), 2, "{stdout}");
+}
+
+#[test]
+fn compare_still_takes_the_old_no_image_spelling() {
+    let dir = scratch("alias");
+    let render = fragsim_in(
+        &dir,
+        &["render", "--scene", "spheres:2", "--width", "16", "--height", "12", "--no-images",
+          "--scheme", "mdts", "--dump", "dumps"],
+    );
+    assert!(render.status.success());
+    for flag in ["--no-images", "--no-image"] {
+        let output = fragsim_in(&dir, &["compare", "oracle", "dumps/mdts", flag]);
+        assert!(output.status.success(), "{flag}: {}", String::from_utf8_lossy(&output.stderr));
+    }
+    assert!(!dir.join("out").exists(), "an image was written");
+}
