@@ -113,3 +113,56 @@ fn compare_still_takes_the_old_no_image_spelling() {
     }
     assert!(!dir.join("out").exists(), "an image was written");
 }
+
+/// `hazard` speaks the others' dialect: percentages in its tables (JSON keeps the fractions, under
+/// the JSON Lines' names), a key for every column, the viewport as `width` and `height` apart
+/// from the threads in flight, hyphenated file names, and the files it wrote named.
+#[test]
+fn hazard_prints_percentages_with_a_key_and_names_what_it_wrote() {
+    let dir = scratch("hazard");
+    let output = fragsim_in(
+        &dir,
+        &["hazard", "--scene", "spheres:3", "--width", "40", "--height", "30",
+          "--threads-in-flight", "1,64", "--seeds", "2", "--write-back", "render-target"],
+    );
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let out = dir.join("out/hazard");
+    assert_eq!(
+        files(&out),
+        ["hazard-vs-depth-complexity.png", "hazard-vs-width.png", "hazard.json", "hazard.md"]
+    );
+    assert!(stdout.contains(&format!(
+        "wrote {}: hazard.md, hazard.json, hazard-vs-width.png, hazard-vs-depth-complexity.png",
+        Path::new("out/hazard").display()
+    )), "{stdout}");
+    let md = std::fs::read_to_string(out.join("hazard.md")).unwrap();
+    for key in ["**W** threads in flight", "**policy**", "**per seed**", "**write-back**", "**dc**"] {
+        assert!(md.contains(key), "no key for {key}:\n{md}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("hazard.json")).unwrap()).unwrap();
+    assert_eq!((json["width"].as_u64(), json["height"].as_u64()), (Some(40), Some(30)));
+    assert!(json.get("size").is_none(), "{json}");
+    // Each table row prints the JSON's fraction as a percentage, per seed too.
+    for row in json["rows"].as_array().unwrap() {
+        let w = row["threads_in_flight"].as_u64().unwrap();
+        let per_seed: Vec<String> = row["mismatched_pixel_rate_per_seed"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| format!("{:.2}", 100.0 * x.as_f64().unwrap()))
+            .collect();
+        let line = format!(
+            "| render-target | {} | {w} | {:.2} | {} |",
+            row["policy"].as_str().unwrap(),
+            100.0 * row["mismatched_pixel_rate"].as_f64().unwrap(),
+            per_seed.join(" ")
+        );
+        assert!(md.contains(&line), "{line} not in\n{md}");
+    }
+    assert!(
+        json["rows"].as_array().unwrap().iter().any(|r| r["mismatched_pixel_rate"].as_f64() > Some(0.0)),
+        "no hazard at 64 threads in flight: the percentages check nothing\n{md}"
+    );
+}

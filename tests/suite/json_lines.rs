@@ -163,7 +163,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
             &scene[..],
             &SIZE,
             &[
-                "--widths",
+                "--threads-in-flight",
                 "1,32",
                 "--seeds",
                 "1",
