@@ -114,7 +114,8 @@ fn entries(words: &[u64]) -> Vec<Entry> {
     words
         .iter()
         .map(|&w| Entry {
-            key: format!("{:#010x}", w >> 32),
+            // As `compare` prints keys: 8 hex digits.
+            key: format!("{:08x}", w >> 32),
             depth: depth_from_key((w >> 32) as u32),
             prim: w as u32,
         })
@@ -240,8 +241,14 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         saved: None,
         replay: None,
     };
+    let saved = args.save.join("case");
     let found = match result {
         Ok(_) => {
+            // A failing case saved by an earlier run no longer describes this backend.
+            if saved.exists() {
+                std::fs::remove_dir_all(&saved)
+                    .map_err(|e| format!("cannot remove {}: {e}", saved.display()))?;
+            }
             let spec = SceneAndCamera::named("generated", 0.0, 0.0);
             let context = sized(
                 Context::new("conform", &spec, args.max_side, args.max_side),
@@ -267,7 +274,6 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         Err(Failure::Refused(message)) => return Err(message),
         Err(Failure::Counterexample(found)) => found,
     };
-    let saved = args.save.join("case");
     let replay = save(&backend, &found, &params, &saved)?;
     let spec = Case::scene_and_camera(
         &saved.join("scene").join("mesh.obj").display().to_string(),
@@ -351,19 +357,27 @@ fn save(
     // the scene files are saved all the same.
     let rerun = backend.run_in(&input, dir);
     let absolute = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    // Every path absolute, so that the script runs from any directory: the backend's command
+    // from the directory conform ran in (its own paths may be relative to it), and this very
+    // fragsim (which need not be on PATH).
+    let here = std::env::current_dir().map_err(|e| format!("the working directory: {e}"))?;
+    let fragsim = std::env::current_exe().map_err(|e| format!("fragsim's own path: {e}"))?;
     let replay = vec![
+        format!("cd {} || exit 2", shell_quoted(&here)),
         backend.command_line(&absolute.join("scene"), &absolute.join("out"), params),
         format!(
-            "fragsim compare oracle '{}'{}",
-            absolute.join("out").display(),
+            "{} compare oracle {}{}",
+            shell_quoted(&fragsim),
+            shell_quoted(&absolute.join("out")),
             match backend.vertex_precision {
                 VertexPrecision::F32 => " --vertex-precision f32",
                 VertexPrecision::F64 => "",
             }
         ),
     ];
-    let mut script =
-        String::from("#!/bin/sh\n# Replays fragsim conform's smallest failing case.\n");
+    let mut script = String::from(
+        "#!/bin/sh\n# Replays fragsim conform's smallest failing case (from any directory).\n",
+    );
     if let Err(e) = rerun {
         script.push_str(&format!("# On saving, the backend failed again: {e}\n"));
     }
@@ -374,6 +388,11 @@ fn save(
     let path = dir.join("replay.sh");
     std::fs::write(&path, script).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(replay)
+}
+
+/// `path` quoted for `sh`: in single quotes, a quote inside written `'\''`.
+fn shell_quoted(path: &Path) -> String {
+    format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
 }
 
 fn print_counterexample(

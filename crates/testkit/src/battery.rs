@@ -22,6 +22,7 @@
 
 use std::cell::{Cell, RefCell};
 use std::fmt;
+use std::time::{Duration, Instant};
 
 use fragsim_capture::Guarantee;
 use fragsim_oracle::compare::{verdict, Comparison};
@@ -129,6 +130,9 @@ pub struct Battery<'b> {
     max_shrink_iters: u32,
 }
 
+/// How long proptest's shrinking may run the backend, as proptest's own default (2 minutes).
+const SHRINK_TIME: Duration = Duration::from_secs(120);
+
 /// Why a case stopped the battery.
 enum Stop {
     /// The backend cannot run at all.
@@ -232,13 +236,23 @@ impl<'b> Battery<'b> {
         }
         let mut seed = [0u8; 32];
         seed[..8].copy_from_slice(&self.seed.to_le_bytes());
+        // proptest prints "Aborting shrinking after …" on stderr whenever it reaches its own
+        // caps, whatever its verbosity: they are set out of reach, and the battery keeps its
+        // own (`max_shrink_iters` backend runs, `SHRINK_TIME`), past which every simplification
+        // is answered "passes" without running the backend, so proptest's shrinking winds down
+        // quietly on the last failing case. 0 still disables shrinking.
         let config = Config {
             cases: self.cases,
             failure_persistence: None,
-            max_shrink_iters: self.max_shrink_iters,
-            max_shrink_time: 120_000,
+            max_shrink_iters: if self.max_shrink_iters == 0 {
+                0
+            } else {
+                u32::MAX - 1
+            },
+            max_shrink_time: 0,
             ..Config::default()
         };
+        let shrink_start = Cell::new(None::<Instant>);
         let mut runner =
             TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
         let events = RefCell::new(on_event);
@@ -254,6 +268,12 @@ impl<'b> Battery<'b> {
                 cases_run.set(cases_run.get() + 1);
                 (events.borrow_mut())(Event::Case(cases_run.get()));
             } else {
+                let started = shrink_start.get().unwrap_or_else(Instant::now);
+                shrink_start.set(Some(started));
+                if shrink_steps.get() >= self.max_shrink_iters || started.elapsed() > SHRINK_TIME
+                {
+                    return Ok(());
+                }
                 shrink_steps.set(shrink_steps.get() + 1);
                 (events.borrow_mut())(Event::Shrink(shrink_steps.get()));
             }
