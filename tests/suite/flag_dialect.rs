@@ -166,3 +166,54 @@ fn hazard_prints_percentages_with_a_key_and_names_what_it_wrote() {
         "no hazard at 64 threads in flight: the percentages check nothing\n{md}"
     );
 }
+
+/// Issue 36's smaller items: at several samples render's header names the pixels and the
+/// samples, with the masked A-buffer's line after it; a long scheme name widens its column
+/// rather than pushing the rest out of line; bench's terminal table fits a terminal; the figures
+/// name their scene, view and scheme.
+#[test]
+fn tables_stay_aligned_and_name_pixels_and_samples() {
+    let dir = scratch("tables");
+    let output = fragsim_in(
+        &dir,
+        &["render", "--scene", "spheres:2", "--width", "64", "--height", "64", "--samples", "4",
+          "--k", "auto", "--capacity", "auto",
+          "--scheme", "mdts,kbuffer-interlock-ordered-first,abuffer-masked"],
+    );
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert!(
+        lines[0].contains("64x64 pixels at 4 samples (256x64 sample lists)"),
+        "{stdout}"
+    );
+    let masked = lines.iter().position(|l| l.starts_with("abuffer-masked")).unwrap();
+    assert!(masked > 2, "the masked A-buffer's line comes before the table:\n{stdout}");
+    // Every row's columns start where the header's do.
+    let header = lines[1];
+    let at = header.find("guarantee").unwrap();
+    let starts = |line: &str| {
+        (line[..at].to_owned(), line[at..].split_whitespace().next().map(str::to_owned))
+    };
+    for row in &lines[2..4] {
+        let (name, guarantee) = starts(row);
+        assert!(name.ends_with(' '), "{row}");
+        assert!(guarantee.is_some_and(|g| g.starts_with("exact")), "{header}\n{row}");
+    }
+    // bench's terminal table stays within 120 characters.
+    let bench = fragsim_in(
+        &dir,
+        &["bench", "--scene", "spheres:2", "--width", "32", "--height", "24", "--frames", "1",
+          "--scheme", "mdts,kbuffer-interlock-ordered-first", "--executor", "all"],
+    );
+    let text = String::from_utf8(bench.stdout).unwrap();
+    assert!(bench.status.success());
+    for line in text.lines().filter(|l| l.starts_with("mdts") || l.starts_with("kbuffer")) {
+        assert!(line.chars().count() <= 120, "{} characters: {line}", line.chars().count());
+    }
+    // The figures carry a caption strip under the picture and its panel.
+    let plain = image::open(dir.join("out/bench/bench-mdts-serial.png")).unwrap();
+    let figure = image::open(dir.join("out/bench/bench-mdts-serial-diff.png")).unwrap();
+    assert_eq!((plain.width(), plain.height()), (32, 24), "the effect image stays pixel data");
+    assert!(figure.height() > 300, "no caption under the figure");
+}

@@ -328,20 +328,64 @@ pub(crate) fn time_frames<T>(
     Ok((first.expect("at least one frame"), times))
 }
 
-/// Writes `image` to `out/<stem>.png` and its difference from `reference` to
-/// `out/<stem>-diff.png`.
-///
-/// # Errors
-/// Images of different sizes, or a file that cannot be written.
-pub(crate) fn save_with_difference(
-    image: &RgbImage,
-    reference: &RgbImage,
-    out: &Path,
-    stem: &str,
-) -> Result<(), String> {
-    fragsim_shade::save_png(image, &out.join(format!("{stem}.png")))?;
-    let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
-    fragsim_shade::save_png(&difference, &out.join(format!("{stem}-diff.png")))
+/// Where bench's images go, and the scene and view their captions name.
+pub(crate) struct Images<'a> {
+    /// The directory (`--out`).
+    pub(crate) dir: &'a Path,
+    /// The scene, view and size, as every caption opens.
+    pub(crate) scene: String,
+}
+
+impl<'a> Images<'a> {
+    /// The images of `args` (`None` under `--no-images`).
+    ///
+    /// # Errors
+    /// The mesh file cannot be read (for its name in the caption).
+    fn of(args: &'a BenchArgs) -> Result<Option<Self>, String> {
+        if args.no_images {
+            return Ok(None);
+        }
+        let context = Context::of_scene("bench", &args.scene)?;
+        Ok(Some(Self {
+            dir: &args.out,
+            scene: format!(
+                "{}, view {}°, elevation {}°, {}x{}",
+                context.scene,
+                args.scene.view,
+                args.scene.elevation,
+                args.scene.width,
+                args.scene.height
+            ),
+        }))
+    }
+
+    /// Saves the effect image `image` as `name`, as it is: pixel data that readers compare
+    /// (its file name says what it is; its figure, the difference, carries the caption).
+    ///
+    /// # Errors
+    /// A file that cannot be written.
+    pub(crate) fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
+        fragsim_shade::save_png(image, &self.dir.join(name))
+    }
+
+    /// Saves `image` as `stem.png` and its difference from `reference` (error pixels red, with
+    /// a legend and insets) as `stem-diff.png`, captioned with the scene and `what` it shows.
+    ///
+    /// # Errors
+    /// Images of different sizes, a font error, or a file that cannot be written.
+    pub(crate) fn save_with_difference(
+        &self,
+        image: &RgbImage,
+        reference: &RgbImage,
+        stem: &str,
+        what: &str,
+    ) -> Result<(), String> {
+        self.save(image, &format!("{stem}.png"))?;
+        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
+        let caption = format!("{}: {what} against the oracle's image", self.scene);
+        let figure = fragsim_shade::legend::captioned(&difference, &caption)?;
+        self.save(&figure, &format!("{stem}-diff.png"))
+    }
 }
 
 /// Runs `bench`.
@@ -400,9 +444,9 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         (schemes.len() * executors.len() * (frames + 1)) as u64,
         "bench",
     );
-    if let Some(image) = judge.reference().filter(|_| !args.no_images) {
-        let name = format!("bench-oracle-{}.png", args.effect.label());
-        fragsim_shade::save_png(image, &args.out.join(name))?;
+    let images = Images::of(args)?;
+    if let (Some(image), Some(images)) = (judge.reference(), &images) {
+        images.save(image, &format!("bench-oracle-{}.png", args.effect.label()))?;
     }
     let mut rows = Vec::new();
     for &name in &schemes {
@@ -435,12 +479,23 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 judged.as_ref().map(|j| (j.reference, &j.image)),
                 &depth_complexity,
             )?;
-            if let Some(Judged {
-                image, reference, ..
-            }) = judged.as_ref().filter(|_| !args.no_images)
+            if let (
+                Some(Judged {
+                    image, reference, ..
+                }),
+                Some(images),
+            ) = (judged.as_ref(), &images)
             {
-                let stem = format!("bench-{}-{executor}", named.name);
-                save_with_difference(image, reference, &args.out, &stem)?;
+                images.save_with_difference(
+                    image,
+                    reference,
+                    &format!("bench-{}-{executor}", named.name),
+                    &format!(
+                        "{} of {} on the {executor} executor",
+                        args.effect.label(),
+                        named.name
+                    ),
+                )?;
             }
             let median_time = times.median();
             let stats = &named.run.stats;
@@ -512,7 +567,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 frames,
                 pool: &pool,
                 serial_pool: &serial_pool,
-                out: (!args.no_images).then_some(args.out.as_path()),
+                images: images.as_ref(),
             };
             crate::multisampled::measure(&bench, pattern)
         })
@@ -528,12 +583,12 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                     scheme, nodes, &judge, &oracle, order, frames, raster_ms,
                 )
             })?;
-            if let Some(reference) = judge.reference().filter(|_| !args.no_images) {
-                save_with_difference(
+            if let (Some(reference), Some(images)) = (judge.reference(), &images) {
+                images.save_with_difference(
                     &image,
                     reference,
-                    &args.out,
                     &format!("bench-{}", row.scheme),
+                    &format!("{} of {}", args.effect.label(), row.label()),
                 )?;
             }
             approximate.push(row);
@@ -648,8 +703,8 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
         out!("{lines}");
         eprintln!("{wrote}");
     } else {
-        out!("{markdown}");
-        outln!("{wrote}");
+        out!("{}", terminal_table(report));
+        outln!("{wrote} (bench.md: every column, with their key, and the per-depth tables)");
     }
     Ok(())
 }
@@ -712,6 +767,69 @@ rasterization, capture) and the post pass (resolve, sort); **frame ms** their me
 median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments per second; \
 **vs DP** depth peeling's median time over this row's (above 1: faster than depth peeling).
 ";
+
+/// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
+/// first, aligned, in about 120 characters (bench.md holds all 26).
+fn terminal_table(report: &BenchReport) -> String {
+    type Cell = fn(&BenchRow) -> String;
+    let columns: [(&str, Cell); 10] = [
+        ("scheme", |r| r.scheme.clone()),
+        ("executor", |r| r.executor.clone()),
+        ("passes", |r| r.passes.to_string()),
+        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
+        ("lost", |r| r.lost.to_string()),
+        ("mismatched px", |r| r.mismatched_pixels.to_string()),
+        ("EPR %", |r| {
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".into(), |e| format!("{:.3}", e * 100.0))
+        }),
+        ("PSNR dB", |r| r.colour.cells()[2].clone()),
+        ("frame ms", |r| format!("{:.2}", r.time_ms)),
+        ("vs DP", |r| {
+            r.speedup_vs_depth_peeling
+                .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
+        }),
+    ];
+    let mut rows = vec![columns.iter().map(|(h, _)| (*h).to_string()).collect::<Vec<_>>()];
+    rows.extend(
+        report
+            .rows
+            .iter()
+            .map(|r| columns.iter().map(|(_, cell)| cell(r)).collect()),
+    );
+    let widths: Vec<usize> = (0..columns.len())
+        .map(|c| rows.iter().map(|row| row[c].chars().count()).max().unwrap_or(0))
+        .collect();
+    let mut text = markdown(report)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    text.push_str("\n\n");
+    for row in &rows {
+        let cells: Vec<String> = row
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (cell, &w))| {
+                if c < 2 {
+                    format!("{cell:<w$}")
+                } else {
+                    format!("{cell:>w$}")
+                }
+            })
+            .collect();
+        text.push_str(cells.join("  ").trim_end());
+        text.push('\n');
+    }
+    text.push_str(
+        "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
+         should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
+         pixels whose 8-bit colour of the effect differs, in % of the covered pixels; PSNR dB of \
+         that image; frame ms the median frame; vs DP speed-up over depth peeling.\n",
+    );
+    text
+}
 
 fn markdown(report: &BenchReport) -> String {
     let mut text = format!(
