@@ -181,7 +181,7 @@ struct WordsReport {
     /// Words the layout leaves undefined (unfilled A-buffer slots past the counter).
     unchecked: u64,
     /// Linked lists: nodes the pool counter handed out that no list reaches (each a lost
-    /// fragment, which the lists' comparison counts as missing).
+    /// fragment, missing at its pixel, or a node no fragment took): never equal.
     unreachable: u64,
 }
 

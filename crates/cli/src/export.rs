@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use fragsim_capture::catalog::DumpLayout;
 use fragsim_oracle::dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
 use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
 use fragsim_oracle::triangles::TriangleExport;
@@ -146,11 +147,12 @@ impl DumpStage {
         })
     }
 
-    /// Stages scheme `name`'s memory, sized as `run` was, after a serial run; a scheme whose
-    /// memory has no dump layout is skipped with the reason on stderr.
+    /// Stages scheme `name`'s memory as `run` left it ([`NamedRun::memory`]: the executors must
+    /// have kept it), so that the dump holds the words of the run reported, a racy one's
+    /// included; a scheme whose memory has no dump layout is skipped with the reason on stderr.
     ///
     /// # Errors
-    /// A dump that cannot be recorded or written.
+    /// A run that kept no memory, or a dump that cannot be recorded or written.
     pub(crate) fn add(
         &mut self,
         name: SchemeName,
@@ -179,8 +181,26 @@ impl DumpStage {
                 ignored.join(" or ")
             );
         }
-        let dump = Dump::record(view, spec, &scheme, &producer)
-            .and_then(|dump| dump.in_layout(layout))
+        // A scheme dumped under its own name wrote its layout's words; one dumped under another
+        // entry's layout (loop64, zbuffer and mdts-probe as mdts, the A-buffer variants as
+        // abuffer) keeps its memory otherwise, and is written as that entry's serial run, whose
+        // lists are the same under every interleaving (they are atomic schemes).
+        let own_words = DumpLayout::header_scheme(name) == Some(name);
+        let dump = match (&run.memory, own_words) {
+            (Some(memory), true) => Dump::of_memory(
+                view,
+                spec,
+                &scheme,
+                memory.words32.clone(),
+                memory.words64.clone(),
+                &producer,
+            ),
+            (None, true) => {
+                return Err(format!("render --dump: {name}: the run kept no memory"));
+            }
+            (_, false) => Dump::record(view, spec, &scheme, &producer),
+        }
+        .and_then(|dump| dump.in_layout(layout))
             .map_err(|e| format!("render --dump: {name}: {e}"))?;
         dump.write(&self.staging.join(name.name()))
             .map_err(|e| e.to_string())?;

@@ -210,6 +210,8 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let max_dc = oracle.max_depth_complexity();
     let mut runner = Executors::default();
     runner.fault = args.inject_fault.map(Into::into);
+    // A dump holds the memory of the run it reports, not a serial re-run's.
+    runner.keep_memory = args.dump.dir.is_some();
     let mut rows = Vec::new();
     let mut nearest_written = false;
     let mut dumps = args

@@ -149,6 +149,10 @@ pub struct Comparison {
     /// What the capture told of the vertices' snaps (`docs/semantics.md` §10, "One snap per
     /// vertex"); all 0 outside a verdict within precision.
     pub snaps: SnapCounts,
+    /// Linked lists: nodes the counter handed out that no list reaches ([`WordCheck::unreachable`]).
+    /// Each is a fragment lost from the lists (missing at its pixel, where the node held one) or
+    /// a counter that handed out a node no fragment took: never equal.
+    pub unreachable_nodes: u64,
 }
 
 /// The joint judgement of the pixels whose coverage hangs on a vertex's snap: every triangle
@@ -215,6 +219,7 @@ impl Comparison {
             first_corrupt: Vec::new(),
             ambiguity: AmbiguityCounts::default(),
             snaps: SnapCounts::default(),
+            unreachable_nodes: words.map_or(0, |w| w.unreachable),
         }
     }
 
@@ -276,10 +281,11 @@ impl Comparison {
             .count() as u64;
     }
 
-    /// Whether every pixel is equal (overflow by design allowed).
+    /// Whether every pixel is equal (overflow by design allowed) and every node a linked list's
+    /// counter handed out is in a list.
     #[must_use]
     pub fn is_equal(&self) -> bool {
-        self.diff.is_exact()
+        self.diff.is_exact() && self.unreachable_nodes == 0
     }
 }
 

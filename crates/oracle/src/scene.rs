@@ -48,7 +48,11 @@ pub fn mesh_hash(bytes: &[u8]) -> String {
 /// bits (ryu), so encode then parse gives every finite value back bit for bit. JSON has no NaN or
 /// infinity: [`SceneAndCamera::check_finite`] refuses them before a header is written (serde_json would
 /// write `null`), and a decimal past the f64 range is a parse error.
+///
+/// An unknown field is refused by name (a misspelt `fov_y_degres` would otherwise judge the dump
+/// under the default field of view).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneAndCamera {
     /// A named scene (`Scene::procedural`: `bunny`, `spheres:8`, …); absent when `mesh` is set.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -25,7 +25,8 @@ pub(super) fn stdout_of(cmd: &mut Command, code: i32) -> String {
 
 const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
 
-/// `fragsim render` of the test scene running `schemes`, their dumps in `out`, with `options`.
+/// `fragsim render` of the test scene running `schemes` serially (a dump holds the memory of
+/// the run, and a parallel k-buffer may race), their dumps in `out`, with `options`.
 pub(super) fn render_dump(out: &Path, schemes: &str, options: &[&str]) {
     stdout_of(
         fragsim()
@@ -35,6 +36,8 @@ pub(super) fn render_dump(out: &Path, schemes: &str, options: &[&str]) {
                 SCENE,
                 "--scheme",
                 schemes,
+                "--executor",
+                "serial",
                 "--no-images",
             ])
             .args(SIZE)

@@ -78,7 +78,7 @@ fn a_dump_written_by_hand_as_a_gpu_backend_writes_it_is_read_and_judged() {
                 "scene": {{"name": "{SCENE}", "view_degrees": 30, "elevation_degrees": 15}},
                 "width": {WIDTH}, "height": {HEIGHT}, "scheme": "mdts", "k": {k},
                 "arrays": {{"slots": {{"file": "words.bin", "dtype": "<u8", "shape": [{pixels}, {k}]}}}},
-                "extra": {{"kernel_ms": 0.25}}, "something_new": true}}"#
+                "extra": {{"kernel_ms": 0.25, "something_new": true}}}}"#
         );
         std::fs::write(dir.join("dump.json"), header).unwrap();
         let dump = Dump::read(&dir).unwrap();

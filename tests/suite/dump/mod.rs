@@ -21,6 +21,7 @@ mod numbers;
 mod parse;
 mod samples;
 mod slots;
+mod soundness;
 
 /// A fresh directory under cargo's per-test-target temporary directory.
 fn scratch(name: &str) -> PathBuf {

@@ -34,7 +34,7 @@ mod run;
 
 pub use build::{Build, SchemeVisitor};
 pub use dump_layout::{DumpLayout, SlotWord};
-pub use run::{check_memory_cap_early, Executors, Fault, NamedRun};
+pub use run::{check_memory_cap_early, Executors, Fault, MemoryWords, NamedRun};
 
 use crate::schemes::abuffer::{
     ABuffer,

@@ -9,8 +9,9 @@ use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use crate::primitive_order::PrimitiveOrder;
-use crate::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step};
+use crate::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory};
 use fragsim_raster::{Fragment, View, Viewport};
+use std::sync::Mutex;
 
 /// A finished run of a named scheme.
 #[derive(Debug, Clone)]
@@ -28,6 +29,33 @@ pub struct NamedRun {
     /// The sizes the scheme was built with (their `counts` are [`NamedRun::counts`]): what a
     /// dump of its memory needs to rebuild it.
     pub sizes: Build<'static>,
+    /// The run's own memory after its last pass, before the post pass, where
+    /// [`Executors::keep_memory`] asked for it: what `render --dump` writes, so that a dump holds
+    /// the words of the run it reports (a racy run's included).
+    pub memory: Option<MemoryWords>,
+}
+
+/// Every word of a scheme's memory, in the order of its [`Layout`].
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MemoryWords {
+    /// The u32 words.
+    pub words32: Vec<u32>,
+    /// The u64 words.
+    pub words64: Vec<u64>,
+}
+
+impl MemoryWords {
+    /// A copy of every word of `memory`.
+    pub fn read<M: Memory>(memory: &M) -> Self {
+        Self {
+            words32: (0..WordMemory::<u32>::len(memory))
+                .map(|i| WordMemory::<u32>::load(memory, i))
+                .collect(),
+            words64: (0..WordMemory::<u64>::len(memory))
+                .map(|i| WordMemory::<u64>::load(memory, i))
+                .collect(),
+        }
+    }
 }
 
 /// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
@@ -48,6 +76,8 @@ pub struct Executors {
     pub count_locked_ops: bool,
     /// A fault injected into every scheme run (tests only).
     pub fault: Option<Fault>,
+    /// Copy each run's memory after its last pass into [`NamedRun::memory`].
+    pub keep_memory: bool,
 }
 
 impl Executors {
@@ -71,6 +101,7 @@ impl Executors {
                 self,
                 executor,
                 view,
+                None,
             ))
         });
         // What `auto` sizes resolve to: the count pass's maximum depth complexity (at least 1).
@@ -199,30 +230,45 @@ struct RunOn<'e, 'v, 'm> {
 impl SchemeVisitor for RunOn<'_, '_, '_> {
     type Output = NamedRun;
     fn visit<S: Scheme>(self, scheme: &S, slots: Option<u32>) -> NamedRun {
+        let kept = self.executors.keep_memory.then(|| Mutex::new(None));
+        let run = run_with_fault(
+            scheme,
+            self.executors,
+            self.executor,
+            self.view,
+            kept.as_ref(),
+        );
         NamedRun {
-            run: run_with_fault(scheme, self.executors, self.executor, self.view),
+            run,
             name: scheme.name(),
             guarantee: scheme.guarantee(),
             slots,
             counts: None,
             sizes: self.sizes,
+            memory: kept.and_then(|kept| kept.into_inner().ok().flatten()),
         }
     }
 }
 
-/// One frame of `scheme` on `executor`, with the executors' fault injected where one is set.
+/// One frame of `scheme` on `executor`, with the executors' fault injected where one is set and
+/// its memory after the last pass copied into `keep` where given.
 fn run_with_fault<S: Scheme>(
     scheme: &S,
     executors: &mut Executors,
     executor: Executor,
     view: &View<'_>,
+    keep: Option<&Mutex<Option<MemoryWords>>>,
 ) -> Run {
-    match executors.fault {
-        Some(Fault::MiscountOverflow) => {
-            run_on(&MiscountOverflow(scheme), executors, executor, view)
-        }
-        None => run_on(scheme, executors, executor, view),
+    let miscount = executors.fault == Some(Fault::MiscountOverflow);
+    if !miscount && keep.is_none() {
+        return run_on(scheme, executors, executor, view);
     }
+    let instrumented = Instrumented {
+        scheme,
+        miscount,
+        keep,
+    };
+    run_on(&instrumented, executors, executor, view)
 }
 
 /// One frame of `scheme` on `executor`.
@@ -243,50 +289,62 @@ fn run_on<S: Scheme>(
     }
 }
 
-/// [`Fault::MiscountOverflow`]: the scheme, reporting one overflowing fragment more at pixel 0
-/// than it counted.
-struct MiscountOverflow<'a, S>(&'a S);
+/// The scheme, watched: with `miscount` ([`Fault::MiscountOverflow`]) reporting one overflowing
+/// fragment more at pixel 0 than it counted, and with `keep` copying its memory out after the
+/// last pass (where the between-pass kernel asks for no more), before the post pass reads it.
+struct Instrumented<'a, S> {
+    scheme: &'a S,
+    miscount: bool,
+    keep: Option<&'a Mutex<Option<MemoryWords>>>,
+}
 
-impl<S: Scheme> Scheme for MiscountOverflow<'_, S> {
+impl<S: Scheme> Scheme for Instrumented<'_, S> {
     type State = S::State;
 
     fn name(&self) -> String {
-        self.0.name()
+        self.scheme.name()
     }
     fn layout(&self) -> Layout {
-        self.0.layout()
+        self.scheme.layout()
     }
     fn identity(&self) -> Identity {
-        self.0.identity()
+        self.scheme.identity()
     }
     fn promise(&self) -> Promise {
-        self.0.promise()
+        self.scheme.promise()
     }
     fn guarantee(&self) -> Guarantee {
-        self.0.guarantee()
+        self.scheme.guarantee()
     }
     fn counts_every_drop(&self) -> bool {
-        self.0.counts_every_drop()
+        self.scheme.counts_every_drop()
     }
     fn begin(&self, fragment: Fragment) -> S::State {
-        self.0.begin(fragment)
+        self.scheme.begin(fragment)
     }
     fn begin_pass(&self, pass: u32, fragment: Fragment) -> Option<S::State> {
-        self.0.begin_pass(pass, fragment)
+        self.scheme.begin_pass(pass, fragment)
     }
     fn step<M: Memory>(&self, state: &mut S::State, memory: &M) -> Step {
-        self.0.step(state, memory)
+        self.scheme.step(state, memory)
     }
     fn simt(&self, state: &S::State) -> crate::executors::scheduled::Simt {
-        self.0.simt(state)
+        self.scheme.simt(state)
     }
     fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
-        self.0.end_pass(pass, memory)
+        let more = self.scheme.end_pass(pass, memory);
+        if let (false, Some(keep)) = (more, self.keep) {
+            if let Ok(mut kept) = keep.lock() {
+                *kept = Some(MemoryWords::read(memory));
+            }
+        }
+        more
     }
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        self.0.resolve_pixel(memory, pixel, out) + u32::from(pixel == 0)
+        let overflow = self.scheme.resolve_pixel(memory, pixel, out);
+        overflow + u32::from(self.miscount && pixel == 0)
     }
     fn pixels(&self) -> usize {
-        self.0.pixels()
+        self.scheme.pixels()
     }
 }

@@ -31,8 +31,9 @@ impl Dtype {
     }
 }
 
-/// Where an array lives and what it holds.
+/// Where an array lives and what it holds. An unknown field is refused by name.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ArraySpec {
     /// File name, relative to the dump directory.
     pub file: String,
@@ -42,8 +43,11 @@ pub struct ArraySpec {
     pub shape: Vec<u64>,
 }
 
-/// The JSON header of a dump (`dump.json`).
+/// The JSON header of a dump (`dump.json`). An unknown field is refused by name, so that a
+/// misspelt one (`"capacty"`) cannot silently change how the dump is judged; anything else the
+/// producer keeps goes in [`Header::extra`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Header {
     /// Always [`FORMAT`](super::FORMAT).
     pub format: String,
@@ -92,7 +96,8 @@ pub struct Header {
     pub word: String,
     /// The arrays by name: `slots`, and for the A-buffer `counters` and maybe `offsets`.
     pub arrays: BTreeMap<String, ArraySpec>,
-    /// Anything else the producer wants to keep (timings, device): ignored by the reader.
+    /// Anything else the producer wants to keep (timings, device): the one field whose contents
+    /// the reader ignores.
     #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
     pub extra: serde_json::Value,
 }

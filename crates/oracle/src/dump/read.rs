@@ -11,7 +11,7 @@ use super::header::{check_array, check_distinct_files, check_file_name, elements
 use super::layouts::stored_lists;
 use super::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{FORMAT, HEADER_FILE, VERSION};
-use fragsim_capture::catalog::SchemeVisitor;
+use fragsim_capture::catalog::{SchemeName, SchemeVisitor};
 
 fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W]) {
     for (i, &w) in words.iter().enumerate() {
@@ -175,8 +175,9 @@ impl Dump {
         DumpScheme::from_header(&self.header, self.u32s("offsets")?)
     }
 
-    /// Decodes the words into per-pixel lists with the scheme's own post pass (sorted A-buffer
-    /// dumps: in stored order).
+    /// Decodes the words into the per-pixel lists the verdict judges, with the scheme's own post
+    /// pass (sorted A-buffer dumps: in stored order). Linked lists are decoded whole: every node
+    /// a pixel's list reaches, sorted, all of them owed ([`Dump::judged_lists`]).
     ///
     /// # Errors
     /// A header that names no known scheme, or arrays missing or of the wrong size or type.
@@ -184,7 +185,7 @@ impl Dump {
         if self.is_masked() {
             return self.masked_capture();
         }
-        let scheme = self.scheme()?;
+        let scheme = Self::judged_lists(self.scheme()?);
         if let Some(own) = self.own_slots(&scheme)? {
             return own.capture();
         }
@@ -212,6 +213,26 @@ impl Dump {
             words64,
         };
         scheme.with_scheme(self.viewport()?, resolve)?
+    }
+}
+
+impl Dump {
+    /// The scheme whose post pass decodes the lists the verdict judges: the header's, except that
+    /// a linked list is judged on every node its lists reach. The resolve's `k` (keep the first
+    /// or the nearest `k` nodes) limits what shading reads, not what the lists hold: a node cut
+    /// out of a list of more than `k` is a lost fragment wherever the resolve would have dropped
+    /// it anyway. So the lists are read by the keep-first resolve with room for the whole pool,
+    /// which keeps every node reached, sorted, and promises each of the pixel's fragments.
+    fn judged_lists(scheme: DumpScheme) -> DumpScheme {
+        match scheme {
+            DumpScheme::LinkedLists { pool, spec, .. } => DumpScheme::LinkedLists {
+                scheme: SchemeName::LinkedList,
+                k: pool,
+                pool,
+                spec,
+            },
+            other => other,
+        }
     }
 }
 

@@ -105,7 +105,10 @@ impl DepthFormat {
 /// Where a payload word keeps the depth and the primitive id: the depth field of
 /// [`DepthFormat::bits`] bits starts at bit `depth_shift`, the primitive id is the low
 /// `prim_bits` bits (below the depth, so that words sort by depth first).
+///
+/// An unknown field is refused by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Payload {
     /// The word's type.
     pub dtype: Dtype,

@@ -47,6 +47,17 @@ fn read_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>) -> Vec<W> {
     (0..memory.len()).map(|i| memory.load(i)).collect()
 }
 
+/// The numbers of u32 and u64 words of a scheme's memory.
+struct LayoutOf;
+
+impl SchemeVisitor for LayoutOf {
+    type Output = (usize, usize);
+    fn visit<S: Scheme>(self, scheme: &S, _slots: Option<u32>) -> Self::Output {
+        let layout = scheme.layout();
+        (layout.words32, layout.words64)
+    }
+}
+
 impl Dump {
     /// Runs fragsim's `scheme` serially over `view` and records its memory as a dump.
     ///
@@ -56,6 +67,25 @@ impl Dump {
         view: &View<'_>,
         scene: SceneAndCamera,
         scheme: &DumpScheme,
+        producer: &str,
+    ) -> Result<Self, DumpError> {
+        let (words32, words64) = scheme.with_scheme(view.viewport(), Record { view })?;
+        Self::of_memory(view, scene, scheme, words32, words64, producer)
+    }
+
+    /// Records the memory a run of `scheme` over `view` left after its last pass (`words32` and
+    /// `words64`, in its layout's order) as a dump: what `render --dump` writes, the words of the
+    /// very run it reports on whatever executor ran it.
+    ///
+    /// # Errors
+    /// Scheme parameters out of range, a view whose framebuffer is not the one `scene`'s sample
+    /// count declares, or words of another number than the scheme's memory holds.
+    pub fn of_memory(
+        view: &View<'_>,
+        scene: SceneAndCamera,
+        scheme: &DumpScheme,
+        words32: Vec<u32>,
+        words64: Vec<u64>,
         producer: &str,
     ) -> Result<Self, DumpError> {
         // The arrays index the view's framebuffer (sample-expanded at more than one sample), the
@@ -73,7 +103,16 @@ impl Dump {
                 declared.height
             ));
         }
-        let (words32, words64) = scheme.with_scheme(viewport, Record { view })?;
+        let (len32, len64) = scheme.with_scheme(viewport, LayoutOf)?;
+        if (words32.len(), words64.len()) != (len32, len64) {
+            return err(format!(
+                "{} over this viewport holds {len32} u32 and {len64} u64 words, the memory given \
+                 {} and {}",
+                scheme.name(),
+                words32.len(),
+                words64.len()
+            ));
+        }
         let pixels = viewport.pixels() as u64;
         let mut arrays = BTreeMap::new();
         let mut shapes: BTreeMap<&str, Vec<u64>> = BTreeMap::new();

@@ -587,25 +587,29 @@ fn judge_pixel(
             if got.len() > k {
                 judged.extra += (got.len() - k) as u64;
             }
+            // A conforming list leaves a fragment it produced out only when it holds K fragments
+            // ahead of it in the promise's order (nearer for K nearest, farther for K farthest),
+            // and those are the fragments it holds: so an absent certain fragment is excused only
+            // by K held fragments that may each be ahead of it. Fragments that could have been
+            // ahead but are not in the list excuse nothing (a list of fewer than K fragments
+            // left nothing out).
+            let held: Vec<usize> = assigned.iter().flatten().copied().collect();
+            let mut owed = 0;
             for &f in &absent_certain {
                 let (f_lo, f_hi) = widened(&possible[f]);
-                // Ahead of f in the promise's order: nearer for K nearest, farther for K farthest.
                 let (mut surely, mut maybe) = (0, 0);
-                for (j, q) in possible.iter().enumerate() {
-                    if j == f {
-                        continue;
-                    }
-                    let (lo, hi) = widened(q);
+                for &j in &held {
+                    let (lo, hi) = widened(&possible[j]);
                     let (sure, could) = if nearest {
                         (hi < f_lo, lo <= f_hi)
                     } else {
                         (lo > f_hi, hi >= f_lo)
                     };
-                    surely += usize::from(sure && q.certain());
+                    surely += usize::from(sure);
                     maybe += usize::from(could);
                 }
                 if maybe < k {
-                    judged.lost += 1;
+                    owed += 1;
                 } else if surely >= k {
                     judged.overflowed += 1;
                 } else {
@@ -613,6 +617,12 @@ fn judge_pixel(
                     judged.ambiguity.order = 1;
                 }
             }
+            // The fragments lost are those the list lacks of the K it owes: K less what it holds
+            // (one at least where a held fragment took an owed one's place); the other owed
+            // fragments lie past the K nearest (farthest), beyond storage as the reference predicts.
+            let lost = owed.min(k.saturating_sub(held.len()).max(1));
+            judged.lost += lost as u64;
+            judged.overflowed += (owed - lost) as u64;
             if judged.overflowed > 0 {
                 judged.flags |= verdict::OVERFLOWED;
             }
@@ -629,22 +639,27 @@ fn judge_pixel(
                 Capacity::Unbounded => usize::MAX,
                 Capacity::PerPixel(_) => counter.capacity as usize,
                 // Storage that stops at `c` without a count (a keep-first list's resolve): which
-                // fragments it keeps follows arrival order, which the reference cannot know, so
-                // any `arrived − c` of them may be absent.
+                // fragments a full list keeps follows arrival order, which the reference cannot
+                // know, so any of them may be absent.
                 Capacity::PerPixelUncounted(c) => *c as usize,
             };
             let counted = !matches!(capacity, Capacity::PerPixelUncounted(_));
             if counted && (count < certain || count > possible.len()) {
                 judged.flags |= verdict::MISCOUNTED;
             }
+            let held = assigned.iter().flatten().count();
             // The fragments storage could not hold: the implementation's own count past the
-            // capacity where it is one the pixel may have, else the most the pixel may have.
-            let arrived = if counted && count >= certain && count <= possible.len() {
-                count
+            // capacity where it is one the pixel may have (a miscounted pixel is an error
+            // already). Uncounted storage keeps every arrival until it is full, so a full list
+            // may have left out any; a shorter one left nothing out, and lacks `cap − held` of
+            // the fragments it owes (the others lie past its capacity).
+            let allowed = if counted && count >= certain && count <= possible.len() {
+                count.saturating_sub(cap)
+            } else if !counted && held < cap {
+                absent_certain.len().saturating_sub(cap - held)
             } else {
-                possible.len()
+                possible.len().saturating_sub(cap)
             };
-            let allowed = arrived.saturating_sub(cap);
             judged.overflowed = allowed.min(absent_certain.len()) as u64;
             judged.lost = absent_certain.len().saturating_sub(allowed) as u64;
             if judged.overflowed > 0 {

@@ -19,26 +19,23 @@ impl View<'_> {
     pub fn set_camera(&mut self, camera: &Camera) {
         self.view_projection = camera.view_projection;
         let count = self.mesh.positions.len();
-        self.outcodes.resize(count, 0);
-        self.window_xy.resize(count, [0, 0]);
+        self.window.resize(count, WindowVertex::default());
         self.window_z.resize(count, 0.0);
         let stage = self.stage();
         // Every vertex is independent: chunks of the arrays go to the pool side by side.
         self.mesh
             .positions
             .par_chunks(VERTICES_PER_TASK)
-            .zip(self.outcodes.par_chunks_mut(VERTICES_PER_TASK))
-            .zip(self.window_xy.par_chunks_mut(VERTICES_PER_TASK))
+            .zip(self.window.par_chunks_mut(VERTICES_PER_TASK))
             .zip(self.window_z.par_chunks_mut(VERTICES_PER_TASK))
-            .for_each(|(((positions, outcodes), window_xy), window_z)| {
-                let outputs = outcodes.iter_mut().zip(window_xy).zip(window_z);
-                for (p, ((outcode, xy), z)) in positions.iter().zip(outputs) {
+            .for_each(|((positions, window), window_z)| {
+                for (p, (vertex, z)) in positions.iter().zip(window.iter_mut().zip(window_z)) {
                     let clip = stage.clip(*p);
-                    *outcode = stage.outcode(clip);
-                    if *outcode & CLIP_BITS == 0 {
+                    vertex.outcode = stage.outcode(clip);
+                    if vertex.outcode & CLIP_BITS == 0 {
                         let ([x, y], depth) = stage.snap(clip);
-                        // Inside the guard band: lossless (see `window_xy`).
-                        *xy = [x as i32, y as i32];
+                        // Inside the guard band: lossless (see `WindowVertex`).
+                        vertex.xy = [x as i32, y as i32];
                         *z = depth;
                     }
                 }
@@ -92,6 +89,25 @@ impl View<'_> {
             DVec4::new(0.0, 1.0, 0.0, gy),
             DVec4::new(0.0, -1.0, 0.0, gy),
         ]
+    }
+}
+
+/// What the vertex stage leaves for the triangle setup of every triangle that uses a vertex.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct WindowVertex {
+    /// The snapped window position, x and y in 1/256 pixel, y down; meaningful only when the
+    /// outcode has no clip bit set. Inside the guard band they fit an `i32` (|x| < 2^23).
+    pub(super) xy: [i32; 2],
+    /// Bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5: beyond far;
+    /// bit 6: not in front of the eye (`w ≤ 0` or NaN).
+    pub(super) outcode: u8,
+}
+
+impl WindowVertex {
+    /// The snapped window position, widened.
+    #[inline]
+    pub(super) fn position(self) -> [i64; 2] {
+        [self.xy[0].into(), self.xy[1].into()]
     }
 }
 
