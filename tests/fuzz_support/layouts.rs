@@ -490,12 +490,8 @@ fn linked_lists(
             walked.push(fragment);
             node = next[i];
         }
-        // `linked-list` keeps the first K nodes of the walk (sorted), `linked-list-nearest` the
-        // K nearest.
-        if scheme == SchemeName::LinkedListNearest {
-            walked.sort_unstable();
-        }
-        walked.truncate(k as usize);
+        // The verdict judges every node a list reaches, whatever the resolve's `k` keeps for
+        // shading (`Dump::capture`), sorted.
         walked.sort_unstable();
         model.lists.push(walked);
     }
