@@ -34,9 +34,33 @@ impl View<'_> {
         let width = i64::from(self.viewport.width);
         let mut row = setup.origin;
         let mut row_pixel = i64::from(y0) * width + i64::from(x0);
+        let step = setup.step_x;
+        if last < NARROW_BOX_WIDTH {
+            // A narrow box: its few centres of a row tested one by one cost less than the
+            // divisions that find a run.
+            for _ in y0..=y1 {
+                let mut e = row;
+                for pixel in row_pixel..=row_pixel + last {
+                    if (0..3).all(|k| e[k] >= setup.threshold[k]) {
+                        if let Some(fragment) =
+                            fragment_at(setup.prim, setup.z, e, setup.area, pixel)
+                        {
+                            emit(fragment);
+                        }
+                    }
+                    for k in 0..3 {
+                        e[k] += step[k];
+                    }
+                }
+                for k in 0..3 {
+                    row[k] += setup.step_y[k];
+                }
+                row_pixel += width;
+            }
+            return;
+        }
         for _ in y0..=y1 {
             if let Some((first, end)) = setup.covered_run(row, last) {
-                let step = setup.step_x;
                 let mut e = [
                     row[0] + step[0] * first,
                     row[1] + step[1] * first,
@@ -58,6 +82,12 @@ impl View<'_> {
         }
     }
 }
+
+/// Boxes at most this many pixels wide are scanned by testing each centre of a row, wider ones
+/// by their covered runs. The full dragon's rows at 2048² hold 1.2 covered centres on average,
+/// and finding a run (three edges classified, up to two divisions) cost about 34 instructions a
+/// row there, more than testing two or three centres.
+const NARROW_BOX_WIDTH: i64 = 3;
 
 impl ScanSetup {
     /// The covered centres of one row of the scan: the first and last offset from the row's
