@@ -199,10 +199,9 @@ fn place_labels(anchors: &[(i32, i32)], widths: &[i32], line: i32) -> Vec<(i32, 
         .zip(widths)
         .map(|(&(x, y), &w)| {
             let (left, mut top) = (x + 7, y - 16);
-            while placed
-                .iter()
-                .any(|&(l, t, pw)| left < l + pw && l < left + w && top < t + line && t < top + line)
-            {
+            while placed.iter().any(|&(l, t, pw)| {
+                left < l + pw && l < left + w && top < t + line && t < top + line
+            }) {
                 top -= line;
             }
             placed.push((left, top, w));
@@ -574,7 +573,11 @@ impl Paint for SpeedAccuracy<'_> {
         for (i, p) in self.points.iter().enumerate() {
             let row = 14 + LEGEND_LINE * (i as i32 + 1);
             let star = if front.contains(&i) { "*" } else { "" };
-            right.draw(&Text::new(format!("{}{star}", i + 1), (4, row), font.clone()))?;
+            right.draw(&Text::new(
+                format!("{}{star}", i + 1),
+                (4, row),
+                font.clone(),
+            ))?;
             Marker::of_family(p.family).draw(&right, (38, row + 7), palette(i))?;
             right.draw(&Text::new(
                 format!(
@@ -670,7 +673,10 @@ mod tests {
         for (i, m) in markers.iter().enumerate() {
             assert!(!markers[..i].contains(m), "{m:?} twice");
         }
-        assert_eq!(super::Marker::of_family("unknown"), super::Marker::of_family("other"));
+        assert_eq!(
+            super::Marker::of_family("unknown"),
+            super::Marker::of_family("other")
+        );
     }
 
     #[test]
