@@ -61,7 +61,7 @@ use std::process::ExitCode;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
-pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
+pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
 pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
