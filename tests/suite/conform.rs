@@ -148,15 +148,34 @@ fn a_counterexample_replays_from_any_directory_and_a_pass_removes_it() {
         Command::cargo_bin("fragsim")
             .unwrap()
             .current_dir(&dir)
-            .args(["conform", "--json", "--scheme", "mdts", "--backend", backend])
-            .args(["--cases", "40", "--seed", "0", "--shrink-steps", "1", "--save", "saved"])
+            .args([
+                "conform",
+                "--json",
+                "--scheme",
+                "mdts",
+                "--backend",
+                backend,
+            ])
+            .args([
+                "--cases",
+                "40",
+                "--seed",
+                "0",
+                "--shrink-steps",
+                "1",
+                "--save",
+                "saved",
+            ])
             .output()
             .unwrap()
     };
     let failing = run("python3 backend.py {scene} {out} --bug top-edge");
     let stderr = String::from_utf8_lossy(&failing.stderr);
     assert_eq!(failing.status.code(), Some(1), "{stderr}");
-    assert!(!stderr.contains("proptest") && !stderr.contains("Aborting"), "{stderr}");
+    assert!(
+        !stderr.contains("proptest") && !stderr.contains("Aborting"),
+        "{stderr}"
+    );
     let records = crate::support::json_lines(&failing.stdout);
     let keys: Vec<&str> = records[1..]
         .iter()
@@ -165,7 +184,10 @@ fn a_counterexample_replays_from_any_directory_and_a_pass_removes_it() {
         .collect();
     assert!(!keys.is_empty(), "{records:?}");
     for key in keys {
-        assert!(key.len() == 8 && key.chars().all(|c| c.is_ascii_hexdigit()), "{key}");
+        assert!(
+            key.len() == 8 && key.chars().all(|c| c.is_ascii_hexdigit()),
+            "{key}"
+        );
     }
     let case = dir.join("saved/case");
     let replay = Command::new("sh")
@@ -175,11 +197,20 @@ fn a_counterexample_replays_from_any_directory_and_a_pass_removes_it() {
         .unwrap();
     let text = String::from_utf8_lossy(&replay.stdout);
     // The backend ran and compare judged its dump: it differs (exit 1), nothing was missing.
-    assert_eq!(replay.status.code(), Some(1), "{text}\n{}", String::from_utf8_lossy(&replay.stderr));
+    assert_eq!(
+        replay.status.code(),
+        Some(1),
+        "{text}\n{}",
+        String::from_utf8_lossy(&replay.stderr)
+    );
     assert!(text.contains("candidate"), "{text}");
     let passing = run("python3 backend.py {scene} {out}");
     assert_eq!(passing.status.code(), Some(0));
-    assert!(!case.exists(), "the stale failing case is still in {}", case.display());
+    assert!(
+        !case.exists(),
+        "the stale failing case is still in {}",
+        case.display()
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -190,7 +221,14 @@ fn a_backend_that_writes_no_dump_stops_the_run_at_once() {
     let save = std::env::temp_dir().join(format!("fragsim-conform-nodump-{}", std::process::id()));
     let output = Command::cargo_bin("fragsim")
         .unwrap()
-        .args(["conform", "--scheme", "mdts", "--backend", "true {out}", "--progress-lines"])
+        .args([
+            "conform",
+            "--scheme",
+            "mdts",
+            "--backend",
+            "true {out}",
+            "--progress-lines",
+        ])
         .args(["--cases", "20", "--save"])
         .arg(&save)
         .output()

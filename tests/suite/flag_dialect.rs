@@ -58,7 +58,10 @@ fn every_command_that_writes_images_takes_no_images_and_help_shows_defaults() {
             .chain(text.lines())
             .find(|block| block.trim_start().starts_with("--k "))
             .unwrap_or_else(|| panic!("{command} --help has no --k:\n{text}"));
-        assert!(k.contains("default"), "{command}'s --k hides its default: {k}");
+        assert!(
+            k.contains("default"),
+            "{command}'s --k hides its default: {k}"
+        );
     }
     // sweep sets the angle itself: --view is not offered, and still refused with the reason.
     let sweep = help("sweep");
@@ -71,14 +74,30 @@ fn every_command_that_writes_images_takes_no_images_and_help_shows_defaults() {
 #[test]
 fn bench_and_sweep_write_their_own_folders_and_say_where() {
     let dir = scratch("defaults");
-    let tiny = ["--scene", "spheres:2", "--width", "24", "--height", "16", "--scheme", "mdts"];
+    let tiny = [
+        "--scene",
+        "spheres:2",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--scheme",
+        "mdts",
+    ];
     let bench = fragsim_in(&dir, &[&["bench", "--frames", "1"], &tiny[..]].concat());
     let sweep = fragsim_in(&dir, &[&["sweep", "--angles", "2"], &tiny[..]].concat());
     for (name, output) in [("bench", &bench), ("sweep", &sweep)] {
         let stdout = String::from_utf8_lossy(&output.stdout);
-        assert!(output.status.success(), "{name}: {}", String::from_utf8_lossy(&output.stderr));
+        assert!(
+            output.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
         let wrote = format!("wrote {}", Path::new("out").join(name).display());
-        assert!(stdout.contains(&wrote), "{name} does not say where it wrote:\n{stdout}");
+        assert!(
+            stdout.contains(&wrote),
+            "{name} does not say where it wrote:\n{stdout}"
+        );
     }
     assert!(files(&dir.join("out/bench")).contains(&"bench.jsonl".to_string()));
     assert_eq!(
@@ -89,13 +108,29 @@ fn bench_and_sweep_write_their_own_folders_and_say_where() {
     let bare = dir.join("bare");
     let output = fragsim_in(
         &dir,
-        &[&["sweep", "--angles", "2", "--no-images", "--json", "--out", "bare"], &tiny[..]].concat(),
+        &[
+            &[
+                "sweep",
+                "--angles",
+                "2",
+                "--no-images",
+                "--json",
+                "--out",
+                "bare",
+            ],
+            &tiny[..],
+        ]
+        .concat(),
     );
     assert!(output.status.success());
     assert_eq!(files(&bare), ["sweep.jsonl"]);
     assert!(String::from_utf8_lossy(&output.stderr).contains("wrote bare: sweep.jsonl"));
     let stdout = String::from_utf8(output.stdout).unwrap();
-    assert_eq!(crate::support::json_lines(stdout.as_bytes()).len(), 2, "{stdout}");
+    assert_eq!(
+        crate::support::json_lines(stdout.as_bytes()).len(),
+        2,
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -103,13 +138,29 @@ fn compare_still_takes_the_old_no_image_spelling() {
     let dir = scratch("alias");
     let render = fragsim_in(
         &dir,
-        &["render", "--scene", "spheres:2", "--width", "16", "--height", "12", "--no-images",
-          "--scheme", "mdts", "--dump", "dumps"],
+        &[
+            "render",
+            "--scene",
+            "spheres:2",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--no-images",
+            "--scheme",
+            "mdts",
+            "--dump",
+            "dumps",
+        ],
     );
     assert!(render.status.success());
     for flag in ["--no-images", "--no-image"] {
         let output = fragsim_in(&dir, &["compare", "oracle", "dumps/mdts", flag]);
-        assert!(output.status.success(), "{flag}: {}", String::from_utf8_lossy(&output.stderr));
+        assert!(
+            output.status.success(),
+            "{flag}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
     }
     assert!(!dir.join("out").exists(), "an image was written");
 }
@@ -122,27 +173,61 @@ fn hazard_prints_percentages_with_a_key_and_names_what_it_wrote() {
     let dir = scratch("hazard");
     let output = fragsim_in(
         &dir,
-        &["hazard", "--scene", "spheres:3", "--width", "40", "--height", "30",
-          "--threads-in-flight", "1,64", "--seeds", "2", "--write-back", "render-target"],
+        &[
+            "hazard",
+            "--scene",
+            "spheres:3",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--threads-in-flight",
+            "1,64",
+            "--seeds",
+            "2",
+            "--write-back",
+            "render-target",
+        ],
     );
     let stdout = String::from_utf8(output.stdout).unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let out = dir.join("out/hazard");
     assert_eq!(
         files(&out),
-        ["hazard-vs-depth-complexity.png", "hazard-vs-width.png", "hazard.json", "hazard.md"]
+        [
+            "hazard-vs-depth-complexity.png",
+            "hazard-vs-width.png",
+            "hazard.json",
+            "hazard.md"
+        ]
     );
-    assert!(stdout.contains(&format!(
-        "wrote {}: hazard.md, hazard.json, hazard-vs-width.png, hazard-vs-depth-complexity.png",
-        Path::new("out/hazard").display()
-    )), "{stdout}");
+    assert!(
+        stdout.contains(&format!(
+            "wrote {}: hazard.md, hazard.json, hazard-vs-width.png, hazard-vs-depth-complexity.png",
+            Path::new("out/hazard").display()
+        )),
+        "{stdout}"
+    );
     let md = std::fs::read_to_string(out.join("hazard.md")).unwrap();
-    for key in ["**W** threads in flight", "**policy**", "**per seed**", "**write-back**", "**dc**"] {
+    for key in [
+        "**W** threads in flight",
+        "**policy**",
+        "**per seed**",
+        "**write-back**",
+        "**dc**",
+    ] {
         assert!(md.contains(key), "no key for {key}:\n{md}");
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("hazard.json")).unwrap()).unwrap();
-    assert_eq!((json["width"].as_u64(), json["height"].as_u64()), (Some(40), Some(30)));
+    assert_eq!(
+        (json["width"].as_u64(), json["height"].as_u64()),
+        (Some(40), Some(30))
+    );
     assert!(json.get("size").is_none(), "{json}");
     // Each table row prints the JSON's fraction as a percentage, per seed too.
     for row in json["rows"].as_array().unwrap() {
@@ -162,7 +247,11 @@ fn hazard_prints_percentages_with_a_key_and_names_what_it_wrote() {
         assert!(md.contains(&line), "{line} not in\n{md}");
     }
     assert!(
-        json["rows"].as_array().unwrap().iter().any(|r| r["mismatched_pixel_rate"].as_f64() > Some(0.0)),
+        json["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|r| r["mismatched_pixel_rate"].as_f64() > Some(0.0)),
         "no hazard at 64 threads in flight: the percentages check nothing\n{md}"
     );
 }
@@ -176,44 +265,98 @@ fn tables_stay_aligned_and_name_pixels_and_samples() {
     let dir = scratch("tables");
     let output = fragsim_in(
         &dir,
-        &["render", "--scene", "spheres:2", "--width", "64", "--height", "64", "--samples", "4",
-          "--k", "auto", "--capacity", "auto",
-          "--scheme", "mdts,kbuffer-interlock-ordered-first,abuffer-masked"],
+        &[
+            "render",
+            "--scene",
+            "spheres:2",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--samples",
+            "4",
+            "--k",
+            "auto",
+            "--capacity",
+            "auto",
+            "--scheme",
+            "mdts,kbuffer-interlock-ordered-first,abuffer-masked",
+        ],
     );
     let stdout = String::from_utf8(output.stdout).unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let lines: Vec<&str> = stdout.lines().collect();
     assert!(
         lines[0].contains("64x64 pixels at 4 samples (256x64 sample lists)"),
         "{stdout}"
     );
-    let masked = lines.iter().position(|l| l.starts_with("abuffer-masked")).unwrap();
-    assert!(masked > 2, "the masked A-buffer's line comes before the table:\n{stdout}");
+    let masked = lines
+        .iter()
+        .position(|l| l.starts_with("abuffer-masked"))
+        .unwrap();
+    assert!(
+        masked > 2,
+        "the masked A-buffer's line comes before the table:\n{stdout}"
+    );
     // Every row's columns start where the header's do.
     let header = lines[1];
     let at = header.find("guarantee").unwrap();
     let starts = |line: &str| {
-        (line[..at].to_owned(), line[at..].split_whitespace().next().map(str::to_owned))
+        (
+            line[..at].to_owned(),
+            line[at..].split_whitespace().next().map(str::to_owned),
+        )
     };
     for row in &lines[2..4] {
         let (name, guarantee) = starts(row);
         assert!(name.ends_with(' '), "{row}");
-        assert!(guarantee.is_some_and(|g| g.starts_with("exact")), "{header}\n{row}");
+        assert!(
+            guarantee.is_some_and(|g| g.starts_with("exact")),
+            "{header}\n{row}"
+        );
     }
     // bench's terminal table stays within 120 characters.
     let bench = fragsim_in(
         &dir,
-        &["bench", "--scene", "spheres:2", "--width", "32", "--height", "24", "--frames", "1",
-          "--scheme", "mdts,kbuffer-interlock-ordered-first", "--executor", "all"],
+        &[
+            "bench",
+            "--scene",
+            "spheres:2",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--scheme",
+            "mdts,kbuffer-interlock-ordered-first",
+            "--executor",
+            "all",
+        ],
     );
     let text = String::from_utf8(bench.stdout).unwrap();
     assert!(bench.status.success());
-    for line in text.lines().filter(|l| l.starts_with("mdts") || l.starts_with("kbuffer")) {
-        assert!(line.chars().count() <= 120, "{} characters: {line}", line.chars().count());
+    for line in text
+        .lines()
+        .filter(|l| l.starts_with("mdts") || l.starts_with("kbuffer"))
+    {
+        assert!(
+            line.chars().count() <= 120,
+            "{} characters: {line}",
+            line.chars().count()
+        );
     }
     // The figures carry a caption strip under the picture and its panel.
     let plain = image::open(dir.join("out/bench/bench-mdts-serial.png")).unwrap();
     let figure = image::open(dir.join("out/bench/bench-mdts-serial-diff.png")).unwrap();
-    assert_eq!((plain.width(), plain.height()), (32, 24), "the effect image stays pixel data");
+    assert_eq!(
+        (plain.width(), plain.height()),
+        (32, 24),
+        "the effect image stays pixel data"
+    );
     assert!(figure.height() > 300, "no caption under the figure");
 }

@@ -22,7 +22,15 @@ fn scratch(name: &str) -> PathBuf {
 fn fragsim(args: &[&str], mesh: &Path) -> Output {
     Command::cargo_bin("fragsim")
         .unwrap()
-        .args(["render", "--no-images", "--width", "40", "--height", "30", "--mesh"])
+        .args([
+            "render",
+            "--no-images",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--mesh",
+        ])
         .arg(mesh)
         .args(args)
         .output()
@@ -131,7 +139,12 @@ fn ply_triangle_strips_load_ascii_or_binary_as_their_faces() {
     for strips in [&binary, &ascii] {
         let got = record(strips, &[]);
         for field in ["triangles", "fragments", "max_depth_complexity", "captured"] {
-            assert_eq!(got[field], expected[field], "{field} of {}", strips.display());
+            assert_eq!(
+                got[field],
+                expected[field],
+                "{field} of {}",
+                strips.display()
+            );
         }
     }
 }
@@ -140,14 +153,21 @@ fn ply_triangle_strips_load_ascii_or_binary_as_their_faces() {
 fn a_truncated_binary_ply_is_refused_on_one_line_without_a_line_number() {
     let dir = scratch("truncated");
     let whole = binary_strips();
-    for cut in [whole.len() - 3, whole.len() - 4 * STRIPS.len(), whole.len() - 60] {
+    for cut in [
+        whole.len() - 3,
+        whole.len() - 4 * STRIPS.len(),
+        whole.len() - 60,
+    ] {
         let path = dir.join(format!("cut-{cut}.ply"));
         std::fs::write(&path, &whole[..cut]).unwrap();
         let output = fragsim(&[], &path);
         let stderr = String::from_utf8(output.stderr).unwrap();
         assert_eq!(output.status.code(), Some(2), "{stderr}");
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
-        assert!(!stderr.contains('\t') && !stderr.contains("Line"), "{stderr}");
+        assert!(
+            !stderr.contains('\t') && !stderr.contains("Line"),
+            "{stderr}"
+        );
         assert!(
             stderr.contains(path.to_str().unwrap()) && stderr.contains("truncated"),
             "{stderr}"
@@ -159,7 +179,13 @@ fn a_truncated_binary_ply_is_refused_on_one_line_without_a_line_number() {
 fn obj_box(lo: [f64; 3], hi: [f64; 3], base: usize, turn: fn([f64; 3]) -> [f64; 3]) -> String {
     let mut text = String::new();
     for corner in 0..8 {
-        let pick = |axis: usize| if corner >> axis & 1 == 0 { lo[axis] } else { hi[axis] };
+        let pick = |axis: usize| {
+            if corner >> axis & 1 == 0 {
+                lo[axis]
+            } else {
+                hi[axis]
+            }
+        };
         let [x, y, z] = turn([pick(0), pick(1), pick(2)]);
         text += &format!("v {x} {y} {z}\n");
     }
@@ -186,7 +212,8 @@ fn obj_box(lo: [f64; 3], hi: [f64; 3], base: usize, turn: fn([f64; 3]) -> [f64; 
 
 /// A tower with an arm: upright along `y` as written by `turn` = identity.
 fn tower(turn: fn([f64; 3]) -> [f64; 3]) -> String {
-    obj_box([0.0, 0.0, 0.0], [1.0, 4.0, 1.0], 0, turn) + &obj_box([1.0, 3.0, 0.0], [2.5, 3.5, 1.0], 8, turn)
+    obj_box([0.0, 0.0, 0.0], [1.0, 4.0, 1.0], 0, turn)
+        + &obj_box([1.0, 3.0, 0.0], [2.5, 3.5, 1.0], 8, turn)
 }
 
 #[test]
@@ -203,11 +230,28 @@ fn up_z_stands_a_z_up_model_as_its_y_up_twin() {
     for field in ["fragments", "max_depth_complexity", "captured"] {
         assert_eq!(stood[field], upright[field], "{field}");
     }
-    assert_ne!(lying["fragments"], upright["fragments"], "the z-up file lies otherwise");
+    assert_ne!(
+        lying["fragments"], upright["fragments"],
+        "the z-up file lies otherwise"
+    );
     // A dump of the stood model records the turned camera, so compare rebuilds the same oracle.
     let dumps = dir.join("dumps");
-    let output = fragsim(&["--up", "z", "--scheme", "mdts", "--dump", dumps.to_str().unwrap()], &z_up);
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let output = fragsim(
+        &[
+            "--up",
+            "z",
+            "--scheme",
+            "mdts",
+            "--dump",
+            dumps.to_str().unwrap(),
+        ],
+        &z_up,
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let compare = Command::cargo_bin("fragsim")
         .unwrap()
         .args(["compare", "oracle"])

@@ -182,8 +182,17 @@ fn bench_charts_speed_against_accuracy_with_a_table_and_no_images_writes_none() 
 #[test]
 fn hazard_writes_png_charts_and_svg_on_request() {
     let args = [
-        "hazard", "--scene", "quads:3", "--width", "16", "--height", "16", "--threads-in-flight", "1,32",
-        "--seeds", "1",
+        "hazard",
+        "--scene",
+        "quads:3",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--threads-in-flight",
+        "1,32",
+        "--seeds",
+        "1",
     ];
     let dir = scratch("hazard");
     run(&args, &dir);

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::approximate::{ApproximateName, ApproximateRow};
-use crate::args::{SceneArgs, SchemeArgs};
+use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
 use crate::multisampled::{MsaaReport, SampledRow};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
@@ -68,6 +68,13 @@ pub struct BenchArgs {
     /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub approximate: Vec<ApproximateName>,
+    /// Measure only shard I of N of the rows (cargo-nextest's `count:I/N`): of the (scheme,
+    /// executor) rows in `--scheme` × `--executor` order, then the `--approximate` rows, row `k`
+    /// (from 0) when `k mod N = I − 1`. The shards' bench.jsonl files together hold the
+    /// unsharded bench's rows (times apart; `vs DP` where depth peeling ran in the same shard).
+    /// Not with `--samples`.
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse, conflicts_with = "samples")]
+    pub shard: Option<Shard>,
 }
 
 /// One row of the bench.
@@ -419,9 +426,11 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let mut view = args
-        .schemes
-        .submission(args.scene.view_at(&scene, args.scene.view, Conventions::REFERENCE)?);
+    let mut view = args.schemes.submission(args.scene.view_at(
+        &scene,
+        args.scene.view,
+        Conventions::REFERENCE,
+    )?);
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -441,16 +450,25 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let executors = args.schemes.executors();
     // One step a frame, plus the untimed frame that counts locked operations.
     let progress = crate::progress::bar(
-        (schemes.len() * executors.len() * (frames + 1)) as u64,
+        ((0..schemes.len() * executors.len())
+            .filter(|&k| args.shard.unwrap_or(Shard::WHOLE).takes(k))
+            .count()
+            * (frames + 1)) as u64,
         "bench",
     );
     let images = Images::of(args)?;
     if let (Some(image), Some(images)) = (judge.reference(), &images) {
         images.save(image, &format!("bench-oracle-{}.png", args.effect.label()))?;
     }
+    let shard = args.shard.unwrap_or(Shard::WHOLE);
+    // Row `k` of the campaign: the (scheme, executor) rows in order, then the approximate ones.
+    let mut row_number = 0..;
     let mut rows = Vec::new();
     for &name in &schemes {
         for &executor in executors {
+            if !row_number.next().is_some_and(|k| shard.takes(k)) {
+                continue;
+            }
             progress.set_message(format!("{name} on the {executor} executor"));
             let mut runner = Executors::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial
@@ -578,6 +596,9 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     if let Some(order) = &order {
         let nodes = crate::approximate::nodes(sizing.k, &oracle);
         for &scheme in &args.approximate {
+            if !row_number.next().is_some_and(|k| shard.takes(k)) {
+                continue;
+            }
             let (row, image) = pool.install(|| {
                 crate::approximate::measure(
                     scheme, nodes, &judge, &oracle, order, frames, raster_ms,
@@ -790,7 +811,10 @@ fn terminal_table(report: &BenchReport) -> String {
                 .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
         }),
     ];
-    let mut rows = vec![columns.iter().map(|(h, _)| (*h).to_string()).collect::<Vec<_>>()];
+    let mut rows = vec![columns
+        .iter()
+        .map(|(h, _)| (*h).to_string())
+        .collect::<Vec<_>>()];
     rows.extend(
         report
             .rows
@@ -798,7 +822,12 @@ fn terminal_table(report: &BenchReport) -> String {
             .map(|r| columns.iter().map(|(_, cell)| cell(r)).collect()),
     );
     let widths: Vec<usize> = (0..columns.len())
-        .map(|c| rows.iter().map(|row| row[c].chars().count()).max().unwrap_or(0))
+        .map(|c| {
+            rows.iter()
+                .map(|row| row[c].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
         .collect();
     let mut text = markdown(report)
         .lines()

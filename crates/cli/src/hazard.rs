@@ -42,8 +42,13 @@ pub struct HazardArgs {
     pub k: u32,
     /// Threads in flight `W`, comma-separated: how many fragments the scheduled executor keeps
     /// walking at once (not the viewport's `--width`; `--widths` is the older spelling).
-    #[arg(long, value_name = "W,...", alias = "widths", value_delimiter = ',',
-          default_value = "1,32,1024,65536")]
+    #[arg(
+        long,
+        value_name = "W,...",
+        alias = "widths",
+        value_delimiter = ',',
+        default_value = "1,32,1024,65536"
+    )]
     pub threads_in_flight: Vec<usize>,
     /// Seeds per (machine, policy, width).
     #[arg(long, default_value_t = 3)]
@@ -186,7 +191,9 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
                     machine_name(machine),
                     policy.1
                 ));
-                let row = rate(&view, &oracle, &scheme, machine, policy, in_flight, args.seeds);
+                let row = rate(
+                    &view, &oracle, &scheme, machine, policy, in_flight, args.seeds,
+                );
                 report.rows.push(row);
                 progress.inc(1);
             }
@@ -357,7 +364,10 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
             r.misordered_pixels
         );
     }
-    let _ = writeln!(md, "\nPixels wrong by depth complexity, % of the bucket's pixels:\n");
+    let _ = writeln!(
+        md,
+        "\nPixels wrong by depth complexity, % of the bucket's pixels:\n"
+    );
     let labels: Vec<String> = report
         .buckets
         .iter()

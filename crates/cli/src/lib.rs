@@ -61,7 +61,7 @@ use std::process::ExitCode;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
-pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
+pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
 pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
@@ -176,7 +176,9 @@ pub fn main() -> ExitCode {
 /// --help` (the sweep sets the angle itself; the flag stays parsed so that [`check_flags`] can
 /// refuse it saying why, rather than clap's bare "unexpected argument").
 fn command() -> clap::Command {
-    Cli::command().mut_subcommand("sweep", |sweep| sweep.mut_arg("view", |view| view.hide(true)))
+    Cli::command().mut_subcommand("sweep", |sweep| {
+        sweep.mut_arg("view", |view| view.hide(true))
+    })
 }
 
 /// `fragsim help … --help` as `fragsim help …`: clap's `help` subcommand takes no flags, so

@@ -21,7 +21,6 @@
 //! way ([`Judge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
 
-
 use fragsim_capture::catalog::{check_memory_cap_early, Count, Executors, SchemeName, Sizing};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};

@@ -10,7 +10,7 @@ use fragsim_oracle::Oracle;
 use serde::Serialize;
 
 use crate::approximate::ApproximateName;
-use crate::args::{SceneArgs, SchemeArgs};
+use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::judge::{ColourColumns, EffectName, Judge};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
@@ -46,6 +46,11 @@ pub struct SweepArgs {
     /// Write no charts; sweep.jsonl is still written.
     #[arg(long)]
     pub no_images: bool,
+    /// Sweep only shard I of N of the angles (cargo-nextest's `count:I/N`): angle step `k`
+    /// (from 0) when `k mod N = I − 1`. The shards' sweep.jsonl files together hold the
+    /// unsharded sweep's records (times apart).
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
+    pub shard: Option<Shard>,
     /// Print JSON Lines instead of the table: one record per scheme and angle
     /// (`docs/json-schema.md`; sweep.jsonl holds the same).
     #[arg(long)]
@@ -109,15 +114,19 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let schemes = SchemeChoice::expand(&args.scheme);
     let mut series: Vec<SweepSeries> = Vec::new();
     let mut angles = Vec::new();
-    let progress = crate::progress::bar(u64::from(args.angles), "sweep");
-    for step in 0..args.angles {
+    let shard = args.shard.unwrap_or(Shard::WHOLE);
+    let steps: Vec<u32> = (0..args.angles)
+        .filter(|&step| shard.takes(step as usize))
+        .collect();
+    let progress = crate::progress::bar(steps.len() as u64, "sweep");
+    for step in steps {
         progress.set_message(format!("angle {step}"));
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
         let orbit = args.scene.orbit(angle);
-        let view = args
-            .schemes
-            .submission(args.scene.view_at(&scene, angle, Conventions::REFERENCE)?);
+        let view =
+            args.schemes
+                .submission(args.scene.view_at(&scene, angle, Conventions::REFERENCE)?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);

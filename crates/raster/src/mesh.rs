@@ -317,7 +317,10 @@ impl UpAxis {
     #[must_use]
     pub fn turn_bounds(self, (lo, hi): ([f64; 3], [f64; 3])) -> ([f64; 3], [f64; 3]) {
         let (a, b) = (self.turn(lo), self.turn(hi));
-        ([0, 1, 2].map(|i| a[i].min(b[i])), [0, 1, 2].map(|i| a[i].max(b[i])))
+        (
+            [0, 1, 2].map(|i| a[i].min(b[i])),
+            [0, 1, 2].map(|i| a[i].max(b[i])),
+        )
     }
 }
 

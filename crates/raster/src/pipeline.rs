@@ -51,7 +51,7 @@ mod viewport;
 
 use sample_scan::Sampling;
 use scan::{bounding_box, edge};
-use vertex::{in_front, WindowVertex};
+use vertex::{in_front, CentreCells, WindowVertex};
 pub use viewport::{PixelRect, Viewport};
 
 /// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
@@ -95,8 +95,11 @@ pub struct ScreenTriangle {
 pub struct View<'mesh> {
     mesh: &'mesh Mesh,
     view_projection: DMat4,
+    /// Per vertex: which interval between pixel-centre lines it lies in on each axis
+    /// ([`CentreCells`]), all the triangle setup reads of a triangle it rejects early.
+    cells: Vec<CentreCells>,
     /// Per vertex: its outcode and snapped window position ([`WindowVertex`]), what the triangle
-    /// setup reads for every triangle. Kept apart from the depth: the triangle loop over a large
+    /// setup reads next. Kept apart from the depth: the triangle loop over a large
     /// mesh is bound by fetching its vertices, and most triangles of a dense mesh are rejected by
     /// their bounding box alone, before the depth is needed.
     window: Vec<WindowVertex>,
@@ -175,6 +178,7 @@ impl<'mesh> View<'mesh> {
         let mut view = Self {
             mesh,
             view_projection: camera.view_projection,
+            cells: Vec::new(),
             window: Vec::new(),
             window_z: Vec::new(),
             viewport,

@@ -299,10 +299,19 @@ fn the_export_takes_renders_conventions() {
     let scene = fragsim::raster::Scene::procedural(SCENE).unwrap();
     let view = gl
         .scene
-        .view(&scene, fragsim::raster::Viewport::new(WIDTH, super::HEIGHT).unwrap())
+        .view(
+            &scene,
+            fragsim::raster::Viewport::new(WIDTH, super::HEIGHT).unwrap(),
+        )
         .unwrap();
-    assert_eq!(gl.triangles, TriangleExport::from_view(&view, gl.scene.clone()).triangles);
-    assert_ne!(gl.triangles, reference.triangles, "the conventions changed nothing");
+    assert_eq!(
+        gl.triangles,
+        TriangleExport::from_view(&view, gl.scene.clone()).triangles
+    );
+    assert_ne!(
+        gl.triangles, reference.triangles,
+        "the conventions changed nothing"
+    );
 }
 
 #[test]

@@ -34,9 +34,30 @@ impl View<'_> {
         let width = i64::from(self.viewport.width);
         let mut row = setup.origin;
         let mut row_pixel = i64::from(y0) * width + i64::from(x0);
+        let step = setup.step_x;
+        if last < NARROW_BOX_WIDTH {
+            // A narrow box: its few centres of a row cost less tested one by one than the
+            // divisions that find the row's covered run. (One loop for both kinds of box,
+            // testing inside the run's loop, cost the A-buffer 2 % more instructions at 2048².)
+            for _ in y0..=y1 {
+                let mut e = row;
+                for pixel in row_pixel..=row_pixel + last {
+                    if setup.covers(e) {
+                        if let Some(fragment) =
+                            fragment_at(setup.prim, setup.z, e, setup.area, pixel)
+                        {
+                            emit(fragment);
+                        }
+                    }
+                    advance(&mut e, step);
+                }
+                advance(&mut row, setup.step_y);
+                row_pixel += width;
+            }
+            return;
+        }
         for _ in y0..=y1 {
             if let Some((first, end)) = setup.covered_run(row, last) {
-                let step = setup.step_x;
                 let mut e = [
                     row[0] + step[0] * first,
                     row[1] + step[1] * first,
@@ -46,20 +67,37 @@ impl View<'_> {
                     if let Some(fragment) = fragment_at(setup.prim, setup.z, e, setup.area, pixel) {
                         emit(fragment);
                     }
-                    for k in 0..3 {
-                        e[k] += step[k];
-                    }
+                    advance(&mut e, step);
                 }
             }
-            for k in 0..3 {
-                row[k] += setup.step_y[k];
-            }
+            advance(&mut row, setup.step_y);
             row_pixel += width;
         }
     }
 }
 
+/// Adds `by` to each edge value of `values`: one step along a row or down a column.
+#[inline]
+fn advance(values: &mut [i64; 3], by: [i64; 3]) {
+    for (value, by) in values.iter_mut().zip(by) {
+        *value += by;
+    }
+}
+
+/// Boxes at most this many pixels wide are scanned by testing each centre of a row, wider ones
+/// by their covered runs. The full dragon's rows at 2048² hold 1.2 covered centres on average,
+/// and finding a run (three edges classified, up to two divisions) cost about 34 instructions a
+/// row there, more than testing two or three centres.
+const NARROW_BOX_WIDTH: i64 = 3;
+
 impl ScanSetup {
+    /// Whether a centre whose edge values are `e` is covered: every edge value at least its
+    /// threshold (rule 6, with the fill rule's ownership of the centres on an edge).
+    #[inline]
+    fn covers(&self, e: [i64; 3]) -> bool {
+        e[0] >= self.threshold[0] && e[1] >= self.threshold[1] && e[2] >= self.threshold[2]
+    }
+
     /// The covered centres of one row of the scan: the first and last offset from the row's
     /// first pixel (within `0..=last`) whose edge values are all at least their thresholds, given
     /// the edge values `row` at offset 0; `None` when no centre of the row is covered.
@@ -70,8 +108,8 @@ impl ScanSetup {
     #[inline]
     fn covered_run(&self, row: [i64; 3], last: i64) -> Option<(i64, i64)> {
         let (mut first, mut end) = (0, last);
-        for k in 0..3 {
-            let (value, step, threshold) = (row[k], self.step_x[k], self.threshold[k]);
+        let edges = row.into_iter().zip(self.step_x).zip(self.threshold);
+        for ((value, step), threshold) in edges {
             if value >= threshold {
                 // Covered by this edge at offset 0: only a falling edge can end the run.
                 if step < 0 && value + step * last < threshold {

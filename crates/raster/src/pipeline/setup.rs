@@ -2,10 +2,14 @@
 //! rejected in a few integer operations or set up once into a compact record for the scan.
 //!
 //! Most triangles of a dense mesh cover no pixel centre (the full dragon at 512², 871,414
-//! triangles, has about 100,000 fragments), so the common case is a reject: the three vertices'
-//! outcodes and snapped positions are loaded, and a triangle whose snapped bounding box holds no
-//! pixel centre of the rectangle scanned is dropped before its depths are loaded or an edge
-//! function is formed. A triangle that survives is oriented (rule 5: facing, culling, zero area)
+//! triangles, has 103,652 fragments), so the common case is a reject. The vertex stage has left
+//! each vertex's interval between pixel-centre lines on each axis (`CentreCells`): a
+//! triangle whose three vertices lie strictly inside one such interval on either axis has a
+//! bounding box that holds no pixel centre, and is dropped after three loads and a few
+//! comparisons. The others load their outcodes and snapped positions, and a triangle whose box
+//! holds no pixel centre of the rectangle scanned is dropped before its depths are loaded or an
+//! edge function is formed; one whose box holds a single centre is tested there first, and
+//! dropped without a record when it misses it. A triangle that survives is oriented (rule 5: facing, culling, zero area)
 //! and set up into a [`ScanSetup`]: the pixels its box holds, its three edge functions at the
 //! first of them and their steps, the fill rule's thresholds and the depth inputs. The scan
 //! (`scan.rs`) reads only that record. Triangles that need clipping take the general path
@@ -85,14 +89,41 @@ impl ScanSetup {
     }
 }
 
+/// Whether the snapped triangle `xy`, of either orientation, covers the centre of pixel `(x, y)`
+/// under the fill rule of `origin`: the scan's coverage test of that centre on the triangle
+/// oriented as [`View::oriented`] orients it, without the rest of its record. A triangle of zero
+/// area covers nothing.
+#[inline]
+fn covers_centre([a, b, c]: [[i64; 2]; 3], (x, y): (u32, u32), origin: WindowOrigin) -> bool {
+    let area = edge(a, b, c);
+    if area == 0 {
+        return false;
+    }
+    let (b, c) = if area < 0 { (c, b) } else { (b, c) };
+    let edges = [(b, c), (c, a), (a, b)];
+    let centre = [i64::from(x) * ONE + HALF, i64::from(y) * ONE + HALF];
+    let e = per_edge(edges, |p, q| edge(p, q, centre));
+    let threshold = fill_thresholds(edges, origin);
+    e[0] >= threshold[0] && e[1] >= threshold[1] && e[2] >= threshold[2]
+}
+
 impl View<'_> {
     /// The setup of triangle `prim` for a scan of `rect`: `visit` gets a record for the triangle,
     /// or for each piece of a clipped one, unless it is rejected, culled, degenerate or its
     /// bounding box holds no pixel centre in `rect`. Not for a view that rasterizes per sample.
     #[inline]
     pub(super) fn set_up_in(&self, prim: u32, rect: PixelRect, visit: &mut impl FnMut(ScanSetup)) {
-        let origin = self.conventions.window_origin;
         let [ia, ib, ic] = self.mesh.triangles[prim as usize];
+        let (ka, kb, kc) = (
+            self.cells[ia as usize],
+            self.cells[ib as usize],
+            self.cells[ic as usize],
+        );
+        let between_centre_lines = |k: usize| ka[k] == kb[k] && kb[k] == kc[k] && ka[k] & 1 == 0;
+        if between_centre_lines(0) || between_centre_lines(1) {
+            return;
+        }
+        let origin = self.conventions.window_origin;
         let (a, b, c) = (
             self.window[ia as usize],
             self.window[ib as usize],
@@ -109,7 +140,7 @@ impl View<'_> {
             });
             return;
         }
-        // The early reject, on the snapped positions alone.
+        // The exact reject, on the snapped bounding box within `rect`.
         let axis = |k: usize| {
             let (p, q, r) = (a.xy[k], b.xy[k], c.xy[k]);
             (i64::from(p.min(q).min(r)), i64::from(p.max(q).max(r)))
@@ -118,10 +149,19 @@ impl View<'_> {
         let Some(pixels) = rect.centres_within([x_lo, y_lo], [x_hi, y_hi]) else {
             return;
         };
+        let xy = [a.position(), b.position(), c.position()];
+        if pixels.x.0 == pixels.x.1
+            && pixels.y.0 == pixels.y.1
+            && !covers_centre(xy, (pixels.x.0, pixels.y.0), origin)
+        {
+            // One centre in the box, and the triangle misses it: most survivors of a dense mesh
+            // at a low resolution, dropped without a record.
+            return;
+        }
         let snapped: [Snapped; 3] = [
-            (a.position(), self.window_z[ia as usize]),
-            (b.position(), self.window_z[ib as usize]),
-            (c.position(), self.window_z[ic as usize]),
+            (xy[0], self.window_z[ia as usize]),
+            (xy[1], self.window_z[ib as usize]),
+            (xy[2], self.window_z[ic as usize]),
         ];
         if let Some((tri, area)) = self.oriented(prim, snapped) {
             visit(ScanSetup::new(&tri, area, pixels, origin));
