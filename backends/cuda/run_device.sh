@@ -60,7 +60,7 @@ for size in $SIZES; do
       [ -f "$f" ] && echo "$(basename "$f" .json) $(python3 -c 'import json,sys; r=json.loads(open(sys.argv[1]).readline()); print(json.dumps({k: r[k] for k in r if k == "equal" or k == "compared" or k.endswith("_pixels") or k in ("captured", "lost", "extra", "overflowed", "reported_overflow")}))' "$f")"
     done
     # One text report of the broken variant, to show the side-by-side lists.
-    [ "$size" = 512 ] && $F compare oracle "$W/$tag/kbuffer" --show 2 --no-image | head -40
+    [ "$size" = 512 ] && $F compare oracle "$W/$tag/kbuffer" --show 2 --no-images | head -40
     rm -rf "$W/$tag" "$W/$tag-k20"
   done
 done

@@ -16,7 +16,7 @@ one() {
   "$bin/fragsim-wgpu" capture --scene "$scene" --width 512 --height 512 --view "$view" --mode "$mode" \
       --scheme "$schemes" --plant all --k 8 --capacity 4 --out "$d" --judge --depth-ulps 256 > "$d.capture.log" 2>&1
   for s in "$d"/*/; do
-    echo "== $scene view $view $mode $(basename "$s"): $("$bin/fragsim" compare oracle "$s" --vertex-precision f32 --no-image --quiet 2>&1 | grep -E '^pixels|^precision|^fragments|^verdict' | sed -E 's/, [0-9]+ clipped.*//; s/, overflowed by design [0-9]+//' | tr '\n' ' ' | cut -c1-700)"
+    echo "== $scene view $view $mode $(basename "$s"): $("$bin/fragsim" compare oracle "$s" --vertex-precision f32 --no-images --quiet 2>&1 | grep -E '^pixels|^precision|^fragments|^verdict' | sed -E 's/, [0-9]+ clipped.*//; s/, overflowed by design [0-9]+//' | tr '\n' ' ' | cut -c1-700)"
   done > "$d.verdict.log"
   rm -rf "$d"
 }

@@ -86,7 +86,7 @@ fn decoded(dir: &Path) -> Result<(Dump, Capture, WordCheck), String> {
     Ok((dump, capture, words))
 }
 
-/// `fragsim compare REFERENCE CANDIDATE --no-image --show 0`, parsed as the command line parses
+/// `fragsim compare REFERENCE CANDIDATE --no-images --show 0`, parsed as the command line parses
 /// it: `Ok(equal)` is exit code 0 or 1, `Err` exit code 2.
 fn run(reference: &Path, candidate: &Path) -> Result<bool, String> {
     let command = CompareArgs::augment_args(Command::new("compare"));
@@ -94,7 +94,7 @@ fn run(reference: &Path, candidate: &Path) -> Result<bool, String> {
         "compare".as_ref(),
         reference.as_os_str(),
         candidate.as_os_str(),
-        "--no-image".as_ref(),
+        "--no-images".as_ref(),
         "--show".as_ref(),
         "0".as_ref(),
     ];

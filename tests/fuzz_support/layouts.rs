@@ -490,8 +490,8 @@ fn linked_lists(
             walked.push(fragment);
             node = next[i];
         }
-        // Judged whole whatever the resolve keeps (`k` is what shading reads): every node the
-        // walk reached, sorted.
+        // The verdict judges every node a list reaches, whatever the resolve's `k` keeps for
+        // shading (`Dump::capture`), sorted.
         walked.sort_unstable();
         model.lists.push(walked);
     }

@@ -343,7 +343,7 @@ fn a_closed_stdout_ends_the_output_quietly_keeping_the_exit_code() {
         String::from_utf8_lossy(&made.stderr)
     );
     let dump = format!("{dumps}/mdts");
-    assert_quiet_on_a_closed_pipe(&["compare", "oracle", dump.as_str(), "--no-image"]);
+    assert_quiet_on_a_closed_pipe(&["compare", "oracle", dump.as_str(), "--no-images"]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -555,7 +555,7 @@ fn an_elevation_the_camera_would_clamp_is_refused() {
 
 #[test]
 fn compare_image_with_no_image_is_refused() {
-    let output = fragsim_raw(&["compare", "a", "b", "--image", "x.png", "--no-image"]);
+    let output = fragsim_raw(&["compare", "a", "b", "--image", "x.png", "--no-images"]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("cannot be used with"), "{stderr}");

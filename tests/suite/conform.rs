@@ -133,3 +133,109 @@ fn progress_lines_count_every_passed_case_on_stderr() {
         .collect();
     assert_eq!(lines, expected, "{stderr}");
 }
+
+/// Issue 36: a failing run's report and saved case read like the rest of fragsim and replay from
+/// anywhere; proptest's own messages stay out of stderr; a passing run removes the stale case.
+#[test]
+fn a_counterexample_replays_from_any_directory_and_a_pass_removes_it() {
+    let dir = std::env::temp_dir().join(format!("fragsim-conform-replay-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // The backend named relative to the directory conform runs in.
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("crates/testkit/python/backend.py");
+    std::fs::copy(&script, dir.join("backend.py")).unwrap();
+    let run = |backend: &str| {
+        Command::cargo_bin("fragsim")
+            .unwrap()
+            .current_dir(&dir)
+            .args([
+                "conform",
+                "--json",
+                "--scheme",
+                "mdts",
+                "--backend",
+                backend,
+            ])
+            .args([
+                "--cases",
+                "40",
+                "--seed",
+                "0",
+                "--shrink-steps",
+                "1",
+                "--save",
+                "saved",
+            ])
+            .output()
+            .unwrap()
+    };
+    let failing = run("python3 backend.py {scene} {out} --bug top-edge");
+    let stderr = String::from_utf8_lossy(&failing.stderr);
+    assert_eq!(failing.status.code(), Some(1), "{stderr}");
+    assert!(
+        !stderr.contains("proptest") && !stderr.contains("Aborting"),
+        "{stderr}"
+    );
+    let records = crate::support::json_lines(&failing.stdout);
+    let keys: Vec<&str> = records[1..]
+        .iter()
+        .flat_map(|r| r["reference"].as_array().unwrap())
+        .map(|e| e["key"].as_str().unwrap())
+        .collect();
+    assert!(!keys.is_empty(), "{records:?}");
+    for key in keys {
+        assert!(
+            key.len() == 8 && key.chars().all(|c| c.is_ascii_hexdigit()),
+            "{key}"
+        );
+    }
+    let case = dir.join("saved/case");
+    let replay = Command::new("sh")
+        .arg(case.join("replay.sh"))
+        .current_dir("/")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&replay.stdout);
+    // The backend ran and compare judged its dump: it differs (exit 1), nothing was missing.
+    assert_eq!(
+        replay.status.code(),
+        Some(1),
+        "{text}\n{}",
+        String::from_utf8_lossy(&replay.stderr)
+    );
+    assert!(text.contains("candidate"), "{text}");
+    let passing = run("python3 backend.py {scene} {out}");
+    assert_eq!(passing.status.code(), Some(0));
+    assert!(
+        !case.exists(),
+        "the stale failing case is still in {}",
+        case.display()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A backend that exits 0 without writing a dump is not shrunk case after case: the run stops on
+/// the first, saying where the dump was expected.
+#[test]
+fn a_backend_that_writes_no_dump_stops_the_run_at_once() {
+    let save = std::env::temp_dir().join(format!("fragsim-conform-nodump-{}", std::process::id()));
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args([
+            "conform",
+            "--scheme",
+            "mdts",
+            "--backend",
+            "true {out}",
+            "--progress-lines",
+        ])
+        .args(["--cases", "20", "--save"])
+        .arg(&save)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&save);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("wrote nothing into"), "{stderr}");
+    assert!(!stderr.contains("shrinking"), "{stderr}");
+}

@@ -185,7 +185,7 @@ fn compare_oracle_rebuilds_the_engine_scene_through_the_binary() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(dir.join("mdts"))
-            .arg("--no-image"),
+            .arg("--no-images"),
         0,
     );
     assert!(text.contains("EQUAL"), "{text}");
@@ -263,7 +263,7 @@ fn a_dump_that_travelled_finds_its_mesh_with_compare_mesh() {
         command
             .args(["compare", "oracle"])
             .arg(dumps.join("mdts"))
-            .arg("--no-image");
+            .arg("--no-images");
         if let Some(mesh) = mesh {
             command.arg("--mesh").arg(mesh);
         }
@@ -307,7 +307,7 @@ fn render_dumps_under_the_conventions_it_is_given_and_compare_agrees() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(dir.join("mdts"))
-            .arg("--no-image"),
+            .arg("--no-images"),
         0,
     );
     assert!(text.contains("EQUAL"), "{text}");

@@ -42,7 +42,7 @@ fn explain_finds_a_losing_kbuffer_interleaving_and_names_the_lost_value() {
         "{lost}"
     );
     // The table has a column per thread and a write-back over another fragment's value.
-    assert!(text.contains("| T0 ("), "{text}");
+    assert!(text.contains("| T"), "{text}");
     assert!(
         text.contains("write [") && text.contains("(was ["),
         "{text}"
@@ -172,5 +172,51 @@ fn explain_offers_the_catalogs_kbuffer_stores_as_the_kbuffer_on_separate_stores(
     assert!(
         stderr.contains("mdts") && stderr.contains("kbuffer-stores"),
         "{stderr}"
+    );
+}
+
+/// Every `DEPTH#PRIM` written in `text` (a thread's heading, a slot, a lost value).
+fn fragments_named(text: &str) -> Vec<(f32, usize)> {
+    text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '#'))
+        .filter_map(|word| {
+            let (depth, prim) = word.split_once('#')?;
+            Some((depth.parse().ok()?, prim.parse().ok()?))
+        })
+        .collect()
+}
+
+/// Issue 36: after shrinking, every fragment keeps the number the user gave it (fragment `i` is
+/// the `i`-th of `--depths`, on thread `Ti`), and the key's example is one of the run's own.
+#[test]
+fn explain_keeps_the_users_fragment_numbering_after_shrinking() {
+    let depths = [0.1f32, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9];
+    let list: Vec<String> = depths.iter().map(f32::to_string).collect();
+    for machine in ["render-target", "separate-stores"] {
+        let (ok, text) = explain(&["--depths", &list.join(","), "--write-back", machine]);
+        assert!(ok, "{text}");
+        let named = fragments_named(&text);
+        assert!(!named.is_empty(), "{text}");
+        for (depth, prim) in named {
+            assert_eq!(depth, depths[prim], "{depth}#{prim} in\n{text}");
+        }
+        // A thread's column is headed by its fragment's own number.
+        let heading = text.lines().find(|l| l.starts_with("| step")).unwrap();
+        for column in heading.split('|').filter(|c| c.trim().starts_with('T')) {
+            let (thread, fragment) = column.trim().split_once(" (").unwrap();
+            let prim = fragment.split_once('#').unwrap().1.trim_end_matches(')');
+            assert_eq!(thread, format!("T{prim}"), "{heading}");
+        }
+        let lost = text.lines().find(|l| l.starts_with("LOST: ")).unwrap();
+        let (value, fragment) = lost["LOST: ".len()..].split_once(" (fragment ").unwrap();
+        let prim: usize = fragment.split_once(',').unwrap().0.parse().unwrap();
+        assert_eq!(value, format!("{}#{prim}", depths[prim]), "{lost}");
+    }
+    // The default run's key illustrates its own first fragment, 0.3 (primitive 0).
+    let (ok, text) = explain(&[]);
+    assert!(ok, "{text}");
+    let key = text.lines().find(|l| l.starts_with("key: ")).unwrap();
+    assert!(
+        key.starts_with("key: 0.3#0 = a fragment: depth 0.3, primitive 0 (index 0 in --depths)"),
+        "{key}"
     );
 }

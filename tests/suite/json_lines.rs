@@ -163,7 +163,7 @@ fn every_command_prints_json_lines_with_the_common_fields() {
             &scene[..],
             &SIZE,
             &[
-                "--widths",
+                "--threads-in-flight",
                 "1,32",
                 "--seeds",
                 "1",
@@ -253,7 +253,7 @@ fn export_scene_and_compare_print_json_lines_with_the_mesh_hash() {
         .unwrap()
         .args(["compare", "oracle"])
         .arg(dumps.join("mdts"))
-        .args(["--json", "--no-image"])
+        .args(["--json", "--no-images"])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&compare.stderr);

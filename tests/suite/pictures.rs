@@ -182,19 +182,28 @@ fn bench_charts_speed_against_accuracy_with_a_table_and_no_images_writes_none() 
 #[test]
 fn hazard_writes_png_charts_and_svg_on_request() {
     let args = [
-        "hazard", "--scene", "quads:3", "--width", "16", "--height", "16", "--widths", "1,32",
-        "--seeds", "1",
+        "hazard",
+        "--scene",
+        "quads:3",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--threads-in-flight",
+        "1,32",
+        "--seeds",
+        "1",
     ];
     let dir = scratch("hazard");
     run(&args, &dir);
-    for chart in ["hazard_vs_width", "hazard_vs_depth_complexity"] {
+    for chart in ["hazard-vs-width", "hazard-vs-depth-complexity"] {
         let image = png(&dir.join(format!("{chart}.png")));
         assert!(image.width() > 100);
         assert!(!dir.join(format!("{chart}.svg")).exists());
     }
     let svg = scratch("hazard-svg");
     run(&[&args[..], &["--svg"]].concat(), &svg);
-    let text = std::fs::read_to_string(svg.join("hazard_vs_depth_complexity.svg")).unwrap();
+    let text = std::fs::read_to_string(svg.join("hazard-vs-depth-complexity.svg")).unwrap();
     // The buckets are named on the axis, not numbered.
     assert!(text.contains("<svg") && text.contains("3–4"), "{text}");
 }

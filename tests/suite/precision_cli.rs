@@ -69,7 +69,7 @@ fn a_k3_reference_against_an_abuffer_is_a_note_and_exit_0() {
             .arg("compare")
             .arg(dir.join("mdts"))
             .arg(dir.join("abuffer"))
-            .arg("--no-image"),
+            .arg("--no-images"),
         0,
     );
     assert!(out.contains("cannot be judged"), "{out}");
@@ -83,7 +83,7 @@ fn dumps_of_different_scenes_exit_2_unless_asked_for() {
     dump(&dir.join("b"), "abuffer", "75");
     let (a, b) = (dir.join("a/abuffer"), dir.join("b/abuffer"));
     let refused = run(
-        fragsim().arg("compare").arg(&a).arg(&b).arg("--no-image"),
+        fragsim().arg("compare").arg(&a).arg(&b).arg("--no-images"),
         2,
     );
     assert!(refused.contains("different scenes"), "{refused}");
@@ -92,7 +92,7 @@ fn dumps_of_different_scenes_exit_2_unless_asked_for() {
             .arg("compare")
             .arg(&a)
             .arg(&b)
-            .args(["--no-image", "--allow-different-scenes"]),
+            .args(["--no-images", "--allow-different-scenes"]),
         1,
     );
     assert!(asked.contains("verdict: DIFFERENT"), "{asked}");
@@ -106,7 +106,7 @@ fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(dir.join("abuffer"))
-            .args(["--no-image", "--vertex-precision", "f32"]),
+            .args(["--no-images", "--vertex-precision", "f32"]),
         0,
     );
     assert!(
@@ -117,7 +117,7 @@ fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(dir.join("abuffer"))
-            .args(["--no-image", "--json", "--vertex-precision", "f32"]),
+            .args(["--no-images", "--json", "--vertex-precision", "f32"]),
         0,
     );
     let report = &crate::support::json_lines(json.as_bytes())[0];

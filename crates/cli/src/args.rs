@@ -7,8 +7,8 @@ use fragsim_capture::executors::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::conventions::MAX_SUBPIXEL_BITS;
 use fragsim_raster::{
-    Conventions, DepthRange, OrbitCamera, Scene, VertexPrecision, View, Viewport, WindowOrigin,
-    DEFAULT_SCENE_NAME,
+    Camera, Conventions, DepthRange, OrbitCamera, Scene, UpAxis, VertexPrecision, View, Viewport,
+    WindowOrigin, DEFAULT_SCENE_NAME,
 };
 
 pub use fragsim_capture::catalog::Count;
@@ -40,6 +40,13 @@ pub struct SceneArgs {
     /// look straight down its up axis).
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = elevation)]
     pub elevation: f64,
+    /// The model's up axis in its file: `y` (OBJ's custom), `z` (most scanner and CAD files: a
+    /// z-up model otherwise lies on its side), `x`, `-y`, `-z` or `-x`. The camera orbits that
+    /// axis; the mesh and its primitive ids stay as they are (a dump records the turned camera as
+    /// its `view_projection`).
+    #[arg(long, value_name = "AXIS", default_value = "y", allow_hyphen_values = true,
+          value_parser = UpAxis::parse)]
+    pub up: UpAxis,
 }
 
 impl SceneArgs {
@@ -71,6 +78,38 @@ impl SceneArgs {
             elevation_degrees: self.elevation,
             ..OrbitCamera::default()
         }
+    }
+
+    /// The camera at orbit `angle` around `scene` stood on its `--up` axis, with the projection
+    /// of `depth_range`.
+    ///
+    /// # Errors
+    /// A side out of range.
+    pub fn camera(
+        &self,
+        scene: &Scene,
+        angle: f64,
+        depth_range: DepthRange,
+    ) -> Result<Camera, String> {
+        Ok(scene.orbit_camera_up(self.viewport()?, &self.orbit(angle), depth_range, self.up))
+    }
+
+    /// `scene` at orbit `angle` under `conventions`: what `render` captures and `export-scene`
+    /// writes (at more than one sample, a view rasterizing per sample whose
+    /// [`View::pixel_viewport`] is the render target).
+    ///
+    /// # Errors
+    /// A bad viewport, or conventions fragsim cannot rasterize under.
+    pub fn view_at<'s>(
+        &self,
+        scene: &'s Scene,
+        angle: f64,
+        conventions: Conventions,
+    ) -> Result<View<'s>, String> {
+        let camera = self.camera(scene, angle, conventions.depth_range)?;
+        scene
+            .view_under(self.viewport()?, &camera, conventions)
+            .map_err(|e| e.to_string())
     }
 }
 
@@ -330,4 +369,51 @@ pub enum ExecutorChoice {
     Scheduled,
     /// Serial, parallel and tiled.
     All,
+}
+
+/// `--shard I/N`: shard `I` of `N` (from 1) of a campaign split over machines, in
+/// cargo-nextest's `--partition count:I/N` convention (`count:I/N` is accepted too): item `k`
+/// (from 0) of the campaign's fixed order belongs to shard `k mod N + 1`, so the `N` shards are
+/// disjoint, deterministic, and together exactly the unsharded run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// This shard, from 1.
+    pub index: u32,
+    /// Shards in all.
+    pub count: u32,
+}
+
+impl Shard {
+    /// The whole campaign, unsharded.
+    pub const WHOLE: Self = Self { index: 1, count: 1 };
+
+    /// Parses `I/N` or `count:I/N`.
+    ///
+    /// # Errors
+    /// Any other form, `N` = 0, or `I` outside `1..=N`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let form = || format!("{text:?} is not I/N (shard I of N, from 1; nextest's count:I/N)");
+        let bare = text.strip_prefix("count:").unwrap_or(text);
+        let (index, count) = bare.split_once('/').ok_or_else(form)?;
+        let number = |field: &str| field.trim().parse::<u32>().map_err(|_| form());
+        let (index, count) = (number(index)?, number(count)?);
+        if count == 0 || !(1..=count).contains(&index) {
+            return Err(format!(
+                "--shard {text}: the shard must be between 1 and the count, which must be at least 1"
+            ));
+        }
+        Ok(Self { index, count })
+    }
+
+    /// Whether item `k` (from 0, in the campaign's order) is this shard's.
+    #[must_use]
+    pub fn takes(self, k: usize) -> bool {
+        k % self.count as usize == (self.index - 1) as usize
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
 }

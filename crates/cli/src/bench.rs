@@ -11,14 +11,14 @@ use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{Camera, SamplePattern, View};
+use fragsim_raster::{Camera, Conventions, DepthRange, SamplePattern, View};
 use image::RgbImage;
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::approximate::{ApproximateName, ApproximateRow};
-use crate::args::{SceneArgs, SchemeArgs};
+use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
 use crate::multisampled::{MsaaReport, SampledRow};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
@@ -42,8 +42,9 @@ pub struct BenchArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart.
-    #[arg(long, default_value = "out")]
+    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart (its own,
+    /// so that the sweep's files do not mix with the bench's).
+    #[arg(long, default_value = "out/bench")]
     pub out: PathBuf,
     /// Print JSON Lines instead of the table: one record per scheme and executor
     /// (`docs/json-schema.md`; bench.jsonl holds the same).
@@ -67,6 +68,13 @@ pub struct BenchArgs {
     /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub approximate: Vec<ApproximateName>,
+    /// Measure only shard I of N of the rows (cargo-nextest's `count:I/N`): of the (scheme,
+    /// executor) rows in `--scheme` × `--executor` order, then the `--approximate` rows, row `k`
+    /// (from 0) when `k mod N = I − 1`. The shards' bench.jsonl files together hold the
+    /// unsharded bench's rows (times apart; `vs DP` where depth peeling ran in the same shard).
+    /// Not with `--samples`.
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse, conflicts_with = "samples")]
+    pub shard: Option<Shard>,
 }
 
 /// One row of the bench.
@@ -328,20 +336,64 @@ pub(crate) fn time_frames<T>(
     Ok((first.expect("at least one frame"), times))
 }
 
-/// Writes `image` to `out/<stem>.png` and its difference from `reference` to
-/// `out/<stem>-diff.png`.
-///
-/// # Errors
-/// Images of different sizes, or a file that cannot be written.
-pub(crate) fn save_with_difference(
-    image: &RgbImage,
-    reference: &RgbImage,
-    out: &Path,
-    stem: &str,
-) -> Result<(), String> {
-    fragsim_shade::save_png(image, &out.join(format!("{stem}.png")))?;
-    let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
-    fragsim_shade::save_png(&difference, &out.join(format!("{stem}-diff.png")))
+/// Where bench's images go, and the scene and view their captions name.
+pub(crate) struct Images<'a> {
+    /// The directory (`--out`).
+    pub(crate) dir: &'a Path,
+    /// The scene, view and size, as every caption opens.
+    pub(crate) scene: String,
+}
+
+impl<'a> Images<'a> {
+    /// The images of `args` (`None` under `--no-images`).
+    ///
+    /// # Errors
+    /// The mesh file cannot be read (for its name in the caption).
+    fn of(args: &'a BenchArgs) -> Result<Option<Self>, String> {
+        if args.no_images {
+            return Ok(None);
+        }
+        let context = Context::of_scene("bench", &args.scene)?;
+        Ok(Some(Self {
+            dir: &args.out,
+            scene: format!(
+                "{}, view {}°, elevation {}°, {}x{}",
+                context.scene,
+                args.scene.view,
+                args.scene.elevation,
+                args.scene.width,
+                args.scene.height
+            ),
+        }))
+    }
+
+    /// Saves the effect image `image` as `name`, as it is: pixel data that readers compare
+    /// (its file name says what it is; its figure, the difference, carries the caption).
+    ///
+    /// # Errors
+    /// A file that cannot be written.
+    pub(crate) fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
+        fragsim_shade::save_png(image, &self.dir.join(name))
+    }
+
+    /// Saves `image` as `stem.png` and its difference from `reference` (error pixels red, with
+    /// a legend and insets) as `stem-diff.png`, captioned with the scene and `what` it shows.
+    ///
+    /// # Errors
+    /// Images of different sizes, a font error, or a file that cannot be written.
+    pub(crate) fn save_with_difference(
+        &self,
+        image: &RgbImage,
+        reference: &RgbImage,
+        stem: &str,
+        what: &str,
+    ) -> Result<(), String> {
+        self.save(image, &format!("{stem}.png"))?;
+        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
+        let caption = format!("{}: {what} against the oracle's image", self.scene);
+        let figure = fragsim_shade::legend::captioned(&difference, &caption)?;
+        self.save(&figure, &format!("{stem}-diff.png"))
+    }
 }
 
 /// Runs `bench`.
@@ -368,15 +420,18 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let frames = args.frames as usize;
     // The camera depends on the model's bounds, a per-scene constant (a GPU application computes
     // it at load); the vertex stage proper is timed per frame, on the pool.
-    let aspect = f64::from(viewport.width) / f64::from(viewport.height);
-    let camera = orbit.camera(scene.mesh.bounds(), aspect);
+    let camera = args
+        .scene
+        .camera(&scene, args.scene.view, DepthRange::ZeroToOne)?;
     let serial_pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let mut view = args
-        .schemes
-        .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
+    let mut view = args.schemes.submission(args.scene.view_at(
+        &scene,
+        args.scene.view,
+        Conventions::REFERENCE,
+    )?);
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -396,16 +451,25 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let executors = args.schemes.executors();
     // One step a frame, plus the untimed frame that counts locked operations.
     let progress = crate::progress::bar(
-        (schemes.len() * executors.len() * (frames + 1)) as u64,
+        ((0..schemes.len() * executors.len())
+            .filter(|&k| args.shard.unwrap_or(Shard::WHOLE).takes(k))
+            .count()
+            * (frames + 1)) as u64,
         "bench",
     );
-    if let Some(image) = judge.reference().filter(|_| !args.no_images) {
-        let name = format!("bench-oracle-{}.png", args.effect.label());
-        fragsim_shade::save_png(image, &args.out.join(name))?;
+    let images = Images::of(args)?;
+    if let (Some(image), Some(images)) = (judge.reference(), &images) {
+        images.save(image, &format!("bench-oracle-{}.png", args.effect.label()))?;
     }
+    let shard = args.shard.unwrap_or(Shard::WHOLE);
+    // Row `k` of the campaign: the (scheme, executor) rows in order, then the approximate ones.
+    let mut row_number = 0..;
     let mut rows = Vec::new();
     for &name in &schemes {
         for &executor in executors {
+            if !row_number.next().is_some_and(|k| shard.takes(k)) {
+                continue;
+            }
             progress.set_message(format!("{name} on the {executor} executor"));
             let mut runner = Executors::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial
@@ -434,12 +498,23 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 judged.as_ref().map(|j| (j.reference, &j.image)),
                 &depth_complexity,
             )?;
-            if let Some(Judged {
-                image, reference, ..
-            }) = judged.as_ref().filter(|_| !args.no_images)
+            if let (
+                Some(Judged {
+                    image, reference, ..
+                }),
+                Some(images),
+            ) = (judged.as_ref(), &images)
             {
-                let stem = format!("bench-{}-{executor}", named.name);
-                save_with_difference(image, reference, &args.out, &stem)?;
+                images.save_with_difference(
+                    image,
+                    reference,
+                    &format!("bench-{}-{executor}", named.name),
+                    &format!(
+                        "{} of {} on the {executor} executor",
+                        args.effect.label(),
+                        named.name
+                    ),
+                )?;
             }
             let median_time = times.median();
             let stats = &named.run.stats;
@@ -511,7 +586,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 frames,
                 pool: &pool,
                 serial_pool: &serial_pool,
-                out: (!args.no_images).then_some(args.out.as_path()),
+                images: images.as_ref(),
             };
             crate::multisampled::measure(&bench, pattern)
         })
@@ -522,17 +597,20 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     if let Some(order) = &order {
         let nodes = crate::approximate::nodes(sizing.k, &oracle);
         for &scheme in &args.approximate {
+            if !row_number.next().is_some_and(|k| shard.takes(k)) {
+                continue;
+            }
             let (row, image) = pool.install(|| {
                 crate::approximate::measure(
                     scheme, nodes, &judge, &oracle, order, frames, raster_ms,
                 )
             })?;
-            if let Some(reference) = judge.reference().filter(|_| !args.no_images) {
-                save_with_difference(
+            if let (Some(reference), Some(images)) = (judge.reference(), &images) {
+                images.save_with_difference(
                     &image,
                     reference,
-                    &args.out,
                     &format!("bench-{}", row.scheme),
+                    &format!("{} of {}", args.effect.label(), row.label()),
                 )?;
             }
             approximate.push(row);
@@ -632,13 +710,23 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
     let md_path = args.out.join("bench.md");
     std::fs::write(&md_path, &markdown)
         .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
-    if !args.no_images {
+    let wrote = if args.no_images {
+        format!("wrote {}: bench.jsonl, bench.md", args.out.display())
+    } else {
         speed_accuracy_chart(report, &args.out.join("bench-speed-accuracy.png"))?;
-    }
+        format!(
+            "wrote {}: bench.jsonl, bench.md, bench-speed-accuracy.png and the effect and \
+             difference images",
+            args.out.display()
+        )
+    };
+    // Under `--json` stdout stays JSON Lines: where the files went goes to stderr.
     if args.json {
         out!("{lines}");
+        eprintln!("{wrote}");
     } else {
-        out!("{markdown}");
+        out!("{}", terminal_table(report));
+        outln!("{wrote} (bench.md: every column, with their key, and the per-depth tables)");
     }
     Ok(())
 }
@@ -701,6 +789,77 @@ rasterization, capture) and the post pass (resolve, sort); **frame ms** their me
 median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments per second; \
 **vs DP** depth peeling's median time over this row's (above 1: faster than depth peeling).
 ";
+
+/// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
+/// first, aligned, in about 120 characters (bench.md holds all 26).
+fn terminal_table(report: &BenchReport) -> String {
+    type Cell = fn(&BenchRow) -> String;
+    let columns: [(&str, Cell); 10] = [
+        ("scheme", |r| r.scheme.clone()),
+        ("executor", |r| r.executor.clone()),
+        ("passes", |r| r.passes.to_string()),
+        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
+        ("lost", |r| r.lost.to_string()),
+        ("mismatched px", |r| r.mismatched_pixels.to_string()),
+        ("EPR %", |r| {
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".into(), |e| format!("{:.3}", e * 100.0))
+        }),
+        ("PSNR dB", |r| r.colour.cells()[2].clone()),
+        ("frame ms", |r| format!("{:.2}", r.time_ms)),
+        ("vs DP", |r| {
+            r.speedup_vs_depth_peeling
+                .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
+        }),
+    ];
+    let mut rows = vec![columns
+        .iter()
+        .map(|(h, _)| (*h).to_string())
+        .collect::<Vec<_>>()];
+    rows.extend(
+        report
+            .rows
+            .iter()
+            .map(|r| columns.iter().map(|(_, cell)| cell(r)).collect()),
+    );
+    let widths: Vec<usize> = (0..columns.len())
+        .map(|c| {
+            rows.iter()
+                .map(|row| row[c].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let mut text = markdown(report)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    text.push_str("\n\n");
+    for row in &rows {
+        let cells: Vec<String> = row
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (cell, &w))| {
+                if c < 2 {
+                    format!("{cell:<w$}")
+                } else {
+                    format!("{cell:>w$}")
+                }
+            })
+            .collect();
+        text.push_str(cells.join("  ").trim_end());
+        text.push('\n');
+    }
+    text.push_str(
+        "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
+         should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
+         pixels whose 8-bit colour of the effect differs, in % of the covered pixels; PSNR dB of \
+         that image; frame ms the median frame; vs DP speed-up over depth peeling.\n",
+    );
+    text
+}
 
 fn markdown(report: &BenchReport) -> String {
     let mut text = format!(

@@ -51,8 +51,9 @@ pub struct CompareArgs {
     /// The difference image (PNG).
     #[arg(long, value_name = "PATH", default_value = "out/compare-diff.png")]
     pub image: PathBuf,
-    /// Write no difference image.
-    #[arg(long, conflicts_with = "image")]
+    /// Write no difference image (`--no-images`, as every command spells it; the older
+    /// `--no-images` still works).
+    #[arg(long = "no-images", alias = "no-image", conflicts_with = "image")]
     pub no_image: bool,
     /// The mesh file to rebuild the oracle from instead of the one the dump names (a dump that
     /// travelled); its bytes must still hash as the dump says.

@@ -24,6 +24,7 @@ use fragsim_testkit::{
 };
 use serde::Serialize;
 
+use crate::args::Shard;
 use crate::record::{self, Context, Slots};
 
 /// Options of `fragsim conform`.
@@ -52,6 +53,11 @@ pub struct ConformArgs {
     /// The seed the cases are generated from (the same seed, the same cases).
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub seed: u64,
+    /// Check only shard I of N of the `--cases` cases (cargo-nextest's `count:I/N`): case `n`
+    /// (from 1) when `(n − 1) mod N = I − 1`. Every shard generates the same cases from the
+    /// seed, so N machines running shards 1 to N check exactly the unsharded run's cases.
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
+    pub shard: Option<Shard>,
     /// Seconds one run of the command may take before it is killed (a failing case).
     #[arg(long, value_name = "SECONDS", default_value_t = 30.0, value_parser = positive)]
     pub timeout: f64,
@@ -114,7 +120,8 @@ fn entries(words: &[u64]) -> Vec<Entry> {
     words
         .iter()
         .map(|&w| Entry {
-            key: format!("{:#010x}", w >> 32),
+            // As `compare` prints keys: 8 hex digits.
+            key: format!("{:08x}", w >> 32),
             depth: depth_from_key((w >> 32) as u32),
             prim: w as u32,
         })
@@ -130,7 +137,12 @@ struct Summary {
     cases: u32,
     seed: u64,
     vertex_precision: String,
+    /// `I/N` under `--shard` (`null` unsharded).
+    shard: Option<String>,
+    /// Cases checked (a shard's own).
     cases_run: u32,
+    /// The failing case's number among the seed's `cases` (the same in a shard as unsharded).
+    case_number: Option<u32>,
     shrink_steps: Option<u32>,
     property: Option<String>,
     message: Option<String>,
@@ -172,6 +184,9 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             args.backend
         ));
     }
+    let shard = args.shard.unwrap_or(Shard::WHOLE);
+    // This shard's cases: those numbered `shard.index`, `shard.index + shard.count`, … of all.
+    let shard_cases = (args.cases + shard.count - shard.index) / shard.count;
     let params = Params {
         scheme,
         k: args.k,
@@ -193,6 +208,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
     let battery = Battery::new(&backend, params)
         .cases(args.cases)
         .seed(args.seed)
+        .shard(shard.index, shard.count)
         .shrink_steps(args.shrink_steps)
         .limits(Limits {
             max_side: args.max_side,
@@ -200,7 +216,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             power_of_two: args.power_of_two,
             ..Limits::default()
         });
-    let bar = crate::progress::bar(u64::from(args.cases), "conform");
+    let bar = crate::progress::bar(u64::from(shard_cases), "conform");
     // Case N starts once case N − 1 has passed; the last case's pass is the run's end.
     let mut cases_started = 0;
     let result = battery.run_with(&mut |event| match event {
@@ -208,7 +224,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             bar.set_position(u64::from(n));
             cases_started = n;
             if args.progress_lines && n > 1 {
-                eprintln!("conform: {} of {} cases passed", n - 1, args.cases);
+                eprintln!("conform: {} of {shard_cases} cases passed", n - 1);
             }
         }
         Event::Shrink(step) => {
@@ -220,7 +236,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
     });
     bar.finish_and_clear();
     if args.progress_lines && result.is_ok() {
-        eprintln!("conform: {0} of {0} cases passed", args.cases);
+        eprintln!("conform: {shard_cases} of {shard_cases} cases passed");
     }
     // The cases' files are scratch; the saved case is written afresh below.
     let _ = std::fs::remove_dir_all(&work);
@@ -231,7 +247,9 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         cases: args.cases,
         seed: args.seed,
         vertex_precision: args.vertex_precision.clone(),
-        cases_run: args.cases,
+        shard: args.shard.map(|s| s.to_string()),
+        cases_run: shard_cases,
+        case_number: None,
         shrink_steps: None,
         property: None,
         message: None,
@@ -240,8 +258,14 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         saved: None,
         replay: None,
     };
+    let saved = args.save.join("case");
     let found = match result {
         Ok(_) => {
+            // A failing case saved by an earlier run no longer describes this backend.
+            if saved.exists() {
+                std::fs::remove_dir_all(&saved)
+                    .map_err(|e| format!("cannot remove {}: {e}", saved.display()))?;
+            }
             let spec = SceneAndCamera::named("generated", 0.0, 0.0);
             let context = sized(
                 Context::new("conform", &spec, args.max_side, args.max_side),
@@ -250,11 +274,14 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             if args.json {
                 record::emit("conform", &context, &summary)?;
             } else {
+                let cases = match args.shard {
+                    Some(shard) => format!("{shard_cases} cases (shard {shard} of {})", args.cases),
+                    None => format!("{} cases", args.cases),
+                };
                 outln!(
-                    "conform: {} passes {} cases of {} (k {}, capacity {}, seed {}, {} vertex \
+                    "conform: {} passes {cases} of {} (k {}, capacity {}, seed {}, {} vertex \
                      stage): equal to the oracle, order-independent, overflow as predicted",
                     args.backend,
-                    args.cases,
                     scheme.name(),
                     args.k,
                     args.capacity,
@@ -267,7 +294,6 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         Err(Failure::Refused(message)) => return Err(message),
         Err(Failure::Counterexample(found)) => found,
     };
-    let saved = args.save.join("case");
     let replay = save(&backend, &found, &params, &saved)?;
     let spec = Case::scene_and_camera(
         &saved.join("scene").join("mesh.obj").display().to_string(),
@@ -281,6 +307,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
     summary = Summary {
         passed: false,
         cases_run: found.cases_run,
+        case_number: Some(found.case_number),
         shrink_steps: Some(found.shrink_steps),
         property: Some(found.property.to_string()),
         message: Some(found.message.clone()),
@@ -351,19 +378,27 @@ fn save(
     // the scene files are saved all the same.
     let rerun = backend.run_in(&input, dir);
     let absolute = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    // Every path absolute, so that the script runs from any directory: the backend's command
+    // from the directory conform ran in (its own paths may be relative to it), and this very
+    // fragsim (which need not be on PATH).
+    let here = std::env::current_dir().map_err(|e| format!("the working directory: {e}"))?;
+    let fragsim = std::env::current_exe().map_err(|e| format!("fragsim's own path: {e}"))?;
     let replay = vec![
+        format!("cd {} || exit 2", shell_quoted(&here)),
         backend.command_line(&absolute.join("scene"), &absolute.join("out"), params),
         format!(
-            "fragsim compare oracle '{}'{}",
-            absolute.join("out").display(),
+            "{} compare oracle {}{}",
+            shell_quoted(&fragsim),
+            shell_quoted(&absolute.join("out")),
             match backend.vertex_precision {
                 VertexPrecision::F32 => " --vertex-precision f32",
                 VertexPrecision::F64 => "",
             }
         ),
     ];
-    let mut script =
-        String::from("#!/bin/sh\n# Replays fragsim conform's smallest failing case.\n");
+    let mut script = String::from(
+        "#!/bin/sh\n# Replays fragsim conform's smallest failing case (from any directory).\n",
+    );
     if let Err(e) = rerun {
         script.push_str(&format!("# On saving, the backend failed again: {e}\n"));
     }
@@ -374,6 +409,11 @@ fn save(
     let path = dir.join("replay.sh");
     std::fs::write(&path, script).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(replay)
+}
+
+/// `path` quoted for `sh`: in single quotes, a quote inside written `'\''`.
+fn shell_quoted(path: &Path) -> String {
+    format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
 }
 
 fn print_counterexample(
@@ -388,7 +428,7 @@ fn print_counterexample(
         "conform: {} FAILS `{}` on case {} of {} (seed {}), shrunk in {} steps to:",
         args.backend,
         found.property,
-        found.cases_run,
+        found.case_number,
         args.cases,
         args.seed,
         found.shrink_steps

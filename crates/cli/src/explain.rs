@@ -72,7 +72,7 @@ pub struct ExplainArgs {
         allow_hyphen_values = true
     )]
     pub depths: Vec<f32>,
-    /// Slots per pixel (default: the number of fragments, so nothing falls off by design).
+    /// Slots per pixel [default: one per depth of --depths, so nothing falls off by design].
     #[arg(long)]
     pub k: Option<u32>,
     /// Seeds of the scheduled executor to search.
@@ -91,11 +91,19 @@ pub struct ExplainArgs {
     pub json: bool,
 }
 
-/// What the symbols of the step table mean, printed under it.
-const KEY: &str = "key: 0.3#1 = a fragment (depth 0.3, primitive 1); ∅ = an empty slot; \
-                   w2 = memory word 2 (the pixel's slot 2); T0 = thread 0; \
-                   ← = the value written; → = the value the operation returned; \
-                   (was …) = what a store overwrote";
+/// What the symbols of the step table mean, printed under it; `example`, a fragment of the
+/// table, illustrates the fragment notation, so that the key agrees with the run it explains.
+fn key(example: &Fragment) -> String {
+    format!(
+        "key: {} = a fragment: depth {}, primitive {p} (index {p} in --depths), run by thread \
+         T{p}; ∅ = an empty slot; w2 = memory word 2 (the pixel's slot 2); \
+         ← = the value written; → = the value the operation returned; \
+         (was …) = what a store overwrote",
+        value(example.packed()),
+        example.depth(),
+        p = example.prim
+    )
+}
 
 /// `explain`'s one JSON Lines record.
 #[derive(serde::Serialize)]
@@ -257,7 +265,7 @@ fn explain_kbuffer(
     );
     let memory = memory_after(&trace, k, EMPTY);
     out.push_str(&table(&fragments, &trace, &memory, &[]));
-    let _ = writeln!(out, "{KEY}");
+    let _ = writeln!(out, "{}", key(&fragments[0]));
     let _ = writeln!(out, "expected slots: {}", values(&nearest(&fragments, k)));
     for v in &damage.lost {
         let _ = writeln!(
@@ -320,7 +328,8 @@ fn explain_mdts(scheme: &Mdts<u64>, k: u32, fragments: &[Fragment], seeds: u64) 
     ));
     let _ = writeln!(
         out,
-        "{KEY}; inv: ✓ the invariant holds after the step (a cross where it fails)"
+        "{}; inv: ✓ the invariant holds after the step (a cross where it fails)",
+        key(&fragments[0])
     );
     let last: Vec<u64> = memory
         .last()
@@ -437,8 +446,7 @@ fn table(
     header.extend(
         fragments
             .iter()
-            .enumerate()
-            .map(|(t, f)| format!("T{t} ({})", value(f.packed()))),
+            .map(|f| format!("T{} ({})", f.prim, value(f.packed()))),
     );
     header.push("memory after".into());
     header.extend(extra.iter().map(|(title, _)| (*title).to_string()));

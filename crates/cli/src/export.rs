@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_oracle::dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
-use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
 use fragsim_oracle::triangles::TriangleExport;
-use fragsim_raster::View;
+use fragsim_raster::{Camera, UpAxis, VertexPrecision, View};
 
-use crate::args::SceneArgs;
+use crate::args::{ConventionsArgs, SceneArgs};
 use crate::schemes::{NamedRun, SchemeName};
 
 /// Options of `fragsim export-scene`.
@@ -19,7 +19,10 @@ pub struct ExportArgs {
     /// The scene and the camera.
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// The triangle file to write.
+    /// The rasterization conventions, as `render` takes them (the export's scene records them).
+    #[command(flatten)]
+    pub conventions: ConventionsArgs,
+    /// The binary triangle file to write (`FRAGTRI1`, `docs/dump-format.md` §3; `.tri` by custom).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
     /// Print one JSON Lines record (`docs/json-schema.md`) instead of the sentence.
@@ -52,17 +55,43 @@ pub(crate) fn scene_spec(args: &SceneArgs) -> Result<SceneAndCamera, String> {
     }
 }
 
+/// The scene a dump or an export of `view` records: [`scene_spec`] under the view's conventions.
+/// A model stood on another `--up` axis is recorded by the view's matrix, turn included, which
+/// the orbit's fields cannot describe.
+pub(crate) fn view_spec(args: &SceneArgs, view: &View<'_>) -> Result<SceneAndCamera, String> {
+    let turned = (args.up != UpAxis::Y).then(|| ViewProjection {
+        row_major: Camera {
+            view_projection: view.view_projection(),
+        }
+        .row_major(),
+        precision: VertexPrecision::F64,
+    });
+    Ok(SceneAndCamera {
+        conventions: view.conventions(),
+        view_projection: turned,
+        ..scene_spec(args)?
+    })
+}
+
 /// Runs `export-scene`.
 ///
 /// # Errors
 /// A scene that cannot be loaded, a bad viewport, a file that cannot be written.
 pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
-    let spec = scene_spec(&args.scene)?;
     let scene = args.scene.scene()?;
-    let view = scene
-        .view(args.scene.viewport()?, &spec.orbit())
-        .map_err(|e| e.to_string())?;
-    let export = TriangleExport::from_view(&view, spec);
+    let view = args
+        .scene
+        .view_at(&scene, args.scene.view, args.conventions.conventions())?;
+    let spec = view_spec(&args.scene, &view)?;
+    // The records are in pixels whatever the sample count (a backend scans them at the samples
+    // the scene's conventions name), so the header's size is the render target's, not the
+    // sample-expanded framebuffer's.
+    let pixels = view.pixel_viewport();
+    let export = TriangleExport {
+        width: pixels.width,
+        height: pixels.height,
+        ..TriangleExport::from_view(&view, spec)
+    };
     export.write(&args.out).map_err(|e| e.to_string())?;
     if args.json {
         let context = crate::record::Context::new(
@@ -79,7 +108,7 @@ pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
         return crate::record::emit("export", &context, &record);
     }
     outln!(
-        "wrote {}: {} screen triangles of {} mesh triangles ({}, {}x{})",
+        "wrote {} (binary FRAGTRI1): {} screen triangles of {} mesh triangles ({}, {}x{})",
         args.out.display(),
         export.triangles.len(),
         export.mesh_triangles,
@@ -144,10 +173,7 @@ impl DumpStage {
             }
         };
         let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-        let spec = SceneAndCamera {
-            conventions: view.conventions(),
-            ..scene_spec(scene)?
-        };
+        let spec = view_spec(scene, view)?;
         let (layout, ignored) = scheme.spec_in(&self.encoding);
         if !ignored.is_empty() {
             eprintln!(
@@ -194,10 +220,7 @@ impl DumpStage {
         capacity: u32,
     ) -> Result<(), String> {
         let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-        let spec = SceneAndCamera {
-            conventions: view.conventions(),
-            ..scene_spec(scene)?
-        };
+        let spec = view_spec(scene, view)?;
         let (layout, ignored) = masked_spec(&self.encoding);
         if !ignored.is_empty() {
             eprintln!(

@@ -29,6 +29,7 @@ use serde::Serialize;
 use crate::args::SceneArgs;
 use crate::explain::WriteBackArg;
 use crate::record::{Context, Slots};
+use fragsim_raster::Conventions;
 
 /// Options of `fragsim hazard`.
 #[derive(Debug, Clone, Args)]
@@ -39,9 +40,16 @@ pub struct HazardArgs {
     /// k-buffer slots per pixel.
     #[arg(long, default_value_t = 8)]
     pub k: u32,
-    /// Threads in flight, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1,32,1024,65536")]
-    pub widths: Vec<usize>,
+    /// Threads in flight `W`, comma-separated: how many fragments the scheduled executor keeps
+    /// walking at once (not the viewport's `--width`; `--widths` is the older spelling).
+    #[arg(
+        long,
+        value_name = "W,...",
+        alias = "widths",
+        value_delimiter = ',',
+        default_value = "1,32,1024,65536"
+    )]
+    pub threads_in_flight: Vec<usize>,
     /// Seeds per (machine, policy, width).
     #[arg(long, default_value_t = 3)]
     pub seeds: u64,
@@ -65,8 +73,11 @@ pub struct HazardArgs {
     #[arg(long, default_value = "out/hazard")]
     pub out: PathBuf,
     /// Write the plots as SVG instead of PNG.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "no_images")]
     pub svg: bool,
+    /// Write no plots; hazard.md and hazard.json are still written.
+    #[arg(long)]
+    pub no_images: bool,
     /// Print JSON Lines instead of the tables: one record per (machine, policy, width), or per
     /// baseline row (`docs/json-schema.md`).
     #[arg(long)]
@@ -117,14 +128,16 @@ struct BaselineRecord<'a> {
 /// # Errors
 /// Scene, parameter or output errors.
 pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
-    if args.widths.contains(&0) || args.seeds == 0 || args.write_back.is_empty() {
-        return Err("hazard needs widths ≥ 1, at least one seed and one machine".into());
+    if args.threads_in_flight.contains(&0) || args.seeds == 0 || args.write_back.is_empty() {
+        return Err(
+            "hazard needs --threads-in-flight ≥ 1, at least one seed and one machine".into(),
+        );
     }
     let scene = args.scene.scene()?;
     let viewport = args.scene.viewport()?;
-    let view = scene
-        .view(viewport, &args.scene.orbit(args.scene.view))
-        .map_err(|e| e.to_string())?;
+    let view = args
+        .scene
+        .view_at(&scene, args.scene.view, Conventions::REFERENCE)?;
     crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT)?;
     let oracle = Oracle::build(&view);
     let in_bucket = covered_by_bucket(&oracle);
@@ -134,7 +147,8 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
             || args.scene.scene.clone(),
             |p| crate::record::file_name(&p.display().to_string()),
         ),
-        size: (args.scene.width, args.scene.height),
+        width: args.scene.width,
+        height: args.scene.height,
         k: args.k,
         covered,
         fragments: oracle.fragments(),
@@ -164,20 +178,22 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
         return Ok(report);
     }
     let progress = crate::progress::bar(
-        (machines.len() * POLICIES.len() * args.widths.len()) as u64,
+        (machines.len() * POLICIES.len() * args.threads_in_flight.len()) as u64,
         "hazard",
     );
     for &machine in &machines {
         let scheme = KBuffer::with_write_back(viewport, args.k, machine, MEMORY_CAP_DEFAULT)
             .map_err(|e| e.to_string())?;
         for policy in POLICIES {
-            for &width in &args.widths {
+            for &in_flight in &args.threads_in_flight {
                 progress.set_message(format!(
-                    "{} {} W = {width}",
+                    "{} {} W = {in_flight}",
                     machine_name(machine),
                     policy.1
                 ));
-                let row = rate(&view, &oracle, &scheme, machine, policy, width, args.seeds);
+                let row = rate(
+                    &view, &oracle, &scheme, machine, policy, in_flight, args.seeds,
+                );
                 report.rows.push(row);
                 progress.inc(1);
             }
@@ -195,7 +211,7 @@ fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), Strin
     let _ = writeln!(
         md,
         "`{}` at {}×{}: {} fragments, {} covered pixels; output lists sized to the maximum depth complexity.\n",
-        report.scene, report.size.0, report.size.1, report.fragments, report.covered
+        report.scene, report.width, report.height, report.fragments, report.covered
     );
     let _ = writeln!(
         md,
@@ -220,12 +236,12 @@ fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), Strin
             r.memory_bytes as f64 / f64::from(1 << 20),
         );
     }
-    std::fs::write(out.join("baselines.md"), &md).map_err(|e| e.to_string())?;
+    write_file(out, "baselines.md", &md)?;
     let json = serde_json::to_string_pretty(&report.baselines).map_err(|e| e.to_string())?;
-    std::fs::write(out.join("baselines.json"), json).map_err(|e| e.to_string())?;
+    write_file(out, "baselines.json", &json)?;
     if !args.json {
         out!("{md}");
-        return Ok(());
+        return say_wrote(args, &["baselines.md", "baselines.json"]);
     }
     let context = Context::of_scene("hazard", &args.scene)?;
     for r in &report.baselines {
@@ -246,7 +262,7 @@ fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), Strin
         };
         crate::record::emit("baseline", &context, &record)?;
     }
-    Ok(())
+    say_wrote(args, &["baselines.md", "baselines.json"])
 }
 
 /// Hazard's JSON Lines: one record per row.
@@ -276,9 +292,40 @@ fn print_json(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
             misordered_pixels: r.misordered_pixels,
             by_depth_complexity,
         };
-        crate::record::emit("hazard", &context.on("scheduled", r.width), &record)?;
+        crate::record::emit(
+            "hazard",
+            &context.on("scheduled", r.threads_in_flight),
+            &record,
+        )?;
     }
     Ok(())
+}
+
+/// What hazard.md's tables mean, under them.
+const KEY: &str = "
+Key: **W** threads in flight: how many fragments the scheduled executor keeps walking at once, one \
+thread each (W = 1 runs each walk alone: no hazard); **write-back** the k-buffer's machine \
+(`render-target`: the K slots read in one step and written back in one, write-backs committed in \
+order, so only a stale read loses; `separate-stores`: K loads and K stores, one step each, as CUDA \
+code does, so write-backs also tear); **policy** how the scheduled executor picks the next step \
+(`random`: any thread in flight, uniformly; `warps`: warps of 32 threads in round-robin, one step \
+per lane in lane order); **pixels wrong %** covered pixels whose slots differ from the oracle's K \
+nearest, in percent, mean over the seeds (JSON: the fraction, `mismatched_pixel_rate`); **per \
+seed** the same for each seed, 0, 1, … (`mismatched_pixel_rate_per_seed`); **lost**, **extra**, \
+**duplicates** fragments summed over the seeds; **misordered px** pixels whose slots are out of \
+order; **dc** a pixel's depth complexity (its fragments), bucketed, with the covered pixels in \
+each bucket.
+";
+
+/// `rate` (a fraction) as the tables print rates: a percentage.
+fn percent(rate: f64) -> String {
+    format!("{:.2}", 100.0 * rate)
+}
+
+/// Writes `text` to `name` in `out`, naming the file in an error.
+fn write_file(out: &std::path::Path, name: &str, text: &str) -> Result<(), String> {
+    let path = out.join(name);
+    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
@@ -290,26 +337,26 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         "k-buffer (K = {}) on `{}` at {}×{}: {} fragments, {} covered pixels; {} seeds per row.\n",
         report.k,
         report.scene,
-        report.size.0,
-        report.size.1,
+        report.width,
+        report.height,
         report.fragments,
         report.covered,
         args.seeds
     );
     let _ = writeln!(
         md,
-        "| write-back | policy | W | pixels wrong (mean) | per seed | lost | extra | duplicates | misordered px |"
+        "| write-back | policy | W | pixels wrong % (mean) | per seed % | lost | extra | duplicates | misordered px |"
     );
     let _ = writeln!(md, "|---|---|---:|---:|---|---:|---:|---:|---:|");
     for r in &report.rows {
-        let per_seed: Vec<String> = r.rate_per_seed.iter().map(|x| format!("{x:.4}")).collect();
+        let per_seed: Vec<String> = r.rate_per_seed.iter().map(|&x| percent(x)).collect();
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.write_back,
             r.policy,
-            r.width,
-            r.rate,
+            r.threads_in_flight,
+            percent(r.rate),
             per_seed.join(" "),
             r.lost,
             r.extra,
@@ -317,7 +364,10 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
             r.misordered_pixels
         );
     }
-    let _ = writeln!(md, "\nFraction of pixels wrong by depth complexity:\n");
+    let _ = writeln!(
+        md,
+        "\nPixels wrong by depth complexity, % of the bucket's pixels:\n"
+    );
     let labels: Vec<String> = report
         .buckets
         .iter()
@@ -330,30 +380,28 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
             .rate_by_depth_complexity
             .iter()
             .zip(&report.buckets)
-            .map(|(x, (_, n))| {
-                if *n == 0 {
-                    "–".into()
-                } else {
-                    format!("{x:.4}")
-                }
-            })
+            .map(|(&x, (_, n))| if *n == 0 { "–".into() } else { percent(x) })
             .collect();
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} |",
             r.write_back,
             r.policy,
-            r.width,
+            r.threads_in_flight,
             cells.join(" | ")
         );
     }
-    std::fs::write(out.join("hazard.md"), &md).map_err(|e| e.to_string())?;
+    md.push_str(KEY);
+    write_file(out, "hazard.md", &md)?;
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
-    std::fs::write(out.join("hazard.json"), json).map_err(|e| e.to_string())?;
+    write_file(out, "hazard.json", &json)?;
     if args.json {
         print_json(args, report)?;
     } else {
         out!("{md}");
+    }
+    if args.no_images {
+        return say_wrote(args, &["hazard.md", "hazard.json"]);
     }
     let ext = if args.svg { "svg" } else { "png" };
     let mut by_width: Vec<Series> = Vec::new();
@@ -363,7 +411,7 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
                 .rows
                 .iter()
                 .filter(|r| r.policy == p && r.write_back == machine_name(write_back.machine()))
-                .map(|r| ((r.width as f64).log2(), r.rate))
+                .map(|r| ((r.threads_in_flight as f64).log2(), 100.0 * r.rate))
                 .collect();
             by_width.push((
                 format!("{} {p}", machine_name(write_back.machine())),
@@ -371,31 +419,32 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
             ));
         }
     }
+    let vs_width = format!("hazard-vs-width.{ext}");
     chart(
-        &out.join(format!("hazard_vs_width.{ext}")),
+        &out.join(&vs_width),
         &format!(
             "k-buffer (K = {}): pixels wrong vs threads in flight",
             report.k
         ),
         "log2 W (threads in flight)",
-        "fraction of covered pixels wrong",
+        "% of covered pixels wrong",
         &by_width,
         false,
     )?;
     let by_dc: Vec<Series> = report
         .rows
         .iter()
-        .filter(|r| r.width > 1)
+        .filter(|r| r.threads_in_flight > 1)
         .map(|r| {
             let points = r
                 .rate_by_depth_complexity
                 .iter()
                 .enumerate()
                 .filter(|&(i, _)| report.buckets[i].1 > 0)
-                .map(|(i, &x)| (i as f64, x))
+                .map(|(i, &x)| (i as f64, 100.0 * x))
                 .collect();
             (
-                format!("{} {} W={}", r.write_back, r.policy, r.width),
+                format!("{} {} W={}", r.write_back, r.policy, r.threads_in_flight),
                 points,
             )
         })
@@ -405,18 +454,32 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         .iter()
         .map(|(label, n)| format!("{label} ({n} px)"))
         .collect();
+    let vs_dc = format!("hazard-vs-depth-complexity.{ext}");
     chart_with_ticks(
-        &out.join(format!("hazard_vs_depth_complexity.{ext}")),
+        &out.join(&vs_dc),
         (
             &format!(
                 "k-buffer (K = {}): pixels wrong vs depth complexity",
                 report.k
             ),
             "depth complexity of the pixel (bucket, pixels in it)",
-            "fraction of the bucket's pixels wrong",
+            "% of the bucket's pixels wrong",
         ),
         &by_dc,
         false,
         Some(&ticks),
-    )
+    )?;
+    say_wrote(args, &["hazard.md", "hazard.json", &vs_width, &vs_dc])
+}
+
+/// Says which files went where: on stdout after the tables, on stderr under `--json` (stdout
+/// stays JSON Lines).
+fn say_wrote(args: &HazardArgs, files: &[&str]) -> Result<(), String> {
+    let wrote = format!("wrote {}: {}", args.out.display(), files.join(", "));
+    if args.json {
+        eprintln!("{wrote}");
+    } else {
+        outln!("{wrote}");
+    }
+    Ok(())
 }

@@ -61,7 +61,7 @@ use std::process::ExitCode;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
-pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs};
+pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
 pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
@@ -118,7 +118,7 @@ pub enum Command {
 /// Parses the command line and runs it; errors go to stderr with a non-zero exit code.
 #[must_use]
 pub fn main() -> ExitCode {
-    let matches = Cli::command().get_matches_from(help_flag_dropped(std::env::args_os().collect()));
+    let matches = command().get_matches_from(help_flag_dropped(std::env::args_os().collect()));
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     progress::set_quiet(cli.quiet);
     if let Err(message) = check_flags(&cli, &matches) {
@@ -170,6 +170,15 @@ pub fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// The command line's definition: the derived one, with `sweep --view` hidden from `sweep
+/// --help` (the sweep sets the angle itself; the flag stays parsed so that [`check_flags`] can
+/// refuse it saying why, rather than clap's bare "unexpected argument").
+fn command() -> clap::Command {
+    Cli::command().mut_subcommand("sweep", |sweep| {
+        sweep.mut_arg("view", |view| view.hide(true))
+    })
 }
 
 /// `fragsim help … --help` as `fragsim help …`: clap's `help` subcommand takes no flags, so

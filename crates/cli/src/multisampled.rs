@@ -21,8 +21,6 @@
 //! way ([`Judge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
 
-use std::path::Path;
-
 use fragsim_capture::catalog::{check_memory_cap_early, Count, Executors, SchemeName, Sizing};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
@@ -31,7 +29,7 @@ use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
 use serde::Serialize;
 
-use crate::bench::{ms, save_with_difference, time_frames, FrameTimes};
+use crate::bench::{ms, time_frames, FrameTimes, Images};
 use crate::judge::{ColourColumns, Judge, Judged};
 
 /// The oracle's transparency image resolved from several samples a pixel, against the
@@ -153,7 +151,7 @@ pub(crate) struct Bench<'b, 'v> {
     /// One thread: a serial row's vertex stage.
     pub serial_pool: &'b rayon::ThreadPool,
     /// Where images go (`None`: `--no-images`).
-    pub out: Option<&'b Path>,
+    pub images: Option<&'b Images<'b>>,
 }
 
 /// Refuses, before any pass, storage of the multisampled rows beyond the memory cap: every scheme
@@ -220,12 +218,12 @@ pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<M
         layer_edge_pixels += usize::from(others().any(|s| lists.pixel(s).len() != layers));
         mixed_pixels += usize::from(others().any(|s| !prims(s).eq(prims(first))));
     }
-    if let Some(out) = bench.out {
-        save_with_difference(
+    if let Some(images) = bench.images {
+        images.save_with_difference(
             image,
             single,
-            out,
             &format!("bench-oracle-transparency-msaa{samples}"),
+            &format!("the oracle's transparency at {samples} samples a pixel, resolved"),
         )?;
     }
     let per_pixel = oracle.per_pixel();
@@ -270,9 +268,16 @@ fn rows(
     // The row of a first frame's per-sample lists and its times; the image unless --no-images.
     let mut row = |common: Common, error: SampleError, judged: Option<Judged<'_>>| {
         let times = &common.times;
-        if let (Some(out), Some(j)) = (bench.out, &judged) {
-            let stem = format!("bench-{}-msaa{samples}-{}", common.scheme, common.executor);
-            save_with_difference(&j.image, j.reference, out, &stem)?;
+        if let (Some(images), Some(j)) = (bench.images, &judged) {
+            images.save_with_difference(
+                &j.image,
+                j.reference,
+                &format!("bench-{}-msaa{samples}-{}", common.scheme, common.executor),
+                &format!(
+                    "transparency of {} at {samples} samples on the {} executor",
+                    common.scheme, common.executor
+                ),
+            )?;
         }
         let error_pixels = judged.as_ref().map(|j| j.errors);
         rows.push(SampledRow {

@@ -12,7 +12,7 @@ use fragsim_capture::schemes::masked_abuffer::MaskedABuffer;
 use fragsim_oracle::dump::MASKED_SCHEME;
 use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{depth_from_key, View, Viewport};
+use fragsim_raster::{depth_from_key, View};
 use serde::Serialize;
 
 use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
@@ -190,14 +190,11 @@ pub struct RunSummary {
 pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let pool = args.schemes.pool()?;
     let scene = args.scene.scene()?;
-    let viewport = args.scene.viewport()?;
-    let conventions = args.conventions.conventions();
-    let orbit = args.scene.orbit(args.scene.view);
-    let camera = scene.orbit_camera(viewport, &orbit, conventions.depth_range);
-    let view = scene
-        .view_under(viewport, &camera, conventions)
-        .map_err(|e| e.to_string())?;
-    let view = args.schemes.submission(view);
+    let view = args.schemes.submission(args.scene.view_at(
+        &scene,
+        args.scene.view,
+        args.conventions.conventions(),
+    )?);
     crate::args::warn_if_empty(&scene, &view);
     // At more than one sample every scheme, the oracle and the images cover the sample-expanded
     // framebuffer (`docs/semantics.md`, "Multisampling").
@@ -260,6 +257,8 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                     viewport.height,
                     &nearest,
                 )?;
+                let what = format!("nearest depth captured by {name} on the {executor} executor");
+                let image = fragsim_shade::legend::captioned(&image, &caption(args, &what)?)?;
                 fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png"))?;
                 nearest_written = true;
             }
@@ -298,8 +297,10 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             stage.add(name, run, &view, &args.scene)?;
         }
     }
+    let mut masked_line = None;
     if args.scheme.contains(&RenderScheme::Masked) {
-        let capacity = masked(&view, &sizing, args.json)?;
+        let (capacity, line) = masked(&view, &sizing)?;
+        masked_line = Some(line);
         if let Some(stage) = &mut dumps {
             stage.add_masked(&view, &args.scene, capacity)?;
         }
@@ -315,6 +316,10 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             &oracle.depth_complexity(),
             args.scale_max,
         )?;
+        let heat = fragsim_shade::legend::captioned(
+            &heat,
+            &caption(args, "depth complexity (the oracle's fragments a pixel)")?,
+        )?;
         fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))?;
     }
     if args.json {
@@ -323,19 +328,38 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             crate::record::emit("run", &context.on(&row.executor, row.threads), row)?;
         }
     } else {
-        print_table(&rows, &scene.name, viewport, &oracle, oracle_ms, args);
+        print_table(&rows, &scene.name, &view, &oracle, oracle_ms, args);
+        // Under the table its header describes (the scene, the pixels and samples).
+        if let Some(line) = masked_line {
+            outln!("{line}");
+        }
     }
     Ok(rows)
 }
 
-/// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample) and
-/// says, unless `json`, whether it holds the per-pixel view of the per-sample oracle; returns its
-/// capacity: `--capacity`, or under `auto` the most nodes a pixel of that view has.
+/// An image's caption: the scene, the view, the size (and samples), then `what` it shows.
+///
+/// # Errors
+/// The mesh file cannot be read (for its name).
+fn caption(args: &RenderArgs, what: &str) -> Result<String, String> {
+    let scene = crate::record::Context::of_scene("render", &args.scene)?.scene;
+    let samples = match args.conventions.samples {
+        1 => String::new(),
+        n => format!(" at {n} samples"),
+    };
+    Ok(format!(
+        "{scene}, view {}°, elevation {}°, {}x{}{samples}: {what}",
+        args.scene.view, args.scene.elevation, args.scene.width, args.scene.height
+    ))
+}
+
+/// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample); returns
+/// its capacity (`--capacity`, or under `auto` the most nodes a pixel of that view has) and the
+/// line saying whether it holds the per-pixel view of the per-sample oracle.
 fn masked(
     view: &View<'_>,
     sizing: &fragsim_capture::catalog::Sizing,
-    json: bool,
-) -> Result<u32, String> {
+) -> Result<(u32, String), String> {
     let Some(pattern) = view.samples() else {
         return Err(format!(
             "--scheme {MASKED_SCHEME} runs per sample: it needs --samples 2, 4, 8 or 16"
@@ -359,36 +383,45 @@ fn masked(
     )
     .map_err(|e| e.to_string())?;
     let lists = scheme.capture(view, false)?;
-    if !json {
-        let overflowed: u64 = lists.overflow.iter().map(|&o| u64::from(o)).sum();
-        let holds = if lists == per_pixel {
-            "equal to"
-        } else {
-            "differs from"
-        };
-        outln!(
-            "{MASKED_SCHEME} (serial): {} samples, capacity {capacity}, {} nodes stored, {overflowed} \
-             overflowed: {holds} the per-pixel view of the per-sample oracle",
-            pattern.count(),
-            lists.nodes.len()
-        );
-    }
-    Ok(capacity)
+    let overflowed: u64 = lists.overflow.iter().map(|&o| u64::from(o)).sum();
+    let holds = if lists == per_pixel {
+        "equal to"
+    } else {
+        "differs from"
+    };
+    let line = format!(
+        "{MASKED_SCHEME} (serial): {} samples, capacity {capacity}, {} nodes stored, {overflowed} \
+         overflowed: {holds} the per-pixel view of the per-sample oracle",
+        pattern.count(),
+        lists.nodes.len()
+    );
+    Ok((capacity, line))
 }
 
 fn print_table(
     rows: &[RunSummary],
     scene: &str,
-    viewport: Viewport,
+    view: &View<'_>,
     oracle: &Oracle,
     oracle_ms: f64,
     args: &RenderArgs,
 ) {
+    let pixels = view.pixel_viewport();
+    // Per sample, the lists and their fragments are the sample-expanded framebuffer's.
+    let sampled = view.samples().map_or(String::new(), |pattern| {
+        let framebuffer = view.viewport();
+        format!(
+            " at {} samples ({}x{} sample lists)",
+            pattern.count(),
+            framebuffer.width,
+            framebuffer.height
+        )
+    });
     outln!(
-        "scene {scene}: {} triangles, {}x{} pixels, {} fragments, max depth complexity {} (oracle {:.1} ms)",
+        "scene {scene}: {} triangles, {}x{} pixels{sampled}, {} fragments, max depth complexity {} (oracle {:.1} ms)",
         rows.first().map_or(0, |r| r.triangles),
-        viewport.width,
-        viewport.height,
+        pixels.width,
+        pixels.height,
         oracle.fragments(),
         oracle.max_depth_complexity(),
         oracle_ms
@@ -428,12 +461,30 @@ fn print_table(
         }),
         ("mem ops", 9, |r| r.memory_ops.to_string()),
     ];
-    let line = |cells: Vec<String>| {
+    let header: Vec<String> = columns.iter().map(|(h, _, _)| (*h).to_string()).collect();
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| columns.iter().map(|(_, _, cell)| cell(r)).collect())
+        .collect();
+    // Each column as wide as its widest cell (a long scheme name widens its column, never
+    // pushes the rest out of line), at least its usual width.
+    let widths: Vec<usize> = columns
+        .iter()
+        .enumerate()
+        .map(|(i, (_, least, _))| {
+            cells
+                .iter()
+                .chain([&header])
+                .map(|row| row[i].chars().count())
+                .fold(*least, usize::max)
+        })
+        .collect();
+    let line = |cells: &[String]| {
         let padded: Vec<String> = cells
             .iter()
-            .zip(&columns)
+            .zip(&widths)
             .enumerate()
-            .map(|(i, (cell, (_, width, _)))| {
+            .map(|(i, (cell, &width))| {
                 if i < 3 {
                     format!("{cell:<width$}")
                 } else {
@@ -443,14 +494,9 @@ fn print_table(
             .collect();
         outln!("{}", padded.join(" "));
     };
-    line(
-        columns
-            .iter()
-            .map(|(header, _, _)| (*header).to_string())
-            .collect(),
-    );
-    for r in rows {
-        line(columns.iter().map(|(_, _, cell)| cell(r)).collect());
+    line(&header);
+    for row in &cells {
+        line(row);
     }
     outln!("captured + overflow + lost − extra = fragments, on every row");
     if rows.iter().any(|r| !r.guarantee_owed) {

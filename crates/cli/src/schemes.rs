@@ -103,3 +103,20 @@ impl From<Fault> for fragsim_capture::catalog::Fault {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// Every scheme's family has its own marker on the charts (`fragsim_shade::plot::FAMILIES`),
+    /// so a family looks the same on bench's chart and sweep's.
+    #[test]
+    fn every_catalog_family_has_a_chart_marker() {
+        for entry in fragsim_capture::catalog::CATALOG {
+            let family = super::family(entry.name);
+            assert!(
+                fragsim_shade::plot::FAMILIES.contains(&family),
+                "{}: {family}",
+                entry.name
+            );
+        }
+    }
+}

@@ -10,10 +10,11 @@ use fragsim_oracle::Oracle;
 use serde::Serialize;
 
 use crate::approximate::ApproximateName;
-use crate::args::{SceneArgs, SchemeArgs};
+use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::judge::{ColourColumns, EffectName, Judge};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
+use fragsim_raster::Conventions;
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
 /// Options of `fragsim sweep`.
@@ -38,9 +39,18 @@ pub struct SweepArgs {
     /// The effect whose image is compared with the oracle's.
     #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for sweep.jsonl and the PNG charts.
-    #[arg(long, default_value = "out")]
+    /// Directory for sweep.jsonl and the PNG charts (its own, so that bench's files do not mix
+    /// with the sweep's).
+    #[arg(long, default_value = "out/sweep")]
     pub out: PathBuf,
+    /// Write no charts; sweep.jsonl is still written.
+    #[arg(long)]
+    pub no_images: bool,
+    /// Sweep only shard I of N of the angles (cargo-nextest's `count:I/N`): angle step `k`
+    /// (from 0) when `k mod N = I − 1`. The shards' sweep.jsonl files together hold the
+    /// unsharded sweep's records (times apart).
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
+    pub shard: Option<Shard>,
     /// Print JSON Lines instead of the table: one record per scheme and angle
     /// (`docs/json-schema.md`; sweep.jsonl holds the same).
     #[arg(long)]
@@ -99,21 +109,24 @@ impl SweepSeries {
 pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let pool = args.schemes.pool()?;
     let scene = args.scene.scene()?;
-    let viewport = args.scene.viewport()?;
     let executor = args.schemes.executors()[0];
     let mut threads = 0;
     let schemes = SchemeChoice::expand(&args.scheme);
     let mut series: Vec<SweepSeries> = Vec::new();
     let mut angles = Vec::new();
-    let progress = crate::progress::bar(u64::from(args.angles), "sweep");
-    for step in 0..args.angles {
+    let shard = args.shard.unwrap_or(Shard::WHOLE);
+    let steps: Vec<u32> = (0..args.angles)
+        .filter(|&step| shard.takes(step as usize))
+        .collect();
+    let progress = crate::progress::bar(steps.len() as u64, "sweep");
+    for step in steps {
         progress.set_message(format!("angle {step}"));
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
         let orbit = args.scene.orbit(angle);
-        let view = args
-            .schemes
-            .submission(scene.view(viewport, &orbit).map_err(|e| e.to_string())?);
+        let view =
+            args.schemes
+                .submission(args.scene.view_at(&scene, angle, Conventions::REFERENCE)?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
@@ -227,6 +240,9 @@ fn write_outputs(
         "{scene}: error pixels of {} per view angle",
         args.effect.label()
     );
+    if args.no_images {
+        return print_summary(args, series, &lines, &["sweep.jsonl"]);
+    }
     fragsim_shade::plot::chart(
         &args.out.join("sweep-epr.png"),
         &title,
@@ -253,8 +269,26 @@ fn write_outputs(
         "mean frame time (ms, log scale)",
         &scatter,
     )?;
+    print_summary(
+        args,
+        series,
+        &lines,
+        &["sweep.jsonl", "sweep-epr.png", "sweep-speed-accuracy.png"],
+    )
+}
+
+/// Prints the JSON Lines or the table, then the files written (on stderr under `--json`, so
+/// that stdout stays JSON Lines).
+fn print_summary(
+    args: &SweepArgs,
+    series: &[SweepSeries],
+    lines: &str,
+    written: &[&str],
+) -> Result<(), String> {
+    let wrote = format!("wrote {}: {}", args.out.display(), written.join(", "));
     if args.json {
         out!("{lines}");
+        eprintln!("{wrote}");
         return Ok(());
     }
     outln!(
@@ -294,10 +328,7 @@ fn write_outputs(
         );
     }
     print_depth_table(series);
-    outln!(
-        "wrote {}/sweep.jsonl, sweep-epr.png, sweep-speed-accuracy.png",
-        args.out.display()
-    );
+    outln!("{wrote}");
     Ok(())
 }
 

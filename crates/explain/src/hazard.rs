@@ -1,5 +1,5 @@
 //! The k-buffer's read–modify–write hazard rate over a whole scene: for one machine, one policy
-//! of the scheduled executor and one width `W` (threads in flight), the fraction of covered
+//! of the scheduled executor and one number `W` of threads in flight, the fraction of covered
 //! pixels whose list differs from the oracle's `K` nearest, over seeds, with the failure classes
 //! counted apart and the rate bucketed by depth complexity.
 //!
@@ -30,18 +30,21 @@ pub const BUCKETS: [(u32, &str); 6] = [
 /// The scheduled executor's policies the rates are measured under, with their names in rows.
 pub const POLICIES: [(Policy, &str); 2] = [(Policy::Random, "random"), (Policy::Warps, "warps")];
 
-/// One (machine, policy, width) measurement, over seeds.
+/// One (machine, policy, threads in flight) measurement, over seeds.
 #[derive(Debug, Clone, Serialize)]
 pub struct HazardRow {
     /// `render-target` or `separate-stores`.
     pub write_back: String,
     /// `random` or `warps`.
     pub policy: String,
-    /// Threads in flight.
-    pub width: usize,
-    /// Fraction of covered pixels that differ from the oracle, per seed.
+    /// Threads in flight, `W` (JSON `threads_in_flight`, as `--threads-in-flight` names it).
+    pub threads_in_flight: usize,
+    /// Fraction of covered pixels that differ from the oracle, per seed (JSON
+    /// `mismatched_pixel_rate_per_seed`, as the JSON Lines record names it).
+    #[serde(rename = "mismatched_pixel_rate_per_seed")]
     pub rate_per_seed: Vec<f64>,
-    /// Its mean.
+    /// Its mean (JSON `mismatched_pixel_rate`).
+    #[serde(rename = "mismatched_pixel_rate")]
     pub rate: f64,
     /// Fragments lost, summed over seeds.
     pub lost: u64,
@@ -51,7 +54,9 @@ pub struct HazardRow {
     pub duplicates: u64,
     /// Pixels whose slots are out of order, summed over seeds.
     pub misordered_pixels: u64,
-    /// Per depth-complexity bucket: fraction of that bucket's pixels that differ (over seeds).
+    /// Per depth-complexity bucket: fraction of that bucket's pixels that differ (over seeds;
+    /// JSON `mismatched_pixel_rate_by_depth_complexity`).
+    #[serde(rename = "mismatched_pixel_rate_by_depth_complexity")]
     pub rate_by_depth_complexity: Vec<f64>,
 }
 
@@ -60,8 +65,10 @@ pub struct HazardRow {
 pub struct HazardReport {
     /// Scene and size.
     pub scene: String,
-    /// Width × height.
-    pub size: (u32, u32),
+    /// Viewport width in pixels.
+    pub width: u32,
+    /// Viewport height in pixels.
+    pub height: u32,
     /// Slots per pixel.
     pub k: u32,
     /// Covered pixels.
@@ -119,7 +126,7 @@ pub fn machine_name(write_back: WriteBack) -> &'static str {
 }
 
 /// The rate of `scheme` (a k-buffer on `machine`) on `view` under `policy` (named `policy_name`)
-/// with `width` fragments in flight, over seeds `0..seeds`, against `oracle`.
+/// with `threads_in_flight` fragments in flight, over seeds `0..seeds`, against `oracle`.
 #[must_use]
 pub fn rate(
     view: &View<'_>,
@@ -127,7 +134,7 @@ pub fn rate(
     scheme: &KBuffer,
     machine: WriteBack,
     (policy, policy_name): (Policy, &str),
-    width: usize,
+    threads_in_flight: usize,
     seeds: u64,
 ) -> HazardRow {
     let dc = oracle.depth_complexity();
@@ -137,7 +144,7 @@ pub fn rate(
     let mut row = HazardRow {
         write_back: machine_name(machine).into(),
         policy: policy_name.into(),
-        width,
+        threads_in_flight,
         rate_per_seed: Vec::new(),
         rate: 0.0,
         lost: 0,
@@ -150,7 +157,7 @@ pub fn rate(
     for seed in 0..seeds {
         let schedule = Schedule {
             policy,
-            in_flight: width,
+            in_flight: threads_in_flight,
             granularity: Granularity::Fragment,
             seed,
         };

@@ -33,7 +33,7 @@ mod scenes;
 pub use camera::{Camera, OrbitCamera};
 pub use conventions::{Conventions, DepthRange, VertexPrecision, WindowOrigin};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
-pub use mesh::{Mesh, MeshError};
+pub use mesh::{Mesh, MeshError, UpAxis};
 pub use pipeline::{
     CullMode, PixelRect, ScreenTriangle, View, Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS,
 };

@@ -234,6 +234,96 @@ impl Mesh {
     }
 }
 
+/// The axis a model points up along in its file. fragsim's orbit camera circles the +y axis
+/// (OBJ's custom); scanners and CAD tools often model z up, so such a mesh would lie on its
+/// side. Turning the model onto +y is a signed permutation of its axes: exact in any
+/// precision, its bounds the permuted bounds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum UpAxis {
+    /// +x up.
+    X,
+    /// −x up.
+    MinusX,
+    /// +y up: the model as the file has it.
+    #[default]
+    Y,
+    /// −y up (a model upside down).
+    MinusY,
+    /// +z up (the horse, most CAD and scanner files).
+    Z,
+    /// −z up.
+    MinusZ,
+}
+
+impl UpAxis {
+    /// Every axis, in the order `--help` lists them.
+    pub const ALL: [Self; 6] = [
+        Self::Y,
+        Self::Z,
+        Self::X,
+        Self::MinusY,
+        Self::MinusZ,
+        Self::MinusX,
+    ];
+
+    /// The axis's name: `x`, `y`, `z`, `-x`, `-y` or `-z`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::X => "x",
+            Self::MinusX => "-x",
+            Self::Y => "y",
+            Self::MinusY => "-y",
+            Self::Z => "z",
+            Self::MinusZ => "-z",
+        }
+    }
+
+    /// The axis named `text` (`x`, `+x`, `-x`, … case-insensitive).
+    ///
+    /// # Errors
+    /// Any other text, with the names accepted.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let lower = text.trim().to_ascii_lowercase();
+        let name = lower.strip_prefix('+').unwrap_or(&lower);
+        Self::ALL
+            .into_iter()
+            .find(|axis| axis.name() == name)
+            .ok_or_else(|| format!("{text:?} is not an axis: x, y, z, -x, -y or -z"))
+    }
+
+    /// The rotation turning this axis onto +y, row by row (`p' = R · p`): a quarter or half turn
+    /// about x or z, so a proper rotation (determinant 1) that keeps the model's handedness.
+    #[must_use]
+    pub fn rows(self) -> [[f64; 3]; 3] {
+        match self {
+            Self::Y => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            Self::MinusY => [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]],
+            Self::Z => [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]],
+            Self::MinusZ => [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]],
+            Self::X => [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            Self::MinusX => [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+        }
+    }
+
+    /// `p` turned so that this axis points along +y.
+    #[must_use]
+    pub fn turn(self, p: [f64; 3]) -> [f64; 3] {
+        self.rows()
+            .map(|row| row[0] * p[0] + row[1] * p[1] + row[2] * p[2])
+    }
+
+    /// The bounds `(min, max)` of a model of `bounds` once turned ([`UpAxis::turn`]).
+    #[must_use]
+    pub fn turn_bounds(self, (lo, hi): ([f64; 3], [f64; 3])) -> ([f64; 3], [f64; 3]) {
+        let (a, b) = (self.turn(lo), self.turn(hi));
+        (
+            [0, 1, 2].map(|i| a[i].min(b[i])),
+            [0, 1, 2].map(|i| a[i].max(b[i])),
+        )
+    }
+}
+
 /// The bytes of a mesh file, decompressed when they start with the gzip magic (whatever the
 /// file's name: fragsim's own `stanford-bunny.obj.gz` is gzipped OBJ).
 ///

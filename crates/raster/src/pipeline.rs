@@ -24,10 +24,12 @@
 //! 2–3 and the window depth (`[−1, 1]`), the snapping grid of rule 4 (subpixel bits), and the
 //! window's y direction with the owner of rule 6's shared edges (lower-left origin).
 //!
-//! The stages live in submodules: `vertex` (rules 1–4: transform, outcodes, clipping, snapping),
-//! `scan` (rules 6–7: bounding box, edge functions, depth), `sample_scan` (rules 6–7 at each
-//! sample of a multisampled view, `docs/semantics.md` §11) and `viewport` (the render target and
-//! pixel rectangles); this file holds the view that ties them together and rule 5 (facing).
+//! The stages live in submodules, in the order a triangle meets them: `vertex` (rules 1–4:
+//! transform, outcodes, clipping, snapping), `setup` (the early reject of triangles whose box holds
+//! no pixel centre, and each survivor set up once for the scan), `scan` (rules 6–7: the covered
+//! centres of each row from the edge functions, depth), `sample_scan` (rules 6–7 at each sample of
+//! a multisampled view, `docs/semantics.md` §11) and `viewport` (the render target and pixel
+//! rectangles); this file holds the view that ties them together and rule 5 (facing).
 
 use glam::{DMat4, DVec4};
 
@@ -40,6 +42,7 @@ use crate::mesh::Mesh;
 mod conventions_tests;
 mod sample_scan;
 mod scan;
+mod setup;
 mod submission;
 #[cfg(test)]
 mod tests;
@@ -48,7 +51,7 @@ mod viewport;
 
 use sample_scan::Sampling;
 use scan::{bounding_box, edge};
-use vertex::in_front;
+use vertex::{in_front, CentreCells, WindowVertex};
 pub use viewport::{PixelRect, Viewport};
 
 /// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
@@ -92,16 +95,16 @@ pub struct ScreenTriangle {
 pub struct View<'mesh> {
     mesh: &'mesh Mesh,
     view_projection: DMat4,
-    /// Per vertex: bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5:
-    /// beyond far; bit 6: not in front of the eye (`w ≤ 0` or NaN).
-    outcodes: Vec<u8>,
-    /// Per vertex: the snapped window position, x and y in 1/256 pixel, y down; meaningful only
-    /// when the vertex's outcode has no clip bit set. Inside the guard band they fit an `i32`
-    /// (|x| < 2^23). Kept apart from the depth: the triangle loop over a large mesh is bound by
-    /// fetching its vertices, and most triangles of a dense mesh are rejected by their bounding
-    /// box alone, before the depth is needed.
-    window_xy: Vec<[i32; 2]>,
-    /// Per vertex: the window depth `z / w`, under the same condition.
+    /// Per vertex: which interval between pixel-centre lines it lies in on each axis
+    /// ([`CentreCells`]), all the triangle setup reads of a triangle it rejects early.
+    cells: Vec<CentreCells>,
+    /// Per vertex: its outcode and snapped window position ([`WindowVertex`]), what the triangle
+    /// setup reads next. Kept apart from the depth: the triangle loop over a large
+    /// mesh is bound by fetching its vertices, and most triangles of a dense mesh are rejected by
+    /// their bounding box alone, before the depth is needed.
+    window: Vec<WindowVertex>,
+    /// Per vertex: the window depth `z / w`; meaningful only when the vertex's outcode has no
+    /// clip bit set.
     window_z: Vec<f64>,
     viewport: Viewport,
     cull: CullMode,
@@ -175,8 +178,8 @@ impl<'mesh> View<'mesh> {
         let mut view = Self {
             mesh,
             view_projection: camera.view_projection,
-            outcodes: Vec::new(),
-            window_xy: Vec::new(),
+            cells: Vec::new(),
+            window: Vec::new(),
             window_z: Vec::new(),
             viewport,
             cull,
@@ -192,8 +195,16 @@ impl<'mesh> View<'mesh> {
     /// The vertex stage's snapped position and depth of vertex `index` (no clip bit set).
     #[inline]
     fn snapped(&self, index: u32) -> Snapped {
-        let [x, y] = self.window_xy[index as usize];
-        ([x.into(), y.into()], self.window_z[index as usize])
+        (
+            self.window[index as usize].position(),
+            self.window_z[index as usize],
+        )
+    }
+
+    /// The outcode of vertex `index`.
+    #[inline]
+    fn outcode(&self, index: u32) -> u8 {
+        self.window[index as usize].outcode
     }
 
     /// The clip-space position of vertex `index`, exactly as the vertex stage computed it.
@@ -248,23 +259,7 @@ impl<'mesh> View<'mesh> {
         if let Some(sampling) = self.sampling {
             return self.rasterize_samples_in(prim, sampling, rect, emit);
         }
-        let indices = self.mesh.triangles[prim as usize];
-        let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
-        if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS != 0 {
-            self.screen_triangles(prim, &mut |tri| self.scan_in(&tri, rect, emit));
-            return;
-        }
-        // The common case, inlined: no clipping, and most triangles of a dense mesh cover no
-        // pixel centre, which their bounding box tells before any edge function is set up.
-        if (ca | cb | cc) & NOT_IN_FRONT_BIT != 0 {
-            return;
-        }
-        let [lo, hi] = bounding_box(indices.map(|i| self.window_xy[i as usize]));
-        if rect.centres_within(lo, hi).is_none() {
-            return;
-        }
-        let snapped = indices.map(|i| self.snapped(i));
-        self.orient(prim, snapped, &mut |tri| self.scan_in(&tri, rect, emit));
+        self.set_up_in(prim, rect, &mut |setup| self.scan_set_up(&setup, emit));
     }
 
     /// The pixels whose centres the bounding boxes of triangle `prim`'s pieces hold: every
@@ -277,7 +272,7 @@ impl<'mesh> View<'mesh> {
             return self.sample_bounds(prim, sampling);
         }
         let indices = self.mesh.triangles[prim as usize];
-        let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
+        let [ca, cb, cc] = indices.map(|i| self.outcode(i));
         let full = self.viewport.rect();
         if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS != 0 {
             let mut bounds: Option<PixelRect> = None;
@@ -292,7 +287,7 @@ impl<'mesh> View<'mesh> {
         if (ca | cb | cc) & NOT_IN_FRONT_BIT != 0 {
             return None;
         }
-        let [lo, hi] = bounding_box(indices.map(|i| self.window_xy[i as usize]));
+        let [lo, hi] = bounding_box(indices.map(|i| self.window[i as usize].position()));
         full.centres_within(lo, hi)
     }
 
@@ -300,7 +295,7 @@ impl<'mesh> View<'mesh> {
     /// is rejected, culled or degenerate).
     pub fn screen_triangles(&self, prim: u32, visit: &mut impl FnMut(ScreenTriangle)) {
         let indices = self.mesh.triangles[prim as usize];
-        let [ca, cb, cc] = indices.map(|i| self.outcodes[i as usize]);
+        let [ca, cb, cc] = indices.map(|i| self.outcode(i));
         // Trivial reject: all three vertices outside one plane.
         if ca & cb & cc != 0 {
             return;
@@ -308,7 +303,9 @@ impl<'mesh> View<'mesh> {
         if (ca | cb | cc) & CLIP_BITS == 0 {
             if (ca | cb | cc) & NOT_IN_FRONT_BIT == 0 {
                 let snapped = indices.map(|i| self.snapped(i));
-                self.orient(prim, snapped, visit);
+                if let Some((tri, _)) = self.oriented(prim, snapped) {
+                    visit(tri);
+                }
             }
             return;
         }
@@ -322,34 +319,39 @@ impl<'mesh> View<'mesh> {
             if piece.iter().any(|v| !in_front(*v)) {
                 continue;
             }
-            self.orient(prim, piece.map(|v| stage.snap(v)), visit);
+            if let Some((tri, _)) = self.oriented(prim, piece.map(|v| stage.snap(v))) {
+                visit(tri);
+            }
         }
     }
 
-    /// Culls or orients a snapped triangle and hands it to `visit`.
-    fn orient(&self, prim: u32, snapped: [Snapped; 3], visit: &mut impl FnMut(ScreenTriangle)) {
+    /// Rule 5: the snapped triangle culled, or oriented so that its doubled signed area is
+    /// positive, with that area; `None` when it is culled or has zero area.
+    #[inline]
+    fn oriented(&self, prim: u32, snapped: [Snapped; 3]) -> Option<(ScreenTriangle, i64)> {
         let [(pa, za), (mut pb, mut zb), (mut pc, mut zc)] = snapped;
         let area = edge(pa, pb, pc);
         if area == 0 {
-            return;
+            return None;
         }
         // In a y-down window a negative area is counter-clockwise as the viewer sees it: a front
         // face under the OpenGL/OBJ convention.
         let front = area < 0;
         match self.cull {
-            CullMode::Back if !front => return,
-            CullMode::Front if front => return,
+            CullMode::Back if !front => return None,
+            CullMode::Front if front => return None,
             _ => {}
         }
-        if area < 0 {
+        if front {
             std::mem::swap(&mut pb, &mut pc);
             std::mem::swap(&mut zb, &mut zc);
         }
-        visit(ScreenTriangle {
+        let triangle = ScreenTriangle {
             prim,
             xy: [pa, pb, pc],
             z: [za, zb, zc],
-        });
+        };
+        Some((triangle, area.abs()))
     }
 
     /// The clip-space position of vertex `index` as the vertex stage computed it (rule 1): what a
@@ -364,7 +366,7 @@ impl<'mesh> View<'mesh> {
     /// or not in front of the eye.
     #[must_use]
     pub fn vertex_window(&self, index: u32) -> Option<([i64; 2], f64)> {
-        let outcode = self.outcodes[index as usize];
+        let outcode = self.outcode(index);
         (outcode & (CLIP_BITS | NOT_IN_FRONT_BIT) == 0).then(|| self.snapped(index))
     }
 }

@@ -1,14 +1,16 @@
 //! PLY loading (ASCII and binary, plain or gzipped), for the Stanford repository's own format.
 //!
-//! Parsing is `ply-rs-bw`'s (a maintained fork of `ply-rs`); gzip is `flate2`'s. Only the `vertex`
-//! element's `x`, `y`, `z` and the `face` element's `vertex_indices` are read; polygons are split
-//! into fans `(v0, vi, vi+1)` as the OBJ loader's triangulation does.
+//! Parsing is `ply-rs-bw`'s (a maintained fork of `ply-rs`); gzip is `flate2`'s. Read are the
+//! `vertex` element's `x`, `y`, `z`, the `face` element's `vertex_indices` (polygons split into
+//! fans `(v0, vi, vi+1)` as the OBJ loader's triangulation does) and the `tristrips` element's
+//! `vertex_indices` (triangle strips, `-1` restarting a strip, as the Stanford scans and the
+//! common test-model collections store them); any other element (edges, materials) is read past.
 
 use std::io::{BufReader, Read};
 use std::path::Path;
 
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{PropertyAccess, PropertyAccessResult};
+use ply_rs_bw::ply::{Encoding, PropertyAccess, PropertyAccessResult};
 
 use crate::mesh::{Mesh, MeshError};
 
@@ -58,6 +60,18 @@ impl PropertyAccess for PlyFace {
     fn new() -> Self {
         Self::default()
     }
+    fn set_list_char(&mut self, name: &str, value: Vec<i8>) -> PropertyAccessResult {
+        self.set(name, value.into_iter().map(i64::from).collect())
+    }
+    fn set_list_uchar(&mut self, name: &str, value: Vec<u8>) -> PropertyAccessResult {
+        self.set(name, value.into_iter().map(i64::from).collect())
+    }
+    fn set_list_short(&mut self, name: &str, value: Vec<i16>) -> PropertyAccessResult {
+        self.set(name, value.into_iter().map(i64::from).collect())
+    }
+    fn set_list_ushort(&mut self, name: &str, value: Vec<u16>) -> PropertyAccessResult {
+        self.set(name, value.into_iter().map(i64::from).collect())
+    }
     fn set_list_int(&mut self, name: &str, value: Vec<i32>) -> PropertyAccessResult {
         self.set(name, value.into_iter().map(i64::from).collect())
     }
@@ -66,12 +80,62 @@ impl PropertyAccess for PlyFace {
     }
 }
 
+/// An element fragsim does not use, read past property by property.
+struct Skipped;
+
+impl PropertyAccess for Skipped {
+    fn new() -> Self {
+        Self
+    }
+}
+
+/// The triangles of a triangle strip `indices` (`-1` ends a strip and starts the next), in
+/// `emit`: triangle `i` of a strip is `(s_i, s_i+1, s_i+2)`, its odd ones turned to
+/// `(s_i+1, s_i, s_i+2)` so that every triangle keeps the strip's winding; a triangle that
+/// repeats a vertex (the degenerate joins strips are stitched with) covers nothing and is left
+/// out.
+fn strip_triangles(indices: &[i64], emit: &mut impl FnMut([i64; 3])) {
+    for strip in indices.split(|&i| i == -1) {
+        for (i, w) in strip.windows(3).enumerate() {
+            let [a, b, c] = [w[0], w[1], w[2]];
+            if a == b || b == c || a == c {
+                continue;
+            }
+            emit(if i % 2 == 0 { [a, b, c] } else { [b, a, c] });
+        }
+    }
+}
+
+/// `ply-rs-bw`'s error on one line. Its text is `Line N: message` with tab-indented detail
+/// lines; a binary payload has no lines (N counts elements read), so there the prefix goes.
+fn one_line(error: &ply_rs_bw::parser::ParseError, binary: bool) -> String {
+    let text = error.to_string();
+    let text = match error.line() {
+        Some(line) if binary => text
+            .strip_prefix(&format!("Line {line}: "))
+            .unwrap_or(&text)
+            .to_string(),
+        Some(line) => format!(
+            "line {line}: {}",
+            text.strip_prefix(&format!("Line {line}: "))
+                .unwrap_or(&text)
+        ),
+        None => text,
+    };
+    text.split(['\n', '\t'])
+        .map(str::trim)
+        .filter(|part| !part.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 impl Mesh {
     /// Loads a PLY file, ASCII or binary, gzipped or not (told by content, not by name).
     ///
     /// # Errors
-    /// A missing or unreadable file, a file the PLY parser rejects, no `vertex` or `face`
-    /// element, a negative or out-of-range index, a non-finite coordinate: each names the file.
+    /// A missing or unreadable file, a file the PLY parser rejects (one line; a binary file's
+    /// error names no line, a truncated one says so), no triangles (neither faces nor strips), a
+    /// negative or out-of-range index, a non-finite coordinate: each names the file.
     pub fn load_ply(path: &Path) -> Result<Self, MeshError> {
         let name = path.display().to_string();
         Self::read_ply(crate::mesh::read_mesh_file(path)?.as_slice(), &name)
@@ -90,40 +154,72 @@ impl Mesh {
         let vertex_parser = Parser::<PlyVertex>::new();
         let header = vertex_parser
             .read_header(&mut reader)
-            .map_err(|e| bad(format!("header: {e}")))?;
+            .map_err(|e| bad(format!("header: {}", one_line(&e, false))))?;
+        let binary = header.encoding != Encoding::Ascii;
+        let payload = |what: &str, e: ply_rs_bw::parser::ParseError, count: usize| {
+            if binary && e.kind() == std::io::ErrorKind::UnexpectedEof {
+                bad(format!(
+                    "the file ends inside its {count} {what} (the header declares more bytes \
+                     than the file holds: a truncated download?)"
+                ))
+            } else {
+                bad(format!("{what}: {}", one_line(&e, binary)))
+            }
+        };
         let mut mesh = Mesh::default();
+        let mut faces: Vec<Vec<i64>> = Vec::new();
+        let mut strips: Vec<Vec<i64>> = Vec::new();
         // Elements come in header order; each must be read (or skipped) in turn.
         for (element_name, element) in &header.elements {
             match element_name.as_str() {
                 "vertex" => {
                     let vertices = vertex_parser
                         .read_payload_for_element(&mut reader, element, &header)
-                        .map_err(|e| bad(format!("vertices: {e}")))?;
+                        .map_err(|e| payload("vertices", e, element.count))?;
                     mesh.positions = vertices.into_iter().map(|v| v.0).collect();
                 }
-                "face" => {
-                    let faces = Parser::<PlyFace>::new()
+                "face" => faces.extend(
+                    Parser::<PlyFace>::new()
                         .read_payload_for_element(&mut reader, element, &header)
-                        .map_err(|e| bad(format!("faces: {e}")))?;
-                    for (face, PlyFace(indices)) in faces.into_iter().enumerate() {
-                        let index = |i: i64| {
-                            u32::try_from(i)
-                                .map_err(|_| bad(format!("face {face} has vertex index {i}")))
-                        };
-                        for k in 1..indices.len().saturating_sub(1) {
-                            mesh.triangles.push([
-                                index(indices[0])?,
-                                index(indices[k])?,
-                                index(indices[k + 1])?,
-                            ]);
-                        }
-                    }
-                }
+                        .map_err(|e| payload("faces", e, element.count))?
+                        .into_iter()
+                        .map(|PlyFace(indices)| indices),
+                ),
+                "tristrips" => strips.extend(
+                    Parser::<PlyFace>::new()
+                        .read_payload_for_element(&mut reader, element, &header)
+                        .map_err(|e| payload("triangle strips", e, element.count))?
+                        .into_iter()
+                        .map(|PlyFace(indices)| indices),
+                ),
                 other => {
-                    return Err(bad(format!(
-                        "unsupported PLY element {other:?} (only vertex and face are read)"
-                    )));
+                    Parser::<Skipped>::new()
+                        .read_payload_for_element(&mut reader, element, &header)
+                        .map_err(|e| payload(&format!("{other:?} elements"), e, element.count))?;
                 }
+            }
+        }
+        let index = |what: &str, n: usize, i: i64| {
+            u32::try_from(i).map_err(|_| bad(format!("{what} {n} has vertex index {i}")))
+        };
+        for (face, indices) in faces.iter().enumerate() {
+            for k in 1..indices.len().saturating_sub(1) {
+                mesh.triangles.push([
+                    index("face", face, indices[0])?,
+                    index("face", face, indices[k])?,
+                    index("face", face, indices[k + 1])?,
+                ]);
+            }
+        }
+        for (strip, indices) in strips.iter().enumerate() {
+            let mut triangles = Vec::new();
+            strip_triangles(indices, &mut |t| triangles.push(t));
+            for [a, b, c] in triangles {
+                mesh.triangles.push([
+                    index("triangle strip", strip, a)?,
+                    index("triangle strip", strip, b)?,
+                    index("triangle strip", strip, c)?,
+                ]);
             }
         }
         if mesh.triangles.is_empty() {

@@ -6,9 +6,10 @@ use std::path::Path;
 
 use crate::camera::{Camera, OrbitCamera};
 use crate::conventions::{Conventions, DepthRange};
-use crate::mesh::{is_ply, read_mesh_file, Mesh, MeshError};
+use crate::mesh::{is_ply, read_mesh_file, Mesh, MeshError, UpAxis};
 use crate::pipeline::{CullMode, View, Viewport};
 use crate::rng::SplitMix64;
+use glam::{DMat4, DVec4};
 
 /// The name of the embedded default scene.
 pub const DEFAULT_SCENE_NAME: &str = "bunny";
@@ -172,6 +173,35 @@ impl Scene {
     ) -> Camera {
         let aspect = f64::from(viewport.width) / f64::from(viewport.height);
         orbit.camera_for(self.mesh.bounds(), aspect, depth_range)
+    }
+
+    /// [`Scene::orbit_camera`] around the model stood on its `up` axis: the orbit of the model
+    /// turned onto +y ([`UpAxis::turn`]), the turn folded into the matrix, so the mesh, its
+    /// primitive ids and its file stay as they are. For [`UpAxis::Y`], exactly
+    /// [`Scene::orbit_camera`].
+    #[must_use]
+    pub fn orbit_camera_up(
+        &self,
+        viewport: Viewport,
+        orbit: &OrbitCamera,
+        depth_range: DepthRange,
+        up: UpAxis,
+    ) -> Camera {
+        if up == UpAxis::Y {
+            return self.orbit_camera(viewport, orbit, depth_range);
+        }
+        let aspect = f64::from(viewport.width) / f64::from(viewport.height);
+        let turned = orbit.camera_for(up.turn_bounds(self.mesh.bounds()), aspect, depth_range);
+        let rows = up.rows();
+        let turn = DMat4::from_cols(
+            DVec4::new(rows[0][0], rows[1][0], rows[2][0], 0.0),
+            DVec4::new(rows[0][1], rows[1][1], rows[2][1], 0.0),
+            DVec4::new(rows[0][2], rows[1][2], rows[2][2], 0.0),
+            DVec4::W,
+        );
+        Camera {
+            view_projection: turned.view_projection * turn,
+        }
     }
 
     /// This scene through any camera on a viewport under `conventions`, all faces kept.

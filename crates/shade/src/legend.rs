@@ -166,6 +166,42 @@ pub fn nearest_depth_with_key(
     })
 }
 
+/// `figure` with `caption` in a strip below it (the scene, the view, the scheme: what a picture
+/// shows, in the picture), its words wrapped to the figure's width.
+///
+/// # Errors
+/// Text cannot be drawn (a font error).
+pub fn captioned(figure: &RgbImage, caption: &str) -> Result<RgbImage, String> {
+    const LINE: u32 = 17;
+    // The embedded font's 13-pixel glyphs average under 7 pixels.
+    let per_line = (figure.width().saturating_sub(12) / 7).max(16) as usize;
+    let mut lines: Vec<String> = Vec::new();
+    for word in caption.split(' ') {
+        match lines.last_mut() {
+            Some(line) if line.chars().count() + 1 + word.chars().count() <= per_line => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    let (w, h) = figure.dimensions();
+    let size = (w, h + 8 + LINE * lines.len() as u32);
+    crate::plot::register_font();
+    let mut out = RgbImage::from_pixel(size.0, size.1, Rgb([255, 255, 255]));
+    for (x, y, p) in figure.enumerate_pixels() {
+        out.put_pixel(x, y, *p);
+    }
+    {
+        let root = BitMapBackend::with_buffer(&mut out, size).into_drawing_area();
+        for (i, line) in lines.iter().enumerate() {
+            text(&root, line, (6, (h + 4 + LINE * i as u32) as i32), 13)?;
+        }
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(out)
+}
+
 /// How many differing pixels get a zoomed inset.
 pub const INSETS: usize = 4;
 /// Pixels of the picture on each side of an inset's centre.
@@ -215,15 +251,23 @@ pub fn difference_figure(
         if marks.is_empty() {
             text(area, "no differing pixel", (x0, note_y), 13)?;
         } else if ring {
-            text(area, "rings: first differing pixels", (x0, note_y), 13)?;
+            text(
+                area,
+                "white rings: first differing pixels",
+                (x0, note_y),
+                13,
+            )?;
         }
+        // White edged in black: a colour no legend entry uses, seen on dark and bright pixels.
         for &(x, y) in marks.iter().filter(|_| ring) {
-            area.draw(&Circle::new(
-                (x as i32, y as i32),
-                9,
-                RGBColor(255, 0, 255).stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?;
+            for (radius, colour, stroke) in [(10, BLACK, 4), (10, WHITE, 2)] {
+                area.draw(&Circle::new(
+                    (x as i32, y as i32),
+                    radius,
+                    colour.stroke_width(stroke),
+                ))
+                .map_err(|e| e.to_string())?;
+            }
         }
         for (i, &(x, y)) in marks.iter().take(INSETS).enumerate() {
             let left = i as i32 * (side as i32 + 12) + 4;
@@ -265,10 +309,14 @@ pub fn difference_figure(
             INSET_RADIUS * INSET_ZOOM,
             (INSET_RADIUS + 1) * INSET_ZOOM - 1,
         );
-        for t in c0..=c1 {
-            for (x, y) in [(t, c0), (t, c1), (c0, t), (c1, t)] {
-                if left + x < out.width() && top + y < out.height() {
-                    out.put_pixel(left + x, top + y, Rgb([255, 0, 255]));
+        // The centre pixel outlined as the rings are: white inside, black around it.
+        for (inset, colour) in [(1, Rgb([0, 0, 0])), (0, Rgb([255, 255, 255]))] {
+            let (lo, hi) = (c0 - inset, c1 + inset);
+            for t in lo..=hi {
+                for (x, y) in [(t, lo), (t, hi), (lo, t), (hi, t)] {
+                    if left + x < out.width() && top + y < out.height() {
+                        out.put_pixel(left + x, top + y, colour);
+                    }
                 }
             }
         }

@@ -67,20 +67,147 @@ pub fn pareto_front(points: &[Point]) -> Vec<usize> {
     front
 }
 
+/// Series and point colours: the tab10 palette with its pale entries (pink, grey, olive, cyan)
+/// darkened, so that each reads on white, as a line or a marker.
 fn palette(i: usize) -> RGBColor {
     const COLOURS: [RGBColor; 10] = [
         RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
+        RGBColor(230, 110, 0),
         RGBColor(44, 160, 44),
         RGBColor(214, 39, 40),
         RGBColor(148, 103, 189),
         RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(127, 127, 127),
-        RGBColor(188, 189, 34),
-        RGBColor(23, 190, 207),
+        RGBColor(200, 60, 160),
+        RGBColor(90, 90, 90),
+        RGBColor(140, 140, 0),
+        RGBColor(0, 140, 160),
     ];
     COLOURS[i % COLOURS.len()]
+}
+
+/// The scheme families, in the order of their markers ([`Marker::of_family`]): a family keeps
+/// its marker on every chart, whichever families a chart holds.
+pub const FAMILIES: [&str; 7] = [
+    "mdts",
+    "a-buffer",
+    "peeling",
+    "k-buffer",
+    "bucket",
+    "approximate",
+    "other",
+];
+
+/// A point's marker shape: seven shapes told apart at a glance, filled or hollow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marker {
+    /// A filled disc.
+    Disc,
+    /// A filled square.
+    Square,
+    /// A filled triangle.
+    Triangle,
+    /// A diagonal cross.
+    Cross,
+    /// A ring (hollow disc).
+    Ring,
+    /// A hollow triangle.
+    HollowTriangle,
+    /// A hollow square.
+    HollowSquare,
+}
+
+impl Marker {
+    /// Every marker, in [`FAMILIES`] order.
+    pub const ALL: [Self; 7] = [
+        Self::Disc,
+        Self::Square,
+        Self::Triangle,
+        Self::Cross,
+        Self::Ring,
+        Self::HollowTriangle,
+        Self::HollowSquare,
+    ];
+
+    /// The marker of `family` (one of [`FAMILIES`]; any other is drawn as `other`).
+    #[must_use]
+    pub fn of_family(family: &str) -> Self {
+        let at = FAMILIES.iter().position(|&f| f == family);
+        Self::ALL[at.unwrap_or(FAMILIES.len() - 1)]
+    }
+
+    /// Draws the marker centred at `at`.
+    fn draw<DB: DrawingBackend>(
+        self,
+        area: &DrawingArea<DB, Shift>,
+        at: (i32, i32),
+        colour: RGBColor,
+    ) -> DrawResult<DB> {
+        let (x, y) = at;
+        let (filled, line) = (colour.filled(), colour.stroke_width(2));
+        let square = [(x - 5, y - 5), (x + 5, y + 5)];
+        match self {
+            Self::Disc => area.draw(&Circle::new(at, 6, filled)),
+            Self::Ring => area.draw(&Circle::new(at, 6, line)),
+            Self::Square => area.draw(&Rectangle::new(square, filled)),
+            Self::HollowSquare => area.draw(&Rectangle::new(square, line)),
+            Self::Triangle => area.draw(&TriangleMarker::new(at, 7, filled)),
+            Self::HollowTriangle => area.draw(&PathElement::new(
+                vec![(x, y - 7), (x + 6, y + 4), (x - 6, y + 4), (x, y - 7)],
+                line,
+            )),
+            Self::Cross => area.draw(&Cross::new(at, 6, colour.stroke_width(3))),
+        }
+    }
+}
+
+/// Tick values for a log axis over `lo..hi` (both positive): the 1-2-5 values of each decade
+/// inside the range, or every unit of the leading digit (1, 2, 3, … 9) where fewer than four
+/// of those fall inside: a narrow range still gets several labelled ticks.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (first..=last)
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let coarse = within(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 4 {
+        return coarse;
+    }
+    within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+}
+
+/// A tick value as a person writes it: `20`, `1.5`, `0.02`.
+fn tick_label(v: &f64) -> String {
+    let digits = (2 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+    let text = format!("{v:.digits$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+/// Where to write each label of `anchors` (pixel positions of points) so that no two overlap:
+/// up and to the right of its point, else moved up a line at a time past the labels already
+/// placed. `widths` are the labels' widths in pixels, `line` their height.
+fn place_labels(anchors: &[(i32, i32)], widths: &[i32], line: i32) -> Vec<(i32, i32)> {
+    let mut placed: Vec<(i32, i32, i32)> = Vec::new();
+    anchors
+        .iter()
+        .zip(widths)
+        .map(|(&(x, y), &w)| {
+            let (left, mut top) = (x + 7, y - 16);
+            while placed.iter().any(|&(l, t, pw)| {
+                left < l + pw && l < left + w && top < t + line && t < top + line
+            }) {
+                top -= line;
+            }
+            placed.push((left, top, w));
+            (left, top)
+        })
+        .collect()
 }
 
 fn range(values: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
@@ -241,20 +368,30 @@ fn draw<DB: DrawingBackend>(
                     + Text::new(name.clone(), (9, -16), font.clone())
             }))?;
         } else {
-            // A dot at every measured point: the lines only join them.
-            chart.draw_series(data.iter().map(|&p| Circle::new(p, 3, style.filled())))?;
+            // A marker of the series' own shape at every measured point (series of equal values
+            // drawn over each other still show both shapes); the lines only join them.
             chart.draw_series(LineSeries::new(data.iter().copied(), style))?;
+            let shape = series_marker(i);
+            for &p in data {
+                shape.draw(root, chart.backend_coord(&p), colour)?;
+            }
         }
     }
     draw_legend(&legend_area, &names)?;
     root.present()
 }
 
+/// The marker of line series `i`: the shapes in turn, so neighbouring series differ in shape as
+/// well as colour.
+fn series_marker(i: usize) -> Marker {
+    Marker::ALL[i % Marker::ALL.len()]
+}
+
 /// Pixels the legend column takes: room for the longest name at the legend's font size.
 fn legend_width(names: &[&str]) -> u32 {
     let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
-    // About 7 pixels a character at 13 px, plus the colour swatch and margins.
-    (longest as u32 * 7 + 56).min(400)
+    // About 7 pixels a character at 13 px, plus the marker and margins.
+    (longest as u32 * 7 + 60).min(400)
 }
 
 /// The series' colours and names, one a row, from the top of `area`.
@@ -267,25 +404,29 @@ fn draw_legend<DB: DrawingBackend>(
         let y = 48 + 20 * i as i32;
         let colour = palette(i);
         area.draw(&PathElement::new(
-            vec![(8, y), (28, y)],
-            colour.stroke_width(3),
+            vec![(6, y), (30, y)],
+            colour.stroke_width(2),
         ))?;
-        area.draw(&Circle::new((18, y), 3, colour.filled()))?;
-        area.draw(&Text::new(name.to_string(), (34, y - 7), font.clone()))?;
+        series_marker(i).draw(area, (18, y), colour)?;
+        area.draw(&Text::new(name.to_string(), (38, y - 7), font.clone()))?;
     }
     Ok(())
 }
 
-/// The speed/accuracy chart's size: the chart, and the table of its points beside it.
+/// The speed/accuracy chart's least size: the chart, and the table of its points beside it
+/// (taller where the table needs it).
 const WIDE: (u32, u32) = (1280, 640);
 
-/// Pixels between the lines of the speed/accuracy chart's legend.
+/// Width of the column beside the chart: the table, then the legend.
+const TABLE_WIDTH: u32 = 440;
+
+/// Pixels between the lines of the table and of the legend (13-pixel text).
 const LEGEND_LINE: i32 = 20;
 
 /// The speed/accuracy chart of `points`: frame time on a log axis, the error-pixel rate in
-/// percent, one marker shape a family, each point numbered and listed in a table beside the
-/// chart (labels beside points collide when many schemes are exact), and the Pareto front (the
-/// points nothing beats on both) joined by a line.
+/// percent on another, one marker shape a family ([`Marker::of_family`], the same on every
+/// chart), each point numbered (the numbers moved apart where points crowd) and listed in a table
+/// beside the chart, and the Pareto front (the points nothing beats on both) joined by a line.
 ///
 /// # Errors
 /// The file cannot be written.
@@ -295,9 +436,13 @@ pub fn speed_accuracy(
     x_label: &str,
     points: &[Point],
 ) -> Result<(), String> {
+    let families = families(points).len() as i32;
+    // The table's rows, the legend's (the Pareto line, a family a line) and the note under them.
+    let column = 40 + LEGEND_LINE * (points.len() as i32 + 1) + LEGEND_LINE * (families + 2) + 40;
+    let size = (WIDE.0, WIDE.1.max(column as u32));
     render(
         path,
-        WIDE,
+        size,
         &SpeedAccuracy {
             title,
             x_label,
@@ -312,45 +457,23 @@ struct SpeedAccuracy<'a> {
     points: &'a [Point],
 }
 
-/// The families in order of first appearance: a family's index picks its marker.
+/// The families of `points`, in [`FAMILIES`] order: the legend's rows.
 fn families(points: &[Point]) -> Vec<&'static str> {
-    let mut seen = Vec::new();
+    let mut present: Vec<&'static str> = Vec::new();
     for p in points {
-        if !seen.contains(&p.family) {
-            seen.push(p.family);
+        if !present.contains(&p.family) {
+            present.push(p.family);
         }
     }
-    seen
-}
-
-/// Marker `shape` (0 circle, 1 triangle, 2 square, 3 cross, then filled/hollow variants) at `at`.
-fn marker<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    at: (i32, i32),
-    shape: usize,
-    colour: RGBColor,
-) -> DrawResult<DB> {
-    let filled = shape < 4;
-    let style = if filled {
-        colour.filled()
-    } else {
-        colour.stroke_width(2)
-    };
-    match shape % 4 {
-        0 => area.draw(&Circle::new(at, 6, style)),
-        1 => area.draw(&TriangleMarker::new(at, 7, style)),
-        2 => area.draw(&Rectangle::new(
-            [(at.0 - 5, at.1 - 5), (at.0 + 5, at.1 + 5)],
-            style,
-        )),
-        _ => area.draw(&Cross::new(at, 6, colour.stroke_width(3))),
-    }
+    present.sort_by_key(|&f| FAMILIES.iter().position(|&known| known == f));
+    present
 }
 
 impl Paint for SpeedAccuracy<'_> {
     fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         root.fill(&WHITE)?;
-        let (left, right) = root.split_horizontally(WIDE.0 - 400);
+        let (width, height) = root.dim_in_pixel();
+        let (left, right) = root.split_horizontally(width - TABLE_WIDTH);
         let times = self.points.iter().map(|p| p.time_ms.max(1e-3));
         let lo = times.clone().fold(f64::INFINITY, f64::min);
         let hi = times.fold(f64::NEG_INFINITY, f64::max);
@@ -370,28 +493,46 @@ impl Paint for SpeedAccuracy<'_> {
             1e-3
         };
         let y = |rate: f64| (rate * 100.0).max(floor);
+        let (y_lo, y_hi) = (floor * 0.7, top);
         let mut chart = ChartBuilder::on(&left)
             .caption(self.title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(72)
-            .build_cartesian_2d((lo..hi).log_scale(), (floor * 0.7..top).log_scale())?;
-        let whole = |v: &f64| format!("{v:.0}");
+            .build_cartesian_2d(
+                (lo..hi).log_scale().with_key_points(log_ticks(lo, hi)),
+                (y_lo..y_hi).log_scale().with_key_points(
+                    std::iter::once(floor)
+                        .chain(log_ticks(y_lo, y_hi).into_iter().filter(|&t| t > floor))
+                        .collect(),
+                ),
+            )?;
+        // The floor's tick names what it stands for: a rate of 0, not of `floor` %.
+        let rate_label = |v: &f64| {
+            if (v / floor - 1.0).abs() < 1e-9 {
+                "0 (exact)".to_string()
+            } else {
+                tick_label(v)
+            }
+        };
         chart
             .configure_mesh()
             .x_desc(self.x_label)
             .y_desc("EPR (% of covered pixels, log scale)")
-            .x_labels(6)
-            .y_labels(8)
-            .x_label_formatter(&whole)
+            .x_label_formatter(&tick_label)
+            .y_label_formatter(&rate_label)
             .light_line_style(WHITE)
+            .bold_line_style(BLACK.mix(0.08))
             .label_style(("sans-serif", 14))
             .draw()?;
-        // The floor line's meaning is written in the table's column, under the table, where no
+        // The floor line, across the plot; its meaning is written under the table, where no
         // point's number can land on it (the fastest exact points sit on this line).
-        let bottom = chart.backend_coord(&(lo, floor));
+        let (floor_start, floor_end) = (
+            chart.backend_coord(&(lo, floor)),
+            chart.backend_coord(&(hi, floor)),
+        );
         root.draw(&PathElement::new(
-            vec![bottom, (bottom.0 + (WIDE.0 as i32 - 520), bottom.1)],
+            vec![floor_start, floor_end],
             BLACK.mix(0.3).stroke_width(1),
         ))?;
         let front = pareto_front(self.points);
@@ -401,71 +542,80 @@ impl Paint for SpeedAccuracy<'_> {
                 .map(|&i| (self.points[i].time_ms.max(1e-3), y(self.points[i].rate))),
             BLACK.mix(0.5).stroke_width(2),
         ))?;
-        let families = families(self.points);
+        let anchors: Vec<(i32, i32)> = self
+            .points
+            .iter()
+            .map(|p| chart.backend_coord(&(p.time_ms.max(1e-3), y(p.rate))))
+            .collect();
+        // The numbers: 7 pixels a digit at 13 px, moved up where they would overprint.
+        let widths: Vec<i32> = (1..=self.points.len())
+            .map(|n| 7 * n.to_string().len() as i32 + 2)
+            .collect();
+        let labels = place_labels(&anchors, &widths, 14);
+        let number_font = ("sans-serif", 13).into_font();
         for (i, p) in self.points.iter().enumerate() {
-            let at = chart.backend_coord(&(p.time_ms.max(1e-3), y(p.rate)));
-            let shape = families.iter().position(|&f| f == p.family).unwrap_or(0);
-            let colour = palette(i);
-            marker(root, at, shape, colour)?;
+            Marker::of_family(p.family).draw(root, anchors[i], palette(i))?;
             root.draw(&Text::new(
                 (i + 1).to_string(),
-                (at.0 + 7, at.1 - 16),
-                ("sans-serif", 12).into_font().color(&colour),
+                labels[i],
+                number_font.clone(),
             ))?;
         }
-        // The legend in the column beside the chart, under the table (drawn inside the chart, it
-        // hid the points of slow, inaccurate schemes): the Pareto line, then a marker a family.
-        let legend_top = WIDE.1 as i32 - 40 - LEGEND_LINE * (families.len() as i32 + 1);
-        let legend_font = ("sans-serif", 13).into_font();
-        right.draw(&PathElement::new(
-            vec![(6, legend_top), (22, legend_top)],
-            BLACK.mix(0.5).stroke_width(2),
-        ))?;
+        // The table beside the chart: number, marker, scheme, time, EPR, mean error; Pareto
+        // points starred. Black 13-pixel text (a colour would be pale on white); the marker in
+        // the point's colour ties the row to its point.
+        let font = ("sans-serif", 13).into_font();
         right.draw(&Text::new(
-            "Pareto front (nothing is both faster and more accurate)",
-            (30, legend_top - 7),
-            legend_font.clone(),
-        ))?;
-        for (f, family) in families.iter().enumerate() {
-            let at = legend_top + LEGEND_LINE * (f as i32 + 1);
-            marker(&right, (14, at), f, BLACK)?;
-            right.draw(&Text::new(
-                format!("family {family}"),
-                (30, at - 7),
-                legend_font.clone(),
-            ))?;
-        }
-        // The table: number, scheme, time, EPR, mean error; Pareto points starred; above the
-        // legend.
-        let rows = self.points.len().max(1) as i32;
-        let line = ((legend_top - 40) / (rows + 1)).clamp(8, 20);
-        let size = (line - 4).clamp(8, 14);
-        let font = ("sans-serif", size).into_font();
-        right.draw(&Text::new(
-            "#  scheme  time ms  EPR %  mean err  (* Pareto)",
+            "#      scheme   time ms   EPR %   mean err   (* Pareto)",
             (4, 14),
             font.clone(),
         ))?;
         for (i, p) in self.points.iter().enumerate() {
-            let y = 14 + line * (i as i32 + 1);
-            let star = if front.contains(&i) { "*" } else { " " };
+            let row = 14 + LEGEND_LINE * (i as i32 + 1);
+            let star = if front.contains(&i) { "*" } else { "" };
+            right.draw(&Text::new(
+                format!("{}{star}", i + 1),
+                (4, row),
+                font.clone(),
+            ))?;
+            Marker::of_family(p.family).draw(&right, (38, row + 7), palette(i))?;
             right.draw(&Text::new(
                 format!(
-                    "{}{star} {}  {:.2}  {:.3}  {}",
-                    i + 1,
+                    "{}   {:.2}   {:.3}   {}",
                     p.label,
                     p.time_ms,
                     p.rate * 100.0,
                     p.mean_error.map_or("n/a".into(), |e| format!("{e:.3}"))
                 ),
-                (4, y),
-                font.clone().color(&palette(i)),
+                (50, row),
+                font.clone(),
+            ))?;
+        }
+        // The legend under the table: the Pareto line, then the marker of each family shown.
+        let families = families(self.points);
+        let legend_top = 14 + LEGEND_LINE * (self.points.len() as i32 + 2) + 7;
+        right.draw(&PathElement::new(
+            vec![(6, legend_top), (30, legend_top)],
+            BLACK.mix(0.5).stroke_width(2),
+        ))?;
+        right.draw(&Text::new(
+            "Pareto front (nothing is both faster and more accurate)",
+            (38, legend_top - 7),
+            font.clone(),
+        ))?;
+        for (f, family) in families.iter().enumerate() {
+            let at = legend_top + LEGEND_LINE * (f as i32 + 1);
+            Marker::of_family(family).draw(&right, (18, at), BLACK)?;
+            right.draw(&Text::new(
+                format!("family {family}"),
+                (38, at - 7),
+                font.clone(),
             ))?;
         }
         right.draw(&Text::new(
             "EPR 0 (exact) is drawn on the chart's grey floor line",
-            (4, WIDE.1 as i32 - 16),
-            ("sans-serif", 13).into_font().color(&BLACK.mix(0.7)),
+            (4, height as i32 - 20),
+            font.color(&BLACK.mix(0.8)),
         ))?;
         root.present()
     }
@@ -509,8 +659,42 @@ mod tests {
                 .filter(|&(x, y)| image.get_pixel(x, y).0.iter().all(|&c| c < 100))
                 .count()
         };
-        assert_eq!(dark(500..860, 45..130), 0, "something dark over the plot");
-        assert!(dark(880..1280, 500..600) > 50, "no legend under the table");
+        assert_eq!(dark(500..830, 45..130), 0, "something dark over the plot");
+        // Two rows of the table, then the legend under them.
+        assert!(dark(880..1280, 90..170) > 50, "no legend under the table");
+    }
+
+    #[test]
+    fn every_family_has_a_marker_of_its_own() {
+        let markers: Vec<super::Marker> = super::FAMILIES
+            .iter()
+            .map(|f| super::Marker::of_family(f))
+            .collect();
+        for (i, m) in markers.iter().enumerate() {
+            assert!(!markers[..i].contains(m), "{m:?} twice");
+        }
+        assert_eq!(
+            super::Marker::of_family("unknown"),
+            super::Marker::of_family("other")
+        );
+    }
+
+    #[test]
+    fn a_narrow_log_axis_still_gets_several_ticks_and_crowded_labels_move_apart() {
+        // 4.4 to 21 ms: a single decade mark (10) before; now 5, 6, … 20.
+        let ticks = super::log_ticks(4.4, 21.0);
+        assert!(ticks.len() >= 4, "{ticks:?}");
+        assert!(ticks.iter().all(|t| (4.4..=21.0).contains(t)));
+        assert_eq!(super::tick_label(&20.0), "20");
+        assert_eq!(super::tick_label(&0.05), "0.05");
+        assert_eq!(super::tick_label(&1.5), "1.5");
+        // Three points on one spot: their labels are stacked, none over another.
+        let placed = super::place_labels(&[(100, 100); 3], &[9, 9, 16], 14);
+        for (i, a) in placed.iter().enumerate() {
+            for b in &placed[..i] {
+                assert!((a.1 - b.1).abs() >= 14, "{placed:?}");
+            }
+        }
     }
 
     #[test]

@@ -22,6 +22,7 @@
 
 use std::cell::{Cell, RefCell};
 use std::fmt;
+use std::time::{Duration, Instant};
 
 use fragsim_capture::Guarantee;
 use fragsim_oracle::compare::{verdict, Comparison};
@@ -74,8 +75,11 @@ pub struct Counterexample {
     pub comparison: Option<Comparison>,
     /// The oracle's fragments in the submitted case.
     pub fragments: usize,
-    /// The cases checked before the failure (the failing one included).
+    /// The cases checked before the failure (the failing one included; in a shard, its own).
     pub cases_run: u32,
+    /// The failing case's number among the cases generated from the seed (from 1): the same
+    /// in a shard as in the unsharded run.
+    pub case_number: u32,
     /// The simplifications proptest tried while shrinking.
     pub shrink_steps: u32,
 }
@@ -103,7 +107,7 @@ pub enum Failure {
 /// A battery that passed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Passed {
-    /// Cases checked.
+    /// Cases checked (in a shard, its own).
     pub cases: u32,
     /// The claim checked.
     pub claim: Guarantee,
@@ -127,7 +131,11 @@ pub struct Battery<'b> {
     cases: u32,
     seed: u64,
     max_shrink_iters: u32,
+    shard: (u32, u32),
 }
+
+/// How long proptest's shrinking may run the backend, as proptest's own default (2 minutes).
+const SHRINK_TIME: Duration = Duration::from_secs(120);
 
 /// Why a case stopped the battery.
 enum Stop {
@@ -159,7 +167,18 @@ impl<'b> Battery<'b> {
             cases: 64,
             seed: 0,
             max_shrink_iters: 2048,
+            shard: (1, 1),
         }
+    }
+
+    /// Checks only shard `index` of `count` (from 1): of the cases generated from the seed,
+    /// case `n` (from 1) when `(n − 1) mod count = index − 1`. Every shard generates the same
+    /// cases, so the shards of one seed and case count are disjoint and together the unsharded
+    /// run, case for case. A failing case is shrunk as in an unsharded run.
+    #[must_use]
+    pub fn shard(mut self, index: u32, count: u32) -> Self {
+        self.shard = (index.clamp(1, count.max(1)), count.max(1));
+        self
     }
 
     /// Checks `claim` instead of the backend's own (e.g. a k-buffer port that claims exactness).
@@ -232,28 +251,51 @@ impl<'b> Battery<'b> {
         }
         let mut seed = [0u8; 32];
         seed[..8].copy_from_slice(&self.seed.to_le_bytes());
+        // proptest prints "Aborting shrinking after …" on stderr whenever it reaches its own
+        // caps, whatever its verbosity: they are set out of reach, and the battery keeps its
+        // own (`max_shrink_iters` backend runs, `SHRINK_TIME`), past which every simplification
+        // is answered "passes" without running the backend, so proptest's shrinking winds down
+        // quietly on the last failing case. 0 still disables shrinking.
         let config = Config {
             cases: self.cases,
             failure_persistence: None,
-            max_shrink_iters: self.max_shrink_iters,
-            max_shrink_time: 120_000,
+            max_shrink_iters: if self.max_shrink_iters == 0 {
+                0
+            } else {
+                u32::MAX - 1
+            },
+            max_shrink_time: 0,
             ..Config::default()
         };
+        let shrink_start = Cell::new(None::<Instant>);
         let mut runner =
             TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
         let events = RefCell::new(on_event);
         let (cases_run, shrink_steps) = (Cell::new(0u32), Cell::new(0u32));
         let last_found = RefCell::new(None);
         let setup = RefCell::new(None);
+        let generated = Cell::new(0u32);
+        let (shard, shards) = self.shard;
         let result = runner.run(&case(self.case_limits()).boxed(), |case| {
             // A backend that cannot run fails every case alike: stop at once, shrink nothing.
             if setup.borrow().is_some() {
                 return Ok(());
             }
             if last_found.borrow().is_none() {
+                generated.set(generated.get() + 1);
+                // Another shard's case: generated (so the cases after it are the same in every
+                // shard), not checked.
+                if (generated.get() - 1) % shards != shard - 1 {
+                    return Ok(());
+                }
                 cases_run.set(cases_run.get() + 1);
                 (events.borrow_mut())(Event::Case(cases_run.get()));
             } else {
+                let started = shrink_start.get().unwrap_or_else(Instant::now);
+                shrink_start.set(Some(started));
+                if shrink_steps.get() >= self.max_shrink_iters || started.elapsed() > SHRINK_TIME {
+                    return Ok(());
+                }
                 shrink_steps.set(shrink_steps.get() + 1);
                 (events.borrow_mut())(Event::Shrink(shrink_steps.get()));
             }
@@ -275,7 +317,7 @@ impl<'b> Battery<'b> {
         }
         match result {
             Ok(()) => Ok(Passed {
-                cases: self.cases,
+                cases: cases_run.get(),
                 claim,
             }),
             Err(TestError::Fail(reason, case)) => {
@@ -299,6 +341,7 @@ impl<'b> Battery<'b> {
                     comparison: found.comparison,
                     fragments: found.fragments,
                     cases_run: cases_run.get(),
+                    case_number: generated.get(),
                     shrink_steps: shrink_steps.get(),
                 })))
             }

@@ -143,6 +143,16 @@ impl CommandBackend {
                 BackendError::Failed(message)
             });
         }
+        // A command that succeeds and writes nothing at all is not failing on this case: it is
+        // not writing where `{out}` says (every case would fail alike, and shrinking would only
+        // run it again and again).
+        if fs::read_dir(&out).map_or(true, |mut entries| entries.next().is_none()) {
+            return Err(BackendError::Setup(format!(
+                "`{line}` exited 0 but wrote nothing into {} (its {{out}}): a backend writes its \
+                 dump there, header.json and its arrays (docs/dump-format.md)",
+                out.display()
+            )));
+        }
         Dump::read(&out).map_err(|e| BackendError::Failed(format!("the backend's dump: {e}")))
     }
 

@@ -58,7 +58,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             fragsim()
                 .args(["compare", "oracle"])
                 .arg(dumps.join(scheme))
-                .args(["--json", "--no-image"]),
+                .args(["--json", "--no-images"]),
             0,
         );
         assert_eq!(
@@ -72,7 +72,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             .arg("compare")
             .arg(dumps.join("abuffer"))
             .arg(dumps.join("mdts"))
-            .arg("--no-image"),
+            .arg("--no-images"),
         0,
     );
     assert!(text.contains("EQUAL (bit-identical)"), "{text}");
@@ -98,7 +98,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(dumps.join("mdts"))
-            .args(["--json", "--no-image"]),
+            .args(["--json", "--no-images"]),
         1,
     );
     let records = crate::support::json_lines(json.as_bytes());
@@ -114,14 +114,14 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
     );
 }
 
-/// Runs `fragsim compare oracle DIR --json --no-image` expecting exit code `code`; the records
+/// Runs `fragsim compare oracle DIR --json --no-images` expecting exit code `code`; the records
 /// (the `compare` record, then one `difference` record per pixel shown).
 pub(super) fn json_report(dir: &Path, code: i32) -> Vec<serde_json::Value> {
     let out = stdout_of(
         fragsim()
             .args(["compare", "oracle"])
             .arg(dir)
-            .args(["--json", "--no-image"]),
+            .args(["--json", "--no-images"]),
         code,
     );
     crate::support::json_lines(out.as_bytes())
@@ -169,7 +169,7 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
             fragsim()
                 .args(["compare", "oracle"])
                 .arg(&path)
-                .arg("--no-image"),
+                .arg("--no-images"),
             1,
         );
         let x = pixel % WIDTH as usize;
@@ -219,7 +219,7 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
         fragsim()
             .args(["compare", "oracle"])
             .arg(&path)
-            .arg("--no-image"),
+            .arg("--no-images"),
         1,
     );
     assert!(
@@ -252,6 +252,66 @@ fn the_binary_exports_the_triangles_of_the_view_it_names() {
     assert!(text.contains("screen triangles"), "{text}");
     let read = TriangleExport::read(&file).unwrap();
     with_view(|view, _| assert_eq!(read, TriangleExport::from_view(view, spec())));
+}
+
+/// Issue 36: `export-scene` takes `render`'s convention flags, records them in its scene, and
+/// writes the view a backend under them rasterizes (its size in pixels at several samples).
+#[test]
+fn the_export_takes_renders_conventions() {
+    let dir = scratch("export-conventions");
+    let export = |name: &str, conventions: &[&str]| {
+        let file = dir.join(name);
+        let text = stdout_of(
+            fragsim()
+                .args(["export-scene", "--scene", SCENE])
+                .args(SIZE)
+                .args(conventions)
+                .arg("--out")
+                .arg(&file),
+            0,
+        );
+        assert!(text.contains("binary FRAGTRI1"), "{text}");
+        TriangleExport::read(&file).unwrap()
+    };
+    let reference = export("reference.tri", &[]);
+    let gl = export(
+        "gl.tri",
+        &[
+            "--window-origin",
+            "lower-left",
+            "--depth-range",
+            "minus-one-to-one",
+            "--subpixel-bits",
+            "4",
+            "--vertex-precision",
+            "f32",
+            "--samples",
+            "4",
+        ],
+    );
+    let declared = gl.scene.conventions;
+    assert_eq!(
+        serde_json::to_value(declared).unwrap(),
+        serde_json::json!({"window_origin": "lower-left", "subpixel_bits": 4,
+            "depth_range": "minus-one-to-one", "vertex_precision": "f32", "samples": 4})
+    );
+    assert_eq!((gl.width, gl.height), (WIDTH, super::HEIGHT));
+    let scene = fragsim::raster::Scene::procedural(SCENE).unwrap();
+    let view = gl
+        .scene
+        .view(
+            &scene,
+            fragsim::raster::Viewport::new(WIDTH, super::HEIGHT).unwrap(),
+        )
+        .unwrap();
+    assert_eq!(
+        gl.triangles,
+        TriangleExport::from_view(&view, gl.scene.clone()).triangles
+    );
+    assert_ne!(
+        gl.triangles, reference.triangles,
+        "the conventions changed nothing"
+    );
 }
 
 #[test]
@@ -290,7 +350,7 @@ fn render_dumps_every_scheme_or_nothing() {
             fragsim()
                 .args(["compare", "oracle"])
                 .arg(dumps.join(scheme))
-                .args(["--json", "--no-image"]),
+                .args(["--json", "--no-images"]),
             0,
         );
         assert_eq!(

@@ -169,7 +169,7 @@ fn a_header_with_a_sample_count_without_a_standard_pattern_is_refused_naming_the
         let output = fragsim()
             .args(["compare", "oracle"])
             .arg(dir.join("mdts"))
-            .arg("--no-image")
+            .arg("--no-images")
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&output.stderr);

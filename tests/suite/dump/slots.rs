@@ -341,7 +341,7 @@ fn compare_record(dir: &std::path::Path) -> (serde_json::Value, i32) {
     let output = fragsim()
         .args(["compare", "oracle"])
         .arg(dir)
-        .args(["--json", "--no-image"])
+        .args(["--json", "--no-images"])
         .output()
         .unwrap();
     let code = output.status.code().unwrap();
@@ -511,7 +511,7 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     let output = fragsim()
         .args(["compare", "oracle"])
         .arg(&path)
-        .arg("--no-image")
+        .arg("--no-images")
         .output()
         .unwrap();
     assert_eq!(output.status.code(), Some(2));

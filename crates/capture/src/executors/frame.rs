@@ -248,18 +248,19 @@ pub fn interleaved<S: Scheme, M: Memory>(
     counters
 }
 
-/// Rasterizes the pixels of `rect` that triangle `prim` covers and runs each fragment's walk of
-/// geometry pass `pass` to its end.
+/// Rasterizes the pixels of `rect` that the triangles `prims` cover, triangle after triangle in
+/// the order given ([`View::rasterize_each_in`]), and runs each fragment's walk of geometry pass
+/// `pass` to its end as it is rasterized.
 pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
     view: &View<'_>,
     scheme: &S,
     memory: &M,
     pass: u32,
-    prim: u32,
+    prims: impl IntoIterator<Item = u32>,
     rect: PixelRect,
     counters: &mut Counters,
 ) {
-    view.rasterize_in(prim, rect, &mut |fragment| {
+    view.rasterize_each_in(prims, rect, &mut |fragment| {
         walk(scheme, memory, pass, fragment, counters);
     });
 }

@@ -77,10 +77,9 @@ pub(crate) fn parallel_frame<S: Scheme, M: Memory + Sync>(
             .map(|task| {
                 let mut counters = Counters::default();
                 let first = task * triangles_per_task;
-                for index in first..(first + triangles_per_task).min(triangles) {
-                    let prim = view.submitted(index as u32);
-                    rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
-                }
+                let prims = (first..(first + triangles_per_task).min(triangles))
+                    .map(|index| view.submitted(index as u32));
+                rasterize_into(view, scheme, memory, pass, prims, rect, &mut counters);
                 counters
             })
             .reduce(Counters::default, Counters::merge)

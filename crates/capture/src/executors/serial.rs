@@ -69,10 +69,8 @@ fn serial_pass<S: Scheme, M: Memory>(
     pass: u32,
 ) -> Counters {
     let mut counters = Counters::default();
+    let prims = (0..view.triangle_count()).map(|index| view.submitted(index));
     let rect = view.viewport().rect();
-    for index in 0..view.triangle_count() {
-        let prim = view.submitted(index);
-        rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
-    }
+    rasterize_into(view, scheme, memory, pass, prims, rect, &mut counters);
     counters
 }

@@ -10,7 +10,7 @@
 //!    centre) list it in every tile they overlap; a counting sort per chunk keeps primitive order
 //!    within each tile's list. The geometry is the same in every pass, so a frame bins once.
 //! 2. **capture**, one geometry pass after another, in parallel over tiles: a tile's thread scans
-//!    its triangles, chunk after chunk, clipped to the tile ([`View::rasterize_in`]), and runs
+//!    its triangles, chunk after chunk, clipped to the tile ([`View::rasterize_each_in`]), and runs
 //!    each fragment's walk to its end.
 //!
 //! Every pixel is written by one thread only, so each pixel sees its fragments in primitive order:
@@ -165,9 +165,8 @@ impl TiledExecutor {
                 .map(|tile| {
                     let rect = tiles.rect(tile);
                     let mut counters = Counters::default();
-                    for &prim in chunks.iter().flat_map(|chunk| chunk.list(tile)) {
-                        rasterize_into(view, scheme, memory, pass, prim, rect, &mut counters);
-                    }
+                    let prims = chunks.iter().flat_map(|chunk| chunk.list(tile)).copied();
+                    rasterize_into(view, scheme, memory, pass, prims, rect, &mut counters);
                     counters
                 })
                 .reduce(Counters::default, Counters::merge)

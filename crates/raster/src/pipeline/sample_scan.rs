@@ -11,7 +11,7 @@
 //! Fragments index the sample-expanded framebuffer ([`crate::samples`]): sample `s` of pixel
 //! `(x, y)` is column `x * n + s`. A rectangle given to the scan (a tile) is in those columns.
 
-use super::scan::{bounding_box, edge, fill_bias, fragment_at};
+use super::scan::{bounding_box, edge, fill_thresholds, fragment_at};
 use super::{PixelRect, ScreenTriangle, View, Viewport, ONE};
 use crate::fragment::Fragment;
 use crate::samples::SamplePattern;
@@ -117,7 +117,7 @@ impl View<'_> {
         debug_assert!(area > 0);
         // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
         let edges = [(b, c), (c, a), (a, b)];
-        let bias = fill_bias(edges, self.conventions.window_origin);
+        let threshold = fill_thresholds(edges, self.conventions.window_origin);
         // The gradient of edge (p, q) is (−(q_y − p_y), q_x − p_x) per 1/256 pixel.
         let gradient = edges.map(|(p, q)| [-(q[1] - p[1]), q[0] - p[0]]);
         let mut offsets = [[0i64; 3]; MAX_SAMPLES];
@@ -138,10 +138,12 @@ impl View<'_> {
                 for (s, offset) in offsets.iter().enumerate().take(n as usize) {
                     let column = x * n + s as i64;
                     let e: [i64; 3] = std::array::from_fn(|k| at_corner[k] + offset[k]);
-                    if !columns.contains(&column) || !(0..3).all(|k| e[k] + bias[k] >= 0) {
+                    if !columns.contains(&column) || !(0..3).all(|k| e[k] >= threshold[k]) {
                         continue;
                     }
-                    if let Some(fragment) = fragment_at(tri, e, area_f, y * width + column) {
+                    if let Some(fragment) =
+                        fragment_at(tri.prim, tri.z, e, area_f, y * width + column)
+                    {
                         emit(fragment);
                     }
                 }

@@ -214,6 +214,103 @@ fn the_inlined_fast_path_emits_what_the_general_path_emits() {
     }
 }
 
+/// Rules 6 and 7 as `docs/semantics.md` states them, the slow way: every pixel centre of the
+/// triangle's bounding box within `rect` tested against the three edge functions, left to right
+/// in each row, rows top to bottom. The scan that visits only covered centres must emit exactly
+/// these fragments in this order.
+fn scan_every_centre(view: &View<'_>, tri: &ScreenTriangle, rect: PixelRect) -> Vec<Fragment> {
+    use super::scan::{fill_thresholds, fragment_at};
+    let mut fragments = Vec::new();
+    let [a, b, c] = tri.xy;
+    let [lo, hi] = bounding_box(tri.xy);
+    let Some(pixels) = rect.centres_within(lo, hi) else {
+        return fragments;
+    };
+    let edges = [(b, c), (c, a), (a, b)];
+    let threshold = fill_thresholds(edges, view.conventions().window_origin);
+    let area = edge(a, b, c) as f64;
+    let width = i64::from(view.viewport().width);
+    for y in i64::from(pixels.y.0)..=i64::from(pixels.y.1) {
+        for x in i64::from(pixels.x.0)..=i64::from(pixels.x.1) {
+            let centre = [x * ONE + HALF, y * ONE + HALF];
+            let e = edges.map(|(p, q)| edge(p, q, centre));
+            if (0..3).all(|k| e[k] >= threshold[k]) {
+                fragments.extend(fragment_at(tri.prim, tri.z, e, area, y * width + x));
+            }
+        }
+    }
+    fragments
+}
+
+#[test]
+fn the_scan_of_covered_runs_emits_what_testing_every_centre_emits() {
+    // Tiny, large and clipped triangles of a soup under both fill rules, on the whole viewport
+    // and on tiles misaligned with it, so that runs are cut by every side of a rectangle.
+    let mesh = crate::scenes::triangle_soup(1500, 5);
+    let lower_left = Conventions {
+        window_origin: crate::conventions::WindowOrigin::LowerLeft,
+        ..Conventions::REFERENCE
+    };
+    let mut fragments = 0;
+    for (distance_scale, view) in soup_views(&mesh) {
+        let camera = Camera {
+            view_projection: view.view_projection(),
+        };
+        let flipped =
+            View::with_conventions(&mesh, &camera, view.viewport(), CullMode::None, lower_left)
+                .unwrap();
+        for view in [view, flipped] {
+            let Viewport { width, height } = view.viewport();
+            let rects = [
+                view.viewport().rect(),
+                PixelRect {
+                    x: (3, (width / 2).min(width - 1)),
+                    y: (height / 3, height - 2),
+                },
+                PixelRect {
+                    x: (width / 2, width / 2),
+                    y: (0, height - 1),
+                },
+            ];
+            for prim in 0..view.triangle_count() {
+                view.screen_triangles(prim, &mut |tri| {
+                    for rect in rects {
+                        let mut scanned = Vec::new();
+                        view.scan_in(&tri, rect, &mut |f| scanned.push(f));
+                        let expected = scan_every_centre(&view, &tri, rect);
+                        assert_eq!(scanned, expected, "{prim} at {distance_scale}, {rect:?}");
+                        fragments += scanned.len();
+                    }
+                });
+            }
+        }
+    }
+    assert!(
+        fragments > 100_000,
+        "{fragments} fragments: too few to test the runs"
+    );
+}
+
+#[test]
+fn rasterizing_triangles_in_batches_emits_them_one_after_the_other() {
+    let mesh = crate::scenes::triangle_soup(1000, 9);
+    for (distance_scale, view) in soup_views(&mesh) {
+        // Reversed, so that the order is the caller's rather than the primitive ids'.
+        let prims: Vec<u32> = (0..view.triangle_count()).rev().collect();
+        let rect = PixelRect {
+            x: (10, 70),
+            y: (5, 50),
+        };
+        let mut one_by_one = Vec::new();
+        for &prim in &prims {
+            view.rasterize_in(prim, rect, &mut |f| one_by_one.push(f));
+        }
+        let mut batched = Vec::new();
+        view.rasterize_each_in(prims.iter().copied(), rect, &mut |f| batched.push(f));
+        assert_eq!(batched, one_by_one, "distance {distance_scale}");
+    }
+}
+
 #[test]
 fn tiles_split_a_triangle_s_fragments_exactly_and_its_bounds_hold_them() {
     // Tiles of 13 × 8 pixels, misaligned with the 97 × 61 viewport's sides on purpose.

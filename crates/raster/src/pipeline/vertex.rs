@@ -9,9 +9,15 @@ use std::ops::{Add, Div, Mul, Sub};
 use glam::{DMat4, DVec4};
 use rayon::prelude::*;
 
-use super::{Snapped, View, Viewport, CLIP_BITS, FAR_BIT, NOT_IN_FRONT_BIT, VERTICES_PER_TASK};
+use super::{
+    Snapped, View, Viewport, CLIP_BITS, FAR_BIT, HALF, NOT_IN_FRONT_BIT, ONE, SUBPIXEL_BITS,
+    VERTICES_PER_TASK,
+};
 use crate::camera::Camera;
-use crate::conventions::{Conventions, DepthRange, VertexPrecision, WindowOrigin};
+use crate::conventions::Conventions;
+use crate::conventions::DepthRange::{self, MinusOneToOne, ZeroToOne};
+use crate::conventions::VertexPrecision::{self, F32, F64};
+use crate::conventions::WindowOrigin::{LowerLeft, UpperLeft};
 
 impl View<'_> {
     /// Runs the vertex stage again for another camera, reusing this view's buffers (a frame loop
@@ -19,28 +25,29 @@ impl View<'_> {
     pub fn set_camera(&mut self, camera: &Camera) {
         self.view_projection = camera.view_projection;
         let count = self.mesh.positions.len();
-        self.outcodes.resize(count, 0);
-        self.window_xy.resize(count, [0, 0]);
+        self.cells.resize(count, NO_CELLS);
+        self.window.resize(count, WindowVertex::default());
         self.window_z.resize(count, 0.0);
         let stage = self.stage();
         // Every vertex is independent: chunks of the arrays go to the pool side by side.
         self.mesh
             .positions
             .par_chunks(VERTICES_PER_TASK)
-            .zip(self.outcodes.par_chunks_mut(VERTICES_PER_TASK))
-            .zip(self.window_xy.par_chunks_mut(VERTICES_PER_TASK))
+            .zip(self.cells.par_chunks_mut(VERTICES_PER_TASK))
+            .zip(self.window.par_chunks_mut(VERTICES_PER_TASK))
             .zip(self.window_z.par_chunks_mut(VERTICES_PER_TASK))
-            .for_each(|(((positions, outcodes), window_xy), window_z)| {
-                let outputs = outcodes.iter_mut().zip(window_xy).zip(window_z);
-                for (p, ((outcode, xy), z)) in positions.iter().zip(outputs) {
-                    let clip = stage.clip(*p);
-                    *outcode = stage.outcode(clip);
-                    if *outcode & CLIP_BITS == 0 {
-                        let ([x, y], depth) = stage.snap(clip);
-                        // Inside the guard band: lossless (see `window_xy`).
-                        *xy = [x as i32, y as i32];
-                        *z = depth;
-                    }
+            .for_each(|(((positions, cells), window), window_z)| {
+                let c = stage.conventions;
+                let chunk = (positions, cells, window, window_z);
+                match (c.vertex_precision, c.window_origin, c.depth_range) {
+                    (F64, UpperLeft, ZeroToOne) => stage.project::<false, false, false>(chunk),
+                    (F64, UpperLeft, MinusOneToOne) => stage.project::<false, false, true>(chunk),
+                    (F64, LowerLeft, ZeroToOne) => stage.project::<false, true, false>(chunk),
+                    (F64, LowerLeft, MinusOneToOne) => stage.project::<false, true, true>(chunk),
+                    (F32, UpperLeft, ZeroToOne) => stage.project::<true, false, false>(chunk),
+                    (F32, UpperLeft, MinusOneToOne) => stage.project::<true, false, true>(chunk),
+                    (F32, LowerLeft, ZeroToOne) => stage.project::<true, true, false>(chunk),
+                    (F32, LowerLeft, MinusOneToOne) => stage.project::<true, true, true>(chunk),
                 }
             });
     }
@@ -95,6 +102,48 @@ impl View<'_> {
     }
 }
 
+/// Per vertex and axis, the interval between pixel-centre lines that the snapped coordinate lies
+/// strictly inside, as `2 · floor((c − ½ pixel) / pixel)`, made odd where the coordinate lies on
+/// a centre line or the vertex has no meaningful window position (it needs clipping or is not in
+/// front of the eye). A triangle whose three vertices have one even cell on an axis lies strictly
+/// between two centre lines there, so its bounding box holds no pixel centre: the triangle
+/// setup's first reject, three loads and a few comparisons.
+pub(super) type CentreCells = [i32; 2];
+
+/// The [`CentreCells`] of a vertex that can never be rejected by them.
+const NO_CELLS: CentreCells = [1, 1];
+
+/// The [`CentreCells`] of a snapped position inside the guard band.
+#[inline]
+fn centre_cells(xy: [i64; 2]) -> CentreCells {
+    let cell = |c: i64| {
+        let from_centre = c - HALF;
+        let on_line = from_centre & (ONE - 1) == 0;
+        // Inside the guard band |c| < 2^24, so the doubled cell fits an i32.
+        ((from_centre >> SUBPIXEL_BITS) * 2 + i64::from(on_line)) as i32
+    };
+    [cell(xy[0]), cell(xy[1])]
+}
+
+/// What the vertex stage leaves for the triangle setup of every triangle that uses a vertex.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct WindowVertex {
+    /// The snapped window position, x and y in 1/256 pixel, y down; meaningful only when the
+    /// outcode has no clip bit set. Inside the guard band they fit an `i32` (|x| < 2^23).
+    pub(super) xy: [i32; 2],
+    /// Bit `i` set when the vertex is outside plane `i` of [`View::planes`]; bit 5: beyond far;
+    /// bit 6: not in front of the eye (`w ≤ 0` or NaN).
+    pub(super) outcode: u8,
+}
+
+impl WindowVertex {
+    /// The snapped window position, widened.
+    #[inline]
+    pub(super) fn position(self) -> [i64; 2] {
+        [self.xy[0].into(), self.xy[1].into()]
+    }
+}
+
 /// What the vertex stage needs, copied out of the view so that it can fill the view's buffers.
 pub(super) struct VertexStage {
     pub(super) view_projection: DMat4,
@@ -103,7 +152,48 @@ pub(super) struct VertexStage {
     pub(super) conventions: Conventions,
 }
 
+/// One chunk of the vertex stage: the positions, and the outputs for them.
+type VertexChunk<'a> = (
+    &'a [[f32; 3]],
+    &'a mut [CentreCells],
+    &'a mut [WindowVertex],
+    &'a mut [f64],
+);
+
 impl VertexStage {
+    /// Rules 1–4 for a chunk of vertices under conventions fixed at compile time (an f32 vertex
+    /// stage, a lower-left window origin, a `[−1, 1]` depth range), so that the loop has no match
+    /// per vertex; the arithmetic is [`VertexStage::clip`]'s and [`snap`]'s, expression for
+    /// expression.
+    fn project<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
+        &self,
+        (positions, cells, window, window_z): VertexChunk<'_>,
+    ) {
+        let outputs = cells.iter_mut().zip(window.iter_mut().zip(window_z));
+        for (p, (cell, (vertex, z))) in positions.iter().zip(outputs) {
+            let clip = if F32_STAGE {
+                transform_f32(self.view_projection, *p)
+            } else {
+                transform(self.view_projection, *p)
+            };
+            vertex.outcode = self.outcode(clip);
+            *cell = NO_CELLS;
+            if vertex.outcode & CLIP_BITS == 0 {
+                let (xy, depth) = snap_fixed::<F32_STAGE, LOWER_LEFT, MINUS_ONE_TO_ONE>(
+                    self.viewport,
+                    self.conventions.subpixel_bits,
+                    clip,
+                );
+                // Inside the guard band: lossless (see `WindowVertex`).
+                vertex.xy = [xy[0] as i32, xy[1] as i32];
+                *z = depth;
+                if vertex.outcode & NOT_IN_FRONT_BIT == 0 {
+                    *cell = centre_cells(xy);
+                }
+            }
+        }
+    }
+
     /// Rule 1: model space to clip space in the conventions' precision.
     pub(super) fn clip(&self, position: [f32; 3]) -> DVec4 {
         match self.conventions.vertex_precision {
@@ -165,27 +255,51 @@ pub(super) fn in_front(clip: DVec4) -> bool {
 /// depth in the conventions' precision; a clipped f32 vertex is rounded to f32 first) and snaps x
 /// and y to the conventions' grid, expressed in 1/256 pixel with y down whatever the origin.
 pub(super) fn snap(viewport: Viewport, conventions: Conventions, v: DVec4) -> Snapped {
+    let bits = conventions.subpixel_bits;
+    match (
+        conventions.vertex_precision,
+        conventions.window_origin,
+        conventions.depth_range,
+    ) {
+        (F64, UpperLeft, ZeroToOne) => snap_fixed::<false, false, false>(viewport, bits, v),
+        (F64, UpperLeft, MinusOneToOne) => snap_fixed::<false, false, true>(viewport, bits, v),
+        (F64, LowerLeft, ZeroToOne) => snap_fixed::<false, true, false>(viewport, bits, v),
+        (F64, LowerLeft, MinusOneToOne) => snap_fixed::<false, true, true>(viewport, bits, v),
+        (F32, UpperLeft, ZeroToOne) => snap_fixed::<true, false, false>(viewport, bits, v),
+        (F32, UpperLeft, MinusOneToOne) => snap_fixed::<true, false, true>(viewport, bits, v),
+        (F32, LowerLeft, ZeroToOne) => snap_fixed::<true, true, false>(viewport, bits, v),
+        (F32, LowerLeft, MinusOneToOne) => snap_fixed::<true, true, true>(viewport, bits, v),
+    }
+}
+
+/// [`snap`] under conventions fixed at compile time (see [`VertexStage::project`]), on the grid
+/// of `bits` subpixel bits.
+#[inline]
+fn snap_fixed<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
+    viewport: Viewport,
+    bits: u32,
+    v: DVec4,
+) -> Snapped {
     let size = [viewport.width, viewport.height];
-    let ([x, y], depth) = match conventions.vertex_precision {
-        VertexPrecision::F64 => window([v.x, v.y, v.z, v.w], size.map(f64::from), conventions),
-        VertexPrecision::F32 => window(
+    let ([x, y], depth) = if F32_STAGE {
+        window::<f32, LOWER_LEFT, MINUS_ONE_TO_ONE>(
             v.to_array().map(|c| c as f32),
             size.map(|s| s as f32),
-            conventions,
-        ),
+        )
+    } else {
+        window::<f64, LOWER_LEFT, MINUS_ONE_TO_ONE>([v.x, v.y, v.z, v.w], size.map(f64::from))
     };
     let grid = |value: f64| {
-        let bits = conventions.subpixel_bits;
         // Round on the coarser grid, then express the grid point in 1/256 pixel (a multiple of
         // 2^(8 − bits)), so that the scan is the same for every grid.
-        round_half_away(value * f64::from(1u32 << bits))
-            .saturating_mul(1 << (super::SUBPIXEL_BITS - bits))
+        round_half_away(value * f64::from(1u32 << bits)).saturating_mul(1 << (SUBPIXEL_BITS - bits))
     };
-    let y = match conventions.window_origin {
-        WindowOrigin::UpperLeft => grid(y),
+    let y = if LOWER_LEFT {
         // Snapped in the API's own y-up window, then flipped into fragsim's rows: row r of the
         // window is fragsim's row height − 1 − r, and the flip is exact on the grid.
-        WindowOrigin::LowerLeft => (i64::from(viewport.height) << super::SUBPIXEL_BITS) - grid(y),
+        (i64::from(viewport.height) << SUBPIXEL_BITS) - grid(y)
+    } else {
+        grid(y)
     };
     ([grid(x), y], depth)
 }
@@ -213,23 +327,26 @@ impl Real for f32 {
 }
 
 /// The perspective divide and the viewport mapping in `T`'s arithmetic: window x and y (y in the
-/// API's own direction, down for upper-left, up for lower-left) in pixels and the window depth.
-/// For f64 under the reference conventions these are exactly fragsim's reference expressions.
-fn window<T: Real>(
+/// API's own direction, down for an upper-left origin, up for a lower-left one) in pixels and
+/// the window depth (of a `[0, 1]` or a `[−1, 1]` clip depth range). For f64 under the reference
+/// conventions these are exactly fragsim's reference expressions.
+#[inline]
+fn window<T: Real, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
     [x, y, z, w]: [T; 4],
     [width, height]: [T; 2],
-    c: Conventions,
 ) -> ([f64; 2], f64) {
     let half = T::HALF;
     let window_x = (x / w * half + half) * width;
-    let window_y = match c.window_origin {
-        WindowOrigin::UpperLeft => (half - y / w * half) * height,
-        WindowOrigin::LowerLeft => (y / w * half + half) * height,
+    let window_y = if LOWER_LEFT {
+        (y / w * half + half) * height
+    } else {
+        (half - y / w * half) * height
     };
-    let depth = match c.depth_range {
-        DepthRange::ZeroToOne => z / w,
+    let depth = if MINUS_ONE_TO_ONE {
         // glDepthRange(0, 1): `(f − n)/2 · z_ndc + (n + f)/2`.
-        DepthRange::MinusOneToOne => z / w * half + half,
+        z / w * half + half
+    } else {
+        z / w
     };
     ([window_x.wide(), window_y.wide()], depth.wide())
 }
