@@ -15,14 +15,9 @@ use fragsim::raster::{
     Conventions, DepthRange, OrbitCamera, Scene, VertexPrecision, Viewport, WindowOrigin,
 };
 
-/// A fresh directory under cargo's per-test-target temporary directory.
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("conventions-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("conventions-tests", name)
 }
 
 /// OpenGL's conventions with an f32 vertex stage: every field away from the reference but the

@@ -8,14 +8,9 @@ use std::process::Output;
 
 use assert_cmd::Command;
 
-/// A fresh directory under cargo's per-test-target temporary directory.
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("flag-dialect")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("flag-dialect", name)
 }
 
 /// `fragsim args` run in `dir`.

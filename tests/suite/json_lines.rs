@@ -30,12 +30,9 @@ const RETIRED: [&str; 4] = ["mismatches", "median_ms", "rows", "first_difference
 
 const SIZE: [&str; 4] = ["--width", "16", "--height", "16"];
 
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("fragsim-json-lines-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("json-lines", name)
 }
 
 /// `fragsim COMMAND ARGS --json [--out OUT]`, expecting exit code 0; its records, each checked

@@ -9,14 +9,9 @@ use std::process::Output;
 
 use assert_cmd::Command;
 
-/// A fresh directory under cargo's per-test-target temporary directory.
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("mesh-files")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("mesh-files", name)
 }
 
 fn fragsim(args: &[&str], mesh: &Path) -> Output {

@@ -9,11 +9,9 @@ use std::path::{Path, PathBuf};
 use assert_cmd::Command;
 use image::RgbImage;
 
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("fragsim-pictures-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("pictures", name)
 }
 
 fn run(args: &[&str], out: &Path) -> String {

@@ -10,13 +10,9 @@ fn fragsim() -> Command {
     Command::cargo_bin("fragsim").unwrap()
 }
 
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("precision-cli")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("precision-cli", name)
 }
 
 fn run(cmd: &mut Command, code: i32) -> String {

@@ -3,7 +3,7 @@
 //! triangle export carries everything a backend needs to reproduce the oracle. CI has no GPU:
 //! these tests are the host side of `backends/cuda`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::mdts::Direction;
@@ -24,14 +24,9 @@ mod samples;
 mod slots;
 mod soundness;
 
-/// A fresh directory under cargo's per-test-target temporary directory.
+/// A fresh directory of this module's group (`crate::support::scratch`).
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("dump-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::support::scratch("dump-tests", name)
 }
 
 const SCENE: &str = "spheres:3";

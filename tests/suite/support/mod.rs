@@ -4,6 +4,7 @@
 //!   and closed meshes, planar tilings, capacities `K` and depths (`fragsim_testkit::strategies`,
 //!   re-exported so that the suites keep their `crate::support::strategies` paths).
 //! - [`json_lines`]: the records of a `--json` output (`docs/json-schema.md`).
+//! - [`scratch`]: a fresh directory for a test's files.
 
 pub use fragsim_testkit::strategies;
 
@@ -19,4 +20,15 @@ pub fn json_lines(stdout: &[u8]) -> Vec<serde_json::Value> {
             record
         })
         .collect()
+}
+
+/// A fresh, empty directory `GROUP/NAME` under cargo's per-test-target temporary directory, where
+/// a test writes its files: emptied first, so that nothing of an earlier run is read back.
+pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(group)
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
 }
