@@ -52,6 +52,11 @@ const UNORM24: Payload = Payload {
     prim_bits: 32,
 };
 
+/// Where the scene lies from the origin, in units of its largest sphere's radius: far enough that
+/// an f32 vertex stage's rounding reaches a fraction of a subpixel (the orbit camera centres it),
+/// so that some pixel centres lie inside the margin of an edge and their coverage is in doubt.
+const OFFSET: f32 = 600.0;
+
 /// How a mutant is judged.
 enum Judge<'a> {
     /// Bit for bit against the oracle.
@@ -109,7 +114,7 @@ struct Layout<'a> {
 fn quad(z: f32, first: usize, times: usize) -> String {
     let mut obj = String::new();
     for (x, y) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
-        obj += &format!("v {x} {y} {z}\n");
+        obj += &format!("v {} {} {}\n", x + OFFSET, y + OFFSET, z + OFFSET);
     }
     let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
     for _ in 0..times {
@@ -124,7 +129,7 @@ fn scene_file(dir: &Path) -> std::path::PathBuf {
     let spheres = Scene::procedural("spheres:3").unwrap().mesh;
     let mut obj = String::new();
     for [x, y, z] in &spheres.positions {
-        obj += &format!("v {x} {y} {z}\n");
+        obj += &format!("v {} {} {}\n", x + OFFSET, y + OFFSET, z + OFFSET);
     }
     for [a, b, c] in &spheres.triangles {
         obj += &format!("f {} {} {}\n", a + 1, b + 1, c + 1);
@@ -145,7 +150,7 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
         let reference = layout.oracle.pixel(p);
         // Overflow past K or the capacity is the layout's promise, not a doubt.
         let doubtless = |c: &Comparison| c.verdicts[p] & !verdict::OVERFLOWED == 0;
-        if reference.len() < 2 || !doubtless(&correct[0]) {
+        if reference.len() < 2 {
             continue;
         }
         let certain = layout.possible.is_none_or(|precision| {
@@ -159,6 +164,7 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
             spans.windows(2).all(|w| w[0].1 < w[1].0)
         });
         let decided = correct.iter().all(doubtless);
+        let equal = correct.iter().all(|c| c.verdicts[p] & verdict::DIFFERS == 0);
         if certain && disjoint && decided {
             pools[0].push(p);
         }
@@ -170,10 +176,10 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
                 .count()
                 >= 2
         });
-        if tied && correct.iter().all(|c| c.verdicts[p] & verdict::DIFFERS == 0) && certain {
+        if tied && equal && certain {
             pools[1].push(p);
         }
-        if !ids {
+        if !ids && equal {
             if let Some(possible) = layout.possible.map(|precision| precision.pixel(p)) {
                 let site = site(layout, p, Some(possible), &|_, _| 0);
                 if kinds::edge_key(&site, &stored).is_some() {
@@ -246,8 +252,9 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
         for i in (1..order.len()).rev() {
             order.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
         }
-        let mut counts = vec![(0, 0); layout.judges.len()];
-        let mut conforming = false;
+        // Per judge: mutants judged as expected, mutants tried, and whether they were expected
+        // EQUAL (a conforming change).
+        let mut counts = vec![(0, 0, false); layout.judges.len()];
         let mut tried = 0;
         for &p in &order {
             if tried == MUTANTS || (tried == 1 && kind.global(&storage)) {
@@ -268,9 +275,9 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
                     Change::Moved(item) => judge.admits(layout.oracle, p, item, storage.has_ids()),
                     Change::OtherSnap => matches!(judge, Judge::Within(_)),
                 };
-                conforming |= expected;
                 let got = judge.judge(layout.oracle, &changed).is_equal();
                 count.1 += 1;
+                count.2 |= expected;
                 if got == expected {
                     count.0 += 1;
                 } else {
@@ -282,7 +289,7 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
                 }
             }
         }
-        for ((judge, _), &(right, tried)) in layout.judges.iter().zip(&counts) {
+        for ((judge, _), &(right, tried, conforming)) in layout.judges.iter().zip(&counts) {
             if tried > 0 {
                 tallies.push(Tally {
                     kind: kind.name(),
@@ -297,8 +304,10 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
     }
 }
 
-/// The kill table: a row per kind, a column per layout, `right/tried` per judge (exact, f32);
-/// `-` where the kind has no meaning for the layout, `n/a` where the judge cannot judge it.
+/// The kill table: a row per kind, a column per layout, `right/tried` per judge (exact, then
+/// f32), `=` before the count where the change is conforming under that judge (kept EQUAL, not
+/// killed); `-` where the kind has no meaning for the layout, `n/a` where the judge cannot judge
+/// it.
 fn table(layouts: &[&'static str], tallies: &[Tally]) -> String {
     let mut out = format!("{:<18}", "kind \\ layout");
     for name in layouts {
@@ -312,19 +321,16 @@ fn table(layouts: &[&'static str], tallies: &[Tally]) -> String {
         }
     }
     for kind in kinds {
-        let conforming = tallies.iter().any(|t| t.kind == kind && t.conforming);
-        let label = if conforming {
-            format!("{kind} (ok)")
-        } else {
-            kind.to_string()
-        };
-        out += &format!("{label:<18}");
+        out += &format!("{kind:<18}");
         for &name in layouts {
             let cell = |judge: &str| {
                 tallies
                     .iter()
                     .find(|t| t.kind == kind && t.layout == name && t.judge == judge)
-                    .map(|t| format!("{}/{}", t.right, t.tried))
+                    .map(|t| {
+                        let kept = if t.conforming { "=" } else { "" };
+                        format!("{kept}{}/{}", t.right, t.tried)
+                    })
             };
             let text = match (cell("exact"), cell("f32")) {
                 (None, None) => "-".to_string(),
@@ -380,10 +386,18 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         order: SlotOrder::SlotMajor,
         payload: None,
     };
-    let single: [(&str, DumpScheme, Option<LayoutSpec>); 13] = [
+    let single: [(&str, DumpScheme, Option<LayoutSpec>); 14] = [
         ("mdts", mdts(Direction::Ascending), None),
         ("mdts-desc", mdts(Direction::Descending), None),
         ("mdts32", DumpScheme::Mdts32 { k: K }, None),
+        // Every layer: more key-only fragments at shared edges whose coverage is in doubt.
+        (
+            "mdts32-all",
+            DumpScheme::Mdts32 {
+                k: oracle.max_depth_complexity(),
+            },
+            None,
+        ),
         (
             "kbuffer",
             DumpScheme::KBuffer {
@@ -489,9 +503,16 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         run(layout, seed as u64, &mut tallies, &mut wrong);
     }
     let names: Vec<&str> = layouts.iter().map(|l| l.name).collect();
+    let bounds = f32_analysis.bounds();
     println!(
-        "cells: right/tried exactly, then under f32 precision; (ok): a conforming change, \
-         expected EQUAL where the judge admits it\n{}",
+        "scene: {} fragments, depth complexity up to {}; f32 analysis: vertex error up to {:.2} \
+         subpixels, {} (pixel, triangle) pairs in doubt\n\
+         cells: right/tried exactly, then under f32 precision; =: a conforming change, kept \
+         EQUAL; -: no such mutant in the layout; n/a: not judged so\n{}",
+        oracle.fragments(),
+        oracle.max_depth_complexity(),
+        bounds.max_vertex_error_subpixels,
+        bounds.ambiguous_pairs,
         table(&names, &tallies)
     );
     let total: usize = tallies.iter().map(|t| t.tried).sum();
