@@ -280,9 +280,9 @@ pub(super) fn edge_key(site: &Site<'_>, items: &[Item]) -> Option<(usize, u32)> 
             let i = items
                 .iter()
                 .position(|item| Some(item.key()) == present.reference)?;
-            let across = possible.iter().find(|e| {
-                e.reference.is_none() && !e.certain() && shared(e.prim, present.prim)
-            })?;
+            let across = possible
+                .iter()
+                .find(|e| e.reference.is_none() && !e.certain() && shared(e.prim, present.prim))?;
             let key = across.key_lo + (across.key_hi - across.key_lo) / 2;
             let outside = !(present.key_lo..=present.key_hi).contains(&key);
             outside.then_some((i, key))
@@ -295,10 +295,17 @@ fn counted(out: &mut Dump, storage: &Storage, p: usize, kind: Kind, list: &[Item
         Storage::ABuffer { ranges } => ("counters", ranges[p].1 > list.len()),
         Storage::Masked { capacity } => ("counters", *capacity > list.len()),
         Storage::Layers { k, .. } => ("counters", *k > list.len()),
-        Storage::Lists => ("counter", words(out, "counter")[0] < words(out, "nodes").len() as u64),
+        Storage::Lists => (
+            "counter",
+            words(out, "counter")[0] < words(out, "nodes").len() as u64,
+        ),
         Storage::Slots { .. } => return None,
     };
-    let at = if matches!(storage, Storage::Lists) { 0 } else { p };
+    let at = if matches!(storage, Storage::Lists) {
+        0
+    } else {
+        p
+    };
     let mut counters = words(out, name);
     match kind {
         Kind::CounterPlusOne if room || !matches!(storage, Storage::Lists) => counters[at] += 1,

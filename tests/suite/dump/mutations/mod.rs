@@ -158,13 +158,18 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
             possible.len() == reference.len() && possible.iter().all(|e| e.certain())
         });
         let disjoint = layout.possible.is_none_or(|precision| {
-            let mut spans: Vec<(u32, u32)> =
-                precision.pixel(p).iter().map(|e| (e.key_lo, e.key_hi)).collect();
+            let mut spans: Vec<(u32, u32)> = precision
+                .pixel(p)
+                .iter()
+                .map(|e| (e.key_lo, e.key_hi))
+                .collect();
             spans.sort_unstable();
             spans.windows(2).all(|w| w[0].1 < w[1].0)
         });
         let decided = correct.iter().all(doubtless);
-        let equal = correct.iter().all(|c| c.verdicts[p] & verdict::DIFFERS == 0);
+        let equal = correct
+            .iter()
+            .all(|c| c.verdicts[p] & verdict::DIFFERS == 0);
         if certain && disjoint && decided {
             pools[0].push(p);
         }
@@ -227,7 +232,12 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
         .map(|(_, judge)| judge.judge(layout.oracle, &correct_dump))
         .collect();
     for ((name, _), c) in layout.judges.iter().zip(&correct) {
-        assert!(c.is_equal(), "{} unmutated, {name}: {:?}", layout.name, c.counts);
+        assert!(
+            c.is_equal(),
+            "{} unmutated, {name}: {:?}",
+            layout.name,
+            c.counts
+        );
     }
     let pools = pools(layout, &storage, &correct);
     assert!(
@@ -237,9 +247,8 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
         pools[0].len()
     );
     let format = layout.format;
-    let step = move |key: u32, by: i64| {
-        format.key_of_field((format.field_of_key(key) as i64 + by) as u64)
-    };
+    let step =
+        move |key: u32, by: i64| format.key_of_field((format.field_of_key(key) as i64 + by) as u64);
     for (index, &kind) in KINDS.iter().enumerate() {
         let pool = match kind.pool() {
             Pool::Clean => &pools[0],
@@ -261,9 +270,12 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
                 break;
             }
             let possible = layout.possible.map(|precision| precision.pixel(p));
-            let Some((changed, change)) =
-                mutant(&layout.own, &storage, &site(layout, p, possible, &step), kind)
-            else {
+            let Some((changed, change)) = mutant(
+                &layout.own,
+                &storage,
+                &site(layout, p, possible, &step),
+                kind,
+            ) else {
                 continue;
             };
             tried += 1;
@@ -354,13 +366,17 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
     let viewport = Viewport::new(48, 36).unwrap();
     let view = spec.view(&scene, viewport).unwrap();
     let (oracle, f32_analysis) = f32_reference(&spec, viewport, None).unwrap();
-    assert!(oracle.max_depth_complexity() > CAPACITY + 2, "deeper than K");
+    assert!(
+        oracle.max_depth_complexity() > CAPACITY + 2,
+        "deeper than K"
+    );
     let triangles = &scene.mesh.triangles[..];
     let exact_conventions = Conventions {
         vertex_precision: VertexPrecision::F64,
         ..spec.conventions
     };
-    let unorm_exact = Precision::derive(&view, &exact_conventions).stored_as(UNORM24.depth, &oracle);
+    let unorm_exact =
+        Precision::derive(&view, &exact_conventions).stored_as(UNORM24.depth, &oracle);
     let unorm_f32 = f32_analysis.clone().stored_as(UNORM24.depth, &oracle);
     let record = |view: &View<'_>, spec: &SceneAndCamera, scheme: DumpScheme| {
         Dump::record(view, spec.clone(), &scheme, "battery").unwrap()
@@ -416,7 +432,11 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             None,
         ),
         ("list", lists(SchemeName::LinkedList), None),
-        ("list-engine", lists(SchemeName::LinkedList), Some(engine_numbering)),
+        (
+            "list-engine",
+            lists(SchemeName::LinkedList),
+            Some(engine_numbering),
+        ),
         ("list-nearest", lists(SchemeName::LinkedListNearest), None),
         (
             "layer-major",
@@ -447,7 +467,11 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
                 &unorm_f32,
             )
         } else {
-            (Judge::Exact, Judge::Within(f32_analysis.clone()), &f32_analysis)
+            (
+                Judge::Exact,
+                Judge::Within(f32_analysis.clone()),
+                &f32_analysis,
+            )
         };
         layouts.push(Layout {
             name,

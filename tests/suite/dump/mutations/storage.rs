@@ -124,7 +124,11 @@ impl Storage {
                 Self::ABuffer { ranges }
             }
             DumpScheme::LinkedLists { spec, .. } => {
-                assert_eq!(spec, LayoutSpec::FRAGSIM_LISTS, "mutated in fragsim's numbering");
+                assert_eq!(
+                    spec,
+                    LayoutSpec::FRAGSIM_LISTS,
+                    "mutated in fragsim's numbering"
+                );
                 Self::Lists
             }
             DumpScheme::LayerMajor { k, .. } => Self::Layers {
@@ -172,7 +176,10 @@ impl Storage {
                 let (counters, slots) = (words(dump, "counters"), words(dump, "slots"));
                 let (first, capacity) = ranges[p];
                 let stored = (counters[p] as usize).min(capacity);
-                slots[first..first + stored].iter().map(|&w| item(w)).collect()
+                slots[first..first + stored]
+                    .iter()
+                    .map(|&w| item(w))
+                    .collect()
             }
             Self::Lists => {
                 let (heads, next) = (words(dump, "heads"), words(dump, "next"));
