@@ -26,12 +26,19 @@ pub(super) enum Kind {
     Swap,
     /// The whole list reversed: an error in sorted layouts, arrival order elsewhere.
     Reverse,
+    /// Two stored fragments of equal depth (coplanar duplicates) swapped: out of the (depth,
+    /// id) order in sorted layouts, arrival order elsewhere.
+    SwapTie,
     /// A fragment's primitive id replaced by a nearby triangle's that cannot cover the pixel.
     NeighbourId,
     /// A depth moved two steps past the interval the f32 analysis derives for it.
     DepthPast,
+    /// The first stored depth moved two steps below its interval.
+    DepthBelow,
     /// A depth moved to the end of its interval: conforming under f32 precision.
     DepthInside,
+    /// A masked node's coverage mask with one sample more or less (never empty).
+    MaskBit,
     /// The counter one more (a pixel's, or a list pool's).
     CounterPlusOne,
     /// The counter one less.
@@ -51,7 +58,7 @@ pub(super) enum Kind {
     EdgeKeySwap,
 }
 
-pub(super) const KINDS: [Kind; 22] = [
+pub(super) const KINDS: [Kind; 25] = [
     Kind::DropAt(0),
     Kind::DropAt(1),
     Kind::DropAt(2),
@@ -62,9 +69,12 @@ pub(super) const KINDS: [Kind; 22] = [
     Kind::Duplicate,
     Kind::Swap,
     Kind::Reverse,
+    Kind::SwapTie,
     Kind::NeighbourId,
     Kind::DepthPast,
+    Kind::DepthBelow,
     Kind::DepthInside,
+    Kind::MaskBit,
     Kind::CounterPlusOne,
     Kind::CounterMinusOne,
     Kind::Unlink,
@@ -98,7 +108,7 @@ impl Kind {
     /// The pixels it mutates.
     pub(super) fn pool(self) -> Pool {
         match self {
-            Self::DropTie | Self::EmptyTie => Pool::Tie,
+            Self::DropTie | Self::EmptyTie | Self::SwapTie => Pool::Tie,
             Self::EdgeKeySwap => Pool::Edge,
             _ => Pool::Clean,
         }
@@ -198,6 +208,13 @@ pub(super) fn mutant(
             }
             unsorted
         }
+        Kind::SwapTie => {
+            // Key-only words of equal depth are the same word: nothing to swap.
+            let i = (1..n)
+                .find(|&i| items[i - 1].key() == items[i].key() && items[i - 1] != items[i])?;
+            items.swap(i - 1, i);
+            unsorted
+        }
         Kind::NeighbourId if storage.has_ids() && n >= 1 => {
             let item = items[0];
             let taken = |prim: u32| {
@@ -217,6 +234,29 @@ pub(super) fn mutant(
             let i = n - 1;
             let (_, hi) = interval(site, storage, items[i])?;
             items[i] = items[i].with_key((site.step)(hi, 2));
+            Change::Broken
+        }
+        Kind::DepthBelow if n >= 1 => {
+            let (lo, _) = interval(site, storage, items[0])?;
+            let below = (site.step)(lo, -2);
+            if below >= lo {
+                return None;
+            }
+            items[0] = items[0].with_key(below);
+            Change::Broken
+        }
+        Kind::MaskBit => {
+            let Storage::Masked { samples, .. } = storage else {
+                return None;
+            };
+            let all = (1u32 << samples) - 1;
+            let mask = items.first()?.mask;
+            // A sample added where one is free, else one taken away.
+            items[0].mask = if mask == all {
+                mask & (mask - 1)
+            } else {
+                mask | (!mask & all) & (!mask & all).wrapping_neg()
+            };
             Change::Broken
         }
         Kind::DepthInside if n >= 1 => {
@@ -293,7 +333,7 @@ pub(super) fn edge_key(site: &Site<'_>, items: &[Item]) -> Option<(usize, u32)> 
 fn counted(out: &mut Dump, storage: &Storage, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
     let (name, room) = match storage {
         Storage::ABuffer { ranges } => ("counters", ranges[p].1 > list.len()),
-        Storage::Masked { capacity } => ("counters", *capacity > list.len()),
+        Storage::Masked { capacity, .. } => ("counters", *capacity > list.len()),
         Storage::Layers { k, .. } => ("counters", *k > list.len()),
         Storage::Lists => (
             "counter",

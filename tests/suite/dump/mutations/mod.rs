@@ -39,7 +39,7 @@ use storage::{Item, Storage};
 use super::scratch;
 
 /// How many pixels each (kind, layout) mutates, one mutant each.
-const MUTANTS: usize = 12;
+const MUTANTS: usize = 24;
 /// Slots of the K-list layouts, fewer than the scene's layers.
 const K: u32 = 2;
 /// Slots a pixel of the fixed A-buffers, fewer than the deepest pixels (which overflow).

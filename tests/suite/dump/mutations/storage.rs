@@ -51,8 +51,9 @@ pub(super) enum Storage {
     Lists,
     /// Bevy's layers: `k` layers of `pixels` pixels, layer-major.
     Layers { k: usize, pixels: usize },
-    /// The masked-node A-buffer: counters, nodes and masks, `capacity` slots a pixel.
-    Masked { capacity: usize },
+    /// The masked-node A-buffer: counters, nodes and masks, `capacity` slots a pixel of
+    /// `samples` samples.
+    Masked { capacity: usize, samples: u32 },
 }
 
 pub(super) fn words(dump: &Dump, name: &str) -> Vec<u64> {
@@ -87,6 +88,7 @@ impl Storage {
         if dump.is_masked() {
             return Self::Masked {
                 capacity: dump.header.capacity.unwrap() as usize,
+                samples: dump.header.scene.conventions.samples,
             };
         }
         let pixels = dump.viewport().unwrap().pixels();
@@ -195,7 +197,7 @@ impl Storage {
                     .map(|l| item(layers[l * pixels + p]))
                     .collect()
             }
-            Self::Masked { capacity } => {
+            Self::Masked { capacity, .. } => {
                 let (counters, nodes) = (words(dump, "counters"), words(dump, "nodes"));
                 let masks = words(dump, "masks");
                 let stored = (counters[p] as usize).min(*capacity);
@@ -262,7 +264,7 @@ impl Storage {
                 set(dump, "counters", &counters);
                 set(dump, "layers", &layers);
             }
-            Self::Masked { capacity } => {
+            Self::Masked { capacity, .. } => {
                 let (mut counters, mut nodes) = (words(dump, "counters"), words(dump, "nodes"));
                 let mut masks = words(dump, "masks");
                 let overflow = counters[p].saturating_sub(*capacity as u64);
