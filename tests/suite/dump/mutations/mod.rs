@@ -402,7 +402,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         order: SlotOrder::SlotMajor,
         payload: None,
     };
-    let single: [(&str, DumpScheme, Option<LayoutSpec>); 14] = [
+    let single: [(&str, DumpScheme, Option<LayoutSpec>); 15] = [
         ("mdts", mdts(Direction::Ascending), None),
         ("mdts-desc", mdts(Direction::Descending), None),
         ("mdts32", DumpScheme::Mdts32 { k: K }, None),
@@ -454,6 +454,15 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             Some(LayoutSpec::Slots {
                 order: SlotOrder::PixelMajor,
                 payload: Some(UNORM24),
+            }),
+        ),
+        (
+            "list-unorm24",
+            lists(SchemeName::LinkedList),
+            Some(LayoutSpec::LinkedList {
+                payload: UNORM24,
+                null: u32::MAX,
+                node_base: 0,
             }),
         ),
     ];
