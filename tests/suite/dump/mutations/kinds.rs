@@ -332,7 +332,7 @@ pub(super) fn edge_key(site: &Site<'_>, items: &[Item]) -> Option<(usize, u32)> 
 /// The counter kinds, and a stray word past the counter.
 fn counted(out: &mut Dump, storage: &Storage, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
     let (name, room) = match storage {
-        Storage::ABuffer { ranges } => ("counters", ranges[p].1 > list.len()),
+        Storage::ABuffer { ranges, .. } => ("counters", ranges[p].1 > list.len()),
         Storage::Masked { capacity, .. } => ("counters", *capacity > list.len()),
         Storage::Layers { k, .. } => ("counters", *k > list.len()),
         Storage::Lists => (

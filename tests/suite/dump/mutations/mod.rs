@@ -402,7 +402,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         order: SlotOrder::SlotMajor,
         payload: None,
     };
-    let single: [(&str, DumpScheme, Option<LayoutSpec>); 15] = [
+    let single: [(&str, DumpScheme, Option<LayoutSpec>); 16] = [
         ("mdts", mdts(Direction::Ascending), None),
         ("mdts-desc", mdts(Direction::Descending), None),
         ("mdts32", DumpScheme::Mdts32 { k: K }, None),
@@ -423,6 +423,15 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             None,
         ),
         ("abuffer", abuffer.clone(), None),
+        // Sorted in place on the GPU: judged in stored order.
+        (
+            "abuf-sorted",
+            DumpScheme::ABufferFixed {
+                capacity: CAPACITY,
+                sorted: true,
+            },
+            None,
+        ),
         (
             "abuffer-offs",
             DumpScheme::ABufferExact {

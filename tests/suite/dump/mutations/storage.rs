@@ -45,8 +45,12 @@ pub(super) enum SlotWord {
 pub(super) enum Storage {
     /// `k` slots a pixel, sorted, full slots first (MDTS, the k-buffers).
     Slots { k: usize, word: SlotWord },
-    /// Counters and slots, each pixel's slots at `ranges[p]` (fixed capacity or offsets).
-    ABuffer { ranges: Vec<(usize, usize)> },
+    /// Counters and slots, each pixel's slots at `ranges[p]` (fixed capacity or offsets), sorted
+    /// in place where the header says so.
+    ABuffer {
+        ranges: Vec<(usize, usize)>,
+        sorted: bool,
+    },
     /// Linked lists, fragsim's numbering (link 0 ends a list, link `n` is node `n − 1`).
     Lists,
     /// Bevy's layers: `k` layers of `pixels` pixels, layer-major.
@@ -108,13 +112,14 @@ impl Storage {
                 k: k as usize,
                 word: SlotWord::Key,
             },
-            DumpScheme::ABufferFixed { capacity, .. } => {
+            DumpScheme::ABufferFixed { capacity, sorted } => {
                 let c = capacity as usize;
                 Self::ABuffer {
                     ranges: (0..pixels).map(|p| (p * c, c)).collect(),
+                    sorted,
                 }
             }
-            DumpScheme::ABufferExact { counts, .. } => {
+            DumpScheme::ABufferExact { counts, sorted } => {
                 let mut first = 0;
                 let ranges = counts
                     .iter()
@@ -123,7 +128,7 @@ impl Storage {
                         (first - c as usize, c as usize)
                     })
                     .collect();
-                Self::ABuffer { ranges }
+                Self::ABuffer { ranges, sorted }
             }
             DumpScheme::LinkedLists { spec, .. } => {
                 assert_eq!(
@@ -143,7 +148,10 @@ impl Storage {
 
     /// Whether the stored order is the layout's sort order (not arrival order).
     pub(super) fn sorted(&self) -> bool {
-        matches!(self, Self::Slots { .. })
+        matches!(
+            self,
+            Self::Slots { .. } | Self::ABuffer { sorted: true, .. }
+        )
     }
 
     /// Whether the words carry primitive ids.
@@ -174,7 +182,7 @@ impl Storage {
                     .map(|&w| item(decode(w)))
                     .collect()
             }
-            Self::ABuffer { ranges } => {
+            Self::ABuffer { ranges, .. } => {
                 let (counters, slots) = (words(dump, "counters"), words(dump, "slots"));
                 let (first, capacity) = ranges[p];
                 let stored = (counters[p] as usize).min(capacity);
@@ -228,7 +236,7 @@ impl Storage {
                 }
                 set(dump, "slots", &slots);
             }
-            Self::ABuffer { ranges } => {
+            Self::ABuffer { ranges, .. } => {
                 let (mut counters, mut slots) = (words(dump, "counters"), words(dump, "slots"));
                 let (first, capacity) = ranges[p];
                 let overflow = counters[p].saturating_sub(capacity as u64);
