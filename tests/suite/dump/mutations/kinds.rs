@@ -1,0 +1,397 @@
+//! The mutation kinds: each a change to one pixel's stored list (or to a list's pool) that no
+//! conforming implementation could make, or, for the conforming kinds, one that some could.
+
+use fragsim::oracle::dump::Dump;
+use fragsim::oracle::precision::Possible;
+
+use super::storage::{links, set, words, Item, Storage};
+
+/// A way to change a capture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// The fragment at this list position taken out, the rest kept in order.
+    DropAt(usize),
+    /// The last stored fragment taken out.
+    DropLast,
+    /// At a pixel of coplanar fragments (equal reference depths), one of the tied fragments taken
+    /// out: a K-nearest list short of what every conforming list holds (the K-nearest excuse).
+    DropTie,
+    /// Every fragment of the pixel taken out.
+    Empty,
+    /// Every fragment of a pixel of coplanar fragments taken out.
+    EmptyTie,
+    /// The second fragment replaced by a copy of the first.
+    Duplicate,
+    /// The first two fragments swapped: an error in sorted layouts, arrival order elsewhere.
+    Swap,
+    /// The whole list reversed: an error in sorted layouts, arrival order elsewhere.
+    Reverse,
+    /// Two stored fragments of equal depth (coplanar duplicates) swapped: out of the (depth,
+    /// id) order in sorted layouts, arrival order elsewhere.
+    SwapTie,
+    /// A fragment's primitive id replaced by a nearby triangle's that cannot cover the pixel.
+    NeighbourId,
+    /// A depth moved two steps past the interval the f32 analysis derives for it.
+    DepthPast,
+    /// The first stored depth moved two steps below its interval.
+    DepthBelow,
+    /// A depth moved to the end of its interval: conforming under f32 precision.
+    DepthInside,
+    /// A masked node's coverage mask with one sample more or less (never empty).
+    MaskBit,
+    /// The counter one more (a pixel's, or a list pool's).
+    CounterPlusOne,
+    /// The counter one less.
+    CounterMinusOne,
+    /// A linked list's node unlinked from the middle of its list (still handed out).
+    Unlink,
+    /// A linked list cut after its first node: the rest orphaned.
+    Orphan,
+    /// A linked list losing its farthest node, past the resolve's k.
+    PastK,
+    /// A 64-bit word torn: its high half written, its low half still the empty marker's.
+    Torn,
+    /// A fragment word written in the slot past the pixel's counter, with `filled`.
+    Stray,
+    /// A key-only word of a triangle at a shared edge replaced by a key of the triangle across
+    /// the edge, which a conforming snap may give the pixel: conforming under f32 precision.
+    EdgeKeySwap,
+}
+
+pub(super) const KINDS: [Kind; 25] = [
+    Kind::DropAt(0),
+    Kind::DropAt(1),
+    Kind::DropAt(2),
+    Kind::DropLast,
+    Kind::DropTie,
+    Kind::Empty,
+    Kind::EmptyTie,
+    Kind::Duplicate,
+    Kind::Swap,
+    Kind::Reverse,
+    Kind::SwapTie,
+    Kind::NeighbourId,
+    Kind::DepthPast,
+    Kind::DepthBelow,
+    Kind::DepthInside,
+    Kind::MaskBit,
+    Kind::CounterPlusOne,
+    Kind::CounterMinusOne,
+    Kind::Unlink,
+    Kind::Orphan,
+    Kind::PastK,
+    Kind::Torn,
+    Kind::Stray,
+    Kind::EdgeKeySwap,
+    Kind::DropAt(3),
+];
+
+impl Kind {
+    /// Its name in the table.
+    pub(super) fn name(self) -> String {
+        match self {
+            Self::DropAt(i) => format!("drop@{i}"),
+            other => {
+                let debug = format!("{other:?}");
+                let mut name = String::new();
+                for (i, c) in debug.chars().enumerate() {
+                    if c.is_uppercase() && i > 0 {
+                        name.push('-');
+                    }
+                    name.push(c.to_ascii_lowercase());
+                }
+                name
+            }
+        }
+    }
+
+    /// The pixels it mutates.
+    pub(super) fn pool(self) -> Pool {
+        match self {
+            Self::DropTie | Self::EmptyTie | Self::SwapTie => Pool::Tie,
+            Self::EdgeKeySwap => Pool::Edge,
+            _ => Pool::Clean,
+        }
+    }
+
+    /// Whether it changes the whole dump rather than a pixel (a list pool's counter): tried once.
+    pub(super) fn global(self, storage: &Storage) -> bool {
+        matches!(storage, Storage::Lists)
+            && matches!(self, Self::CounterPlusOne | Self::CounterMinusOne)
+    }
+}
+
+/// Which pixels a kind mutates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Pool {
+    /// Two fragments or more, every one certain, their depth intervals disjoint, decided by
+    /// every judge.
+    Clean,
+    /// Two fragments or more of equal reference depth, every one certain.
+    Tie,
+    /// A key-only pixel whose fragment lies at an edge shared with a triangle that may cover it
+    /// instead.
+    Edge,
+}
+
+/// What a mutant is, for the judges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Change {
+    /// No conforming implementation stores it: DIFFERENT under every judge.
+    Broken,
+    /// Another arrival order: EQUAL under every judge.
+    Reordered,
+    /// One fragment's depth moved: EQUAL exactly where the judge's interval holds it.
+    Moved(Item),
+    /// Another triangle's key at a shared edge: DIFFERENT bit for bit, EQUAL under f32.
+    OtherSnap,
+}
+
+/// The pixel a mutant changes, and what the judges know of it.
+pub(super) struct Site<'a> {
+    pub(super) p: usize,
+    /// The reference's fragments at the pixel, in canonical order.
+    pub(super) reference: &'a [u64],
+    /// What a conforming f32 implementation may store there (`None`: judged exactly only).
+    pub(super) possible: Option<&'a [Possible]>,
+    /// The scene's triangles, by their vertices' ids.
+    pub(super) triangles: &'a [[u32; 3]],
+    /// Keys of the f32 analysis, as the layout stores depth: the next step past a key.
+    pub(super) step: &'a dyn Fn(u32, i64) -> u32,
+}
+
+/// `dump` (fragsim's own encoding) with the site's pixel changed as `kind`, and what the change
+/// is; `None` where the kind has no meaning for the layout or the pixel.
+pub(super) fn mutant(
+    dump: &Dump,
+    storage: &Storage,
+    site: &Site<'_>,
+    kind: Kind,
+) -> Option<(Dump, Change)> {
+    let p = site.p;
+    let mut out = dump.clone();
+    let list = storage.read(dump, p);
+    let n = list.len();
+    let mut items = list.clone();
+    let unsorted = if storage.sorted() {
+        Change::Broken
+    } else {
+        Change::Reordered
+    };
+    let change = match kind {
+        Kind::DropAt(i) if i < n => {
+            items.remove(i);
+            Change::Broken
+        }
+        Kind::DropLast | Kind::DropTie if n >= 1 => {
+            // At a tie pixel the last stored fragment of a K-nearest list is one of the tied ones
+            // or nearer than them: either way the list is short.
+            items.pop();
+            Change::Broken
+        }
+        Kind::Empty | Kind::EmptyTie if n >= 1 => {
+            items.clear();
+            Change::Broken
+        }
+        Kind::Duplicate if n >= 2 && items[0] != items[1] => {
+            items[1] = items[0];
+            Change::Broken
+        }
+        Kind::Swap if n >= 2 && items[0] != items[1] => {
+            items.swap(0, 1);
+            unsorted
+        }
+        Kind::Reverse if n >= 2 => {
+            items.reverse();
+            if items == list {
+                return None;
+            }
+            unsorted
+        }
+        Kind::SwapTie => {
+            // Key-only words of equal depth are the same word: nothing to swap.
+            let i = (1..n)
+                .find(|&i| items[i - 1].key() == items[i].key() && items[i - 1] != items[i])?;
+            items.swap(i - 1, i);
+            unsorted
+        }
+        Kind::NeighbourId if storage.has_ids() && n >= 1 => {
+            let item = items[0];
+            let taken = |prim: u32| {
+                site.reference.iter().any(|&r| r as u32 == prim)
+                    || site
+                        .possible
+                        .is_some_and(|ps| ps.iter().any(|e| e.prim == prim))
+            };
+            let count = site.triangles.len() as u32;
+            let prim = (1..count)
+                .flat_map(|d| [item.prim().wrapping_add(d), item.prim().wrapping_sub(d)])
+                .find(|&q| q < count && !taken(q))?;
+            items[0].word = item.word & !0xFFFF_FFFF | u64::from(prim);
+            Change::Broken
+        }
+        Kind::DepthPast if n >= 1 => {
+            let i = n - 1;
+            let (_, hi) = interval(site, storage, items[i])?;
+            items[i] = items[i].with_key((site.step)(hi, 2));
+            Change::Broken
+        }
+        Kind::DepthBelow if n >= 1 => {
+            let (lo, _) = interval(site, storage, items[0])?;
+            let below = (site.step)(lo, -2);
+            if below >= lo {
+                return None;
+            }
+            items[0] = items[0].with_key(below);
+            Change::Broken
+        }
+        Kind::MaskBit => {
+            let Storage::Masked { samples, .. } = storage else {
+                return None;
+            };
+            let all = (1u32 << samples) - 1;
+            let mask = items.first()?.mask;
+            // A sample added where one is free, else one taken away.
+            items[0].mask = if mask == all {
+                mask & (mask - 1)
+            } else {
+                mask | (!mask & all) & (!mask & all).wrapping_neg()
+            };
+            Change::Broken
+        }
+        Kind::DepthInside if n >= 1 => {
+            let i = n - 1;
+            let (lo, hi) = interval(site, storage, items[i])?;
+            let key = [hi, lo].into_iter().find(|&k| k != items[i].key())?;
+            items[i] = items[i].with_key(key);
+            Change::Moved(items[i])
+        }
+        Kind::Torn if storage.has_ids() && n >= 1 => {
+            items[0].word |= 0xFFFF_FFFF;
+            Change::Broken
+        }
+        Kind::EdgeKeySwap if !storage.has_ids() => {
+            let (i, key) = edge_key(site, &items)?;
+            items[i] = items[i].with_key(key);
+            items.sort_unstable_by_key(|item| item.word);
+            Change::OtherSnap
+        }
+        Kind::CounterPlusOne | Kind::CounterMinusOne | Kind::Stray => {
+            return counted(&mut out, storage, p, kind, &list).map(|()| (out, Change::Broken));
+        }
+        Kind::Unlink | Kind::Orphan | Kind::PastK if matches!(storage, Storage::Lists) => {
+            return unlinked(&mut out, p, kind, &list).map(|()| (out, Change::Broken));
+        }
+        _ => return None,
+    };
+    storage.write(&mut out, p, &items);
+    Some((out, change))
+}
+
+/// The f32 analysis's interval of the stored fragment `item` (matched by key where the words
+/// carry none, by primitive id otherwise); judged exactly only, the reference's key.
+fn interval(site: &Site<'_>, storage: &Storage, item: Item) -> Option<(u32, u32)> {
+    let Some(possible) = site.possible else {
+        let key = site.reference.iter().find(|&&r| r as u32 == item.prim())? >> 32;
+        return Some((key as u32, key as u32));
+    };
+    let entry = if storage.has_ids() {
+        possible.iter().find(|e| e.prim == item.prim())?
+    } else {
+        possible
+            .iter()
+            .find(|e| (e.key_lo..=e.key_hi).contains(&item.key()))?
+    };
+    Some((entry.key_lo, entry.key_hi))
+}
+
+/// A stored fragment whose coverage the snaps decide, and a key of the triangle across a shared
+/// edge that may cover the pixel instead (the middle of its interval, outside the stored one's).
+pub(super) fn edge_key(site: &Site<'_>, items: &[Item]) -> Option<(usize, u32)> {
+    let possible = site.possible?;
+    let shared = |a: u32, b: u32| {
+        let (a, b) = (site.triangles[a as usize], site.triangles[b as usize]);
+        a.iter().filter(|v| b.contains(v)).count() == 2
+    };
+    possible
+        .iter()
+        .filter(|e| !e.certain() && e.reference.is_some())
+        .find_map(|present| {
+            let i = items
+                .iter()
+                .position(|item| Some(item.key()) == present.reference)?;
+            let across = possible
+                .iter()
+                .find(|e| e.reference.is_none() && !e.certain() && shared(e.prim, present.prim))?;
+            let key = across.key_lo + (across.key_hi - across.key_lo) / 2;
+            let outside = !(present.key_lo..=present.key_hi).contains(&key);
+            outside.then_some((i, key))
+        })
+}
+
+/// The counter kinds, and a stray word past the counter.
+fn counted(out: &mut Dump, storage: &Storage, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
+    let (name, room) = match storage {
+        Storage::ABuffer { ranges, .. } => ("counters", ranges[p].1 > list.len()),
+        Storage::Masked { capacity, .. } => ("counters", *capacity > list.len()),
+        Storage::Layers { k, .. } => ("counters", *k > list.len()),
+        Storage::Lists => (
+            "counter",
+            words(out, "counter")[0] < words(out, "nodes").len() as u64,
+        ),
+        Storage::Slots { .. } => return None,
+    };
+    let at = if matches!(storage, Storage::Lists) {
+        0
+    } else {
+        p
+    };
+    let mut counters = words(out, name);
+    match kind {
+        Kind::CounterPlusOne if room || !matches!(storage, Storage::Lists) => counters[at] += 1,
+        Kind::CounterMinusOne if counters[at] > 0 => counters[at] -= 1,
+        Kind::Stray if room && out.header.filled && !list.is_empty() => {
+            // A word where the empty marker must be, the counter unchanged.
+            let mut stored = list.to_vec();
+            stored.push(list[0]);
+            let count = words(out, name)[at];
+            storage.write(out, p, &stored);
+            set(out, name, &{
+                let mut back = words(out, name);
+                back[at] = count;
+                back
+            });
+            return Some(());
+        }
+        _ => return None,
+    }
+    set(out, name, &counters);
+    Some(())
+}
+
+/// A linked list's links cut: a node unlinked from the middle, the tail after the head orphaned,
+/// or the farthest node past the resolve's k unlinked; the nodes stay handed out.
+fn unlinked(out: &mut Dump, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
+    let (mut heads, mut next) = (words(out, "heads"), words(out, "next"));
+    let chain = links(&heads, &next, p);
+    let n = chain.len();
+    let cut = match kind {
+        Kind::Unlink if n >= 3 => n / 2,
+        Kind::Orphan if n >= 2 => {
+            next[chain[0] as usize - 1] = 0;
+            set(out, "next", &next);
+            return Some(());
+        }
+        // The farthest node, in a list longer than the two the battery's resolve keeps.
+        Kind::PastK if n > 2 => (0..n).max_by_key(|&i| list[i].word)?,
+        _ => return None,
+    };
+    let after = next[chain[cut] as usize - 1];
+    match cut {
+        0 => heads[p] = after,
+        i => next[chain[i - 1] as usize - 1] = after,
+    }
+    set(out, "heads", &heads);
+    set(out, "next", &next);
+    Some(())
+}
