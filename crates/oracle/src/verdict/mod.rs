@@ -117,14 +117,24 @@ impl Verdict {
 /// Judges `candidate` against `reference` (see the module documentation).
 ///
 /// # Errors
-/// A candidate dump that cannot be decoded, a candidate of another number of lists than the
-/// reference, a masked-node dump against anything but the per-sample oracle's per-pixel view.
+/// A candidate dump of another viewport than the reference's or one that cannot be decoded, a
+/// candidate of another number of lists than the reference, a masked-node dump against anything
+/// but the per-sample oracle's per-pixel view.
 pub fn judge(
     reference: &Reference<'_>,
     candidate: Candidate<'_>,
     options: &Options,
 ) -> Result<Verdict, String> {
     let oracle = reference.oracle();
+    if let Candidate::Dump(dump) = candidate {
+        let (w, h) = (dump.header.width, dump.header.height);
+        if (w, h) != (reference.width, reference.height) {
+            return Err(format!(
+                "the dump covers {w}x{h} pixels, the reference {}x{}",
+                reference.width, reference.height
+            ));
+        }
+    }
     // A unorm payload cannot owe the f32 bits: the oracle's fragments are judged as the dump
     // stores depth, each interval the steps the conversion may land on.
     let stored = match (candidate, reference.precision()) {
