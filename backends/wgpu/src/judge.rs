@@ -1,5 +1,5 @@
-//! A capture judged against fragsim's oracle: the conformance verdict (`Dump::compare`, every
-//! word read) and, separately, **coverage**: whether the GPU produced exactly fragsim's
+//! A capture judged against fragsim's oracle: the conformance verdict (the oracle's own,
+//! [`fragsim_oracle::verdict::judge`], every word read) and, separately, **coverage**: whether the GPU produced exactly fragsim's
 //! (pixel, primitive) pairs, whatever their depths.
 //!
 //! Coverage is what replay mode guarantees by construction (the GPU scans fragsim's own snapped
@@ -12,20 +12,25 @@
 //!
 //! [`Within`] is the other verdict, issue 16's: the dump judged within the precision of an f32
 //! vertex stage against the exact oracle under the dump's conventions, what `fragsim compare
-//! oracle DIR --vertex-precision f32` prints (the same library calls, [`f32_reference`] and
-//! [`compare_within`]), its reference built once and shared by every capture of one view.
+//! oracle DIR --vertex-precision f32` prints (the same calls, [`f32_reference`] and the oracle's
+//! verdict), its reference built once and shared by every capture of one view.
+
+use std::borrow::Cow;
 
 use fragsim_capture::{Capacity, Identity, Keeps};
-use fragsim_oracle::compare::{CompareOptions, Comparison};
+use fragsim_oracle::compare::Comparison;
 use fragsim_oracle::dump::{Dump, DumpError, Words};
-use fragsim_oracle::precision::{compare_within, f32_reference, Bounds, Precision};
+use fragsim_oracle::precision::{f32_reference, Bounds, Precision};
 use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::verdict::{self, Candidate, Options, Reference};
 use fragsim_oracle::Oracle;
+use fragsim_raster::VertexPrecision;
 
 /// The verdict and the coverage of one capture.
 #[derive(Debug)]
 pub struct Judgement {
-    /// `Dump::compare` against the oracle.
+    /// The oracle's verdict on the dump, every bit owed (`fragsim compare oracle DIR
+    /// --depth-ulps N`).
     pub comparison: Comparison,
     /// Pixels where coverage was checked.
     pub coverage_checked: u64,
@@ -76,14 +81,20 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
             "the dump covers {dump_pixels} pixels, the oracle {pixels}"
         )));
     }
-    // The oracle knows every fragment (`complete: None`); any option added later keeps its
-    // default.
-    let options = CompareOptions {
+    let (width, height) = (dump.header.width, dump.header.height);
+    let reference = Reference::new(
+        Cow::Borrowed(oracle),
+        Precision::exact(),
+        VertexPrecision::F64,
+        (width, height),
+    );
+    let options = Options {
         depth_ulps,
         examples: 8,
-        ..Default::default()
     };
-    let comparison = dump.compare(oracle, &options)?;
+    let comparison = verdict::judge(&reference, Candidate::Dump(dump), &options)
+        .map_err(DumpError)?
+        .comparison;
     let capture = dump.capture()?;
     // The most fragments of a pixel the scheme keeps.
     let keeps = match &capture.keeps {
@@ -135,8 +146,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
 pub struct Within {
     scene: SceneAndCamera,
     viewport: (u32, u32),
-    oracle: Oracle,
-    precision: Precision,
+    reference: Reference<'static>,
     covered: u64,
 }
 
@@ -192,11 +202,11 @@ impl Within {
         let covered = (0..oracle.pixels())
             .filter(|&p| !oracle.pixel(p).is_empty())
             .count() as u64;
+        let size = (viewport.width, viewport.height);
         Ok(Self {
             scene,
-            viewport: (viewport.width, viewport.height),
-            oracle,
-            precision,
+            viewport: size,
+            reference: Reference::new(Cow::Owned(oracle), precision, VertexPrecision::F32, size),
             covered,
         })
     }
@@ -205,7 +215,7 @@ impl Within {
     /// conventions, fragsim's own oracle of the view: what [`judge`] takes).
     #[must_use]
     pub fn oracle(&self) -> &Oracle {
-        &self.oracle
+        self.reference.oracle()
     }
 
     /// Whether `dump` names this reference's scene and viewport.
@@ -214,7 +224,7 @@ impl Within {
         dump.header.scene == self.scene && (dump.header.width, dump.header.height) == self.viewport
     }
 
-    /// `dump` judged within precision, every word read (`Dump::compare_within`'s steps).
+    /// `dump` judged within precision by the oracle's verdict, every word read.
     ///
     /// # Errors
     /// A dump of another scene or viewport, or one its layout cannot decode.
@@ -224,22 +234,15 @@ impl Within {
                 "the dump names another scene or viewport than the reference's".into(),
             ));
         }
-        let options = CompareOptions {
+        let options = Options {
+            depth_ulps: 0,
             examples: 8,
-            ..Default::default()
         };
-        let capture = dump.capture()?;
-        let words = dump.check_words()?;
-        let comparison = compare_within(
-            &self.precision,
-            &self.oracle,
-            &capture,
-            Some(&words),
-            &options,
-        );
+        let verdict =
+            verdict::judge(&self.reference, Candidate::Dump(dump), &options).map_err(DumpError)?;
         Ok(WithinJudgement {
-            comparison,
-            bounds: self.precision.bounds(),
+            bounds: verdict.bounds.unwrap_or_default(),
+            comparison: verdict.comparison,
             covered: self.covered,
         })
     }

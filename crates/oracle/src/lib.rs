@@ -22,6 +22,7 @@ pub mod precision;
 pub mod samples;
 pub mod scene;
 pub mod triangles;
+pub mod verdict;
 
 pub use diff::{Diff, PixelMismatch};
 

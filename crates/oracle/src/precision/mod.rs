@@ -177,14 +177,7 @@ impl Precision {
     #[must_use]
     pub fn derive(view: &View<'_>, conventions: &Conventions) -> Self {
         if conventions.vertex_precision == VertexPrecision::F64 {
-            return Self {
-                exact: true,
-                offsets: Vec::new(),
-                entries: Vec::new(),
-                dependencies: Vec::new(),
-                vertex_points: Vec::new(),
-                bounds: Bounds::default(),
-            };
+            return Self::exact();
         }
         let mut bounds = Bounds::default();
         let vertices: Vec<Option<VertexBound>> = (0..view.mesh().positions.len() as u32)
@@ -320,6 +313,20 @@ impl Precision {
             offsets,
             dependencies: vec![None; entries.len()],
             entries,
+            vertex_points: Vec::new(),
+            bounds: Bounds::default(),
+        }
+    }
+
+    /// The analysis of an implementation that owes every bit (f64 vertex precision): empty, the
+    /// exact comparison applies.
+    #[must_use]
+    pub fn exact() -> Self {
+        Self {
+            exact: true,
+            offsets: Vec::new(),
+            entries: Vec::new(),
+            dependencies: Vec::new(),
             vertex_points: Vec::new(),
             bounds: Bounds::default(),
         }

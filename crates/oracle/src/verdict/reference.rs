@@ -1,0 +1,305 @@
+//! What a candidate is judged against: the oracle of a view under the precision its vertex stage
+//! owes, the per-pixel view of the per-sample oracle (masked-node dumps), or another dump's lists
+//! with what such a reference cannot know.
+
+use std::borrow::Cow;
+
+use fragsim_capture::schemes::masked_abuffer::MaskedLists;
+use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
+use fragsim_raster::{Conventions, VertexPrecision, View};
+
+use crate::compare::complete_pixels;
+use crate::dump::{node_capture, Dump};
+use crate::precision::Precision;
+use crate::Oracle;
+
+/// The reference side of a verdict ([`super::judge`]).
+#[derive(Clone, Debug)]
+pub struct Reference<'a> {
+    /// The reference's lists: the oracle's, or a dump's decoded ones.
+    lists: Cow<'a, Oracle>,
+    kind: Kind,
+    /// Viewport width, pixels.
+    pub(super) width: u32,
+    /// Viewport height, pixels.
+    pub(super) height: u32,
+    /// Notes on the sides made before the verdict (dumps of different scenes compared anyway).
+    pub(super) notes: Vec<String>,
+}
+
+/// How a reference knows its lists.
+#[derive(Clone, Debug)]
+enum Kind {
+    /// The oracle, owed within `precision` by a vertex stage of `vertex_precision`.
+    Oracle {
+        precision: Precision,
+        vertex_precision: VertexPrecision,
+    },
+    /// The per-pixel view of the per-sample oracle (masked nodes, every bit owed).
+    Masked(MaskedLists),
+    /// Another dump's decoded lists.
+    Dump {
+        /// Whether each pixel's list holds every fragment of the pixel.
+        complete: Vec<bool>,
+        keeps: Keeps,
+        identity: Identity,
+        /// Words its layout says cannot be there: the comparison is then never equal.
+        corrupt_words: u64,
+        /// Why the dump may not be the whole truth.
+        notes: Vec<String>,
+    },
+}
+
+impl<'a> Reference<'a> {
+    /// The oracle `oracle` of a `width × height` viewport, owed within `precision` by an
+    /// implementation whose vertex stage computes in `vertex_precision` (an exact `precision`,
+    /// f64: every bit).
+    #[must_use]
+    pub fn new(
+        oracle: Cow<'a, Oracle>,
+        precision: Precision,
+        vertex_precision: VertexPrecision,
+        (width, height): (u32, u32),
+    ) -> Self {
+        Self {
+            lists: oracle,
+            kind: Kind::Oracle {
+                precision,
+                vertex_precision,
+            },
+            width,
+            height,
+            notes: Vec::new(),
+        }
+    }
+
+    /// The oracle `oracle` of `view` (the reference's f64 pipeline under the conventions the
+    /// implementation declares), owed by a vertex stage of `vertex_precision`: every bit under
+    /// f64, the bounds [`Precision::derive`] finds under f32.
+    #[must_use]
+    pub fn of_view(oracle: &'a Oracle, view: &View<'_>, vertex_precision: VertexPrecision) -> Self {
+        let conventions = Conventions {
+            vertex_precision,
+            ..view.conventions()
+        };
+        let viewport = view.pixel_viewport();
+        Self::new(
+            Cow::Borrowed(oracle),
+            Precision::derive(view, &conventions),
+            vertex_precision,
+            (viewport.width, viewport.height),
+        )
+    }
+
+    /// The per-pixel view of the per-sample oracle, `nodes`, over a `width × height` viewport:
+    /// what a masked-node dump is judged against.
+    #[must_use]
+    pub fn masked(nodes: MaskedLists, (width, height): (u32, u32)) -> Self {
+        Self {
+            lists: Cow::Owned(Oracle::from_capture(&node_capture(
+                &nodes,
+                Capacity::Unbounded,
+            ))),
+            kind: Kind::Masked(nodes),
+            width,
+            height,
+            notes: Vec::new(),
+        }
+    }
+
+    /// `dump`'s decoded lists: a reference that knows every fragment only where its list is not
+    /// full, and that is not trusted when a word of it is corrupt.
+    ///
+    /// # Errors
+    /// A dump that cannot be decoded.
+    pub fn dump(dump: &Dump) -> Result<Self, String> {
+        let capture = dump.capture().map_err(|e| e.to_string())?;
+        let mut notes = caveats(&capture);
+        let corrupt_words = dump
+            .check_words()
+            .map_err(|e| e.to_string())?
+            .corrupt_words();
+        if corrupt_words > 0 {
+            notes.push(format!(
+                "the reference dump holds {corrupt_words} words its layout says cannot be there: \
+                 the comparison cannot be trusted, and is not called equal"
+            ));
+        }
+        Ok(Self {
+            lists: Cow::Owned(Oracle::from_capture(&capture)),
+            kind: Kind::Dump {
+                complete: complete_pixels(&capture),
+                keeps: capture.keeps,
+                identity: capture.identity,
+                corrupt_words,
+                notes,
+            },
+            width: dump.header.width,
+            height: dump.header.height,
+            notes: Vec::new(),
+        })
+    }
+
+    /// The reference's lists.
+    #[must_use]
+    pub fn oracle(&self) -> &Oracle {
+        &self.lists
+    }
+
+    /// The precision the oracle is owed within (`None` for a dump or a masked reference).
+    pub(super) fn precision(&self) -> Option<&Precision> {
+        match &self.kind {
+            Kind::Oracle { precision, .. } => Some(precision),
+            _ => None,
+        }
+    }
+
+    /// The vertex stage the candidate is judged as (f64 but against the oracle under f32).
+    pub(super) fn vertex_precision(&self) -> VertexPrecision {
+        match &self.kind {
+            Kind::Oracle {
+                vertex_precision, ..
+            } => *vertex_precision,
+            _ => VertexPrecision::F64,
+        }
+    }
+
+    /// The per-pixel view of the per-sample oracle, for a masked reference.
+    pub(super) fn per_pixel(&self) -> Option<&MaskedLists> {
+        match &self.kind {
+            Kind::Masked(nodes) => Some(nodes),
+            _ => None,
+        }
+    }
+
+    /// Whether this is the per-sample oracle's per-pixel view.
+    pub(super) fn is_masked(&self) -> bool {
+        matches!(self.kind, Kind::Masked(_))
+    }
+
+    /// The identity of the reference's words.
+    pub(super) fn identity(&self) -> Identity {
+        match &self.kind {
+            Kind::Dump { identity, .. } => *identity,
+            _ => Identity::KeyAndPrim,
+        }
+    }
+
+    /// Per list, whether the reference knows every fragment (`None`: everywhere).
+    pub(super) fn complete(&self) -> Option<&[bool]> {
+        match &self.kind {
+            Kind::Dump { complete, .. } => Some(complete),
+            _ => None,
+        }
+    }
+
+    /// Corrupt words of a reference dump.
+    pub(super) fn corrupt_words(&self) -> u64 {
+        match &self.kind {
+            Kind::Dump { corrupt_words, .. } => *corrupt_words,
+            _ => 0,
+        }
+    }
+
+    /// A reference dump's caveats.
+    pub(super) fn dump_notes(&self) -> Vec<String> {
+        match &self.kind {
+            Kind::Dump { notes, .. } => notes.clone(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Lists per pixel: the samples of a per-sample layout, else 1.
+    pub(super) fn lists_per_pixel(&self) -> u32 {
+        let pixels = (self.width as usize * self.height as usize).max(1);
+        (self.lists.pixels() / pixels).max(1) as u32
+    }
+
+    /// Takes out of `candidate` the fragments a K-list dump reference cannot know: in a pixel
+    /// where the reference is full, those beyond its K-th (farther for K nearest, nearer for K
+    /// farthest), which it would have dropped itself. Returns the note that says how many.
+    pub(super) fn drop_unknowable(&self, candidate: &mut Capture) -> Option<String> {
+        let Kind::Dump {
+            keeps, complete, ..
+        } = &self.kind
+        else {
+            return None;
+        };
+        let nearest = match keeps {
+            Keeps::Nearest(_) => true,
+            Keeps::Farthest(_) => false,
+            Keeps::All { .. } => return None,
+        };
+        let mask = match candidate.identity {
+            Identity::KeyAndPrim => u64::MAX,
+            Identity::KeyOnly => u64::MAX << 32,
+            Identity::PrimOnly => return None,
+        };
+        let mut lists = PixelLists::with_pixels(candidate.pixels());
+        let (mut dropped, mut pixels) = (0, 0);
+        for (p, &known) in complete.iter().enumerate() {
+            let reference = self.lists.pixel(p);
+            let bound = if nearest {
+                reference.last()
+            } else {
+                reference.first()
+            };
+            let got = candidate.pixel(p);
+            let beyond = |e: u64, bound: u64| {
+                if nearest {
+                    e & mask > bound & mask
+                } else {
+                    e & mask < bound & mask
+                }
+            };
+            let kept: Vec<u64> = match bound.filter(|_| !known) {
+                Some(&bound) => got
+                    .iter()
+                    .copied()
+                    .filter(|&e| e == u64::MAX || !beyond(e, bound))
+                    .collect(),
+                None => got.to_vec(),
+            };
+            let gone = (got.len() - kept.len()) as u64;
+            dropped += gone;
+            pixels += u64::from(gone > 0);
+            lists.push_pixel(kept);
+        }
+        candidate.lists = lists;
+        (dropped > 0).then(|| {
+            format!(
+                "{dropped} candidate fragments in {pixels} pixels lie beyond what the reference \
+                 kept there (its K-th fragment) and cannot be judged: not counted as extra"
+            )
+        })
+    }
+}
+
+/// Why a dump used as the reference may not be the whole truth.
+fn caveats(capture: &Capture) -> Vec<String> {
+    match &capture.keeps {
+        Keeps::Nearest(k) | Keeps::Farthest(k) => {
+            let full = (0..capture.pixels())
+                .filter(|&p| capture.pixel(p).len() >= *k as usize)
+                .count();
+            (full > 0)
+                .then(|| {
+                    format!(
+                        "the reference is an MDTS dump keeping {k} fragments per pixel and \
+                         {full} pixels are full: fragments beyond K there are unknown to it"
+                    )
+                })
+                .into_iter()
+                .collect()
+        }
+        Keeps::All { overflow, .. } => {
+            let lost: u64 = overflow.iter().map(|&o| u64::from(o)).sum();
+            (lost > 0)
+                .then(|| {
+                    format!("the reference A-buffer overflowed: {lost} fragments are unknown to it")
+                })
+                .into_iter()
+                .collect()
+        }
+    }
+}

@@ -1,0 +1,257 @@
+//! The two sides of `fragsim compare`, as the command line names them (a dump directory or its
+//! `dump.json`, or `oracle`): their headers checked against each other, the oracle rebuilt from
+//! the scene a dump names when a side asks for it, and the verdict of [`super::judge`].
+
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+use fragsim_raster::{Conventions, VertexPrecision, Viewport};
+use serde::Serialize;
+
+use super::{judge, Candidate, Options, Reference, Verdict};
+use crate::dump::{Dump, Header, MASKED_SCHEME};
+use crate::precision::{f32_reference, Precision};
+use crate::samples::SampleOracle;
+use crate::Oracle;
+
+/// One side of a comparison.
+#[derive(Debug)]
+pub enum Side {
+    /// fragsim's serial oracle on the scene the other side's header names.
+    Oracle,
+    /// A dump, read from `path`.
+    Dump(Box<Dump>, PathBuf),
+}
+
+/// A side as a report names it.
+#[derive(Clone, Debug, Serialize)]
+pub struct SideReport {
+    /// The path given, or `oracle`.
+    pub source: String,
+    /// The dump's scheme, or `oracle`.
+    pub scheme: String,
+    /// What wrote it.
+    pub producer: String,
+    /// The K of a K-list dump.
+    pub k: Option<u32>,
+    /// The capacity of a fixed-capacity dump.
+    pub capacity: Option<u32>,
+}
+
+impl SideReport {
+    /// The side in one line: `fragsim oracle`, or the dump's path, scheme, size and producer.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let size = match (self.k, self.capacity) {
+            (Some(k), _) => format!(" K={k}"),
+            (None, Some(c)) => format!(" capacity={c}"),
+            _ => String::new(),
+        };
+        if self.source == "oracle" {
+            "fragsim oracle".to_string()
+        } else {
+            let (source, scheme, producer) = (&self.source, &self.scheme, &self.producer);
+            format!("{source} ({scheme}{size}, by {producer})")
+        }
+    }
+}
+
+impl Side {
+    /// The side `text` names: `oracle`, or a dump directory (or its `dump.json`), read.
+    ///
+    /// # Errors
+    /// A dump that cannot be read.
+    pub fn open(text: &str) -> Result<Self, String> {
+        if text == "oracle" {
+            return Ok(Self::Oracle);
+        }
+        let path = PathBuf::from(text);
+        let dump = Dump::read(&path).map_err(|e| e.to_string())?;
+        Ok(Self::Dump(Box::new(dump), path))
+    }
+
+    fn header(&self) -> Option<&Header> {
+        match self {
+            Self::Oracle => None,
+            Self::Dump(dump, _) => Some(&dump.header),
+        }
+    }
+
+    fn is_masked(&self) -> bool {
+        matches!(self, Self::Dump(dump, _) if dump.is_masked())
+    }
+
+    /// The side as a report names it.
+    #[must_use]
+    pub fn describe(&self) -> SideReport {
+        match self {
+            Self::Oracle => SideReport {
+                source: "oracle".into(),
+                scheme: "oracle".into(),
+                producer: format!("fragsim {}", env!("CARGO_PKG_VERSION")),
+                k: None,
+                capacity: None,
+            },
+            Self::Dump(dump, path) => SideReport {
+                source: path.display().to_string(),
+                scheme: dump.header.scheme.clone(),
+                producer: dump.header.producer.clone(),
+                k: dump.header.k,
+                capacity: dump.header.capacity,
+            },
+        }
+    }
+}
+
+/// How [`judge_sides`] judges: [`Options`] and what the command line adds.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SidesOptions<'a> {
+    /// Tolerance and examples.
+    pub options: Options,
+    /// How the candidate's vertex stage is judged against the oracle: f64 owes every bit to the
+    /// oracle rebuilt under the dump's declared conventions; f32 judges within the bounds derived
+    /// for an f32 vertex stage against the exact f64 one.
+    pub vertex_precision: VertexPrecision,
+    /// The mesh file to rebuild the oracle from instead of the one the dump names.
+    pub mesh: Option<&'a Path>,
+    /// Compare two dumps that name different scenes (a note) instead of refusing them.
+    pub allow_different_scenes: bool,
+}
+
+/// Judges `candidate` against `reference` ([`super::judge`]), the oracle rebuilt from the scene
+/// the dump names (`--mesh` replaces its mesh) where a side is [`Side::Oracle`].
+///
+/// # Errors
+/// Both sides the oracle; dumps of different viewports, or of different scenes unless allowed;
+/// `--vertex-precision f32` on a multisampled dump or against a reference dump; a masked-node dump
+/// anywhere but as the candidate against the oracle; a scene that cannot be rebuilt; a dump that
+/// cannot be decoded.
+pub fn judge_sides(
+    reference: &Side,
+    candidate: &Side,
+    options: &SidesOptions<'_>,
+) -> Result<Verdict, String> {
+    let (mut header, beside) = match (reference, candidate) {
+        (Side::Dump(dump, path), _) | (Side::Oracle, Side::Dump(dump, path)) => {
+            (dump.header.clone(), dump_dir(path))
+        }
+        (Side::Oracle, Side::Oracle) => {
+            return Err("compare needs at least one dump: both sides are `oracle`".into())
+        }
+    };
+    if let Some(mesh) = options.mesh {
+        (header.scene.mesh, header.scene.name) = (Some(mesh.display().to_string()), None);
+    }
+    let mut notes = Vec::new();
+    if let (Some(a), Some(b)) = (reference.header(), candidate.header()) {
+        if (a.width, a.height) != (b.width, b.height) {
+            return Err(format!(
+                "the dumps cover different viewports: {}x{} and {}x{}",
+                a.width, a.height, b.width, b.height
+            ));
+        }
+        if a.scene != b.scene {
+            let which = format!(
+                "the dumps name different scenes: {} and {}",
+                a.scene.describe(),
+                b.scene.describe()
+            );
+            if !options.allow_different_scenes {
+                return Err(format!(
+                    "{which} (--allow-different-scenes compares them anyway)"
+                ));
+            }
+            notes.push(which);
+        }
+    }
+    let judged_f32 = options.vertex_precision == VertexPrecision::F32;
+    let samples = header.samples().map_err(|e| e.to_string())?;
+    // The refusal stays until the precision verdict derives its bounds per sample.
+    if judged_f32 && samples > 1 {
+        return Err(format!(
+            "--vertex-precision f32 derives its bounds at pixel centres: the dump has {samples} \
+             samples a pixel"
+        ));
+    }
+    // A masked-node dump is judged against the per-pixel view of the per-sample oracle, which
+    // only the oracle side can give.
+    let masked = candidate.is_masked();
+    if reference.is_masked() || (masked && !matches!(reference, Side::Oracle)) {
+        return Err(format!(
+            "a masked-node dump ({MASKED_SCHEME}) is compared as the candidate against the \
+             oracle: `fragsim compare oracle DUMP`"
+        ));
+    }
+    let size = (header.width, header.height);
+    // The oracle is built only when a side asks for it (the scene may be a large mesh). Without
+    // f32 it is rebuilt under the conventions the dump declares, its vertex stage included, and
+    // owes every bit; with f32 it takes the exact f64 vertex stage under the declared
+    // conventions, and the candidate is judged within the bounds derived for an f32 one: they
+    // measure an implementation's distance from the exact positions, not from another f32 order.
+    let needs_oracle = matches!(reference, Side::Oracle) || matches!(candidate, Side::Oracle);
+    let oracle = if !needs_oracle {
+        None
+    } else if judged_f32 {
+        let viewport = Viewport::new(header.width, header.height)?;
+        let (oracle, precision) =
+            f32_reference(&header.scene, viewport, Some(&beside)).map_err(|e| e.to_string())?;
+        Some(Reference::new(
+            Cow::Owned(oracle),
+            precision,
+            VertexPrecision::F32,
+            size,
+        ))
+    } else {
+        let scene = header
+            .scene
+            .load(Some(&beside))
+            .map_err(|e| e.to_string())?;
+        let viewport = Viewport::new(header.width, header.height)?;
+        let view = header
+            .scene
+            .view(&scene, viewport)
+            .map_err(|e| e.to_string())?;
+        Some(if masked {
+            Reference::masked(SampleOracle::build(&view)?.per_pixel(), size)
+        } else {
+            let oracle = Oracle::build(&view);
+            let exact = Conventions {
+                vertex_precision: VertexPrecision::F64,
+                ..view.conventions()
+            };
+            let precision = Precision::derive(&view, &exact);
+            Reference::new(Cow::Owned(oracle), precision, VertexPrecision::F64, size)
+        })
+    };
+    if judged_f32 && !matches!(reference, Side::Oracle) {
+        return Err(
+            "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
+             to derive bounds from"
+                .into(),
+        );
+    }
+    // The oracle is the reference, or (against a reference dump) the candidate.
+    let (mut reference, oracle) = match (reference, oracle) {
+        (Side::Dump(dump, _), oracle) => (Reference::dump(dump)?, oracle),
+        (Side::Oracle, Some(oracle)) => (oracle, None),
+        (Side::Oracle, None) => unreachable!("the oracle is built when a side names it"),
+    };
+    reference.notes = notes;
+    let candidate = match (candidate, &oracle) {
+        (Side::Dump(dump, _), _) => Candidate::Dump(dump),
+        (Side::Oracle, Some(oracle)) => Candidate::Oracle(oracle.oracle()),
+        (Side::Oracle, None) => unreachable!("the oracle is built when a side names it"),
+    };
+    let mut verdict = judge(&reference, candidate, &options.options)?;
+    verdict.scene = Some(header.scene);
+    Ok(verdict)
+}
+
+/// The directory a dump's relative paths are taken from.
+fn dump_dir(path: &Path) -> PathBuf {
+    if path.is_dir() {
+        path.to_path_buf()
+    } else {
+        path.parent().unwrap_or(Path::new(".")).to_path_buf()
+    }
+}
