@@ -86,7 +86,8 @@ impl Executors {
     /// then its own passes.
     ///
     /// # Errors
-    /// A parameter the scheme rejects, or storage beyond the memory cap.
+    /// A parameter the scheme rejects, or storage beyond the memory cap: its tables when it is
+    /// built, or the pages its frame's writes reach ([`crate::memory::pages`]).
     pub fn run(
         &mut self,
         name: SchemeName,
@@ -95,6 +96,13 @@ impl Executors {
         sizing: &Sizing,
     ) -> Result<NamedRun, String> {
         let viewport = view.viewport();
+        for cap in [
+            &mut self.serial.memory_cap,
+            &mut self.parallel.memory_cap,
+            &mut self.tiled.memory_cap,
+        ] {
+            *cap = Some(sizing.memory_cap);
+        }
         let counted = name.needs_count_pass(sizing).then(|| {
             DepthCounts::from_run(run_with_fault(
                 &DepthCount::new(viewport),
@@ -148,6 +156,13 @@ impl Executors {
         if let Some(counted) = counted {
             named.run = named.run.after_count_pass(&counted.run);
             named.counts = Some(counted.counts);
+        }
+        if named.run.stats.over_cap {
+            return Err(format!(
+                "{} needed more than the memory cap of {} bytes of per-pixel storage: its frame \
+                 allocated {} bytes and its writes reached more pages (--memory-cap raises it)",
+                named.name, sizing.memory_cap, named.run.stats.allocated_bytes
+            ));
         }
         Ok(named)
     }
