@@ -173,10 +173,11 @@ impl Executors {
 ///
 /// With `--k auto`, `--capacity auto` or a scheme sized to the scene, storage is known only after
 /// a counting pass, and the oracle alone needs 24 bytes a pixel (6 GiB at 16384 × 16384): a
-/// refusal must not wait for them. The smallest storage is one slot per pixel for MDTS and the
-/// fixed A-buffer, and for the exact A-buffer its counters and offsets with no fragment (4 + 4
-/// bytes a pixel, as `ABuffer::exact` counts them): every catalog entry is built at its smallest
-/// (one slot or layer, the least pool, no fragments) and refused if even that exceeds the cap.
+/// refusal must not wait for them. Every catalog entry is built at its smallest (one slot or
+/// layer, the least pool, no fragments) and refused if even that exceeds the cap; what a build
+/// checks is what is allocated before any fragment (tables and page tables,
+/// [`Layout::least_bytes`]: the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
+/// being checked as a frame writes them.
 ///
 /// # Errors
 /// The first scheme refused, with the bytes it would need at least.
