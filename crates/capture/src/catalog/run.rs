@@ -87,7 +87,7 @@ impl Executors {
     ///
     /// # Errors
     /// A parameter the scheme rejects, or storage beyond the memory cap: its tables when it is
-    /// built, or the pages its frame's writes reach ([`crate::memory::pages`]).
+    /// built, or the pages its frame's writes reach (`memory/pages.rs`).
     pub fn run(
         &mut self,
         name: SchemeName,

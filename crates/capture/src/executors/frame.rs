@@ -79,7 +79,7 @@ pub struct RunStats {
     /// Bytes of per-pixel storage the scheme addresses (its [`Layout`], words and tables).
     pub memory_bytes: u64,
     /// Bytes of per-pixel storage allocated: the tables and the pages of words that writes
-    /// reached ([`crate::memory::pages`]), at most [`RunStats::memory_bytes`] and the page tables.
+    /// reached (`memory/pages.rs`), at most [`RunStats::memory_bytes`] and the page tables.
     pub allocated_bytes: u64,
     /// Whether a write found no storage within the memory cap: the capture is not to be used
     /// (`Executors::run` reports the run as over the cap).

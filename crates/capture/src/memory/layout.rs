@@ -42,7 +42,7 @@ impl Layout {
     }
 
     /// The bytes a frame allocates before any fragment: the tables and the page tables of the
-    /// words, whose pages are allocated as writes reach them ([`super::pages`]). What the memory
+    /// words, whose pages are allocated as writes reach them (`memory/pages.rs`). What the memory
     /// cap is checked against when a scheme is built; the pages are checked as they are
     /// allocated.
     #[must_use]

@@ -10,7 +10,7 @@
 //! of a pass, a thread join, publishes everything (the proof is in `docs/proof.md`, loom checks it).
 //!
 //! Both memories allocate their words a page at a time, on the first write that reaches a page
-//! ([`pages`]), within a byte cap set by the executor ([`SerialMemory::reset`]): storage, its
+//! (`memory/pages.rs`), within a byte cap set by the executor ([`SerialMemory::reset`]): storage, its
 //! reset and the post pass then follow the pixels the fragments reach, not viewport × K. That
 //! bookkeeping is no memory operation of the simulated GPU: it costs a load of the page's entry
 //! and of its written flag beside each operation, and the first write to a page its allocation.
@@ -105,7 +105,7 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
         Self: Sized;
 
     /// Bytes of storage actually allocated, where the memory allocates as it is written
-    /// ([`pages`]); `None` for a memory that holds every word of its layout.
+    /// (`memory/pages.rs`); `None` for a memory that holds every word of its layout.
     fn allocated_bytes(&self) -> Option<u64> {
         None
     }
