@@ -10,7 +10,7 @@ use fragsim::capture::executors::{run_parallel, run_serial, Run};
 use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
 use fragsim::capture::schemes::peeling::DepthPeeling;
 use fragsim::capture::schemes::zbuffer::ZBuffer;
-use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{CaptureError, Layout, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
 use proptest::prelude::*;
@@ -369,8 +369,8 @@ fn layers_beyond_storage_are_counted_as_overflow_and_the_kept_ones_are_the_right
     }
 }
 
-/// Builds a scheme within a memory cap and names it.
-type Build = Box<dyn Fn(u64) -> Result<String, CaptureError>>;
+/// Builds a scheme within a memory cap: its name and layout.
+type Build = Box<dyn Fn(u64) -> Result<(String, Layout), CaptureError>>;
 
 #[test]
 fn zero_layers_or_too_much_memory_is_an_error() {
@@ -390,35 +390,48 @@ fn zero_layers_or_too_much_memory_is_an_error() {
     let cases: [(u64, Build); 5] = [
         (
             (2 + 5) * 8 + 4,
-            Box::new(move |cap| DepthPeeling::<u64>::new(viewport, 5, cap).map(|s| s.name())),
+            Box::new(move |cap| {
+                DepthPeeling::<u64>::new(viewport, 5, cap).map(|s| (s.name(), s.layout()))
+            }),
         ),
         (
             (2 + 5) * 4 + 4,
-            Box::new(move |cap| DepthPeeling::<u32>::new(viewport, 5, cap).map(|s| s.name())),
+            Box::new(move |cap| {
+                DepthPeeling::<u32>::new(viewport, 5, cap).map(|s| (s.name(), s.layout()))
+            }),
         ),
         (
             (4 + 5) * 8 + 4,
-            Box::new(move |cap| DualDepthPeeling::<u64>::new(viewport, 5, cap).map(|s| s.name())),
+            Box::new(move |cap| {
+                DualDepthPeeling::<u64>::new(viewport, 5, cap).map(|s| (s.name(), s.layout()))
+            }),
         ),
         (
             (4 + 5) * 4 + 4,
-            Box::new(move |cap| DualDepthPeeling::<u32>::new(viewport, 5, cap).map(|s| s.name())),
+            Box::new(move |cap| {
+                DualDepthPeeling::<u32>::new(viewport, 5, cap).map(|s| (s.name(), s.layout()))
+            }),
         ),
         (
             8,
-            Box::new(move |cap| ZBuffer::new(viewport, cap).map(|s| s.name())),
+            Box::new(move |cap| ZBuffer::new(viewport, cap).map(|s| (s.name(), s.layout()))),
         ),
     ];
     let mut names = Vec::new();
     for (bytes_per_pixel, build) in cases {
-        let needed = bytes_per_pixel * pixels;
-        names.push(build(needed).unwrap());
-        match build(needed - 1) {
+        let (name, layout) = build(MEMORY_CAP_DEFAULT).unwrap();
+        assert_eq!(layout.bytes(), bytes_per_pixel * pixels, "{name}");
+        // The cap refuses at build what is allocated before any fragment (the page tables);
+        // the pages are checked as a frame writes them.
+        let least = layout.least_bytes();
+        assert!(build(least).is_ok(), "{name}");
+        match build(least - 1) {
             Err(CaptureError::TooMuchMemory { needed: n, cap, .. }) => {
-                assert_eq!((n, cap), (needed, needed - 1));
+                assert_eq!((n, cap), (least, least - 1));
             }
             other => panic!("expected TooMuchMemory, got {other:?}"),
         }
+        names.push(name);
     }
     assert_eq!(
         names,

@@ -45,7 +45,8 @@ pub enum CaptureError {
     /// A scheme parameter is out of range (K = 0, say).
     #[error("{0}")]
     BadParameter(String),
-    /// The storage would exceed the memory cap.
+    /// The storage would exceed the memory cap: its tables and page tables, allocated before
+    /// any fragment ([`Layout::least_bytes`]), or the pages of words a frame's writes reached.
     #[error(
         "{scheme} would need {needed} bytes of per-pixel storage, more than the cap of {cap} bytes"
     )]
@@ -168,9 +169,12 @@ pub trait Scheme: Sync {
     }
 }
 
-/// Fails with [`CaptureError::TooMuchMemory`] when `layout` exceeds `cap`.
+/// Fails with [`CaptureError::TooMuchMemory`] when what `layout` allocates before any fragment
+/// ([`Layout::least_bytes`]: its tables and page tables) exceeds `cap`. The pages of words are
+/// allocated as writes reach them, and checked against the cap then: a frame whose pages exceed
+/// it is reported over the cap (`RunStats::over_cap`), never returned as a result.
 pub(crate) fn check_cap(scheme: &str, layout: &Layout, cap: u64) -> Result<(), CaptureError> {
-    let needed = layout.bytes();
+    let needed = layout.least_bytes();
     if needed > cap {
         return Err(CaptureError::TooMuchMemory {
             scheme: scheme.into(),

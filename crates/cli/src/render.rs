@@ -176,8 +176,12 @@ pub struct RunSummary {
     pub pass_ms: f64,
     /// The post pass (resolve, sort), in milliseconds.
     pub resolve_ms: f64,
-    /// Bytes of per-pixel storage.
+    /// Bytes of per-pixel storage the scheme addresses (its layout: viewport × slots).
     pub memory_bytes: u64,
+    /// Bytes of per-pixel storage allocated: the tables, the page tables and the pages of words
+    /// the frame's writes reached (the larger of the counting pass and the capture where both
+    /// ran). The memory cap bounds this.
+    pub allocated_bytes: u64,
     /// Slots per pixel (MDTS K or fixed A-buffer capacity); absent for exact storage.
     pub slots_per_pixel: Option<u32>,
 }
@@ -288,6 +292,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 pass_ms: ms(run.stats.pass_time),
                 resolve_ms: ms(run.stats.resolve_time),
                 memory_bytes: run.stats.memory_bytes,
+                allocated_bytes: run.stats.allocated_bytes,
                 slots_per_pixel: named.slots,
             });
             progress.inc(1);
@@ -427,7 +432,7 @@ fn print_table(
         oracle_ms
     );
     type Cell = fn(&RunSummary) -> String;
-    let columns: [(&str, usize, Cell); 17] = [
+    let columns: [(&str, usize, Cell); 18] = [
         ("scheme", 24, |r| r.scheme.clone()),
         ("guarantee", 26, |r| r.guarantee.clone()),
         ("executor", 9, |r| r.executor.clone()),
@@ -444,6 +449,7 @@ fn print_table(
         ("maxdc", 5, |r| r.max_depth_complexity.to_string()),
         ("time ms", 9, |r| format!("{:.2}", r.time_ms)),
         ("memory B", 11, |r| r.memory_bytes.to_string()),
+        ("allocated B", 11, |r| r.allocated_bytes.to_string()),
         ("captured", 9, |r| r.captured.to_string()),
         ("overflow", 8, |r| r.overflowed.to_string()),
         ("lost", 6, |r| r.lost.to_string()),

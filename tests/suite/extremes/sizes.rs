@@ -7,7 +7,7 @@ use assert_cmd::Command;
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
 use fragsim::capture::schemes::mdts::{Direction, Mdts};
-use fragsim::capture::{CaptureError, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, MeshError, OrbitCamera, Scene, Viewport};
 
@@ -51,17 +51,26 @@ fn a_16384_square_viewport_beyond_the_memory_cap_is_refused_naming_the_bytes() {
         let message = err.to_string();
         assert!(message.contains(&needed.to_string()), "{message}");
     };
+    // The storage addressed, as documented; what the cap refuses at build is what is allocated
+    // before any fragment (the page tables), the pages being checked as a frame writes them.
+    let unbounded = u64::MAX;
+    let mdts = Mdts::<u64>::new(huge, 1, Direction::Ascending, unbounded).unwrap();
+    let mdts32 = Mdts::<u32>::new(huge, 1, Direction::Ascending, unbounded).unwrap();
+    let abuffer = ABuffer::fixed(huge, 1, PostSort::Insertion, unbounded).unwrap();
+    assert_eq!(mdts.layout().bytes(), pixels * 8);
+    assert_eq!(mdts32.layout().bytes(), pixels * 4);
+    assert_eq!(abuffer.layout().bytes(), pixels * 12);
     refused(
         Mdts::<u64>::new(huge, 1, Direction::Ascending, cap).map(drop),
-        pixels * 8,
+        mdts.layout().least_bytes(),
     );
     refused(
         Mdts::<u32>::new(huge, 1, Direction::Ascending, cap).map(drop),
-        pixels * 4,
+        mdts32.layout().least_bytes(),
     );
     refused(
         ABuffer::fixed(huge, 1, PostSort::Insertion, cap).map(drop),
-        pixels * 12,
+        abuffer.layout().least_bytes(),
     );
     // One more pixel per side is refused by the viewport itself.
     let err = Viewport::new(side + 1, 1).unwrap_err();
@@ -88,9 +97,14 @@ fn the_binary_refuses_a_16384_square_viewport_beyond_the_memory_cap_before_the_o
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success());
     assert!(!stderr.contains("panicked"), "{stderr}");
-    // MDTS with 64-bit words and the default K = 20: 16384² × 20 × 8 bytes.
+    // MDTS with 64-bit words and the default K = 20: the page tables of 16384² × 20 words.
+    let huge = viewport(16384, 16384);
+    let least = Mdts::<u64>::new(huge, 20, Direction::Ascending, u64::MAX)
+        .unwrap()
+        .layout()
+        .least_bytes();
     assert!(
-        stderr.contains("42949672960") && stderr.contains("1000000"),
+        stderr.contains(&least.to_string()) && stderr.contains("1000000"),
         "{stderr}"
     );
     // Refused before the oracle's counting pass (which took 20 s and 5.4 GB here before the fix).

@@ -123,24 +123,48 @@ fn constructors_reject_k_zero_no_passes_and_too_much_memory() {
         KBufferMultipass::new(v, 0, 4, MEMORY_CAP_DEFAULT).map(drop)
     ));
     assert!(bad(StencilRouted::new(v, 0, MEMORY_CAP_DEFAULT).map(drop)));
+    // The storage as documented, per pixel of 4,096: 8 slots of 8 bytes; render targets add a
+    // lock and two tickets (12 bytes); the multi-pass k-buffer's slots and tentative list
+    // (2 × 64), c, t and the window's nearest (24), three counts (12), the render-target words
+    // (12), the output list too; stencil routing's 2 × 64 and a 4-byte count.
+    let stores = |k, cap| KBuffer::with_write_back(v, k, WriteBack::SeparateStores, cap);
+    let per_pixel = 128 + 24 + 12 + 12;
+    let layouts = [
+        (stores(8, MEMORY_CAP_DEFAULT).unwrap().layout(), 64),
+        (KBuffer::new(v, 8, MEMORY_CAP_DEFAULT).unwrap().layout(), 76),
+        (
+            KBufferMultipass::new(v, 8, 0, MEMORY_CAP_DEFAULT)
+                .unwrap()
+                .layout(),
+            per_pixel,
+        ),
+        (
+            StencilRouted::new(v, 2, MEMORY_CAP_DEFAULT)
+                .unwrap()
+                .layout(),
+            132,
+        ),
+    ];
+    for (layout, bytes) in layouts {
+        assert_eq!(layout.bytes(), 4096 * bytes);
+    }
+    assert!(
+        KBufferMultipass::new(v, 8, 1, MEMORY_CAP_DEFAULT)
+            .unwrap()
+            .layout()
+            .bytes()
+            > 4096 * per_pixel
+    );
+    // The cap refuses at build what is allocated before any fragment (the page tables); the
+    // pages are checked as a frame writes them.
     let too_much =
         |e: Result<(), CaptureError>| matches!(e, Err(CaptureError::TooMuchMemory { .. }));
-    // 4,096 pixels: 8 slots of 8 bytes are 256 KiB, and render targets add a lock and two
-    // tickets (12 bytes a pixel).
-    let stores = |k, cap| KBuffer::with_write_back(v, k, WriteBack::SeparateStores, cap);
-    assert!(stores(8, 256 << 10).is_ok());
-    assert!(too_much(stores(8, (256 << 10) - 1).map(drop)));
-    assert!(KBuffer::new(v, 8, 4096 * 76).is_ok());
-    assert!(too_much(KBuffer::new(v, 8, 4096 * 76 - 1).map(drop)));
-    // The multi-pass k-buffer: slots and tentative list (2 × 64), c, t and the window's nearest
-    // (24), three counts (12), the render-target words (12); the output list counts too.
-    let per_pixel = 128 + 24 + 12 + 12;
-    assert!(KBufferMultipass::new(v, 8, 0, 4096 * per_pixel).is_ok());
-    assert!(too_much(
-        KBufferMultipass::new(v, 8, 1, 4096 * per_pixel).map(drop)
-    ));
-    assert!(too_much(StencilRouted::new(v, 2, 4096 * 132 - 1).map(drop)));
-    assert!(StencilRouted::new(v, 2, 4096 * 132).is_ok());
+    let least = layouts[1].0.least_bytes();
+    assert!(KBuffer::new(v, 8, least).is_ok());
+    assert!(too_much(KBuffer::new(v, 8, least - 1).map(drop)));
+    let least = layouts[3].0.least_bytes();
+    assert!(StencilRouted::new(v, 2, least).is_ok());
+    assert!(too_much(StencilRouted::new(v, 2, least - 1).map(drop)));
 }
 
 // ---------------------------------------------------------------- random scenes

@@ -86,7 +86,8 @@ impl Executors {
     /// then its own passes.
     ///
     /// # Errors
-    /// A parameter the scheme rejects, or storage beyond the memory cap.
+    /// A parameter the scheme rejects, or storage beyond the memory cap: its tables when it is
+    /// built, or the pages its frame's writes reach (`memory/pages.rs`).
     pub fn run(
         &mut self,
         name: SchemeName,
@@ -95,6 +96,13 @@ impl Executors {
         sizing: &Sizing,
     ) -> Result<NamedRun, String> {
         let viewport = view.viewport();
+        for cap in [
+            &mut self.serial.memory_cap,
+            &mut self.parallel.memory_cap,
+            &mut self.tiled.memory_cap,
+        ] {
+            *cap = Some(sizing.memory_cap);
+        }
         let counted = name.needs_count_pass(sizing).then(|| {
             DepthCounts::from_run(run_with_fault(
                 &DepthCount::new(viewport),
@@ -149,6 +157,13 @@ impl Executors {
             named.run = named.run.after_count_pass(&counted.run);
             named.counts = Some(counted.counts);
         }
+        if named.run.stats.over_cap {
+            return Err(format!(
+                "{} needed more than the memory cap of {} bytes of per-pixel storage: its frame \
+                 allocated {} bytes and its writes reached more pages (--memory-cap raises it)",
+                named.name, sizing.memory_cap, named.run.stats.allocated_bytes
+            ));
+        }
         Ok(named)
     }
 }
@@ -158,10 +173,11 @@ impl Executors {
 ///
 /// With `--k auto`, `--capacity auto` or a scheme sized to the scene, storage is known only after
 /// a counting pass, and the oracle alone needs 24 bytes a pixel (6 GiB at 16384 × 16384): a
-/// refusal must not wait for them. The smallest storage is one slot per pixel for MDTS and the
-/// fixed A-buffer, and for the exact A-buffer its counters and offsets with no fragment (4 + 4
-/// bytes a pixel, as `ABuffer::exact` counts them): every catalog entry is built at its smallest
-/// (one slot or layer, the least pool, no fragments) and refused if even that exceeds the cap.
+/// refusal must not wait for them. Every catalog entry is built at its smallest (one slot or
+/// layer, the least pool, no fragments) and refused if even that exceeds the cap; what a build
+/// checks is what is allocated before any fragment (tables and page tables,
+/// [`Layout::least_bytes`]: the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
+/// being checked as a frame writes them.
 ///
 /// # Errors
 /// The first scheme refused, with the bytes it would need at least.

@@ -76,8 +76,14 @@ pub struct RunStats {
     pub pass_time: Duration,
     /// The post pass.
     pub resolve_time: Duration,
-    /// Bytes of per-pixel storage.
+    /// Bytes of per-pixel storage the scheme addresses (its [`Layout`], words and tables).
     pub memory_bytes: u64,
+    /// Bytes of per-pixel storage allocated: the tables and the pages of words that writes
+    /// reached (`memory/pages.rs`), at most [`RunStats::memory_bytes`] and the page tables.
+    pub allocated_bytes: u64,
+    /// Whether a write found no storage within the memory cap: the capture is not to be used
+    /// (`Executors::run` reports the run as over the cap).
+    pub over_cap: bool,
     /// Threads that ran the pass.
     pub threads: usize,
     /// Read-modify-write (locked) operations, when the run counted them
@@ -111,6 +117,8 @@ impl Run {
                 passes: count.stats.passes + self.stats.passes,
                 pass_time: counted + self.stats.pass_time,
                 memory_bytes: count.stats.memory_bytes.max(self.stats.memory_bytes),
+                allocated_bytes: count.stats.allocated_bytes.max(self.stats.allocated_bytes),
+                over_cap: count.stats.over_cap || self.stats.over_cap,
                 locked_ops: self
                     .stats
                     .locked_ops
@@ -138,17 +146,28 @@ pub fn run<S: Scheme, M: Memory>(
     let pass_time = start.elapsed();
     let resolve_start = Instant::now();
     let capture = resolve(memory);
+    let layout = scheme.layout();
     let stats = RunStats {
         counters,
         passes,
         pass_time,
         resolve_time: resolve_start.elapsed(),
-        memory_bytes: scheme.layout().bytes(),
+        memory_bytes: layout.bytes(),
+        allocated_bytes: allocated_bytes(&layout, memory),
+        over_cap: memory.over_cap(),
         threads,
         locked_ops: None,
         count_pass_time: None,
     };
     Run { capture, stats }
+}
+
+/// The bytes of `layout` that `memory` allocated: its tables and the words allocated, every word
+/// where the memory holds them all.
+pub(crate) fn allocated_bytes<M: Memory>(layout: &Layout, memory: &M) -> u64 {
+    memory
+        .allocated_bytes()
+        .map_or(layout.bytes(), |words| words + layout.table_bytes as u64)
 }
 
 /// Every geometry pass of a frame on `memory`, kept by the caller: `geometry_pass(pass)` runs
@@ -269,16 +288,17 @@ pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
 pub(crate) trait ReusableStorage: Memory + Sized {
     /// Whether this storage has exactly the words `layout` asks for.
     fn fits(&self, layout: &Layout) -> bool;
-    /// Re-initialises every word to `layout`'s initial values.
-    fn reset(&mut self, layout: &Layout);
+    /// Re-initialises every word to `layout`'s initial values, with `cap` bytes for the words
+    /// allocated from now on.
+    fn reset(&mut self, layout: &Layout, cap: u64);
 }
 
 impl ReusableStorage for SerialMemory {
     fn fits(&self, layout: &Layout) -> bool {
         SerialMemory::fits(self, layout)
     }
-    fn reset(&mut self, layout: &Layout) {
-        SerialMemory::reset(self, layout);
+    fn reset(&mut self, layout: &Layout, cap: u64) {
+        SerialMemory::reset(self, layout, cap);
     }
 }
 
@@ -286,25 +306,26 @@ impl ReusableStorage for AtomicMemory {
     fn fits(&self, layout: &Layout) -> bool {
         AtomicMemory::fits(self, layout)
     }
-    fn reset(&mut self, layout: &Layout) {
-        AtomicMemory::reset(self, layout);
+    fn reset(&mut self, layout: &Layout, cap: u64) {
+        AtomicMemory::reset(self, layout, cap);
     }
 }
 
 /// The storage of `scheme`'s frame: `kept` re-initialised when it fits the scheme's layout, else
-/// newly allocated; kept again for the next frame.
+/// newly allocated; kept again for the next frame. The pages of words allocated as the frame
+/// writes them may take `memory_cap` bytes less what is allocated before any
+/// ([`Layout::least_bytes`]).
 pub(crate) fn reuse_storage<'a, S: Scheme, M: ReusableStorage>(
     kept: &'a mut Option<M>,
     scheme: &S,
+    memory_cap: u64,
 ) -> &'a mut M {
     let layout = scheme.layout();
-    let memory = match kept.take() {
-        Some(mut memory) if memory.fits(&layout) => {
-            memory.reset(&layout);
-            memory
-        }
+    let mut memory = match kept.take() {
+        Some(memory) if memory.fits(&layout) => memory,
         _ => layout.allocate(),
     };
+    memory.reset(&layout, memory_cap.saturating_sub(layout.least_bytes()));
     kept.insert(memory)
 }
 

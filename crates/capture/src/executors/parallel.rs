@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use super::frame::{self, rasterize_into, reuse_storage, Counters, Run};
 use crate::capture::Capture;
 use crate::memory::{AtomicMemory, Memory};
-use crate::scheme::{Promise, Scheme};
+use crate::scheme::{Promise, Scheme, MEMORY_CAP_DEFAULT};
 
 /// Triangles per rayon work item by default: large enough to amortise scheduling (~100 ns a
 /// task), small enough to balance the uneven cost of triangles. Scenes of fewer triangles than two
@@ -28,6 +28,9 @@ pub fn run_parallel<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
 #[derive(Debug)]
 pub struct ParallelExecutor {
     memory: Option<AtomicMemory>,
+    /// The cap on the bytes of storage a frame allocates (`None`: [`MEMORY_CAP_DEFAULT`]); a
+    /// frame that needs more is reported [`RunStats::over_cap`](super::RunStats).
+    pub memory_cap: Option<u64>,
     triangles_per_task: usize,
 }
 
@@ -44,6 +47,7 @@ impl ParallelExecutor {
     pub fn with_task_size(triangles_per_task: usize) -> Self {
         Self {
             memory: None,
+            memory_cap: None,
             triangles_per_task: triangles_per_task.max(1),
         }
     }
@@ -51,7 +55,11 @@ impl ParallelExecutor {
     /// Runs one frame of `scheme` over `view` on the current rayon pool.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
-        let memory = reuse_storage(&mut self.memory, scheme);
+        let memory = reuse_storage(
+            &mut self.memory,
+            scheme,
+            self.memory_cap.unwrap_or(MEMORY_CAP_DEFAULT),
+        );
         parallel_frame(view, scheme, &*memory, start, self.triangles_per_task)
     }
 }

@@ -361,6 +361,12 @@ impl Memory for RecordingMemory {
             context: Cell::new((0, 0, 0, 0, 0)),
         }
     }
+    fn allocated_bytes(&self) -> Option<u64> {
+        Memory::allocated_bytes(&self.inner)
+    }
+    fn over_cap(&self) -> bool {
+        self.inner.over_cap()
+    }
 }
 
 /// One logical thread: its current walk and the fragments still queued for it.

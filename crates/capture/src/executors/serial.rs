@@ -8,7 +8,7 @@ use fragsim_raster::View;
 
 use super::frame::{self, rasterize_into, reuse_storage, Counters, Run};
 use crate::memory::{Memory, SerialMemory};
-use crate::scheme::Scheme;
+use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
 
 /// Runs `scheme` over `view` serially, in submission order, on fresh storage.
 pub fn run_serial<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
@@ -20,13 +20,20 @@ pub fn run_serial<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
 #[derive(Debug, Default)]
 pub struct SerialExecutor {
     memory: Option<SerialMemory>,
+    /// The cap on the bytes of storage a frame allocates (`None`: [`MEMORY_CAP_DEFAULT`]); a
+    /// frame that needs more is reported [`RunStats::over_cap`](super::RunStats).
+    pub memory_cap: Option<u64>,
 }
 
 impl SerialExecutor {
     /// Runs one frame of `scheme` over `view`.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
-        let memory = reuse_storage(&mut self.memory, scheme);
+        let memory = reuse_storage(
+            &mut self.memory,
+            scheme,
+            self.memory_cap.unwrap_or(MEMORY_CAP_DEFAULT),
+        );
         serial_frame(view, scheme, &*memory, start)
     }
 }

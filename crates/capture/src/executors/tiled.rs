@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use super::frame::{rasterize_into, reuse_storage, Counters, Run};
 use super::parallel::rayon_frame;
 use crate::memory::AtomicMemory;
-use crate::scheme::Scheme;
+use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
 
 /// Pixels on a side of a tile: 32 × 32 pixels make 256 tiles at 512 × 512, enough to balance 16
 /// threads over a model that covers the middle of the screen.
@@ -41,6 +41,9 @@ const TRIANGLES_PER_CHUNK: u32 = 16 * 1024;
 #[derive(Debug, Default)]
 pub struct TiledExecutor {
     memory: Option<AtomicMemory>,
+    /// The cap on the bytes of storage a frame allocates (`None`: [`MEMORY_CAP_DEFAULT`]); a
+    /// frame that needs more is reported [`RunStats::over_cap`](super::RunStats).
+    pub memory_cap: Option<u64>,
     chunks: Vec<ChunkBins>,
 }
 
@@ -141,7 +144,11 @@ impl TiledExecutor {
     /// geometry pass tile by tile, then the post pass.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
-        let memory = reuse_storage(&mut self.memory, scheme);
+        let memory = reuse_storage(
+            &mut self.memory,
+            scheme,
+            self.memory_cap.unwrap_or(MEMORY_CAP_DEFAULT),
+        );
         let tiles = Tiles::new(view.viewport());
         let triangles = view.triangle_count();
         let chunk_count = triangles.div_ceil(TRIANGLES_PER_CHUNK) as usize;

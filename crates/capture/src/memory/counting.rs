@@ -66,4 +66,10 @@ impl<M: Memory> Memory for CountingMemory<M> {
             read_modify_writes: AtomicU64::new(0),
         }
     }
+    fn allocated_bytes(&self) -> Option<u64> {
+        self.inner.allocated_bytes()
+    }
+    fn over_cap(&self) -> bool {
+        self.inner.over_cap()
+    }
 }

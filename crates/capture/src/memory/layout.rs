@@ -41,6 +41,17 @@ impl Layout {
         self.words32 as u64 * 4 + self.words64 as u64 * 8 + self.table_bytes as u64
     }
 
+    /// The bytes a frame allocates before any fragment: the tables and the page tables of the
+    /// words, whose pages are allocated as writes reach them (`memory/pages.rs`). What the memory
+    /// cap is checked against when a scheme is built; the pages are checked as they are
+    /// allocated.
+    #[must_use]
+    pub fn least_bytes(&self) -> u64 {
+        self.table_bytes as u64
+            + super::pages::page_table_bytes(self.words32)
+            + super::pages::page_table_bytes(self.words64)
+    }
+
     /// Fresh storage for this layout.
     #[must_use]
     pub fn allocate<M: Memory>(&self) -> M {

@@ -9,22 +9,23 @@
 //! only per-location atomicity (a total order of the read-modify-writes on each word), and the end
 //! of a pass, a thread join, publishes everything (the proof is in `docs/proof.md`, loom checks it).
 //!
-//! [`AtomicMemory`] also remembers which blocks of [`BLOCK_WORDS`] words any write touched since
-//! its last reset, so that the next frame's reset re-initialises only those (a 2048² MDTS frame
-//! touches a fifth of its 671 MB), and a post pass may skip what no fragment reached
-//! ([`WordMemory::untouched`]). That bookkeeping is no memory operation of the simulated GPU: it
-//! costs a plain load (and once per block a store) beside each write, and the reset it shortens is
-//! still timed as pass time.
+//! Both memories allocate their words a page at a time, on the first write that reaches a page
+//! (`memory/pages.rs`), within a byte cap set by the executor ([`SerialMemory::reset`]): storage, its
+//! reset and the post pass then follow the pixels the fragments reach, not viewport × K. That
+//! bookkeeping is no memory operation of the simulated GPU: it costs a load of the page's entry
+//! and of its written flag beside each operation, and the first write to a page its allocation.
 
 use std::cell::Cell;
 use std::fmt::Debug;
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering::Relaxed};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
 mod counting;
 mod layout;
+pub(crate) mod pages;
 
 pub use counting::CountingMemory;
 pub use layout::Layout;
+use pages::{Budget, Pages, WordCell};
 
 /// A memory word: `u32` or `u64`.
 pub trait Word: Copy + Eq + Ord + Debug + Send + Sync + 'static {
@@ -87,7 +88,7 @@ pub trait WordMemory<W: Word> {
     /// `atomicExch` (`imageAtomicExchange`): stores `value`, returns the old value.
     fn swap(&self, index: usize, value: W) -> W;
     /// Whether word `index` is known to hold its initial value, no write having reached its
-    /// block since the storage was allocated or reset: a hint for post passes, which may skip
+    /// page since the storage was allocated or reset: a hint for post passes, which may skip
     /// such words. `false` is always a correct answer, and the default; it is no memory
     /// operation and no step.
     fn untouched(&self, index: usize) -> bool {
@@ -102,6 +103,18 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
     fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self
     where
         Self: Sized;
+
+    /// Bytes of storage actually allocated, where the memory allocates as it is written
+    /// (`memory/pages.rs`); `None` for a memory that holds every word of its layout.
+    fn allocated_bytes(&self) -> Option<u64> {
+        None
+    }
+
+    /// Whether a write found no storage within the cap since the last reset: the frame is to be
+    /// reported over the cap, its words not used.
+    fn over_cap(&self) -> bool {
+        false
+    }
 
     /// Takes the spin lock held in `u32` word `index` (0 free, 1 held), waiting while another
     /// thread holds it; everything the previous holder did before its [`Memory::unlock`] is
@@ -145,294 +158,296 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
 /// Plain cells for one thread: the fastest memory and the reference behaviour of a scheme.
 #[derive(Clone, Debug)]
 pub struct SerialMemory {
-    words32: Vec<Cell<u32>>,
-    words64: Vec<Cell<u64>>,
+    words32: Pages<u32, Cell<u32>>,
+    words64: Pages<u64, Cell<u64>>,
+    budget: Budget,
 }
 
-/// Std atomics with `Relaxed` ordering, shared by the threads of the parallel executor, with a
-/// flag per block of 64 words (`BLOCK_WORDS`) set by the first write to the block (see the module
-/// documentation): what [`AtomicMemory::reset`] re-initialises.
+/// Std atomics with `Relaxed` ordering, shared by the threads of the parallel executor.
 #[derive(Debug)]
 pub struct AtomicMemory {
-    words32: Vec<AtomicU32>,
-    words64: Vec<AtomicU64>,
-    touched32: Vec<AtomicBool>,
-    touched64: Vec<AtomicBool>,
-    /// The initial values the words were last set to: a reset to other values writes every word.
-    init: (u32, u64),
+    words32: Pages<u32, AtomicU32>,
+    words64: Pages<u64, AtomicU64>,
+    budget: Budget,
 }
 
-/// Words per block of [`AtomicMemory`]'s touched flags: 64 words, four or eight cache lines,
-/// small enough that a sparse frame's blocks are mostly untouched, large enough that the flags
-/// (a byte per block) stay in cache beside the words.
-const BLOCK_WORDS: usize = 64;
-
-/// One flag per block of `len` words, every one clear.
-fn untouched_blocks(len: usize) -> Vec<AtomicBool> {
-    (0..len.div_ceil(BLOCK_WORDS))
-        .map(|_| AtomicBool::new(false))
-        .collect()
-}
-
-/// Marks word `index`'s block touched. The flag is loaded first, so that after the first write
-/// to a block its cache line is only read, never bounced between threads.
-#[inline]
-fn touch(flags: &[AtomicBool], index: usize) {
-    let flag = &flags[index / BLOCK_WORDS];
-    if !flag.load(Relaxed) {
-        flag.store(true, Relaxed);
-    }
-}
-
-/// Sets every word of the touched blocks of `words` to `init` (every block when `all`), in
-/// parallel, and clears the flags.
-fn reset_touched<A: Send>(
-    words: &mut [A],
-    flags: &mut [AtomicBool],
-    all: bool,
-    set: impl Fn(&mut A) + Sync,
-) {
-    use rayon::prelude::*;
-    words
-        .par_chunks_mut(BLOCK_WORDS)
-        .zip(flags.par_iter_mut())
-        .with_min_len(1024)
-        .for_each(|(block, flag)| {
-            if all || *flag.get_mut() {
-                block.iter_mut().for_each(&set);
-                *flag.get_mut() = false;
+macro_rules! word_cells {
+    ($word:ty, $cell:ty, $value:expr) => {
+        impl WordCell<$word> for $cell {
+            fn new(value: $word) -> Self {
+                <$cell>::new(value)
             }
-        });
-}
-
-macro_rules! serial_words {
-    ($word:ty, $field:ident) => {
-        impl WordMemory<$word> for SerialMemory {
-            #[inline]
-            fn len(&self) -> usize {
-                self.$field.len()
+            fn set_mut(&mut self, value: $word) {
+                *self.get_mut() = value;
             }
-            #[inline]
-            fn load(&self, i: usize) -> $word {
-                self.$field[i].get()
-            }
-            #[inline]
-            fn store(&self, i: usize, v: $word) {
-                self.$field[i].set(v);
-            }
-            #[inline]
-            fn fetch_min(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].get();
-                self.$field[i].set(old.min(v));
-                old
-            }
-            #[inline]
-            fn fetch_max(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].get();
-                self.$field[i].set(old.max(v));
-                old
-            }
-            #[inline]
-            fn fetch_add(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].get();
-                self.$field[i].set(old.wrapping_add(v));
-                old
-            }
-            #[inline]
-            fn fetch_or(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].get();
-                self.$field[i].set(old | v);
-                old
-            }
-            #[inline]
-            fn swap(&self, i: usize, v: $word) -> $word {
-                self.$field[i].replace(v)
+            fn value(&self) -> $word {
+                $value(self)
             }
         }
     };
 }
 
-macro_rules! atomic_words {
-    ($word:ty, $field:ident, $touched:ident) => {
-        impl WordMemory<$word> for AtomicMemory {
+word_cells!(u32, Cell<u32>, Cell::get);
+word_cells!(u64, Cell<u64>, Cell::get);
+word_cells!(u32, AtomicU32, |cell: &AtomicU32| cell.load(Relaxed));
+word_cells!(u64, AtomicU64, |cell: &AtomicU64| cell.load(Relaxed));
+
+/// `WordMemory<$word>` for a memory whose `$field` pages hold its cells: `$get` reads a cell,
+/// `$set` writes one, `$rmw!` applies a read-modify-write to one and returns the old value.
+macro_rules! paged_words {
+    ($memory:ty, $word:ty, $field:ident, $get:expr, $set:expr, $rmw:ident) => {
+        impl WordMemory<$word> for $memory {
             #[inline]
             fn len(&self) -> usize {
                 self.$field.len()
             }
             #[inline]
             fn load(&self, i: usize) -> $word {
-                self.$field[i].load(Relaxed)
+                self.$field
+                    .read(i, &self.budget)
+                    .map_or(self.$field.init(), $get)
             }
             #[inline]
             fn store(&self, i: usize, v: $word) {
-                self.$field[i].store(v, Relaxed);
-                touch(&self.$touched, i);
+                $set(self.$field.write(i, &self.budget), v);
             }
             #[inline]
             fn fetch_min(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].fetch_min(v, Relaxed);
-                touch(&self.$touched, i);
-                old
+                $rmw!(self.$field.write(i, &self.budget), fetch_min, Ord::min, v)
             }
             #[inline]
             fn fetch_max(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].fetch_max(v, Relaxed);
-                touch(&self.$touched, i);
-                old
+                $rmw!(self.$field.write(i, &self.budget), fetch_max, Ord::max, v)
             }
             #[inline]
             fn fetch_add(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].fetch_add(v, Relaxed);
-                touch(&self.$touched, i);
-                old
+                $rmw!(
+                    self.$field.write(i, &self.budget),
+                    fetch_add,
+                    Word::wrapping_add,
+                    v
+                )
             }
             #[inline]
             fn fetch_or(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].fetch_or(v, Relaxed);
-                touch(&self.$touched, i);
-                old
+                $rmw!(
+                    self.$field.write(i, &self.budget),
+                    fetch_or,
+                    std::ops::BitOr::bitor,
+                    v
+                )
             }
             #[inline]
             fn swap(&self, i: usize, v: $word) -> $word {
-                let old = self.$field[i].swap(v, Relaxed);
-                touch(&self.$touched, i);
-                old
+                $rmw!(self.$field.write(i, &self.budget), swap, |_, v| v, v)
             }
             #[inline]
             fn untouched(&self, i: usize) -> bool {
-                !self.$touched[i / BLOCK_WORDS].load(Relaxed)
+                self.$field.untouched(i, &self.budget)
             }
         }
     };
 }
 
-serial_words!(u32, words32);
-serial_words!(u64, words64);
-atomic_words!(u32, words32, touched32);
-atomic_words!(u64, words64, touched64);
-
-impl SerialMemory {
-    /// Whether this storage has exactly the words `layout` asks for.
-    #[must_use]
-    pub fn fits(&self, layout: &Layout) -> bool {
-        self.words32.len() == layout.words32 && self.words64.len() == layout.words64
-    }
-
-    /// Re-initialises every word to `layout`'s initial values.
-    pub fn reset(&mut self, layout: &Layout) {
-        self.words32
-            .iter_mut()
-            .for_each(|w| *w.get_mut() = layout.init32);
-        self.words64
-            .iter_mut()
-            .for_each(|w| *w.get_mut() = layout.init64);
-    }
+/// A read-modify-write on a `Cell`: read, `$combine` the old value with `$value`, write; returns
+/// the old value (`$op` names the atomic method it stands for).
+macro_rules! cell_rmw {
+    ($cell:expr, $op:ident, $combine:expr, $value:expr) => {{
+        let cell = $cell;
+        let old = cell.get();
+        cell.set($combine(old, $value));
+        old
+    }};
 }
 
-impl AtomicMemory {
-    /// Whether this storage has exactly the words `layout` asks for.
-    #[must_use]
-    pub fn fits(&self, layout: &Layout) -> bool {
-        self.words32.len() == layout.words32 && self.words64.len() == layout.words64
-    }
-
-    /// Re-initialises every word to `layout`'s initial values, in parallel (FreePipe's
-    /// initialisation kernel: one GPU thread per word): the blocks a write touched since the last
-    /// reset, the others holding them already; every block when the initial values change.
-    pub fn reset(&mut self, layout: &Layout) {
-        let (init32, init64) = (layout.init32, layout.init64);
-        let all = self.init != (init32, init64);
-        reset_touched(&mut self.words32, &mut self.touched32, all, |w| {
-            *w.get_mut() = init32;
-        });
-        reset_touched(&mut self.words64, &mut self.touched64, all, |w| {
-            *w.get_mut() = init64;
-        });
-        self.init = (init32, init64);
-    }
+/// A read-modify-write on an atomic: its `Relaxed` method `$op`; returns the old value.
+macro_rules! atomic_rmw {
+    ($cell:expr, $op:ident, $combine:expr, $value:expr) => {
+        $cell.$op($value, Relaxed)
+    };
 }
 
-impl Memory for SerialMemory {
-    fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
-        Self {
-            words32: vec![Cell::new(init32); len32],
-            words64: vec![Cell::new(init64); len64],
+paged_words!(SerialMemory, u32, words32, Cell::get, Cell::set, cell_rmw);
+paged_words!(SerialMemory, u64, words64, Cell::get, Cell::set, cell_rmw);
+paged_words!(
+    AtomicMemory,
+    u32,
+    words32,
+    |c: &AtomicU32| c.load(Relaxed),
+    |c: &AtomicU32, v| c.store(v, Relaxed),
+    atomic_rmw
+);
+paged_words!(
+    AtomicMemory,
+    u64,
+    words64,
+    |c: &AtomicU64| c.load(Relaxed),
+    |c: &AtomicU64, v| c.store(v, Relaxed),
+    atomic_rmw
+);
+
+/// The storage methods both memories share: fit, reset, cap and what is allocated.
+macro_rules! paged_memory {
+    ($memory:ty) => {
+        impl $memory {
+            /// Whether this storage has exactly the words `layout` asks for.
+            #[must_use]
+            pub fn fits(&self, layout: &Layout) -> bool {
+                self.words32.len() == layout.words32 && self.words64.len() == layout.words64
+            }
+
+            /// Re-initialises every word to `layout`'s initial values (the blocks written since the
+            /// last reset; every allocated page where the initial values change) and sets the cap
+            /// on the bytes of pages allocated from now on (FreePipe's initialisation kernel, one
+            /// GPU thread per word; rayon tasks of a few pages here).
+            pub fn reset(&mut self, layout: &Layout, cap: u64) {
+                self.words32.reset(layout.init32);
+                self.words64.reset(layout.init64);
+                self.budget.reset(cap);
+            }
+
+            /// Bytes allocated: the pages written so far (since allocation, resets included) and
+            /// the page tables.
+            #[must_use]
+            pub fn allocated_bytes(&self) -> u64 {
+                self.budget.allocated() + self.words32.table_bytes() + self.words64.table_bytes()
+            }
         }
-    }
+
+        impl Memory for $memory {
+            fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
+                Self {
+                    words32: Pages::new(len32, init32),
+                    words64: Pages::new(len64, init64),
+                    budget: Budget::new(u64::MAX),
+                }
+            }
+            fn allocated_bytes(&self) -> Option<u64> {
+                Some(<$memory>::allocated_bytes(self))
+            }
+            fn over_cap(&self) -> bool {
+                self.budget.refused()
+            }
+        }
+    };
 }
 
-impl Memory for AtomicMemory {
-    fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
-        // FreePipe initialises with one GPU thread per word; here rayon fills in parallel chunks.
-        use rayon::prelude::*;
-        let words32 = (0..len32)
-            .into_par_iter()
-            .map(|_| AtomicU32::new(init32))
-            .collect();
-        let words64 = (0..len64)
-            .into_par_iter()
-            .map(|_| AtomicU64::new(init64))
-            .collect();
-        Self {
-            words32,
-            words64,
-            touched32: untouched_blocks(len32),
-            touched64: untouched_blocks(len64),
-            init: (init32, init64),
-        }
-    }
-}
+paged_memory!(SerialMemory);
+paged_memory!(AtomicMemory);
 
 #[cfg(test)]
 mod tests {
+    use super::pages::PAGE_WORDS;
     use super::*;
 
     /// Every word of `memory`: the `u32` array widened, then the `u64` array.
-    fn words(memory: &AtomicMemory) -> Vec<u64> {
+    fn words<M: Memory>(memory: &M) -> Vec<u64> {
         let narrow = (0..WordMemory::<u32>::len(memory))
             .map(|i| u64::from(WordMemory::<u32>::load(memory, i)));
         let wide = (0..WordMemory::<u64>::len(memory)).map(|i| WordMemory::<u64>::load(memory, i));
         narrow.chain(wide).collect()
     }
 
-    #[test]
-    fn a_reset_re_initialises_every_word_a_write_reached_and_only_their_blocks_read_touched() {
-        let layout = Layout::counters_and_slots(5 * BLOCK_WORDS + 3, 7 * BLOCK_WORDS + 1);
-        let mut memory: AtomicMemory = layout.allocate();
-        let fresh = words(&memory);
-        // One write of each kind, in blocks apart, the last words of both arrays included.
-        WordMemory::<u32>::fetch_add(&memory, 0, 1);
-        WordMemory::<u32>::store(&memory, 5 * BLOCK_WORDS + 2, 9);
-        WordMemory::<u32>::swap(&memory, 2 * BLOCK_WORDS, 4);
-        WordMemory::<u64>::fetch_min(&memory, BLOCK_WORDS + 1, 3);
-        WordMemory::<u64>::fetch_max(&memory, 3 * BLOCK_WORDS, 8);
-        WordMemory::<u64>::fetch_or(&memory, 7 * BLOCK_WORDS, 2);
-        assert!(
-            !WordMemory::<u32>::untouched(&memory, 1),
-            "block 0 was written"
-        );
-        assert!(WordMemory::<u32>::untouched(&memory, BLOCK_WORDS));
-        assert!(!WordMemory::<u64>::untouched(&memory, 2 * BLOCK_WORDS - 1));
-        assert!(WordMemory::<u64>::untouched(&memory, 0));
-        assert_ne!(words(&memory), fresh);
-        memory.reset(&layout);
-        assert_eq!(words(&memory), fresh);
-        assert!((0..7 * BLOCK_WORDS + 1).all(|i| WordMemory::<u64>::untouched(&memory, i)));
+    /// Writes of every kind to pages apart (the last, shorter pages of both arrays included);
+    /// the pages of the `u64` array written, in order.
+    fn write_pages_apart<M: Memory>(memory: &M) -> [usize; 3] {
+        WordMemory::<u32>::fetch_add(memory, 0, 1);
+        WordMemory::<u32>::store(memory, 5 * PAGE_WORDS + 2, 9);
+        WordMemory::<u32>::swap(memory, 2 * PAGE_WORDS, 4);
+        WordMemory::<u64>::fetch_min(memory, PAGE_WORDS + 1, 3);
+        WordMemory::<u64>::fetch_max(memory, 3 * PAGE_WORDS, 8);
+        WordMemory::<u64>::fetch_or(memory, 7 * PAGE_WORDS, 2);
+        [1, 3, 7]
     }
 
-    #[test]
-    fn a_reset_to_other_initial_values_writes_every_word() {
-        let layout = Layout::counters_and_slots(3 * BLOCK_WORDS, 2 * BLOCK_WORDS);
-        let mut memory: AtomicMemory = layout.allocate();
+    fn pages_are_allocated_on_first_write_and_reset_to_their_initial_values<
+        M: Memory + WordMemory<u32> + WordMemory<u64>,
+    >(
+        mut reset: impl FnMut(&mut M, &Layout),
+    ) {
+        let layout = Layout::counters_and_slots(5 * PAGE_WORDS + 3, 7 * PAGE_WORDS + 1);
+        let mut memory: M = layout.allocate();
+        let fresh = words(&memory);
+        assert_eq!(fresh, words(&layout.allocate::<M>()));
+        // Reading every word allocated nothing: the page tables alone.
+        let tables = memory.allocated_bytes().unwrap();
+        assert_eq!(tables, layout.least_bytes());
+        let written = write_pages_apart(&memory);
+        // Three pages of each array, the last one of each 3 and 1 words long.
+        let pages = 2 * PAGE_WORDS as u64 * 4 + 3 * 4 + 2 * PAGE_WORDS as u64 * 8 + 8;
+        assert_eq!(memory.allocated_bytes(), Some(tables + pages));
+        assert!(
+            !WordMemory::<u32>::untouched(&memory, 1),
+            "page 0 was written"
+        );
+        assert!(WordMemory::<u32>::untouched(&memory, PAGE_WORDS));
+        for page in 0..8 {
+            let index = page * PAGE_WORDS;
+            assert_eq!(
+                WordMemory::<u64>::untouched(&memory, index),
+                !written.contains(&page),
+                "page {page}"
+            );
+        }
+        // Within a page written, only the block written.
+        assert!(WordMemory::<u64>::untouched(
+            &memory,
+            PAGE_WORDS + pages::BLOCK_WORDS
+        ));
+        assert_ne!(words(&memory), fresh);
+        reset(&mut memory, &layout);
+        assert_eq!(words(&memory), fresh);
+        // The pages stay allocated, none of them written since the reset.
+        assert_eq!(memory.allocated_bytes(), Some(tables + pages));
+        assert!((0..7 * PAGE_WORDS + 1).all(|i| WordMemory::<u64>::untouched(&memory, i)));
+        // Other initial values reach every allocated page and every page not allocated.
         let other = Layout {
             init32: 7,
             init64: 0,
             ..layout
         };
-        memory.reset(&other);
-        assert!((0..3 * BLOCK_WORDS).all(|i| WordMemory::<u32>::load(&memory, i) == 7));
-        assert!((0..2 * BLOCK_WORDS).all(|i| WordMemory::<u64>::load(&memory, i) == 0));
-        memory.reset(&layout);
-        assert_eq!(words(&memory), words(&layout.allocate()));
+        reset(&mut memory, &other);
+        assert!((0..5 * PAGE_WORDS + 3).all(|i| WordMemory::<u32>::load(&memory, i) == 7));
+        assert!((0..7 * PAGE_WORDS + 1).all(|i| WordMemory::<u64>::load(&memory, i) == 0));
+        reset(&mut memory, &layout);
+        assert_eq!(words(&memory), fresh);
+    }
+
+    #[test]
+    fn atomic_pages_are_allocated_on_first_write_and_reset_to_their_initial_values() {
+        pages_are_allocated_on_first_write_and_reset_to_their_initial_values::<AtomicMemory>(
+            |memory, layout| memory.reset(layout, u64::MAX),
+        );
+    }
+
+    #[test]
+    fn serial_pages_are_allocated_on_first_write_and_reset_to_their_initial_values() {
+        pages_are_allocated_on_first_write_and_reset_to_their_initial_values::<SerialMemory>(
+            |memory, layout| memory.reset(layout, u64::MAX),
+        );
+    }
+
+    #[test]
+    fn a_write_beyond_the_cap_is_reported_and_read_back_never_allocated() {
+        let layout = Layout::counters_and_slots(0, 4 * PAGE_WORDS);
+        let mut memory: AtomicMemory = layout.allocate();
+        // Room for one page of u64 words and the page table.
+        memory.reset(&layout, memory.allocated_bytes() + PAGE_WORDS as u64 * 8);
+        WordMemory::<u64>::fetch_min(&memory, 0, 5);
+        assert!(!memory.over_cap());
+        let before = memory.allocated_bytes();
+        WordMemory::<u64>::fetch_min(&memory, 2 * PAGE_WORDS + 3, 6);
+        assert!(memory.over_cap(), "the second page is refused");
+        assert_eq!(memory.allocated_bytes(), before);
+        // Written to the scratch page, and read back: a scheme that checks its own write ends.
+        assert_eq!(WordMemory::<u64>::load(&memory, 2 * PAGE_WORDS + 3), 6);
+        assert_eq!(WordMemory::<u64>::load(&memory, 0), 5);
+        // A reset with room clears the refusal.
+        memory.reset(&layout, u64::MAX);
+        assert!(!memory.over_cap());
+        assert_eq!(
+            WordMemory::<u64>::load(&memory, 2 * PAGE_WORDS + 3),
+            u64::MAX
+        );
     }
 }

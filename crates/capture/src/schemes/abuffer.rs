@@ -93,21 +93,15 @@ impl ABuffer {
                 "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
             ));
         }
-        let needed = viewport.pixels() as u64 * (u64::from(capacity) * 8 + 4);
-        if needed > memory_cap {
-            return Err(CaptureError::TooMuchMemory {
-                scheme: "abuffer".into(),
-                needed,
-                cap: memory_cap,
-            });
-        }
-        Ok(Self {
+        let scheme = Self {
             storage: Storage::Fixed {
                 pixels: viewport.pixels(),
                 capacity: capacity as usize,
             },
             sort,
-        })
+        };
+        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
+        Ok(scheme)
     }
 
     /// Exactly `counts[p]` slots for pixel `p` (the counts of a counting pass), in one flat array.
@@ -239,6 +233,11 @@ impl Scheme for ABuffer {
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+        // Most pixels of a frame are empty: where no write reached the counter's block, it is
+        // still 0, known without reading its cache line.
+        if WordMemory::<u32>::untouched(memory, pixel) {
+            return 0;
+        }
         let count = WordMemory::<u32>::load(memory, pixel) as usize;
         let (first, capacity) = self.slots(pixel);
         let stored = count.min(capacity);

@@ -232,6 +232,8 @@ mod tests {
         let add = ABuffer::fixed(viewport, 8, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
         assert_eq!(one_pixel(&inc, 20), one_pixel(&add, 20));
         assert!(ABufferAtomicInc::wrapping(viewport, 0, MEMORY_CAP_DEFAULT).is_err());
-        assert!(ABufferAtomicInc::wrapping(viewport, 8, 8 * 8).is_err());
+        let least = inc.layout().least_bytes();
+        assert!(ABufferAtomicInc::wrapping(viewport, 8, least - 1).is_err());
+        assert!(ABufferAtomicInc::wrapping(viewport, 8, least).is_ok());
     }
 }

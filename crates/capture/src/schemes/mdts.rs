@@ -258,16 +258,22 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         if words.untouched(pixel * k) {
             return 0;
         }
-        let stored = (0..k)
-            .take_while(|&slot| words.load(pixel * k + slot) != self.empty())
-            .count();
-        let slots = (0..stored).map(|slot| words.load(pixel * k + slot));
-        match self.direction {
-            Direction::Ascending => out.extend(slots.map(MdtsWord::decode)),
-            // Undo the +1 offset and report nearest first, like every other scheme.
-            Direction::Descending => {
-                out.extend(slots.rev().map(|w| w.wrapping_sub(W::ONE).decode()))
+        // Each slot loaded once: the stored values up to the first empty slot.
+        let start = out.len();
+        for slot in pixel * k..(pixel + 1) * k {
+            let word = words.load(slot);
+            if word == self.empty() {
+                break;
             }
+            out.push(match self.direction {
+                Direction::Ascending => word.decode(),
+                // Undo the +1 offset.
+                Direction::Descending => word.wrapping_sub(W::ONE).decode(),
+            });
+        }
+        if self.direction == Direction::Descending {
+            // Nearest first, like every other scheme.
+            out[start..].reverse();
         }
         // What fell off the end is not in memory: the executors count it from the walks.
         0

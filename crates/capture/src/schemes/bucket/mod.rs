@@ -68,7 +68,7 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{CaptureError, Step};
+use crate::scheme::{check_cap, CaptureError, Step};
 use crate::schemes::common::MdtsWord;
 
 /// u32 words of the depth-range pass per pixel: the near word (complemented key) and the far word.
@@ -117,22 +117,25 @@ impl Plan {
         let pixels = viewport.pixels();
         let wide = W::IDENTITY == Identity::KeyAndPrim;
         let bucket_bytes = if wide { 8 } else { 4 };
-        // In u128 so that absurd bucket counts are refused, never overflowed.
+        // In u128 so that absurd bucket counts are refused, never overflowed: storage no
+        // address space holds is refused whatever the cap.
         let needed = pixels as u128 * (aux as u128 * 4 + buckets as u128 * bucket_bytes);
-        if needed > u128::from(cap) {
+        if needed > u128::from(cap) && needed > isize::MAX as u128 {
             return Err(CaptureError::TooMuchMemory {
                 scheme: scheme.into(),
                 needed: u64::try_from(needed).unwrap_or(u64::MAX),
                 cap,
             });
         }
-        Ok(Self {
+        let plan = Self {
             pixels,
             aux,
             buckets,
             wide,
             bucket_base: if wide { 0 } else { pixels * aux },
-        })
+        };
+        check_cap(scheme, &plan.layout(), cap)?;
+        Ok(plan)
     }
 
     fn layout(&self) -> Layout {

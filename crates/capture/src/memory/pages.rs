@@ -1,0 +1,311 @@
+//! [`Pages`]: one array of words whose storage is allocated a page at a time, on the first write
+//! that reaches the page, within a byte budget shared by a memory's arrays ([`Budget`]).
+//!
+//! A frame of a real scene covers a fraction of the viewport (the dragon a sixth of a 2048²
+//! frame), so storage sized viewport × K is mostly never written. Here a page is allocated, filled
+//! with the array's initial value, when a write first reaches it; a read of a page never written
+//! returns the initial value without allocating. Memory, the reset and the post pass then grow
+//! with the pixels the fragments reach.
+//!
+//! Pages stay allocated across frames (a GPU application allocates once, and freeing them would
+//! only fault them in again next frame). Each block of [`BLOCK_WORDS`] words of a page carries a
+//! flag set by the first write since the last reset, so that a reset re-initialises the blocks
+//! written and a post pass skips the others: a page is a row of a few hundred pixels, most of
+//! whose blocks the edge of a mesh leaves unwritten.
+//!
+//! Where the budget would be exceeded, the write is not lost silently: it goes to a scratch page
+//! shared by every page refused, the budget records the refusal, and the frame is reported over
+//! the cap ([`Budget::refused`]), never as a result.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
+use std::sync::OnceLock;
+
+use super::Word;
+
+/// Words per page: 32 KiB of `u64` words, a few hundred pixels of K slots, large enough that the
+/// page table (one entry a page) is a fraction of a percent of the storage, small enough that a
+/// sparse frame leaves most pages unallocated.
+pub const PAGE_WORDS: usize = 4096;
+
+/// Words per block of a page's written flags: 64 words, four or eight cache lines, a few pixels
+/// of K slots.
+pub const BLOCK_WORDS: usize = 64;
+
+/// Written flags per page.
+const BLOCKS: usize = PAGE_WORDS / BLOCK_WORDS;
+
+/// Bytes of the page table of an array of `words` words: one entry a page, allocated with the
+/// array whether or not its pages are.
+#[must_use]
+pub fn page_table_bytes(words: usize) -> u64 {
+    // An entry's size does not depend on the cell type (a pointer, a length, two flags).
+    (words.div_ceil(PAGE_WORDS) * std::mem::size_of::<OnceLock<Page<AtomicU64>>>()) as u64
+}
+
+/// A cell of one word: `Cell` for one thread, an atomic for several.
+pub trait WordCell<W: Word>: Send {
+    /// A cell holding `value`.
+    fn new(value: W) -> Self;
+    /// Sets the value through exclusive access (a reset, no memory operation of the GPU).
+    fn set_mut(&mut self, value: W);
+    /// The value, for a copy of the storage (no memory operation of the GPU).
+    fn value(&self) -> W;
+}
+
+/// One page: its words and, for each block of them, whether a write reached it since the last
+/// reset.
+#[derive(Debug)]
+pub struct Page<C> {
+    written: [AtomicBool; BLOCKS],
+    words: Box<[C]>,
+}
+
+impl<C> Page<C> {
+    fn filled<W: Word>(init: W, len: usize) -> Self
+    where
+        C: WordCell<W>,
+    {
+        Self {
+            written: std::array::from_fn(|_| AtomicBool::new(false)),
+            words: (0..len).map(|_| C::new(init)).collect(),
+        }
+    }
+}
+
+impl<C> Page<C> {
+    fn copy<W: Word>(&self) -> Self
+    where
+        C: WordCell<W>,
+    {
+        Self {
+            written: std::array::from_fn(|block| {
+                AtomicBool::new(self.written[block].load(Relaxed))
+            }),
+            words: self.words.iter().map(|word| C::new(word.value())).collect(),
+        }
+    }
+}
+
+/// The byte budget of a memory's pages, shared by its arrays: what is allocated, the cap, and
+/// whether a page was refused for lack of budget since the last reset.
+#[derive(Debug)]
+pub struct Budget {
+    allocated: AtomicU64,
+    cap: u64,
+    refused: AtomicBool,
+}
+
+impl Budget {
+    /// A budget of `cap` bytes, nothing allocated.
+    #[must_use]
+    pub fn new(cap: u64) -> Self {
+        Self {
+            allocated: AtomicU64::new(0),
+            cap,
+            refused: AtomicBool::new(false),
+        }
+    }
+
+    /// Bytes of pages allocated.
+    #[must_use]
+    pub fn allocated(&self) -> u64 {
+        self.allocated.load(Relaxed)
+    }
+
+    /// Whether a page was refused since the last reset: the frame's results are not to be used.
+    #[must_use]
+    #[inline]
+    pub fn refused(&self) -> bool {
+        self.refused.load(Relaxed)
+    }
+
+    /// Sets the cap for the next frames (pages already allocated stay) and forgets refusals.
+    pub fn reset(&mut self, cap: u64) {
+        self.cap = cap;
+        *self.refused.get_mut() = false;
+    }
+
+    /// Takes `bytes` from the budget, or records a refusal and returns false.
+    fn take(&self, bytes: u64) -> bool {
+        let before = self.allocated.fetch_add(bytes, Relaxed);
+        if before + bytes <= self.cap {
+            return true;
+        }
+        self.allocated.fetch_sub(bytes, Relaxed);
+        self.refused.store(true, Relaxed);
+        false
+    }
+
+    /// Gives back `bytes` taken for a page another thread allocated first.
+    fn give_back(&self, bytes: u64) {
+        self.allocated.fetch_sub(bytes, Relaxed);
+    }
+}
+
+impl Clone for Budget {
+    fn clone(&self) -> Self {
+        Self {
+            allocated: AtomicU64::new(self.allocated()),
+            cap: self.cap,
+            refused: AtomicBool::new(self.refused()),
+        }
+    }
+}
+
+/// An array of `len` words of initial value `init`, allocated a page at a time.
+#[derive(Debug)]
+pub struct Pages<W, C> {
+    len: usize,
+    init: W,
+    pages: Vec<OnceLock<Page<C>>>,
+    /// Where the writes to refused pages go (see the module documentation).
+    scratch: OnceLock<Page<C>>,
+}
+
+impl<W: Word, C: WordCell<W>> Clone for Pages<W, C> {
+    fn clone(&self) -> Self {
+        let copy = |slot: &OnceLock<Page<C>>| {
+            let copied = OnceLock::new();
+            if let Some(page) = slot.get() {
+                let _ = copied.set(page.copy());
+            }
+            copied
+        };
+        Self {
+            len: self.len,
+            init: self.init,
+            pages: self.pages.iter().map(copy).collect(),
+            scratch: copy(&self.scratch),
+        }
+    }
+}
+
+impl<W: Word, C: WordCell<W>> Pages<W, C> {
+    /// `len` words of `init`, no page allocated.
+    pub fn new(len: usize, init: W) -> Self {
+        Self {
+            len,
+            init,
+            pages: (0..len.div_ceil(PAGE_WORDS))
+                .map(|_| OnceLock::new())
+                .collect(),
+            scratch: OnceLock::new(),
+        }
+    }
+
+    /// Number of words.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// The value of every word not written since the last reset.
+    #[inline]
+    pub fn init(&self) -> W {
+        self.init
+    }
+
+    /// Bytes of the page table itself, allocated with the array.
+    pub fn table_bytes(&self) -> u64 {
+        page_table_bytes(self.len)
+    }
+
+    /// The cell of word `index` for a read, or `None` where its page holds the initial value
+    /// (never written, and no page refused).
+    #[inline]
+    pub fn read(&self, index: usize, budget: &Budget) -> Option<&C> {
+        debug_assert!(index < self.len, "word {index} of {}", self.len);
+        match self.pages[index / PAGE_WORDS].get() {
+            Some(page) => Some(&page.words[index % PAGE_WORDS]),
+            None => self.absent(index, budget),
+        }
+    }
+
+    /// A read of a page not allocated: its initial value, unless a page was refused, when the
+    /// scratch page stands for every refused page (a write then read back is seen).
+    #[cold]
+    fn absent(&self, index: usize, budget: &Budget) -> Option<&C> {
+        if budget.refused() {
+            return Some(self.scratch(index));
+        }
+        None
+    }
+
+    /// The cell of word `index` for a write: its page allocated if it was not, and marked
+    /// written.
+    #[inline]
+    pub fn write(&self, index: usize, budget: &Budget) -> &C {
+        debug_assert!(index < self.len, "word {index} of {}", self.len);
+        let page = match self.pages[index / PAGE_WORDS].get() {
+            Some(page) => page,
+            None => match self.allocate(index / PAGE_WORDS, budget) {
+                Some(page) => page,
+                None => return self.scratch(index),
+            },
+        };
+        // Loaded first, so that after the first write the flag's line is only read.
+        let written = &page.written[index % PAGE_WORDS / BLOCK_WORDS];
+        if !written.load(Relaxed) {
+            written.store(true, Relaxed);
+        }
+        &page.words[index % PAGE_WORDS]
+    }
+
+    /// Allocates page `page` (filled with the initial value) within the budget, or `None`.
+    #[cold]
+    fn allocate(&self, page: usize, budget: &Budget) -> Option<&Page<C>> {
+        let words = PAGE_WORDS.min(self.len - page * PAGE_WORDS);
+        let bytes = (words * std::mem::size_of::<C>()) as u64;
+        if !budget.take(bytes) {
+            return None;
+        }
+        let mut filled_here = false;
+        let allocated = self.pages[page].get_or_init(|| {
+            filled_here = true;
+            Page::filled(self.init, words)
+        });
+        if !filled_here {
+            budget.give_back(bytes);
+        }
+        Some(allocated)
+    }
+
+    /// The scratch page's cell for word `index`.
+    fn scratch(&self, index: usize) -> &C {
+        &self
+            .scratch
+            .get_or_init(|| Page::filled(self.init, PAGE_WORDS))
+            .words[index % PAGE_WORDS]
+    }
+
+    /// Whether word `index` holds its initial value for certain: its block not written since
+    /// the last reset (and no page refused).
+    #[inline]
+    pub fn untouched(&self, index: usize, budget: &Budget) -> bool {
+        match self.pages[index / PAGE_WORDS].get() {
+            Some(page) => !page.written[index % PAGE_WORDS / BLOCK_WORDS].load(Relaxed),
+            None => !budget.refused(),
+        }
+    }
+
+    /// Sets every word to `init`: the blocks written since the last reset (every allocated page
+    /// when the initial value changes), one rayon task a few pages; drops the scratch page.
+    pub fn reset(&mut self, init: W) {
+        use rayon::prelude::*;
+        let all = init != self.init;
+        self.pages
+            .par_iter_mut()
+            .with_min_len(8)
+            .filter_map(OnceLock::get_mut)
+            .for_each(|page| {
+                for (block, written) in page.words.chunks_mut(BLOCK_WORDS).zip(&mut page.written) {
+                    if all || *written.get_mut() {
+                        block.iter_mut().for_each(|word| word.set_mut(init));
+                        *written.get_mut() = false;
+                    }
+                }
+            });
+        self.init = init;
+        self.scratch = OnceLock::new();
+    }
+}
