@@ -54,7 +54,11 @@ fn analyse(
         ids: [0, 1, 2],
         verts,
     };
-    triangle(viewport, origin, tri, found, &mut Vec::new(), bounds)
+    let target = Target {
+        pixels: viewport,
+        pattern: SamplePattern::CENTRE,
+    };
+    triangle(target, origin, tri, found, &mut Vec::new(), bounds)
 }
 
 /// A vertex that may reach every grid point within `radius` of `(x, y)` (1/256-pixel grid).
