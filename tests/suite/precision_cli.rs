@@ -200,7 +200,9 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
                     .args(["--no-images", "--json", "--vertex-precision", "f32"]),
                 code,
             );
-            crate::support::json_lines(json.as_bytes())[0].clone()
+            // The report is the JSON line; a DIFFERENT verdict adds a line on stderr.
+            let line = json.lines().find(|l| l.starts_with('{')).unwrap_or_default();
+            crate::support::json_lines(line.as_bytes())[0].clone()
         };
         for scheme in ["mdts", "abuffer"] {
             let report = judge(scheme, 0);
@@ -215,7 +217,7 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
             serde_json::from_str(&std::fs::read_to_string(abuffer.join("dump.json")).unwrap())
                 .unwrap();
         let capacity = header["capacity"].as_u64().unwrap() as usize;
-        let counters_file = abuffer.join("counters.bin");
+        let counters_file = abuffer.join("counters.u32");
         let mut counters: Vec<u32> = std::fs::read(&counters_file)
             .unwrap()
             .chunks_exact(4)
@@ -225,7 +227,7 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
         counters[sample] -= 1;
         let bytes: Vec<u8> = counters.iter().flat_map(|c| c.to_le_bytes()).collect();
         std::fs::write(&counters_file, bytes).unwrap();
-        let slots_file = abuffer.join("slots.bin");
+        let slots_file = abuffer.join("slots.u64");
         let mut slots = std::fs::read(&slots_file).unwrap();
         let last = (sample * capacity + counters[sample] as usize) * 8;
         slots[last..last + 8].copy_from_slice(&u64::MAX.to_le_bytes());
