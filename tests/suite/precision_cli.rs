@@ -201,7 +201,10 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
                 code,
             );
             // The report is the JSON line; a DIFFERENT verdict adds a line on stderr.
-            let line = json.lines().find(|l| l.starts_with('{')).unwrap_or_default();
+            let line = json
+                .lines()
+                .find(|l| l.starts_with('{'))
+                .unwrap_or_default();
             crate::support::json_lines(line.as_bytes())[0].clone()
         };
         for scheme in ["mdts", "abuffer"] {

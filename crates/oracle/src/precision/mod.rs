@@ -22,7 +22,9 @@
 
 use fragsim_raster::conventions::{DepthRange, VertexPrecision, WindowOrigin};
 use fragsim_raster::samples::SamplePattern;
-use fragsim_raster::{depth_key, Conventions, View, Viewport, SUBPIXEL_BITS};
+use fragsim_raster::{
+    depth_key, edge_function as edge, fill_thresholds, Conventions, View, Viewport, SUBPIXEL_BITS,
+};
 use serde::Serialize;
 
 use crate::dump::DepthFormat;
@@ -518,11 +520,6 @@ fn snap_reach(x: f64, error: f64, bits: u32) -> [i64; 2] {
     ]
 }
 
-/// The doubled signed area of `(a, b, p)` (the pipeline's edge function).
-fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
-    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
-}
-
 /// The edge function of `(a, b, p)` in f64 for real positions, and a bound on its rounding:
 /// two rounded differences per product, the products, the difference (`γ_3` of `|a·b| + |c·d|`;
 /// 0 in effect for integer positions, whose products f64 holds exactly).
@@ -549,19 +546,6 @@ fn edge_bound(p0: [f64; 2], q: [f64; 2], p: [f64; 2], r0: f64, rq: f64, rp: f64)
 /// Integer subpixel coordinates as f64 (exact).
 fn real(p: [i64; 2]) -> [f64; 2] {
     p.map(|c| c as f64)
-}
-
-/// The pipeline's fill rule for an edge of a positively oriented triangle in fragsim's y-down
-/// rows (`scan.rs`): top-left under an upper-left window origin; under a lower-left one the
-/// window's top edge is fragsim's bottom edge, so a horizontal edge with the interior above.
-fn owns(origin: WindowOrigin, a: [i64; 2], b: [i64; 2]) -> bool {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    dy < 0
-        || (dy == 0
-            && match origin {
-                WindowOrigin::UpperLeft => dx > 0,
-                WindowOrigin::LowerLeft => dx < 0,
-            })
 }
 
 /// The largest f32 not above `x`, and the smallest not below.
@@ -753,8 +737,8 @@ fn combinations(v: &[VertexBound; 3]) -> Option<Vec<[[i64; 2]; 3]>> {
 }
 
 /// Whether the pipeline covers sample position `p` with the snapped triangle `xy` (`scan.rs`: the
-/// triangle oriented positively, a degenerate one covering nothing, each edge under the fill
-/// rule of `origin`).
+/// triangle oriented positively, a degenerate one covering nothing, each edge under the
+/// rasterizer's fill rule for `origin`, [`fill_thresholds`]).
 fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
     let [a, mut b, mut c] = xy;
     let area = edge(a, b, c);
@@ -764,10 +748,9 @@ fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
     if area < 0 {
         std::mem::swap(&mut b, &mut c);
     }
-    [(b, c), (c, a), (a, b)].into_iter().all(|(i, j)| {
-        let e = edge(i, j, p);
-        e > 0 || (e == 0 && owns(origin, i, j))
-    })
+    let edges = [(b, c), (c, a), (a, b)];
+    let threshold = fill_thresholds(edges, origin);
+    (0..3).all(|k| edge(edges[k].0, edges[k].1, p) >= threshold[k])
 }
 
 /// Lists, for every sample of `target`'s pattern within the grown bounding box of an unclipped
@@ -840,6 +823,9 @@ fn triangle(
     let (y0, y1) = span(1, pixels.height);
     let samples = i64::from(pattern.count());
     let edges = [(1, 2), (2, 0), (0, 1)];
+    // The rasterizer's own fill rule (`scan.rs`): an edge covers a point where its value is at
+    // least its threshold.
+    let threshold = fill_thresholds(edges.map(|(i, j)| (v[i].snapped, v[j].snapped)), origin);
     let area_stable = area as f64 > area_bound;
     let mut planes = Vec::new();
     let positions =
@@ -848,10 +834,7 @@ fn triangle(
         let [ox, oy] = pattern.fixed_offset(s as usize);
         let p = [x * one + ox, y * one + oy];
         let e = edges.map(|(i, j)| edge(v[i].snapped, v[j].snapped, p));
-        let passes = |k: usize| {
-            let (i, j) = edges[k];
-            e[k] > 0 || (e[k] == 0 && owns(origin, v[i].snapped, v[j].snapped))
-        };
+        let passes = |k: usize| e[k] >= threshold[k];
         let covered = area > 0 && (0..3).all(passes);
         planes.clear();
         planes.push(unsnapped);
