@@ -157,7 +157,7 @@ fn an_f32_vertex_stage_is_judged_within_printed_bounds() {
 /// rasterizer's own f32 stage, its dump declaring both) judged under `--vertex-precision f32`,
 /// which derives its bounds at each sample: EQUAL with no differing sample at 4 and 8 samples, for
 /// MDTS keys and the A-buffer's ids; a sample dropped from the A-buffer (its counter and slot
-/// as a capture that lost it) is DIFFERENT.
+/// as a capture that lost it) is DIFFERENT. A masked-node dump under the flag is refused by name.
 #[test]
 fn a_per_sample_f32_capture_is_judged_at_each_sample() {
     for samples in ["4", "8"] {
@@ -185,7 +185,7 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
                     "--capacity",
                     "auto",
                     "--scheme",
-                    "mdts,abuffer",
+                    "mdts,abuffer,abuffer-masked",
                     "--no-images",
                 ])
                 .arg("--dump")
@@ -213,6 +213,16 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
             assert_eq!(report["per_sample_differing_samples"], 0, "{report}");
             assert!(report["per_sample_compared"].as_u64().unwrap() > 0);
         }
+        // The masked-node dump is judged per sample by the library, not yet by compare: refused
+        // by name, not misread.
+        let refused = run(
+            fragsim()
+                .args(["compare", "oracle"])
+                .arg(dir.join("abuffer-masked"))
+                .args(["--no-images", "--vertex-precision", "f32"]),
+            2,
+        );
+        assert!(refused.contains("masked-node dump"), "{refused}");
         // Drop the first stored fragment of the first sample holding one: the counter one less
         // and the slot emptied, as an implementation that lost it would leave them.
         let abuffer = dir.join("abuffer");
