@@ -419,7 +419,7 @@ impl Dump {
                     .map_or(u32::MAX, |q| q.key_lo)
             };
             list.sort_by_key(|w| (lowest(w), *w));
-            capture.push_pixel(list.into_iter());
+            capture.push_pixel(list);
         }
         let mut nodes = compare_within(
             precision,
