@@ -430,15 +430,16 @@ fn key_only_words_leave_the_triangle_unnamed_and_still_catch_a_dropped_or_double
     });
 }
 
-/// The bunny at 64 × 48 rasterized per sample at `samples` (the standard pattern) under
+/// The bunny at `width × height` rasterized per sample at `samples` (the standard pattern) under
 /// `vertex_precision`, the rest of the reference conventions.
 fn with_sampled_bunny(
+    (width, height): (u32, u32),
     samples: u32,
     vertex_precision: VertexPrecision,
     test: impl FnOnce(&View<'_>),
 ) {
     let scene = Scene::default_scene();
-    let viewport = Viewport::new(64, 48).unwrap();
+    let viewport = Viewport::new(width, height).unwrap();
     let camera = scene.orbit_camera(viewport, &OrbitCamera::default(), DepthRange::ZeroToOne);
     let conventions = Conventions {
         vertex_precision,
@@ -511,11 +512,15 @@ fn engine_like_samples(view: &View<'_>) -> Vec<Vec<u64>> {
 /// The per-sample f32 captures of the bunny at `samples`: the rasterizer's own f32 vertex stage
 /// (a view declaring f32 vertex precision) and [`engine_like_samples`]'s, each with the f64
 /// per-sample oracle and the f32 analysis it is judged by.
-fn with_f32_samples(samples: u32, test: impl FnOnce(&Oracle, &Precision, [Vec<Vec<u64>>; 2])) {
-    with_sampled_bunny(samples, VertexPrecision::F32, |f32_view| {
+fn with_f32_samples(
+    size: (u32, u32),
+    samples: u32,
+    test: impl FnOnce(&Oracle, &Precision, [Vec<Vec<u64>>; 2]),
+) {
+    with_sampled_bunny(size, samples, VertexPrecision::F32, |f32_view| {
         let own = Oracle::build(f32_view);
         let own: Vec<Vec<u64>> = (0..own.pixels()).map(|p| own.pixel(p).to_vec()).collect();
-        with_sampled_bunny(samples, VertexPrecision::F64, |view| {
+        with_sampled_bunny(size, samples, VertexPrecision::F64, |view| {
             let oracle = Oracle::build(view);
             let precision = Precision::derive(view, &Conventions { samples, ..F32 });
             assert_eq!(precision.pixels(), oracle.pixels());
@@ -527,7 +532,7 @@ fn with_f32_samples(samples: u32, test: impl FnOnce(&Oracle, &Precision, [Vec<Ve
 #[test]
 fn per_sample_f32_captures_are_equal_at_4_and_8_samples_and_different_bit_for_bit() {
     for samples in [4, 8] {
-        with_f32_samples(samples, |oracle, precision, captures| {
+        with_f32_samples((64, 48), samples, |oracle, precision, captures| {
             for (name, lists) in ["rasterizer's f32 stage", "engine-like"]
                 .iter()
                 .zip(&captures)
@@ -565,7 +570,7 @@ fn per_sample_f32_captures_are_equal_at_4_and_8_samples_and_different_bit_for_bi
 #[test]
 fn a_dropped_sample_and_a_sample_depth_past_its_interval_are_different_per_sample() {
     for samples in [4, 8] {
-        with_f32_samples(samples, |oracle, precision, [lists, _]| {
+        with_f32_samples((64, 48), samples, |oracle, precision, [lists, _]| {
             let p = certain_pixel(precision, &lists);
             let q = precision.pixel(p)[0];
             let i = lists[p].iter().position(|&w| w as u32 == q.prim).unwrap();
@@ -592,4 +597,47 @@ fn a_dropped_sample_and_a_sample_depth_past_its_interval_are_different_per_sampl
             }
         });
     }
+}
+
+/// Per sample the snaps are inferred over every sample of every pixel: at samples beside an edge
+/// shared by two triangles (each one's coverage undecided alone), either snap of the edge gives
+/// the sample to exactly one of them, so a dropped or a doubled sample there is an error, not an
+/// ambiguity.
+#[test]
+fn per_sample_joint_snaps_decide_shared_edges_and_catch_a_dropped_or_doubled_sample() {
+    with_f32_samples((384, 288), 4, |oracle, precision, [_, lists]| {
+        let judged = judge(precision, oracle, &lists);
+        assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
+        let snaps = judged.snaps;
+        assert_eq!(snaps.contradicting_pixels, 0, "{snaps:?}");
+        let shared = shared_edge_pixels(precision, &lists);
+        println!(
+            "{} samples judged, {} beside a shared edge, {snaps:?}",
+            judged.verdicts.len(),
+            shared.len()
+        );
+        assert!(shared.len() >= 4, "{} shared-edge samples", shared.len());
+        for &(p, present, absent) in shared.iter().take(8) {
+            assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "sample {p}");
+            let mut dropped = lists.clone();
+            dropped[p].retain(|&w| w as u32 != present);
+            let flags = judge(precision, oracle, &dropped).verdicts[p];
+            assert_ne!(
+                flags & verdict::MISSING,
+                0,
+                "sample {p} dropped: {flags:#b}"
+            );
+            let key_lo = precision
+                .pixel(p)
+                .iter()
+                .find(|q| q.prim == absent)
+                .unwrap()
+                .key_lo;
+            let mut doubled = lists.clone();
+            doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
+            doubled[p].sort_unstable();
+            let flags = judge(precision, oracle, &doubled).verdicts[p];
+            assert_ne!(flags & verdict::EXTRA, 0, "sample {p} doubled: {flags:#b}");
+        }
+    });
 }
