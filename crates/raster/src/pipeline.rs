@@ -51,6 +51,7 @@ mod viewport;
 
 use sample_scan::Sampling;
 use scan::{bounding_box, edge};
+pub use scan::{edge as edge_function, fill_thresholds};
 use vertex::{in_front, CentreCells, WindowVertex};
 pub use viewport::{PixelRect, Viewport};
 

@@ -15,6 +15,12 @@
 //! overflow allowed past `capacity` and counted, counters checked), and each stored node's mask
 //! against the reference node of its primitive: a mask that differs makes the reference's node
 //! missing and the stored one extra ([`Dump::compare_masked`]).
+//!
+//! Under the precision of an f32 vertex stage ([`Dump::compare_masked_within`]) the nodes are
+//! spread over the samples their masks hold and judged per sample by the precision verdict
+//! ([`compare_within`]: coverage at each sample, the joint snaps per vertex), by primitive id; a
+//! node's key, the nearest of its samples' depths, must lie in the interval that nearest may
+//! take: from the least of its samples' lowest keys to the least of their highest.
 
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists, MaskedNode};
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, SerialMemory, WordMemory};
@@ -27,6 +33,7 @@ use super::{err, Dtype, Dump, DumpError, Header, Words};
 use super::{FORMAT, VERSION};
 use crate::compare::{compare_with, verdict, CompareOptions, Comparison};
 use crate::diff::PixelMismatch;
+use crate::precision::{compare_within, Precision};
 use crate::scene::SceneAndCamera;
 use crate::Oracle;
 
@@ -307,6 +314,134 @@ impl Dump {
         Ok(MaskedComparison { nodes, wrong_masks })
     }
 
+    /// Judges this masked-node dump within the precision of an f32 vertex stage: `precision` and
+    /// `reference` are the per-sample analysis and oracle of the dump's view
+    /// ([`f32_reference`](crate::precision::f32_reference) of a scene declaring the dump's
+    /// sample count). Each node stands for its primitive at every sample its mask holds; those
+    /// per-sample lists, by primitive id, go through [`compare_within`] (a sample a node wrongly
+    /// covers or leaves out is extra or missing there, ambiguous only where coverage at that
+    /// sample is undecided under the joint snaps). A node's key is the nearest of its samples'
+    /// depths, so it must lie from the least `key_lo` to the least `key_hi` of its primitive's
+    /// possibilities at the samples of its mask: a key outside makes the node's first sample
+    /// [`verdict::MISSING`] and [`verdict::EXTRA`] (one lost and one extra fragment). Corrupt
+    /// words are charged to their pixel's first sample. The verdicts are per sample
+    /// (`pixels × samples`, sample `s` of pixel `p` at `p · samples + s`); `wrong_masks` is empty
+    /// (a wrong mask is judged per sample).
+    ///
+    /// # Errors
+    /// As [`Dump::masked_lists`]; an analysis or oracle of another number of samples; a pixel
+    /// whose nodes overflowed its capacity (which samples a dropped node covered is unknowable,
+    /// so the dump is judged exactly only, [`Dump::compare_masked`]).
+    pub fn compare_masked_within(
+        &self,
+        precision: &Precision,
+        reference: &Oracle,
+        options: &CompareOptions<'_>,
+    ) -> Result<MaskedComparison, DumpError> {
+        let lists = self.masked_lists()?;
+        let n = lists.samples as usize;
+        let samples = lists.pixels() * n;
+        if precision.pixels() != samples || reference.pixels() != samples {
+            return err(format!(
+                "the analysis covers {} samples and the reference {}, the dump {} pixels at {n} \
+                 samples ({samples})",
+                precision.pixels(),
+                reference.pixels(),
+                lists.pixels()
+            ));
+        }
+        if let Some(p) = (0..lists.pixels()).find(|&p| lists.overflow[p] > 0) {
+            return err(format!(
+                "pixel {p} dropped {} nodes past the capacity: which samples they covered is \
+                 unknown, so a masked-node dump that overflowed is judged exactly only",
+                lists.overflow[p]
+            ));
+        }
+        let words = self.check_words()?;
+        let per_sample_words = WordCheck {
+            corrupt: (0..samples)
+                .map(|i| {
+                    if i % n == 0 {
+                        words.corrupt[i / n].clone()
+                    } else {
+                        Vec::new()
+                    }
+                })
+                .collect(),
+            counters: None,
+            unchecked: words.unchecked,
+            unreachable: 0,
+        };
+        let mut capture = Capture::with_pixels(
+            samples,
+            Identity::PrimOnly,
+            Keeps::All {
+                capacity: Capacity::Unbounded,
+                overflow: vec![0; samples],
+            },
+        );
+        let mut stray_keys: Vec<(usize, u8)> = Vec::new();
+        let mut per_sample: Vec<Vec<u64>> = vec![Vec::new(); samples];
+        for p in 0..lists.pixels() {
+            for node in lists.pixel(p) {
+                let covered: Vec<usize> = (0..n)
+                    .filter(|&s| node.mask >> s & 1 == 1)
+                    .map(|s| p * n + s)
+                    .collect();
+                let mut interval: Option<(u32, u32)> = None;
+                for &sample in &covered {
+                    per_sample[sample].push(node.packed());
+                    let possible = precision.pixel(sample).iter().find(|q| q.prim == node.prim);
+                    if let Some(q) = possible {
+                        interval = Some(interval.map_or((q.key_lo, q.key_hi), |(lo, hi)| {
+                            (lo.min(q.key_lo), hi.min(q.key_hi))
+                        }));
+                    }
+                }
+                let widen = options.depth_ulps;
+                let inside = interval.is_none_or(|(lo, hi)| {
+                    node.depth_key >= lo.saturating_sub(widen)
+                        && node.depth_key <= hi.saturating_add(widen)
+                });
+                if let (false, Some(&first)) = (inside, covered.first()) {
+                    stray_keys.push((first, verdict::MISSING | verdict::EXTRA));
+                }
+            }
+        }
+        for (sample, mut list) in per_sample.into_iter().enumerate() {
+            // A node's place in its pixel is its nearest sample's: at another sample the order
+            // owes nothing, so each sample lists its nodes as the analysis orders them there.
+            let possible = precision.pixel(sample);
+            let lowest = |w: &u64| {
+                possible
+                    .iter()
+                    .find(|q| q.prim == *w as u32)
+                    .map_or(u32::MAX, |q| q.key_lo)
+            };
+            list.sort_by_key(|w| (lowest(w), *w));
+            capture.push_pixel(list);
+        }
+        let mut nodes = compare_within(
+            precision,
+            reference,
+            &capture,
+            Some(&per_sample_words),
+            options,
+        );
+        let stray = stray_keys.len() as u64;
+        nodes.diff.lost += stray;
+        nodes.diff.extra += stray;
+        nodes.add_flags(&stray_keys, options.examples, |sample| PixelMismatch {
+            pixel: sample,
+            expected: reference.pixel(sample).to_vec(),
+            got: capture.pixel(sample).to_vec(),
+        });
+        Ok(MaskedComparison {
+            nodes,
+            wrong_masks: Vec::new(),
+        })
+    }
+
     /// Runs the masked-node A-buffer of `capacity` nodes a pixel serially over `view` (which
     /// rasterizes per sample, at the sample count `scene`'s conventions declare) and records its
     /// memory as a dump, `filled` (fragsim's storage starts empty).
@@ -429,4 +564,110 @@ pub fn masked_spec(encoding: &Encoding) -> (Option<LayoutSpec>, Vec<&'static str
         },
     );
     (spec, ignored)
+}
+
+#[cfg(test)]
+mod tests {
+    use fragsim_raster::conventions::VertexPrecision;
+    use fragsim_raster::{Conventions, Viewport};
+
+    use super::*;
+    use crate::precision::f32_reference;
+
+    const CAPACITY: u32 = 64;
+
+    fn options() -> CompareOptions<'static> {
+        CompareOptions {
+            depth_ulps: 0,
+            examples: 4,
+            complete: None,
+        }
+    }
+
+    /// A masked-node dump of `spheres:3` at `samples` made through the rasterizer's f32 vertex
+    /// stage, with the per-sample f64 oracle and f32 analysis it is judged by.
+    fn f32_masked(samples: u32) -> (Dump, Precision, Oracle) {
+        let mut spec = SceneAndCamera::named("spheres:3", 30.0, 15.0);
+        spec.conventions = Conventions {
+            vertex_precision: VertexPrecision::F32,
+            samples,
+            ..Conventions::REFERENCE
+        };
+        let viewport = Viewport::new(40, 30).unwrap();
+        let loaded = spec.load(None).unwrap();
+        let view = spec.view(&loaded, viewport).unwrap();
+        let dump = Dump::record_masked(&view, spec.clone(), CAPACITY, "test").unwrap();
+        let (oracle, precision) = f32_reference(&spec, viewport, None).unwrap();
+        (dump, precision, oracle)
+    }
+
+    /// The first stored node covering at least two samples, each certain for its primitive:
+    /// its slot, word and mask, and the least highest key of those samples.
+    fn certain_node(dump: &Dump, precision: &Precision, n: usize) -> (usize, u64, u32, u32) {
+        let counters = dump.u32s("counters").unwrap().unwrap();
+        let nodes = dump.u64s("nodes").unwrap().unwrap();
+        let masks = dump.u32s("masks").unwrap().unwrap();
+        (0..counters.len())
+            .flat_map(|p| (0..counters[p] as usize).map(move |i| (p, p * CAPACITY as usize + i)))
+            .find_map(|(p, slot)| {
+                let (word, mask) = (nodes[slot], masks[slot]);
+                let entries: Option<Vec<_>> = (0..n)
+                    .filter(|&s| mask >> s & 1 == 1)
+                    .map(|s| {
+                        let q = precision
+                            .pixel(p * n + s)
+                            .iter()
+                            .find(|q| q.prim == word as u32);
+                        q.filter(|q| q.certain()).copied()
+                    })
+                    .collect();
+                let entries = entries.filter(|e| e.len() >= 2)?;
+                let hi = entries.iter().map(|q| q.key_hi).min()?;
+                Some((slot, word, mask, hi))
+            })
+            .expect("a node covering two certain samples")
+    }
+
+    #[test]
+    fn an_f32_masked_dump_is_equal_per_sample_and_a_dropped_sample_or_a_stray_key_is_not() {
+        for samples in [4, 8] {
+            let (dump, precision, oracle) = f32_masked(samples);
+            let judged = dump
+                .compare_masked_within(&precision, &oracle, &options())
+                .unwrap();
+            assert_eq!(judged.nodes.verdicts.len(), oracle.pixels());
+            assert_eq!(
+                judged.nodes.diff.mismatched_pixels, 0,
+                "{samples}x: {:?}",
+                judged.nodes.diff
+            );
+            let n = samples as usize;
+            let (slot, word, mask, key_hi) = certain_node(&dump, &precision, n);
+            let shape = dump.shape_of("masks");
+            let mut dropped = dump.clone();
+            let mut masks = dump.u32s("masks").unwrap().unwrap().to_vec();
+            masks[slot] = mask & (mask - 1);
+            dropped.set_array("masks", Words::U32(masks), shape.clone());
+            let mut stray = dump.clone();
+            let mut nodes = dump.u64s("nodes").unwrap().unwrap().to_vec();
+            nodes[slot] = u64::from(key_hi + 1) << 32 | (word & u64::from(u32::MAX));
+            stray.set_array("nodes", Words::U64(nodes), shape);
+            // The pixel's first covered sample: the one dropped, or the one a stray key is
+            // charged to. Dropping the sample of the node's nearest depth may also leave its key
+            // below the other samples' intervals, a second error.
+            let planted = slot / CAPACITY as usize * n + mask.trailing_zeros() as usize;
+            for (name, bugged) in [
+                ("a sample dropped", dropped),
+                ("a key past its interval", stray),
+            ] {
+                let judged = bugged
+                    .compare_masked_within(&precision, &oracle, &options())
+                    .unwrap();
+                let flags = judged.nodes.verdicts[planted];
+                assert_ne!(flags & verdict::DIFFERS, 0, "{samples}x {name}: {flags:#b}");
+                let wrong = judged.nodes.diff.mismatched_pixels;
+                assert!(wrong <= 2, "{samples}x {name}: {:?}", judged.nodes.diff);
+            }
+        }
+    }
 }

@@ -9,13 +9,22 @@
 //! depth key inside that entry's interval; every entry marked `certain` is emitted. Coverage is
 //! enumerated over the snapped triangles its vertices may reach, so it is exact. With f64 vertex
 //! precision the contract is bit-exactness and the analysis is empty ([`Precision::is_exact`]).
+//!
+//! Per sample: for a view that rasterizes per sample (`View::with_samples`, a dump declaring
+//! `conventions.samples`), the same bounds are derived at each sample position of the standard
+//! pattern instead of the pixel centre, and the entries index the sample-expanded framebuffer
+//! (sample `s` of pixel `p` at `p · n + s`), as the per-sample oracle and per-sample dumps do.
+//! A vertex still snaps once for every sample of every triangle that uses it.
 //! Source: the
 //! derivation in `docs/semantics.md`, "Precision of a conforming implementation" (standard
 //! floating-point error analysis, Higham's `γ_n`; the Vulkan CTS rasterization verifier's
 //! "definitely / maybe covered" classification).
 
 use fragsim_raster::conventions::{DepthRange, VertexPrecision, WindowOrigin};
-use fragsim_raster::{depth_key, Conventions, View, Viewport, SUBPIXEL_BITS};
+use fragsim_raster::samples::SamplePattern;
+use fragsim_raster::{
+    depth_key, edge_function as edge, fill_thresholds, Conventions, View, Viewport, SUBPIXEL_BITS,
+};
 use serde::Serialize;
 
 use crate::dump::DepthFormat;
@@ -69,7 +78,7 @@ impl Possible {
 /// What leaves a possible fragment undecided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Doubt {
-    /// Some snapped triangle the vertices may reach covers the pixel centre and another does
+    /// Some snapped triangle the vertices may reach covers the sample position and another does
     /// not (or the edge bound cannot decide): present or absent, both conform.
     Coverage,
     /// Coverage is certain but the depth interval leaves `[0, 1]`: the fragment may be clipped.
@@ -133,7 +142,7 @@ struct Dependence {
     /// How many grid points each may reach: the `i`-th combination takes point
     /// `i / (n1·n2)` of vertex 0, `(i / n2) mod n1` of vertex 1 and `i mod n2` of vertex 2.
     points: [u8; 3],
-    /// Bit `i`: the `i`-th combination covers the pixel centre.
+    /// Bit `i`: the `i`-th combination covers the sample position.
     covering: u64,
     /// Whether the fragment is certain wherever its triangle covers the centre (its depth
     /// interval inside `[0, 1]`): else a covering snap may still drop it.
@@ -180,6 +189,10 @@ impl Precision {
             return Self::exact();
         }
         let mut bounds = Bounds::default();
+        let target = Target {
+            pixels: view.pixel_viewport(),
+            pattern: view.samples().unwrap_or(SamplePattern::CENTRE),
+        };
         let vertices: Vec<Option<VertexBound>> = (0..view.mesh().positions.len() as u32)
             .map(|i| vertex_bound(view, conventions, i, &mut bounds))
             .collect();
@@ -193,16 +206,14 @@ impl Precision {
             let ids = view.mesh().triangles[prim as usize];
             match ids.map(|i| vertices[i as usize]) {
                 [Some(a), Some(b), Some(c)] => {
-                    let origin = conventions.window_origin;
                     let tri = Triangle {
                         prim,
                         ids,
                         verts: [a, b, c],
                     };
-                    let viewport = view.viewport();
                     if !triangle(
-                        viewport,
-                        origin,
+                        target,
+                        conventions.window_origin,
                         tri,
                         &mut found,
                         &mut dependent,
@@ -415,7 +426,8 @@ fn vertex_bound(
     );
     // X = (ndc·½ + ½)·width, or the spec's (width/2)·ndc + width/2: the error scaled by
     // width/2, and two more roundings of results no larger than these (the halving is exact).
-    let viewport = view.viewport();
+    // The render target in pixels: a view rasterizing per sample maps positions to pixels too.
+    let viewport = view.pixel_viewport();
     let window_error = |n: f64, e: f64, side: u32| {
         let side = f64::from(side);
         let shifted = (n.abs() + e) / 2.0 + 0.5;
@@ -515,11 +527,6 @@ fn snap_reach(x: f64, error: f64, bits: u32) -> [i64; 2] {
     ]
 }
 
-/// The doubled signed area of `(a, b, p)` (the pipeline's edge function).
-fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
-    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
-}
-
 /// The edge function of `(a, b, p)` in f64 for real positions, and a bound on its rounding:
 /// two rounded differences per product, the products, the difference (`γ_3` of `|a·b| + |c·d|`;
 /// 0 in effect for integer positions, whose products f64 holds exactly).
@@ -546,19 +553,6 @@ fn edge_bound(p0: [f64; 2], q: [f64; 2], p: [f64; 2], r0: f64, rq: f64, rp: f64)
 /// Integer subpixel coordinates as f64 (exact).
 fn real(p: [i64; 2]) -> [f64; 2] {
     p.map(|c| c as f64)
-}
-
-/// The pipeline's fill rule for an edge of a positively oriented triangle in fragsim's y-down
-/// rows (`scan.rs`): top-left under an upper-left window origin; under a lower-left one the
-/// window's top edge is fragsim's bottom edge, so a horizontal edge with the interior above.
-fn owns(origin: WindowOrigin, a: [i64; 2], b: [i64; 2]) -> bool {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    dy < 0
-        || (dy == 0
-            && match origin {
-                WindowOrigin::UpperLeft => dx > 0,
-                WindowOrigin::LowerLeft => dx < 0,
-            })
 }
 
 /// The largest f32 not above `x`, and the smallest not below.
@@ -588,7 +582,7 @@ struct Plane {
     radius: [f64; 3],
 }
 
-/// The depth keys an implementation may give the fragment of triangle `v` at pixel centre `p`
+/// The depth keys an implementation may give the fragment of triangle `v` at sample position `p`
 /// when its plane is one of `planes`, around the reference's plane value `z`; and whether the
 /// whole interval lies in `[0, 1]` (else the fragment may be dropped). The interval is the hull
 /// of each plane's ([`plane_interval`]), with the reference's value in it; one unbounded plane
@@ -616,7 +610,7 @@ fn depth_interval(
     )
 }
 
-/// The real interval of depths at pixel centre `p` of an implementation whose plane passes
+/// The real interval of depths at sample position `p` (subpixels) of an implementation whose plane passes
 /// through `plane`'s positions (each moved within its radius) and `v`'s vertex depths (each within
 /// its error), evaluated in f32; `None` when the moved triangle's area may reach 0. With
 /// `λ_k = E_k/A` and `B` the edge bounds over the radii, `|Δλ_k| ≤ (B_k + |λ_k|·B_A)/(A − B_A)`
@@ -749,9 +743,9 @@ fn combinations(v: &[VertexBound; 3]) -> Option<Vec<[[i64; 2]; 3]>> {
     Some(all)
 }
 
-/// Whether the pipeline covers centre `p` with the snapped triangle `xy` (`scan.rs`: the
-/// triangle oriented positively, a degenerate one covering nothing, each edge under the fill
-/// rule of `origin`).
+/// Whether the pipeline covers sample position `p` with the snapped triangle `xy` (`scan.rs`: the
+/// triangle oriented positively, a degenerate one covering nothing, each edge under the
+/// rasterizer's fill rule for `origin`, [`fill_thresholds`]).
 fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
     let [a, mut b, mut c] = xy;
     let area = edge(a, b, c);
@@ -761,13 +755,13 @@ fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
     if area < 0 {
         std::mem::swap(&mut b, &mut c);
     }
-    [(b, c), (c, a), (a, b)].into_iter().all(|(i, j)| {
-        let e = edge(i, j, p);
-        e > 0 || (e == 0 && owns(origin, i, j))
-    })
+    let edges = [(b, c), (c, a), (a, b)];
+    let threshold = fill_thresholds(edges, origin);
+    (0..3).all(|k| edge(edges[k].0, edges[k].1, p) >= threshold[k])
 }
 
-/// Lists, for every pixel centre within the grown bounding box of an unclipped triangle, what an
+/// Lists, for every sample of `target`'s pattern within the grown bounding box of an unclipped
+/// triangle (the pixel centres at one sample), what an
 /// implementation may emit there: coverage enumerated over every snapped triangle the vertices
 /// may reach (step 5 of `docs/semantics.md` §10), or past [`MAX_COMBINATIONS`] decided by the
 /// bilinear edge bound over their radius; depth over the planes of the snapped triangles that
@@ -776,7 +770,7 @@ fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
 /// enumerated fragment whose coverage is split depends on the vertices' snaps. Returns whether it
 /// enumerated.
 fn triangle(
-    viewport: Viewport,
+    target: Target,
     origin: WindowOrigin,
     tri: Triangle,
     found: &mut Vec<(u32, Possible)>,
@@ -818,123 +812,140 @@ fn triangle(
     };
     let grow = v.iter().map(|x| x.radius).max().unwrap_or(0);
     let one = 1i64 << SUBPIXEL_BITS;
-    let half = one / 2;
+    let Target { pixels, pattern } = target;
     let lo = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).min().unwrap_or(0) - grow);
     let hi = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).max().unwrap_or(0) + grow);
-    let span = |lo: i64, hi: i64, side: u32| {
-        let from = (lo - half + one - 1).div_euclid(one).max(0);
-        let to = (hi - half).div_euclid(one).min(i64::from(side) - 1);
+    // The pixels one of whose samples may lie in the grown box (at one sample, the centres).
+    let [min_offset, max_offset] = pattern.fixed_extent();
+    let span = |axis: usize, side: u32| {
+        let from = (lo[axis] - max_offset[axis] + one - 1)
+            .div_euclid(one)
+            .max(0);
+        let to = (hi[axis] - min_offset[axis])
+            .div_euclid(one)
+            .min(i64::from(side) - 1);
         (from, to)
     };
-    let (x0, x1) = span(lo[0], hi[0], viewport.width);
-    let (y0, y1) = span(lo[1], hi[1], viewport.height);
+    let (x0, x1) = span(0, pixels.width);
+    let (y0, y1) = span(1, pixels.height);
+    let samples = i64::from(pattern.count());
     let edges = [(1, 2), (2, 0), (0, 1)];
+    // The rasterizer's own fill rule (`scan.rs`): an edge covers a point where its value is at
+    // least its threshold.
+    let threshold = fill_thresholds(edges.map(|(i, j)| (v[i].snapped, v[j].snapped)), origin);
     let area_stable = area as f64 > area_bound;
     let mut planes = Vec::new();
-    for y in y0..=y1 {
-        for x in x0..=x1 {
-            let p = [x * one + half, y * one + half];
-            let e = edges.map(|(i, j)| edge(v[i].snapped, v[j].snapped, p));
-            let passes = |k: usize| {
-                let (i, j) = edges[k];
-                e[k] > 0 || (e[k] == 0 && owns(origin, v[i].snapped, v[j].snapped))
-            };
-            let covered = area > 0 && (0..3).all(passes);
-            planes.clear();
-            planes.push(unsnapped);
-            let mut covering = 0u64;
-            let (certain, possible) = match &reachable {
-                // The reference's own triangle is one of them: `certain` implies `covered`.
-                Some(all) => {
-                    let mut split = false;
-                    for (i, &xy) in all.iter().enumerate() {
-                        if covers(origin, xy, p) {
-                            planes.push(Plane {
-                                at: xy.map(real),
-                                radius: [0.0; 3],
-                            });
-                            covering |= 1 << i;
-                            split |= !covered;
-                        } else {
-                            split |= covered;
-                        }
-                    }
-                    (covered && !split, covered || split)
-                }
-                None => {
-                    planes.push(snapped_within_radius);
-                    let eb = edges.map(|(i, j)| {
-                        edge_bound(
-                            real(v[i].snapped),
-                            real(v[j].snapped),
-                            real(p),
-                            radius[i],
-                            radius[j],
-                            0.0,
-                        )
-                    });
-                    let decided = |k: usize| eb[k] == 0.0 || e[k].abs() as f64 > eb[k];
-                    if area_stable {
-                        let out = (0..3).any(|k| decided(k) && !passes(k));
-                        ((0..3).all(|k| decided(k) && passes(k)), !out)
+    let positions =
+        (y0..=y1).flat_map(|y| (x0..=x1).flat_map(move |x| (0..samples).map(move |s| (x, y, s))));
+    for (x, y, s) in positions {
+        let [ox, oy] = pattern.fixed_offset(s as usize);
+        let p = [x * one + ox, y * one + oy];
+        let e = edges.map(|(i, j)| edge(v[i].snapped, v[j].snapped, p));
+        let passes = |k: usize| e[k] >= threshold[k];
+        let covered = area > 0 && (0..3).all(passes);
+        planes.clear();
+        planes.push(unsnapped);
+        let mut covering = 0u64;
+        let (certain, possible) = match &reachable {
+            // The reference's own triangle is one of them: `certain` implies `covered`.
+            Some(all) => {
+                let mut split = false;
+                for (i, &xy) in all.iter().enumerate() {
+                    if covers(origin, xy, p) {
+                        planes.push(Plane {
+                            at: xy.map(real),
+                            radius: [0.0; 3],
+                        });
+                        covering |= 1 << i;
+                        split |= !covered;
                     } else {
-                        // The orientation itself may flip: either side's coverage may be emitted.
-                        let pos = (0..3).all(|k| e[k] as f64 >= -eb[k]);
-                        let neg = (0..3).all(|k| e[k] as f64 <= eb[k]);
-                        (false, pos || neg)
+                        split |= covered;
                     }
                 }
-            };
-            if !possible && !covered {
-                continue;
+                (covered && !split, covered || split)
             }
-            let area_f = area as f64;
-            let z =
-                (e[0] as f64 * v[0].depth + e[1] as f64 * v[1].depth + e[2] as f64 * v[2].depth)
-                    / area_f;
-            let reference = if covered { depth_key(z as f32) } else { None };
-            let (key_lo, key_hi, inside) = depth_interval(viewport, &v, &planes, p, z);
-            if !certain && reachable.is_some() {
-                dependent.push((
-                    found.len(),
-                    Dependence {
-                        vertices: ids,
-                        points,
-                        covering,
-                        depth_certain: inside && (reference.is_some() || !covered),
-                    },
-                ));
-            }
-            let doubt = if !certain {
-                Some(Doubt::Coverage)
-            } else if !inside || reference.is_none() {
-                Some(Doubt::Depth)
-            } else {
-                None
-            };
-            if doubt.is_some() {
-                bounds.ambiguous_pairs += 1;
-                if reference.is_none() && !covered {
-                    bounds.may_be_present_pairs += 1;
-                } else if doubt == Some(Doubt::Coverage) {
-                    bounds.coverage_undecided_pairs += 1;
+            None => {
+                planes.push(snapped_within_radius);
+                let eb = edges.map(|(i, j)| {
+                    edge_bound(
+                        real(v[i].snapped),
+                        real(v[j].snapped),
+                        real(p),
+                        radius[i],
+                        radius[j],
+                        0.0,
+                    )
+                });
+                let decided = |k: usize| eb[k] == 0.0 || e[k].abs() as f64 > eb[k];
+                if area_stable {
+                    let out = (0..3).any(|k| decided(k) && !passes(k));
+                    ((0..3).all(|k| decided(k) && passes(k)), !out)
                 } else {
-                    bounds.depth_undecided_pairs += 1;
+                    // The orientation itself may flip: either side's coverage may be emitted.
+                    let pos = (0..3).all(|k| e[k] as f64 >= -eb[k]);
+                    let neg = (0..3).all(|k| e[k] as f64 <= eb[k]);
+                    (false, pos || neg)
                 }
             }
-            found.push((
-                (y * i64::from(viewport.width) + x) as u32,
-                Possible {
-                    prim,
-                    key_lo,
-                    key_hi,
-                    doubt,
-                    reference,
+        };
+        if !possible && !covered {
+            continue;
+        }
+        let area_f = area as f64;
+        let z = (e[0] as f64 * v[0].depth + e[1] as f64 * v[1].depth + e[2] as f64 * v[2].depth)
+            / area_f;
+        let reference = if covered { depth_key(z as f32) } else { None };
+        let (key_lo, key_hi, inside) = depth_interval(pixels, &v, &planes, p, z);
+        if !certain && reachable.is_some() {
+            dependent.push((
+                found.len(),
+                Dependence {
+                    vertices: ids,
+                    points,
+                    covering,
+                    depth_certain: inside && (reference.is_some() || !covered),
                 },
             ));
         }
+        let doubt = if !certain {
+            Some(Doubt::Coverage)
+        } else if !inside || reference.is_none() {
+            Some(Doubt::Depth)
+        } else {
+            None
+        };
+        if doubt.is_some() {
+            bounds.ambiguous_pairs += 1;
+            if reference.is_none() && !covered {
+                bounds.may_be_present_pairs += 1;
+            } else if doubt == Some(Doubt::Coverage) {
+                bounds.coverage_undecided_pairs += 1;
+            } else {
+                bounds.depth_undecided_pairs += 1;
+            }
+        }
+        found.push((
+            ((y * i64::from(pixels.width) + x) * samples + s) as u32,
+            Possible {
+                prim,
+                key_lo,
+                key_hi,
+                doubt,
+                reference,
+            },
+        ));
     }
     reachable.is_some()
+}
+
+/// Where a view's fragments are analysed: the render target in pixels and the sample positions of
+/// each pixel ([`SamplePattern::CENTRE`] for single-sample rasterization). A fragment of sample `s`
+/// of pixel `(x, y)` is entry `(y · width + x) · n + s`, the index of the sample-expanded
+/// framebuffer the raster crate's per-sample views emit (`fragsim_raster::samples`).
+#[derive(Clone, Copy, Debug)]
+struct Target {
+    pixels: Viewport,
+    pattern: SamplePattern,
 }
 
 /// A triangle to analyse: its primitive id, its vertices' mesh indices and their bounds.

@@ -24,12 +24,11 @@ fn rasterize(viewport: Viewport, xy: [[i64; 2]; 3], z: [f64; 3]) -> Vec<(u32, f6
     for y in 0..i64::from(viewport.height) {
         for x in 0..i64::from(viewport.width) {
             let p = [x * 256 + 128, y * 256 + 128];
-            let e = [(1, 2), (2, 0), (0, 1)].map(|(i, j)| {
-                let value = edge(v[i], v[j], p);
-                (
-                    value,
-                    value > 0 || (value == 0 && owns(WindowOrigin::UpperLeft, v[i], v[j])),
-                )
+            let edges = [(1, 2), (2, 0), (0, 1)].map(|(i, j)| (v[i], v[j]));
+            let threshold = fill_thresholds(edges, WindowOrigin::UpperLeft);
+            let e: [(i64, bool); 3] = std::array::from_fn(|k| {
+                let value = edge(edges[k].0, edges[k].1, p);
+                (value, value >= threshold[k])
             });
             if e.iter().all(|&(_, pass)| pass) {
                 let depth = (0..3).map(|k| e[k].0 as f64 * zs[k]).sum::<f64>() / area as f64;
@@ -54,7 +53,11 @@ fn analyse(
         ids: [0, 1, 2],
         verts,
     };
-    triangle(viewport, origin, tri, found, &mut Vec::new(), bounds)
+    let target = Target {
+        pixels: viewport,
+        pattern: SamplePattern::CENTRE,
+    };
+    triangle(target, origin, tri, found, &mut Vec::new(), bounds)
 }
 
 /// A vertex that may reach every grid point within `radius` of `(x, y)` (1/256-pixel grid).

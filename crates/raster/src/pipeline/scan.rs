@@ -135,7 +135,7 @@ impl ScanSetup {
 /// on it and 1 where it does not (the single-sample and the per-sample scan share it, so they
 /// share the rule).
 #[inline]
-pub(super) fn fill_thresholds(edges: [([i64; 2], [i64; 2]); 3], origin: WindowOrigin) -> [i64; 3] {
+pub fn fill_thresholds(edges: [([i64; 2], [i64; 2]); 3], origin: WindowOrigin) -> [i64; 3] {
     per_edge(edges, |p, q| {
         let owns = match origin {
             WindowOrigin::UpperLeft => is_top_left(p, q),
@@ -204,7 +204,7 @@ pub(super) fn pixel_span(lo: i64, hi: i64, (first, last): (u32, u32)) -> Option<
 /// Twice the signed area of `(a, b, p)`: positive when `p` is on the interior side of `a → b` for
 /// a positively oriented triangle in the y-down window.
 #[inline]
-pub(super) fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
+pub fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
     (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
 }
 
