@@ -165,8 +165,8 @@ pub fn judge_sides(
         }
     }
     let judged_f32 = options.vertex_precision == VertexPrecision::F32;
+    // The precision bounds are derived per sample; the sample count is checked here all the same.
     header.samples().map_err(|e| e.to_string())?;
-    // The refusal stays until the precision verdict derives its bounds per sample.
     // A masked-node dump is judged against the per-pixel view of the per-sample oracle, which
     // only the oracle side can give.
     let masked = candidate.is_masked();
