@@ -28,6 +28,7 @@ const GL_F32: Conventions = Conventions {
     depth_range: DepthRange::MinusOneToOne,
     vertex_precision: VertexPrecision::F32,
     samples: 1,
+    edge_ties: None,
 };
 
 const VIEWPORT: (u32, u32) = (40, 28);

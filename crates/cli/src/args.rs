@@ -148,6 +148,7 @@ impl ConventionsArgs {
             depth_range: self.depth_range,
             vertex_precision: self.vertex_precision,
             samples: self.samples,
+            edge_ties: None,
         }
     }
 }

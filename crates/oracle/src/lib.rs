@@ -18,6 +18,7 @@
 pub mod compare;
 mod diff;
 pub mod dump;
+pub mod edge_ties;
 pub mod precision;
 pub mod samples;
 pub mod scene;

@@ -58,6 +58,74 @@ pub enum VertexPrecision {
     F32,
 }
 
+/// Which edges own a sample lying exactly on them (an edge function of 0), in the API's own window
+/// (the one [`WindowOrigin`] names: y down for an upper-left origin, y up for a lower-left one).
+/// Vulkan and OpenGL leave the choice to the implementation, requiring only that a sample on an
+/// edge shared by two triangles belong to exactly one of them; D3D fixes the top-left rule.
+/// "Top" is a horizontal edge with the triangle below it in that window, "left" a non-horizontal
+/// edge with the triangle to its right.
+///
+/// fragsim's pipeline rasterizes with the top-left rule of the declared window whatever this says
+/// (`docs/semantics.md` §4 and §9); the oracle's verdict owes the declared rule, and where none is
+/// declared accepts any one of the four, the same one throughout a capture
+/// (`fragsim_oracle::edge_ties`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EdgeTies {
+    /// Top and left edges own their samples (D3D's rule, fragsim's pipeline).
+    TopLeft,
+    /// Top and right edges.
+    TopRight,
+    /// Bottom and left edges.
+    BottomLeft,
+    /// Bottom and right edges.
+    BottomRight,
+}
+
+impl EdgeTies {
+    /// The four rules.
+    pub const ALL: [Self; 4] = [
+        Self::TopLeft,
+        Self::TopRight,
+        Self::BottomLeft,
+        Self::BottomRight,
+    ];
+
+    /// Whether horizontal edges with the triangle below them own their samples.
+    #[must_use]
+    pub fn top(self) -> bool {
+        matches!(self, Self::TopLeft | Self::TopRight)
+    }
+
+    /// Whether non-horizontal edges with the triangle to their right own their samples.
+    #[must_use]
+    pub fn left(self) -> bool {
+        matches!(self, Self::TopLeft | Self::BottomLeft)
+    }
+
+    /// The rule with `top` and `left` as given.
+    #[must_use]
+    pub fn of(top: bool, left: bool) -> Self {
+        match (top, left) {
+            (true, true) => Self::TopLeft,
+            (true, false) => Self::TopRight,
+            (false, true) => Self::BottomLeft,
+            (false, false) => Self::BottomRight,
+        }
+    }
+
+    /// The rule as its JSON spells it (`top-left`, …).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::TopLeft => "top-left",
+            Self::TopRight => "top-right",
+            Self::BottomLeft => "bottom-left",
+            Self::BottomRight => "bottom-right",
+        }
+    }
+}
+
 /// The conventions under which a scene was rasterized.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -76,6 +144,10 @@ pub struct Conventions {
     /// that a header written without it reads, and is written back, as before.
     #[serde(skip_serializing_if = "is_one")]
     pub samples: u32,
+    /// The rule that decides a sample exactly on an edge, when the implementation declares one
+    /// ([`EdgeTies`]); absent: undeclared, any one rule for the whole capture.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edge_ties: Option<EdgeTies>,
 }
 
 // serde's `skip_serializing_if` takes a reference.
@@ -95,6 +167,7 @@ impl Conventions {
         depth_range: DepthRange::ZeroToOne,
         vertex_precision: VertexPrecision::F64,
         samples: 1,
+        edge_ties: None,
     };
 
     /// Whether these are the reference conventions (a header then leaves them out).

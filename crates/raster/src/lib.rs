@@ -31,7 +31,7 @@ pub mod samples;
 mod scenes;
 
 pub use camera::{Camera, OrbitCamera};
-pub use conventions::{Conventions, DepthRange, VertexPrecision, WindowOrigin};
+pub use conventions::{Conventions, DepthRange, EdgeTies, VertexPrecision, WindowOrigin};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError, UpAxis};
 pub use pipeline::{
