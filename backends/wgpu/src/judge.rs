@@ -24,7 +24,7 @@ use fragsim_oracle::precision::{f32_reference, Bounds, Precision};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::verdict::{self, Candidate, Options, Reference};
 use fragsim_oracle::Oracle;
-use fragsim_raster::VertexPrecision;
+use fragsim_raster::{Scene, VertexPrecision, Viewport};
 
 /// The verdict and the coverage of one capture.
 #[derive(Debug)]
@@ -84,7 +84,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
     let (width, height) = (dump.header.width, dump.header.height);
     let reference = Reference::new(
         Cow::Borrowed(oracle),
-        Precision::exact(),
+        Cow::Owned(Precision::exact()),
         VertexPrecision::F64,
         (width, height),
     );
@@ -142,11 +142,17 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
 }
 
 /// The reference of the precision verdict for one scene and viewport: the exact oracle under the
-/// scene's conventions and what an f32 vertex stage may produce ([`f32_reference`]).
+/// scene's conventions and what an f32 vertex stage may produce ([`f32_reference`]), with the
+/// scene loaded, so that each verdict can judge samples exactly on an edge under whichever rule
+/// the capture follows (the oracle's [`Reference::with_edge_ties`]).
 pub struct Within {
     scene: SceneAndCamera,
-    viewport: (u32, u32),
-    reference: Reference<'static>,
+    /// The scene with the exact f64 vertex stage, as the oracle was built.
+    exact: SceneAndCamera,
+    loaded: Scene,
+    viewport: Viewport,
+    oracle: Oracle,
+    precision: Precision,
     covered: u64,
 }
 
@@ -202,11 +208,15 @@ impl Within {
         let covered = (0..oracle.pixels())
             .filter(|&p| !oracle.pixel(p).is_empty())
             .count() as u64;
-        let size = (viewport.width, viewport.height);
+        let mut exact = scene.clone();
+        exact.conventions.vertex_precision = VertexPrecision::F64;
         Ok(Self {
+            loaded: exact.load(None)?,
             scene,
-            viewport: size,
-            reference: Reference::new(Cow::Owned(oracle), precision, VertexPrecision::F32, size),
+            exact,
+            viewport,
+            oracle,
+            precision,
             covered,
         })
     }
@@ -215,13 +225,14 @@ impl Within {
     /// conventions, fragsim's own oracle of the view: what [`judge`] takes).
     #[must_use]
     pub fn oracle(&self) -> &Oracle {
-        self.reference.oracle()
+        &self.oracle
     }
 
     /// Whether `dump` names this reference's scene and viewport.
     #[must_use]
     pub fn fits(&self, dump: &Dump) -> bool {
-        dump.header.scene == self.scene && (dump.header.width, dump.header.height) == self.viewport
+        dump.header.scene == self.scene
+            && (dump.header.width, dump.header.height) == (self.viewport.width, self.viewport.height)
     }
 
     /// `dump` judged within precision by the oracle's verdict, every word read.
@@ -238,8 +249,16 @@ impl Within {
             depth_ulps: 0,
             examples: 8,
         };
+        let view = self.exact.view(&self.loaded, self.viewport)?;
+        let reference = Reference::new(
+            Cow::Borrowed(&self.oracle),
+            Cow::Borrowed(&self.precision),
+            VertexPrecision::F32,
+            (self.viewport.width, self.viewport.height),
+        )
+        .with_edge_ties(&view);
         let verdict =
-            verdict::judge(&self.reference, Candidate::Dump(dump), &options).map_err(DumpError)?;
+            verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError)?;
         Ok(WithinJudgement {
             bounds: verdict.bounds.unwrap_or_default(),
             comparison: verdict.comparison,

@@ -20,14 +20,15 @@
 //! floating-point error analysis, Higham's `γ_n`; the Vulkan CTS rasterization verifier's
 //! "definitely / maybe covered" classification).
 
-use fragsim_raster::conventions::{DepthRange, VertexPrecision, WindowOrigin};
+use fragsim_raster::conventions::{DepthRange, VertexPrecision};
 use fragsim_raster::samples::SamplePattern;
 use fragsim_raster::{
-    depth_key, edge_function as edge, fill_thresholds, Conventions, View, Viewport, SUBPIXEL_BITS,
+    depth_key, edge_function as edge, Conventions, EdgeTies, View, Viewport, SUBPIXEL_BITS,
 };
 use serde::Serialize;
 
 use crate::dump::DepthFormat;
+use crate::edge_ties::{pipeline_rule, thresholds};
 use crate::Oracle;
 
 /// f32's unit roundoff, `2^-24`.
@@ -114,6 +115,10 @@ pub struct Bounds {
     /// Triangles whose vertices may reach more than 64 combinations of snapped positions: their
     /// coverage judged by the bilinear edge bound over the radius instead of by enumeration.
     pub bounded_triangles: u64,
+    /// (sample, triangle) pairs lying exactly on an edge of some snapped triangle the vertices
+    /// may reach, where the implementation's edge-tie rule may decide coverage
+    /// ([`crate::edge_ties`]).
+    pub edge_tie_pairs: u64,
 }
 
 /// The per-pixel possibilities of a view under an implementation's conventions.
@@ -183,8 +188,23 @@ struct VertexBound {
 impl Precision {
     /// The analysis of `view` (built under the reference's f64 pipeline) for an implementation
     /// declaring `conventions`: empty for f64 vertex precision, where the contract is bit-exact.
+    /// Samples exactly on an edge are decided by the pipeline's rule (the top-left rule of the
+    /// window origin), as the oracle of the view decides them.
     #[must_use]
     pub fn derive(view: &View<'_>, conventions: &Conventions) -> Self {
+        Self::derive_under(
+            view,
+            conventions,
+            pipeline_rule(conventions.window_origin),
+        )
+    }
+
+    /// [`Precision::derive`] for an implementation that decides samples exactly on an edge by
+    /// `rule` (in fragsim's y-down rows, [`crate::edge_ties`]): every snapped triangle its
+    /// vertices may reach is rasterized with that rule, and the reference keys are those of the
+    /// oracle under it.
+    #[must_use]
+    pub fn derive_under(view: &View<'_>, conventions: &Conventions, rule: EdgeTies) -> Self {
         if conventions.vertex_precision == VertexPrecision::F64 {
             return Self::exact();
         }
@@ -213,7 +233,7 @@ impl Precision {
                     };
                     if !triangle(
                         target,
-                        conventions.window_origin,
+                        rule,
                         tri,
                         &mut found,
                         &mut dependent,
@@ -745,19 +765,24 @@ fn combinations(v: &[VertexBound; 3]) -> Option<Vec<[[i64; 2]; 3]>> {
 
 /// Whether the pipeline covers sample position `p` with the snapped triangle `xy` (`scan.rs`: the
 /// triangle oriented positively, a degenerate one covering nothing, each edge under the
-/// rasterizer's fill rule for `origin`, [`fill_thresholds`]).
-fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
+/// rasterizer's fill rule with the ownership of `rule`, [`thresholds`]); and whether `p` lies
+/// exactly on one of its edges and inside the others, where the rule decides.
+fn covers(rule: EdgeTies, xy: [[i64; 2]; 3], p: [i64; 2]) -> (bool, bool) {
     let [a, mut b, mut c] = xy;
     let area = edge(a, b, c);
     if area == 0 {
-        return false;
+        return (false, false);
     }
     if area < 0 {
         std::mem::swap(&mut b, &mut c);
     }
     let edges = [(b, c), (c, a), (a, b)];
-    let threshold = fill_thresholds(edges, origin);
-    (0..3).all(|k| edge(edges[k].0, edges[k].1, p) >= threshold[k])
+    let threshold = thresholds(edges, rule);
+    let e = edges.map(|(q, r)| edge(q, r, p));
+    (
+        (0..3).all(|k| e[k] >= threshold[k]),
+        e.contains(&0) && e.iter().all(|&v| v >= 0),
+    )
 }
 
 /// Lists, for every sample of `target`'s pattern within the grown bounding box of an unclipped
@@ -771,7 +796,7 @@ fn covers(origin: WindowOrigin, xy: [[i64; 2]; 3], p: [i64; 2]) -> bool {
 /// enumerated.
 fn triangle(
     target: Target,
-    origin: WindowOrigin,
+    rule: EdgeTies,
     tri: Triangle,
     found: &mut Vec<(u32, Possible)>,
     dependent: &mut Vec<(usize, Dependence)>,
@@ -830,9 +855,9 @@ fn triangle(
     let (y0, y1) = span(1, pixels.height);
     let samples = i64::from(pattern.count());
     let edges = [(1, 2), (2, 0), (0, 1)];
-    // The rasterizer's own fill rule (`scan.rs`): an edge covers a point where its value is at
-    // least its threshold.
-    let threshold = fill_thresholds(edges.map(|(i, j)| (v[i].snapped, v[j].snapped)), origin);
+    // The rasterizer's own fill rule (`scan.rs`) with `rule`'s ownership: an edge covers a point
+    // where its value is at least its threshold.
+    let threshold = thresholds(edges.map(|(i, j)| (v[i].snapped, v[j].snapped)), rule);
     let area_stable = area as f64 > area_bound;
     let mut planes = Vec::new();
     let positions =
@@ -846,12 +871,15 @@ fn triangle(
         planes.clear();
         planes.push(unsnapped);
         let mut covering = 0u64;
+        let mut on_edge = e.contains(&0) && e.iter().all(|&v| v >= 0);
         let (certain, possible) = match &reachable {
             // The reference's own triangle is one of them: `certain` implies `covered`.
             Some(all) => {
                 let mut split = false;
                 for (i, &xy) in all.iter().enumerate() {
-                    if covers(origin, xy, p) {
+                    let (covers, tie) = covers(rule, xy, p);
+                    on_edge |= tie;
+                    if covers {
                         planes.push(Plane {
                             at: xy.map(real),
                             radius: [0.0; 3],
@@ -888,6 +916,7 @@ fn triangle(
                 }
             }
         };
+        bounds.edge_tie_pairs += u64::from(on_edge);
         if !possible && !covered {
             continue;
         }

@@ -4,6 +4,7 @@
 //! depths inside their intervals, and covers every `certain` pair.
 
 use super::*;
+use fragsim_raster::{fill_thresholds, WindowOrigin};
 
 /// The pipeline's coverage and depth of one snapped triangle at every pixel centre, as
 /// `docs/semantics.md` rules 4 and 5 state them.
@@ -57,7 +58,14 @@ fn analyse(
         pixels: viewport,
         pattern: SamplePattern::CENTRE,
     };
-    triangle(target, origin, tri, found, &mut Vec::new(), bounds)
+    triangle(
+        target,
+        pipeline_rule(origin),
+        tri,
+        found,
+        &mut Vec::new(),
+        bounds,
+    )
 }
 
 /// A vertex that may reach every grid point within `radius` of `(x, y)` (1/256-pixel grid).
@@ -359,7 +367,7 @@ fn a_triangle_a_few_subpixels_across_gets_the_depth_of_its_reachable_planes() {
     let all = combinations(&verts).unwrap();
     let (mut lowest, mut highest) = (f64::INFINITY, f64::NEG_INFINITY);
     for xy in all {
-        assert!(covers(WindowOrigin::UpperLeft, xy, p));
+        assert!(covers(pipeline_rule(WindowOrigin::UpperLeft), xy, p).0);
         let area = edge(xy[0], xy[1], xy[2]) as f64;
         let z = [(1, 2), (2, 0), (0, 1)]
             .iter()
@@ -458,7 +466,8 @@ fn enumerated_coverage_is_exactly_that_of_the_reachable_snapped_triangles() {
             for y in 0..6 {
                 for x in 0..6 {
                     let p = [x * 256 + 128, y * 256 + 128];
-                    let hits = all.iter().filter(|&&xy| covers(origin, xy, p)).count();
+                    let hits = all.iter().filter(|&&xy| covers(pipeline_rule(origin), xy, p).0)
+                        .count();
                     let pixel = (y * 6 + x) as u32;
                     let listed = found.iter().find(|(q, _)| *q == pixel).map(|(_, q)| *q);
                     assert_eq!(listed.is_some(), hits > 0, "case {prim} pixel {pixel}");
@@ -517,12 +526,12 @@ fn the_fill_rule_follows_the_window_origin() {
     // y-down rows: a top edge under an upper-left origin (owned), the window's bottom edge
     // under a lower-left one (not owned).
     let xy = [[0, 128], [512, 128], [256, 600]];
-    assert!(covers(WindowOrigin::UpperLeft, xy, [128, 128]));
-    assert!(!covers(WindowOrigin::LowerLeft, xy, [128, 128]));
+    assert!(covers(pipeline_rule(WindowOrigin::UpperLeft), xy, [128, 128]).0);
+    assert!(!covers(pipeline_rule(WindowOrigin::LowerLeft), xy, [128, 128]).0);
     // Mirrored, the interior above: owned under a lower-left origin only.
     let above = [[0, 128], [512, 128], [256, -400]];
-    assert!(!covers(WindowOrigin::UpperLeft, above, [128, 128]));
-    assert!(covers(WindowOrigin::LowerLeft, above, [128, 128]));
+    assert!(!covers(pipeline_rule(WindowOrigin::UpperLeft), above, [128, 128]).0);
+    assert!(covers(pipeline_rule(WindowOrigin::LowerLeft), above, [128, 128]).0);
 }
 
 #[test]

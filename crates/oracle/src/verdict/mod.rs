@@ -27,10 +27,11 @@ mod tests;
 use std::borrow::Cow;
 
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
-use fragsim_raster::VertexPrecision;
+use fragsim_raster::{EdgeTies, VertexPrecision};
 
 use crate::compare::{verdict, with_identity, CompareOptions, Comparison};
 use crate::dump::{DepthFormat, Dump};
+use crate::edge_ties::TiePoints;
 use crate::precision::{compare_within, Bounds, Precision};
 use crate::scene::SceneAndCamera;
 use crate::Oracle;
@@ -103,14 +104,17 @@ pub struct Verdict {
     pub notes: Vec<String>,
     /// The first differing lists, both sides.
     pub examples: Vec<Example>,
+    /// The edge-tie rule (in fragsim's y-down rows) samples exactly on an edge were judged
+    /// under: the declared one, or the one that explains the capture; `None` where the reference
+    /// says how they fall (a dump, a masked-node reference, an oracle without its view).
+    pub edge_ties: Option<EdgeTies>,
 }
 
 impl Verdict {
     /// Lists with a verdict that is an error.
     #[must_use]
     pub fn mismatched_lists(&self) -> u64 {
-        let differs = |v: &&u8| **v & verdict::DIFFERS != 0;
-        self.comparison.verdicts.iter().filter(differs).count() as u64
+        errors(&self.comparison) as u64
     }
 }
 
@@ -183,40 +187,115 @@ pub fn judge(
         examples: options.examples,
         complete: reference.complete(),
     };
+    // The analysis as the candidate stores depth: a unorm payload's steps.
+    let as_stored = |precision: Cow<'_, Precision>, oracle: &Oracle| -> Precision {
+        if stored == DepthFormat::F32 {
+            precision.into_owned()
+        } else {
+            precision.into_owned().stored_as(stored, oracle)
+        }
+    };
     let precision = reference.precision().map(|precision| {
         if stored == DepthFormat::F32 {
             Cow::Borrowed(precision)
         } else {
-            Cow::Owned(precision.clone().stored_as(stored, oracle))
+            Cow::Owned(as_stored(Cow::Borrowed(precision), oracle))
         }
     });
     let mut wrong_masks = None;
-    let mut comparison = match (precision.as_deref(), candidate, reference.per_pixel()) {
-        (_, Candidate::Dump(dump), Some(per_pixel)) => {
-            let masked = dump
-                .compare_masked(per_pixel, &compare_options)
-                .map_err(|e| e.to_string())?;
-            wrong_masks = Some(masked.wrong_masks.len() as u64);
-            masked.nodes
-        }
-        (_, _, Some(_)) => {
-            return Err(
-                "the per-pixel view of the per-sample oracle judges masked-node dumps \
-                        only"
-                    .into(),
-            )
-        }
-        (Some(precision), _, None) => compare_within(
+    let compare = |oracle: &Oracle, precision: Option<&Precision>| match precision {
+        Some(precision) => compare_within(
             precision,
             oracle,
             &capture,
             words.as_ref(),
             &compare_options,
         ),
-        (None, _, None) => {
-            crate::compare::compare_with(oracle, &capture, words.as_ref(), &compare_options)
-        }
+        None => crate::compare::compare_with(oracle, &capture, words.as_ref(), &compare_options),
     };
+    let mut comparison = match (candidate, reference.per_pixel()) {
+        (Candidate::Dump(dump), Some(per_pixel)) => {
+            let masked = dump
+                .compare_masked(per_pixel, &compare_options)
+                .map_err(|e| e.to_string())?;
+            wrong_masks = Some(masked.wrong_masks.len() as u64);
+            masked.nodes
+        }
+        (_, Some(_)) => {
+            return Err(
+                "the per-pixel view of the per-sample oracle judges masked-node dumps \
+                        only"
+                    .into(),
+            )
+        }
+        (_, None) => compare(oracle, precision.as_deref()),
+    };
+    let mut precision = precision;
+    let mut edge_ties = None;
+    if let Some(source) = reference.edge_ties() {
+        let pipeline_fits = source.candidates.contains(&source.pipeline);
+        edge_ties = Some(source.pipeline);
+        if !(pipeline_fits && comparison.is_equal()) {
+            let ties = TiePoints::of(source.view);
+            let exact = precision.as_deref().is_none_or(Precision::is_exact);
+            // Where no snapped triangle the vertices may reach puts a sample on an edge, every
+            // rule gives the pipeline's lists.
+            let met = !ties.is_empty()
+                || precision
+                    .as_deref()
+                    .is_some_and(|p| p.bounds().edge_tie_pairs > 0);
+            let mut best: Option<(EdgeTies, Comparison, Option<Precision>)> = None;
+            if pipeline_fits || !met {
+                best = Some((source.pipeline, comparison.clone(), None));
+            }
+            let others = source
+                .candidates
+                .iter()
+                .copied()
+                .filter(|&rule| met && rule != source.pipeline);
+            for rule in others {
+                let under = ties.oracle_under(oracle, source.pipeline, rule);
+                let lists = under.as_ref().unwrap_or(oracle);
+                let analysis = (!exact).then(|| {
+                    Precision::derive_under(source.view, &source.conventions, rule)
+                });
+                let analysis = match (analysis, stored) {
+                    (Some(a), _) => Some(as_stored(Cow::Owned(a), lists)),
+                    (None, DepthFormat::F32) => None,
+                    (None, _) => Some(as_stored(Cow::Owned(Precision::exact()), lists)),
+                };
+                let judged = compare(lists, analysis.as_ref());
+                let better = best.as_ref().is_none_or(|(_, b, _)| {
+                    (judged.is_equal(), std::cmp::Reverse(errors(&judged)))
+                        > (b.is_equal(), std::cmp::Reverse(errors(b)))
+                });
+                if better {
+                    best = Some((rule, judged, analysis));
+                }
+            }
+            if let Some((rule, judged, analysis)) = best {
+                if rule != source.pipeline {
+                    notes.push(format!(
+                        "samples exactly on an edge judged under the {} rule (fragsim \
+                         rasterizes with {}; they disagree on {} fragments): {}",
+                        rule.name(),
+                        source.pipeline.name(),
+                        ties.differences(source.pipeline, rule),
+                        if source.candidates.len() == 1 {
+                            "the rule the dump declares"
+                        } else {
+                            "the one rule that explains the capture best"
+                        }
+                    ));
+                    comparison = judged;
+                    if let Some(analysis) = analysis {
+                        precision = Some(Cow::Owned(analysis));
+                    }
+                }
+                edge_ties = Some(rule);
+            }
+        }
+    }
     if !matches!(capture.keeps, Keeps::All { .. }) {
         // A K-nearest (K-farthest) list claims nothing: what lies beyond K is its promise, as
         // the exact comparison counts it (the precision verdict leaves it at 0).
@@ -253,7 +332,17 @@ pub fn judge(
         reference_fragments: oracle.depth_complexity(),
         identity: capture.identity,
         notes,
+        edge_ties,
     })
+}
+
+/// The lists of a comparison whose verdict is an error.
+fn errors(comparison: &Comparison) -> usize {
+    comparison
+        .verdicts
+        .iter()
+        .filter(|&&v| v & verdict::DIFFERS != 0)
+        .count()
 }
 
 /// The notes on overflow: storage that stops without a count, and counters that claim another

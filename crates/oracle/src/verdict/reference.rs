@@ -6,10 +6,11 @@ use std::borrow::Cow;
 
 use fragsim_capture::schemes::masked_abuffer::MaskedLists;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
-use fragsim_raster::{Conventions, VertexPrecision, View};
+use fragsim_raster::{Conventions, EdgeTies, VertexPrecision, View};
 
 use crate::compare::complete_pixels;
 use crate::dump::{node_capture, Dump};
+use crate::edge_ties::{candidates, pipeline_rule};
 use crate::precision::Precision;
 use crate::Oracle;
 
@@ -18,7 +19,7 @@ use crate::Oracle;
 pub struct Reference<'a> {
     /// The reference's lists: the oracle's, or a dump's decoded ones.
     lists: Cow<'a, Oracle>,
-    kind: Kind,
+    kind: Kind<'a>,
     /// Viewport width, pixels.
     pub(super) width: u32,
     /// Viewport height, pixels.
@@ -29,11 +30,13 @@ pub struct Reference<'a> {
 
 /// How a reference knows its lists.
 #[derive(Clone, Debug)]
-enum Kind {
-    /// The oracle, owed within `precision` by a vertex stage of `vertex_precision`.
+enum Kind<'a> {
+    /// The oracle, owed within `precision` by a vertex stage of `vertex_precision`, with the
+    /// view to judge samples exactly on an edge under another rule than the pipeline's.
     Oracle {
-        precision: Precision,
+        precision: Cow<'a, Precision>,
         vertex_precision: VertexPrecision,
+        edge_ties: Option<EdgeTieSource<'a>>,
     },
     /// The per-pixel view of the per-sample oracle (masked nodes, every bit owed).
     Masked(MaskedLists),
@@ -50,14 +53,30 @@ enum Kind {
     },
 }
 
+/// What judging samples exactly on an edge under another rule needs: the view the oracle was
+/// built from, the conventions the precision was derived under, and the rules the implementation
+/// may follow (`docs/semantics.md` §4, "Edge ties").
+#[derive(Clone, Debug)]
+pub(super) struct EdgeTieSource<'a> {
+    /// The view of the reference's oracle (the pipeline's rule).
+    pub(super) view: &'a View<'a>,
+    /// The conventions of the vertex stage judged (what [`Precision::derive_under`] takes).
+    pub(super) conventions: Conventions,
+    /// The rules, in fragsim's rows, a conforming capture may follow: the declared one, or all.
+    pub(super) candidates: Vec<EdgeTies>,
+    /// The rule the oracle was rasterized with.
+    pub(super) pipeline: EdgeTies,
+}
+
 impl<'a> Reference<'a> {
     /// The oracle `oracle` of a `width × height` viewport, owed within `precision` by an
     /// implementation whose vertex stage computes in `vertex_precision` (an exact `precision`,
-    /// f64: every bit).
+    /// f64: every bit). Samples exactly on an edge are owed as the oracle decides them, unless
+    /// [`Reference::with_edge_ties`] gives the view.
     #[must_use]
     pub fn new(
         oracle: Cow<'a, Oracle>,
-        precision: Precision,
+        precision: Cow<'a, Precision>,
         vertex_precision: VertexPrecision,
         (width, height): (u32, u32),
     ) -> Self {
@@ -66,6 +85,7 @@ impl<'a> Reference<'a> {
             kind: Kind::Oracle {
                 precision,
                 vertex_precision,
+                edge_ties: None,
             },
             width,
             height,
@@ -73,11 +93,43 @@ impl<'a> Reference<'a> {
         }
     }
 
+    /// This oracle reference judging samples exactly on an edge as the implementation's
+    /// conventions allow (`view`, the oracle's view, says which): under the rule declared in
+    /// `conventions.edge_ties`, or, undeclared, under whichever one rule explains the capture
+    /// ([`crate::edge_ties`]). Another reference is returned as it is.
+    #[must_use]
+    pub fn with_edge_ties(mut self, view: &'a View<'a>) -> Self {
+        if let Kind::Oracle {
+            vertex_precision,
+            edge_ties,
+            ..
+        } = &mut self.kind
+        {
+            let declared = view.conventions();
+            let conventions = Conventions {
+                vertex_precision: *vertex_precision,
+                ..declared
+            };
+            *edge_ties = Some(EdgeTieSource {
+                view,
+                conventions,
+                candidates: candidates(declared.edge_ties, declared.window_origin),
+                pipeline: pipeline_rule(declared.window_origin),
+            });
+        }
+        self
+    }
+
     /// The oracle `oracle` of `view` (the reference's f64 pipeline under the conventions the
     /// implementation declares), owed by a vertex stage of `vertex_precision`: every bit under
-    /// f64, the bounds [`Precision::derive`] finds under f32.
+    /// f64, the bounds [`Precision::derive`] finds under f32; samples exactly on an edge under
+    /// any one rule, or the declared one ([`Reference::with_edge_ties`]).
     #[must_use]
-    pub fn of_view(oracle: &'a Oracle, view: &View<'_>, vertex_precision: VertexPrecision) -> Self {
+    pub fn of_view(
+        oracle: &'a Oracle,
+        view: &'a View<'a>,
+        vertex_precision: VertexPrecision,
+    ) -> Self {
         let conventions = Conventions {
             vertex_precision,
             ..view.conventions()
@@ -85,10 +137,11 @@ impl<'a> Reference<'a> {
         let viewport = view.pixel_viewport();
         Self::new(
             Cow::Borrowed(oracle),
-            Precision::derive(view, &conventions),
+            Cow::Owned(Precision::derive(view, &conventions)),
             vertex_precision,
             (viewport.width, viewport.height),
         )
+        .with_edge_ties(view)
     }
 
     /// The per-pixel view of the per-sample oracle, `nodes`, over a `width × height` viewport:
@@ -146,10 +199,18 @@ impl<'a> Reference<'a> {
         &self.lists
     }
 
+    /// How samples exactly on an edge may be judged (`None`: as the reference's lists say).
+    pub(super) fn edge_ties(&self) -> Option<&EdgeTieSource<'a>> {
+        match &self.kind {
+            Kind::Oracle { edge_ties, .. } => edge_ties.as_ref(),
+            _ => None,
+        }
+    }
+
     /// The precision the oracle is owed within (`None` for a dump or a masked reference).
     pub(super) fn precision(&self) -> Option<&Precision> {
         match &self.kind {
-            Kind::Oracle { precision, .. } => Some(precision),
+            Kind::Oracle { precision, .. } => Some(&**precision),
             _ => None,
         }
     }

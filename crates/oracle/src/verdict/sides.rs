@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::{judge, Candidate, Options, Reference, Verdict};
 use crate::dump::{Dump, Header, MASKED_SCHEME};
-use crate::precision::{f32_reference, Precision};
+use crate::precision::Precision;
 use crate::samples::SampleOracle;
 use crate::Oracle;
 
@@ -190,39 +190,45 @@ pub fn judge_sides(
     // conventions, and the candidate is judged within the bounds derived for an f32 one: they
     // measure an implementation's distance from the exact positions, not from another f32 order.
     let needs_oracle = matches!(reference, Side::Oracle) || matches!(candidate, Side::Oracle);
-    let oracle = if !needs_oracle {
-        None
-    } else if judged_f32 {
-        let viewport = Viewport::new(header.width, header.height)?;
-        let (oracle, precision) =
-            f32_reference(&header.scene, viewport, Some(&beside)).map_err(|e| e.to_string())?;
-        Some(Reference::new(
-            Cow::Owned(oracle),
-            precision,
-            VertexPrecision::F32,
-            size,
-        ))
+    let mut spec = header.scene.clone();
+    if judged_f32 {
+        spec.conventions.vertex_precision = VertexPrecision::F64;
+    }
+    let loaded = if needs_oracle {
+        Some(spec.load(Some(&beside)).map_err(|e| e.to_string())?)
     } else {
-        let scene = header
-            .scene
-            .load(Some(&beside))
-            .map_err(|e| e.to_string())?;
-        let viewport = Viewport::new(header.width, header.height)?;
-        let view = header
-            .scene
-            .view(&scene, viewport)
-            .map_err(|e| e.to_string())?;
-        Some(if masked {
-            Reference::masked(SampleOracle::build(&view)?.per_pixel(), size)
-        } else {
-            let oracle = Oracle::build(&view);
-            let exact = Conventions {
-                vertex_precision: VertexPrecision::F64,
+        None
+    };
+    let view = match &loaded {
+        Some(loaded) => {
+            let viewport = Viewport::new(header.width, header.height)?;
+            Some(spec.view(loaded, viewport).map_err(|e| e.to_string())?)
+        }
+        None => None,
+    };
+    let oracle = match &view {
+        None => None,
+        Some(view) if masked => Some(Reference::masked(
+            SampleOracle::build(view)?.per_pixel(),
+            size,
+        )),
+        Some(view) => {
+            let stage = options.vertex_precision;
+            let conventions = Conventions {
+                vertex_precision: stage,
                 ..view.conventions()
             };
-            let precision = Precision::derive(&view, &exact);
-            Reference::new(Cow::Owned(oracle), precision, VertexPrecision::F64, size)
-        })
+            let precision = Precision::derive(view, &conventions);
+            Some(
+                Reference::new(
+                    Cow::Owned(Oracle::build(view)),
+                    Cow::Owned(precision),
+                    stage,
+                    size,
+                )
+                .with_edge_ties(view),
+            )
+        }
     };
     if judged_f32 && !matches!(reference, Side::Oracle) {
         return Err(
