@@ -15,6 +15,7 @@ use fragsim::raster::{Scene, Viewport};
 
 mod binary;
 mod compare;
+mod edge_ties;
 mod files;
 mod layouts;
 mod mutations;

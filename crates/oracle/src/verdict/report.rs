@@ -4,7 +4,7 @@
 //! (`docs/json-schema.md`).
 
 use fragsim_capture::{Capture, Identity, Keeps};
-use fragsim_raster::{depth_from_key, VertexPrecision};
+use fragsim_raster::{depth_from_key, EdgeTies, VertexPrecision};
 use serde::Serialize;
 
 use super::{SideReport, Verdict};
@@ -226,6 +226,10 @@ pub struct Summary<'a> {
     pub words: WordTotals,
     /// The first differing lists, both sides.
     pub first_differences: &'a [Example],
+    /// The edge-tie rule samples exactly on an edge were judged under, in fragsim's y-down rows
+    /// (`top-left`, …; absent where the reference decides them: a dump, a masked-node reference).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edge_ties: Option<&'static str>,
     /// Notes that qualify the verdict.
     pub notes: &'a [String],
 }
@@ -320,6 +324,7 @@ impl Verdict {
                 unreachable: c.unreachable_nodes,
             },
             first_differences: &self.examples,
+            edge_ties: self.edge_ties.map(EdgeTies::name),
             notes: &self.notes,
         }
     }
