@@ -158,7 +158,7 @@ fn a_counterexample_replays_from_any_directory_and_a_pass_removes_it() {
             ])
             .args([
                 "--cases",
-                "40",
+                "100",
                 "--seed",
                 "0",
                 "--shrink-steps",

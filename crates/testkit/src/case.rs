@@ -4,8 +4,10 @@
 //!
 //! Guarantee: a case's corners lie on the half-pixel grid (pixel centres and pixel edges), so a
 //! case makes the rasterizer's hard decisions often: edges exactly through pixel centres (the
-//! top-left rule), triangles sharing edges and vertices, coplanar triangles at equal depths (the
-//! tie policy), depths exactly 0 and 1, triangles crossing the near plane (`z < 0`) and the far
+//! fill rule; some triangles are drawn with their legs on the centre lines), triangles sharing
+//! edges and vertices (some are drawn sharing an edge with the triangle before them, as a mesh's
+//! quads do: a hole or a double there is wrong under every edge-tie rule), coplanar triangles at
+//! equal depths (the tie policy), depths exactly 0 and 1, triangles crossing the near plane (`z < 0`) and the far
 //! one, and a few corners far beyond the guard band. The snapped corners are exact: a corner at
 //! `h` half pixels is `h / width − 1` in normalised device coordinates, which f32 holds to far
 //! below the 1/256-pixel snapping grid at these viewport sizes, so snapping gives back `128 · h`.
@@ -264,16 +266,81 @@ pub fn case(limits: Limits) -> impl Strategy<Value = Case> {
     (
         (side(), side()),
         vec(
-            triangle(limits.max_side, limits.far_corners),
+            (triangle(limits.max_side, limits.far_corners), shape()),
             1..=max_triangles,
         ),
         vec(any::<u8>(), max_triangles),
         schedule(),
     )
-        .prop_map(|((w, h), triangles, order_keys, schedule)| Case {
+        .prop_map(|((w, h), drawn, order_keys, schedule)| Case {
             viewport: Viewport::new(w, h).expect("valid viewport side"),
-            triangles,
+            triangles: placed(&drawn),
             order_keys,
             schedule,
         })
+}
+
+/// How a generated triangle is placed.
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    /// At its own three corners.
+    Free,
+    /// A right triangle on the pixel-centre lines: its first corner moved onto a pixel centre,
+    /// its second onto that centre's row and its third onto its column (each onto the centre
+    /// line nearest its own coordinate), so that its legs pass through pixel centres, where
+    /// the fill rule decides.
+    OnCentres,
+    /// Sharing an edge with the triangle before it: that triangle's edge `k` (from corner `k`),
+    /// walked the other way as in a consistently wound mesh, with a third corner reflected
+    /// through the edge's midpoint (a parallelogram split along the shared edge), so that the
+    /// centres on the edge belong to exactly one of the two.
+    SharesEdge(usize),
+}
+
+/// A [`Shape`]: a triangle placed freely three times in six. Shrinks towards [`Shape::Free`].
+fn shape() -> impl Strategy<Value = Shape> {
+    prop_oneof![
+        3 => Just(Shape::Free),
+        1 => Just(Shape::OnCentres),
+        2 => (0usize..3).prop_map(Shape::SharesEdge),
+    ]
+}
+
+/// The triangles `drawn` placed by their shapes, in order (the first has no triangle to share
+/// an edge with, and stays where it was drawn).
+fn placed(drawn: &[(CaseTriangle, Shape)]) -> Vec<CaseTriangle> {
+    let mut placed: Vec<CaseTriangle> = Vec::with_capacity(drawn.len());
+    // The centre line nearest a coordinate in half pixels: centres lie at odd ones.
+    let centre_line = |h: i32| h | 1;
+    for &(t, shape) in drawn {
+        let next = match (shape, placed.last()) {
+            (Shape::OnCentres, _) => {
+                let [a, b, c] = t.corners;
+                let corner = a.map(centre_line);
+                CaseTriangle {
+                    corners: [
+                        corner,
+                        [centre_line(b[0]), corner[1]],
+                        [corner[0], centre_line(c[1])],
+                    ],
+                    ..t
+                }
+            }
+            (Shape::SharesEdge(k), Some(before)) => {
+                let (p, q, r) = (k, (k + 1) % 3, (k + 2) % 3);
+                let [p_at, q_at, r_at] = [p, q, r].map(|i| before.corners[i]);
+                CaseTriangle {
+                    corners: [
+                        q_at,
+                        p_at,
+                        [p_at[0] + q_at[0] - r_at[0], p_at[1] + q_at[1] - r_at[1]],
+                    ],
+                    depths: [before.depths[q], before.depths[p], t.depths[2]],
+                }
+            }
+            _ => t,
+        };
+        placed.push(next);
+    }
+    placed
 }
