@@ -1,20 +1,22 @@
 //! The conformance battery (what `fragsim conform` runs) against the wgpu backend on whatever
 //! Vulkan adapter this machine has (Mesa's lavapipe in CI), in process ([`WgpuBackend`]): MDTS and
 //! the fixed A-buffer pass in replay and engine mode, judged within the precision of an f32
-//! vertex stage; a planted bug is found and shrunk to one pixel and one triangle. Without an
+//! vertex stage, samples exactly on an edge under any one rule; a planted bug is found and
+//! shrunk to one pixel and one triangle. Without an
 //! adapter each test prints one line saying it was skipped and why; with `CI=true` or
 //! `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 //!
-//! Small N (issue 21: "in CI, small N"): each case is two captures (its submission order and
-//! another), each a fresh pipeline on the adapter; the cases are at most 8×8 pixels and 6
-//! triangles, as `fragsim conform`'s defaults.
+//! Each case is two captures (its submission order and another), each a fresh pipeline on the
+//! adapter; the cases are at most 8×8 pixels and 6 triangles, as `fragsim conform`'s defaults.
 
 use fragsim_capture::catalog::SchemeName;
 use fragsim_testkit::{Battery, Case, Failure, Limits, Params};
 use fragsim_wgpu::{adapter_or_skip, Mode, Plant, WgpuBackend};
 
-/// Cases per scheme and mode.
-const CASES: u32 = 16;
+/// Cases per scheme, mode and seed.
+const CASES: u32 = 64;
+/// The battery's seeds.
+const SEEDS: std::ops::Range<u64> = 0..5;
 
 /// The battery's default cases without corners far beyond the guard band. Lavapipe covers pixels
 /// fragsim does not where a sliver crosses it (found by this battery, seed 0, 2026-12-02: one
@@ -37,32 +39,14 @@ fn params(scheme: SchemeName) -> Params {
     }
 }
 
-/// Whether pixel `(x, y)`'s centre lies exactly on an edge of one of `case`'s triangles: the
-/// sample a fill rule decides (corners and centres are on the half-pixel grid, so the test is
-/// exact in integers).
-fn centre_on_an_edge(case: &Case, x: u32, y: u32) -> bool {
-    let (px, py) = (2 * i64::from(x) + 1, 2 * i64::from(y) + 1);
-    case.triangles.iter().any(|t| {
-        (0..3).any(|i| {
-            let ([ax, ay], [bx, by]) = (t.corners[i], t.corners[(i + 1) % 3]);
-            let (ax, ay, bx, by) = (i64::from(ax), i64::from(ay), i64::from(bx), i64::from(by));
-            let cross = (bx - ax) * (py - ay) - (by - ay) * (px - ax);
-            let within =
-                (ax.min(bx)..=ax.max(bx)).contains(&px) && (ay.min(by)..=ay.max(by)).contains(&py);
-            cross == 0 && within && (ax, ay) != (bx, by)
-        })
-    })
-}
-
-/// The correct shaders under the battery, each scheme and mode from three seeds: either every
-/// case passes, or the shrunk counterexample's differing pixels all have their centre exactly on
-/// a triangle's edge. Found by this test on lavapipe (2026-12-02): lavapipe decides samples on
-/// an edge the other way from fragsim's top-left rule (an extra fragment on a right edge, a
-/// missing one on a left edge; Vulkan leaves the rule to the implementation, the precision
-/// verdict does not yet), so a tie is the one difference allowed here; any other fails the test.
-/// `docs/testing.md` records what each run found.
+/// The correct shaders under the battery, each scheme and mode from five seeds, every case
+/// judged by the oracle's verdict alone. Lavapipe decides a sample exactly on an edge the other
+/// way from fragsim's top-left rule (an extra fragment on a right edge, a missing one on a left
+/// edge: found by this test, 2026-12-02); Vulkan leaves that rule to the implementation, and the
+/// verdict takes any one rule a capture follows throughout (`docs/semantics.md` §4), so this is
+/// no difference. `docs/testing.md` records what the runs found.
 #[test]
-fn mdts_and_the_abuffer_conform_in_replay_and_engine_mode_but_for_edge_ties() {
+fn mdts_and_the_abuffer_conform_in_replay_and_engine_mode() {
     let Some(gpu) = adapter_or_skip() else { return };
     for mode in [Mode::Replay, Mode::Engine] {
         let backend = WgpuBackend {
@@ -71,7 +55,7 @@ fn mdts_and_the_abuffer_conform_in_replay_and_engine_mode_but_for_edge_ties() {
             plant: None,
         };
         for scheme in [SchemeName::Mdts, SchemeName::Abuffer] {
-            for seed in 0..3 {
+            for seed in SEEDS {
                 let result = Battery::new(&backend, params(scheme))
                     .cases(CASES)
                     .seed(seed)
@@ -85,27 +69,7 @@ fn mdts_and_the_abuffer_conform_in_replay_and_engine_mode_but_for_edge_ties() {
                         println!("{what}: {CASES} cases pass");
                     }
                     Err(Failure::Counterexample(found)) => {
-                        let case = &found.submitted;
-                        let width = case.viewport.width;
-                        let pixels: Vec<(u32, u32)> = found
-                            .mismatches()
-                            .iter()
-                            .map(|m| (m.pixel as u32 % width, m.pixel as u32 / width))
-                            .collect();
-                        println!(
-                            "{what}: case {} shrunk to {}x{}, differs at {pixels:?} ({}), \
-                             triangles {:?}",
-                            found.cases_run,
-                            width,
-                            case.viewport.height,
-                            found.message,
-                            case.triangles
-                        );
-                        assert!(!pixels.is_empty(), "{what}: {found:?}");
-                        assert!(
-                            pixels.iter().all(|&(x, y)| centre_on_an_edge(case, x, y)),
-                            "{what}: a difference that is no edge tie: {found:?}"
-                        );
+                        panic!("{what}: {found:?}")
                     }
                     Err(Failure::Refused(message)) => panic!("{what}: refused: {message}"),
                 }

@@ -82,19 +82,9 @@ fn every_scheme_is_equal(gpu: &Gpu, name: &str, spec_at: impl Fn(f64) -> SceneAn
                     assert_eq!(coverage.coverage_differs, 0, "{what}");
                     assert_eq!(coverage.counters_differ.unwrap_or(0), 0, "{what}");
                 }
-                // The keep-first list keeps the first K fragments to arrive, an order the GPU
-                // does not promise and the oracle takes as submission order (issue 20 item 8):
-                // at pixels of more than K fragments it is judged against a list the reference
-                // does not know, so only its coverage, at the pixels it keeps whole, is asserted.
-                if !matches!(
-                    scheme,
-                    GpuScheme::LinkedList {
-                        resolve: Resolve::KeepFirst,
-                        ..
-                    }
-                ) {
-                    assert!(verdict.comparison.is_equal(), "{what}");
-                }
+                // Every scheme, the keep-first list too: the verdict judges a linked list on every
+                // node its lists reach, whatever its resolve keeps.
+                assert!(verdict.comparison.is_equal(), "{what}");
             }
         }
     }

@@ -9,9 +9,11 @@
 //! implementation could (another arrival order in unsorted layouts, a depth moved inside its
 //! interval, a key-only triangle swap at a shared edge). Each mutant is judged bit-exactly and
 //! within the precision of an f32 vertex stage: every non-conforming one must be DIFFERENT, every
-//! conforming one EQUAL where the judge admits it. Per-sample arrays and masked nodes are judged
-//! exactly only (the f32 analysis derives bounds at pixel centres). The test prints a kill table
-//! by kind and layout, per judge (`docs/testing.md` has it and its command).
+//! conforming one EQUAL where the judge admits it. Per-sample arrays are judged under the f32
+//! analysis of the per-sample view as any other layout; masked nodes exactly only (the kinds
+//! choose their sites from one list's possibilities, and a node stands for several samples'
+//! lists). The test prints a kill table by kind and layout, per judge (`docs/testing.md` has it
+//! and its command).
 
 mod kinds;
 mod storage;
@@ -513,6 +515,15 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
     let view4 = sampled.view(&scene, small).unwrap();
     let samples = SampleOracle::build(&view4).unwrap();
     let per_pixel = samples.per_pixel();
+    // The f32 analysis per sample: bounds at each sample position (the per-sample f32 refusal
+    // is lifted, `docs/semantics.md` §10, "Per sample").
+    let f32_per_sample = Precision::derive(
+        &view4,
+        &Conventions {
+            vertex_precision: VertexPrecision::F32,
+            ..sampled.conventions
+        },
+    );
     let nodes = Oracle::from_capture(&node_capture(&per_pixel, Capacity::Unbounded));
     let deepest = nodes.max_depth_complexity();
     for (name, scheme) in [
@@ -524,8 +535,11 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             own: record(&view4, &sampled, scheme),
             encoding: None,
             oracle: samples.oracle(),
-            judges: vec![("exact", Judge::Exact)],
-            possible: None,
+            judges: vec![
+                ("exact", Judge::Exact),
+                ("f32", Judge::Within(f32_per_sample.clone())),
+            ],
+            possible: Some(&f32_per_sample),
             format: DepthFormat::F32,
             triangles,
         });
@@ -535,6 +549,9 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         own: Dump::record_masked(&view4, sampled.clone(), deepest, "battery").unwrap(),
         encoding: None,
         oracle: &nodes,
+        // Exactly only: the kinds choose their sites (away from any edge, past an interval) from
+        // one list's possibilities, and a node stands for the lists of the samples of its mask.
+        // Its f32 judgement (`Dump::compare_masked_within`) is the oracle's unit test's.
         judges: vec![("exact", Judge::Masked(&per_pixel))],
         possible: None,
         format: DepthFormat::F32,
