@@ -859,6 +859,10 @@ fn triangle(
     // where its value is at least its threshold.
     let threshold = thresholds(edges.map(|(i, j)| (v[i].snapped, v[j].snapped)), rule);
     let area_stable = area as f64 > area_bound;
+    // Per edge, whether an end lies outside the viewport: the edge leaves the clip volume.
+    let window = [pixels.width, pixels.height].map(|side| i64::from(side) * one);
+    let outside = |x: &VertexBound| (0..2).any(|a| !(0..=window[a]).contains(&x.snapped[a]));
+    let leaves = edges.map(|(i, j)| outside(&v[i]) || outside(&v[j]));
     let mut planes = Vec::new();
     let positions =
         (y0..=y1).flat_map(|y| (x0..=x1).flat_map(move |x| (0..samples).map(move |s| (x, y, s))));
@@ -917,6 +921,16 @@ fn triangle(
             }
         };
         bounds.edge_tie_pairs += u64::from(on_edge);
+        // A sample exactly on an edge that leaves the clip volume: an implementation may clip
+        // the triangle there (Vulkan clips to `−w ≤ x, y ≤ w`; a guard band only where the result
+        // is the same), and the clipped edge's new end is computed and snapped in its own
+        // arithmetic, so the sample may fall on either side whatever the fill rule.
+        let clipped_tie = (0..3).any(|k| e[k] == 0 && leaves[k]) && e.iter().all(|&v| v >= 0);
+        let (certain, possible) = if clipped_tie {
+            (false, true)
+        } else {
+            (certain, possible)
+        };
         if !possible && !covered {
             continue;
         }
@@ -925,7 +939,7 @@ fn triangle(
             / area_f;
         let reference = if covered { depth_key(z as f32) } else { None };
         let (key_lo, key_hi, inside) = depth_interval(pixels, &v, &planes, p, z);
-        if !certain && reachable.is_some() {
+        if !certain && !clipped_tie && reachable.is_some() {
             dependent.push((
                 found.len(),
                 Dependence {
