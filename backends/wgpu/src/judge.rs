@@ -232,7 +232,8 @@ impl Within {
     #[must_use]
     pub fn fits(&self, dump: &Dump) -> bool {
         dump.header.scene == self.scene
-            && (dump.header.width, dump.header.height) == (self.viewport.width, self.viewport.height)
+            && (dump.header.width, dump.header.height)
+                == (self.viewport.width, self.viewport.height)
     }
 
     /// `dump` judged within precision by the oracle's verdict, every word read.

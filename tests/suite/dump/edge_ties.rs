@@ -155,7 +155,11 @@ fn a_capture_deciding_edge_ties_by_any_one_rule_is_equal() {
             assert_eq!(record["edge_ties"], rule.name(), "{options:?}: {record}");
         }
         if rule != EdgeTies::TopLeft {
-            assert_ne!(lists, grid.lists(EdgeTies::TopLeft), "{rule:?} changes nothing");
+            assert_ne!(
+                lists,
+                grid.lists(EdgeTies::TopLeft),
+                "{rule:?} changes nothing"
+            );
         }
     }
 }

@@ -32,7 +32,12 @@ fn soup(side: u32, triangles: usize, first_sample: [i64; 2], seed: u64) -> Mesh 
     }
     let centre = first_sample.map(|o| (32 + o / 16) as f64);
     let corner = |dx: f64, dy: f64| at(centre[0] + 32.0 * dx, centre[1] + 32.0 * dy, 0.5);
-    let ring = [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)];
+    let ring = [
+        corner(-1.0, -1.0),
+        corner(1.0, -1.0),
+        corner(1.0, 1.0),
+        corner(-1.0, 1.0),
+    ];
     for k in 0..4 {
         positions.extend([at(centre[0], centre[1], 0.5), ring[k], ring[(k + 1) % 4]]);
     }
@@ -92,7 +97,16 @@ fn rasterized_under(view: &View<'_>, rule: EdgeTies) -> Oracle {
 fn each_rule_owns_the_edges_it_names() {
     // Edges of a positively oriented triangle in y-down rows: d.y < 0 is a left edge (the
     // interior to its right), d.y == 0 with d.x > 0 a top edge (the interior below).
-    let directions = [[3, -2], [-3, -2], [0, -5], [3, 2], [-3, 2], [0, 5], [4, 0], [-4, 0]];
+    let directions = [
+        [3, -2],
+        [-3, -2],
+        [0, -5],
+        [3, 2],
+        [-3, 2],
+        [0, 5],
+        [4, 0],
+        [-4, 0],
+    ];
     for rule in EdgeTies::ALL {
         for d in directions {
             let owns = if d[1] != 0 {

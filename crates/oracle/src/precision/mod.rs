@@ -192,11 +192,7 @@ impl Precision {
     /// window origin), as the oracle of the view decides them.
     #[must_use]
     pub fn derive(view: &View<'_>, conventions: &Conventions) -> Self {
-        Self::derive_under(
-            view,
-            conventions,
-            pipeline_rule(conventions.window_origin),
-        )
+        Self::derive_under(view, conventions, pipeline_rule(conventions.window_origin))
     }
 
     /// [`Precision::derive`] for an implementation that decides samples exactly on an edge by
@@ -231,14 +227,7 @@ impl Precision {
                         ids,
                         verts: [a, b, c],
                     };
-                    if !triangle(
-                        target,
-                        rule,
-                        tri,
-                        &mut found,
-                        &mut dependent,
-                        &mut bounds,
-                    ) {
+                    if !triangle(target, rule, tri, &mut found, &mut dependent, &mut bounds) {
                         bounds.bounded_triangles += 1;
                     }
                 }

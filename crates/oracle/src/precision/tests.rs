@@ -466,7 +466,9 @@ fn enumerated_coverage_is_exactly_that_of_the_reachable_snapped_triangles() {
             for y in 0..6 {
                 for x in 0..6 {
                     let p = [x * 256 + 128, y * 256 + 128];
-                    let hits = all.iter().filter(|&&xy| covers(pipeline_rule(origin), xy, p).0)
+                    let hits = all
+                        .iter()
+                        .filter(|&&xy| covers(pipeline_rule(origin), xy, p).0)
                         .count();
                     let pixel = (y * 6 + x) as u32;
                     let listed = found.iter().find(|(q, _)| *q == pixel).map(|(_, q)| *q);

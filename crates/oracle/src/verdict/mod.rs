@@ -256,9 +256,8 @@ pub fn judge(
             for rule in others {
                 let under = ties.oracle_under(oracle, source.pipeline, rule);
                 let lists = under.as_ref().unwrap_or(oracle);
-                let analysis = (!exact).then(|| {
-                    Precision::derive_under(source.view, &source.conventions, rule)
-                });
+                let analysis = (!exact)
+                    .then(|| Precision::derive_under(source.view, &source.conventions, rule));
                 let analysis = match (analysis, stored) {
                     (Some(a), _) => Some(as_stored(Cow::Owned(a), lists)),
                     (None, DepthFormat::F32) => None,
