@@ -7,6 +7,7 @@
 //!     --view 30 --mode replay --out out/wgpu --judge
 //! fragsim-wgpu capture --scheme linked-list --plant lost-node --scene bunny --out out/wgpu
 //! fragsim-wgpu capture --case DIR --scheme mdts --k 2 --mode engine --out OUT
+//! fragsim-wgpu capture --scheme abuffer,mdts --samples 4 --mode engine --precision --out OUT
 //! fragsim-wgpu msaa-count --scene bunny --samples 1,4,8 --view 30,120 --width 512 \
 //!     --height 512 --mode replay,engine --mirrored
 //! ```
@@ -22,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use fragsim_oracle::compare::{verdict, Comparison};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
@@ -33,7 +35,7 @@ use fragsim_wgpu::sample_counts::{
     CountDiff, NearEdges,
 };
 use fragsim_wgpu::shaders::NAMES;
-use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
+use fragsim_wgpu::{capture_samples, judge, Gpu, GpuScheme, Mode, Plant};
 
 #[derive(Parser)]
 #[command(
@@ -168,6 +170,11 @@ struct CaptureArgs {
     /// `fragsim compare oracle DIR --vertex-precision f32`) and print it.
     #[arg(long)]
     precision: bool,
+    /// Samples a pixel: 1, or a per-sample capture at 2, 4, 8 (a list per (pixel, sample), the
+    /// depth at the sample; the adapter's target must render at the count; abuffer,
+    /// abuffer-exact, mdts, mdts32 and the linked lists). Judged by --precision only.
+    #[arg(long, default_value_t = 1)]
+    samples: u32,
 }
 
 fn main() -> ExitCode {
@@ -215,7 +222,15 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
         judge: judge_it,
         depth_ulps,
         precision,
+        samples,
     } = args;
+    if samples > 1 && judge_it {
+        return Err(
+            "--judge compares with the single-sample oracle: judge a per-sample capture with \
+             --precision (fragsim compare oracle DIR --vertex-precision f32)"
+                .into(),
+        );
+    }
     let names: Vec<&str> = if scheme == "all" {
         NAMES.to_vec()
     } else {
@@ -265,21 +280,28 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
     let mut runs = 0;
     for scheme in &schemes {
         for &plant in &plants {
-            if every && plant.is_some_and(|p| !p.applies_to(scheme)) {
+            if every && plant.is_some_and(|p| !p.applies_at(scheme, samples)) {
                 continue;
             }
             runs += 1;
             // One scheme the adapter cannot run (a buffer past its limits, a missing feature)
             // does not stop the others: it is reported and the command exits 2 at the end.
-            let captured =
-                match capture_planted(gpu, &fragsim_view, spec.clone(), scheme, mode, plant) {
-                    Ok(captured) => captured,
-                    Err(e) => {
-                        eprintln!("fragsim-wgpu: {e}");
-                        failed += 1;
-                        continue;
-                    }
-                };
+            let captured = match capture_samples(
+                gpu,
+                &fragsim_view,
+                spec.clone(),
+                scheme,
+                mode,
+                plant,
+                samples,
+            ) {
+                Ok(captured) => captured,
+                Err(e) => {
+                    eprintln!("fragsim-wgpu: {e}");
+                    failed += 1;
+                    continue;
+                }
+            };
             let dir = match plant {
                 Some(p) => out.join(format!("{}-planted-{}", scheme.name(), p.name())),
                 None => out.join(scheme.name()),
@@ -291,12 +313,17 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                 .gpu_ms
                 .map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.3} ms"));
             println!(
-                "{}{} {} {}x{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
+                "{}{} {} {}x{}{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
                 scheme.name(),
                 plant.map_or(String::new(), |p| format!(" (planted: {})", p.name())),
                 mode.name(),
                 width,
                 height,
+                if samples > 1 {
+                    format!(" {samples}x")
+                } else {
+                    String::new()
+                },
                 spec.describe(),
                 captured.triangles,
                 captured.wall_ms,
@@ -322,6 +349,9 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                         "  precision verdict (f32 vertex stage): {}",
                         judgement.summary()
                     );
+                    if samples > 1 {
+                        println!("  {}", per_sample_line(&judgement.comparison, samples));
+                    }
                 }
             }
         }
@@ -330,6 +360,21 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
         return Err(format!("{failed} of {runs} captures could not run").into());
     }
     Ok(())
+}
+
+/// A per-sample verdict's lists (samples) counted by pixel, as `fragsim compare` prints them:
+/// the "error pixels" of the precision verdict's summary are samples there.
+fn per_sample_line(comparison: &Comparison, samples: u32) -> String {
+    let differs = |v: &u8| v & verdict::DIFFERS != 0;
+    let lists = &comparison.verdicts;
+    let differing_samples = lists.iter().filter(|v| differs(v)).count();
+    let pixels = lists.chunks(samples as usize);
+    let differing_pixels = pixels.clone().filter(|p| p.iter().any(differs)).count();
+    format!(
+        "per sample ({samples} a pixel): {differing_samples} of {} samples differ, in {differing_pixels} of {} pixels",
+        lists.len(),
+        pixels.len()
+    )
 }
 
 /// Engine mode: at most this many differing samples of a comparison are measured against the

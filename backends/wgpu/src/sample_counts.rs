@@ -90,8 +90,8 @@ pub fn count_samples(
             "the counting pass draws a single-sample view into a multisampled target".into(),
         ));
     }
-    let scheme = GpuScheme::SampleCounts { samples };
-    let ((_, words, gpu_ms, wall_ms), triangles) = execute(gpu, view, &scheme, mode, None)?;
+    let ((_, words, gpu_ms, wall_ms), triangles) =
+        execute(gpu, view, &GpuScheme::SampleCounts, mode, None, samples)?;
     SampleCounts::read(samples, words, gpu_ms, wall_ms, triangles)
 }
 
@@ -108,8 +108,8 @@ pub fn count_samples_of(
     prims: &[u32],
     samples: u32,
 ) -> Result<SampleCounts, GpuError> {
-    let scheme = GpuScheme::SampleCounts { samples };
-    let (_, words, gpu_ms, wall_ms) = execute_replay_of(gpu, view, prims, &scheme)?;
+    let (_, words, gpu_ms, wall_ms) =
+        execute_replay_of(gpu, view, prims, &GpuScheme::SampleCounts, samples)?;
     SampleCounts::read(samples, words, gpu_ms, wall_ms, prims.len() as u32)
 }
 
