@@ -5,9 +5,10 @@
 //!   fragsim's per-sample oracle at 4 and 8 samples a pixel and at 1 (the control); against the
 //!   standard positions mirrored in y they differ, so identity does tell the sample positions
 //!   apart.
-//! - Per-sample captures (issue 34, `capture_samples`): the A-buffer (ids) and MDTS (u64 words)
-//!   of the bunny and `bunny-spheres:8` at 4 samples a pixel in engine mode (the f32 vertex
-//!   shader, each sample's depth interpolated at the sample), judged by the oracle's verdict as
+//! - Per-sample captures (issue 34, `capture_samples`): the A-buffer (fixed and exact, ids), MDTS
+//!   (u64 words with ids, u32 keys) and the keep-nearest linked list of the bunny and
+//!   `bunny-spheres:8` at 4 samples a pixel in engine mode (the f32 vertex shader, each sample's
+//!   depth interpolated at the sample), judged by the oracle's verdict as
 //!   `fragsim compare oracle DIR --vertex-precision f32` judges them: equal with 0 error
 //!   samples, and every planted bug different.
 //!
@@ -105,8 +106,15 @@ fn per_sample_verdicts(
     let viewport = Viewport::new(128, 128).unwrap();
     let view = spec.view(&loaded, viewport).unwrap();
     // A capacity the A-buffer reaches on these scenes at 4 slots, so that its off-by-one plant
-    // has full lists to show in.
-    let schemes = [GpuScheme::ABuffer { capacity: 4 }, GpuScheme::Mdts { k: 8 }];
+    // has full lists to show in; MDTS on u64 words (ids) and on u32 keys; linked lists judged
+    // on every node.
+    let schemes = [
+        GpuScheme::ABuffer { capacity: 4 },
+        GpuScheme::ABufferExact,
+        GpuScheme::Mdts { k: 8 },
+        GpuScheme::Mdts32 { k: 8 },
+        GpuScheme::parse("linked-list-nearest", 8, 4).unwrap(),
+    ];
     let mut reference: Option<Reference<'static>> = None;
     let mut verdicts = Vec::new();
     for scheme in schemes {
