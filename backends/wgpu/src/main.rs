@@ -23,16 +23,15 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use fragsim_oracle::compare::{verdict, Comparison};
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{SamplePattern, View, Viewport};
 use fragsim_wgpu::capture::engine_scene;
-use fragsim_wgpu::judge::Within;
+use fragsim_wgpu::judge::{Within, WithinJudgement};
 use fragsim_wgpu::sample_counts::{
     count_samples, count_samples_of, covering_prims, f32_snap_radius, mirrored, reference_counts,
-    CountDiff, NearEdges,
+    CountDiff, NearEdges, SampledReference,
 };
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_samples, judge, Gpu, GpuScheme, Mode, Plant};
@@ -274,8 +273,9 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
     };
     let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
     // The precision verdict's reference, built for the first dump and kept while the dumps name
-    // its scene (one view and mode: every dump of this command).
+    // its scene (one view and mode: every dump of this command); per sample its own.
     let mut within: Option<Within> = None;
+    let mut sampled: Option<SampledReference> = None;
     let mut failed = 0;
     let mut runs = 0;
     for scheme in &schemes {
@@ -339,7 +339,35 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                     println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
                 }
             }
-            if precision {
+            if precision && samples > 1 {
+                if !sampled.as_ref().is_some_and(|r| r.fits(&captured.dump)) {
+                    sampled = Some(SampledReference::of(&captured.dump)?);
+                }
+                if let Some(reference) = &sampled {
+                    let verdict = reference.judge(&captured.dump)?;
+                    let per_sample = verdict.per_sample;
+                    // The summary `fragsim-wgpu capture` prints at one sample (what
+                    // run_device.sh reads), its "pixels" the samples, then the pixels.
+                    let judgement = WithinJudgement {
+                        comparison: verdict.comparison,
+                        bounds: verdict.bounds.unwrap_or_default(),
+                        covered: reference.covered,
+                    };
+                    println!(
+                        "  precision verdict (f32 vertex stage): {}",
+                        judgement.summary()
+                    );
+                    if let Some(c) = per_sample {
+                        println!(
+                            "  per sample ({samples} a pixel): {} of {} samples differ, in {} of {} pixels",
+                            c.differing_samples,
+                            c.compared,
+                            c.differing_pixels,
+                            c.compared / u64::from(samples)
+                        );
+                    }
+                }
+            } else if precision {
                 if !within.as_ref().is_some_and(|w| w.fits(&captured.dump)) {
                     within = Some(Within::of(&captured.dump)?);
                 }
@@ -349,9 +377,6 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                         "  precision verdict (f32 vertex stage): {}",
                         judgement.summary()
                     );
-                    if samples > 1 {
-                        println!("  {}", per_sample_line(&judgement.comparison, samples));
-                    }
                 }
             }
         }
@@ -360,21 +385,6 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
         return Err(format!("{failed} of {runs} captures could not run").into());
     }
     Ok(())
-}
-
-/// A per-sample verdict's lists (samples) counted by pixel, as `fragsim compare` prints them:
-/// the "error pixels" of the precision verdict's summary are samples there.
-fn per_sample_line(comparison: &Comparison, samples: u32) -> String {
-    let differs = |v: &u8| v & verdict::DIFFERS != 0;
-    let lists = &comparison.verdicts;
-    let differing_samples = lists.iter().filter(|v| differs(v)).count();
-    let pixels = lists.chunks(samples as usize);
-    let differing_pixels = pixels.clone().filter(|p| p.iter().any(differs)).count();
-    format!(
-        "per sample ({samples} a pixel): {differing_samples} of {} samples differ, in {differing_pixels} of {} pixels",
-        lists.len(),
-        pixels.len()
-    )
 }
 
 /// Engine mode: at most this many differing samples of a comparison are measured against the

@@ -16,14 +16,13 @@
 //! at 1 and 4); without an adapter the tests are skipped with a line, or fail where a GPU is
 //! required (`adapter_or_skip`).
 
-use std::borrow::Cow;
-
-use fragsim_oracle::precision::f32_reference;
+use fragsim_oracle::dump::Dump;
 use fragsim_oracle::scene::SceneAndCamera;
-use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Verdict};
+use fragsim_oracle::verdict::{judge_sides, Side, SidesOptions, Verdict};
 use fragsim_raster::{SamplePattern, VertexPrecision, Viewport};
 use fragsim_wgpu::sample_counts::{
     count_samples, count_samples_of, covering_prims, mirrored, reference_counts, CountDiff,
+    SampledReference,
 };
 use fragsim_wgpu::{adapter_or_skip, capture_samples, say_skipped, GpuScheme, Mode, Plant};
 
@@ -94,8 +93,8 @@ fn triangles_drawn_alone_cover_the_samples_the_oracle_gives_them() {
 
 /// The per-sample engine captures of `scene` at `samples` a pixel and 128², view 30°, each scheme
 /// correct and with every plant that applies, judged as `fragsim compare oracle DIR
-/// --vertex-precision f32` judges them (the reference built once, from the scene the first dump
-/// names); the verdicts by (scheme, plant).
+/// --vertex-precision f32` judges them (`SampledReference`: built once, from the scene the first
+/// dump names); the verdicts by (scheme, plant).
 fn per_sample_verdicts(
     gpu: &fragsim_wgpu::Gpu,
     scene: &str,
@@ -115,7 +114,7 @@ fn per_sample_verdicts(
         GpuScheme::Mdts32 { k: 8 },
         GpuScheme::parse("linked-list-nearest", 8, 4).unwrap(),
     ];
-    let mut reference: Option<Reference<'static>> = None;
+    let mut reference: Option<SampledReference> = None;
     let mut verdicts = Vec::new();
     for scheme in schemes {
         let plants = std::iter::once(None).chain(
@@ -137,24 +136,48 @@ fn per_sample_verdicts(
             .unwrap();
             let dump = &captured.dump;
             assert_eq!(dump.header.scene.conventions.samples, samples);
-            let reference = reference.get_or_insert_with(|| {
-                let (oracle, precision) = f32_reference(&dump.header.scene, viewport, None).unwrap();
-                Reference::new(
-                    Cow::Owned(oracle),
-                    precision,
-                    VertexPrecision::F32,
-                    (viewport.width, viewport.height),
-                )
-            });
-            let options = Options {
-                depth_ulps: 0,
-                examples: 4,
-            };
-            let verdict = verdict::judge(reference, Candidate::Dump(dump), &options).unwrap();
+            if !reference.as_ref().is_some_and(|r| r.fits(dump)) {
+                reference = Some(SampledReference::of(dump).unwrap());
+            }
+            let verdict = reference.as_ref().unwrap().judge(dump).unwrap();
+            if plant.is_none() {
+                same_through_the_files(dump, &verdict, &format!("{scene} {}", scheme.name()));
+            }
             verdicts.push((scheme, plant, verdict));
         }
     }
     verdicts
+}
+
+/// `dump` written, read back and judged by `fragsim compare oracle DIR --vertex-precision f32`'s
+/// library call (`judge_sides`, the oracle rebuilt from the header): the verdict `judged` in
+/// memory.
+fn same_through_the_files(dump: &Dump, judged: &Verdict, what: &str) {
+    let dir = std::env::temp_dir().join(format!(
+        "fragsim-wgpu-msaa-{}-{}",
+        std::process::id(),
+        what.replace([' ', ':'], "-")
+    ));
+    dump.write(&dir).unwrap();
+    let side = Side::open(dir.to_str().unwrap()).unwrap();
+    let options = SidesOptions {
+        vertex_precision: VertexPrecision::F32,
+        ..SidesOptions::default()
+    };
+    let verdict = judge_sides(&Side::Oracle, &side, &options).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(verdict.equal, judged.equal, "{what}");
+    assert_eq!(
+        verdict.lists_per_pixel,
+        dump.header.scene.conventions.samples
+    );
+    assert_eq!(
+        verdict
+            .per_sample
+            .map(|c| (c.compared, c.differing_samples)),
+        judged.per_sample.map(|c| (c.compared, c.differing_samples)),
+        "{what}"
+    );
 }
 
 #[test]
@@ -167,7 +190,7 @@ fn per_sample_engine_captures_are_equal_within_precision_and_planted_bugs_are_no
     }
     for scene in ["bunny", "bunny-spheres:8"] {
         for (scheme, plant, verdict) in per_sample_verdicts(&gpu, scene, samples) {
-            let counts = verdict.per_sample.clone().expect("a per-sample verdict");
+            let counts = verdict.per_sample.expect("a per-sample verdict");
             let c = &verdict.comparison.counts;
             let what = format!(
                 "{scene} 128² {samples}x engine {} {}: {} of {} samples differ in {} pixels \
