@@ -468,6 +468,43 @@ mod tests {
     }
 
     #[test]
+    fn per_sample_captures_draw_entry_points_their_variant_defines() {
+        // Each draw's entry point is a function of the WGSL the capture compiles: the scheme's
+        // file at one sample, its per-sample variant past one (which the k-buffers lack).
+        let draws = |passes: Vec<Pass>| -> Vec<&'static str> {
+            passes
+                .into_iter()
+                .filter_map(|p| match p {
+                    Pass::Draw(entry) => Some(entry),
+                    _ => None,
+                })
+                .collect()
+        };
+        let defines = |source: &str, entry: &str| source.contains(&format!("fn {entry}("));
+        for name in NAMES {
+            let scheme = GpuScheme::parse(name, 8, 4).unwrap();
+            let at = |samples| {
+                let mut all = scheme.counting_passes(samples);
+                all.extend(scheme.passes(samples));
+                draws(all)
+            };
+            for entry in at(1) {
+                assert!(defines(scheme.source(), entry), "{name}: {entry}");
+            }
+            match scheme.per_sample_source() {
+                Some(variant) => {
+                    assert!(scheme.captures_at(4), "{name}");
+                    for entry in at(4) {
+                        assert!(defines(variant, entry), "{name} per sample: {entry}");
+                        assert!(!defines(scheme.source(), entry), "{name}: {entry} twice");
+                    }
+                }
+                None => assert!(!scheme.captures_at(4) && scheme.captures_at(1), "{name}"),
+            }
+        }
+    }
+
+    #[test]
     fn storages_have_the_shapes_of_their_dump_layouts() {
         let list = GpuScheme::parse("linked-list-nearest", 8, 3).unwrap();
         let shapes: Vec<(&str, Vec<u64>)> = list
