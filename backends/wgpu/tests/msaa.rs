@@ -7,10 +7,10 @@
 //!   apart.
 //! - Per-sample captures (issue 34, `capture_samples`): the A-buffer (fixed and exact, ids), MDTS
 //!   (u64 words with ids, u32 keys) and the keep-nearest linked list of the bunny and
-//!   `bunny-spheres:8` at 4 samples a pixel in engine mode (the f32 vertex shader, each sample's
-//!   depth interpolated at the sample), judged by the oracle's verdict as
-//!   `fragsim compare oracle DIR --vertex-precision f32` judges them: equal with 0 error
-//!   samples, and every planted bug different.
+//!   `bunny-spheres:8` at 4 and 8 samples a pixel in engine mode (the f32 vertex shader, each
+//!   sample's depth interpolated at the sample), judged by the oracle's verdict as `fragsim
+//!   compare oracle DIR --vertex-precision f32` judges them: equal with 0 error samples, and
+//!   every planted bug different.
 //!
 //! A sample count the adapter's target cannot render at is skipped with a line (lavapipe renders
 //! at 1 and 4); without an adapter the tests are skipped with a line, or fail where a GPU is
@@ -183,46 +183,47 @@ fn same_through_the_files(dump: &Dump, judged: &Verdict, what: &str) {
 #[test]
 fn per_sample_engine_captures_are_equal_within_precision_and_planted_bugs_are_not() {
     let Some(gpu) = adapter_or_skip() else { return };
-    let samples = 4;
-    if let Err(e) = gpu.check_samples(samples) {
-        say_skipped(&format!("{samples} samples: {e}"));
-        return;
-    }
-    for scene in ["bunny", "bunny-spheres:8"] {
-        for (scheme, plant, verdict) in per_sample_verdicts(&gpu, scene, samples) {
-            let counts = verdict.per_sample.expect("a per-sample verdict");
-            let c = &verdict.comparison.counts;
-            let what = format!(
-                "{scene} 128² {samples}x engine {} {}: {} of {} samples differ in {} pixels \
-                 (missing {}, extra {}, misordered {}, miscounted {}, corrupt {}), {} ambiguous, \
-                 {} within precision",
-                scheme.name(),
-                plant.map_or("correct", Plant::name),
-                counts.differing_samples,
-                counts.compared,
-                counts.differing_pixels,
-                c.missing,
-                c.extra,
-                c.misordered,
-                c.miscounted,
-                c.corrupt,
-                c.ambiguous,
-                c.within_precision,
-            );
-            println!("{what}");
-            assert_eq!(counts.samples, samples, "{what}");
-            assert!(verdict.reference_fragments.iter().any(|&n| n > 0), "{what}");
-            match plant {
-                None => {
-                    assert!(verdict.equal, "{what}: {:?}", verdict.examples);
-                    assert_eq!(counts.differing_samples, 0, "{what}");
-                    // The depths are the GPU's, not fragsim's: some are owed within precision,
-                    // which the exact comparison would call wrong.
-                    assert!(c.within_precision > 0, "{what}");
-                }
-                Some(_) => {
-                    assert!(!verdict.equal, "{what}");
-                    assert!(counts.differing_samples > 0, "{what}");
+    for samples in [4, 8] {
+        if let Err(e) = gpu.check_samples(samples) {
+            say_skipped(&format!("{samples} samples: {e}"));
+            continue;
+        }
+        for scene in ["bunny", "bunny-spheres:8"] {
+            for (scheme, plant, verdict) in per_sample_verdicts(&gpu, scene, samples) {
+                let counts = verdict.per_sample.expect("a per-sample verdict");
+                let c = &verdict.comparison.counts;
+                let what = format!(
+                    "{scene} 128² {samples}x engine {} {}: {} of {} samples differ in {} pixels \
+                     (missing {}, extra {}, misordered {}, miscounted {}, corrupt {}), {} ambiguous, \
+                     {} within precision",
+                    scheme.name(),
+                    plant.map_or("correct", Plant::name),
+                    counts.differing_samples,
+                    counts.compared,
+                    counts.differing_pixels,
+                    c.missing,
+                    c.extra,
+                    c.misordered,
+                    c.miscounted,
+                    c.corrupt,
+                    c.ambiguous,
+                    c.within_precision,
+                );
+                println!("{what}");
+                assert_eq!(counts.samples, samples, "{what}");
+                assert!(verdict.reference_fragments.iter().any(|&n| n > 0), "{what}");
+                match plant {
+                    None => {
+                        assert!(verdict.equal, "{what}: {:?}", verdict.examples);
+                        assert_eq!(counts.differing_samples, 0, "{what}");
+                        // The depths are the GPU's, not fragsim's: some are owed within precision,
+                        // which the exact comparison would call wrong.
+                        assert!(c.within_precision > 0, "{what}");
+                    }
+                    Some(_) => {
+                        assert!(!verdict.equal, "{what}");
+                        assert!(counts.differing_samples > 0, "{what}");
+                    }
                 }
             }
         }
