@@ -159,10 +159,10 @@ one() {
         echo "== $scene ${side}x${side} view $view $mode, $samples sample(s) a pixel"
         left=$((deadline - $(date +%s)))
         if [ "$left" -lt 5 ]; then
-            echo "job $scene $side $view $mode: not run, the budget was spent"
+            echo "job $scene $side $view $mode $samples: not run, the budget was spent"
         else
             timeout "$left" "$bin/fragsim-wgpu" capture --scheme "$schemes" --plant "$plant" "${common[@]}" \
-                || echo "job $scene $side $view $mode: exit $? (124: stopped at the deadline)"
+                || echo "job $scene $side $view $mode $samples: exit $? (124: stopped at the deadline)"
         fi
         left=$((deadline - $(date +%s)))
         if [ "$plant" = all ] && [ "$samples" = 1 ] && [ "${SPINLOCK:-1}" = 1 ] && [ "$left" -ge 5 ]; then
