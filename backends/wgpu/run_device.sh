@@ -38,9 +38,9 @@
 # backends/wgpu/run_device.sh.
 #
 # Output: every job's log on stdout and in $OUT/wgpu-device.log, then the summary table (scheme,
-# scene, view, size, mode, verdict, error px, ambiguous px, coverage px, ms: GPU timestamps where
-# the adapter has them, else the wall time of submit to read-back) on stdout and in
-# $OUT/wgpu-summary.tsv.
+# scene, view, size, mode, samples, verdict, error px, ambiguous px, coverage px, differing
+# samples/pixels of a per-sample capture, ms: GPU timestamps where the adapter has them, else the
+# wall time of submit to read-back) on stdout and in $OUT/wgpu-summary.tsv.
 #
 # MSAA=1: issue 22's per-sample counting pass instead of the captures (`fragsim-wgpu msaa-count`,
 # src/sample_counts.rs): per scene and side one command over every view, mode and sample count,
