@@ -38,9 +38,9 @@
 # backends/wgpu/run_device.sh.
 #
 # Output: every job's log on stdout and in $OUT/wgpu-device.log, then the summary table (scheme,
-# scene, view, size, mode, verdict, error px, ambiguous px, coverage px, ms: GPU timestamps where
-# the adapter has them, else the wall time of submit to read-back) on stdout and in
-# $OUT/wgpu-summary.tsv.
+# scene, view, size, mode, samples, verdict, error px, ambiguous px, coverage px, differing
+# samples/pixels of a per-sample capture, ms: GPU timestamps where the adapter has them, else the
+# wall time of submit to read-back) on stdout and in $OUT/wgpu-summary.tsv.
 #
 # MSAA=1: issue 22's per-sample counting pass instead of the captures (`fragsim-wgpu msaa-count`,
 # src/sample_counts.rs): per scene and side one command over every view, mode and sample count,
@@ -56,16 +56,31 @@
 # MSAA=1 bash target/devbin-wgpu/run_device.sh. A dry run on lavapipe (1 and 4 samples only):
 # MSAA=1 BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES=64 SAMPLES="1 4"
 # bash backends/wgpu/run_device.sh.
+#
+# MSAA=capture: issue 34's per-sample captures instead (`fragsim-wgpu capture --samples N`,
+# src/capture.rs): a list per (pixel, sample), each sample's depth interpolated at the sample,
+# the schemes with a per-sample variant (abuffer, abuffer-exact, mdts, mdts32, linked-list,
+# linked-list-nearest), correct and planted (--plant all: the centre-depth plant too), each
+# judged in place by --precision (the library calls of `fragsim compare oracle DIR
+# --vertex-precision f32`, per sample). One job per (scene, side, view, mode, samples). Defaults
+# then: SIZES "512", SCENES "bunny dragon", VIEWS "30 120", MODES "engine replay", SAMPLES "4 8",
+# BUDGET 300 s. The summary table gains the sample count and the differing samples and pixels.
+# On the H200: MSAA=capture bash target/devbin-wgpu/run_device.sh. A dry run on lavapipe:
+# MSAA=capture BIN=target/release SCENES=bunny SIZES=64 SAMPLES=4 bash backends/wgpu/run_device.sh.
 set -uo pipefail
 msaa=${MSAA:-0}
 bin=${BIN:-target/devbin-wgpu}
 if [ "$msaa" = 1 ]; then
     sizes=${SIZES:-512} scenes=${SCENES:-"bunny dragon"} views=${VIEWS:-"30 120"} budget=${BUDGET:-240}
+elif [ "$msaa" = capture ]; then
+    sizes=${SIZES:-512} scenes=${SCENES:-"bunny dragon"} views=${VIEWS:-"30 120"} budget=${BUDGET:-300}
 else
     sizes=${SIZES:-"512 2048"} scenes=${SCENES:-"bunny dragon bunny-spheres"}
     views=${VIEWS:-"30 120 210 300"} budget=${BUDGET:-210}
 fi
 modes=${MODES:-"replay engine"}
+# The sample counts of the captures: one a pixel but under MSAA=capture.
+if [ "$msaa" = capture ]; then capture_samples=${SAMPLES:-"4 8"}; else capture_samples=1; fi
 jobs=${JOBS:-$(( $(nproc) / 2 > 0 ? $(nproc) / 2 : 1 ))}
 deadline=$(( $(date +%s) + budget ))
 dragon=${DRAGON:-$bin/dragon_vrip.ply.gz}
@@ -123,48 +138,53 @@ fi
 logs=$(mktemp -d)
 export bin dragon logs deadline
 
-# One job: the captures of one scene, side, view and mode.
+# One job: the captures of one scene, side, view, mode and sample count.
 one() {
-    local scene=$1 side=$2 view=$3 mode=$4 what schemes plant
+    local scene=$1 side=$2 view=$3 mode=$4 samples=$5 what schemes plant verdicts
     case $scene in
         dragon) what=(--mesh "$dragon") ;;
         *) what=(--scene "$scene") ;;
     esac
+    # Per sample the exact --judge (the single-sample oracle) does not apply: --precision alone.
+    if [ "$samples" = 1 ]; then verdicts=(--judge --precision); else verdicts=(--precision); fi
     local common=("${what[@]}" --width "$side" --height "$side" --view "$view" --mode "$mode"
-        --k 8 --capacity 4 --judge --precision --discard)
-    case $view in
-        30 | 120) schemes=abuffer,abuffer-exact,mdts,mdts32,kbuffer,linked-list,linked-list-nearest plant=all ;;
-        *) schemes=abuffer,mdts,mdts32,linked-list-nearest plant=none ;;
+        --k 8 --capacity 4 --samples "$samples" "${verdicts[@]}" --discard)
+    case $samples-$view in
+        1-30 | 1-120) schemes=abuffer,abuffer-exact,mdts,mdts32,kbuffer,linked-list,linked-list-nearest plant=all ;;
+        1-*) schemes=abuffer,mdts,mdts32,linked-list-nearest plant=none ;;
+        *) schemes=abuffer,abuffer-exact,mdts,mdts32,linked-list,linked-list-nearest plant=all ;;
     esac
-    local log=$logs/$scene-$side-$view-$mode.log start=$SECONDS left
+    local log=$logs/$scene-$side-$view-$mode-$samples.log start=$SECONDS left
     {
-        echo "== $scene ${side}x${side} view $view $mode"
+        echo "== $scene ${side}x${side} view $view $mode, $samples sample(s) a pixel"
         left=$((deadline - $(date +%s)))
         if [ "$left" -lt 5 ]; then
-            echo "job $scene $side $view $mode: not run, the budget was spent"
+            echo "job $scene $side $view $mode $samples: not run, the budget was spent"
         else
             timeout "$left" "$bin/fragsim-wgpu" capture --scheme "$schemes" --plant "$plant" "${common[@]}" \
-                || echo "job $scene $side $view $mode: exit $? (124: stopped at the deadline)"
+                || echo "job $scene $side $view $mode $samples: exit $? (124: stopped at the deadline)"
         fi
         left=$((deadline - $(date +%s)))
-        if [ "$plant" = all ] && [ "${SPINLOCK:-1}" = 1 ] && [ "$left" -ge 5 ]; then
+        if [ "$plant" = all ] && [ "$samples" = 1 ] && [ "${SPINLOCK:-1}" = 1 ] && [ "$left" -ge 5 ]; then
             timeout "$((left < 60 ? left : 60))" "$bin/fragsim-wgpu" capture --scheme kbuffer-spinlock-fixed "${common[@]}" \
                 || echo "kbuffer-spinlock-fixed $scene $side $view $mode: exit $? (124: timed out, at most 60 s)"
         fi
-        echo "== $scene ${side}x${side} view $view $mode: $((SECONDS - start)) s"
+        echo "== $scene ${side}x${side} view $view $mode $samples: $((SECONDS - start)) s"
     } >"$log" 2>&1
 }
 export -f one
 
 # The jobs in order: the smaller sides first; within a side the planted views (30°, 120°) of
-# every scene, then the other views.
+# every scene, then the other views; the sample counts innermost.
 for side in $(echo "$sizes" | tr ' ' '\n' | sort -n); do
     for planted in yes no; do
         for scene in $scenes; do
             for view in $views; do
                 case $view in 30 | 120) [ $planted = yes ] ;; *) [ $planted = no ] ;; esac || continue
                 for mode in $modes; do
-                    echo "$scene $side $view $mode"
+                    for samples in $capture_samples; do
+                        echo "$scene $side $view $mode $samples"
+                    done
                 done
             done
         done
@@ -172,17 +192,25 @@ for side in $(echo "$sizes" | tr ' ' '\n' | sort -n); do
 done | xargs -P "$jobs" -L 1 bash -c 'one "$@"' _
 cat "$logs"/*.log | tee "$out/wgpu-device.log"
 
-# The table: one row per capture, from each job's capture lines and the verdicts below them.
+# The table: one row per capture, from each job's capture lines and the verdicts below them
+# (per sample, error_px and ambiguous_px count samples, and the per-sample line adds the
+# differing samples and pixels).
 summary() {
-    printf 'scheme\tscene\tview\tsize\tmode\tverdict\terror_px\tambiguous_px\tcoverage_px\tms\n'
+    printf 'scheme\tscene\tview\tsize\tmode\tsamples\tverdict\terror_px\tambiguous_px\tcoverage_px\tdiffering_samples/pixels\tms\n'
     for f in "$logs"/*.log; do
-        local base scene side view mode
+        local base scene side view mode samples
         base=$(basename "$f" .log)
+        samples=${base##*-}; base=${base%-*}
         mode=${base##*-}; base=${base%-*}
         view=${base##*-}; base=${base%-*}
         side=${base##*-}; scene=${base%-*}
-        awk -v scene="$scene" -v view="$view" -v side="$side" -v mode="$mode" '
+        awk -v scene="$scene" -v view="$view" -v side="$side" -v mode="$mode" -v samples="$samples" '
+            function flush() {
+                if (row != "") printf "%s\t%s\t%s\n", row, per, ms
+                row = ""
+            }
             / triangles, GPU / {
+                flush()
                 name = $1
                 if ($2 == "(planted:") { p = $3; sub(/\)$/, "", p); name = name "+" p }
                 ms = $0; sub(/.*GPU /, "", ms); sub(/,.*/, "", ms)
@@ -194,8 +222,11 @@ summary() {
             /^  precision verdict/ {
                 v = $6; sub(/:$/, "", v); err = $7
                 amb = $0; sub(/ ambiguous,.*/, "", amb); sub(/.*\), /, "", amb)
-                printf "%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n", name, scene, view, side, mode, v, err, amb, cov, ms
-            }' "$f"
+                row = name "\t" scene "\t" view "\t" side "\t" mode "\t" samples "\t" v "\t" err "\t" amb "\t" cov
+                per = "-"
+            }
+            /^  per sample \(/ { per = $6 "/" $12 }
+            END { flush() }' "$f"
     done
 }
 echo

@@ -13,6 +13,9 @@
 //
 // The sort (one invocation per pixel) is the Rust post pass's insertion sort, in place: the dump
 // then holds each pixel's list in canonical order and says so ("sorted": true).
+//
+// A "pixel" here is a list: one per pixel, or one per (pixel, sample) in a per-sample capture
+// (abuffer_samples.wgsl's entry points, list_count() lists).
 
 @group(0) @binding(1) var<storage, read_write> counters: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> slots: array<vec2<u32>>;
@@ -30,9 +33,8 @@ fn store_fragment(f: Fragment, taken: u32, first: u32, room: u32) {
     }
 }
 
-@fragment
-fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
-    let f = fragment_of(v, primitive_index);
+// The fixed A-buffer's insertion of one fragment (fs_main, and per sample fs_main_samples).
+fn insert_fixed(f: Fragment) {
     if !f.inside {
         return;
     }
@@ -40,23 +42,36 @@ fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
     store_fragment(f, taken, f.pixel * params.slots, params.slots);
 }
 
-@fragment
-fn fs_count(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
-    let f = fragment_of(v, primitive_index);
+// The exact A-buffer's counting pass for one fragment.
+fn count_fragment(f: Fragment) {
     if f.inside {
         atomicAdd(&counters[f.pixel], 1u);
     }
 }
 
-@fragment
-fn fs_exact(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
-    let f = fragment_of(v, primitive_index);
+// The exact A-buffer's fill pass for one fragment.
+fn insert_exact(f: Fragment) {
     if !f.inside {
         return;
     }
     let taken = atomicAdd(&counters[f.pixel], 1u);
     let first = offsets[f.pixel];
     store_fragment(f, taken, first, offsets[f.pixel + 1u] - first);
+}
+
+@fragment
+fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
+    insert_fixed(fragment_of(v, primitive_index));
+}
+
+@fragment
+fn fs_count(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
+    count_fragment(fragment_of(v, primitive_index));
+}
+
+@fragment
+fn fs_exact(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
+    insert_exact(fragment_of(v, primitive_index));
 }
 
 const SCAN_THREADS: u32 = 256u;
@@ -66,7 +81,7 @@ var<workgroup> partial: array<u32, SCAN_THREADS>;
 // then each thread writes its chunk's exclusive prefix sums and zeroes its counters.
 @compute @workgroup_size(256)
 fn cs_prefix(@builtin(local_invocation_index) t: u32) {
-    let pixels = params.width * params.height;
+    let pixels = list_count();
     let chunk = (pixels + SCAN_THREADS - 1u) / SCAN_THREADS;
     let begin = min(t * chunk, pixels);
     let end = min(begin + chunk, pixels);
@@ -118,7 +133,7 @@ fn sort_pixel(id: vec3<u32>, groups: vec3<u32>) -> u32 {
 @compute @workgroup_size(64)
 fn cs_sort_fixed(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let p = sort_pixel(id, groups);
-    if p < params.width * params.height {
+    if p < list_count() {
         sort_slots(p * params.slots, min(atomicLoad(&counters[p]), params.slots));
     }
 }
@@ -126,7 +141,7 @@ fn cs_sort_fixed(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_work
 @compute @workgroup_size(64)
 fn cs_sort_exact(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let p = sort_pixel(id, groups);
-    if p < params.width * params.height {
+    if p < list_count() {
         let first = offsets[p];
         sort_slots(first, min(atomicLoad(&counters[p]), offsets[p + 1u] - first));
     }

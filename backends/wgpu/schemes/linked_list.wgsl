@@ -13,9 +13,9 @@
 @group(0) @binding(3) var<storage, read_write> next_: array<u32>;
 @group(0) @binding(4) var<storage, read_write> nodes: array<vec2<u32>>;
 
-@fragment
-fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
-    let f = fragment_of(v, primitive_index);
+// The append of one fragment (fs_main, and per sample fs_main_samples: a list per (pixel,
+// sample), the pool shared by all).
+fn append(f: Fragment) {
     if !f.inside {
         return;
     }
@@ -30,4 +30,9 @@ fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
     }
     nodes[n - 1u] = vec2<u32>(f.prim, f.key);
     next_[n - 1u] = old;
+}
+
+@fragment
+fn fs_main(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
+    append(fragment_of(v, primitive_index));
 }

@@ -10,9 +10,8 @@
 @group(0) @binding(1) var<storage, read_write> words: array<atomic<u64>>;
 @group(0) @binding(3) var<storage, read_write> keys: array<atomic<u32>>;
 
-@fragment
-fn fs_u64(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
-    let f = fragment_of(v, primitive_index);
+// The walk of one fragment's u64 word (fs_u64, and per sample fs_u64_samples).
+fn insert_u64(f: Fragment) {
     if !f.inside {
         return;
     }
@@ -27,9 +26,8 @@ fn fs_u64(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
     }
 }
 
-@fragment
-fn fs_u32(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
-    let f = fragment_of(v, primitive_index);
+// The walk of one fragment's u32 depth key (fs_u32, and per sample fs_u32_samples).
+fn insert_u32(f: Fragment) {
     if !f.inside {
         return;
     }
@@ -42,4 +40,14 @@ fn fs_u32(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
         }
         value = max(value, old);
     }
+}
+
+@fragment
+fn fs_u64(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
+    insert_u64(fragment_of(v, primitive_index));
+}
+
+@fragment
+fn fs_u32(v: Varyings, @builtin(primitive_index) primitive_index: u32) {
+    insert_u32(fragment_of(v, primitive_index));
 }

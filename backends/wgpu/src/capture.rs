@@ -9,6 +9,16 @@
 //! does (Vulkan conventions: upper-left origin, depth in [0, 1], the f32 vertex stage). Depth is
 //! the GPU's own interpolation in both modes (`@builtin(position).z`).
 //!
+//! **Per sample** ([`capture_samples`], issue 34): at N > 1 samples a pixel the colour target is
+//! multisampled and the scheme's per-sample variant (`schemes/*_samples.wgsl`) draws: its entry
+//! points read `@builtin(sample_index)`, so the pipeline shades once per covered sample, and each
+//! sample's fragment goes to its own list `pixel · N + sample` with the depth of a varying
+//! interpolated at the sample (`@interpolate(linear, sample)` of the clip `z / w`: window depth is
+//! affine in the window, so screen-linear interpolation at the sample position is the depth plane
+//! there, fragsim's per-sample depth, `docs/semantics.md` §11; `position.z` is the pixel
+//! centre's on the H200). The dump is the scheme's single-sample layout over the sample-expanded
+//! framebuffer, its scene declaring `conventions.samples` N (`docs/dump-format.md`).
+//!
 //! A scheme is a list of passes ([`Pass`]: draws and compute dispatches) over its storage
 //! buffers, in one submission, read back at its end; the exact A-buffer first runs its counting
 //! passes in a submission of their own and reads back the prefix sum's total, which sizes its
@@ -156,7 +166,7 @@ pub fn capture(
     scheme: &GpuScheme,
     mode: Mode,
 ) -> Result<Captured, GpuError> {
-    capture_planted(gpu, view, scene, scheme, mode, None)
+    capture_samples(gpu, view, scene, scheme, mode, None, 1)
 }
 
 /// [`capture`] with a planted bug's shader variant ([`Plant`]); `None` is the correct shader.
@@ -173,17 +183,50 @@ pub fn capture_planted(
     mode: Mode,
     plant: Option<Plant>,
 ) -> Result<Captured, GpuError> {
-    if let GpuScheme::SampleCounts { .. } = scheme {
+    capture_samples(gpu, view, scene, scheme, mode, plant, 1)
+}
+
+/// [`capture_planted`] at `samples` a pixel: at more than one, per sample (the module says how),
+/// the dump's scene declaring the sample count. `view` is the single-sample view (the geometry
+/// drawn); the GPU samples at its own positions, which the verdict takes for Vulkan's standard
+/// ones.
+///
+/// # Errors
+/// As [`capture_planted`], and a sample count the adapter's target cannot render at, a scheme
+/// without a per-sample variant at more than one sample ([`GpuScheme::captures_at`]), a view that
+/// already rasterizes per sample, a plant that cannot show at `samples` ([`Plant::check_at`]).
+pub fn capture_samples(
+    gpu: &Gpu,
+    view: &View<'_>,
+    mut scene: SceneAndCamera,
+    scheme: &GpuScheme,
+    mode: Mode,
+    plant: Option<Plant>,
+    samples: u32,
+) -> Result<Captured, GpuError> {
+    if let GpuScheme::SampleCounts = scheme {
         return Err(GpuError(format!(
             "{} is a pass, not a capture scheme: it has no dump layout",
             scheme.name()
         )));
     }
-    if let Some(plant) = plant {
-        plant.check(scheme)?;
+    if !scheme.captures_at(samples) {
+        return Err(GpuError(format!(
+            "{} has no per-sample variant: it captures at 1 sample a pixel, not {samples}",
+            scheme.name()
+        )));
     }
-    let (run, triangles) = execute(gpu, view, scheme, mode, plant)?;
+    if view.samples().is_some() {
+        return Err(GpuError(
+            "a per-sample capture draws a single-sample view into a multisampled target".into(),
+        ));
+    }
+    if let Some(plant) = plant {
+        plant.check_at(scheme, samples)?;
+    }
+    let (run, triangles) = execute(gpu, view, scheme, mode, plant, samples)?;
     let (storages, words, gpu_ms, wall_ms) = run;
+    scene.conventions.samples = samples;
     let dump = to_dump(
         gpu, view, scene, scheme, mode, plant, triangles, &storages, words, gpu_ms, wall_ms,
     )?;
@@ -195,8 +238,9 @@ pub fn capture_planted(
     })
 }
 
-/// Draws `view` (at one sample a pixel, or the scheme's [`GpuScheme::samples`]) in `mode`
-/// through `scheme`'s passes and reads its storages back; with the triangles drawn.
+/// Draws `view` into a target of `samples` a pixel in `mode` through `scheme`'s passes (the
+/// per-sample variant's draws past one sample, the counting pass's own) and reads its storages
+/// back, a list per pixel or per (pixel, sample); with the triangles drawn.
 ///
 /// # Errors
 /// As [`capture`]: a feature or sample count the adapter lacks, a replay viewport that is not a
@@ -208,13 +252,14 @@ pub(crate) fn execute(
     scheme: &GpuScheme,
     mode: Mode,
     plant: Option<Plant>,
+    samples: u32,
 ) -> Result<(RunResult, u32), GpuError> {
     let geometry = match mode {
         Mode::Replay => replay_geometry(view)?,
         Mode::Engine => engine_geometry(view),
     };
     Ok((
-        execute_geometry(gpu, view, &geometry, scheme, mode, plant)?,
+        execute_geometry(gpu, view, &geometry, scheme, mode, plant, samples)?,
         geometry.count,
     ))
 }
@@ -229,12 +274,14 @@ pub(crate) fn execute_replay_of(
     view: &View<'_>,
     prims: &[u32],
     scheme: &GpuScheme,
+    samples: u32,
 ) -> Result<RunResult, GpuError> {
     let geometry = replay_geometry_of(view, prims.iter().copied())?;
-    execute_geometry(gpu, view, &geometry, scheme, Mode::Replay, None)
+    execute_geometry(gpu, view, &geometry, scheme, Mode::Replay, None, samples)
 }
 
-/// Draws `geometry` over `view`'s viewport through `scheme`'s passes and reads its storages back.
+/// Draws `geometry` over `view`'s viewport at `samples` a pixel through `scheme`'s passes and
+/// reads its storages back.
 fn execute_geometry(
     gpu: &Gpu,
     view: &View<'_>,
@@ -242,12 +289,13 @@ fn execute_geometry(
     scheme: &GpuScheme,
     mode: Mode,
     plant: Option<Plant>,
+    samples: u32,
 ) -> Result<RunResult, GpuError> {
     gpu.check(scheme.name(), scheme.needs())?;
-    gpu.check_samples(scheme.samples())?;
+    gpu.check_samples(samples)?;
     let viewport = view.viewport();
-    let pixels = viewport.pixels() as u64;
-    if let Some(pool) = scheme.pool(pixels) {
+    let lists = viewport.pixels() as u64 * u64::from(samples);
+    if let Some(pool) = scheme.pool(lists) {
         if pool >= u64::from(u32::MAX) {
             return Err(GpuError(format!(
                 "{}: a pool of {pool} nodes does not fit 32-bit node numbers",
@@ -256,8 +304,8 @@ fn execute_geometry(
         }
     }
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let run = Run::new(gpu, viewport, geometry, scheme, mode, plant);
-    let result = run.all(pixels);
+    let run = Run::new(gpu, viewport, geometry, scheme, mode, plant, samples);
+    let result = run.all();
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(GpuError(format!(
             "{}: the device refused: {e}",
@@ -281,7 +329,7 @@ struct PhaseOutput {
 }
 
 /// The objects every pass of one capture shares: the shader module, the parameters, the
-/// geometry and the (never written) colour target.
+/// geometry and the (never written) colour target of `samples` a pixel.
 struct Run<'a> {
     gpu: &'a Gpu,
     scheme: &'a GpuScheme,
@@ -293,12 +341,14 @@ struct Run<'a> {
     indices: Option<wgpu::Buffer>,
     target: wgpu::TextureView,
     constants: Vec<(&'static str, f64)>,
-    pixels: u64,
+    samples: u32,
+    /// The lists: pixels times samples.
+    lists: u64,
 }
 
 /// The format of the colour target the shaders never write (write mask empty): Vulkan draws
-/// need a render area, the schemes write storage buffers only. Multisampled as the scheme asks
-/// ([`GpuScheme::samples`]: the counting pass).
+/// need a render area, the schemes write storage buffers only. Multisampled for the counting pass
+/// and per-sample captures.
 pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
 impl<'a> Run<'a> {
@@ -309,29 +359,34 @@ impl<'a> Run<'a> {
         scheme: &'a GpuScheme,
         mode: Mode,
         plant: Option<Plant>,
+        samples: u32,
     ) -> Self {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
-        let source = format!("{COMMON}\n{}", scheme.source());
+        let per_sample = match scheme.per_sample_source() {
+            Some(entries) if samples > 1 => entries,
+            _ => "",
+        };
+        let source = format!("{COMMON}\n{}\n{per_sample}", scheme.source());
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(scheme.name()),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let pixels = viewport.pixels() as u64;
+        let lists = viewport.pixels() as u64 * u64::from(samples);
         let mut params = Vec::with_capacity(96);
         for v in geometry.view_projection {
             params.extend_from_slice(&v.to_le_bytes());
         }
         let replay = u32::from(mode == Mode::Replay);
         // `pool` fits: `capture_planted` refused larger pools.
-        let pool = scheme.pool(pixels).unwrap_or(0) as u32;
+        let pool = scheme.pool(lists).unwrap_or(0) as u32;
         for v in [
             viewport.width,
             viewport.height,
             scheme.slots(),
             replay,
             pool,
-            scheme.samples(),
+            samples,
             0,
             0,
         ] {
@@ -363,7 +418,7 @@ impl<'a> Run<'a> {
                     depth_or_array_layers: 1,
                 },
                 mip_level_count: 1,
-                sample_count: scheme.samples(),
+                sample_count: samples,
                 dimension: wgpu::TextureDimension::D2,
                 format: TARGET_FORMAT,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -381,22 +436,24 @@ impl<'a> Run<'a> {
             indices,
             target,
             constants: vec![("plant", plant.map_or(0.0, Plant::constant))],
-            pixels,
+            samples,
+            lists,
         }
     }
 
     /// The counting passes (if any), the size read back, the passes, every storage read back.
-    fn all(&self, pixels: u64) -> Result<RunResult, GpuError> {
-        let counting = self.scheme.counting_storages(pixels);
+    fn all(&self) -> Result<RunResult, GpuError> {
+        let lists = self.lists;
+        let counting = self.scheme.counting_storages(lists);
         let mut buffers = Vec::new();
         for s in &counting {
             buffers.push((s.binding, self.buffer(s)?));
         }
         let (mut gpu_ms, mut wall_ms) = (None, 0.0);
         let mut total = 0;
-        let passes = self.scheme.counting_passes();
+        let passes = self.scheme.counting_passes(self.samples);
         if !passes.is_empty() {
-            // The storage's size is the GPU's own count: offsets[pixels], the prefix sum's total.
+            // The storage's size is the GPU's own count: offsets[lists], the prefix sum's total.
             let offsets = buffers
                 .iter()
                 .zip(&counting)
@@ -407,11 +464,11 @@ impl<'a> Run<'a> {
                 .iter()
                 .zip(buffers.iter().map(|(_, b)| b))
                 .collect();
-            let counted = self.phase(&bound, &passes, &[(offsets, pixels * 4, 4)])?;
+            let counted = self.phase(&bound, &passes, &[(offsets, lists * 4, 4)])?;
             (gpu_ms, wall_ms) = (counted.gpu_ms, counted.wall_ms);
             total = u64::from(counted.words[0][0]);
         }
-        let storages = self.scheme.storages(pixels, total);
+        let storages = self.scheme.storages(lists, total);
         for s in &storages {
             if !buffers.iter().any(|(b, _)| *b == s.binding) {
                 buffers.push((s.binding, self.buffer(s)?));
@@ -434,7 +491,7 @@ impl<'a> Run<'a> {
             words,
             gpu_ms: ms,
             wall_ms: wall,
-        } = self.phase(&bound, &self.scheme.passes(), &read)?;
+        } = self.phase(&bound, &self.scheme.passes(self.samples), &read)?;
         wall_ms += wall;
         let gpu_ms = match (gpu_ms, ms) {
             (Some(a), Some(b)) => Some(a + b),
@@ -574,7 +631,7 @@ impl<'a> Run<'a> {
                     cpass.set_bind_group(0, &bind_group, &[]);
                     let (x, y) = match pass {
                         Pass::ComputePerPixel(_) => per_pixel_groups(
-                            self.pixels,
+                            self.lists,
                             device.limits().max_compute_workgroups_per_dimension,
                         ),
                         _ => (1, 1),
@@ -673,7 +730,7 @@ impl<'a> Run<'a> {
                 },
                 depth_stencil: None,
                 multisample: wgpu::MultisampleState {
-                    count: self.scheme.samples(),
+                    count: self.samples,
                     ..Default::default()
                 },
                 fragment: Some(wgpu::FragmentState {
@@ -791,6 +848,7 @@ fn to_dump(
         Mode::Engine => engine_scene(scene, view),
         Mode::Replay => scene,
     };
+    let scene_samples = scene.conventions.samples;
     let header = Header {
         format: FORMAT.into(),
         version: VERSION,
@@ -810,7 +868,7 @@ fn to_dump(
         sorted: scheme.sorted(),
         filled: scheme.filled(),
         word: scheme.word().into(),
-        pool: scheme.pool(viewport.pixels() as u64),
+        pool: scheme.pool(viewport.pixels() as u64 * u64::from(scene_samples)),
         layers: None,
         layout: scheme.layout_spec(),
         arrays: specs,
@@ -829,7 +887,8 @@ fn to_dump(
 
 /// `scene` as engine mode draws `view`: the orbit camera's matrix rounded to f32 (what
 /// `vs_engine` multiplies by) and Vulkan's conventions with the f32 vertex stage (upper-left
-/// origin, depth in [0, 1]); the scene fragsim rebuilds an engine capture's oracle from.
+/// origin, depth in [0, 1]), the sample count kept; the scene fragsim rebuilds an engine
+/// capture's oracle from.
 #[must_use]
 pub fn engine_scene(mut scene: SceneAndCamera, view: &View<'_>) -> SceneAndCamera {
     let m = view.view_projection().as_mat4().to_cols_array();
@@ -840,6 +899,7 @@ pub fn engine_scene(mut scene: SceneAndCamera, view: &View<'_>) -> SceneAndCamer
     });
     scene.conventions = Conventions {
         vertex_precision: VertexPrecision::F32,
+        samples: scene.conventions.samples,
         ..Conventions::REFERENCE
     };
     scene

@@ -7,7 +7,8 @@
 //! and buffers ([`shaders`], the WGSL files in `backends/wgpu/schemes/`), the planted bugs
 //! ([`plant`]), one capture in replay or engine mode ([`mod@capture`]), the judgement of a
 //! capture against fragsim's oracle ([`judge`]), the backend as the conformance battery's
-//! [`fragsim_testkit::Backend`] ([`mod@conform`]), and the per-sample counting pass of a
+//! [`fragsim_testkit::Backend`] ([`mod@conform`]), per-sample captures of a multisampled target
+//! ([`capture_samples`]), and the per-sample counting pass of a
 //! multisampled target against fragsim's per-sample oracle ([`sample_counts`]). The command is `fragsim-wgpu` (`src/main.rs`).
 
 pub mod capture;
@@ -18,7 +19,7 @@ pub mod plant;
 pub mod sample_counts;
 pub mod shaders;
 
-pub use capture::{capture, capture_planted, Captured, Mode};
+pub use capture::{capture, capture_planted, capture_samples, Captured, Mode};
 pub use conform::WgpuBackend;
 pub use device::{adapter_or_skip, say_skipped, Gpu, GpuError};
 pub use plant::Plant;

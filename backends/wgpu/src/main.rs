@@ -7,6 +7,7 @@
 //!     --view 30 --mode replay --out out/wgpu --judge
 //! fragsim-wgpu capture --scheme linked-list --plant lost-node --scene bunny --out out/wgpu
 //! fragsim-wgpu capture --case DIR --scheme mdts --k 2 --mode engine --out OUT
+//! fragsim-wgpu capture --scheme abuffer,mdts --samples 4 --mode engine --precision --out OUT
 //! fragsim-wgpu msaa-count --scene bunny --samples 1,4,8 --view 30,120 --width 512 \
 //!     --height 512 --mode replay,engine --mirrored
 //! ```
@@ -27,13 +28,13 @@ use fragsim_oracle::Oracle;
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{SamplePattern, View, Viewport};
 use fragsim_wgpu::capture::engine_scene;
-use fragsim_wgpu::judge::Within;
+use fragsim_wgpu::judge::{Within, WithinJudgement};
 use fragsim_wgpu::sample_counts::{
     count_samples, count_samples_of, covering_prims, f32_snap_radius, mirrored, reference_counts,
-    CountDiff, NearEdges,
+    CountDiff, NearEdges, SampledReference,
 };
 use fragsim_wgpu::shaders::NAMES;
-use fragsim_wgpu::{capture_planted, judge, Gpu, GpuScheme, Mode, Plant};
+use fragsim_wgpu::{capture_samples, judge, Gpu, GpuScheme, Mode, Plant};
 
 #[derive(Parser)]
 #[command(
@@ -168,6 +169,11 @@ struct CaptureArgs {
     /// `fragsim compare oracle DIR --vertex-precision f32`) and print it.
     #[arg(long)]
     precision: bool,
+    /// Samples a pixel: 1, or a per-sample capture at 2, 4, 8 (a list per (pixel, sample), the
+    /// depth at the sample; the adapter's target must render at the count; abuffer,
+    /// abuffer-exact, mdts, mdts32 and the linked lists). Judged by --precision only.
+    #[arg(long, default_value_t = 1)]
+    samples: u32,
 }
 
 fn main() -> ExitCode {
@@ -215,7 +221,15 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
         judge: judge_it,
         depth_ulps,
         precision,
+        samples,
     } = args;
+    if samples > 1 && judge_it {
+        return Err(
+            "--judge compares with the single-sample oracle: judge a per-sample capture with \
+             --precision (fragsim compare oracle DIR --vertex-precision f32)"
+                .into(),
+        );
+    }
     let names: Vec<&str> = if scheme == "all" {
         NAMES.to_vec()
     } else {
@@ -259,27 +273,35 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
     };
     let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
     // The precision verdict's reference, built for the first dump and kept while the dumps name
-    // its scene (one view and mode: every dump of this command).
+    // its scene (one view and mode: every dump of this command); per sample its own.
     let mut within: Option<Within> = None;
+    let mut sampled: Option<SampledReference> = None;
     let mut failed = 0;
     let mut runs = 0;
     for scheme in &schemes {
         for &plant in &plants {
-            if every && plant.is_some_and(|p| !p.applies_to(scheme)) {
+            if every && plant.is_some_and(|p| !p.applies_at(scheme, samples)) {
                 continue;
             }
             runs += 1;
             // One scheme the adapter cannot run (a buffer past its limits, a missing feature)
             // does not stop the others: it is reported and the command exits 2 at the end.
-            let captured =
-                match capture_planted(gpu, &fragsim_view, spec.clone(), scheme, mode, plant) {
-                    Ok(captured) => captured,
-                    Err(e) => {
-                        eprintln!("fragsim-wgpu: {e}");
-                        failed += 1;
-                        continue;
-                    }
-                };
+            let captured = match capture_samples(
+                gpu,
+                &fragsim_view,
+                spec.clone(),
+                scheme,
+                mode,
+                plant,
+                samples,
+            ) {
+                Ok(captured) => captured,
+                Err(e) => {
+                    eprintln!("fragsim-wgpu: {e}");
+                    failed += 1;
+                    continue;
+                }
+            };
             let dir = match plant {
                 Some(p) => out.join(format!("{}-planted-{}", scheme.name(), p.name())),
                 None => out.join(scheme.name()),
@@ -291,12 +313,17 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                 .gpu_ms
                 .map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.3} ms"));
             println!(
-                "{}{} {} {}x{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
+                "{}{} {} {}x{}{} {}: {} triangles, GPU {gpu_ms}, wall {:.1} ms -> {}",
                 scheme.name(),
                 plant.map_or(String::new(), |p| format!(" (planted: {})", p.name())),
                 mode.name(),
                 width,
                 height,
+                if samples > 1 {
+                    format!(" {samples}x")
+                } else {
+                    String::new()
+                },
                 spec.describe(),
                 captured.triangles,
                 captured.wall_ms,
@@ -312,7 +339,35 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                     println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
                 }
             }
-            if precision {
+            if precision && samples > 1 {
+                if !sampled.as_ref().is_some_and(|r| r.fits(&captured.dump)) {
+                    sampled = Some(SampledReference::of(&captured.dump)?);
+                }
+                if let Some(reference) = &sampled {
+                    let verdict = reference.judge(&captured.dump)?;
+                    let per_sample = verdict.per_sample;
+                    // The summary `fragsim-wgpu capture` prints at one sample (what
+                    // run_device.sh reads), its "pixels" the samples, then the pixels.
+                    let judgement = WithinJudgement {
+                        comparison: verdict.comparison,
+                        bounds: verdict.bounds.unwrap_or_default(),
+                        covered: reference.covered,
+                    };
+                    println!(
+                        "  precision verdict (f32 vertex stage): {}",
+                        judgement.summary()
+                    );
+                    if let Some(c) = per_sample {
+                        println!(
+                            "  per sample ({samples} a pixel): {} of {} samples differ, in {} of {} pixels",
+                            c.differing_samples,
+                            c.compared,
+                            c.differing_pixels,
+                            c.compared / u64::from(samples)
+                        );
+                    }
+                }
+            } else if precision {
                 if !within.as_ref().is_some_and(|w| w.fits(&captured.dump)) {
                     within = Some(Within::of(&captured.dump)?);
                 }

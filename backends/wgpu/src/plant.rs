@@ -8,7 +8,8 @@
 //! by a hash of (pixel, primitive id) (`planted` in `common.wgsl`).
 //!
 //! Guarantee: a plant that cannot show in a scheme (an unsorted list where nothing is sorted, a
-//! wrong id in key-only words) is refused for it, naming the schemes it applies to.
+//! wrong id in key-only words, the pixel centre's depth where the sample is the centre) is
+//! refused for it, naming the schemes it applies to.
 
 use crate::device::GpuError;
 use crate::shaders::GpuScheme;
@@ -28,25 +29,31 @@ pub enum Plant {
     Unsorted,
     /// A hit fragment's head exchange drops the old head: the rest of its pixel's list is lost.
     LostNode,
+    /// Per sample only: a hit sample's fragment carries the depth at its pixel's centre instead
+    /// of the sample's (what `position.z` gives under sample shading on the H200,
+    /// `docs/semantics.md` §11).
+    CentreDepth,
 }
 
 /// The names [`Plant::parse`] accepts, in [`Plant::ALL`]'s order.
-pub const NAMES: [&str; 5] = [
+pub const NAMES: [&str; 6] = [
     "dropped",
     "wrong-id",
     "off-by-one-capacity",
     "unsorted",
     "lost-node",
+    "centre-depth",
 ];
 
 impl Plant {
     /// Every plant.
-    pub const ALL: [Plant; 5] = [
+    pub const ALL: [Plant; 6] = [
         Plant::Dropped,
         Plant::WrongId,
         Plant::OffByOneCapacity,
         Plant::Unsorted,
         Plant::LostNode,
+        Plant::CentreDepth,
     ];
 
     /// The plant called `name` ([`NAMES`]).
@@ -78,11 +85,19 @@ impl Plant {
         f64::from(self as u32 + 1)
     }
 
-    /// Whether the plant is in `scheme`'s shader and shows in its dump.
+    /// Whether the plant is in `scheme`'s shader and shows in its dump at one sample a pixel.
     #[must_use]
     pub fn applies_to(self, scheme: &GpuScheme) -> bool {
+        self.applies_at(scheme, 1)
+    }
+
+    /// Whether the plant is in `scheme`'s shader and shows in its dump at `samples` a pixel.
+    #[must_use]
+    pub fn applies_at(self, scheme: &GpuScheme, samples: u32) -> bool {
         use GpuScheme as S;
         match self {
+            // At one sample the sample is the centre; the per-sample variants carry the plant.
+            Self::CentreDepth => samples > 1 && scheme.per_sample_source().is_some(),
             Self::Dropped => true,
             Self::WrongId => !matches!(scheme, S::Mdts32 { .. }),
             Self::OffByOneCapacity | Self::Unsorted => {
@@ -92,24 +107,37 @@ impl Plant {
         }
     }
 
-    /// Refuses the plant for a scheme it does not apply to.
+    /// Refuses the plant for a scheme it does not apply to at one sample a pixel.
     ///
     /// # Errors
-    /// The plant, the scheme and the schemes it applies to.
+    /// As [`Plant::check_at`].
     pub fn check(self, scheme: &GpuScheme) -> Result<(), GpuError> {
-        if self.applies_to(scheme) {
+        self.check_at(scheme, 1)
+    }
+
+    /// Refuses the plant for a scheme it does not apply to at `samples` a pixel.
+    ///
+    /// # Errors
+    /// The plant, the scheme, the sample count and the schemes it applies to there (none: the
+    /// plant needs more samples).
+    pub fn check_at(self, scheme: &GpuScheme, samples: u32) -> Result<(), GpuError> {
+        if self.applies_at(scheme, samples) {
             return Ok(());
         }
         let fits: Vec<&str> = crate::shaders::NAMES
             .iter()
-            .filter(|&&n| GpuScheme::parse(n, 1, 1).is_ok_and(|s| self.applies_to(&s)))
+            .filter(|&&n| GpuScheme::parse(n, 1, 1).is_ok_and(|s| self.applies_at(&s, samples)))
             .copied()
             .collect();
+        let fits = if fits.is_empty() {
+            "none at this sample count".to_string()
+        } else {
+            fits.join(", ")
+        };
         Err(GpuError(format!(
-            "plant {} does not apply to {}: it applies to {}",
+            "plant {} does not apply to {} at {samples} sample(s) a pixel: it applies to {fits}",
             self.name(),
             scheme.name(),
-            fits.join(", ")
         )))
     }
 }
@@ -141,5 +169,17 @@ mod tests {
         assert!(e.0.contains("mdts32"), "{e}");
         assert!(Plant::Unsorted.check(&GpuScheme::ABufferExact).is_ok());
         assert!(Plant::Dropped.check(&mdts).is_ok());
+    }
+
+    #[test]
+    fn the_centre_depth_plant_needs_samples_and_a_per_sample_variant() {
+        let mdts = GpuScheme::Mdts { k: 4 };
+        let e = Plant::CentreDepth.check(&mdts).unwrap_err();
+        assert!(e.0.ends_with("none at this sample count"), "{e}");
+        assert!(Plant::CentreDepth.check_at(&mdts, 4).is_ok());
+        let e = Plant::CentreDepth
+            .check_at(&GpuScheme::Kbuffer { k: 4 }, 4)
+            .unwrap_err();
+        assert!(e.0.contains("abuffer, abuffer-exact, mdts"), "{e}");
     }
 }

@@ -21,6 +21,9 @@ const KBUFFER: &str = include_str!("../schemes/kbuffer.wgsl");
 const LINKED_LIST: &str = include_str!("../schemes/linked_list.wgsl");
 const KBUFFER_SPINLOCK: &str = include_str!("../schemes/kbuffer_spinlock.wgsl");
 const SAMPLE_COUNTS: &str = include_str!("../schemes/sample_counts.wgsl");
+const ABUFFER_SAMPLES: &str = include_str!("../schemes/abuffer_samples.wgsl");
+const MDTS_SAMPLES: &str = include_str!("../schemes/mdts_samples.wgsl");
+const LINKED_LIST_SAMPLES: &str = include_str!("../schemes/linked_list_samples.wgsl");
 
 /// The scheme names [`GpuScheme::parse`] accepts (the catalog's names).
 pub const NAMES: [&str; 8] = [
@@ -81,10 +84,13 @@ pub enum GpuScheme {
     /// Not a capture scheme but the counting pass of [`crate::sample_counts`]: one `atomicAdd`
     /// per covered sample of a multisampled target. It has no dump layout: `capture` refuses it
     /// and [`GpuScheme::parse`] does not know it.
-    SampleCounts {
-        /// Samples per pixel of the target.
-        samples: u32,
-    },
+    SampleCounts,
+}
+
+/// The draw through `per_pixel`, or at `samples` > 1 a pixel through `per_sample` (the entry
+/// point of the scheme's `*_samples.wgsl` that shades per sample).
+fn draw(per_pixel: &'static str, per_sample: &'static str, samples: u32) -> Pass {
+    Pass::Draw(if samples > 1 { per_sample } else { per_pixel })
 }
 
 /// A pass of a scheme, in order.
@@ -202,16 +208,7 @@ impl GpuScheme {
                 ..
             } => "linked-list-nearest",
             Self::KbufferSpinlock { .. } => "kbuffer-spinlock-fixed",
-            Self::SampleCounts { .. } => "sample-counts",
-        }
-    }
-
-    /// Samples per pixel of the colour target the passes draw into: 1 but for the counting pass.
-    #[must_use]
-    pub fn samples(&self) -> u32 {
-        match *self {
-            Self::SampleCounts { samples } => samples,
-            _ => 1,
+            Self::SampleCounts => "sample-counts",
         }
     }
 
@@ -224,7 +221,7 @@ impl GpuScheme {
             | Self::Kbuffer { k }
             | Self::KbufferSpinlock { k }
             | Self::LinkedList { k, .. } => Some(k),
-            Self::ABuffer { .. } | Self::ABufferExact | Self::SampleCounts { .. } => None,
+            Self::ABuffer { .. } | Self::ABufferExact | Self::SampleCounts => None,
         }
     }
 
@@ -244,10 +241,10 @@ impl GpuScheme {
         }
     }
 
-    /// Linked lists: the nodes of the pool over `pixels` pixels.
+    /// Linked lists: the nodes of the pool over `lists` lists (pixels, or (pixel, sample)s).
     #[must_use]
-    pub fn pool(&self, pixels: u64) -> Option<u64> {
-        self.pool_per_pixel().map(|n| u64::from(n) * pixels)
+    pub fn pool(&self, lists: u64) -> Option<u64> {
+        self.pool_per_pixel().map(|n| u64::from(n) * lists)
     }
 
     /// The shader's `params.slots`: a pixel's slots (0 where storage is not per pixel).
@@ -272,7 +269,7 @@ impl GpuScheme {
             Self::LinkedList { .. }
             | Self::Kbuffer { .. }
             | Self::KbufferSpinlock { .. }
-            | Self::SampleCounts { .. } => self.name(),
+            | Self::SampleCounts => self.name(),
         }
     }
 
@@ -306,7 +303,7 @@ impl GpuScheme {
         }
     }
 
-    /// The WGSL file (without [`COMMON`]).
+    /// The WGSL file (without [`COMMON`]) of a capture at one sample a pixel.
     #[must_use]
     pub fn source(&self) -> &'static str {
         match self {
@@ -315,35 +312,65 @@ impl GpuScheme {
             Self::Kbuffer { .. } => KBUFFER,
             Self::LinkedList { .. } => LINKED_LIST,
             Self::KbufferSpinlock { .. } => KBUFFER_SPINLOCK,
-            Self::SampleCounts { .. } => SAMPLE_COUNTS,
+            Self::SampleCounts => SAMPLE_COUNTS,
         }
     }
 
-    /// The passes before the host reads the storage's size back (the exact A-buffer's counting
-    /// pass and prefix sum, over [`GpuScheme::counting_storages`]); empty for the others.
+    /// The per-sample variant's WGSL file (`*_samples.wgsl`, appended to [`GpuScheme::source`]):
+    /// entry points that shade per sample, a list per (pixel, sample); `None` for a scheme without
+    /// one (the k-buffers; the counting pass, per sample already).
     #[must_use]
-    pub fn counting_passes(&self) -> Vec<Pass> {
+    pub fn per_sample_source(&self) -> Option<&'static str> {
         match self {
-            Self::ABufferExact => vec![Pass::Draw("fs_count"), Pass::ComputeOnce("cs_prefix")],
+            Self::ABuffer { .. } | Self::ABufferExact => Some(ABUFFER_SAMPLES),
+            Self::Mdts { .. } | Self::Mdts32 { .. } => Some(MDTS_SAMPLES),
+            Self::LinkedList { .. } => Some(LINKED_LIST_SAMPLES),
+            Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } | Self::SampleCounts => None,
+        }
+    }
+
+    /// Whether the scheme captures at `samples` a pixel: every scheme at one, those with a
+    /// per-sample variant ([`GpuScheme::per_sample_source`]) and the counting pass at more.
+    #[must_use]
+    pub fn captures_at(&self, samples: u32) -> bool {
+        samples == 1 || *self == Self::SampleCounts || self.per_sample_source().is_some()
+    }
+
+    /// The passes before the host reads the storage's size back (the exact A-buffer's counting
+    /// pass and prefix sum, over [`GpuScheme::counting_storages`]); empty for the others. At
+    /// `samples` > 1 a pixel the draws are the per-sample variant's.
+    #[must_use]
+    pub fn counting_passes(&self, samples: u32) -> Vec<Pass> {
+        match self {
+            Self::ABufferExact => vec![
+                draw("fs_count", "fs_count_samples", samples),
+                Pass::ComputeOnce("cs_prefix"),
+            ],
             _ => Vec::new(),
         }
     }
 
-    /// The passes that leave the words the dump holds.
+    /// The passes that leave the words the dump holds; at `samples` > 1 a pixel the draws are the
+    /// per-sample variant's.
     #[must_use]
-    pub fn passes(&self) -> Vec<Pass> {
+    pub fn passes(&self, samples: u32) -> Vec<Pass> {
         match self {
             Self::ABuffer { .. } => vec![
-                Pass::Draw("fs_main"),
+                draw("fs_main", "fs_main_samples", samples),
                 Pass::ComputePerPixel("cs_sort_fixed"),
             ],
             Self::ABufferExact => vec![
-                Pass::Draw("fs_exact"),
+                draw("fs_exact", "fs_exact_samples", samples),
                 Pass::ComputePerPixel("cs_sort_exact"),
             ],
-            Self::Mdts { .. } => vec![Pass::Draw("fs_u64")],
-            Self::Mdts32 { .. } => vec![Pass::Draw("fs_u32")],
-            _ => vec![Pass::Draw("fs_main")],
+            Self::Mdts { .. } => vec![draw("fs_u64", "fs_u64_samples", samples)],
+            Self::Mdts32 { .. } => vec![draw("fs_u32", "fs_u32_samples", samples)],
+            Self::LinkedList { .. } => vec![draw("fs_main", "fs_main_samples", samples)],
+            // The counting pass shades per sample in its one entry point; the k-buffers have no
+            // per-sample variant (`captures_at` refuses them).
+            Self::Kbuffer { .. } | Self::KbufferSpinlock { .. } | Self::SampleCounts => {
+                vec![Pass::Draw("fs_main")]
+            }
         }
     }
 
@@ -359,21 +386,24 @@ impl GpuScheme {
         }
     }
 
-    /// The exact A-buffer's counters and offsets, bound by the counting passes: the counters
-    /// count, the prefix sum leaves the offsets (the total last) and the counters at 0.
+    /// The exact A-buffer's counters and offsets over `lists` lists, bound by the counting
+    /// passes: the counters count, the prefix sum leaves the offsets (the total last) and the
+    /// counters at 0.
     #[must_use]
-    pub fn counting_storages(&self, pixels: u64) -> Vec<Storage> {
+    pub fn counting_storages(&self, lists: u64) -> Vec<Storage> {
         match self {
             Self::ABufferExact => vec![
-                Storage::new(1, "counters", Dtype::U32, vec![pixels], 0),
-                Storage::new(4, "offsets", Dtype::U32, vec![pixels + 1], 0),
+                Storage::new(1, "counters", Dtype::U32, vec![lists], 0),
+                Storage::new(4, "offsets", Dtype::U32, vec![lists + 1], 0),
             ],
             _ => Vec::new(),
         }
     }
 
-    /// The storage buffers over `pixels` pixels, in the order they are read back; `total` is
-    /// the exact A-buffer's slot count (read back after [`GpuScheme::counting_passes`]).
+    /// The storage buffers over `pixels` lists (pixels, or the (pixel, sample)s of a per-sample
+    /// capture: the layouts are the same over the sample-expanded framebuffer), in the order they
+    /// are read back; `total` is the exact A-buffer's slot count (read back after
+    /// [`GpuScheme::counting_passes`]).
     #[must_use]
     pub fn storages(&self, pixels: u64, total: u64) -> Vec<Storage> {
         let per_pixel = |k: u32| vec![pixels, u64::from(k)];
@@ -415,15 +445,9 @@ impl GpuScheme {
             }
             // One lock word per pixel before the slots.
             Self::KbufferSpinlock { k } => kbuffer(pixels, k),
-            // A count per (pixel, sample), sample-index order within a pixel; then as many
-            // counts of depth-range drops, and as many example depths (sample_counts.wgsl).
-            Self::SampleCounts { samples } => vec![Storage::new(
-                1,
-                "counts",
-                Dtype::U32,
-                vec![3 * pixels * u64::from(samples)],
-                0,
-            )],
+            // A count per list, (pixel, sample) in sample-index order within a pixel; then as
+            // many counts of depth-range drops, and as many example depths (sample_counts.wgsl).
+            Self::SampleCounts => vec![Storage::new(1, "counts", Dtype::U32, vec![3 * pixels], 0)],
         }
     }
 }
@@ -441,6 +465,43 @@ mod tests {
         assert!(GpuScheme::parse("linked-list", 0, 4).is_err());
         let e = GpuScheme::parse("mdts64", 8, 4).unwrap_err();
         assert!(e.0.contains("abuffer, abuffer-exact"), "{e}");
+    }
+
+    #[test]
+    fn per_sample_captures_draw_entry_points_their_variant_defines() {
+        // Each draw's entry point is a function of the WGSL the capture compiles: the scheme's
+        // file at one sample, its per-sample variant past one (which the k-buffers lack).
+        let draws = |passes: Vec<Pass>| -> Vec<&'static str> {
+            passes
+                .into_iter()
+                .filter_map(|p| match p {
+                    Pass::Draw(entry) => Some(entry),
+                    _ => None,
+                })
+                .collect()
+        };
+        let defines = |source: &str, entry: &str| source.contains(&format!("fn {entry}("));
+        for name in NAMES {
+            let scheme = GpuScheme::parse(name, 8, 4).unwrap();
+            let at = |samples| {
+                let mut all = scheme.counting_passes(samples);
+                all.extend(scheme.passes(samples));
+                draws(all)
+            };
+            for entry in at(1) {
+                assert!(defines(scheme.source(), entry), "{name}: {entry}");
+            }
+            match scheme.per_sample_source() {
+                Some(variant) => {
+                    assert!(scheme.captures_at(4), "{name}");
+                    for entry in at(4) {
+                        assert!(defines(variant, entry), "{name} per sample: {entry}");
+                        assert!(!defines(scheme.source(), entry), "{name}: {entry} twice");
+                    }
+                }
+                None => assert!(!scheme.captures_at(4) && scheme.captures_at(1), "{name}"),
+            }
+        }
     }
 
     #[test]
