@@ -127,20 +127,23 @@ pub trait Scheme: Sync {
     /// canonical order to `out` and returns how many of its fragments overflowed storage.
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32;
 
+    /// How many pixels from `pixel` on, before `end`, hold an empty list and no overflow for
+    /// certain, known in bulk from the memory's written flags ([`WordMemory::untouched_run`])
+    /// without reading their words: the post pass skips them. 0, the default, is always correct.
+    ///
+    /// [`WordMemory::untouched_run`]: crate::memory::WordMemory::untouched_run
+    fn empty_pixels<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> usize {
+        let _ = (memory, pixel, end);
+        0
+    }
+
     /// Number of pixels the scheme's storage covers.
     fn pixels(&self) -> usize;
 
-    /// The post pass over every pixel, serially.
+    /// The post pass over every pixel, serially (`crate::post_pass`: the empty parts of the frame
+    /// skipped in bulk, [`Scheme::empty_pixels`]).
     fn resolve<M: Memory>(&self, memory: &M) -> Capture {
-        let mut capture =
-            Capture::with_pixels(self.pixels(), self.identity(), self.keeps(Vec::new()));
-        let mut overflow = Vec::with_capacity(self.pixels());
-        for pixel in 0..self.pixels() {
-            overflow.push(self.resolve_pixel(memory, pixel, &mut capture.entries));
-            capture.lists.offsets.push(capture.lists.entries.len());
-        }
-        capture.keeps = self.keeps(overflow);
-        capture
+        crate::post_pass::resolve_serial(self, memory)
     }
 
     /// The promise with the per-pixel overflow counts filled in.

@@ -95,6 +95,14 @@ pub trait WordMemory<W: Word> {
         let _ = index;
         false
     }
+    /// How many words from `index` on, up to `end`, are known to hold their initial value as
+    /// [`WordMemory::untouched`] knows it, found in bulk (a page's written flags at a time): what
+    /// lets a post pass skip the empty parts of a frame without visiting each pixel. 0 is always
+    /// a correct answer, and the default; it is no memory operation and no step.
+    fn untouched_run(&self, index: usize, end: usize) -> usize {
+        let _ = (index, end);
+        0
+    }
 }
 
 /// Per-pixel storage: a `u32` array and a `u64` array.
@@ -245,6 +253,10 @@ macro_rules! paged_words {
             fn untouched(&self, i: usize) -> bool {
                 self.$field.untouched(i, &self.budget)
             }
+            #[inline]
+            fn untouched_run(&self, i: usize, end: usize) -> usize {
+                self.$field.untouched_run(i, end, &self.budget)
+            }
         }
     };
 }
@@ -360,6 +372,23 @@ mod tests {
         [1, 3, 7]
     }
 
+    /// `untouched_run` from words spread over the array (and to ends within it) counts the
+    /// words from there on that `untouched` knows untouched, up to the end given.
+    fn untouched_runs_are_runs_of_untouched_words<M: WordMemory<W>, W: Word>(memory: &M) {
+        let len = memory.len();
+        for start in (0..len).step_by(61).chain([len - 1, len]) {
+            for end in [len, start + 100, start + 3 * PAGE_WORDS / 2] {
+                let end = end.min(len);
+                let expected = (start..end).take_while(|&i| memory.untouched(i)).count();
+                assert_eq!(
+                    memory.untouched_run(start, end),
+                    expected,
+                    "from {start} to {end}"
+                );
+            }
+        }
+    }
+
     fn pages_are_allocated_on_first_write_and_reset_to_their_initial_values<
         M: Memory + WordMemory<u32> + WordMemory<u64>,
     >(
@@ -394,6 +423,8 @@ mod tests {
             &memory,
             PAGE_WORDS + pages::BLOCK_WORDS
         ));
+        untouched_runs_are_runs_of_untouched_words::<M, u32>(&memory);
+        untouched_runs_are_runs_of_untouched_words::<M, u64>(&memory);
         assert_ne!(words(&memory), fresh);
         reset(&mut memory, &layout);
         assert_eq!(words(&memory), fresh);

@@ -31,8 +31,10 @@ pub const PAGE_WORDS: usize = 4096;
 /// of K slots.
 pub const BLOCK_WORDS: usize = 64;
 
-/// Written flags per page.
+/// Written flags per page: one bit of a page's `u64` mask each, so that a page's unwritten
+/// blocks are found a mask at a time.
 const BLOCKS: usize = PAGE_WORDS / BLOCK_WORDS;
+const _: () = assert!(BLOCKS == u64::BITS as usize);
 
 /// Bytes of the page table of an array of `words` words: one entry a page, allocated with the
 /// array whether or not its pages are.
@@ -52,11 +54,11 @@ pub trait WordCell<W: Word>: Send {
     fn value(&self) -> W;
 }
 
-/// One page: its words and, for each block of them, whether a write reached it since the last
-/// reset.
+/// One page: its words and, bit `b` of `written` for block `b` of them, whether a write reached
+/// the block since the last reset.
 #[derive(Debug)]
 pub struct Page<C> {
-    written: [AtomicBool; BLOCKS],
+    written: AtomicU64,
     words: Box<[C]>,
 }
 
@@ -66,7 +68,7 @@ impl<C> Page<C> {
         C: WordCell<W>,
     {
         Self {
-            written: std::array::from_fn(|_| AtomicBool::new(false)),
+            written: AtomicU64::new(0),
             words: (0..len).map(|_| C::new(init)).collect(),
         }
     }
@@ -78,9 +80,7 @@ impl<C> Page<C> {
         C: WordCell<W>,
     {
         Self {
-            written: std::array::from_fn(|block| {
-                AtomicBool::new(self.written[block].load(Relaxed))
-            }),
+            written: AtomicU64::new(self.written.load(Relaxed)),
             words: self.words.iter().map(|word| C::new(word.value())).collect(),
         }
     }
@@ -243,10 +243,11 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
                 None => return self.scratch(index),
             },
         };
-        // Loaded first, so that after the first write the flag's line is only read.
-        let written = &page.written[index % PAGE_WORDS / BLOCK_WORDS];
-        if !written.load(Relaxed) {
-            written.store(true, Relaxed);
+        // Loaded first, so that after the block's first write the mask's line is only read (the
+        // `fetch_or`, a locked instruction, runs once a block a frame at most).
+        let bit = 1 << (index % PAGE_WORDS / BLOCK_WORDS);
+        if page.written.load(Relaxed) & bit == 0 {
+            page.written.fetch_or(bit, Relaxed);
         }
         &page.words[index % PAGE_WORDS]
     }
@@ -283,9 +284,35 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     #[inline]
     pub fn untouched(&self, index: usize, budget: &Budget) -> bool {
         match self.pages[index / PAGE_WORDS].get() {
-            Some(page) => !page.written[index % PAGE_WORDS / BLOCK_WORDS].load(Relaxed),
+            Some(page) => page.written.load(Relaxed) >> (index % PAGE_WORDS / BLOCK_WORDS) & 1 == 0,
             None => !budget.refused(),
         }
+    }
+
+    /// How many words from `index` on, up to `end`, hold their initial value for certain: the
+    /// run of blocks not written since the last reset (and pages never allocated, while no page
+    /// was refused) that starts at `index`'s block, a page's mask at a time.
+    pub fn untouched_run(&self, index: usize, end: usize, budget: &Budget) -> usize {
+        let end = end.min(self.len);
+        let mut at = index;
+        while at < end {
+            let page = at / PAGE_WORDS;
+            match self.pages[page].get() {
+                Some(allocated) => {
+                    let block = at % PAGE_WORDS / BLOCK_WORDS;
+                    let written = allocated.written.load(Relaxed) >> block;
+                    if written & 1 != 0 {
+                        break;
+                    }
+                    // The blocks before the next written one, or the rest of the page.
+                    let blocks = (written.trailing_zeros() as usize).min(BLOCKS - block);
+                    at = (at / BLOCK_WORDS + blocks) * BLOCK_WORDS;
+                }
+                None if budget.refused() => break,
+                None => at = (page + 1) * PAGE_WORDS,
+            }
+        }
+        at.min(end).saturating_sub(index)
     }
 
     /// Sets every word to `init`: the blocks written since the last reset (every allocated page
@@ -298,10 +325,10 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
             .with_min_len(8)
             .filter_map(OnceLock::get_mut)
             .for_each(|page| {
-                for (block, written) in page.words.chunks_mut(BLOCK_WORDS).zip(&mut page.written) {
-                    if all || *written.get_mut() {
+                let written = std::mem::take(page.written.get_mut());
+                for (index, block) in page.words.chunks_mut(BLOCK_WORDS).enumerate() {
+                    if all || written >> index & 1 != 0 {
                         block.iter_mut().for_each(|word| word.set_mut(init));
-                        *written.get_mut() = false;
                     }
                 }
             });

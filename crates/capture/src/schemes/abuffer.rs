@@ -232,12 +232,12 @@ impl Scheme for ABuffer {
         self.pixel_count()
     }
 
+    fn empty_pixels<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> usize {
+        // A counter no write reached is still 0: no list, no overflow.
+        WordMemory::<u32>::untouched_run(memory, pixel, end)
+    }
+
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        // Most pixels of a frame are empty: where no write reached the counter's block, it is
-        // still 0, known without reading its cache line.
-        if WordMemory::<u32>::untouched(memory, pixel) {
-            return 0;
-        }
         let count = WordMemory::<u32>::load(memory, pixel) as usize;
         let (first, capacity) = self.slots(pixel);
         let stored = count.min(capacity);

@@ -250,14 +250,18 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         self.pixels
     }
 
+    fn empty_pixels<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> usize {
+        // A pixel whose first slot no write reached holds an empty list: every pixel whose first
+        // slot lies in the run of untouched words from `pixel`'s.
+        let k = self.k as usize;
+        W::words(memory)
+            .untouched_run(pixel * k, end * k)
+            .div_ceil(k)
+    }
+
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let words = W::words(memory);
         let k = self.k as usize;
-        // Most pixels of a frame are empty: where no write reached the first slot's block, the
-        // slot is empty and so is the list, known without reading the slot's cache line.
-        if words.untouched(pixel * k) {
-            return 0;
-        }
         // Each slot loaded once: the stored values up to the first empty slot.
         let start = out.len();
         for slot in pixel * k..(pixel + 1) * k {
