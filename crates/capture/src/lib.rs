@@ -79,5 +79,7 @@ pub mod schemes;
 
 pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 pub use guarantee::Guarantee;
-pub use memory::{AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, Word, WordMemory};
+pub use memory::{
+    AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, SpanVisitor, Word, WordMemory,
+};
 pub use scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};

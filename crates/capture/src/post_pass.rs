@@ -3,8 +3,9 @@
 //!
 //! A frame of a real scene covers a fraction of the viewport (the dragon a sixth of a 2048²
 //! frame). The pass therefore asks the scheme how many pixels from the current one are empty for
-//! certain ([`Scheme::empty_pixels`], from the memory's written flags, a page's mask at a time)
-//! and steps over them; only the other pixels are resolved ([`Scheme::resolve_pixel`]). Each range
+//! certain, and how many from there are to be resolved ([`Scheme::pixel_run`], from the memory's
+//! written flags, a page's mask at a time), steps over the first and resolves the others
+//! ([`Scheme::resolve_pixel`]). Each range
 //! of pixels is resolved into a short record (its entries, the end of each list that is not
 //! empty, its non-zero overflow counts), so that the work grows with the pixels the fragments
 //! reached; the capture's offsets are then written once, each range's own in parallel, an empty
@@ -17,7 +18,7 @@ use rayon::prelude::*;
 
 use crate::capture::{Capture, PixelLists};
 use crate::memory::Memory;
-use crate::scheme::{Promise, Scheme};
+use crate::scheme::{PixelRun, Promise, Scheme};
 
 /// Pixels per rayon work item: a few pages of slots, enough to amortise a task, small enough to
 /// balance a frame whose covered pixels gather in a few places.
@@ -44,22 +45,27 @@ fn resolve_range<S: Scheme + ?Sized, M: Memory>(
     let mut resolved = Resolved::default();
     let mut pixel = range.start;
     while pixel < range.end {
-        let empty = scheme.empty_pixels(memory, pixel, range.end);
-        if empty > 0 {
-            pixel += empty;
-            continue;
+        let run = match scheme.pixel_run(memory, pixel, range.end) {
+            PixelRun::Empty(pixels) => {
+                pixel += pixels;
+                continue;
+            }
+            // At least one pixel, so that the pass moves on whatever the scheme says.
+            PixelRun::Resolve(pixels) => pixel..(pixel + pixels.max(1)).min(range.end),
+        };
+        pixel = run.end;
+        for pixel in run {
+            let before = resolved.entries.len();
+            let over = scheme.resolve_pixel(memory, pixel, &mut resolved.entries);
+            if resolved.entries.len() != before {
+                resolved
+                    .ends
+                    .push((pixel - range.start, resolved.entries.len()));
+            }
+            if over != 0 {
+                resolved.overflow.push((pixel - range.start, over));
+            }
         }
-        let before = resolved.entries.len();
-        let over = scheme.resolve_pixel(memory, pixel, &mut resolved.entries);
-        if resolved.entries.len() != before {
-            resolved
-                .ends
-                .push((pixel - range.start, resolved.entries.len()));
-        }
-        if over != 0 {
-            resolved.overflow.push((pixel - range.start, over));
-        }
-        pixel += 1;
     }
     resolved
 }

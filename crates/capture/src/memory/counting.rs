@@ -60,6 +60,9 @@ impl<W: Word, M: WordMemory<W>> WordMemory<W> for CountingMemory<M> {
     fn untouched_run(&self, index: usize, end: usize) -> usize {
         self.inner.untouched_run(index, end)
     }
+    fn written_run(&self, index: usize, end: usize) -> usize {
+        self.inner.written_run(index, end)
+    }
 }
 
 impl<M: Memory> Memory for CountingMemory<M> {

@@ -29,7 +29,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{check_cap, CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::sort::{bitonic_sort, insertion_sort};
 
 /// The post pass's sort.
@@ -232,9 +232,9 @@ impl Scheme for ABuffer {
         self.pixel_count()
     }
 
-    fn empty_pixels<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> usize {
+    fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {
         // A counter no write reached is still 0: no list, no overflow.
-        WordMemory::<u32>::untouched_run(memory, pixel, end)
+        PixelRun::of_first_words::<u32, _>(memory, pixel, end, 1)
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
@@ -242,7 +242,7 @@ impl Scheme for ABuffer {
         let (first, capacity) = self.slots(pixel);
         let stored = count.min(capacity);
         let start = out.len();
-        out.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
+        WordMemory::<u64>::load_into(memory, first, stored, out);
         let list = &mut out[start..];
         match self.sort {
             PostSort::Insertion => insertion_sort(list),
