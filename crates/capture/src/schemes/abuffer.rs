@@ -239,6 +239,11 @@ impl Scheme for ABuffer {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let count = WordMemory::<u32>::load(memory, pixel) as usize;
+        if count == 0 {
+            // Most pixels of a written block of counters (64 pixels) are empty: their slots'
+            // pages are not looked up.
+            return 0;
+        }
         let (first, capacity) = self.slots(pixel);
         let stored = count.min(capacity);
         let start = out.len();
