@@ -37,6 +37,7 @@
 //! guarantee.rs    what a scheme guarantees against the oracle
 //! capture.rs      the per-pixel lists a run returns, and what they keep
 //! depth_count.rs  the counting pass that sizes exact storage
+//! post_pass.rs    the post pass of every executor: empty pixels skipped in bulk, in parallel
 //! primitive_order.rs  each pixel's primitives in submission order (the ordered interlock's)
 //! catalog/        every scheme by name: passes, sizing, dump layout, its constructor (mod.rs),
 //!                 building it for a visitor (build.rs), running it (run.rs), dump layouts
@@ -71,11 +72,14 @@ pub mod depth_count;
 pub mod executors;
 mod guarantee;
 mod memory;
+mod post_pass;
 pub mod primitive_order;
 mod scheme;
 pub mod schemes;
 
 pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 pub use guarantee::Guarantee;
-pub use memory::{AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, Word, WordMemory};
-pub use scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+pub use memory::{
+    AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, SpanVisitor, Word, WordMemory,
+};
+pub use scheme::{CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};

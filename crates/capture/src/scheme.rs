@@ -39,6 +39,35 @@ pub enum Promise {
     All(Capacity),
 }
 
+/// A run of pixels the post pass treats alike ([`Scheme::pixel_run`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelRun {
+    /// This many pixels hold empty lists and overflowed nothing: skipped.
+    Empty(usize),
+    /// This many pixels are to be resolved one by one ([`Scheme::resolve_pixel`]).
+    Resolve(usize),
+}
+
+impl PixelRun {
+    /// The run of `words_per_pixel` words a pixel from `pixel`'s first word on, before `end`:
+    /// empty where the pixels' first words lie in a run of untouched words, else to resolve
+    /// while their first words lie in the run of written blocks (at least `pixel` itself).
+    pub(crate) fn of_first_words<W: crate::memory::Word, A: crate::memory::WordMemory<W>>(
+        words: &A,
+        pixel: usize,
+        end: usize,
+        words_per_pixel: usize,
+    ) -> Self {
+        let (first, last) = (pixel * words_per_pixel, end * words_per_pixel);
+        // The pixels whose first word lies in a run of `n` words from `first`.
+        let pixels = |n: usize| n.div_ceil(words_per_pixel);
+        match words.untouched_run(first, last) {
+            0 => PixelRun::Resolve(pixels(words.written_run(first, last)).max(1)),
+            untouched => PixelRun::Empty(pixels(untouched)),
+        }
+    }
+}
+
 /// Why a scheme could not be set up.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum CaptureError {
@@ -127,20 +156,27 @@ pub trait Scheme: Sync {
     /// canonical order to `out` and returns how many of its fragments overflowed storage.
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32;
 
+    /// The run of pixels from `pixel` on, before `end`, that the post pass may treat alike,
+    /// found in bulk from the memory's written flags ([`WordMemory::untouched_run`],
+    /// [`WordMemory::written_run`]) without reading their words: pixels whose lists are empty
+    /// and nothing overflowed for certain, skipped; or pixels to resolve one by one before
+    /// asking again. [`PixelRun::Resolve`] of every pixel up to `end`, the default, is always
+    /// correct.
+    ///
+    /// [`WordMemory::untouched_run`]: crate::memory::WordMemory::untouched_run
+    /// [`WordMemory::written_run`]: crate::memory::WordMemory::written_run
+    fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {
+        let _ = memory;
+        PixelRun::Resolve(end - pixel)
+    }
+
     /// Number of pixels the scheme's storage covers.
     fn pixels(&self) -> usize;
 
-    /// The post pass over every pixel, serially.
+    /// The post pass over every pixel, serially (`crate::post_pass`: the empty parts of the frame
+    /// skipped in bulk, [`Scheme::pixel_run`]).
     fn resolve<M: Memory>(&self, memory: &M) -> Capture {
-        let mut capture =
-            Capture::with_pixels(self.pixels(), self.identity(), self.keeps(Vec::new()));
-        let mut overflow = Vec::with_capacity(self.pixels());
-        for pixel in 0..self.pixels() {
-            overflow.push(self.resolve_pixel(memory, pixel, &mut capture.entries));
-            capture.lists.offsets.push(capture.lists.entries.len());
-        }
-        capture.keeps = self.keeps(overflow);
-        capture
+        crate::post_pass::resolve_serial(self, memory)
     }
 
     /// The promise with the per-pixel overflow counts filled in.
@@ -159,12 +195,19 @@ pub trait Scheme: Sync {
 
     /// Runs a walk from `state` to the end on `memory`, counting the steps into `steps`.
     fn insert_state<M: Memory>(&self, mut state: Self::State, memory: &M, steps: &mut u64) -> Step {
-        loop {
-            *steps += 1;
-            match self.step(&mut state, memory) {
-                Step::Continue => {}
-                done => return done,
-            }
+        walk_to_end(steps, || self.step(&mut state, memory))
+    }
+}
+
+/// Runs `step` until it ends the walk, counting each step into `steps`: a walk's loop, for
+/// [`Scheme::insert_state`] and the schemes that run it on a span of memory.
+#[inline]
+pub(crate) fn walk_to_end(steps: &mut u64, mut step: impl FnMut() -> Step) -> Step {
+    loop {
+        *steps += 1;
+        match step() {
+            Step::Continue => {}
+            done => return done,
         }
     }
 }

@@ -9,9 +9,9 @@ use fragsim_raster::View;
 use rayon::prelude::*;
 
 use super::frame::{self, rasterize_into, reuse_storage, Counters, Run};
-use crate::capture::Capture;
 use crate::memory::{AtomicMemory, Memory};
-use crate::scheme::{Promise, Scheme, MEMORY_CAP_DEFAULT};
+use crate::post_pass::resolve_parallel;
+use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
 
 /// Triangles per rayon work item by default: large enough to amortise scheduling (~100 ns a
 /// task), small enough to balance the uneven cost of triangles. Scenes of fewer triangles than two
@@ -96,7 +96,7 @@ pub(crate) fn parallel_frame<S: Scheme, M: Memory + Sync>(
 }
 
 /// A frame of the executors that run on the rayon pool (parallel and tiled): their geometry
-/// passes, then the post pass in parallel ([`resolve_parallel`]).
+/// passes, then the post pass in parallel (`crate::post_pass`).
 pub(crate) fn rayon_frame<S: Scheme, M: Memory + Sync>(
     scheme: &S,
     memory: &M,
@@ -111,66 +111,4 @@ pub(crate) fn rayon_frame<S: Scheme, M: Memory + Sync>(
         geometry_pass,
         |memory| resolve_parallel(scheme, memory),
     )
-}
-
-/// Pixels per rayon work item in the post pass.
-const PIXELS_PER_TASK: usize = 4096;
-
-/// The post pass on the rayon pool: pixel chunks resolved independently, each writing its pixels'
-/// offsets straight into the capture (relative to the chunk's first entry), then the chunks'
-/// entries copied into the capture and their offsets moved by where each chunk starts, in parallel
-/// (a serial concatenation of a megapixel's offsets would cost as much as the resolve itself on
-/// many threads). Overflow counts are kept only for a scheme whose promise reads them
-/// ([`Promise::All`]): for MDTS they would be a megapixel of zeros written and copied for nothing.
-pub(crate) fn resolve_parallel<S: Scheme, M: Memory + Sync>(scheme: &S, memory: &M) -> Capture {
-    let pixels = scheme.pixels();
-    let counts_overflow = matches!(scheme.promise(), Promise::All(_));
-    let mut capture = Capture::with_pixels(pixels, scheme.identity(), scheme.keeps(Vec::new()));
-    capture.offsets.resize(pixels + 1, 0);
-    let chunks: Vec<(Vec<u64>, Vec<u32>)> = capture.lists.offsets[1..]
-        .par_chunks_mut(PIXELS_PER_TASK)
-        .enumerate()
-        .map(|(chunk, ends)| {
-            let mut entries = Vec::new();
-            let mut overflow = Vec::with_capacity(if counts_overflow { ends.len() } else { 0 });
-            for (pixel, end) in (chunk * PIXELS_PER_TASK..).zip(ends.iter_mut()) {
-                let over = scheme.resolve_pixel(memory, pixel, &mut entries);
-                if counts_overflow {
-                    overflow.push(over);
-                }
-                *end = entries.len();
-            }
-            (entries, overflow)
-        })
-        .collect();
-    let total: usize = chunks.iter().map(|(entries, _)| entries.len()).sum();
-    capture.lists.entries.resize(total, 0);
-    // Each chunk's share of the entries, cut in order.
-    let mut entry_slices = Vec::with_capacity(chunks.len());
-    let (mut rest, mut base) = (capture.lists.entries.as_mut_slice(), 0);
-    for (entries, _) in &chunks {
-        let (slice, tail) = rest.split_at_mut(entries.len());
-        entry_slices.push((slice, base));
-        base += entries.len();
-        rest = tail;
-    }
-    chunks
-        .par_iter()
-        .zip(entry_slices)
-        .zip(capture.lists.offsets[1..].par_chunks_mut(PIXELS_PER_TASK))
-        .for_each(|(((entries, _), (entry_slice, base)), offsets)| {
-            entry_slice.copy_from_slice(entries);
-            if base != 0 {
-                offsets.iter_mut().for_each(|offset| *offset += base);
-            }
-        });
-    if counts_overflow {
-        let mut all_overflow = vec![0; pixels];
-        all_overflow
-            .par_chunks_mut(PIXELS_PER_TASK)
-            .zip(&chunks)
-            .for_each(|(out, (_, overflow))| out.copy_from_slice(overflow));
-        capture.keeps = scheme.keeps(all_overflow);
-    }
-    capture
 }

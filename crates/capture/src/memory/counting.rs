@@ -57,6 +57,12 @@ impl<W: Word, M: WordMemory<W>> WordMemory<W> for CountingMemory<M> {
     fn untouched(&self, index: usize) -> bool {
         self.inner.untouched(index)
     }
+    fn untouched_run(&self, index: usize, end: usize) -> usize {
+        self.inner.untouched_run(index, end)
+    }
+    fn written_run(&self, index: usize, end: usize) -> usize {
+        self.inner.written_run(index, end)
+    }
 }
 
 impl<M: Memory> Memory for CountingMemory<M> {

@@ -25,7 +25,7 @@ pub(crate) mod pages;
 
 pub use counting::CountingMemory;
 pub use layout::Layout;
-use pages::{Budget, Pages, WordCell};
+use pages::{Budget, Cells, Pages, Span, WordCell};
 
 /// A memory word: `u32` or `u64`.
 pub trait Word: Copy + Eq + Ord + Debug + Send + Sync + 'static {
@@ -94,6 +94,64 @@ pub trait WordMemory<W: Word> {
     fn untouched(&self, index: usize) -> bool {
         let _ = index;
         false
+    }
+    /// How many words from `index` on, up to `end`, are known to hold their initial value as
+    /// [`WordMemory::untouched`] knows it, found in bulk (a page's written flags at a time): what
+    /// lets a post pass skip the empty parts of a frame without visiting each pixel. 0 is always
+    /// a correct answer, and the default; it is no memory operation and no step.
+    fn untouched_run(&self, index: usize, end: usize) -> usize {
+        let _ = (index, end);
+        0
+    }
+    /// How many words from `index` on, up to `end`, lie in the run of blocks written since the
+    /// storage was allocated or reset that holds `index`: words a post pass is to read, found in
+    /// bulk, so that it asks again only after them. Every word up to `end`, the default, is
+    /// always a correct answer; it is no memory operation and no step.
+    fn written_run(&self, index: usize, end: usize) -> usize {
+        end.saturating_sub(index)
+    }
+    /// Runs `visitor` on words `start..start + len`, handing it either this memory or a view of
+    /// the one page that holds those words, whose operations find no page each: the same
+    /// operations on the same words, with the same results, found once (a fragment's walk of a
+    /// pixel's slots, a pixel's list read back). Indices stay those of the whole array, and the
+    /// visitor is to use no word outside the span. The default hands it this memory.
+    fn with_span<V: SpanVisitor<W>>(&self, start: usize, len: usize, visitor: V) -> V::Output
+    where
+        Self: Sized,
+    {
+        let _ = (start, len);
+        visitor.visit(self)
+    }
+    /// Appends words `start..start + len` to `out`, in order: `len` loads, their page found once
+    /// where one page holds them ([`WordMemory::with_span`]).
+    fn load_into(&self, start: usize, len: usize, out: &mut Vec<W>)
+    where
+        Self: Sized,
+    {
+        self.with_span(start, len, LoadInto { start, len, out });
+    }
+}
+
+/// What runs on a span of words ([`WordMemory::with_span`]), generic over the words it is handed.
+pub trait SpanVisitor<W: Word> {
+    /// What the visit returns.
+    type Output;
+    /// Runs on `words`, using only the span's words.
+    fn visit<A: WordMemory<W>>(self, words: &A) -> Self::Output;
+}
+
+/// [`WordMemory::load_into`]'s visit.
+struct LoadInto<'a, W> {
+    start: usize,
+    len: usize,
+    out: &'a mut Vec<W>,
+}
+
+impl<W: Word> SpanVisitor<W> for LoadInto<'_, W> {
+    type Output = ();
+    fn visit<A: WordMemory<W>>(self, words: &A) {
+        self.out
+            .extend((self.start..self.start + self.len).map(|i| words.load(i)));
     }
 }
 
@@ -192,37 +250,61 @@ word_cells!(u64, Cell<u64>, Cell::get);
 word_cells!(u32, AtomicU32, |cell: &AtomicU32| cell.load(Relaxed));
 word_cells!(u64, AtomicU64, |cell: &AtomicU64| cell.load(Relaxed));
 
-/// `WordMemory<$word>` for a memory whose `$field` pages hold its cells: `$get` reads a cell,
-/// `$set` writes one, `$rmw!` applies a read-modify-write to one and returns the old value.
-macro_rules! paged_words {
-    ($memory:ty, $word:ty, $field:ident, $get:expr, $set:expr, $rmw:ident) => {
-        impl WordMemory<$word> for $memory {
+/// `Cells<$word, $cell>` for a memory whose `$field` pages hold its cells of `$word`.
+macro_rules! memory_cells {
+    ($memory:ty, $word:ty, $cell:ty, $field:ident) => {
+        impl Cells<$word, $cell> for $memory {
             #[inline]
             fn len(&self) -> usize {
                 self.$field.len()
             }
             #[inline]
+            fn init(&self) -> $word {
+                self.$field.init()
+            }
+            #[inline]
+            fn read_cell(&self, i: usize) -> Option<&$cell> {
+                self.$field.read(i, &self.budget)
+            }
+            #[inline]
+            fn write_cell(&self, i: usize) -> &$cell {
+                self.$field.write(i, &self.budget)
+            }
+        }
+    };
+}
+
+/// `WordMemory<$word>` for `$words`, whose cells of type `$cell` it finds through [`Cells`]: `$get`
+/// reads a cell, `$set` writes one, `$rmw!` applies a read-modify-write to one and returns the
+/// old value; `$extra` are further methods (the memories' own).
+macro_rules! word_ops {
+    ($words:ty, $word:ty, $cell:ty, $get:expr, $set:expr, $rmw:ident { $($extra:item)* }) => {
+        impl WordMemory<$word> for $words {
+            #[inline]
+            fn len(&self) -> usize {
+                Cells::<$word, $cell>::len(self)
+            }
+            #[inline]
             fn load(&self, i: usize) -> $word {
-                self.$field
-                    .read(i, &self.budget)
-                    .map_or(self.$field.init(), $get)
+                Cells::<$word, $cell>::read_cell(self, i)
+                    .map_or(Cells::<$word, $cell>::init(self), $get)
             }
             #[inline]
             fn store(&self, i: usize, v: $word) {
-                $set(self.$field.write(i, &self.budget), v);
+                $set(Cells::<$word, $cell>::write_cell(self, i), v);
             }
             #[inline]
             fn fetch_min(&self, i: usize, v: $word) -> $word {
-                $rmw!(self.$field.write(i, &self.budget), fetch_min, Ord::min, v)
+                $rmw!(Cells::<$word, $cell>::write_cell(self, i), fetch_min, Ord::min, v)
             }
             #[inline]
             fn fetch_max(&self, i: usize, v: $word) -> $word {
-                $rmw!(self.$field.write(i, &self.budget), fetch_max, Ord::max, v)
+                $rmw!(Cells::<$word, $cell>::write_cell(self, i), fetch_max, Ord::max, v)
             }
             #[inline]
             fn fetch_add(&self, i: usize, v: $word) -> $word {
                 $rmw!(
-                    self.$field.write(i, &self.budget),
+                    Cells::<$word, $cell>::write_cell(self, i),
                     fetch_add,
                     Word::wrapping_add,
                     v
@@ -231,7 +313,7 @@ macro_rules! paged_words {
             #[inline]
             fn fetch_or(&self, i: usize, v: $word) -> $word {
                 $rmw!(
-                    self.$field.write(i, &self.budget),
+                    Cells::<$word, $cell>::write_cell(self, i),
                     fetch_or,
                     std::ops::BitOr::bitor,
                     v
@@ -239,13 +321,40 @@ macro_rules! paged_words {
             }
             #[inline]
             fn swap(&self, i: usize, v: $word) -> $word {
-                $rmw!(self.$field.write(i, &self.budget), swap, |_, v| v, v)
+                $rmw!(Cells::<$word, $cell>::write_cell(self, i), swap, |_, v| v, v)
             }
+            $($extra)*
+        }
+    };
+}
+
+/// `WordMemory<$word>` for a memory whose `$field` pages hold its cells of type `$cell`, and for
+/// the [`Span`]s of those pages (`$get`, `$set` and `$rmw` as in `word_ops!`).
+macro_rules! paged_words {
+    ($memory:ty, $word:ty, $cell:ty, $field:ident, $get:expr, $set:expr, $rmw:ident) => {
+        memory_cells!($memory, $word, $cell, $field);
+        word_ops!($memory, $word, $cell, $get, $set, $rmw {
             #[inline]
             fn untouched(&self, i: usize) -> bool {
                 self.$field.untouched(i, &self.budget)
             }
-        }
+            #[inline]
+            fn untouched_run(&self, i: usize, end: usize) -> usize {
+                self.$field.untouched_run(i, end, &self.budget)
+            }
+            #[inline]
+            fn written_run(&self, i: usize, end: usize) -> usize {
+                self.$field.written_run(i, end)
+            }
+            #[inline]
+            fn with_span<V: SpanVisitor<$word>>(&self, start: usize, len: usize, visitor: V) -> V::Output {
+                match self.$field.span(start, len) {
+                    Some(span) => visitor.visit(&span),
+                    None => visitor.visit(self),
+                }
+            }
+        });
+        word_ops!(Span<'_, $word, $cell>, $word, $cell, $get, $set, $rmw {});
     };
 }
 
@@ -267,11 +376,28 @@ macro_rules! atomic_rmw {
     };
 }
 
-paged_words!(SerialMemory, u32, words32, Cell::get, Cell::set, cell_rmw);
-paged_words!(SerialMemory, u64, words64, Cell::get, Cell::set, cell_rmw);
+paged_words!(
+    SerialMemory,
+    u32,
+    Cell<u32>,
+    words32,
+    Cell::get,
+    Cell::set,
+    cell_rmw
+);
+paged_words!(
+    SerialMemory,
+    u64,
+    Cell<u64>,
+    words64,
+    Cell::get,
+    Cell::set,
+    cell_rmw
+);
 paged_words!(
     AtomicMemory,
     u32,
+    AtomicU32,
     words32,
     |c: &AtomicU32| c.load(Relaxed),
     |c: &AtomicU32, v| c.store(v, Relaxed),
@@ -280,6 +406,7 @@ paged_words!(
 paged_words!(
     AtomicMemory,
     u64,
+    AtomicU64,
     words64,
     |c: &AtomicU64| c.load(Relaxed),
     |c: &AtomicU64, v| c.store(v, Relaxed),
@@ -360,6 +487,28 @@ mod tests {
         [1, 3, 7]
     }
 
+    /// `untouched_run` from words spread over the array (and to ends within it) counts the
+    /// words from there on that `untouched` knows untouched, up to the end given.
+    fn untouched_runs_are_runs_of_untouched_words<M: WordMemory<W>, W: Word>(memory: &M) {
+        let len = memory.len();
+        for start in (0..len).step_by(61).chain([len - 1, len]) {
+            for end in [len, start + 100, start + 3 * PAGE_WORDS / 2] {
+                let end = end.min(len);
+                let expected = (start..end).take_while(|&i| memory.untouched(i)).count();
+                assert_eq!(
+                    memory.untouched_run(start, end),
+                    expected,
+                    "from {start} to {end}"
+                );
+                // A written run ends where a block is untouched (or at `end`), and holds no
+                // untouched word.
+                let written = memory.written_run(start, end);
+                assert!((start..start + written).all(|i| !memory.untouched(i)));
+                assert!(start + written == end || memory.untouched(start + written));
+            }
+        }
+    }
+
     fn pages_are_allocated_on_first_write_and_reset_to_their_initial_values<
         M: Memory + WordMemory<u32> + WordMemory<u64>,
     >(
@@ -394,6 +543,8 @@ mod tests {
             &memory,
             PAGE_WORDS + pages::BLOCK_WORDS
         ));
+        untouched_runs_are_runs_of_untouched_words::<M, u32>(&memory);
+        untouched_runs_are_runs_of_untouched_words::<M, u64>(&memory);
         assert_ne!(words(&memory), fresh);
         reset(&mut memory, &layout);
         assert_eq!(words(&memory), fresh);

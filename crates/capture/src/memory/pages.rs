@@ -31,8 +31,10 @@ pub const PAGE_WORDS: usize = 4096;
 /// of K slots.
 pub const BLOCK_WORDS: usize = 64;
 
-/// Written flags per page.
+/// Written flags per page: one bit of a page's `u64` mask each, so that a page's unwritten
+/// blocks are found a mask at a time.
 const BLOCKS: usize = PAGE_WORDS / BLOCK_WORDS;
+const _: () = assert!(BLOCKS == u64::BITS as usize);
 
 /// Bytes of the page table of an array of `words` words: one entry a page, allocated with the
 /// array whether or not its pages are.
@@ -52,11 +54,11 @@ pub trait WordCell<W: Word>: Send {
     fn value(&self) -> W;
 }
 
-/// One page: its words and, for each block of them, whether a write reached it since the last
-/// reset.
+/// One page: its words and, bit `b` of `written` for block `b` of them, whether a write reached
+/// the block since the last reset.
 #[derive(Debug)]
 pub struct Page<C> {
-    written: [AtomicBool; BLOCKS],
+    written: AtomicU64,
     words: Box<[C]>,
 }
 
@@ -66,21 +68,31 @@ impl<C> Page<C> {
         C: WordCell<W>,
     {
         Self {
-            written: std::array::from_fn(|_| AtomicBool::new(false)),
+            written: AtomicU64::new(0),
             words: (0..len).map(|_| C::new(init)).collect(),
         }
     }
 }
 
 impl<C> Page<C> {
+    /// The cell of the page's word `offset` for a write, its block marked written.
+    #[inline]
+    fn write(&self, offset: usize) -> &C {
+        // Loaded first, so that after the block's first write the mask's line is only read (the
+        // `fetch_or`, a locked instruction, runs once a block a frame at most).
+        let bit = 1 << (offset / BLOCK_WORDS);
+        if self.written.load(Relaxed) & bit == 0 {
+            self.written.fetch_or(bit, Relaxed);
+        }
+        &self.words[offset]
+    }
+
     fn copy<W: Word>(&self) -> Self
     where
         C: WordCell<W>,
     {
         Self {
-            written: std::array::from_fn(|block| {
-                AtomicBool::new(self.written[block].load(Relaxed))
-            }),
+            written: AtomicU64::new(self.written.load(Relaxed)),
             words: self.words.iter().map(|word| C::new(word.value())).collect(),
         }
     }
@@ -149,6 +161,51 @@ impl Clone for Budget {
             cap: self.cap,
             refused: AtomicBool::new(self.refused()),
         }
+    }
+}
+
+/// The words of one allocated page, addressed by their index in the whole array: a memory's
+/// operations on words that one page holds, without finding the page for each
+/// ([`crate::WordMemory::with_span`]). A write marks its block written, as the array's does.
+#[derive(Debug)]
+pub struct Span<'a, W, C> {
+    page: &'a Page<C>,
+    /// The array's index of the page's first word.
+    first: usize,
+    /// The array's length.
+    len: usize,
+    init: W,
+}
+
+/// Where a memory's operations find the cell of a word: the memory's whole array (its
+/// [`Pages`] within its [`Budget`]) or one page's [`Span`].
+pub trait Cells<W, C> {
+    /// The array's length.
+    fn len(&self) -> usize;
+    /// The array's initial value.
+    fn init(&self) -> W;
+    /// The cell of word `index` for a read, `None` where it holds the initial value.
+    fn read_cell(&self, index: usize) -> Option<&C>;
+    /// The cell of word `index` for a write, its block marked written.
+    fn write_cell(&self, index: usize) -> &C;
+}
+
+impl<W: Word, C> Cells<W, C> for Span<'_, W, C> {
+    #[inline]
+    fn len(&self) -> usize {
+        self.len
+    }
+    #[inline]
+    fn init(&self) -> W {
+        self.init
+    }
+    #[inline]
+    fn read_cell(&self, index: usize) -> Option<&C> {
+        Some(&self.page.words[index - self.first])
+    }
+    #[inline]
+    fn write_cell(&self, index: usize) -> &C {
+        self.page.write(index - self.first)
     }
 }
 
@@ -243,12 +300,22 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
                 None => return self.scratch(index),
             },
         };
-        // Loaded first, so that after the first write the flag's line is only read.
-        let written = &page.written[index % PAGE_WORDS / BLOCK_WORDS];
-        if !written.load(Relaxed) {
-            written.store(true, Relaxed);
-        }
-        &page.words[index % PAGE_WORDS]
+        page.write(index % PAGE_WORDS)
+    }
+
+    /// Words `start..start + len` as a [`Span`] of their page, when one page already allocated
+    /// holds them all; `None` where they reach past a page's edge or their page is not
+    /// allocated (its first write allocates it, which the span leaves to the array).
+    #[inline]
+    pub fn span(&self, start: usize, len: usize) -> Option<Span<'_, W, C>> {
+        let page = self.pages[start / PAGE_WORDS].get()?;
+        let first = start / PAGE_WORDS * PAGE_WORDS;
+        (start - first + len <= page.words.len()).then_some(Span {
+            page,
+            first,
+            len: self.len,
+            init: self.init,
+        })
     }
 
     /// Allocates page `page` (filled with the initial value) within the budget, or `None`.
@@ -283,9 +350,55 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     #[inline]
     pub fn untouched(&self, index: usize, budget: &Budget) -> bool {
         match self.pages[index / PAGE_WORDS].get() {
-            Some(page) => !page.written[index % PAGE_WORDS / BLOCK_WORDS].load(Relaxed),
+            Some(page) => page.written.load(Relaxed) >> (index % PAGE_WORDS / BLOCK_WORDS) & 1 == 0,
             None => !budget.refused(),
         }
+    }
+
+    /// How many words from `index` on, up to `end`, hold their initial value for certain: the
+    /// run of blocks not written since the last reset (and pages never allocated, while no page
+    /// was refused) that starts at `index`'s block, a page's mask at a time.
+    pub fn untouched_run(&self, index: usize, end: usize, budget: &Budget) -> usize {
+        let end = end.min(self.len);
+        let mut at = index;
+        while at < end {
+            let page = at / PAGE_WORDS;
+            match self.pages[page].get() {
+                Some(allocated) => {
+                    let block = at % PAGE_WORDS / BLOCK_WORDS;
+                    let written = allocated.written.load(Relaxed) >> block;
+                    if written & 1 != 0 {
+                        break;
+                    }
+                    // The blocks before the next written one, or the rest of the page.
+                    let blocks = (written.trailing_zeros() as usize).min(BLOCKS - block);
+                    at = (at / BLOCK_WORDS + blocks) * BLOCK_WORDS;
+                }
+                None if budget.refused() => break,
+                None => at = (page + 1) * PAGE_WORDS,
+            }
+        }
+        at.min(end).saturating_sub(index)
+    }
+
+    /// How many words from `index` on, up to `end`, lie in blocks written since the last reset,
+    /// from `index`'s block on, a page's mask at a time: where [`Pages::untouched_run`] is 0, the
+    /// words a post pass reads before it need ask again.
+    pub fn written_run(&self, index: usize, end: usize) -> usize {
+        let end = end.min(self.len);
+        let mut at = index;
+        while at < end {
+            let Some(page) = self.pages[at / PAGE_WORDS].get() else {
+                break;
+            };
+            let block = at % PAGE_WORDS / BLOCK_WORDS;
+            let written = (page.written.load(Relaxed) >> block).trailing_ones() as usize;
+            if written == 0 {
+                break;
+            }
+            at = (at / BLOCK_WORDS + written.min(BLOCKS - block)) * BLOCK_WORDS;
+        }
+        at.min(end).saturating_sub(index)
     }
 
     /// Sets every word to `init`: the blocks written since the last reset (every allocated page
@@ -298,11 +411,22 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
             .with_min_len(8)
             .filter_map(OnceLock::get_mut)
             .for_each(|page| {
-                for (block, written) in page.words.chunks_mut(BLOCK_WORDS).zip(&mut page.written) {
-                    if all || *written.get_mut() {
-                        block.iter_mut().for_each(|word| word.set_mut(init));
-                        *written.get_mut() = false;
+                let mut written = std::mem::take(page.written.get_mut());
+                if all {
+                    written = u64::MAX;
+                }
+                // The written blocks, a set bit at a time (every block of a last, shorter page
+                // where all are).
+                while written != 0 {
+                    let start = written.trailing_zeros() as usize * BLOCK_WORDS;
+                    written &= written - 1;
+                    if start >= page.words.len() {
+                        break;
                     }
+                    let end = (start + BLOCK_WORDS).min(page.words.len());
+                    page.words[start..end]
+                        .iter_mut()
+                        .for_each(|word| word.set_mut(init));
                 }
             });
         self.init = init;

@@ -29,7 +29,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{check_cap, CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::sort::{bitonic_sort, insertion_sort};
 
 /// The post pass's sort.
@@ -232,17 +232,22 @@ impl Scheme for ABuffer {
         self.pixel_count()
     }
 
+    fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {
+        // A counter no write reached is still 0: no list, no overflow.
+        PixelRun::of_first_words::<u32, _>(memory, pixel, end, 1)
+    }
+
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        // Most pixels of a frame are empty: where no write reached the counter's block, it is
-        // still 0, known without reading its cache line.
-        if WordMemory::<u32>::untouched(memory, pixel) {
+        let count = WordMemory::<u32>::load(memory, pixel) as usize;
+        if count == 0 {
+            // Most pixels of a written block of counters (64 pixels) are empty: their slots'
+            // pages are not looked up.
             return 0;
         }
-        let count = WordMemory::<u32>::load(memory, pixel) as usize;
         let (first, capacity) = self.slots(pixel);
         let stored = count.min(capacity);
         let start = out.len();
-        out.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
+        WordMemory::<u64>::load_into(memory, first, stored, out);
         let list = &mut out[start..];
         match self.sort {
             PostSort::Insertion => insertion_sort(list),

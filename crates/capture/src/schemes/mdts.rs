@@ -34,8 +34,10 @@ use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Layout, Memory, SpanVisitor, WordMemory};
+use crate::scheme::{
+    check_cap, walk_to_end, CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
+};
 
 pub use crate::schemes::common::MdtsWord;
 
@@ -151,6 +153,88 @@ impl<W: MdtsWord> Mdts<W> {
             Step::Continue
         }
     }
+
+    /// One step of `walk` on `words` (the memory's array of `W`, or the span of its page that
+    /// holds the pixel's slots).
+    #[inline]
+    fn step_on(&self, walk: &mut Walk<W>, words: &impl WordMemory<W>) -> Step {
+        let index = walk.base + walk.slot as usize;
+        if self.probe && !walk.probed {
+            let seen = words.load(index);
+            // `carried` is never empty, so a slot at or past it in sort order holds a value.
+            let no_op = match self.direction {
+                Direction::Ascending => seen <= walk.carried,
+                Direction::Descending => seen >= walk.carried,
+            };
+            if !no_op {
+                walk.probed = true;
+                return Step::Continue;
+            }
+            return self.next_slot(walk);
+        }
+        walk.probed = false;
+        let old = match self.direction {
+            Direction::Ascending => words.fetch_min(index, walk.carried),
+            Direction::Descending => words.fetch_max(index, walk.carried),
+        };
+        if old == self.empty() {
+            return Step::Stored;
+        }
+        walk.carried = match self.direction {
+            Direction::Ascending => walk.carried.max(old),
+            Direction::Descending => walk.carried.min(old),
+        };
+        self.next_slot(walk)
+    }
+
+    /// Appends the stored values of the pixel whose slots begin at `base` to `out`, nearest first:
+    /// each slot loaded once, up to the first empty one.
+    fn read_list(&self, words: &impl WordMemory<W>, base: usize, out: &mut Vec<u64>) {
+        let start = out.len();
+        for slot in base..base + self.k as usize {
+            let word = words.load(slot);
+            if word == self.empty() {
+                break;
+            }
+            out.push(match self.direction {
+                Direction::Ascending => word.decode(),
+                // Undo the +1 offset.
+                Direction::Descending => word.wrapping_sub(W::ONE).decode(),
+            });
+        }
+        if self.direction == Direction::Descending {
+            // Nearest first, like every other scheme.
+            out[start..].reverse();
+        }
+    }
+}
+
+/// A fragment's walk to its end on the words it is handed ([`WordMemory::with_span`]).
+struct WalkOn<'a, W: MdtsWord> {
+    scheme: &'a Mdts<W>,
+    walk: Walk<W>,
+    steps: &'a mut u64,
+}
+
+impl<W: MdtsWord> SpanVisitor<W> for WalkOn<'_, W> {
+    type Output = Step;
+    fn visit<A: WordMemory<W>>(mut self, words: &A) -> Step {
+        walk_to_end(self.steps, || self.scheme.step_on(&mut self.walk, words))
+    }
+}
+
+/// A pixel's list read back on the words it is handed ([`WordMemory::with_span`]).
+struct ReadList<'a, W: MdtsWord> {
+    scheme: &'a Mdts<W>,
+    base: usize,
+    out: &'a mut Vec<u64>,
+}
+
+impl<W: MdtsWord> SpanVisitor<W> for ReadList<'_, W> {
+    type Output = ();
+    fn visit<A: WordMemory<W>>(self, words: &A) {
+        self.scheme.read_list(words, self.base, self.out);
+    }
 }
 
 impl<W: MdtsWord> Scheme for Mdts<W> {
@@ -197,34 +281,18 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
     }
 
     fn step<M: Memory>(&self, walk: &mut Walk<W>, memory: &M) -> Step {
-        let words = W::words(memory);
-        let index = walk.base + walk.slot as usize;
-        if self.probe && !walk.probed {
-            let seen = words.load(index);
-            // `carried` is never empty, so a slot at or past it in sort order holds a value.
-            let no_op = match self.direction {
-                Direction::Ascending => seen <= walk.carried,
-                Direction::Descending => seen >= walk.carried,
-            };
-            if !no_op {
-                walk.probed = true;
-                return Step::Continue;
-            }
-            return self.next_slot(walk);
-        }
-        walk.probed = false;
-        let old = match self.direction {
-            Direction::Ascending => words.fetch_min(index, walk.carried),
-            Direction::Descending => words.fetch_max(index, walk.carried),
+        self.step_on(walk, W::words(memory))
+    }
+
+    fn insert_state<M: Memory>(&self, walk: Walk<W>, memory: &M, steps: &mut u64) -> Step {
+        // The pixel's K slots share a page but at a page's edge: their page is found once for
+        // the walk, not for each memory operation.
+        let walk_on = WalkOn {
+            scheme: self,
+            walk,
+            steps,
         };
-        if old == self.empty() {
-            return Step::Stored;
-        }
-        walk.carried = match self.direction {
-            Direction::Ascending => walk.carried.max(old),
-            Direction::Descending => walk.carried.min(old),
-        };
-        self.next_slot(walk)
+        W::words(memory).with_span(walk.base, self.k as usize, walk_on)
     }
 
     fn identity(&self) -> Identity {
@@ -250,32 +318,79 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         self.pixels
     }
 
+    fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {
+        // A pixel whose first slot no write reached holds an empty list.
+        PixelRun::of_first_words(W::words(memory), pixel, end, self.k as usize)
+    }
+
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        let words = W::words(memory);
-        let k = self.k as usize;
-        // Most pixels of a frame are empty: where no write reached the first slot's block, the
-        // slot is empty and so is the list, known without reading the slot's cache line.
-        if words.untouched(pixel * k) {
-            return 0;
-        }
-        // Each slot loaded once: the stored values up to the first empty slot.
-        let start = out.len();
-        for slot in pixel * k..(pixel + 1) * k {
-            let word = words.load(slot);
-            if word == self.empty() {
-                break;
-            }
-            out.push(match self.direction {
-                Direction::Ascending => word.decode(),
-                // Undo the +1 offset.
-                Direction::Descending => word.wrapping_sub(W::ONE).decode(),
-            });
-        }
-        if self.direction == Direction::Descending {
-            // Nearest first, like every other scheme.
-            out[start..].reverse();
-        }
+        let (base, k) = (pixel * self.k as usize, self.k as usize);
+        let read = ReadList {
+            scheme: self,
+            base,
+            out,
+        };
+        W::words(memory).with_span(base, k, read);
         // What fell off the end is not in memory: the executors count it from the walks.
         0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::executors::frame::{interleaved, walks};
+    use crate::memory::pages::PAGE_WORDS;
+    use crate::SerialMemory;
+
+    /// Every word of the `u64` array.
+    fn words(memory: &SerialMemory) -> Vec<u64> {
+        (0..WordMemory::<u64>::len(memory))
+            .map(|i| WordMemory::<u64>::load(memory, i))
+            .collect()
+    }
+
+    /// A walk run to its end on its page's span (`insert_state`) leaves the words, the pages
+    /// allocated and the lists that step after step on the whole array leaves, for pixels inside a
+    /// page, across a page's edge and on pages not yet allocated, in both directions and probing.
+    #[test]
+    fn walks_on_a_span_are_walks_on_the_array_across_page_edges() {
+        let k = 20;
+        // 420 pixels of 20 slots: pixel 204's slots cross the first page's edge (word 4096).
+        let viewport = Viewport::new(420, 1).unwrap();
+        let mut rng = fragsim_raster::SplitMix64::new(35);
+        let fragments: Vec<Fragment> = (0..4000)
+            .map(|prim| Fragment {
+                pixel: [0, 203, 204, 205, 300, 409][rng.next_u64() as usize % 6],
+                depth_key: (rng.next_u64() % 64) as u32,
+                prim,
+            })
+            .collect();
+        assert_eq!(204 * k as usize / PAGE_WORDS, 0);
+        assert_eq!((205 * k as usize - 1) / PAGE_WORDS, 1);
+        for direction in [Direction::Ascending, Direction::Descending] {
+            for probe in [false, true] {
+                let mut mdts =
+                    Mdts::<u64>::new(viewport, k, direction, MEMORY_CAP_DEFAULT).unwrap();
+                if probe {
+                    mdts = mdts.probing();
+                }
+                let on_spans: SerialMemory = mdts.layout().allocate();
+                let on_array: SerialMemory = mdts.layout().allocate();
+                let counted = walks(&mdts, &on_spans, 0, &fragments);
+                let stepped = interleaved(&mdts, &on_array, 0, &fragments, |_| 0);
+                assert_eq!(counted, stepped, "{direction:?}, probing {probe}");
+                assert_eq!(words(&on_spans), words(&on_array));
+                assert_eq!(on_spans.allocated_bytes(), on_array.allocated_bytes());
+                assert_eq!(mdts.resolve(&on_spans), mdts.resolve(&on_array));
+                for pixel in 0..viewport.pixels() {
+                    let base = pixel * k as usize;
+                    assert_eq!(
+                        WordMemory::<u64>::untouched(&on_spans, base),
+                        WordMemory::<u64>::untouched(&on_array, base)
+                    );
+                }
+            }
+        }
     }
 }
