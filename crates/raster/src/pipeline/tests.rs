@@ -1,6 +1,6 @@
 //! Unit tests of the pipeline's rules.
 
-use super::vertex::{round_half_away, VertexStage};
+use super::vertex::{round_half_away, VertexStage, ROUNDING_BOUND};
 use super::*;
 use crate::conventions::Conventions;
 
@@ -94,6 +94,7 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
     let view = view_of(&mesh, 37);
     let stage = VertexStage {
         view_projection: DMat4::IDENTITY,
+        view_projection_f32: DMat4::IDENTITY.to_cols_array().map(|e| e as f32),
         planes: view.planes(),
         viewport: view.viewport(),
         conventions: Conventions::REFERENCE,
@@ -133,7 +134,11 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
         };
         let clip = DVec4::new(coordinate(), coordinate(), coordinate(), coordinate());
         if clip.is_finite() {
-            assert_eq!(stage.outcode(clip), by_dot_products(clip), "{clip:?}");
+            assert_eq!(
+                stage.outcode(clip),
+                u64::from(by_dot_products(clip)),
+                "{clip:?}"
+            );
         }
     }
 }
@@ -160,8 +165,13 @@ fn rounding_without_libm_equals_f64_round() {
         -0.0,
         f64::MIN_POSITIVE,
     ];
-    // Halves and their neighbours over the snapped range, and a deterministic spread.
-    for i in -3000i32..3000 {
+    // Halves and their neighbours over the snapped range, at the guard band's edge (2^24) and at
+    // the bound, and a deterministic spread.
+    let edges = [0, 1 << 24, -(1 << 24), 1 << 30, -(1 << 30)];
+    for i in edges
+        .into_iter()
+        .flat_map(|at: i32| at.saturating_sub(3000)..at.saturating_add(3000))
+    {
         let half = f64::from(i) + 0.5;
         values.extend([half, half.next_up(), half.next_down()]);
     }
@@ -173,7 +183,9 @@ fn rounding_without_libm_equals_f64_round() {
         values.push(f64::from_bits(x));
     }
     for v in values {
-        assert_eq!(round_half_away(v), v.round() as i64, "{v:e}");
+        // NaN goes to the lower bound (`f64::max` takes the number).
+        let expected = v.max(-ROUNDING_BOUND).min(ROUNDING_BOUND).round() as i32;
+        assert_eq!(round_half_away(v), expected, "{v:e}");
     }
 }
 
@@ -361,4 +373,116 @@ fn a_triangle_crossing_the_near_plane_is_clipped_not_lost() {
     let covered = counts.iter().filter(|&&c| c == 1).count();
     assert!(covered > 0 && covered < 64, "{covered}");
     assert!(counts.iter().all(|&c| c <= 1));
+}
+
+/// Rules 1 and 3 written the plain way, one vertex at a time, in i64 with `f64::round`: what the
+/// batched, branch-free vertex stage must leave for every vertex inside the guard band, under
+/// every vertex precision, window origin, depth range and a few grids.
+#[test]
+fn the_batched_vertex_stage_equals_rules_1_and_3_vertex_by_vertex() {
+    use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
+    let scene = crate::Scene::procedural("soup:300:7").unwrap();
+    let viewport = Viewport::new(97, 61).unwrap();
+    let mut checked = [0usize; 2];
+    for distance_scale in [40.0, 1.1, 0.3, 0.01] {
+        let orbit = crate::OrbitCamera {
+            distance_scale,
+            ..crate::OrbitCamera::default()
+        };
+        for vertex_precision in [VertexPrecision::F64, VertexPrecision::F32] {
+            for window_origin in [WindowOrigin::UpperLeft, WindowOrigin::LowerLeft] {
+                for depth_range in [DepthRange::ZeroToOne, DepthRange::MinusOneToOne] {
+                    for subpixel_bits in [8, 4, 1] {
+                        let conventions = Conventions {
+                            window_origin,
+                            subpixel_bits,
+                            depth_range,
+                            vertex_precision,
+                            ..Conventions::REFERENCE
+                        };
+                        let camera = scene.orbit_camera(viewport, &orbit, depth_range);
+                        let view = View::with_conventions(
+                            &scene.mesh,
+                            &camera,
+                            viewport,
+                            CullMode::None,
+                            conventions,
+                        )
+                        .unwrap();
+                        for (index, p) in scene.mesh.positions.iter().enumerate() {
+                            let inside = expected_window(&view, camera.view_projection, *p);
+                            assert_eq!(
+                                view.vertex_window(index as u32),
+                                inside,
+                                "{conventions:?}, vertex {index}"
+                            );
+                            checked[usize::from(inside.is_some())] += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Both kinds of vertex were met: clipped (or behind the eye) and placed.
+    assert!(checked[0] > 100 && checked[1] > 1000, "{checked:?}");
+}
+
+/// The snapped window position and depth of model position `p` under `view`'s conventions,
+/// computed one vertex at a time from `docs/semantics.md` (rules 1 and 3, §9); `None` when the
+/// vertex lies outside the near plane or the guard band, or not in front of the eye.
+fn expected_window(view: &View<'_>, matrix: DMat4, p: [f32; 3]) -> Option<([i64; 2], f64)> {
+    use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
+    let c = view.conventions();
+    let clip = match c.vertex_precision {
+        VertexPrecision::F64 => matrix * DVec4::new(p[0].into(), p[1].into(), p[2].into(), 1.0),
+        VertexPrecision::F32 => {
+            let m = matrix.to_cols_array().map(|e| e as f32);
+            let row = |r: usize| m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+            DVec4::new(row(0).into(), row(1).into(), row(2).into(), row(3).into())
+        }
+    };
+    if view.planes().iter().any(|plane| plane.dot(clip) < 0.0) || clip.w <= 0.0 {
+        return None;
+    }
+    let (width, height) = (view.viewport.width, view.viewport.height);
+    let lower_left = c.window_origin == WindowOrigin::LowerLeft;
+    let minus_one = c.depth_range == DepthRange::MinusOneToOne;
+    let ([x, y], depth) = match c.vertex_precision {
+        VertexPrecision::F64 => {
+            let (x, y, z, w) = (clip.x, clip.y, clip.z, clip.w);
+            let wy = if lower_left {
+                y / w * 0.5 + 0.5
+            } else {
+                0.5 - y / w * 0.5
+            };
+            let depth = if minus_one { z / w * 0.5 + 0.5 } else { z / w };
+            (
+                [
+                    (x / w * 0.5 + 0.5) * f64::from(width),
+                    wy * f64::from(height),
+                ],
+                depth,
+            )
+        }
+        VertexPrecision::F32 => {
+            let [x, y, z, w] = clip.to_array().map(|v| v as f32);
+            let wy = if lower_left {
+                y / w * 0.5 + 0.5
+            } else {
+                0.5 - y / w * 0.5
+            };
+            let depth = if minus_one { z / w * 0.5 + 0.5 } else { z / w };
+            let window = [(x / w * 0.5 + 0.5) * width as f32, wy * height as f32];
+            (window.map(f64::from), f64::from(depth))
+        }
+    };
+    let bits = c.subpixel_bits;
+    let grid =
+        |v: f64| (v * f64::from(1u32 << bits)).round() as i64 * (1 << (SUBPIXEL_BITS - bits));
+    let y = if lower_left {
+        (i64::from(height) << SUBPIXEL_BITS) - grid(y)
+    } else {
+        grid(y)
+    };
+    Some(([grid(x), y], depth))
 }
