@@ -93,15 +93,39 @@ impl ScanSetup {
 /// under the fill rule of `origin`: the scan's coverage test of that centre on the triangle
 /// oriented as [`View::oriented`] orients it, without the rest of its record. A triangle of zero
 /// area covers nothing.
+///
+/// The three edge functions of the triangle as given sum to its doubled signed area, and
+/// reorienting it negates them: so a centre where all three have one strict sign is inside
+/// whatever the orientation, one where they have both strict signs is outside (or the area is
+/// zero), and only a centre on an edge needs the orientation and the fill rule.
 #[inline]
-fn covers_centre([a, b, c]: [[i64; 2]; 3], (x, y): (u32, u32), origin: WindowOrigin) -> bool {
+fn covers_centre(xy: [[i64; 2]; 3], (x, y): (u32, u32), origin: WindowOrigin) -> bool {
+    let [a, b, c] = xy;
+    let centre = [i64::from(x) * ONE + HALF, i64::from(y) * ONE + HALF];
+    let e = [edge(b, c, centre), edge(c, a, centre), edge(a, b, centre)];
+    let positive = (e[0] > 0) as u8 + (e[1] > 0) as u8 + (e[2] > 0) as u8;
+    let negative = (e[0] < 0) as u8 + (e[1] < 0) as u8 + (e[2] < 0) as u8;
+    match (positive, negative) {
+        (3, _) | (_, 3) => true,
+        (1.., 1..) => false,
+        _ => covers_centre_on_an_edge(xy, centre, origin),
+    }
+}
+
+/// [`covers_centre`] for a centre on an edge of the triangle: oriented, then tested against the
+/// fill rule's thresholds as the scan tests it.
+#[cold]
+fn covers_centre_on_an_edge(
+    [a, b, c]: [[i64; 2]; 3],
+    centre: [i64; 2],
+    origin: WindowOrigin,
+) -> bool {
     let area = edge(a, b, c);
     if area == 0 {
         return false;
     }
     let (b, c) = if area < 0 { (c, b) } else { (b, c) };
     let edges = [(b, c), (c, a), (a, b)];
-    let centre = [i64::from(x) * ONE + HALF, i64::from(y) * ONE + HALF];
     let e = per_edge(edges, |p, q| edge(p, q, centre));
     let threshold = fill_thresholds(edges, origin);
     e[0] >= threshold[0] && e[1] >= threshold[1] && e[2] >= threshold[2]

@@ -294,6 +294,17 @@ fn the_scan_of_covered_runs_emits_what_testing_every_centre_emits() {
                         fragments += scanned.len();
                     }
                 });
+                // The whole path from the vertex stage: the early rejects and the test of a box
+                // of one centre in the setup emit what testing every centre of each piece does.
+                for rect in rects {
+                    let mut expected = Vec::new();
+                    view.screen_triangles(prim, &mut |tri| {
+                        expected.extend(scan_every_centre(&view, &tri, rect));
+                    });
+                    let mut rasterized = Vec::new();
+                    view.rasterize_in(prim, rect, &mut |f| rasterized.push(f));
+                    assert_eq!(rasterized, expected, "{prim} at {distance_scale}, {rect:?}");
+                }
             }
         }
     }
@@ -485,4 +496,60 @@ fn expected_window(view: &View<'_>, matrix: DMat4, p: [f32; 3]) -> Option<([i64;
         grid(y)
     };
     Some(([grid(x), y], depth))
+}
+
+/// Tiny triangles whose box holds one centre lying on a vertex or an edge, in both orientations
+/// and under both fill rules: the setup's test of that centre must settle it as the scan does.
+#[test]
+fn a_box_of_one_centre_on_an_edge_is_decided_by_the_fill_rule() {
+    // Window positions in pixels on an 8 × 8 viewport (identity camera: x = X/4 − 1, y = 1 − Y/4);
+    // pixel (3, 3)'s centre is (3.5, 3.5).
+    let at = |x: f32, y: f32| [x / 4.0 - 1.0, 1.0 - y / 4.0, 0.5];
+    let mesh = Mesh {
+        positions: vec![
+            at(3.5, 3.5),
+            at(3.875, 3.5),
+            at(3.5, 3.875),
+            at(3.125, 3.25),
+            at(3.875, 3.75),
+            at(3.25, 3.875),
+        ],
+        // On a vertex, on a horizontal and a vertical edge; on a slanted edge; each both ways.
+        triangles: vec![
+            [0, 1, 2],
+            [0, 2, 1],
+            [3, 4, 5],
+            [3, 5, 4],
+            [3, 4, 2],
+            [3, 2, 4],
+        ],
+    };
+    let mut covered = 0;
+    for window_origin in [
+        crate::conventions::WindowOrigin::UpperLeft,
+        crate::conventions::WindowOrigin::LowerLeft,
+    ] {
+        let conventions = Conventions {
+            window_origin,
+            ..Conventions::REFERENCE
+        };
+        let camera = Camera {
+            view_projection: DMat4::IDENTITY,
+        };
+        let viewport = Viewport::new(8, 8).unwrap();
+        let view =
+            View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions).unwrap();
+        for prim in 0..view.triangle_count() {
+            let mut expected = Vec::new();
+            view.screen_triangles(prim, &mut |tri| {
+                expected.extend(scan_every_centre(&view, &tri, viewport.rect()));
+            });
+            let mut rasterized = Vec::new();
+            view.rasterize(prim, &mut |f| rasterized.push(f));
+            assert_eq!(rasterized, expected, "{prim} under {window_origin:?}");
+            covered += rasterized.len();
+        }
+    }
+    // The fill rule gives some of these centres and withholds others.
+    assert!(covered > 0 && covered < 24, "{covered}");
 }
