@@ -52,6 +52,7 @@ mod viewport;
 use sample_scan::Sampling;
 use scan::{bounding_box, edge};
 pub use scan::{edge as edge_function, fill_thresholds};
+pub use setup::TriangleSetup;
 use vertex::{in_front, AxisPositions, CentreCells, WindowVertex};
 pub use viewport::{PixelRect, Viewport};
 

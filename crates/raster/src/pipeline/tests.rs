@@ -553,3 +553,53 @@ fn a_box_of_one_centre_on_an_edge_is_decided_by_the_fill_rule() {
     // The fill rule gives some of these centres and withholds others.
     assert!(covered > 0 && covered < 24, "{covered}");
 }
+
+/// Triangles set up once for the whole framebuffer and scanned tile by tile give, in every tile,
+/// what rasterizing the same triangles restricted to that tile gives, in the same order: under
+/// both fill rules, per sample, and with tiny, large and clipped triangles.
+#[test]
+fn set_up_triangles_scanned_by_tiles_equal_rasterizing_each_tile() {
+    let mesh = crate::scenes::triangle_soup(600, 11);
+    let lower_left = Conventions {
+        window_origin: crate::conventions::WindowOrigin::LowerLeft,
+        ..Conventions::REFERENCE
+    };
+    let mut fragments = 0;
+    for (_, view) in soup_views(&mesh) {
+        let camera = Camera {
+            view_projection: view.view_projection(),
+        };
+        let flipped =
+            View::with_conventions(&mesh, &camera, view.viewport(), CullMode::None, lower_left)
+                .unwrap();
+        let sampled = view
+            .clone()
+            .with_samples(crate::SamplePattern::standard(4).unwrap())
+            .unwrap();
+        for view in [view, flipped, sampled] {
+            let mut setups = Vec::new();
+            view.set_up_each(0..view.triangle_count(), &mut |setup| setups.push(setup));
+            let Viewport { width, height } = view.viewport();
+            let side = 13;
+            for tile_y in 0..height.div_ceil(side) {
+                for tile_x in 0..width.div_ceil(side) {
+                    let tile = PixelRect {
+                        x: (tile_x * side, (tile_x * side + side - 1).min(width - 1)),
+                        y: (tile_y * side, (tile_y * side + side - 1).min(height - 1)),
+                    };
+                    let mut expected = Vec::new();
+                    view.rasterize_each_in(0..view.triangle_count(), tile, &mut |f| {
+                        expected.push(f);
+                    });
+                    let mut scanned = Vec::new();
+                    for setup in &setups {
+                        view.scan_within(setup, tile, &mut |f| scanned.push(f));
+                    }
+                    assert_eq!(scanned, expected, "{tile:?}");
+                    fragments += scanned.len();
+                }
+            }
+        }
+    }
+    assert!(fragments > 10_000, "{fragments} fragments");
+}
