@@ -89,15 +89,16 @@ impl Tiles {
         }
     }
 
-    /// The tiles that `rect` overlaps.
-    fn overlapped(self, rect: PixelRect) -> impl Iterator<Item = usize> {
-        let columns = rect.x.0 / TILE_SIDE..=rect.x.1 / TILE_SIDE;
+    /// Calls `visit` with each tile that `rect` overlaps (nested loops rather than an iterator
+    /// of iterators, which cost the binning more than the loops' bodies).
+    #[inline]
+    fn overlapped(self, rect: PixelRect, mut visit: impl FnMut(usize)) {
         let stride = self.columns as usize;
-        (rect.y.0 / TILE_SIDE..=rect.y.1 / TILE_SIDE).flat_map(move |row| {
-            columns
-                .clone()
-                .map(move |column| row as usize * stride + column as usize)
-        })
+        for row in rect.y.0 / TILE_SIDE..=rect.y.1 / TILE_SIDE {
+            for column in rect.x.0 / TILE_SIDE..=rect.x.1 / TILE_SIDE {
+                visit(row as usize * stride + column as usize);
+            }
+        }
     }
 }
 
@@ -114,9 +115,7 @@ impl ChunkBins {
         self.starts.clear();
         self.starts.resize(tiles.count() + 1, 0);
         for setup in &self.setups {
-            for tile in tiles.overlapped(setup.pixels()) {
-                self.starts[tile + 1] += 1;
-            }
+            tiles.overlapped(setup.pixels(), |tile| self.starts[tile + 1] += 1);
         }
         for tile in 0..tiles.count() {
             self.starts[tile + 1] += self.starts[tile];
@@ -124,10 +123,10 @@ impl ChunkBins {
         self.indices.clear();
         self.indices.resize(self.starts[tiles.count()] as usize, 0);
         for (index, setup) in (0u32..).zip(&self.setups) {
-            for tile in tiles.overlapped(setup.pixels()) {
+            tiles.overlapped(setup.pixels(), |tile| {
                 self.indices[self.starts[tile] as usize] = index;
                 self.starts[tile] += 1;
-            }
+            });
         }
         self.starts.rotate_right(1);
         self.starts[0] = 0;
