@@ -89,14 +89,17 @@ impl Tiles {
         }
     }
 
-    /// Calls `visit` with each tile that `rect` overlaps (nested loops rather than an iterator
-    /// of iterators, which cost the binning more than the loops' bodies).
+    /// Calls `visit` with each tile that `rect` overlaps: nested loops over half-open ranges
+    /// (an iterator of iterators, or inclusive ranges, cost the binning more than the loops'
+    /// bodies; the last tile index is below `u32::MAX`).
     #[inline]
     fn overlapped(self, rect: PixelRect, mut visit: impl FnMut(usize)) {
         let stride = self.columns as usize;
-        for row in rect.y.0 / TILE_SIDE..=rect.y.1 / TILE_SIDE {
-            for column in rect.x.0 / TILE_SIDE..=rect.x.1 / TILE_SIDE {
-                visit(row as usize * stride + column as usize);
+        let columns = rect.x.0 / TILE_SIDE..rect.x.1 / TILE_SIDE + 1;
+        for row in rect.y.0 / TILE_SIDE..rect.y.1 / TILE_SIDE + 1 {
+            let first = row as usize * stride;
+            for column in columns.clone() {
+                visit(first + column as usize);
             }
         }
     }
