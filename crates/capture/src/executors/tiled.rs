@@ -89,19 +89,15 @@ impl Tiles {
         }
     }
 
-    /// Calls `visit` with each tile that `rect` overlaps: nested loops over half-open ranges
-    /// (an iterator of iterators, or inclusive ranges, cost the binning more than the loops'
-    /// bodies; the last tile index is below `u32::MAX`).
-    #[inline]
-    fn overlapped(self, rect: PixelRect, mut visit: impl FnMut(usize)) {
+    /// The tiles that `rect` overlaps.
+    fn overlapped(self, rect: PixelRect) -> impl Iterator<Item = usize> {
+        let columns = rect.x.0 / TILE_SIDE..=rect.x.1 / TILE_SIDE;
         let stride = self.columns as usize;
-        let columns = rect.x.0 / TILE_SIDE..rect.x.1 / TILE_SIDE + 1;
-        for row in rect.y.0 / TILE_SIDE..rect.y.1 / TILE_SIDE + 1 {
-            let first = row as usize * stride;
-            for column in columns.clone() {
-                visit(first + column as usize);
-            }
-        }
+        (rect.y.0 / TILE_SIDE..=rect.y.1 / TILE_SIDE).flat_map(move |row| {
+            columns
+                .clone()
+                .map(move |column| row as usize * stride + column as usize)
+        })
     }
 }
 
@@ -118,7 +114,9 @@ impl ChunkBins {
         self.starts.clear();
         self.starts.resize(tiles.count() + 1, 0);
         for setup in &self.setups {
-            tiles.overlapped(setup.pixels(), |tile| self.starts[tile + 1] += 1);
+            for tile in tiles.overlapped(setup.pixels()) {
+                self.starts[tile + 1] += 1;
+            }
         }
         for tile in 0..tiles.count() {
             self.starts[tile + 1] += self.starts[tile];
@@ -126,10 +124,10 @@ impl ChunkBins {
         self.indices.clear();
         self.indices.resize(self.starts[tiles.count()] as usize, 0);
         for (index, setup) in (0u32..).zip(&self.setups) {
-            tiles.overlapped(setup.pixels(), |tile| {
+            for tile in tiles.overlapped(setup.pixels()) {
                 self.indices[self.starts[tile] as usize] = index;
                 self.starts[tile] += 1;
-            });
+            }
         }
         self.starts.rotate_right(1);
         self.starts[0] = 0;
