@@ -426,6 +426,8 @@ pub(super) const ROUNDING_BOUND: f64 = (1u32 << 30) as f64;
 /// a tie, where rounding half away from zero differs from rounding to even by one when to even
 /// went toward zero.
 #[inline]
+// `f64::clamp` keeps NaN, which the sum below would carry into the integer's bits.
+#[allow(clippy::manual_clamp)]
 pub(super) fn round_half_away(value: f64) -> i32 {
     const SHIFT: f64 = (3u64 << 51) as f64;
     // `max` and `min` return the number when one side is NaN (`f64::clamp` keeps NaN).
