@@ -35,8 +35,8 @@ pub use conventions::{Conventions, DepthRange, EdgeTies, VertexPrecision, Window
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError, UpAxis};
 pub use pipeline::{
-    edge_function, fill_thresholds, CullMode, PixelRect, ScreenTriangle, View, Viewport,
-    GUARD_BAND_PIXELS, SUBPIXEL_BITS,
+    edge_function, fill_thresholds, CullMode, PixelRect, ScreenTriangle, TriangleSetup, View,
+    Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS,
 };
 pub use rng::SplitMix64;
 pub use samples::SamplePattern;

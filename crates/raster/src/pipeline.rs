@@ -52,7 +52,8 @@ mod viewport;
 use sample_scan::Sampling;
 use scan::{bounding_box, edge};
 pub use scan::{edge as edge_function, fill_thresholds};
-use vertex::{in_front, CentreCells, WindowVertex};
+pub use setup::TriangleSetup;
+use vertex::{in_front, AxisPositions, CentreCells, WindowVertex};
 pub use viewport::{PixelRect, Viewport};
 
 /// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
@@ -96,6 +97,8 @@ pub struct ScreenTriangle {
 pub struct View<'mesh> {
     mesh: &'mesh Mesh,
     view_projection: DMat4,
+    /// The mesh's positions, an array per axis: what the vertex stage reads.
+    axes: AxisPositions,
     /// Per vertex: which interval between pixel-centre lines it lies in on each axis
     /// ([`CentreCells`]), all the triangle setup reads of a triangle it rejects early.
     cells: Vec<CentreCells>,
@@ -179,6 +182,7 @@ impl<'mesh> View<'mesh> {
         let mut view = Self {
             mesh,
             view_projection: camera.view_projection,
+            axes: AxisPositions::of(&mesh.positions),
             cells: Vec::new(),
             window: Vec::new(),
             window_z: Vec::new(),

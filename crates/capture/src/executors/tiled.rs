@@ -1,17 +1,19 @@
-//! The tiled executor: triangles binned into screen tiles, each tile's fragments inserted by one
-//! thread at a time.
+//! The tiled executor: triangles set up once, binned into screen tiles, each tile's fragments
+//! inserted by one thread at a time.
 //!
 //! Threads inserting into the same cache lines cost more than the atomics themselves; binning
 //! triangles into screen tiles so that each tile's pixels are owned by one thread at a time is
 //! the known cure (cudaraster, Laine and Karras 2011; Masked Software Occlusion Culling, Hasselgren
-//! et al. 2016). A frame runs in two phases:
-//! 1. **binning**, in parallel over chunks of triangles: each triangle's pixel bounds
-//!    ([`View::pixel_bounds`], `None` for most triangles of a dense mesh, which cover no pixel
-//!    centre) list it in every tile they overlap; a counting sort per chunk keeps primitive order
-//!    within each tile's list. The geometry is the same in every pass, so a frame bins once.
+//! et al. 2016; llvmpipe's 64-pixel tiles). A frame runs in two phases:
+//! 1. **setup and binning**, in parallel over chunks of triangles: each triangle is set up once
+//!    ([`View::set_up_each`]: the early rejects drop most triangles of a dense mesh, which cover
+//!    no pixel centre, and a survivor becomes the record the scan reads), and each record is
+//!    listed in every tile its pixels overlap; a counting sort per chunk keeps submission order
+//!    within each tile's list. The geometry is the same in every pass, so a frame sets up and bins
+//!    once.
 //! 2. **capture**, one geometry pass after another, in parallel over tiles: a tile's thread scans
-//!    its triangles, chunk after chunk, clipped to the tile ([`View::rasterize_each_in`]), and runs
-//!    each fragment's walk to its end.
+//!    the part of its records inside the tile ([`View::scan_within`]), chunk after chunk, and runs
+//!    each fragment's walk to its end, so that the tile's storage stays in its cache.
 //!
 //! Every pixel is written by one thread only, so each pixel sees its fragments in primitive order:
 //! the serial executor's order, which FreePipe's per-triangle model can also produce. An atomic
@@ -22,10 +24,10 @@
 use std::ops::Range;
 use std::time::Instant;
 
-use fragsim_raster::{PixelRect, View, Viewport};
+use fragsim_raster::{PixelRect, TriangleSetup, View, Viewport};
 use rayon::prelude::*;
 
-use super::frame::{rasterize_into, reuse_storage, Counters, Run};
+use super::frame::{reuse_storage, walk, Counters, Run};
 use super::parallel::rayon_frame;
 use crate::memory::AtomicMemory;
 use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
@@ -47,15 +49,15 @@ pub struct TiledExecutor {
     chunks: Vec<ChunkBins>,
 }
 
-/// One chunk of triangles binned by tile.
+/// One chunk of triangles set up and binned by tile.
 #[derive(Debug, Default)]
 struct ChunkBins {
-    /// Primitive ids, tile after tile, in primitive order within a tile.
-    prims: Vec<u32>,
-    /// `prims[starts[t]..starts[t + 1]]` is tile `t`'s list.
+    /// The chunk's set-up triangles (pieces, for clipped ones), in submission order.
+    setups: Vec<TriangleSetup>,
+    /// Indices into `setups`, tile after tile, in submission order within a tile.
+    indices: Vec<u32>,
+    /// `indices[starts[t]..starts[t + 1]]` is tile `t`'s list.
     starts: Vec<u32>,
-    /// The chunk's triangles that cover a pixel centre, with their pixel bounds.
-    bounded: Vec<(u32, PixelRect)>,
 }
 
 /// The tile grid over a viewport.
@@ -100,32 +102,30 @@ impl Tiles {
 }
 
 impl ChunkBins {
-    /// Bins the triangles submitted `submitted`-th of `view` ([`View::submitted`]), in submission
-    /// order, reusing this chunk's buffers.
+    /// Sets up the triangles submitted `submitted`-th of `view` ([`View::submitted`]), in
+    /// submission order, and bins them, reusing this chunk's buffers.
     fn bin(&mut self, view: &View<'_>, tiles: Tiles, submitted: Range<u32>) {
-        self.bounded.clear();
-        self.bounded.extend(
-            submitted
-                .map(|i| view.submitted(i))
-                .filter_map(|prim| view.pixel_bounds(prim).map(|rect| (prim, rect))),
-        );
+        self.setups.clear();
+        view.set_up_each(submitted.map(|i| view.submitted(i)), &mut |setup| {
+            self.setups.push(setup);
+        });
         // Counting sort: counts into `starts[t + 1]`, prefix sums, then a stable scatter that
         // advances `starts[t]` to where tile `t`'s list ends, and a shift back.
         self.starts.clear();
         self.starts.resize(tiles.count() + 1, 0);
-        for &(_, rect) in &self.bounded {
-            for tile in tiles.overlapped(rect) {
+        for setup in &self.setups {
+            for tile in tiles.overlapped(setup.pixels()) {
                 self.starts[tile + 1] += 1;
             }
         }
         for tile in 0..tiles.count() {
             self.starts[tile + 1] += self.starts[tile];
         }
-        self.prims.clear();
-        self.prims.resize(self.starts[tiles.count()] as usize, 0);
-        for &(prim, rect) in &self.bounded {
-            for tile in tiles.overlapped(rect) {
-                self.prims[self.starts[tile] as usize] = prim;
+        self.indices.clear();
+        self.indices.resize(self.starts[tiles.count()] as usize, 0);
+        for (index, setup) in (0u32..).zip(&self.setups) {
+            for tile in tiles.overlapped(setup.pixels()) {
+                self.indices[self.starts[tile] as usize] = index;
                 self.starts[tile] += 1;
             }
         }
@@ -133,15 +133,16 @@ impl ChunkBins {
         self.starts[0] = 0;
     }
 
-    /// Tile `tile`'s triangles, in primitive order.
-    fn list(&self, tile: usize) -> &[u32] {
-        &self.prims[self.starts[tile] as usize..self.starts[tile + 1] as usize]
+    /// Tile `tile`'s set-up triangles, in submission order.
+    fn list(&self, tile: usize) -> impl Iterator<Item = &TriangleSetup> {
+        let indices = &self.indices[self.starts[tile] as usize..self.starts[tile + 1] as usize];
+        indices.iter().map(|&index| &self.setups[index as usize])
     }
 }
 
 impl TiledExecutor {
-    /// Runs one frame of `scheme` over `view` on the current rayon pool: bins, then every
-    /// geometry pass tile by tile, then the post pass.
+    /// Runs one frame of `scheme` over `view` on the current rayon pool: sets up and bins, then
+    /// every geometry pass tile by tile, then the post pass.
     pub fn run<S: Scheme>(&mut self, view: &View<'_>, scheme: &S) -> Run {
         let start = Instant::now();
         let memory = reuse_storage(
@@ -172,8 +173,11 @@ impl TiledExecutor {
                 .map(|tile| {
                     let rect = tiles.rect(tile);
                     let mut counters = Counters::default();
-                    let prims = chunks.iter().flat_map(|chunk| chunk.list(tile)).copied();
-                    rasterize_into(view, scheme, memory, pass, prims, rect, &mut counters);
+                    for setup in chunks.iter().flat_map(|chunk| chunk.list(tile)) {
+                        view.scan_within(setup, rect, &mut |fragment| {
+                            walk(scheme, memory, pass, fragment, &mut counters);
+                        });
+                    }
                     counters
                 })
                 .reduce(Counters::default, Counters::merge)

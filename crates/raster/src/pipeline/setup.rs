@@ -18,6 +18,10 @@
 //! [`View::rasterize_each_in`] runs the stages over a run of triangles in batches: the setup of a
 //! batch, then the scan of its records, so that each loop stays small; the fragments come out in
 //! the order of triangle after triangle, as [`View::rasterize_in`] gives them.
+//!
+//! [`View::set_up_each`] hands the records out instead ([`TriangleSetup`]), so that an executor can
+//! bin them to screen tiles and scan each tile's part later ([`View::scan_within`]): a triangle is
+//! set up once however many tiles and geometry passes scan it.
 
 use super::scan::{bounding_box, edge, fill_thresholds, per_edge};
 use super::{PixelRect, ScreenTriangle, Snapped, View, CLIP_BITS, HALF, NOT_IN_FRONT_BIT, ONE};
@@ -53,6 +57,25 @@ pub(super) struct ScanSetup {
 }
 
 impl ScanSetup {
+    /// This record restricted to the pixels of `rect`, its edge functions moved to the first of
+    /// them (exactly: they are linear in the pixel); `None` when no pixel of its box lies there.
+    #[inline]
+    fn restricted(&self, rect: PixelRect) -> Option<Self> {
+        let x = (self.pixels.x.0.max(rect.x.0), self.pixels.x.1.min(rect.x.1));
+        let y = (self.pixels.y.0.max(rect.y.0), self.pixels.y.1.min(rect.y.1));
+        if x.0 > x.1 || y.0 > y.1 {
+            return None;
+        }
+        let right = i64::from(x.0 - self.pixels.x.0);
+        let down = i64::from(y.0 - self.pixels.y.0);
+        let moved = |k: usize| self.origin[k] + self.step_x[k] * right + self.step_y[k] * down;
+        Some(Self {
+            pixels: PixelRect { x, y },
+            origin: [moved(0), moved(1), moved(2)],
+            ..*self
+        })
+    }
+
     /// Sets up an oriented triangle of doubled area `area` (positive) for a scan of `pixels`,
     /// which must lie within its bounding box's centres.
     #[inline]
@@ -89,19 +112,72 @@ impl ScanSetup {
     }
 }
 
+/// A triangle, or one piece of a clipped one, set up once by [`View::set_up_each`] for the scan
+/// of any rectangle of its pixels ([`View::scan_within`]): what an executor that bins triangles
+/// to screen tiles keeps for each tile.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleSetup(SetUp);
+
+/// The two kinds of [`TriangleSetup`].
+#[derive(Clone, Copy, Debug)]
+enum SetUp {
+    /// A record for the scan of pixel centres.
+    Centres(ScanSetup),
+    /// A triangle of a view that rasterizes per sample, with the sample columns its pieces may
+    /// cover ([`View::pixel_bounds`]): the sample scan sets its pieces up for each rectangle.
+    Samples { prim: u32, pixels: PixelRect },
+}
+
+impl TriangleSetup {
+    /// The pixels (sample columns, for a view that rasterizes per sample) that its fragments may
+    /// cover: every fragment of the triangle lies inside.
+    #[must_use]
+    #[inline]
+    pub fn pixels(&self) -> PixelRect {
+        match self.0 {
+            SetUp::Centres(record) => record.pixels,
+            SetUp::Samples { pixels, .. } => pixels,
+        }
+    }
+}
+
 /// Whether the snapped triangle `xy`, of either orientation, covers the centre of pixel `(x, y)`
 /// under the fill rule of `origin`: the scan's coverage test of that centre on the triangle
 /// oriented as [`View::oriented`] orients it, without the rest of its record. A triangle of zero
 /// area covers nothing.
+///
+/// The three edge functions of the triangle as given sum to its doubled signed area, and
+/// reorienting it negates them: so a centre where all three have one strict sign is inside
+/// whatever the orientation, one where they have both strict signs is outside (or the area is
+/// zero), and only a centre on an edge needs the orientation and the fill rule.
 #[inline]
-fn covers_centre([a, b, c]: [[i64; 2]; 3], (x, y): (u32, u32), origin: WindowOrigin) -> bool {
+fn covers_centre(xy: [[i64; 2]; 3], (x, y): (u32, u32), origin: WindowOrigin) -> bool {
+    let [a, b, c] = xy;
+    let centre = [i64::from(x) * ONE + HALF, i64::from(y) * ONE + HALF];
+    let e = [edge(b, c, centre), edge(c, a, centre), edge(a, b, centre)];
+    let positive = (e[0] > 0) as u8 + (e[1] > 0) as u8 + (e[2] > 0) as u8;
+    let negative = (e[0] < 0) as u8 + (e[1] < 0) as u8 + (e[2] < 0) as u8;
+    match (positive, negative) {
+        (3, _) | (_, 3) => true,
+        (1.., 1..) => false,
+        _ => covers_centre_on_an_edge(xy, centre, origin),
+    }
+}
+
+/// [`covers_centre`] for a centre on an edge of the triangle: oriented, then tested against the
+/// fill rule's thresholds as the scan tests it.
+#[cold]
+fn covers_centre_on_an_edge(
+    [a, b, c]: [[i64; 2]; 3],
+    centre: [i64; 2],
+    origin: WindowOrigin,
+) -> bool {
     let area = edge(a, b, c);
     if area == 0 {
         return false;
     }
     let (b, c) = if area < 0 { (c, b) } else { (b, c) };
     let edges = [(b, c), (c, a), (a, b)];
-    let centre = [i64::from(x) * ONE + HALF, i64::from(y) * ONE + HALF];
     let e = per_edge(edges, |p, q| edge(p, q, centre));
     let threshold = fill_thresholds(edges, origin);
     e[0] >= threshold[0] && e[1] >= threshold[1] && e[2] >= threshold[2]
@@ -165,6 +241,54 @@ impl View<'_> {
         ];
         if let Some((tri, area)) = self.oriented(prim, snapped) {
             visit(ScanSetup::new(&tri, area, pixels, origin));
+        }
+    }
+
+    /// Sets up the triangles `prims`, in that order, for scans of the framebuffer
+    /// ([`View::scan_within`]): `visit` gets a record for each triangle, or for each piece of a
+    /// clipped one, in order, unless it is rejected, culled, degenerate or holds no pixel centre
+    /// (no sample, for a view that rasterizes per sample).
+    pub fn set_up_each(
+        &self,
+        prims: impl IntoIterator<Item = u32>,
+        visit: &mut impl FnMut(TriangleSetup),
+    ) {
+        if let Some(sampling) = self.sampling {
+            for prim in prims {
+                if let Some(pixels) = self.sample_bounds(prim, sampling) {
+                    visit(TriangleSetup(SetUp::Samples { prim, pixels }));
+                }
+            }
+            return;
+        }
+        let rect = self.viewport.rect();
+        for prim in prims {
+            self.set_up_in(prim, rect, &mut |record| {
+                visit(TriangleSetup(SetUp::Centres(record)));
+            });
+        }
+    }
+
+    /// Scans the pixels of `rect` of a triangle that this view set up ([`View::set_up_each`]):
+    /// exactly the fragments [`View::rasterize_in`] gives there for that triangle (or that piece
+    /// of it), in the same order.
+    pub fn scan_within(
+        &self,
+        setup: &TriangleSetup,
+        rect: PixelRect,
+        emit: &mut impl FnMut(Fragment),
+    ) {
+        match setup.0 {
+            SetUp::Centres(record) => {
+                if let Some(part) = record.restricted(rect) {
+                    self.scan_set_up(&part, emit);
+                }
+            }
+            SetUp::Samples { prim, .. } => {
+                if let Some(sampling) = self.sampling {
+                    self.rasterize_samples_in(prim, sampling, rect, emit);
+                }
+            }
         }
     }
 

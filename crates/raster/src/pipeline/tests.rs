@@ -1,6 +1,6 @@
 //! Unit tests of the pipeline's rules.
 
-use super::vertex::{round_half_away, VertexStage};
+use super::vertex::{round_half_away, VertexStage, ROUNDING_BOUND};
 use super::*;
 use crate::conventions::Conventions;
 
@@ -94,6 +94,7 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
     let view = view_of(&mesh, 37);
     let stage = VertexStage {
         view_projection: DMat4::IDENTITY,
+        view_projection_f32: DMat4::IDENTITY.to_cols_array().map(|e| e as f32),
         planes: view.planes(),
         viewport: view.viewport(),
         conventions: Conventions::REFERENCE,
@@ -133,12 +134,18 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
         };
         let clip = DVec4::new(coordinate(), coordinate(), coordinate(), coordinate());
         if clip.is_finite() {
-            assert_eq!(stage.outcode(clip), by_dot_products(clip), "{clip:?}");
+            assert_eq!(
+                stage.outcode(clip),
+                u64::from(by_dot_products(clip)),
+                "{clip:?}"
+            );
         }
     }
 }
 
 #[test]
+// NaN is rounded as `max` and `min` take it, which `f64::clamp` does not.
+#[allow(clippy::manual_clamp)]
 fn rounding_without_libm_equals_f64_round() {
     let mut values = vec![
         0.5,
@@ -160,8 +167,13 @@ fn rounding_without_libm_equals_f64_round() {
         -0.0,
         f64::MIN_POSITIVE,
     ];
-    // Halves and their neighbours over the snapped range, and a deterministic spread.
-    for i in -3000i32..3000 {
+    // Halves and their neighbours over the snapped range, at the guard band's edge (2^24) and at
+    // the bound, and a deterministic spread.
+    let edges = [0, 1 << 24, -(1 << 24), 1 << 30, -(1 << 30)];
+    for i in edges
+        .into_iter()
+        .flat_map(|at: i32| at.saturating_sub(3000)..at.saturating_add(3000))
+    {
         let half = f64::from(i) + 0.5;
         values.extend([half, half.next_up(), half.next_down()]);
     }
@@ -173,7 +185,9 @@ fn rounding_without_libm_equals_f64_round() {
         values.push(f64::from_bits(x));
     }
     for v in values {
-        assert_eq!(round_half_away(v), v.round() as i64, "{v:e}");
+        // NaN goes to the lower bound (`f64::max` takes the number).
+        let expected = v.max(-ROUNDING_BOUND).min(ROUNDING_BOUND).round() as i32;
+        assert_eq!(round_half_away(v), expected, "{v:e}");
     }
 }
 
@@ -282,6 +296,17 @@ fn the_scan_of_covered_runs_emits_what_testing_every_centre_emits() {
                         fragments += scanned.len();
                     }
                 });
+                // The whole path from the vertex stage: the early rejects and the test of a box
+                // of one centre in the setup emit what testing every centre of each piece does.
+                for rect in rects {
+                    let mut expected = Vec::new();
+                    view.screen_triangles(prim, &mut |tri| {
+                        expected.extend(scan_every_centre(&view, &tri, rect));
+                    });
+                    let mut rasterized = Vec::new();
+                    view.rasterize_in(prim, rect, &mut |f| rasterized.push(f));
+                    assert_eq!(rasterized, expected, "{prim} at {distance_scale}, {rect:?}");
+                }
             }
         }
     }
@@ -361,4 +386,222 @@ fn a_triangle_crossing_the_near_plane_is_clipped_not_lost() {
     let covered = counts.iter().filter(|&&c| c == 1).count();
     assert!(covered > 0 && covered < 64, "{covered}");
     assert!(counts.iter().all(|&c| c <= 1));
+}
+
+/// Rules 1 and 3 written the plain way, one vertex at a time, in i64 with `f64::round`: what the
+/// batched, branch-free vertex stage must leave for every vertex inside the guard band, under
+/// every vertex precision, window origin, depth range and a few grids.
+#[test]
+fn the_batched_vertex_stage_equals_rules_1_and_3_vertex_by_vertex() {
+    use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
+    let scene = crate::Scene::procedural("soup:300:7").unwrap();
+    let viewport = Viewport::new(97, 61).unwrap();
+    let mut checked = [0usize; 2];
+    for distance_scale in [40.0, 1.1, 0.3, 0.01] {
+        let orbit = crate::OrbitCamera {
+            distance_scale,
+            ..crate::OrbitCamera::default()
+        };
+        for vertex_precision in [VertexPrecision::F64, VertexPrecision::F32] {
+            for window_origin in [WindowOrigin::UpperLeft, WindowOrigin::LowerLeft] {
+                for depth_range in [DepthRange::ZeroToOne, DepthRange::MinusOneToOne] {
+                    for subpixel_bits in [8, 4, 1] {
+                        let conventions = Conventions {
+                            window_origin,
+                            subpixel_bits,
+                            depth_range,
+                            vertex_precision,
+                            ..Conventions::REFERENCE
+                        };
+                        let camera = scene.orbit_camera(viewport, &orbit, depth_range);
+                        let view = View::with_conventions(
+                            &scene.mesh,
+                            &camera,
+                            viewport,
+                            CullMode::None,
+                            conventions,
+                        )
+                        .unwrap();
+                        for (index, p) in scene.mesh.positions.iter().enumerate() {
+                            let inside = expected_window(&view, camera.view_projection, *p);
+                            assert_eq!(
+                                view.vertex_window(index as u32),
+                                inside,
+                                "{conventions:?}, vertex {index}"
+                            );
+                            checked[usize::from(inside.is_some())] += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Both kinds of vertex were met: clipped (or behind the eye) and placed.
+    assert!(checked[0] > 100 && checked[1] > 1000, "{checked:?}");
+}
+
+/// The snapped window position and depth of model position `p` under `view`'s conventions,
+/// computed one vertex at a time from `docs/semantics.md` (rules 1 and 3, §9); `None` when the
+/// vertex lies outside the near plane or the guard band, or not in front of the eye.
+fn expected_window(view: &View<'_>, matrix: DMat4, p: [f32; 3]) -> Option<([i64; 2], f64)> {
+    use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
+    let c = view.conventions();
+    let clip = match c.vertex_precision {
+        VertexPrecision::F64 => matrix * DVec4::new(p[0].into(), p[1].into(), p[2].into(), 1.0),
+        VertexPrecision::F32 => {
+            let m = matrix.to_cols_array().map(|e| e as f32);
+            let row = |r: usize| m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+            DVec4::new(row(0).into(), row(1).into(), row(2).into(), row(3).into())
+        }
+    };
+    if view.planes().iter().any(|plane| plane.dot(clip) < 0.0) || clip.w <= 0.0 {
+        return None;
+    }
+    let (width, height) = (view.viewport.width, view.viewport.height);
+    let lower_left = c.window_origin == WindowOrigin::LowerLeft;
+    let minus_one = c.depth_range == DepthRange::MinusOneToOne;
+    let ([x, y], depth) = match c.vertex_precision {
+        VertexPrecision::F64 => {
+            let (x, y, z, w) = (clip.x, clip.y, clip.z, clip.w);
+            let wy = if lower_left {
+                y / w * 0.5 + 0.5
+            } else {
+                0.5 - y / w * 0.5
+            };
+            let depth = if minus_one { z / w * 0.5 + 0.5 } else { z / w };
+            (
+                [
+                    (x / w * 0.5 + 0.5) * f64::from(width),
+                    wy * f64::from(height),
+                ],
+                depth,
+            )
+        }
+        VertexPrecision::F32 => {
+            let [x, y, z, w] = clip.to_array().map(|v| v as f32);
+            let wy = if lower_left {
+                y / w * 0.5 + 0.5
+            } else {
+                0.5 - y / w * 0.5
+            };
+            let depth = if minus_one { z / w * 0.5 + 0.5 } else { z / w };
+            let window = [(x / w * 0.5 + 0.5) * width as f32, wy * height as f32];
+            (window.map(f64::from), f64::from(depth))
+        }
+    };
+    let bits = c.subpixel_bits;
+    let grid =
+        |v: f64| (v * f64::from(1u32 << bits)).round() as i64 * (1 << (SUBPIXEL_BITS - bits));
+    let y = if lower_left {
+        (i64::from(height) << SUBPIXEL_BITS) - grid(y)
+    } else {
+        grid(y)
+    };
+    Some(([grid(x), y], depth))
+}
+
+/// Tiny triangles whose box holds one centre lying on a vertex or an edge, in both orientations
+/// and under both fill rules: the setup's test of that centre must settle it as the scan does.
+#[test]
+fn a_box_of_one_centre_on_an_edge_is_decided_by_the_fill_rule() {
+    // Window positions in pixels on an 8 × 8 viewport (identity camera: x = X/4 − 1, y = 1 − Y/4);
+    // pixel (3, 3)'s centre is (3.5, 3.5).
+    let at = |x: f32, y: f32| [x / 4.0 - 1.0, 1.0 - y / 4.0, 0.5];
+    let mesh = Mesh {
+        positions: vec![
+            at(3.5, 3.5),
+            at(3.875, 3.5),
+            at(3.5, 3.875),
+            at(3.125, 3.25),
+            at(3.875, 3.75),
+            at(3.25, 3.875),
+        ],
+        // On a vertex, on a horizontal and a vertical edge; on a slanted edge; each both ways.
+        triangles: vec![
+            [0, 1, 2],
+            [0, 2, 1],
+            [3, 4, 5],
+            [3, 5, 4],
+            [3, 4, 2],
+            [3, 2, 4],
+        ],
+    };
+    let mut covered = 0;
+    for window_origin in [
+        crate::conventions::WindowOrigin::UpperLeft,
+        crate::conventions::WindowOrigin::LowerLeft,
+    ] {
+        let conventions = Conventions {
+            window_origin,
+            ..Conventions::REFERENCE
+        };
+        let camera = Camera {
+            view_projection: DMat4::IDENTITY,
+        };
+        let viewport = Viewport::new(8, 8).unwrap();
+        let view =
+            View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions).unwrap();
+        for prim in 0..view.triangle_count() {
+            let mut expected = Vec::new();
+            view.screen_triangles(prim, &mut |tri| {
+                expected.extend(scan_every_centre(&view, &tri, viewport.rect()));
+            });
+            let mut rasterized = Vec::new();
+            view.rasterize(prim, &mut |f| rasterized.push(f));
+            assert_eq!(rasterized, expected, "{prim} under {window_origin:?}");
+            covered += rasterized.len();
+        }
+    }
+    // The fill rule gives some of these centres and withholds others.
+    assert!(covered > 0 && covered < 24, "{covered}");
+}
+
+/// Triangles set up once for the whole framebuffer and scanned tile by tile give, in every tile,
+/// what rasterizing the same triangles restricted to that tile gives, in the same order: under
+/// both fill rules, per sample, and with tiny, large and clipped triangles.
+#[test]
+fn set_up_triangles_scanned_by_tiles_equal_rasterizing_each_tile() {
+    let mesh = crate::scenes::triangle_soup(600, 11);
+    let lower_left = Conventions {
+        window_origin: crate::conventions::WindowOrigin::LowerLeft,
+        ..Conventions::REFERENCE
+    };
+    let mut fragments = 0;
+    for (_, view) in soup_views(&mesh) {
+        let camera = Camera {
+            view_projection: view.view_projection(),
+        };
+        let flipped =
+            View::with_conventions(&mesh, &camera, view.viewport(), CullMode::None, lower_left)
+                .unwrap();
+        let sampled = view
+            .clone()
+            .with_samples(crate::SamplePattern::standard(4).unwrap())
+            .unwrap();
+        for view in [view, flipped, sampled] {
+            let mut setups = Vec::new();
+            view.set_up_each(0..view.triangle_count(), &mut |setup| setups.push(setup));
+            let Viewport { width, height } = view.viewport();
+            let side = 13;
+            for tile_y in 0..height.div_ceil(side) {
+                for tile_x in 0..width.div_ceil(side) {
+                    let tile = PixelRect {
+                        x: (tile_x * side, (tile_x * side + side - 1).min(width - 1)),
+                        y: (tile_y * side, (tile_y * side + side - 1).min(height - 1)),
+                    };
+                    let mut expected = Vec::new();
+                    view.rasterize_each_in(0..view.triangle_count(), tile, &mut |f| {
+                        expected.push(f);
+                    });
+                    let mut scanned = Vec::new();
+                    for setup in &setups {
+                        view.scan_within(setup, tile, &mut |f| scanned.push(f));
+                    }
+                    assert_eq!(scanned, expected, "{tile:?}");
+                    fragments += scanned.len();
+                }
+            }
+        }
+    }
+    assert!(fragments > 10_000, "{fragments} fragments");
 }

@@ -29,16 +29,17 @@ impl View<'_> {
         self.window.resize(count, WindowVertex::default());
         self.window_z.resize(count, 0.0);
         let stage = self.stage();
+        let AxisPositions { x, y, z } = &self.axes;
         // Every vertex is independent: chunks of the arrays go to the pool side by side.
-        self.mesh
-            .positions
-            .par_chunks(VERTICES_PER_TASK)
+        x.par_chunks(VERTICES_PER_TASK)
+            .zip(y.par_chunks(VERTICES_PER_TASK))
+            .zip(z.par_chunks(VERTICES_PER_TASK))
             .zip(self.cells.par_chunks_mut(VERTICES_PER_TASK))
             .zip(self.window.par_chunks_mut(VERTICES_PER_TASK))
             .zip(self.window_z.par_chunks_mut(VERTICES_PER_TASK))
-            .for_each(|(((positions, cells), window), window_z)| {
+            .for_each(|(((((x, y), z), cells), window), window_z)| {
                 let c = stage.conventions;
-                let chunk = (positions, cells, window, window_z);
+                let chunk = ([x, y, z], cells, window, window_z);
                 match (c.vertex_precision, c.window_origin, c.depth_range) {
                     (F64, UpperLeft, ZeroToOne) => stage.project::<false, false, false>(chunk),
                     (F64, UpperLeft, MinusOneToOne) => stage.project::<false, false, true>(chunk),
@@ -78,6 +79,7 @@ impl View<'_> {
     pub(super) fn stage(&self) -> VertexStage {
         VertexStage {
             view_projection: self.view_projection,
+            view_projection_f32: self.view_projection.to_cols_array().map(|e| e as f32),
             planes: self.planes(),
             viewport: self.viewport,
             conventions: self.conventions,
@@ -113,16 +115,38 @@ pub(super) type CentreCells = [i32; 2];
 /// The [`CentreCells`] of a vertex that can never be rejected by them.
 const NO_CELLS: CentreCells = [1, 1];
 
-/// The [`CentreCells`] of a snapped position inside the guard band.
+/// The [`CentreCells`] of a snapped position inside the guard band (|c| < 2^24); any other
+/// position gives some value without overflowing, which no triangle reads.
 #[inline]
-fn centre_cells(xy: [i64; 2]) -> CentreCells {
-    let cell = |c: i64| {
-        let from_centre = c - HALF;
-        let on_line = from_centre & (ONE - 1) == 0;
-        // Inside the guard band |c| < 2^24, so the doubled cell fits an i32.
-        ((from_centre >> SUBPIXEL_BITS) * 2 + i64::from(on_line)) as i32
+fn centre_cells(xy: [i32; 2]) -> CentreCells {
+    let cell = |c: i32| {
+        let from_centre = c.wrapping_sub(HALF as i32);
+        let on_line = from_centre & (ONE as i32 - 1) == 0;
+        // `2 · floor(…) + on_line`, written with shifts so that no value can overflow.
+        (from_centre >> SUBPIXEL_BITS) << 1 | i32::from(on_line)
     };
     [cell(xy[0]), cell(xy[1])]
+}
+
+/// The mesh's positions as one array per axis: the vertex stage's loop reads them a few vertices
+/// per instruction (SIMD lanes), which interleaved `[x, y, z]` triples would prevent. Built once
+/// per view; the mesh a view borrows cannot change.
+#[derive(Clone, Debug, Default)]
+pub(super) struct AxisPositions {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+}
+
+impl AxisPositions {
+    /// The axes of `positions`.
+    pub(super) fn of(positions: &[[f32; 3]]) -> Self {
+        Self {
+            x: positions.iter().map(|p| p[0]).collect(),
+            y: positions.iter().map(|p| p[1]).collect(),
+            z: positions.iter().map(|p| p[2]).collect(),
+        }
+    }
 }
 
 /// What the vertex stage leaves for the triangle setup of every triangle that uses a vertex.
@@ -144,17 +168,22 @@ impl WindowVertex {
     }
 }
 
+/// Vertices the vertex stage computes into local arrays before it copies them out.
+const LANE_BLOCK: usize = 64;
+
 /// What the vertex stage needs, copied out of the view so that it can fill the view's buffers.
 pub(super) struct VertexStage {
     pub(super) view_projection: DMat4,
+    /// The matrix's entries rounded to f32 once, column-major, for an f32 vertex stage.
+    pub(super) view_projection_f32: [f32; 16],
     pub(super) planes: [DVec4; 5],
     pub(super) viewport: Viewport,
     pub(super) conventions: Conventions,
 }
 
-/// One chunk of the vertex stage: the positions, and the outputs for them.
+/// One chunk of the vertex stage: the positions (x, y and z apart), and the outputs for them.
 type VertexChunk<'a> = (
-    &'a [[f32; 3]],
+    [&'a [f32]; 3],
     &'a mut [CentreCells],
     &'a mut [WindowVertex],
     &'a mut [f64],
@@ -165,32 +194,55 @@ impl VertexStage {
     /// stage, a lower-left window origin, a `[−1, 1]` depth range), so that the loop has no match
     /// per vertex; the arithmetic is [`VertexStage::clip`]'s and [`snap`]'s, expression for
     /// expression.
+    ///
+    /// The loop has no branch, so that the compiler runs it on several vertices at once (SIMD
+    /// lanes): every vertex is projected and snapped, and what a clipped vertex gets (a
+    /// position, a depth) is never read, as [`WindowVertex`] says. Rounding and the centre cells
+    /// work in `i32`, which holds every coordinate inside the guard band, because baseline
+    /// x86-64 converts f64 lanes to `i32` but not to `i64`.
     fn project<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
         &self,
-        (positions, cells, window, window_z): VertexChunk<'_>,
+        ([x, y, z], cells, window, window_z): VertexChunk<'_>,
     ) {
-        let outputs = cells.iter_mut().zip(window.iter_mut().zip(window_z));
-        for (p, (cell, (vertex, z))) in positions.iter().zip(outputs) {
-            let clip = if F32_STAGE {
-                transform_f32(self.view_projection, *p)
-            } else {
-                transform(self.view_projection, *p)
-            };
-            vertex.outcode = self.outcode(clip);
-            *cell = NO_CELLS;
-            if vertex.outcode & CLIP_BITS == 0 {
+        // A block's results go to local arrays first: the compiler then knows that no store
+        // can change what a later vertex reads, which it cannot prove of the outputs.
+        let mut block_cells = [NO_CELLS; LANE_BLOCK];
+        let mut block_xy = [[0; 2]; LANE_BLOCK];
+        let mut block_outcode = [0; LANE_BLOCK];
+        let mut block_z = [0.0; LANE_BLOCK];
+        let mut start = 0;
+        while start < cells.len() {
+            let end = (start + LANE_BLOCK).min(cells.len());
+            let lanes = end - start;
+            let (x, y, z) = (&x[start..end], &y[start..end], &z[start..end]);
+            for i in 0..lanes {
+                let position = [x[i], y[i], z[i]];
+                let clip = if F32_STAGE {
+                    transform_f32(&self.view_projection_f32, position)
+                } else {
+                    transform(self.view_projection, position)
+                };
+                let outcode = self.outcode(clip);
                 let (xy, depth) = snap_fixed::<F32_STAGE, LOWER_LEFT, MINUS_ONE_TO_ONE>(
                     self.viewport,
                     self.conventions.subpixel_bits,
                     clip,
                 );
-                // Inside the guard band: lossless (see `WindowVertex`).
-                vertex.xy = [xy[0] as i32, xy[1] as i32];
-                *z = depth;
-                if vertex.outcode & NOT_IN_FRONT_BIT == 0 {
-                    *cell = centre_cells(xy);
-                }
+                let placed = outcode & u64::from(CLIP_BITS | NOT_IN_FRONT_BIT) == 0;
+                block_cells[i] = if placed { centre_cells(xy) } else { NO_CELLS };
+                block_xy[i] = xy;
+                block_outcode[i] = outcode;
+                block_z[i] = depth;
             }
+            cells[start..end].copy_from_slice(&block_cells[..lanes]);
+            let results = block_xy.iter().zip(block_outcode);
+            for (vertex, (&xy, outcode)) in window[start..end].iter_mut().zip(results) {
+                // Seven bits: lossless.
+                let outcode = outcode as u8;
+                *vertex = WindowVertex { xy, outcode };
+            }
+            window_z[start..end].copy_from_slice(&block_z[..lanes]);
+            start = end;
         }
     }
 
@@ -198,7 +250,7 @@ impl VertexStage {
     pub(super) fn clip(&self, position: [f32; 3]) -> DVec4 {
         match self.conventions.vertex_precision {
             VertexPrecision::F64 => transform(self.view_projection, position),
-            VertexPrecision::F32 => transform_f32(self.view_projection, position),
+            VertexPrecision::F32 => transform_f32(&self.view_projection_f32, position),
         }
     }
 
@@ -207,46 +259,51 @@ impl VertexStage {
         snap(self.viewport, self.conventions, v)
     }
 
-    /// The outcode of [`View::planes`] and the far plane, each plane written out rather than as a
-    /// dot product with mostly zero coefficients: for finite coordinates (always: positions are
-    /// finite f32 and the matrix finite f64) the zero terms add only signed zeros, so each sum is
-    /// rounded exactly as the dot product's and every comparison decides the same.
-    pub(super) fn outcode(&self, clip: DVec4) -> u8 {
+    /// The outcode of [`View::planes`] and the far plane (the bits of [`WindowVertex::outcode`]),
+    /// each plane written out rather than as a dot product with mostly zero coefficients: for
+    /// finite coordinates (always: positions are finite f32 and the matrix finite f64) the zero
+    /// terms add only signed zeros, so each sum is rounded exactly as the dot product's and every
+    /// comparison decides the same. In 64 bits: on SIMD lanes of f64 a comparison gives a 64-bit
+    /// mask, which narrowing comparison by comparison would cost several instructions each.
+    #[inline]
+    pub(super) fn outcode(&self, clip: DVec4) -> u64 {
         let [near, right, _, bottom, _] = self.planes;
         let (gx, gy) = (right.w, bottom.w);
         let DVec4 { x, y, z, w } = clip;
-        let mut outcode = u8::from(z + near.w * w < 0.0)
-            | u8::from(x + gx * w < 0.0) << 1
-            | u8::from(-x + gx * w < 0.0) << 2
-            | u8::from(y + gy * w < 0.0) << 3
-            | u8::from(-y + gy * w < 0.0) << 4;
-        if -z + w < 0.0 {
-            outcode |= FAR_BIT;
-        }
-        if !in_front(clip) {
-            outcode |= NOT_IN_FRONT_BIT;
-        }
-        outcode
+        let bit = |outside: bool, bit: u8| u64::from(outside) << bit.trailing_zeros();
+        bit(z + near.w * w < 0.0, 1)
+            | bit(x + gx * w < 0.0, 1 << 1)
+            | bit(-x + gx * w < 0.0, 1 << 2)
+            | bit(y + gy * w < 0.0, 1 << 3)
+            | bit(-y + gy * w < 0.0, 1 << 4)
+            | bit(-z + w < 0.0, FAR_BIT)
+            | bit(!in_front(clip), NOT_IN_FRONT_BIT)
     }
 }
 
-/// Rule 1: model space to clip space, in f64.
-pub(super) fn transform(view_projection: DMat4, p: [f32; 3]) -> DVec4 {
-    view_projection * DVec4::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0)
+/// Rule 1: model space to clip space, in f64: glam's `DMat4 * DVec4`, each row
+/// `((m0·x + m1·y) + m2·z) + m3·1` left to right, written out (the product by 1 is exact).
+#[inline]
+pub(super) fn transform(view_projection: DMat4, [x, y, z]: [f32; 3]) -> DVec4 {
+    let (x, y, z) = (f64::from(x), f64::from(y), f64::from(z));
+    let [c0, c1, c2, c3] = view_projection.to_cols_array_2d();
+    let row = |r: usize| c0[r] * x + c1[r] * y + c2[r] * z + c3[r];
+    DVec4::new(row(0), row(1), row(2), row(3))
 }
 
-/// Rule 1 as a vertex shader computes `M * vec4(p, 1)` in f32: each matrix entry rounded to f32
-/// once, then every row `((m0·x + m1·y) + m2·z) + m3` with each product and sum rounded to f32 (no
-/// fused multiply-add: Rust never contracts, and `docs/semantics.md` says what a GPU's FMA
-/// changes). The result is exact in f64.
-pub(super) fn transform_f32(view_projection: DMat4, [x, y, z]: [f32; 3]) -> DVec4 {
-    // Column-major: entry (row r, column c) at c * 4 + r.
-    let m = view_projection.to_cols_array().map(|e| e as f32);
+/// Rule 1 as a vertex shader computes `M * vec4(p, 1)` in f32, from the matrix's entries rounded
+/// to f32 once (column-major: entry (row r, column c) at c * 4 + r): every row
+/// `((m0·x + m1·y) + m2·z) + m3` with each product and sum rounded to f32 (no fused
+/// multiply-add: Rust never contracts, and `docs/semantics.md` says what a GPU's FMA changes).
+/// The result is exact in f64.
+#[inline]
+pub(super) fn transform_f32(m: &[f32; 16], [x, y, z]: [f32; 3]) -> DVec4 {
     let row = |r: usize| f64::from(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
     DVec4::new(row(0), row(1), row(2), row(3))
 }
 
 /// Whether a clip-space vertex has `w > 0` (false for NaN).
+#[inline]
 pub(super) fn in_front(clip: DVec4) -> bool {
     clip.w > 0.0
 }
@@ -256,7 +313,7 @@ pub(super) fn in_front(clip: DVec4) -> bool {
 /// and y to the conventions' grid, expressed in 1/256 pixel with y down whatever the origin.
 pub(super) fn snap(viewport: Viewport, conventions: Conventions, v: DVec4) -> Snapped {
     let bits = conventions.subpixel_bits;
-    match (
+    let ([x, y], depth) = match (
         conventions.vertex_precision,
         conventions.window_origin,
         conventions.depth_range,
@@ -269,17 +326,19 @@ pub(super) fn snap(viewport: Viewport, conventions: Conventions, v: DVec4) -> Sn
         (F32, UpperLeft, MinusOneToOne) => snap_fixed::<true, false, true>(viewport, bits, v),
         (F32, LowerLeft, ZeroToOne) => snap_fixed::<true, true, false>(viewport, bits, v),
         (F32, LowerLeft, MinusOneToOne) => snap_fixed::<true, true, true>(viewport, bits, v),
-    }
+    };
+    ([x.into(), y.into()], depth)
 }
 
 /// [`snap`] under conventions fixed at compile time (see [`VertexStage::project`]), on the grid
-/// of `bits` subpixel bits.
+/// of `bits` subpixel bits, in `i32`: exact for a vertex inside the guard band (|x|, |y| < 2^24
+/// in 1/256 pixel), some value without overflow for any other, which no triangle reads.
 #[inline]
 fn snap_fixed<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
     viewport: Viewport,
     bits: u32,
     v: DVec4,
-) -> Snapped {
+) -> ([i32; 2], f64) {
     let size = [viewport.width, viewport.height];
     let ([x, y], depth) = if F32_STAGE {
         window::<f32, LOWER_LEFT, MINUS_ONE_TO_ONE>(
@@ -292,12 +351,12 @@ fn snap_fixed<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_
     let grid = |value: f64| {
         // Round on the coarser grid, then express the grid point in 1/256 pixel (a multiple of
         // 2^(8 − bits)), so that the scan is the same for every grid.
-        round_half_away(value * f64::from(1u32 << bits)).saturating_mul(1 << (SUBPIXEL_BITS - bits))
+        round_half_away(value * f64::from(1u32 << bits)).wrapping_shl(SUBPIXEL_BITS - bits)
     };
     let y = if LOWER_LEFT {
         // Snapped in the API's own y-up window, then flipped into fragsim's rows: row r of the
         // window is fragsim's row height − 1 − r, and the flip is exact on the grid.
-        (i64::from(viewport.height) << SUBPIXEL_BITS) - grid(y)
+        ((viewport.height as i32) << SUBPIXEL_BITS).wrapping_sub(grid(y))
     } else {
         grid(y)
     };
@@ -351,20 +410,35 @@ fn window<T: Real, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
     ([window_x.wide(), window_y.wide()], depth.wide())
 }
 
-/// `value.round() as i64` (half away from zero, saturating, NaN to 0) without a libm call:
-/// baseline x86-64 has no rounding instruction, only the truncating conversion. The fraction
-/// `value − trunc(value)` is exact for every f64, so the comparison with one half decides exactly
-/// as `round` does.
-pub(super) fn round_half_away(value: f64) -> i64 {
-    let truncated = value as i64;
-    let fraction = value - truncated as f64;
-    if fraction >= 0.5 {
-        truncated.saturating_add(1)
-    } else if fraction <= -0.5 {
-        truncated.saturating_sub(1)
-    } else {
-        truncated
-    }
+/// The largest magnitude [`round_half_away`] rounds exactly: 2^30, far beyond the guard band's
+/// 2^24 and leaving room for the rounding's step of one inside `i32`.
+pub(super) const ROUNDING_BOUND: f64 = (1u32 << 30) as f64;
+
+/// `value.round() as i32` (half away from zero) for `|value| ≤` [`ROUNDING_BOUND`]; a value
+/// beyond is first clamped to it, and NaN to its negative. No libm call, no conversion
+/// instruction and no branch: baseline x86-64 has no rounding instruction, its conversions of
+/// SIMD lanes of f64 to integers saturate only through scalar code, and the vertex stage's loop
+/// must run on SIMD lanes.
+///
+/// Adding `1.5 · 2^52` to a number below 2^51 in magnitude rounds it to an integer, to nearest
+/// with ties to even (IEEE addition), and leaves that integer in the low bits of the sum, two's
+/// complement; the difference between the value and that integer is exact, and is ±½ exactly at
+/// a tie, where rounding half away from zero differs from rounding to even by one when to even
+/// went toward zero.
+#[inline]
+// `f64::clamp` keeps NaN, which the sum below would carry into the integer's bits.
+#[allow(clippy::manual_clamp)]
+pub(super) fn round_half_away(value: f64) -> i32 {
+    const SHIFT: f64 = (3u64 << 51) as f64;
+    // `max` and `min` return the number when one side is NaN (`f64::clamp` keeps NaN).
+    let value = value.max(-ROUNDING_BOUND).min(ROUNDING_BOUND);
+    let shifted = value + SHIFT;
+    let to_even = shifted - SHIFT;
+    let tie = value - to_even;
+    // The integer's low 32 bits, all it has (|value| ≤ 2^30).
+    let rounded = shifted.to_bits() as i32;
+    // At a tie, to even went toward zero where the value's sign and the tie's agree.
+    rounded + i32::from(tie == 0.5 && value > 0.0) - i32::from(tie == -0.5 && value < 0.0)
 }
 
 /// Sutherland–Hodgman against one plane `p · v ≥ 0`.
