@@ -175,7 +175,12 @@ impl SampledReference {
         Ok(Self {
             scene,
             viewport: size,
-            reference: Reference::new(Cow::Owned(oracle), precision, VertexPrecision::F32, size),
+            reference: Reference::new(
+                Cow::Owned(oracle),
+                Cow::Owned(precision),
+                VertexPrecision::F32,
+                size,
+            ),
             covered,
         })
     }
