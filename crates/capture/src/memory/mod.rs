@@ -579,6 +579,20 @@ mod tests {
     }
 
     #[test]
+    fn an_empty_read_of_an_array_with_no_words_loads_nothing() {
+        // A dump may declare no slots (fuzz corpus dump_layouts/01bb91ef): its resolve reads an
+        // empty run at word 0 of an array with no page.
+        let layout = Layout::counters_and_slots(4, 0);
+        let memory: AtomicMemory = layout.allocate();
+        let mut out = vec![7u64];
+        WordMemory::<u64>::load_into(&memory, 0, 0, &mut out);
+        assert_eq!(out, [7], "nothing appended");
+        let mut out32 = Vec::new();
+        WordMemory::<u32>::load_into(&memory, 4, 0, &mut out32);
+        assert!(out32.is_empty());
+    }
+
+    #[test]
     fn a_write_beyond_the_cap_is_reported_and_read_back_never_allocated() {
         let layout = Layout::counters_and_slots(0, 4 * PAGE_WORDS);
         let mut memory: AtomicMemory = layout.allocate();

@@ -305,10 +305,11 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
 
     /// Words `start..start + len` as a [`Span`] of their page, when one page already allocated
     /// holds them all; `None` where they reach past a page's edge or their page is not
-    /// allocated (its first write allocates it, which the span leaves to the array).
+    /// allocated (its first write allocates it, which the span leaves to the array), or start
+    /// at or past the array's end (an empty array has no page to lend).
     #[inline]
     pub fn span(&self, start: usize, len: usize) -> Option<Span<'_, W, C>> {
-        let page = self.pages[start / PAGE_WORDS].get()?;
+        let page = self.pages.get(start / PAGE_WORDS)?.get()?;
         let first = start / PAGE_WORDS * PAGE_WORDS;
         (start - first + len <= page.words.len()).then_some(Span {
             page,
