@@ -7,7 +7,7 @@
 //! vertex on a pixel centre, each quad split along a diagonal: centres lie exactly on shared
 //! horizontal, vertical and diagonal edges and on the grid's outline.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use fragsim::oracle::dump::{Dump, DumpScheme, Words};
 use fragsim::oracle::edge_ties::{pipeline_rule, TiePoints};
@@ -15,8 +15,8 @@ use fragsim::oracle::scene::{SceneAndCamera, ViewProjection};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{EdgeTies, VertexPrecision, Viewport, WindowOrigin};
 
-use super::binary::stdout_of;
 use super::scratch;
+use super::soundness::compared;
 
 const SIDE: u32 = 8;
 /// Slots a pixel: more than any list of the grid holds (a doubled sample included).
@@ -120,19 +120,6 @@ impl Grid {
         dump.write(&dir).unwrap();
         dir
     }
-}
-
-/// `fragsim compare oracle DIR --json --no-image` with `options`, expecting exit `code`.
-fn compared(dir: &Path, options: &[&str], code: i32) -> serde_json::Value {
-    let out = stdout_of(
-        super::binary::fragsim()
-            .args(["compare", "oracle"])
-            .arg(dir)
-            .args(["--json", "--no-image"])
-            .args(options),
-        code,
-    );
-    crate::support::json_lines(out.as_bytes())[0].clone()
 }
 
 /// Both ways of judging the grid: every bit owed, and within an f32 vertex stage's precision.

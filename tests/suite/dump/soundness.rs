@@ -27,7 +27,7 @@ fn render(out: &Path, source: &[&str], size: u32, schemes: &str, options: &[&str
 
 /// `fragsim compare oracle DIR --json --no-image` with `options`, expecting exit `code`: the
 /// `compare` record.
-fn compared(dir: &Path, options: &[&str], code: i32) -> serde_json::Value {
+pub(super) fn compared(dir: &Path, options: &[&str], code: i32) -> serde_json::Value {
     let out = stdout_of(
         Command::cargo_bin("fragsim")
             .unwrap()
