@@ -22,7 +22,7 @@ use fragsim_oracle::compare::Comparison;
 use fragsim_oracle::dump::{Dump, DumpError, Words};
 use fragsim_oracle::precision::{f32_reference, Bounds, Precision};
 use fragsim_oracle::scene::SceneAndCamera;
-use fragsim_oracle::verdict::{self, Candidate, Options, Reference};
+use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Verdict};
 use fragsim_oracle::Oracle;
 use fragsim_raster::{Scene, VertexPrecision, Viewport};
 
@@ -197,12 +197,14 @@ impl WithinJudgement {
 }
 
 impl Within {
-    /// The reference for the scene and viewport `dump` names.
+    /// The reference for the scene and pixel viewport `dump` names: for a per-sample dump
+    /// (`conventions.samples` above 1, [`crate::capture_samples`]) the exact oracle per sample
+    /// and the bounds of an f32 vertex stage at every sample.
     ///
     /// # Errors
-    /// As [`f32_reference`]: a scene that cannot be loaded or rasterized.
+    /// As [`f32_reference`]: a bad viewport, or a scene that cannot be loaded or rasterized.
     pub fn of(dump: &Dump) -> Result<Self, DumpError> {
-        let viewport = dump.viewport()?;
+        let viewport = dump.header.pixel_viewport()?;
         let scene = dump.header.scene.clone();
         let (oracle, precision) = f32_reference(&scene, viewport, None)?;
         let covered = (0..oracle.pixels())
@@ -228,7 +230,7 @@ impl Within {
         &self.oracle
     }
 
-    /// Whether `dump` names this reference's scene and viewport.
+    /// Whether `dump` names this reference's scene (its sample count included) and viewport.
     #[must_use]
     pub fn fits(&self, dump: &Dump) -> bool {
         dump.header.scene == self.scene
@@ -236,11 +238,26 @@ impl Within {
                 == (self.viewport.width, self.viewport.height)
     }
 
-    /// `dump` judged within precision by the oracle's verdict, every word read.
+    /// `dump` judged within precision by the oracle's verdict, every word read: one line of
+    /// figures ([`WithinJudgement`]).
     ///
     /// # Errors
     /// A dump of another scene or viewport, or one its layout cannot decode.
     pub fn judge(&self, dump: &Dump) -> Result<WithinJudgement, DumpError> {
+        let verdict = self.verdict(dump)?;
+        Ok(WithinJudgement {
+            bounds: verdict.bounds.unwrap_or_default(),
+            comparison: verdict.comparison,
+            covered: self.covered,
+        })
+    }
+
+    /// `dump` judged within precision: the oracle's whole [`Verdict`] (per sample, its
+    /// `per_sample` counts), what `fragsim compare oracle DIR --vertex-precision f32` prints.
+    ///
+    /// # Errors
+    /// As [`Within::judge`].
+    pub fn verdict(&self, dump: &Dump) -> Result<Verdict, DumpError> {
         if !self.fits(dump) {
             return Err(DumpError(
                 "the dump names another scene or viewport than the reference's".into(),
@@ -258,12 +275,13 @@ impl Within {
             (self.viewport.width, self.viewport.height),
         )
         .with_edge_ties(&view);
-        let verdict =
-            verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError)?;
-        Ok(WithinJudgement {
-            bounds: verdict.bounds.unwrap_or_default(),
-            comparison: verdict.comparison,
-            covered: self.covered,
-        })
+        verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError)
+    }
+
+    /// Lists (pixels, or samples of a per-sample dump) the reference covers: what ambiguous
+    /// ones are a share of.
+    #[must_use]
+    pub fn covered(&self) -> u64 {
+        self.covered
     }
 }

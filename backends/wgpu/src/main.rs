@@ -31,7 +31,7 @@ use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::judge::{Within, WithinJudgement};
 use fragsim_wgpu::sample_counts::{
     count_samples, count_samples_of, covering_prims, f32_snap_radius, mirrored, reference_counts,
-    CountDiff, NearEdges, SampledReference,
+    CountDiff, NearEdges,
 };
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_samples, judge, Gpu, GpuScheme, Mode, Plant};
@@ -273,9 +273,8 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
     };
     let oracle = judge_it.then(|| Oracle::build(&fragsim_view));
     // The precision verdict's reference, built for the first dump and kept while the dumps name
-    // its scene (one view and mode: every dump of this command); per sample its own.
+    // its scene (one view and mode: every dump of this command).
     let mut within: Option<Within> = None;
-    let mut sampled: Option<SampledReference> = None;
     let mut failed = 0;
     let mut runs = 0;
     for scheme in &schemes {
@@ -339,25 +338,25 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                     println!("  verdict (depth ulps {ulps}): {}", judgement.summary());
                 }
             }
-            if precision && samples > 1 {
-                if !sampled.as_ref().is_some_and(|r| r.fits(&captured.dump)) {
-                    sampled = Some(SampledReference::of(&captured.dump)?);
+            if precision {
+                if !within.as_ref().is_some_and(|w| w.fits(&captured.dump)) {
+                    within = Some(Within::of(&captured.dump)?);
                 }
-                if let Some(reference) = &sampled {
-                    let verdict = reference.judge(&captured.dump)?;
+                if let Some(reference) = &within {
+                    let verdict = reference.verdict(&captured.dump)?;
                     let per_sample = verdict.per_sample;
-                    // The summary `fragsim-wgpu capture` prints at one sample (what
-                    // run_device.sh reads), its "pixels" the samples, then the pixels.
+                    // One line of figures (what run_device.sh reads), per sample its "pixels"
+                    // the samples, then the samples and pixels that differ.
                     let judgement = WithinJudgement {
                         comparison: verdict.comparison,
                         bounds: verdict.bounds.unwrap_or_default(),
-                        covered: reference.covered,
+                        covered: reference.covered(),
                     };
                     println!(
                         "  precision verdict (f32 vertex stage): {}",
                         judgement.summary()
                     );
-                    if let Some(c) = per_sample {
+                    if let Some(c) = per_sample.filter(|_| samples > 1) {
                         println!(
                             "  per sample ({samples} a pixel): {} of {} samples differ, in {} of {} pixels",
                             c.differing_samples,
@@ -366,17 +365,6 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                             c.compared / u64::from(samples)
                         );
                     }
-                }
-            } else if precision {
-                if !within.as_ref().is_some_and(|w| w.fits(&captured.dump)) {
-                    within = Some(Within::of(&captured.dump)?);
-                }
-                if let Some(reference) = &within {
-                    let judgement = reference.judge(&captured.dump)?;
-                    println!(
-                        "  precision verdict (f32 vertex stage): {}",
-                        judgement.summary()
-                    );
                 }
             }
         }

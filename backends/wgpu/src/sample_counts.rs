@@ -41,13 +41,8 @@
 //! the adapter's target format lacks, or a view that already rasterizes per sample, is an error
 //! naming it.
 
-use std::borrow::Cow;
-
-use fragsim_oracle::dump::{Dump, DumpError};
-use fragsim_oracle::precision::{f32_reference, Precision};
+use fragsim_oracle::precision::Precision;
 use fragsim_oracle::samples::SampleOracle;
-use fragsim_oracle::scene::SceneAndCamera;
-use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Verdict};
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{SamplePattern, View, SUBPIXEL_BITS};
 
@@ -142,68 +137,6 @@ impl SampleCounts {
             wall_ms,
             triangles,
         })
-    }
-}
-
-/// The precision verdict's reference for per-sample captures ([`crate::capture_samples`]): what
-/// `fragsim compare oracle DIR --vertex-precision f32` builds for a dump declaring
-/// `conventions.samples` (the exact oracle per sample under the dump's conventions and the bounds
-/// of an f32 vertex stage at every sample, [`f32_reference`] on the dump's pixel viewport), built
-/// once and kept for every dump naming its scene and viewport. (`judge::Within` takes the dump's
-/// framebuffer for its viewport, which per sample is the sample-expanded one.)
-pub struct SampledReference {
-    scene: SceneAndCamera,
-    viewport: (u32, u32),
-    reference: Reference<'static>,
-    /// Lists (samples) the reference covers: what ambiguous samples are a share of.
-    pub covered: u64,
-}
-
-impl SampledReference {
-    /// The reference for the scene and pixel viewport `dump` names.
-    ///
-    /// # Errors
-    /// A bad viewport, or a scene that cannot be loaded or rasterized ([`f32_reference`]).
-    pub fn of(dump: &Dump) -> Result<Self, DumpError> {
-        let viewport = dump.header.pixel_viewport()?;
-        let scene = dump.header.scene.clone();
-        let (oracle, precision) = f32_reference(&scene, viewport, None)?;
-        let covered = (0..oracle.pixels())
-            .filter(|&p| !oracle.pixel(p).is_empty())
-            .count() as u64;
-        let size = (viewport.width, viewport.height);
-        Ok(Self {
-            scene,
-            viewport: size,
-            reference: Reference::new(
-                Cow::Owned(oracle),
-                Cow::Owned(precision),
-                VertexPrecision::F32,
-                size,
-            ),
-            covered,
-        })
-    }
-
-    /// Whether `dump` names this reference's scene (its sample count included) and viewport.
-    #[must_use]
-    pub fn fits(&self, dump: &Dump) -> bool {
-        dump.header.scene == self.scene && (dump.header.width, dump.header.height) == self.viewport
-    }
-
-    /// `dump` judged by the oracle's verdict within precision, per sample, every word read.
-    ///
-    /// # Errors
-    /// A dump of another scene or viewport, or one its layout cannot decode.
-    pub fn judge(&self, dump: &Dump) -> Result<Verdict, String> {
-        if !self.fits(dump) {
-            return Err("the dump names another scene or viewport than the reference's".into());
-        }
-        let options = Options {
-            depth_ulps: 0,
-            examples: 8,
-        };
-        verdict::judge(&self.reference, Candidate::Dump(dump), &options)
     }
 }
 

@@ -20,9 +20,9 @@ use fragsim_oracle::dump::Dump;
 use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::verdict::{judge_sides, Side, SidesOptions, Verdict};
 use fragsim_raster::{SamplePattern, VertexPrecision, Viewport};
+use fragsim_wgpu::judge::Within;
 use fragsim_wgpu::sample_counts::{
     count_samples, count_samples_of, covering_prims, mirrored, reference_counts, CountDiff,
-    SampledReference,
 };
 use fragsim_wgpu::{adapter_or_skip, capture_samples, say_skipped, GpuScheme, Mode, Plant};
 
@@ -93,7 +93,7 @@ fn triangles_drawn_alone_cover_the_samples_the_oracle_gives_them() {
 
 /// The per-sample engine captures of `scene` at `samples` a pixel and 128², view 30°, each scheme
 /// correct and with every plant that applies, judged as `fragsim compare oracle DIR
-/// --vertex-precision f32` judges them (`SampledReference`: built once, from the scene the first
+/// --vertex-precision f32` judges them (`judge::Within`: built once, from the scene the first
 /// dump names); the verdicts by (scheme, plant).
 fn per_sample_verdicts(
     gpu: &fragsim_wgpu::Gpu,
@@ -114,7 +114,7 @@ fn per_sample_verdicts(
         GpuScheme::Mdts32 { k: 8 },
         GpuScheme::parse("linked-list-nearest", 8, 4).unwrap(),
     ];
-    let mut reference: Option<SampledReference> = None;
+    let mut reference: Option<Within> = None;
     let mut verdicts = Vec::new();
     for scheme in schemes {
         let plants = std::iter::once(None).chain(
@@ -137,9 +137,9 @@ fn per_sample_verdicts(
             let dump = &captured.dump;
             assert_eq!(dump.header.scene.conventions.samples, samples);
             if !reference.as_ref().is_some_and(|r| r.fits(dump)) {
-                reference = Some(SampledReference::of(dump).unwrap());
+                reference = Some(Within::of(dump).unwrap());
             }
-            let verdict = reference.as_ref().unwrap().judge(dump).unwrap();
+            let verdict = reference.as_ref().unwrap().verdict(dump).unwrap();
             if plant.is_none() {
                 same_through_the_files(dump, &verdict, &format!("{scene} {}", scheme.name()));
             }
