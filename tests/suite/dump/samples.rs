@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::binary::{fragsim, json_report, stdout_of};
 use super::scratch;
+use super::soundness::compared;
 
 /// `render --samples 4` of a small scene, with the dumps of `schemes` in `out` and `options`.
 fn render_4x(out: &Path, schemes: &str, options: &[&str]) {
@@ -195,4 +196,71 @@ fn a_header_with_a_sample_count_without_a_standard_pattern_is_refused_naming_the
         .unwrap();
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("--samples 2, 4, 8 or 16"));
+}
+
+#[test]
+fn an_f32_masked_node_dump_is_judged_a_sample_at_a_time_and_a_wrong_mask_a_lost_node_or_a_stray_key_is_different(
+) {
+    let dir = scratch("samples-masked-f32");
+    let f32 = ["--vertex-precision", "f32"];
+    render_4x(&dir, "abuffer-masked", &f32);
+    let masked = dir.join("abuffer-masked");
+    let record = compared(&masked, &f32, 0);
+    assert_eq!(record["equal"], true, "{record}");
+    // Judged a sample at a time, against the per-sample oracle.
+    assert_eq!(record["pixels"], 432 * 4, "{record}");
+    assert_eq!(record["per_sample_differing_samples"], 0, "{record}");
+    assert_eq!(
+        record["captured"], record["reference_fragments"],
+        "{record}"
+    );
+    assert!(
+        record["precision_max_vertex_error_subpixels"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+
+    let counters_path = masked.join("counters.u32");
+    let masks_path = masked.join("masks.u32");
+    let nodes_path = masked.join("nodes.u64");
+    let (counters, masks, nodes) = (
+        read_words::<4>(&counters_path),
+        read_words::<4>(&masks_path),
+        read_words::<8>(&nodes_path),
+    );
+    let capacity = masks.len() / counters.len();
+    let pixel = counters
+        .iter()
+        .position(|c| u32::from_le_bytes(*c) > 0)
+        .unwrap();
+    let first = pixel * capacity;
+    // A wrong mask: samples 0 and 1 swapped in the pixel's first node.
+    let mut wrong = masks.clone();
+    let mask = u32::from_le_bytes(wrong[first]);
+    wrong[first] = (if mask == 0b11 { 0b01 } else { mask ^ 0b11 }).to_le_bytes();
+    write_words(&masks_path, &wrong);
+    let record = compared(&masked, &f32, 1);
+    assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
+    write_words(&masks_path, &masks);
+    // A stray key: the first node's depth 0, in front of every depth the scene can reach.
+    let mut stray = nodes.clone();
+    stray[first][4..].copy_from_slice(&[0; 4]);
+    write_words(&nodes_path, &stray);
+    let record = compared(&masked, &f32, 1);
+    assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
+    write_words(&nodes_path, &nodes);
+    // A lost node: the pixel's last node and mask cleared and its counter one less.
+    let count = u32::from_le_bytes(counters[pixel]);
+    let last = first + count as usize - 1;
+    let (mut fewer, mut cleared, mut gone) = (counters.clone(), masks.clone(), nodes.clone());
+    fewer[pixel] = (count - 1).to_le_bytes();
+    cleared[last] = [0; 4];
+    gone[last] = [0xff; 8];
+    write_words(&counters_path, &fewer);
+    write_words(&masks_path, &cleared);
+    write_words(&nodes_path, &gone);
+    let record = compared(&masked, &f32, 1);
+    assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
+    assert!(record["lost"].as_u64().unwrap() >= 1, "{record}");
 }

@@ -214,13 +214,22 @@ pub fn judge(
         None => crate::compare::compare_with(oracle, &capture, words.as_ref(), &compare_options),
     };
     let mut comparison = match (candidate, reference.per_pixel()) {
-        (Candidate::Dump(dump), Some(per_pixel)) => {
-            let masked = dump
-                .compare_masked(per_pixel, &compare_options)
-                .map_err(|e| e.to_string())?;
-            wrong_masks = Some(masked.wrong_masks.len() as u64);
-            masked.nodes
-        }
+        (Candidate::Dump(dump), Some(per_pixel)) => match reference.masked_within_precision() {
+            // Per sample: a wrong mask is a missing or an extra node at the samples it gets
+            // wrong, counted there.
+            Some(within) => {
+                dump.compare_masked_within(&within.precision, &within.samples, &compare_options)
+                    .map_err(|e| e.to_string())?
+                    .nodes
+            }
+            None => {
+                let masked = dump
+                    .compare_masked(per_pixel, &compare_options)
+                    .map_err(|e| e.to_string())?;
+                wrong_masks = Some(masked.wrong_masks.len() as u64);
+                masked.nodes
+            }
+        },
         (_, Some(_)) => {
             return Err(
                 "the per-pixel view of the per-sample oracle judges masked-node dumps \
@@ -328,7 +337,10 @@ pub fn judge(
         stored_depth: stored,
         bounds,
         wrong_masks,
-        reference_fragments: oracle.depth_complexity(),
+        reference_fragments: reference
+            .masked_within_precision()
+            .map_or(oracle, |within| &within.samples)
+            .depth_complexity(),
         identity: capture.identity,
         notes,
         edge_ties,

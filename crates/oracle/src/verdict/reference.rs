@@ -38,8 +38,13 @@ enum Kind<'a> {
         vertex_precision: VertexPrecision,
         edge_ties: Option<EdgeTieSource<'a>>,
     },
-    /// The per-pixel view of the per-sample oracle (masked nodes, every bit owed).
-    Masked(MaskedLists),
+    /// The per-pixel view of the per-sample oracle (masked nodes): every bit owed, or, with
+    /// `within`, each node judged at each sample it covers within an f32 vertex stage's
+    /// precision.
+    Masked {
+        nodes: MaskedLists,
+        within: Option<MaskedWithin>,
+    },
     /// Another dump's decoded lists.
     Dump {
         /// Whether each pixel's list holds every fragment of the pixel.
@@ -51,6 +56,16 @@ enum Kind<'a> {
         /// Why the dump may not be the whole truth.
         notes: Vec<String>,
     },
+}
+
+/// What judging masked nodes within precision needs: the per-sample oracle and the bounds of an
+/// f32 vertex stage at every sample ([`crate::dump::Dump::compare_masked_within`]).
+#[derive(Clone, Debug)]
+pub(super) struct MaskedWithin {
+    /// The exact oracle, a list per (pixel, sample).
+    pub(super) samples: Oracle,
+    /// The bounds at every sample.
+    pub(super) precision: Precision,
 }
 
 /// What judging samples exactly on an edge under another rule needs: the view the oracle was
@@ -153,11 +168,26 @@ impl<'a> Reference<'a> {
                 &nodes,
                 Capacity::Unbounded,
             ))),
-            kind: Kind::Masked(nodes),
+            kind: Kind::Masked {
+                nodes,
+                within: None,
+            },
             width,
             height,
             notes: Vec::new(),
         }
+    }
+
+    /// This masked-node reference judging each node at each sample it covers within
+    /// `precision`, the bounds of an f32 vertex stage at every sample of `samples`, the exact
+    /// per-sample oracle (a list per (pixel, sample)) whose per-pixel view this is. Another
+    /// reference is returned as it is.
+    #[must_use]
+    pub fn masked_within(mut self, samples: Oracle, precision: Precision) -> Self {
+        if let Kind::Masked { within, .. } = &mut self.kind {
+            *within = Some(MaskedWithin { samples, precision });
+        }
+        self
     }
 
     /// `dump`'s decoded lists: a reference that knows every fragment only where its list is not
@@ -207,10 +237,15 @@ impl<'a> Reference<'a> {
         }
     }
 
-    /// The precision the oracle is owed within (`None` for a dump or a masked reference).
+    /// The precision the oracle is owed within (`None` for a dump or an exact masked
+    /// reference).
     pub(super) fn precision(&self) -> Option<&Precision> {
         match &self.kind {
             Kind::Oracle { precision, .. } => Some(&**precision),
+            Kind::Masked {
+                within: Some(within),
+                ..
+            } => Some(&within.precision),
             _ => None,
         }
     }
@@ -221,6 +256,9 @@ impl<'a> Reference<'a> {
             Kind::Oracle {
                 vertex_precision, ..
             } => *vertex_precision,
+            Kind::Masked {
+                within: Some(_), ..
+            } => VertexPrecision::F32,
             _ => VertexPrecision::F64,
         }
     }
@@ -228,14 +266,22 @@ impl<'a> Reference<'a> {
     /// The per-pixel view of the per-sample oracle, for a masked reference.
     pub(super) fn per_pixel(&self) -> Option<&MaskedLists> {
         match &self.kind {
-            Kind::Masked(nodes) => Some(nodes),
+            Kind::Masked { nodes, .. } => Some(nodes),
             _ => None,
         }
     }
 
     /// Whether this is the per-sample oracle's per-pixel view.
     pub(super) fn is_masked(&self) -> bool {
-        matches!(self.kind, Kind::Masked(_))
+        matches!(self.kind, Kind::Masked { .. })
+    }
+
+    /// What a masked reference judges within precision with (`None`: every bit owed).
+    pub(super) fn masked_within_precision(&self) -> Option<&MaskedWithin> {
+        match &self.kind {
+            Kind::Masked { within, .. } => within.as_ref(),
+            _ => None,
+        }
     }
 
     /// The identity of the reference's words.
@@ -273,7 +319,11 @@ impl<'a> Reference<'a> {
     /// Lists per pixel: the samples of a per-sample layout, else 1.
     pub(super) fn lists_per_pixel(&self) -> u32 {
         let pixels = (self.width as usize * self.height as usize).max(1);
-        (self.lists.pixels() / pixels).max(1) as u32
+        // Masked nodes judged within precision are judged a sample at a time.
+        let lists = self
+            .masked_within_precision()
+            .map_or(self.lists.pixels(), |within| within.samples.pixels());
+        (lists / pixels).max(1) as u32
     }
 
     /// Takes out of `candidate` the fragments a K-list dump reference cannot know: in a pixel

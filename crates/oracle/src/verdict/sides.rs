@@ -170,13 +170,6 @@ pub fn judge_sides(
     // A masked-node dump is judged against the per-pixel view of the per-sample oracle, which
     // only the oracle side can give.
     let masked = candidate.is_masked();
-    if judged_f32 && masked {
-        return Err(format!(
-            "--vertex-precision f32 does not judge a masked-node dump ({MASKED_SCHEME}) in \
-             compare yet (the oracle's Dump::compare_masked_within does, per sample): judge it \
-             exactly"
-        ));
-    }
     if reference.is_masked() || (masked && !matches!(reference, Side::Oracle)) {
         return Err(format!(
             "a masked-node dump ({MASKED_SCHEME}) is compared as the candidate against the \
@@ -208,10 +201,22 @@ pub fn judge_sides(
     };
     let oracle = match &view {
         None => None,
-        Some(view) if masked => Some(Reference::masked(
-            SampleOracle::build(view)?.per_pixel(),
-            size,
-        )),
+        Some(view) if masked => {
+            let sampled = SampleOracle::build(view)?;
+            let reference = Reference::masked(sampled.per_pixel(), size);
+            Some(if judged_f32 {
+                // The exact per-sample oracle (the view's vertex stage is f64 here) and the
+                // bounds of an f32 one at every sample, as for a per-sample dump.
+                let conventions = Conventions {
+                    vertex_precision: VertexPrecision::F32,
+                    ..view.conventions()
+                };
+                let precision = Precision::derive(view, &conventions);
+                reference.masked_within(sampled.oracle().clone(), precision)
+            } else {
+                reference
+            })
+        }
         Some(view) => {
             let stage = options.vertex_precision;
             let conventions = Conventions {
