@@ -123,9 +123,9 @@ pub struct SidesOptions<'a> {
 ///
 /// # Errors
 /// Both sides the oracle; dumps of different viewports, or of different scenes unless allowed;
-/// `--vertex-precision f32` on a multisampled dump or against a reference dump; a masked-node dump
-/// anywhere but as the candidate against the oracle; a scene that cannot be rebuilt; a dump that
-/// cannot be decoded.
+/// `--vertex-precision f32` against a reference dump; a masked-node dump anywhere but as the
+/// candidate against the oracle, or under f32 one whose nodes overflowed; a scene that cannot be
+/// rebuilt; a dump that cannot be decoded.
 pub fn judge_sides(
     reference: &Side,
     candidate: &Side,
