@@ -115,44 +115,91 @@ fn a_dropped_sample_fragment_a_wrong_mask_bit_and_a_dropped_node_are_different()
     assert_eq!(report["lost"], 1, "{report}");
 
     let masked = dir.join("abuffer-masked");
-    let counters_path = masked.join("counters.u32");
-    let masks_path = masked.join("masks.u32");
-    let nodes_path = masked.join("nodes.u64");
-    let (counters, masks, nodes) = (
-        read_words::<4>(&counters_path),
-        read_words::<4>(&masks_path),
-        read_words::<8>(&nodes_path),
-    );
-    let capacity = masks.len() / counters.len();
-    let pixel = counters
-        .iter()
-        .position(|c| u32::from_le_bytes(*c) > 0)
-        .unwrap();
-    // A wrong mask bit: sample 0 and 1 swapped in the pixel's first node (a mask of one bit
-    // moves, of two or more changes, never empties).
-    let mut wrong = masks.clone();
-    let mask = u32::from_le_bytes(wrong[pixel * capacity]);
-    let flipped = if mask == 0b11 { 0b01 } else { mask ^ 0b11 };
-    wrong[pixel * capacity] = flipped.to_le_bytes();
-    write_words(&masks_path, &wrong);
+    let arrays = MaskedArrays::read(&masked);
+    arrays.write_wrong_mask();
     let records = json_report(&masked, 1);
     assert_eq!(records[0]["wrong_masks"], 1, "{:?}", records[0]);
     assert_eq!(records[0]["corrupt_words"], 0, "{:?}", records[0]);
-    assert_eq!(records[1]["pixel"], pixel, "{:?}", records[1]);
-    write_words(&masks_path, &masks);
-    // A dropped node: the pixel's last node and mask cleared and its counter one less.
-    let count = u32::from_le_bytes(counters[pixel]);
-    let last = pixel * capacity + count as usize - 1;
-    let (mut fewer, mut cleared, mut gone) = (counters.clone(), masks.clone(), nodes.clone());
-    fewer[pixel] = (count - 1).to_le_bytes();
-    cleared[last] = [0; 4];
-    gone[last] = [0xff; 8];
-    write_words(&counters_path, &fewer);
-    write_words(&masks_path, &cleared);
-    write_words(&nodes_path, &gone);
+    assert_eq!(records[1]["pixel"], arrays.pixel, "{:?}", records[1]);
+    arrays.write_lost_node();
     let report = &json_report(&masked, 1)[0];
     assert_eq!(report["lost"], 1, "{report}");
     assert_eq!(report["missing_pixels"], 1, "{report}");
+}
+
+/// A masked-node dump's arrays as written, and the first pixel that stored a node: the plants
+/// of the tests, each written over the files from the arrays as written (one plant at a time).
+struct MaskedArrays {
+    dir: std::path::PathBuf,
+    counters: Vec<[u8; 4]>,
+    masks: Vec<[u8; 4]>,
+    nodes: Vec<[u8; 8]>,
+    capacity: usize,
+    pixel: usize,
+}
+
+impl MaskedArrays {
+    fn read(dir: &Path) -> Self {
+        let counters = read_words::<4>(&dir.join("counters.u32"));
+        let masks = read_words::<4>(&dir.join("masks.u32"));
+        let nodes = read_words::<8>(&dir.join("nodes.u64"));
+        let capacity = masks.len() / counters.len();
+        let pixel = counters
+            .iter()
+            .position(|c| u32::from_le_bytes(*c) > 0)
+            .unwrap();
+        Self {
+            dir: dir.to_path_buf(),
+            counters,
+            masks,
+            nodes,
+            capacity,
+            pixel,
+        }
+    }
+
+    /// The slot of the pixel's first node.
+    fn first(&self) -> usize {
+        self.pixel * self.capacity
+    }
+
+    fn write(&self, counters: &[[u8; 4]], masks: &[[u8; 4]], nodes: &[[u8; 8]]) {
+        write_words(&self.dir.join("counters.u32"), counters);
+        write_words(&self.dir.join("masks.u32"), masks);
+        write_words(&self.dir.join("nodes.u64"), nodes);
+    }
+
+    /// A wrong mask: samples 0 and 1 swapped in the pixel's first node (a mask of one bit
+    /// moves, of two or more changes, never empties).
+    fn write_wrong_mask(&self) {
+        let mut wrong = self.masks.clone();
+        let mask = u32::from_le_bytes(wrong[self.first()]);
+        wrong[self.first()] = (if mask == 0b11 { 0b01 } else { mask ^ 0b11 }).to_le_bytes();
+        self.write(&self.counters, &wrong, &self.nodes);
+    }
+
+    /// A stray key: the pixel's first node at depth 0, in front of every depth the scene can
+    /// reach.
+    fn write_stray_key(&self) {
+        let mut stray = self.nodes.clone();
+        stray[self.first()][4..].copy_from_slice(&[0; 4]);
+        self.write(&self.counters, &self.masks, &stray);
+    }
+
+    /// A lost node: the pixel's last node and mask cleared and its counter one less.
+    fn write_lost_node(&self) {
+        let count = u32::from_le_bytes(self.counters[self.pixel]);
+        let last = self.first() + count as usize - 1;
+        let (mut fewer, mut cleared, mut gone) = (
+            self.counters.clone(),
+            self.masks.clone(),
+            self.nodes.clone(),
+        );
+        fewer[self.pixel] = (count - 1).to_le_bytes();
+        cleared[last] = [0; 4];
+        gone[last] = [0xff; 8];
+        self.write(&fewer, &cleared, &gone);
+    }
 }
 
 #[test]
@@ -221,45 +268,14 @@ fn an_f32_masked_node_dump_is_judged_a_sample_at_a_time_and_a_wrong_mask_a_lost_
             > 0.0
     );
 
-    let counters_path = masked.join("counters.u32");
-    let masks_path = masked.join("masks.u32");
-    let nodes_path = masked.join("nodes.u64");
-    let (counters, masks, nodes) = (
-        read_words::<4>(&counters_path),
-        read_words::<4>(&masks_path),
-        read_words::<8>(&nodes_path),
-    );
-    let capacity = masks.len() / counters.len();
-    let pixel = counters
-        .iter()
-        .position(|c| u32::from_le_bytes(*c) > 0)
-        .unwrap();
-    let first = pixel * capacity;
-    // A wrong mask: samples 0 and 1 swapped in the pixel's first node.
-    let mut wrong = masks.clone();
-    let mask = u32::from_le_bytes(wrong[first]);
-    wrong[first] = (if mask == 0b11 { 0b01 } else { mask ^ 0b11 }).to_le_bytes();
-    write_words(&masks_path, &wrong);
+    let arrays = MaskedArrays::read(&masked);
+    arrays.write_wrong_mask();
     let record = compared(&masked, &f32, 1);
     assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
-    write_words(&masks_path, &masks);
-    // A stray key: the first node's depth 0, in front of every depth the scene can reach.
-    let mut stray = nodes.clone();
-    stray[first][4..].copy_from_slice(&[0; 4]);
-    write_words(&nodes_path, &stray);
+    arrays.write_stray_key();
     let record = compared(&masked, &f32, 1);
     assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
-    write_words(&nodes_path, &nodes);
-    // A lost node: the pixel's last node and mask cleared and its counter one less.
-    let count = u32::from_le_bytes(counters[pixel]);
-    let last = first + count as usize - 1;
-    let (mut fewer, mut cleared, mut gone) = (counters.clone(), masks.clone(), nodes.clone());
-    fewer[pixel] = (count - 1).to_le_bytes();
-    cleared[last] = [0; 4];
-    gone[last] = [0xff; 8];
-    write_words(&counters_path, &fewer);
-    write_words(&masks_path, &cleared);
-    write_words(&nodes_path, &gone);
+    arrays.write_lost_node();
     let record = compared(&masked, &f32, 1);
     assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
     assert!(record["lost"].as_u64().unwrap() >= 1, "{record}");
