@@ -4,6 +4,8 @@
 //! (top-left, or bottom-left in fragsim's y-down rows for a lower-left origin); per covered
 //! centre only the depth is interpolated, in f64 from the edge values, and rounded once to f32.
 
+use glam::Vec4;
+
 use super::setup::ScanSetup;
 use super::{PixelRect, ScreenTriangle, View, HALF, ONE, SUBPIXEL_BITS};
 use crate::conventions::WindowOrigin;
@@ -35,6 +37,25 @@ impl View<'_> {
         let mut row = setup.origin;
         let mut row_pixel = i64::from(y0) * width + i64::from(x0);
         let step = setup.step_x;
+        if setup.block {
+            // Most triangles of a dense mesh: their whole box at once.
+            let mut covered = setup.block_coverage(last, i64::from(y1 - y0));
+            while covered != 0 {
+                let bit = i64::from(covered.trailing_zeros());
+                let (down, right) = (bit / BLOCK_SIDE, bit % BLOCK_SIDE);
+                let e = [
+                    row[0] + step[0] * right + setup.step_y[0] * down,
+                    row[1] + step[1] * right + setup.step_y[1] * down,
+                    row[2] + step[2] * right + setup.step_y[2] * down,
+                ];
+                let pixel = row_pixel + down * width + right;
+                if let Some(fragment) = fragment_at(setup.prim, setup.z, e, setup.area, pixel) {
+                    emit(fragment);
+                }
+                covered &= covered - 1;
+            }
+            return;
+        }
         if last < NARROW_BOX_WIDTH {
             // A narrow box: its few centres of a row cost less tested one by one than the
             // divisions that find the row's covered run. (One loop for both kinds of box,
@@ -90,7 +111,51 @@ fn advance(values: &mut [i64; 3], by: [i64; 3]) {
 /// row there, more than testing two or three centres.
 const NARROW_BOX_WIDTH: i64 = 3;
 
+/// Triangles that span less than this many pixels on each axis (so that their boxes hold at most
+/// this many centres a side) are scanned as one block ([`ScanSetup::block_coverage`]): every
+/// centre of the box tested at once, without a branch,
+/// then the covered ones visited. Tested one by one, the coverage of a centre is a branch the
+/// processor guesses wrong about as often as right on a dense mesh (callgrind's branch
+/// simulation put a quarter of the 2048² dragon frame's mispredictions there).
+pub(super) const BLOCK_SIDE: i64 = 4;
+
 impl ScanSetup {
+    /// The covered centres of a box of at most [`BLOCK_SIDE`] × [`BLOCK_SIDE`] pixels whose last
+    /// column and row are `last_column` and `last_row` (offsets from its first pixel): bit
+    /// `BLOCK_SIDE · down + right` set when the centre `right` pixels right of and `down` below
+    /// the first is covered.
+    ///
+    /// Every centre of the block is tested at once, a row of four centres in one four-lane vector
+    /// per edge (glam's `Vec4`: SSE2 on x86-64, NEON on ARM), in f32, which is exact here: the
+    /// record's triangle spans less than [`BLOCK_SIDE`] pixels (1,024 grid units) on each axis, so
+    /// its box holds at most four centres a side, each step (a vertex difference times 256) is
+    /// below 2^18, the edge value `(b − a) × (p − a)` at the first centre (inside the box) is below
+    /// 2 · 1,024 · 1,024 = 2^21, and every value formed from it and at most six steps stays below
+    /// 2^22: integers that f32 holds exactly, as it does their sums and the products of a step
+    /// by 3.
+    #[inline]
+    fn block_coverage(&self, last_column: i64, last_row: i64) -> u32 {
+        const RIGHT: Vec4 = Vec4::new(0.0, 1.0, 2.0, 3.0);
+        let lane = |value: i64| Vec4::splat(value as f32);
+        let mut rows = [Vec4::ZERO; 3];
+        let mut down = [Vec4::ZERO; 3];
+        let mut below = [Vec4::ZERO; 3];
+        for k in 0..3 {
+            rows[k] = lane(self.origin[k]) + RIGHT * lane(self.step_x[k]);
+            down[k] = lane(self.step_y[k]);
+            below[k] = lane(self.threshold[k] - 1);
+        }
+        let mut covered = 0u32;
+        for row in 0..BLOCK_SIDE as u32 {
+            let inside = |k: usize| rows[k].cmpgt(below[k]);
+            covered |= (inside(0) & inside(1) & inside(2)).bitmask() << (BLOCK_SIDE as u32 * row);
+            for k in 0..3 {
+                rows[k] += down[k];
+            }
+        }
+        covered & BLOCK_MASKS[last_row as usize][last_column as usize]
+    }
+
     /// Whether a centre whose edge values are `e` is covered: every edge value at least its
     /// threshold (rule 6, with the fill rule's ownership of the centres on an edge).
     #[inline]
@@ -129,6 +194,28 @@ impl ScanSetup {
         (first <= end).then_some((first, end))
     }
 }
+
+/// The bits of [`ScanSetup::block_coverage`] inside a box whose last row and column are the
+/// indices: the first `last_row + 1` rows of `last_column + 1` bits each.
+const BLOCK_MASKS: [[u32; BLOCK_SIDE as usize]; BLOCK_SIDE as usize] = {
+    let side = BLOCK_SIDE as usize;
+    let mut masks = [[0; BLOCK_SIDE as usize]; BLOCK_SIDE as usize];
+    let mut last_row = 0;
+    while last_row < side {
+        let mut last_column = 0;
+        while last_column < side {
+            let row_bits = (1u32 << (last_column + 1)) - 1;
+            let mut down = 0;
+            while down <= last_row {
+                masks[last_row][last_column] |= row_bits << (side * down);
+                down += 1;
+            }
+            last_column += 1;
+        }
+        last_row += 1;
+    }
+    masks
+};
 
 /// The fill rule's threshold of each edge for a window origin: a sample point is covered by an
 /// edge when the edge's value there is at least the threshold, 0 where the edge owns the points

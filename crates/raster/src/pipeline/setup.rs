@@ -23,7 +23,7 @@
 //! bin them to screen tiles and scan each tile's part later ([`View::scan_within`]): a triangle is
 //! set up once however many tiles and geometry passes scan it.
 
-use super::scan::{bounding_box, edge, fill_thresholds, per_edge};
+use super::scan::{bounding_box, edge, fill_thresholds, per_edge, BLOCK_SIDE};
 use super::{PixelRect, ScreenTriangle, Snapped, View, CLIP_BITS, HALF, NOT_IN_FRONT_BIT, ONE};
 use crate::conventions::WindowOrigin;
 use crate::fragment::Fragment;
@@ -54,6 +54,9 @@ pub(super) struct ScanSetup {
     pub(super) z: [f64; 3],
     /// Twice the triangle's area, positive, as f64 (exact: below 2^49).
     pub(super) area: f64,
+    /// Whether the triangle's snapped bounding box spans less than [`BLOCK_SIDE`] pixels on
+    /// each axis, so that the scan tests its box as one block ([`ScanSetup::block_coverage`]).
+    pub(super) block: bool,
 }
 
 impl ScanSetup {
@@ -76,10 +79,18 @@ impl ScanSetup {
         })
     }
 
-    /// Sets up an oriented triangle of doubled area `area` (positive) for a scan of `pixels`,
-    /// which must lie within its bounding box's centres.
-    #[inline]
-    fn new(tri: &ScreenTriangle, area: i64, pixels: PixelRect, origin: WindowOrigin) -> Self {
+    /// Sets up an oriented triangle of doubled area `area` (positive) and bounding box
+    /// `[lo, hi]` for a scan of `pixels`, which must lie within the box's centres.
+    // Always inlined: the record is then written straight into the caller's batch (a call
+    // returned it through the stack and copied it, 150 instructions a triangle at 2048²).
+    #[inline(always)]
+    fn new(
+        tri: &ScreenTriangle,
+        area: i64,
+        [lo, hi]: [[i64; 2]; 2],
+        pixels: PixelRect,
+        origin: WindowOrigin,
+    ) -> Self {
         let [a, b, c] = tri.xy;
         let edges = [(b, c), (c, a), (a, b)];
         let first_centre = [
@@ -95,6 +106,7 @@ impl ScanSetup {
             threshold: fill_thresholds(edges, origin),
             z: tri.z,
             area: area as f64,
+            block: (hi[0] - lo[0]) | (hi[1] - lo[1]) < BLOCK_SIDE * ONE,
         }
     }
 
@@ -108,7 +120,7 @@ impl ScanSetup {
         let [lo, hi] = bounding_box(tri.xy);
         let pixels = rect.centres_within(lo, hi)?;
         let [a, b, c] = tri.xy;
-        Some(Self::new(tri, edge(a, b, c), pixels, origin))
+        Some(Self::new(tri, edge(a, b, c), [lo, hi], pixels, origin))
     }
 }
 
@@ -222,7 +234,8 @@ impl View<'_> {
             (i64::from(p.min(q).min(r)), i64::from(p.max(q).max(r)))
         };
         let ((x_lo, x_hi), (y_lo, y_hi)) = (axis(0), axis(1));
-        let Some(pixels) = rect.centres_within([x_lo, y_lo], [x_hi, y_hi]) else {
+        let (lo, hi) = ([x_lo, y_lo], [x_hi, y_hi]);
+        let Some(pixels) = rect.centres_within(lo, hi) else {
             return;
         };
         let xy = [a.position(), b.position(), c.position()];
@@ -240,7 +253,7 @@ impl View<'_> {
             (xy[2], self.window_z[ic as usize]),
         ];
         if let Some((tri, area)) = self.oriented(prim, snapped) {
-            visit(ScanSetup::new(&tri, area, pixels, origin));
+            visit(ScanSetup::new(&tri, area, [lo, hi], pixels, origin));
         }
     }
 

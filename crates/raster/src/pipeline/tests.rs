@@ -605,3 +605,78 @@ fn set_up_triangles_scanned_by_tiles_equal_rasterizing_each_tile() {
     }
     assert!(fragments > 10_000, "{fragments} fragments");
 }
+
+/// Small triangles, scanned as one block ([`super::scan`]'s block coverage), emit what testing
+/// every centre emits: vertices on a grid of a quarter pixel, so that edges and vertices fall on
+/// centres and the fill rule decides, with boxes spanning up to just under the block's side (the
+/// largest values the vector lanes hold) and just over it (scanned row by row), in both
+/// orientations, under both fill rules, on the viewport and on rectangles that cut the box.
+#[test]
+fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
+    use super::scan::BLOCK_SIDE;
+    use super::setup::ScanSetup;
+    let mut rng = crate::rng::SplitMix64::new(35);
+    let viewport = Viewport::new(24, 20).unwrap();
+    let mesh = Mesh {
+        positions: Vec::new(),
+        triangles: Vec::new(),
+    };
+    let camera = Camera {
+        view_projection: DMat4::IDENTITY,
+    };
+    let (mut blocks, mut fragments) = (0, 0);
+    for window_origin in [
+        crate::conventions::WindowOrigin::UpperLeft,
+        crate::conventions::WindowOrigin::LowerLeft,
+    ] {
+        let conventions = Conventions {
+            window_origin,
+            ..Conventions::REFERENCE
+        };
+        let view =
+            View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions).unwrap();
+        for prim in 0..4000 {
+            // A corner away from the viewport's sides, and vertices within `span` quarter pixels
+            // of it: up to 4 pixels and 1/4 over, so boxes on both sides of the limit.
+            let span = 1 + rng.next_u64() % (4 * BLOCK_SIDE as u64 + 2);
+            let corner = [2 + rng.next_u64() % 16, 2 + rng.next_u64() % 12].map(|c| c * 256);
+            let mut offset = |c: u64| (c + (rng.next_u64() % (span + 1)) * ONE as u64 / 4) as i64;
+            let [a, b, c] = [(); 3].map(|()| [offset(corner[0]), offset(corner[1])]);
+            let area = edge(a, b, c);
+            if area == 0 {
+                continue;
+            }
+            // Oriented as the pipeline orients a triangle: positive doubled area.
+            let xy = if area > 0 { [a, b, c] } else { [a, c, b] };
+            let tri = ScreenTriangle {
+                prim,
+                xy,
+                z: [0.25, 0.5, 0.75],
+            };
+            let rects = [
+                viewport.rect(),
+                PixelRect {
+                    x: (0, (corner[0] / 256 + 1) as u32),
+                    y: ((corner[1] / 256 + 2) as u32, 19),
+                },
+            ];
+            for rect in rects {
+                let mut scanned = Vec::new();
+                view.scan_in(&tri, rect, &mut |f| scanned.push(f));
+                assert_eq!(
+                    scanned,
+                    scan_every_centre(&view, &tri, rect),
+                    "{xy:?} in {rect:?} under {window_origin:?}"
+                );
+                fragments += scanned.len();
+                let origin = view.conventions().window_origin;
+                blocks +=
+                    usize::from(ScanSetup::within(&tri, rect, origin).is_some_and(|s| s.block));
+            }
+        }
+    }
+    assert!(
+        blocks > 5_000 && fragments > 5_000,
+        "{blocks} blocks, {fragments} fragments"
+    );
+}
