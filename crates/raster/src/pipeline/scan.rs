@@ -113,11 +113,11 @@ const NARROW_BOX_WIDTH: i64 = 3;
 
 /// Triangles that span less than this many pixels on each axis (so that their boxes hold at most
 /// this many centres a side) are scanned as one block ([`ScanSetup::block_coverage`]): every
-/// centre of the box tested at once, without a branch,
-/// then the covered ones visited. Tested one by one, the coverage of a centre is a branch the
-/// processor guesses wrong about as often as right on a dense mesh (callgrind's branch
-/// simulation put a quarter of the 2048² dragon frame's mispredictions there).
-pub(super) const BLOCK_SIDE: i64 = 4;
+/// centre of the box tested at once, without a branch, then the covered ones visited. Tested one
+/// by one, the coverage of a centre is a branch the processor guesses wrong about as often as
+/// right on a dense mesh (callgrind's branch simulation put a quarter of the 2048² dragon frame's
+/// mispredictions there), and so is the end of a row's run.
+pub(super) const BLOCK_SIDE: i64 = 8;
 
 impl ScanSetup {
     /// The covered centres of a box of at most [`BLOCK_SIDE`] × [`BLOCK_SIDE`] pixels whose last
@@ -125,35 +125,55 @@ impl ScanSetup {
     /// `BLOCK_SIDE · down + right` set when the centre `right` pixels right of and `down` below
     /// the first is covered.
     ///
-    /// Every centre of the block is tested at once, a row of four centres in one four-lane vector
+    /// Every centre of the box is tested at once, four centres of a row in one four-lane vector
     /// per edge (glam's `Vec4`: SSE2 on x86-64, NEON on ARM), in f32, which is exact here: the
-    /// record's triangle spans less than [`BLOCK_SIDE`] pixels (1,024 grid units) on each axis, so
-    /// its box holds at most four centres a side, each step (a vertex difference times 256) is
-    /// below 2^18, the edge value `(b − a) × (p − a)` at the first centre (inside the box) is below
-    /// 2 · 1,024 · 1,024 = 2^21, and every value formed from it and at most six steps stays below
-    /// 2^22: integers that f32 holds exactly, as it does their sums and the products of a step
-    /// by 3.
+    /// record's triangle spans less than [`BLOCK_SIDE`] pixels (2,048 grid units) on each axis,
+    /// so each step (a vertex difference times 256) is below 2^19, the edge value
+    /// `(b − a) × (p − a)` at the first centre (inside the box) is below 2 · 2,048 · 2,048 = 2^23,
+    /// and every value formed from it and at most seven steps along each axis stays below
+    /// 2^23 + 14 · 2^19 < 2^24: integers that f32 holds exactly, as it does their sums and the
+    /// products of a step by at most 7.
     #[inline]
-    fn block_coverage(&self, last_column: i64, last_row: i64) -> u32 {
-        const RIGHT: Vec4 = Vec4::new(0.0, 1.0, 2.0, 3.0);
+    fn block_coverage(&self, last_column: i64, last_row: i64) -> u64 {
+        const COLUMNS: Vec4 = Vec4::new(0.0, 1.0, 2.0, 3.0);
         let lane = |value: i64| Vec4::splat(value as f32);
-        let mut rows = [Vec4::ZERO; 3];
+        let mut left = [Vec4::ZERO; 3];
+        let mut right = [Vec4::ZERO; 3];
         let mut down = [Vec4::ZERO; 3];
         let mut below = [Vec4::ZERO; 3];
         for k in 0..3 {
-            rows[k] = lane(self.origin[k]) + RIGHT * lane(self.step_x[k]);
+            let step = lane(self.step_x[k]);
+            left[k] = lane(self.origin[k]) + COLUMNS * step;
+            right[k] = left[k] + 4.0 * step;
             down[k] = lane(self.step_y[k]);
             below[k] = lane(self.threshold[k] - 1);
         }
-        let mut covered = 0u32;
-        for row in 0..BLOCK_SIDE as u32 {
-            let inside = |k: usize| rows[k].cmpgt(below[k]);
-            covered |= (inside(0) & inside(1) & inside(2)).bitmask() << (BLOCK_SIDE as u32 * row);
-            for k in 0..3 {
-                rows[k] += down[k];
+        let inside = |half: &[Vec4; 3]| {
+            let edge = |k: usize| half[k].cmpgt(below[k]);
+            u64::from((edge(0) & edge(1) & edge(2)).bitmask())
+        };
+        let wide = last_column >= 4;
+        let mut covered = 0u64;
+        // Four rows always, without a branch (most boxes have at most four), four more when the
+        // box has them; rows past the last are masked off below.
+        for rows in [0..4, 4..8] {
+            if rows.start > last_row {
+                break;
+            }
+            for row in rows {
+                let mut bits = inside(&left);
+                if wide {
+                    bits |= inside(&right) << 4;
+                }
+                covered |= bits << (BLOCK_SIDE * row);
+                for k in 0..3 {
+                    left[k] += down[k];
+                    right[k] += down[k];
+                }
             }
         }
-        covered & BLOCK_MASKS[last_row as usize][last_column as usize]
+        let columns = ((1u64 << (last_column + 1)) - 1) * 0x0101_0101_0101_0101;
+        covered & columns & (u64::MAX >> (BLOCK_SIDE * (BLOCK_SIDE - 1 - last_row)))
     }
 
     /// Whether a centre whose edge values are `e` is covered: every edge value at least its
@@ -194,28 +214,6 @@ impl ScanSetup {
         (first <= end).then_some((first, end))
     }
 }
-
-/// The bits of [`ScanSetup::block_coverage`] inside a box whose last row and column are the
-/// indices: the first `last_row + 1` rows of `last_column + 1` bits each.
-const BLOCK_MASKS: [[u32; BLOCK_SIDE as usize]; BLOCK_SIDE as usize] = {
-    let side = BLOCK_SIDE as usize;
-    let mut masks = [[0; BLOCK_SIDE as usize]; BLOCK_SIDE as usize];
-    let mut last_row = 0;
-    while last_row < side {
-        let mut last_column = 0;
-        while last_column < side {
-            let row_bits = (1u32 << (last_column + 1)) - 1;
-            let mut down = 0;
-            while down <= last_row {
-                masks[last_row][last_column] |= row_bits << (side * down);
-                down += 1;
-            }
-            last_column += 1;
-        }
-        last_row += 1;
-    }
-    masks
-};
 
 /// The fill rule's threshold of each edge for a window origin: a sample point is covered by an
 /// edge when the edge's value there is at least the threshold, 0 where the edge owns the points

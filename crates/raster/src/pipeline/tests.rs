@@ -616,7 +616,7 @@ fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
     use super::scan::BLOCK_SIDE;
     use super::setup::ScanSetup;
     let mut rng = crate::rng::SplitMix64::new(35);
-    let viewport = Viewport::new(24, 20).unwrap();
+    let viewport = Viewport::new(32, 28).unwrap();
     let mesh = Mesh {
         positions: Vec::new(),
         triangles: Vec::new(),
@@ -637,7 +637,7 @@ fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
             View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions).unwrap();
         for prim in 0..4000 {
             // A corner away from the viewport's sides, and vertices within `span` quarter pixels
-            // of it: up to 4 pixels and 1/4 over, so boxes on both sides of the limit.
+            // of it: up to a quarter pixel over the block side, so boxes on both sides of the limit.
             let span = 1 + rng.next_u64() % (4 * BLOCK_SIDE as u64 + 2);
             let corner = [2 + rng.next_u64() % 16, 2 + rng.next_u64() % 12].map(|c| c * 256);
             let mut offset = |c: u64| (c + (rng.next_u64() % (span + 1)) * ONE as u64 / 4) as i64;
@@ -657,7 +657,7 @@ fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
                 viewport.rect(),
                 PixelRect {
                     x: (0, (corner[0] / 256 + 1) as u32),
-                    y: ((corner[1] / 256 + 2) as u32, 19),
+                    y: ((corner[1] / 256 + 2) as u32, 27),
                 },
             ];
             for rect in rects {
