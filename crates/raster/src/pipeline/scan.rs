@@ -298,7 +298,9 @@ pub fn edge(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 #[inline]
 pub(super) fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    dy < 0 || (dy == 0 && dx > 0)
+    // Without short-circuits: the edge's direction is as good as random on a mesh, and a
+    // branch on it was guessed wrong for one triangle in ten at 2048² (callgrind).
+    (dy < 0) | ((dy == 0) & (dx > 0))
 }
 
 /// The top-left rule of a y-up window (OpenGL's lower-left origin) seen in fragsim's y-down rows:
@@ -307,5 +309,5 @@ pub(super) fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
 #[inline]
 pub(super) fn is_bottom_left(a: [i64; 2], b: [i64; 2]) -> bool {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    dy < 0 || (dy == 0 && dx < 0)
+    (dy < 0) | ((dy == 0) & (dx < 0))
 }
