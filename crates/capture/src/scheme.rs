@@ -137,6 +137,15 @@ pub trait Scheme: Sync {
     /// One memory operation of the fragment's walk.
     fn step<M: Memory>(&self, state: &mut Self::State, memory: &M) -> Step;
 
+    /// Loads the words that the fragment's walk of the first geometry pass begins with, ahead
+    /// of the walk ([`WordMemory::prefetch`]): an executor that rasterizes a run of fragments
+    /// before walking them calls it as each is rasterized, so that their cache misses overlap.
+    /// No step and no memory operation of the GPU; schemes that do not override it load
+    /// nothing ahead.
+    fn prefetch<M: Memory>(&self, fragment: Fragment, memory: &M) {
+        let _ = (fragment, memory);
+    }
+
     /// Where the walk stands for a SIMT scheduler (a spin on a lock, a reconvergence point): what
     /// the scheduled executor's lockstep policy and deadlock detection read. Schemes without
     /// locks need not override it.

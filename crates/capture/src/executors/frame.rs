@@ -267,9 +267,18 @@ pub fn interleaved<S: Scheme, M: Memory>(
     counters
 }
 
+/// Fragments rasterized ahead of their walks: each fragment's first words are loaded as it is
+/// rasterized ([`Scheme::prefetch`]) and its walk runs this many fragments later. A walk's
+/// read-modify-write waits for its pixel's line, and so does everything after it on that
+/// thread: walked as they came, the 2048² dragon's fragments missed the last-level cache 1.6
+/// times each, one after the other (callgrind's cache simulation). Loaded ahead, those misses
+/// overlap one another and the rasterization in between.
+const FRAGMENTS_AHEAD: usize = 32;
+
 /// Rasterizes the pixels of `rect` that the triangles `prims` cover, triangle after triangle in
 /// the order given ([`View::rasterize_each_in`]), and runs each fragment's walk of geometry pass
-/// `pass` to its end as it is rasterized.
+/// `pass` to its end, in the order rasterized, [`FRAGMENTS_AHEAD`] fragments after it is
+/// rasterized (the first pass's fragments loaded ahead).
 pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
     view: &View<'_>,
     scheme: &S,
@@ -279,9 +288,20 @@ pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
     rect: PixelRect,
     counters: &mut Counters,
 ) {
+    let mut ahead = [None; FRAGMENTS_AHEAD];
+    let mut next = 0;
     view.rasterize_each_in(prims, rect, &mut |fragment| {
-        walk(scheme, memory, pass, fragment, counters);
+        if pass == 0 {
+            scheme.prefetch(fragment, memory);
+        }
+        if let Some(earlier) = ahead[next].replace(fragment) {
+            walk(scheme, memory, pass, earlier, counters);
+        }
+        next = (next + 1) % FRAGMENTS_AHEAD;
     });
+    for fragment in ahead[next..].iter().chain(&ahead[..next]).flatten() {
+        walk(scheme, memory, pass, *fragment, counters);
+    }
 }
 
 /// Storage that a frame loop re-initialises rather than allocates again.

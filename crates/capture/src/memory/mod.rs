@@ -110,6 +110,14 @@ pub trait WordMemory<W: Word> {
     fn written_run(&self, index: usize, end: usize) -> usize {
         end.saturating_sub(index)
     }
+    /// Loads word `index` ahead of the walk that will operate on it, its value unused, so that
+    /// its cache miss overlaps other work instead of stalling that walk's read-modify-write (a
+    /// locked instruction waits for its line, and so does everything after it). Not a memory
+    /// operation of the GPU: nothing is counted or recorded, no value changes, and doing nothing,
+    /// the default, is always correct.
+    fn prefetch(&self, index: usize) {
+        let _ = index;
+    }
     /// Runs `visitor` on words `start..start + len`, handing it either this memory or a view of
     /// the one page that holds those words, whose operations find no page each: the same
     /// operations on the same words, with the same results, found once (a fragment's walk of a
@@ -345,6 +353,12 @@ macro_rules! paged_words {
             #[inline]
             fn written_run(&self, i: usize, end: usize) -> usize {
                 self.$field.written_run(i, end)
+            }
+            #[inline]
+            fn prefetch(&self, i: usize) {
+                if i < self.$field.len() {
+                    std::hint::black_box(WordMemory::<$word>::load(self, i));
+                }
             }
             #[inline]
             fn with_span<V: SpanVisitor<$word>>(&self, start: usize, len: usize, visitor: V) -> V::Output {

@@ -184,6 +184,12 @@ impl Scheme for ABuffer {
         }
     }
 
+    fn prefetch<M: Memory>(&self, fragment: Fragment, memory: &M) {
+        let pixel = fragment.pixel as usize;
+        WordMemory::<u32>::prefetch(memory, pixel);
+        WordMemory::<u64>::prefetch(memory, self.slots(pixel).0);
+    }
+
     fn step<M: Memory>(&self, claim: &mut Claim, memory: &M) -> Step {
         match *claim {
             Claim::Count { pixel, value } => {

@@ -284,6 +284,10 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         self.step_on(walk, W::words(memory))
     }
 
+    fn prefetch<M: Memory>(&self, fragment: Fragment, memory: &M) {
+        W::words(memory).prefetch(fragment.pixel as usize * self.k as usize);
+    }
+
     fn insert_state<M: Memory>(&self, walk: Walk<W>, memory: &M, steps: &mut u64) -> Step {
         // The pixel's K slots share a page but at a page's edge: their page is found once for
         // the walk, not for each memory operation.
