@@ -21,9 +21,10 @@
 # reach is paid for twice.
 set -euo pipefail
 
-WORK=${WORK:-/tmp/fragsim-fuzz}
-TARGET_DIR=${CARGO_TARGET_DIR:-fuzz/target}
+WORK=$(realpath -m "${WORK:-/tmp/fragsim-fuzz}")
+TARGET_DIR=$(realpath -m "${CARGO_TARGET_DIR:-fuzz/target}")
 BIN=$TARGET_DIR/x86_64-unknown-linux-gnu/release
+ROOT=$PWD
 TARGETS=${TARGETS:-$(basename -s .rs fuzz/fuzz_targets/*.rs)}
 # Inputs named by their SHA-1 that are regressions of past bugs (the fix commit names them).
 KEEP=(
@@ -41,9 +42,9 @@ grow() {
   local seconds=${1:-600}
   for target in $TARGETS; do
     mkdir -p "$WORK/$target/run" "$WORK/$target/corpus"
-    (cd "$WORK/$target/run" && "$OLDPWD/$BIN/$target" "${LIMITS[@]}" \
+    (cd "$WORK/$target/run" && "$BIN/$target" "${LIMITS[@]}" \
       -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$WORK/$target/run/" \
-      "$WORK/$target/corpus" "$OLDPWD/fuzz/corpus/$target")
+      "$WORK/$target/corpus" "$ROOT/fuzz/corpus/$target")
     echo "$target: $(ls "$WORK/$target/corpus" | wc -l) new inputs in $WORK/$target/corpus"
   done
 }
