@@ -34,19 +34,26 @@
 //! Unlike a GPU, steps run one at a time: the schedule is a total order of memory operations. That
 //! is the model the schemes' proofs use (per-location atomicity); a GPU's lockstep warp is modelled
 //! by its lane order.
+//!
+//! This file holds the run loop; the policies and their chooser are in `scheduled/policy.rs`, the
+//! trace in `scheduled/trace.rs`, the memory that records it in `memory/recording.rs`.
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::time::Instant;
 
-use fragsim_raster::{Fragment, SplitMix64, View};
+use fragsim_raster::{Fragment, View};
 
 use super::frame::{self, Counters, Run};
-use crate::memory::{Memory, SerialMemory, WordMemory};
+use crate::memory::recording::RecordingMemory;
+use crate::memory::SerialMemory;
 use crate::scheme::{Scheme, Step};
+use policy::Chooser;
+pub use policy::{Granularity, Policy, Schedule, WARP_LANES};
+pub use trace::{Op, Trace, TraceEvent};
 
-/// Lanes of a warp in [`Policy::Warps`] and [`Policy::Lockstep`].
-pub const WARP_LANES: usize = 32;
+mod policy;
+mod trace;
 
 /// The deadlock bound: a run stops with a [`Deadlock`] after this many consecutive spins per
 /// thread in flight (module doc: why no run that can progress reaches it).
@@ -127,127 +134,6 @@ impl std::fmt::Display for Deadlock {
 
 impl std::error::Error for Deadlock {}
 
-/// How the next step is chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Policy {
-    /// Any in-flight thread, uniformly at random.
-    Random,
-    /// Warps of [`WARP_LANES`] threads in round-robin; a warp issues one step per active lane, in
-    /// lane order.
-    Warps,
-    /// Lockstep warps (SIMT before Volta's independent thread scheduling): as [`Policy::Warps`],
-    /// but a warp issues its step only for its active lanes not standing at a reconvergence point
-    /// ([`Simt::reconverging`]), or for all of them when every one stands at one.
-    Lockstep,
-    /// Probabilistic concurrency testing with `depth − 1` priority change points.
-    Pct {
-        /// PCT's bug depth `d` (≥ 1).
-        depth: u32,
-    },
-}
-
-/// What one logical thread carries.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Granularity {
-    /// One fragment per thread.
-    #[default]
-    Fragment,
-    /// One triangle per thread, its fragments in scan order (FreePipe's model).
-    Triangle,
-}
-
-/// A complete description of an interleaving: replaying it gives the same run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Schedule {
-    /// The scheduling policy.
-    pub policy: Policy,
-    /// Threads in flight (`W` ≥ 1).
-    pub in_flight: usize,
-    /// What a thread carries.
-    pub granularity: Granularity,
-    /// The seed of every random choice.
-    pub seed: u64,
-}
-
-/// A memory operation, as recorded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Op {
-    /// Plain load.
-    Load,
-    /// Plain store.
-    Store,
-    /// `atomicMin`.
-    FetchMin,
-    /// `atomicMax`.
-    FetchMax,
-    /// `atomicAdd`.
-    FetchAdd,
-    /// `atomicOr`.
-    FetchOr,
-    /// `atomicExch`.
-    Swap,
-}
-
-/// One recorded memory operation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TraceEvent {
-    /// Index of the step in the whole run.
-    pub step: u64,
-    /// The logical thread (slot) that ran it.
-    pub thread: u32,
-    /// Index of the fragment in the pass's stream.
-    pub fragment: u64,
-    /// The fragment's pixel.
-    pub pixel: u32,
-    /// Geometry pass.
-    pub pass: u32,
-    /// Word width in bits (32 or 64).
-    pub width: u8,
-    /// Word index in its array.
-    pub word: usize,
-    /// The operation.
-    pub op: Op,
-    /// The value passed in (0 for a load).
-    pub operand: u64,
-    /// The value returned (the old value of a read-modify-write, the value of a load; the value
-    /// overwritten, for a store).
-    pub returned: u64,
-}
-
-/// The recorded memory operations of a run, in execution order.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Trace {
-    /// Events in execution order.
-    pub events: Vec<TraceEvent>,
-}
-
-impl Trace {
-    /// The thread that ran each step, in order: one entry per step, however many memory
-    /// operations the step did (what [`run_fragments_in_order`] replays).
-    #[must_use]
-    pub fn order(&self) -> Vec<u32> {
-        self.steps().map(|events| events[0].thread).collect()
-    }
-
-    /// The events grouped by step (consecutive events with one `step` index), in order.
-    pub fn steps(&self) -> impl Iterator<Item = &[TraceEvent]> + '_ {
-        self.events.chunk_by(|a, b| a.step == b.step)
-    }
-
-    /// The events that touched `pixel`'s fragments.
-    #[must_use]
-    pub fn pixel(&self, pixel: u32) -> Trace {
-        Trace {
-            events: self
-                .events
-                .iter()
-                .filter(|e| e.pixel == pixel)
-                .copied()
-                .collect(),
-        }
-    }
-}
-
 /// A scheduled run: the usual result plus the trace, if one was asked for, and the memory the
 /// run left, for a caller that reads the words themselves.
 #[derive(Clone, Debug)]
@@ -276,235 +162,11 @@ impl ScheduledRun {
     }
 }
 
-/// Storage that can record every operation: plain memory plus a log.
-struct RecordingMemory {
-    inner: SerialMemory,
-    log: Option<RefCell<Vec<TraceEvent>>>,
-    /// (step, thread, fragment, pixel, pass) of the step being run.
-    context: Cell<(u64, u32, u64, u32, u32)>,
-}
-
-impl RecordingMemory {
-    fn note(&self, width: u8, word: usize, op: Op, operand: u64, returned: u64) {
-        if let Some(log) = &self.log {
-            let (step, thread, fragment, pixel, pass) = self.context.get();
-            log.borrow_mut().push(TraceEvent {
-                step,
-                thread,
-                fragment,
-                pixel,
-                pass,
-                width,
-                word,
-                op,
-                operand,
-                returned,
-            });
-        }
-    }
-}
-
-/// Forwards each operation to the inner memory and records it.
-macro_rules! recording_words {
-    ($word:ty, $bits:expr) => {
-        impl WordMemory<$word> for RecordingMemory {
-            fn len(&self) -> usize {
-                WordMemory::<$word>::len(&self.inner)
-            }
-            fn load(&self, i: usize) -> $word {
-                let v = WordMemory::<$word>::load(&self.inner, i);
-                self.note($bits, i, Op::Load, 0, u64::from(v));
-                v
-            }
-            fn store(&self, i: usize, v: $word) {
-                let old = WordMemory::<$word>::load(&self.inner, i);
-                WordMemory::<$word>::store(&self.inner, i, v);
-                self.note($bits, i, Op::Store, u64::from(v), u64::from(old));
-            }
-            fn fetch_min(&self, i: usize, v: $word) -> $word {
-                let old = WordMemory::<$word>::fetch_min(&self.inner, i, v);
-                self.note($bits, i, Op::FetchMin, u64::from(v), u64::from(old));
-                old
-            }
-            fn fetch_max(&self, i: usize, v: $word) -> $word {
-                let old = WordMemory::<$word>::fetch_max(&self.inner, i, v);
-                self.note($bits, i, Op::FetchMax, u64::from(v), u64::from(old));
-                old
-            }
-            fn fetch_add(&self, i: usize, v: $word) -> $word {
-                let old = WordMemory::<$word>::fetch_add(&self.inner, i, v);
-                self.note($bits, i, Op::FetchAdd, u64::from(v), u64::from(old));
-                old
-            }
-            fn fetch_or(&self, i: usize, v: $word) -> $word {
-                let old = WordMemory::<$word>::fetch_or(&self.inner, i, v);
-                self.note($bits, i, Op::FetchOr, u64::from(v), u64::from(old));
-                old
-            }
-            fn swap(&self, i: usize, v: $word) -> $word {
-                let old = WordMemory::<$word>::swap(&self.inner, i, v);
-                self.note($bits, i, Op::Swap, u64::from(v), u64::from(old));
-                old
-            }
-        }
-    };
-}
-
-recording_words!(u32, 32);
-recording_words!(u64, 64);
-
-impl Memory for RecordingMemory {
-    fn new(len32: usize, init32: u32, len64: usize, init64: u64) -> Self {
-        Self {
-            inner: SerialMemory::new(len32, init32, len64, init64),
-            log: None,
-            context: Cell::new((0, 0, 0, 0, 0)),
-        }
-    }
-    fn allocated_bytes(&self) -> Option<u64> {
-        Memory::allocated_bytes(&self.inner)
-    }
-    fn over_cap(&self) -> bool {
-        self.inner.over_cap()
-    }
-}
-
 /// One logical thread: its current walk and the fragments still queued for it.
 struct Thread<S> {
     walk: Option<(S, Fragment, u64)>,
     queue: VecDeque<(Fragment, u64)>,
     priority: u64,
-}
-
-/// Chooses the next thread to step.
-struct Chooser {
-    policy: Policy,
-    rng: SplitMix64,
-    /// Warps: the warp being issued and the next lane to issue in it.
-    warp: usize,
-    lane: usize,
-    /// Lockstep: the lanes of the current issue still to step.
-    issue: VecDeque<usize>,
-    /// PCT: steps at which the running thread's priority drops, and the next low priority.
-    change_points: Vec<u64>,
-    next_low: u64,
-    /// Replay: the threads to step, in order, and the next entry to use.
-    order: Option<(Vec<u32>, usize)>,
-}
-
-impl Chooser {
-    fn new(schedule: &Schedule, expected_steps: u64) -> Self {
-        let mut rng = SplitMix64::new(schedule.seed);
-        let change_points = match schedule.policy {
-            Policy::Pct { depth } => {
-                let mut points: Vec<u64> = (1..depth.max(1))
-                    .map(|_| rng.next_u64() % expected_steps.max(1))
-                    .collect();
-                points.sort_unstable();
-                points
-            }
-            _ => Vec::new(),
-        };
-        Self {
-            policy: schedule.policy,
-            rng,
-            warp: 0,
-            lane: 0,
-            issue: VecDeque::new(),
-            change_points,
-            next_low: u64::from(u32::MAX),
-            order: None,
-        }
-    }
-
-    fn fresh_priority(&mut self) -> u64 {
-        // High priorities live above 2^32, lowered ones below, so a lowered thread yields to all.
-        (1 << 32) + (self.rng.next_u64() >> 32)
-    }
-
-    /// Lowers a thread's priority below every other's (PCT only): what a thread that spun does,
-    /// so that the lock's holder runs.
-    fn spun<S>(&mut self, thread: &mut Thread<S>) {
-        if let Policy::Pct { .. } = self.policy {
-            thread.priority = self.next_low;
-            self.next_low = self.next_low.saturating_sub(1);
-        }
-    }
-
-    /// The next thread to step among `threads`, of which those with `walk.is_some()` are active;
-    /// `reconverging` says whether a walk stands at a reconvergence point.
-    fn choose<S>(
-        &mut self,
-        threads: &mut [Thread<S>],
-        active: &[usize],
-        step: u64,
-        reconverging: impl Fn(&S) -> bool,
-    ) -> usize {
-        if let Some((order, next)) = &mut self.order {
-            // Entries naming a finished thread are skipped, so every order is a valid schedule
-            // (what shrinking needs); past the end, the lowest-numbered thread runs.
-            while let Some(&t) = order.get(*next) {
-                *next += 1;
-                if active.contains(&(t as usize)) {
-                    return t as usize;
-                }
-            }
-            return *active
-                .iter()
-                .min()
-                .expect("choose is called with an active thread");
-        }
-        match self.policy {
-            Policy::Random => active[(self.rng.next_u64() % active.len() as u64) as usize],
-            Policy::Warps => {
-                let warps = threads.len().div_ceil(WARP_LANES);
-                loop {
-                    let base = self.warp * WARP_LANES;
-                    while self.lane < WARP_LANES && base + self.lane < threads.len() {
-                        let t = base + self.lane;
-                        self.lane += 1;
-                        if threads[t].walk.is_some() {
-                            return t;
-                        }
-                    }
-                    self.warp = (self.warp + 1) % warps;
-                    self.lane = 0;
-                }
-            }
-            Policy::Lockstep => {
-                let warps = threads.len().div_ceil(WARP_LANES);
-                while self.issue.is_empty() {
-                    let lanes =
-                        self.warp * WARP_LANES..((self.warp + 1) * WARP_LANES).min(threads.len());
-                    self.warp = (self.warp + 1) % warps;
-                    let walks = |t: &usize| threads[*t].walk.as_ref().map(|(s, _, _)| s);
-                    let running: VecDeque<usize> = lanes
-                        .clone()
-                        .filter(|t| walks(t).is_some_and(|s| !reconverging(s)))
-                        .collect();
-                    // Every active lane at the reconvergence point: the warp reconverges.
-                    self.issue = if running.is_empty() {
-                        lanes.filter(|t| walks(t).is_some()).collect()
-                    } else {
-                        running
-                    };
-                }
-                self.issue.pop_front().expect("the issue is not empty")
-            }
-            Policy::Pct { .. } => {
-                let best = *active
-                    .iter()
-                    .max_by_key(|&&t| (threads[t].priority, std::cmp::Reverse(t)))
-                    .unwrap_or(&0);
-                while self.change_points.first().is_some_and(|&p| p <= step) {
-                    self.change_points.remove(0);
-                    threads[best].priority = self.next_low;
-                    self.next_low -= 1;
-                }
-                best
-            }
-        }
-    }
 }
 
 /// Runs `scheme` over `view` under `schedule` on one thread; records a trace when `record`.

@@ -22,6 +22,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 mod counting;
 mod layout;
 pub(crate) mod pages;
+pub(crate) mod recording;
 
 pub use counting::CountingMemory;
 pub use layout::Layout;

@@ -9,9 +9,9 @@
 //! at a node the counter never handed out, or reaches a node already visited (a cycle, or two
 //! lists sharing a node) is cut there and named a [`CorruptWord`] of its pixel.
 
-use super::layouts::{CorruptWord, Corruption};
 use super::slots::words_of;
 use super::spec::{LayoutSpec, ListNumbering, Payload};
+use super::word_check::{CorruptWord, Corruption};
 use super::{err, Dump, DumpError, Words};
 
 /// Fragsim's memory of a scheme built from a dump's arrays, and what the translation found.

@@ -62,6 +62,7 @@
 //! A header field this format does not name is refused by name (`extra` holds anything else), and
 //! an array whose size the header's fields contradict is refused naming the fields at fault.
 
+mod arrays;
 mod header;
 mod layouts;
 mod lists;
@@ -70,6 +71,7 @@ mod read;
 mod shapes;
 mod slots;
 mod spec;
+mod word_check;
 mod write;
 
 use std::collections::BTreeMap;
@@ -84,9 +86,10 @@ use fragsim_capture::{Capture, SerialMemory};
 use crate::Oracle;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
-pub use layouts::{CorruptWord, Corruption, Counter, DumpScheme, WordCheck};
+pub use layouts::DumpScheme;
 pub use masked::{masked_spec, node_capture, MaskedComparison, WrongMask, MASKED_SCHEME};
 pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
+pub use word_check::{CorruptWord, Corruption, Counter, WordCheck};
 
 /// The `format` field of every dump header.
 pub const FORMAT: &str = "fragsim-dump";

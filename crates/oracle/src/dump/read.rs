@@ -7,8 +7,8 @@ use std::path::Path;
 use fragsim_capture::{Capture, Scheme, SerialMemory, WordMemory};
 use fragsim_raster::Viewport;
 
+use super::arrays::stored_lists;
 use super::header::{check_array, check_distinct_files, check_file_name, elements};
-use super::layouts::stored_lists;
 use super::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{FORMAT, HEADER_FILE, VERSION};
 use fragsim_capture::catalog::{SchemeName, SchemeVisitor};

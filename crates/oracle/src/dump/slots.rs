@@ -10,8 +10,9 @@
 //! index is taken, so a header cannot make the reader index past it or allocate more than it
 //! holds.
 
-use super::layouts::{pixel_slots, WordCheck};
+use super::arrays::pixel_slots;
 use super::spec::{LayoutSpec, Payload, SlotOrder};
+use super::word_check::WordCheck;
 use super::{err, Dtype, Dump, DumpError, DumpScheme, Words};
 use fragsim_capture::schemes::mdts::Direction;
 

@@ -8,8 +8,8 @@ use fragsim_capture::catalog::DumpLayout;
 use fragsim_capture::{Scheme, SerialMemory, WordMemory};
 use fragsim_raster::View;
 
+use super::arrays::sort_abuffer_in_place;
 use super::header::{check_array, check_distinct_files, check_file_name};
-use super::layouts::sort_abuffer_in_place;
 use super::{err, io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{LayoutSpec, ListNumbering};
 use super::{FORMAT, HEADER_FILE, VERSION};

@@ -3,8 +3,10 @@
 //! either end of its error), rasterized by the pipeline's rules, gives only listed fragments, with
 //! depths inside their intervals, and covers every `certain` pair.
 
+use super::error_analysis::{dot_error, edge_bound, plane_interval, real, snap_reach, Plane};
+use super::triangle::{combinations, covers};
 use super::*;
-use fragsim_raster::{fill_thresholds, WindowOrigin};
+use fragsim_raster::{edge_function as edge, fill_thresholds, Viewport, WindowOrigin};
 
 /// The pipeline's coverage and depth of one snapped triangle at every pixel centre, as
 /// `docs/semantics.md` rules 4 and 5 state them.
