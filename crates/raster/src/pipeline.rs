@@ -42,6 +42,8 @@ use crate::mesh::Mesh;
 mod conventions_tests;
 mod sample_scan;
 mod scan;
+#[cfg(test)]
+mod scan_tests;
 mod setup;
 mod submission;
 #[cfg(test)]
