@@ -138,7 +138,7 @@ pub trait Scheme: Sync {
     fn step<M: Memory>(&self, state: &mut Self::State, memory: &M) -> Step;
 
     /// Loads the words that the fragment's walk of the first geometry pass begins with, ahead
-    /// of the walk ([`WordMemory::prefetch`]): an executor that rasterizes a run of fragments
+    /// of the walk ([`crate::WordMemory::prefetch`]): an executor that rasterizes a run of fragments
     /// before walking them calls it as each is rasterized, so that their cache misses overlap.
     /// No step and no memory operation of the GPU; schemes that do not override it load
     /// nothing ahead.
