@@ -3,7 +3,20 @@
 
 use super::tests::soup_views;
 use super::*;
-use crate::conventions::Conventions;
+use crate::conventions::{Conventions, WindowOrigin};
+
+/// The reference conventions under each window origin, so under both fill rules.
+fn under_each_window_origin() -> impl Iterator<Item = (WindowOrigin, Conventions)> {
+    [WindowOrigin::UpperLeft, WindowOrigin::LowerLeft]
+        .map(|window_origin| {
+            let conventions = Conventions {
+                window_origin,
+                ..Conventions::REFERENCE
+            };
+            (window_origin, conventions)
+        })
+        .into_iter()
+}
 
 /// Rules 6 and 7 as `docs/semantics.md` states them, the slow way: every pixel centre of the
 /// triangle's bounding box within `rect` tested against the three edge functions, left to right
@@ -39,7 +52,7 @@ fn the_scan_of_covered_runs_emits_what_testing_every_centre_emits() {
     // and on tiles misaligned with it, so that runs are cut by every side of a rectangle.
     let mesh = crate::scenes::triangle_soup(1500, 5);
     let lower_left = Conventions {
-        window_origin: crate::conventions::WindowOrigin::LowerLeft,
+        window_origin: WindowOrigin::LowerLeft,
         ..Conventions::REFERENCE
     };
     let mut fragments = 0;
@@ -120,14 +133,7 @@ fn a_box_of_one_centre_on_an_edge_is_decided_by_the_fill_rule() {
         ],
     };
     let mut covered = 0;
-    for window_origin in [
-        crate::conventions::WindowOrigin::UpperLeft,
-        crate::conventions::WindowOrigin::LowerLeft,
-    ] {
-        let conventions = Conventions {
-            window_origin,
-            ..Conventions::REFERENCE
-        };
+    for (window_origin, conventions) in under_each_window_origin() {
         let camera = Camera {
             view_projection: DMat4::IDENTITY,
         };
@@ -168,14 +174,7 @@ fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
         view_projection: DMat4::IDENTITY,
     };
     let (mut blocks, mut fragments) = (0, 0);
-    for window_origin in [
-        crate::conventions::WindowOrigin::UpperLeft,
-        crate::conventions::WindowOrigin::LowerLeft,
-    ] {
-        let conventions = Conventions {
-            window_origin,
-            ..Conventions::REFERENCE
-        };
+    for (window_origin, conventions) in under_each_window_origin() {
         let view =
             View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions).unwrap();
         for prim in 0..4000 {
