@@ -1,4 +1,4 @@
-//! Shipping OIT schemes (issue 8, `docs/baselines/shipping.md`).
+//! Shipping OIT schemes (`docs/baselines/shipping.md`).
 
 use fragsim::capture::schemes::layer_counter::LayerCounter;
 use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};

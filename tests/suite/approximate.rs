@@ -1,4 +1,4 @@
-//! The approximate OIT schemes of issue 19 through `fragsim bench --approximate`: weighted
+//! The approximate OIT schemes through `fragsim bench --approximate`: weighted
 //! blended OIT, multi-layer alpha blending and tail blending are judged by their transparency
 //! image's colour error; MLAB and tail blending are exact when no pixel has more fragments than
 //! their nodes, and off when some pixel has, by no more pixels than have that many; the catalog's

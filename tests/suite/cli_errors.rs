@@ -1,4 +1,4 @@
-//! Bad input through the `fragsim` binary (issue 5): malformed OBJ files and bad command-line
+//! Bad input through the `fragsim` binary: malformed OBJ files and bad command-line
 //! values each give a clear error naming the reason and exit with status 2, never a panic. Mesh
 //! formats told by content are in `mesh_formats`, flags that do nothing in their context in
 //! `context_flags`.

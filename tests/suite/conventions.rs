@@ -1,4 +1,4 @@
-//! The scene a dump names is the engine's (issue 16): an explicit view-projection matrix and the
+//! The scene a dump names is the engine's: an explicit view-projection matrix and the
 //! conventions round-trip through a header to their bits, `compare` rebuilds the view under them,
 //! and the mesh is named by path and content hash, so that a different file is refused and a
 //! dump that travelled finds its mesh again with `--mesh`.

@@ -1,4 +1,4 @@
-//! The effects of issue 7: the three effects shade every scheme (key-only and primitive-only
+//! The effects: the three effects shade every scheme (key-only and primitive-only
 //! captures through the deferred attribute pass) and the error-pixel rate sees exactly what a
 //! scheme lost; Fresnel's per-fragment term is Schlick's; sRGB encoding is the standard's.
 

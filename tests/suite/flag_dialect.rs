@@ -1,4 +1,4 @@
-//! One dialect of flags across commands (issue 36): `--no-images` is spelled so everywhere (the
+//! One dialect of flags across commands: `--no-images` is spelled so everywhere (the
 //! older `compare --no-image` still parses), sweep takes it, `sweep --help` lists no flag sweep
 //! refuses, every `--help` that offers `--k` shows its default, and bench and sweep write into
 //! their own folders and say where.

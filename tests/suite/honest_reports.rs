@@ -1,4 +1,4 @@
-//! What `render` and `bench` report adds up (issue 34, "Honest reports"), through the binary:
+//! What `render` and `bench` report adds up, through the binary:
 //! every row of `render` accounts for every fragment of the scene, and a run whose guarantee owes
 //! nothing on its executor says so instead of `kept`.
 

@@ -1,11 +1,10 @@
-//! The ordered fragment-shader interlock (issue 19;
-//! `docs/baselines/kbuffer-interlock-ordered.md`): a pixel's critical sections in primitive
-//! order. Keeping the `K` nearest it is exact on every executor, as the unordered one; keeping
-//! the first `K` it keeps exactly the first `K` of each pixel's fragments in submission order on
-//! every executor and under every schedule, where keep-first without the order (Bevy's layer
-//! counter) keeps whichever arrived first; and it departs from the `K` nearest then and only
-//! then when the first `K` submitted are not the `K` nearest. A different submission order
-//! (`--shuffle`) keeps different fragments, as on a GPU.
+//! The ordered fragment-shader interlock (`docs/baselines/kbuffer-interlock-ordered.md`): a pixel's
+//! critical sections in primitive order. Keeping the `K` nearest it is exact on every executor, as
+//! the unordered one; keeping the first `K` it keeps exactly the first `K` of each pixel's
+//! fragments in submission order on every executor and under every schedule, where keep-first
+//! without the order (Bevy's layer counter) keeps whichever arrived first; and it departs from the
+//! `K` nearest then and only then when the first `K` submitted are not the `K` nearest. A different
+//! submission order (`--shuffle`) keeps different fragments, as on a GPU.
 
 use fragsim::capture::catalog::{Count, Executors, SchemeName, Sizing};
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};

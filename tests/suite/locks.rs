@@ -1,4 +1,4 @@
-//! The lock-based k-buffers (issue 19; `docs/baselines/kbuffer-spinlock.md`) against the oracle:
+//! The lock-based k-buffers (`docs/baselines/kbuffer-spinlock.md`) against the oracle:
 //! exact on every executor and every independent-scheduling policy; under lockstep warps the naive
 //! spinlock deadlocks then and only then when two fragments of one pixel share the warp, and the
 //! fixed loop never does.

@@ -1,4 +1,4 @@
-//! nvpro-samples' loop64 (issue 19; `docs/baselines/loop64.md`): one pass of 64-bit `atomicMin`
+//! nvpro-samples' loop64 (`docs/baselines/loop64.md`): one pass of 64-bit `atomicMin`
 //! on packed words, exact on every executor, where loop32 (32-bit depths, equal depths merged)
 //! departs then and only then when a pixel's `K` nearest distinct depths repeat a key
 //! (`shipping.rs`). Here: on a real scene through the catalog, every executor, loop64's lists are

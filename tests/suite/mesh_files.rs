@@ -1,4 +1,4 @@
-//! Mesh files as users bring them, through the `fragsim` binary (issue 36): PLY triangle strips
+//! Mesh files as users bring them, through the `fragsim` binary: PLY triangle strips
 //! (`tristrips`, `-1` restarting a strip, as the common test-model collections store their
 //! scans) load, ASCII or binary, into the triangles of the same mesh written as faces; a truncated
 //! binary PLY is refused on one line that names no line number (a binary file has no lines); and

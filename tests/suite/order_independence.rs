@@ -1,4 +1,4 @@
-//! Order independence as a property (issue 19): a shuffled submission order (`--shuffle SEED`,
+//! Order independence as a property: a shuffled submission order (`--shuffle SEED`,
 //! `View::shuffled`) rasterizes the same fragments in another order, and every scheme that
 //! promises order independence captures bit-identical lists under it; the schemes that depend on
 //! order (keep-first linked list, layer counter without tail, loop32 with equal depths, and

@@ -1,4 +1,4 @@
-//! `--shard I/N` (issue 36): `conform`, `sweep` and `bench` split a campaign over machines in
+//! `--shard I/N`: `conform`, `sweep` and `bench` split a campaign over machines in
 //! cargo-nextest's `count:I/N` convention; the shards are disjoint and their union is the
 //! unsharded run, case for case (conform: the very cases the backend is given; sweep and bench:
 //! their records, the measured times apart).

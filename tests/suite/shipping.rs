@@ -1,4 +1,4 @@
-//! The shipping OIT algorithms against the oracle (issue 8; `docs/baselines/shipping.md`): each
+//! The shipping OIT algorithms against the oracle (`docs/baselines/shipping.md`): each
 //! property states the exact condition under which a scheme departs from the oracle and asserts
 //! that it departs then and only then.
 //!

@@ -9,7 +9,7 @@
 //! does (Vulkan conventions: upper-left origin, depth in [0, 1], the f32 vertex stage). Depth is
 //! the GPU's own interpolation in both modes (`@builtin(position).z`).
 //!
-//! **Per sample** ([`capture_samples`], issue 34): at N > 1 samples a pixel the colour target is
+//! **Per sample** ([`capture_samples`]): at N > 1 samples a pixel the colour target is
 //! multisampled and the scheme's per-sample variant (`schemes/*_samples.wgsl`) draws: its entry
 //! points read `@builtin(sample_index)`, so the pipeline shades once per covered sample, and each
 //! sample's fragment goes to its own list `pixel · N + sample` with the depth of a varying

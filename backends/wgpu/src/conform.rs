@@ -14,7 +14,7 @@
 //! fragsim's f64 plane (replay mode's coverage is still fragsim's exactly: its snapped positions
 //! are inside every bound). Replay mode takes only power-of-two viewports (its clip coordinates
 //! are exact only then), so the battery generates and shrinks to those alone
-//! ([`Backend::power_of_two_viewports`]). Source: issue 21 ("implemented by the wgpu backend").
+//! ([`Backend::power_of_two_viewports`]).
 //!
 //! Departures: a scheme the adapter lacks a feature for, or a plant that does not apply to the
 //! scheme, is refused before any case runs (the battery's `Refused`), not failed case by case.

@@ -10,8 +10,8 @@
 //! every pixel of the exact A-buffer), from the primitive ids stored (or, for key-only words, the
 //! number of fragments).
 //!
-//! [`Within`] is the other verdict, issue 16's: the dump judged within the precision of an f32
-//! vertex stage against the exact oracle under the dump's conventions, what `fragsim compare
+//! [`Within`] is the other verdict, the precision one: the dump judged within the precision of an
+//! f32 vertex stage against the exact oracle under the dump's conventions, what `fragsim compare
 //! oracle DIR --vertex-precision f32` prints (the same calls, [`f32_reference`] and the oracle's
 //! verdict), its reference built once and shared by every capture of one view.
 

@@ -119,7 +119,7 @@ struct CaptureArgs {
     /// verdict per value.
     #[arg(long, default_value = "0", value_delimiter = ',')]
     depth_ulps: Vec<u32>,
-    /// Also judge each dump within the precision of an f32 vertex stage (issue 16's verdict:
+    /// Also judge each dump within the precision of an f32 vertex stage (the precision verdict:
     /// `fragsim compare oracle DIR --vertex-precision f32`) and print it.
     #[arg(long)]
     precision: bool,

@@ -1,5 +1,5 @@
 //! Planted bugs: shader variants that break a scheme on purpose, so that a test can show that
-//! `fragsim compare` calls each of them an error (issue 16's list) while it calls the correct
+//! `fragsim compare` calls each of them an error while it calls the correct
 //! shader equal.
 //!
 //! Each plant is a value of the WGSL pipeline-overridable constant `plant` (`common.wgsl`), so a

@@ -1,5 +1,5 @@
 //! The per-sample counting pass on the GPU and its comparison with fragsim's per-sample oracle
-//! (issue 22: per-pixel sample counts identical to the hardware's).
+//! (per-pixel sample counts identical to the hardware's).
 //!
 //! **The pass** ([`count_samples`]): a single-sample view drawn, in replay or engine mode as
 //! every capture, into a colour target of `n` samples a pixel through

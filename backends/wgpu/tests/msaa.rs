@@ -1,11 +1,11 @@
 //! Multisampling on whatever Vulkan adapter this machine has.
 //!
-//! - The per-sample counting pass (issue 22, `src/sample_counts.rs`): the GPU's per-sample
+//! - The per-sample counting pass (`src/sample_counts.rs`): the GPU's per-sample
 //!   fragment counts of the bunny, replay mode, views 30° and 120° at 256², identical to
 //!   fragsim's per-sample oracle at 4 and 8 samples a pixel and at 1 (the control); against the
 //!   standard positions mirrored in y they differ, so identity does tell the sample positions
 //!   apart.
-//! - Per-sample captures (issue 34, `capture_samples`): the A-buffer (fixed and exact, ids), MDTS
+//! - Per-sample captures (`capture_samples`): the A-buffer (fixed and exact, ids), MDTS
 //!   (u64 words with ids, u32 keys) and the keep-nearest linked list of the bunny and
 //!   `bunny-spheres:8` at 4 and 8 samples a pixel in engine mode (the f32 vertex shader, each
 //!   sample's depth interpolated at the sample), judged by the oracle's verdict as `fragsim

@@ -1,5 +1,5 @@
 //! Issue 17's three scenes through every correct wgpu scheme at 128², views 30° and 120°, replay
-//! and engine mode, each dump judged by the precision verdict (issue 16's, as `fragsim compare
+//! and engine mode, each dump judged by the precision verdict (as `fragsim compare
 //! oracle DIR --vertex-precision f32` judges it): the bunny and `bunny-spheres` (depth complexity
 //! about 40) always, and the dragon (`dragon_vrip.ply.gz`, 871,414 triangles, in
 //! `../shared/meshes/` beside the repository) where that folder exists. In replay mode (fragsim's

@@ -1,4 +1,4 @@
-//! Flags that do nothing in their context (issue 20, item 6): a warning or a refusal naming the
+//! Flags that do nothing in their context: a warning or a refusal naming the
 //! flag, and every scheme's name as a run prints it the one it was given.
 
 use std::process::Output;

@@ -1,4 +1,4 @@
-//! Meshes told by content, not by name (issue 20, item 5): the gzipped bunny and PLY load
+//! Meshes told by content, not by name: the gzipped bunny and PLY load
 //! whatever the file is called, and errors name the format, the file and the line.
 
 use super::{assert_obj_refused, assert_refused, fragsim, obj_file, TRIANGLE_VERTICES};

@@ -1,4 +1,4 @@
-//! Implementation-defined edge ties through the binary (issue 34, item 4; `docs/semantics.md`
+//! Implementation-defined edge ties through the binary (`docs/semantics.md`
 //! §4, "Edge ties"): a capture that decides every sample exactly on an edge by one rule other
 //! than fragsim's top-left is EQUAL, exactly and under f32 precision; a hole or a doubled sample
 //! on a shared edge, or two rules in one capture, is DIFFERENT; a declared rule is owed.

@@ -1,4 +1,4 @@
-//! A layout for every catalog scheme (issue 16): every scheme's memory, run as `render --dump`
+//! A layout for every catalog scheme: every scheme's memory, run as `render --dump`
 //! runs it, records, goes through files and decodes to exactly what the scheme captured, and
 //! compares equal with the oracle; linked-list and layer-major dumps in another engine's
 //! encoding read the same; each rule of their words names a corrupted word, a cycle included.

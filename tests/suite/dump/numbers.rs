@@ -145,7 +145,7 @@ proptest! {
 
 #[test]
 fn regression_the_fuzz_found_elevation_parses_to_the_nearest_f64_and_round_trips() {
-    // `dump_parse` found it (issue 23): without `float_roundtrip` it parsed to
+    // `dump_parse` found it: without `float_roundtrip` it parsed to
     // 6.666666665999999e32, which re-encodes as 6.666666666e32 and parses to another number.
     // The same input is checked in as a corpus seed, `regression-elevation-not-read-exactly`.
     let decimal = "666666666600000133584280347126390.0";

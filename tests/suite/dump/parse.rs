@@ -69,7 +69,7 @@ fn regression_dump_parse_refuses_a_shape_whose_element_count_overflows() {
 
 #[test]
 fn regression_dump_parse_refuses_two_arrays_naming_the_same_file() {
-    // `dump_parse` found it (issue 23, seed `regression-two-arrays-one-file`): an A-buffer whose
+    // `dump_parse` found it (seed `regression-two-arrays-one-file`): an A-buffer whose
     // `offsets` and `slots` both named `slots.u64` parsed, then encoded one array's words under
     // both names and failed to parse back.
     let header = r#"{"format": "fragsim-dump", "version": 1, "scene": {"name": "quads:2",

@@ -1,4 +1,4 @@
-//! Multisampled dumps (issue 22): the sample count in `scene.conventions.samples`, per-sample
+//! Multisampled dumps: the sample count in `scene.conventions.samples`, per-sample
 //! MDTS and A-buffer dumps over the sample-expanded framebuffer, and the masked-node A-buffer's
 //! dump, through the binary: written by `render --samples 4 --dump`, judged by `compare`.
 

@@ -1,4 +1,4 @@
-//! Slot layouts described by the header (issue 16): the `slots` array of `mdts`, `mdts-desc`,
+//! Slot layouts described by the header: the `slots` array of `mdts`, `mdts-desc`,
 //! `mdts32` and `abuffer` slot-major or pixel-major, its words packed as a payload, written as
 //! `render --dump` writes them, read back to fragsim's own words and judged by `compare` as
 //! fragsim's own dumps are; a mutated word is named as stored; a bad field is a clear error.

@@ -1,6 +1,6 @@
-//! Captures no conforming implementation produces are DIFFERENT through the binary (issue 34,
-//! "Soundness"): each test is named after what it caught, mutates a dump `render --dump` wrote
-//! and checks first that the unmutated dump is equal, so that it can fail both ways.
+//! Captures no conforming implementation produces are DIFFERENT through the binary: each test
+//! is named after what it caught, mutates a dump `render --dump` wrote and checks first that the
+//! unmutated dump is equal, so that it can fail both ways.
 
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! Numerical stability at the extremes (issue 5): the ends of the depth range, the sentinels, the
+//! Numerical stability at the extremes: the ends of the depth range, the sentinels, the
 //! counters, hostile geometry and extreme sizes. Each test names the extreme and asserts the expected result;
 //! `docs/extremes.md` lists them with the numbers measured here.
 

@@ -122,7 +122,7 @@ mod tests {
             let name = layout.scheme().name();
             assert_eq!(DumpLayout::named(name), Some(layout), "{name}");
         }
-        // Every entry dumps (issue 16), and each header name is a catalog entry's.
+        // Every entry dumps, and each header name is a catalog entry's.
         assert!(CATALOG.iter().all(|e| e.dump.is_some()));
         let own = CATALOG
             .iter()

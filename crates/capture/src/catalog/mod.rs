@@ -12,7 +12,7 @@
 //! plus one `catalog!` line here (`kbuffer-interlock` was added so: its module, its `pub mod` line
 //! and its entry).
 //!
-//! **What is not here: weighted blended OIT and tail blending** (issue 19). An entry is a
+//! **What is not here: weighted blended OIT and tail blending**. An entry is a
 //! capture: per-pixel storage of fragments that the oracle judges list by list. WBOIT keeps no
 //! fragment (two blend targets, sums over every fragment), so as an entry it would capture empty
 //! lists and its verdict would say nothing; tail blending's kept part is the `K` nearest, which

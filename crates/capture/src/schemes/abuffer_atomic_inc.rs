@@ -1,5 +1,5 @@
 //! The A-buffer as GPU code often writes it, with CUDA's wrapping `atomicInc(addr, bound)` for
-//! the slot counter: a model of what goes wrong when storage overflows (issue 5), next to
+//! the slot counter: a model of what goes wrong when storage overflows, next to
 //! [`ABuffer`](crate::schemes::abuffer::ABuffer), which uses `fetch_add` and counts every drop.
 //!
 //! **CUDA's `atomicInc(addr, bound)`** reads `old = *addr`, stores `old >= bound ? 0 : old + 1`

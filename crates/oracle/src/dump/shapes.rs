@@ -1,6 +1,6 @@
 //! The arrays' sizes checked against the header fields that fix them, before any word is
 //! decoded, so that a mismatch names the field at fault (`k`, `width`, `capacity`, `pool`, the
-//! array's `shape`) instead of a total of words (issue 36).
+//! array's `shape`) instead of a total of words.
 
 use super::spec::{LayoutSpec, SlotOrder};
 use super::{err, Dump, DumpError, DumpScheme};

@@ -1,4 +1,4 @@
-//! The verdict's mutation battery (issue 34, "What to build" item 5). A scene deeper than K with
+//! The verdict's mutation battery. A scene deeper than K with
 //! shared edges and coplanar duplicates (three nested spheres, and a quad drawn three times in
 //! front of them and another behind) is recorded in every dump layout; its dumps are mutated,
 //! seeded and deterministically, in every way no conforming implementation could store (a
