@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Turns run_device.sh's log into the Markdown tables of docs/results-gpu.md."""
+"""Turns tools/device/cuda-captures.sh's log into the Markdown tables of docs/results-gpu.md."""
 import json
 import sys
 

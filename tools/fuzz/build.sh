@@ -2,7 +2,7 @@
 # Builds every fuzz target as cargo-fuzz would with `--sanitizer none` (libFuzzer's coverage
 # instrumentation, `--cfg fuzzing`, debug assertions and overflow checks), without cargo-fuzz
 # itself: nightly Rust is enough. The binaries land in fuzzbin/ (stripped), ready to carry to a
-# machine without cargo (tools/fuzz/device.sh).
+# machine without cargo (tools/device/fuzz.sh).
 set -eu
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-target/fuzz}
 export RUSTFLAGS="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4 \

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Markdown tables of docs/results.md from the JSON that tools/remeasure/run.sh wrote.
+"""Markdown tables of docs/results.md from the JSON that tools/device/remeasure.sh wrote.
 
 Usage: tables.py DIR   (prints every table, headed by the file it comes from)
 """

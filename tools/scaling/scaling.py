@@ -44,7 +44,7 @@ for (mesh, executor, scheme), by_threads in sorted(rows.items()):
     base = by_threads.get(1, (None,))[0]
     cells = []
     for t in (1, 2, 4, 8, 16):
-        # A sweep cut short (device.sh's time budget) leaves thread counts out: a dash, not a crash.
+        # A sweep cut short (tools/device/scaling.sh's time budget) leaves thread counts out: a dash, not a crash.
         if t not in by_threads:
             cells.append("–")
             continue

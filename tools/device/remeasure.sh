@@ -2,7 +2,7 @@
 # The re-measurement of issue 14 (trust): every figure of docs/results.md and docs/baselines/*.md
 # that the trust changes move (fixed-capacity A-buffer, counting passes, overflow predicted by
 # the oracle, k-buffer write-back models), on the device machine's 16 cores.
-# Usage (device): tools/remeasure/run.sh FRAGSIM DRAGON OUTDIR
+# Usage (device): tools/device/remeasure.sh FRAGSIM DRAGON OUTDIR
 set -euo pipefail
 B=$1 D=$2 R=$3
 mkdir -p "$R" /tmp/remeasure

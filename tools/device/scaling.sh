@@ -4,7 +4,7 @@
 # 2048² and on `bunny-spheres` at 512², MDTS and the fixed-capacity A-buffer (FreePipe's
 # configurations: K = 20 and 20 slots, one geometry pass), at 1, 2, 4, 8 and 16 threads.
 #
-#   FRAGSIM=./fragsim MESH=./dragon_vrip.ply.gz OUT=out/device tools/scaling/device.sh
+#   FRAGSIM=./fragsim MESH=./dragon_vrip.ply.gz OUT=out/device tools/device/scaling.sh
 #
 # Environment (defaults in brackets):
 #   FRAGSIM [target/release/fragsim]   the binary

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The wgpu backend on the device machine in one call (docs/results-gpu.md, "wgpu"; issue 17 and
-# issue 16's captures): every scheme, correct and planted, and the non-atomic k-buffer, of the
+# The wgpu backend on the device machine in one call (docs/results-gpu.md, "wgpu on the H200";
+# issue 17 and issue 16's captures): every scheme, correct and planted, and the non-atomic k-buffer, of the
 # bunny, the dragon and bunny-spheres at 512² and 2048², replay and engine mode, views 30° and
 # 120° (the planted bugs there too), and views 210° and 300° for the schemes issue 16 asks at 4
 # views (abuffer, mdts, mdts32, linked-list-nearest). Each capture is judged in place by
@@ -15,9 +15,9 @@
 # off-by-one plant has pixels at its capacity to show in; K = 8; elevation 15°.
 #
 # Carry `target/devbin-wgpu` (`carry: ["target/devbin-wgpu"]`): the stripped release
-# `fragsim-wgpu`, the dragon, this script and the Vulkan loader's .debs in gl/ (the device has
-# the NVIDIA driver's ICD but maybe no loader); docs/results-gpu.md says how to fill it. Run
-# `bash target/devbin-wgpu/run_device.sh`. Jobs (one per scene, side, view and mode) run side by
+# `fragsim-wgpu`, the dragon and the Vulkan loader's .debs in gl/ (the device has the NVIDIA
+# driver's ICD but maybe no loader); backends/wgpu/README.md says how to fill it. Run
+# `bash tools/device/wgpu-captures.sh` from the repository root. Jobs (one per scene, side, view and mode) run side by
 # side (the verdicts are CPU work), in the order the knobs give: each side in turn, smallest
 # first, so that it is complete whatever happens; within a side views 30° and 120° (the planted
 # ones) of every scene first, in SCENES's order (the bunny first by default, so that the bunny
@@ -27,15 +27,15 @@
 #
 # SPINLOCK=0 leaves the spinlocked k-buffer out: on the H200 (2026-12-03) its shaders, killed
 # by `timeout`, kept the GPU busy after their processes ended, and every capture started after
-# them stalled until the deadline (docs/results-gpu.md, session 8).
+# them stalled until the deadline (docs/results-gpu.md, "The spinlocked k-buffer hangs on NVIDIA").
 #
 # Knobs (environment): SIZES (default "512 2048"), SCENES ("bunny dragon bunny-spheres"), VIEWS
 # ("30 120 210 300"), MODES ("replay engine"), JOBS (parallel jobs, default the cores / 2), BUDGET
 # (seconds for all the jobs, default 210), BIN (default target/devbin-wgpu), DRAGON (default
 # $BIN/dragon_vrip.ply.gz). Exactly the bunny at 512², 2 views, both modes (4 jobs):
-# SCENES=bunny SIZES=512 VIEWS="30 120" bash target/devbin-wgpu/run_device.sh. A dry run on
+# SCENES=bunny SIZES=512 VIEWS="30 120" bash tools/device/wgpu-captures.sh. A dry run on
 # lavapipe: BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES="32 64" bash
-# backends/wgpu/run_device.sh.
+# tools/device/wgpu-captures.sh.
 #
 # Output: every job's log on stdout and in $OUT/wgpu-device.log, then the summary table (scheme,
 # scene, view, size, mode, samples, verdict, error px, ambiguous px, coverage px, differing
@@ -53,9 +53,9 @@
 # a command failed (a sample count the GPU lacks, the budget spent). MSAA_ARGS: more options of
 # msaa-count (e.g. "--alone --examples 8": each differing replay sample's triangles drawn alone).
 # On the H200:
-# MSAA=1 bash target/devbin-wgpu/run_device.sh. A dry run on lavapipe (1 and 4 samples only):
+# MSAA=1 bash tools/device/wgpu-captures.sh. A dry run on lavapipe (1 and 4 samples only):
 # MSAA=1 BIN=target/release DRAGON=../shared/meshes/dragon_vrip.ply.gz SIZES=64 SAMPLES="1 4"
-# bash backends/wgpu/run_device.sh.
+# bash tools/device/wgpu-captures.sh.
 #
 # MSAA=capture: issue 34's per-sample captures instead (`fragsim-wgpu capture --samples N`,
 # src/capture.rs): a list per (pixel, sample), each sample's depth interpolated at the sample,
@@ -65,8 +65,8 @@
 # --vertex-precision f32`, per sample). One job per (scene, side, view, mode, samples). Defaults
 # then: SIZES "512", SCENES "bunny dragon", VIEWS "30 120", MODES "engine replay", SAMPLES "4 8",
 # BUDGET 300 s. The summary table gains the sample count and the differing samples and pixels.
-# On the H200: MSAA=capture bash target/devbin-wgpu/run_device.sh. A dry run on lavapipe:
-# MSAA=capture BIN=target/release SCENES=bunny SIZES=64 SAMPLES=4 bash backends/wgpu/run_device.sh.
+# On the H200: MSAA=capture bash tools/device/wgpu-captures.sh. A dry run on lavapipe:
+# MSAA=capture BIN=target/release SCENES=bunny SIZES=64 SAMPLES=4 bash tools/device/wgpu-captures.sh.
 set -uo pipefail
 msaa=${MSAA:-0}
 bin=${BIN:-target/devbin-wgpu}

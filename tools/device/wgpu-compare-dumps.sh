@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The H200 captures of this session (docs/results-gpu.md): every wgpu scheme, correct and planted,
-# of the bunny and bunny-spheres at 512², two views, replay and engine mode, each dump judged by
-# `fragsim compare oracle DUMP --vertex-precision f32` (the precision verdict, issue 16).
+# The wgpu captures written as dumps and judged by `fragsim compare` on the H200 (from the
+# repository root, target/devbin-wgpu carried: backends/wgpu/README.md): every wgpu scheme,
+# correct and planted, of the bunny and bunny-spheres at 512², two views, replay and engine
+# mode, each dump judged by `fragsim compare oracle DUMP --vertex-precision f32` (the precision
+# verdict, issue 16).
 set -uo pipefail
 bin=target/devbin-wgpu
 for f in "$bin"/gl/*.deb; do dpkg -x "$f" /; done

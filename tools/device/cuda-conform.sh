@@ -23,9 +23,9 @@
 # line>` goes to stdout and $OUT/conform.log: a run stopped by `timeout` still says how many cases
 # passed.
 #
-# Run from the repository root: `OUT=/some/dir bash backends/cuda/conform_device.sh`. Needs nvcc
+# Run from the repository root: `OUT=/some/dir bash tools/device/cuda-conform.sh`. Needs nvcc
 # and the driver, and a release `fragsim` binary (no cargo on the device): FRAGSIM (default
-# target/devbin-cuda/fragsim, as run_device.sh). Knobs (environment): CASES (default 500), K
+# target/devbin-cuda/fragsim, as cuda-captures.sh). Knobs (environment): CASES (default 500), K
 # (default 4), SEED (default 0), PART (seconds per run, default 330: with the build's 90 the whole
 # script stays under 8 minutes), FRAGSIM_CUDA (a prebuilt backend binary: skips the build; the CPU
 # emulation, `make -C backends/cuda emulate`, checks this script without a GPU, where the serial
