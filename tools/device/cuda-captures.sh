@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole device session in one command (docs/results-gpu.md records its output).
 # Run from the repository root on the GPU machine, with the x86-64 `fragsim` binary and the
-# meshes carried in target/devbin-cuda/ (see README.md). Writes its logs under $OUT.
+# meshes carried in target/devbin-cuda/ (see backends/cuda/README.md). Writes its logs under $OUT.
 set -u
 BIN=target/devbin-cuda
 F=$BIN/fragsim

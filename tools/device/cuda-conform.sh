@@ -9,7 +9,7 @@
 # serve.cuh: one process, one CUDA context for all its cases) and the per-case command is its
 # client (`fragsim_cuda --client`, which waits at most 20 s for the answer; conform kills a case
 # at 30 s); started afresh per case, fragsim_cuda spent about a second a case creating a context
-# (docs/results-gpu.md). Three runs side by side, each under `timeout`:
+# (docs/journal/2026-12-02-wgpu-h200.md). Three runs side by side, each under `timeout`:
 #   - mdts, K 4, 500 cases: must pass (exit 0);
 #   - abuffer, capacity 4, 500 cases: must pass (fragsim_cuda's `--k` sizes its A-buffer);
 #   - kbuffer (the deliberately non-atomic read-all / insert / write-all, dumped in MDTS's layout

@@ -1,10 +1,10 @@
 #!/bin/bash
-# The figures of docs/results.md "Approximate OIT against the exact answer (issue 19)" and its
-# per-depth-complexity sections: bench at K = 8 and 4 on the bunny, the dragon and
-# bunny-spheres, at K = 2, 16 and 32 on bunny-spheres, and sweep on the bunny and bunny-spheres
+# The figures of docs/results.md "Approximate OIT against the exact answer" and the
+# per-depth-complexity tables of docs/journal/2026-12-02-approximate-oit.md: bench at K = 8 and
+# 4 on the bunny, the dragon and bunny-spheres, at K = 2, 16 and 32 on bunny-spheres, and sweep on the bunny and bunny-spheres
 # (the dragon too with SWEEP_DRAGON=1), all at 512². Each run's bench.md / sweep table and its
 # JSON Lines are kept as $O/<run>.md (.txt) and $O/<run>.jsonl; `python3 tables.py $O` prints
-# results.md's tables from the JSON Lines.
+# the tables from the JSON Lines.
 set -e
 B=${FRAGSIM:-target/release/fragsim}
 D=${DRAGON:-../shared/meshes/dragon_vrip.ply.gz}

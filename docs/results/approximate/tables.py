@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""docs/results.md's per-K and per-bucket tables of the approximate OIT schemes (issue 19), read
-from the JSON Lines run.sh keeps: python3 tables.py DIR (run.sh's $O)."""
+"""The approximate OIT schemes' per-K table (docs/results.md) and per-bucket tables
+(docs/journal/2026-12-02-approximate-oit.md), read from the JSON Lines run.sh keeps:
+python3 tables.py DIR (run.sh's $O)."""
 import json
 import sys
 from pathlib import Path
