@@ -299,8 +299,8 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
                 if let Some(reference) = &within {
                     let verdict = reference.verdict(&captured.dump)?;
                     let per_sample = verdict.per_sample;
-                    // One line of figures (what tools/device/wgpu-captures.sh reads), per
-                    // sample its "pixels" the samples, then the samples and pixels that differ.
+                    // One line of figures (what wgpu-captures.sh reads), per sample its "pixels"
+                    // the samples, then the samples and pixels that differ.
                     let judgement = WithinJudgement {
                         comparison: verdict.comparison,
                         bounds: verdict.bounds.unwrap_or_default(),

@@ -10,10 +10,10 @@
 //! The depth-range test is made on the depth interpolated at the sample (a varying with sample
 //! interpolation), as fragsim makes it, not on `@builtin(position).z`: under sample shading the
 //! H200 gives the shader the depth at the pixel centre, which for a sliver triangle beside the
-//! centre lies far outside `[0, 1]` (measured: `docs/journal/2026-12-03-msaa-h200.md`), so a
-//! test on it dropped covered samples. The pass counts those (`shader_depth_outside`), the
-//! evidence of that convention. A per-pixel invocation counting the bits of
-//! `@builtin(sample_mask)` would cost fewer invocations but sees the centre's depth too.
+//! centre lies far outside `[0, 1]` (measured: `docs/results-gpu.md`, "MSAA"), so a test on it
+//! dropped covered samples. The pass counts those (`shader_depth_outside`), the evidence of that
+//! convention. A per-pixel invocation counting the bits of `@builtin(sample_mask)` would cost
+//! fewer invocations but sees the centre's depth too.
 //!
 //! **The reference** ([`reference_counts`]): fragsim's per-sample oracle
 //! ([`SampleOracle`]) of the same view with a sample pattern: in replay mode the view itself
