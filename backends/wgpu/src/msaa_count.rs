@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{SamplePattern, View, Viewport};
 use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::sample_counts::{
@@ -69,8 +69,8 @@ const CHECKED: usize = 200;
 /// then a table; `Ok(false)` when any count differs.
 pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Error>> {
     let base = match &args.mesh {
-        Some(path) => SceneAndCamera::hashed_mesh(path, 0.0, args.elevation)?,
-        None => SceneAndCamera::named(&args.scene, 0.0, args.elevation),
+        Some(path) => SceneSpec::hashed_mesh(path, 0.0, args.elevation)?,
+        None => SceneSpec::named(&args.scene, 0.0, args.elevation),
     };
     let name = match &args.mesh {
         Some(path) => path.file_name().map_or_else(
@@ -84,7 +84,7 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
     let mut rows = Vec::new();
     let (mut identical, mut failed) = (true, 0);
     for &degrees in &args.view {
-        let spec = SceneAndCamera {
+        let spec = SceneSpec {
             view_degrees: degrees,
             ..base.clone()
         };

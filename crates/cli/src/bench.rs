@@ -11,7 +11,7 @@ use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{Camera, Conventions, DepthRange, SamplePattern, View};
+use fragsim_raster::{Camera, Conventions, SamplePattern, View};
 use image::RgbImage;
 use indicatif::ProgressBar;
 use rayon::prelude::*;
@@ -414,24 +414,21 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         })
         .transpose()?;
     let pool = args.schemes.pool()?;
-    let scene = args.scene.scene()?;
+    let spec = args.scene.spec(Conventions::REFERENCE);
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
     let viewport = args.scene.viewport()?;
-    let orbit = args.scene.orbit(args.scene.view);
+    let orbit = spec.orbit();
     let frames = args.frames as usize;
     // The camera depends on the model's bounds, a per-scene constant (a GPU application computes
     // it at load); the vertex stage proper is timed per frame, on the pool.
-    let camera = args
-        .scene
-        .camera(&scene, args.scene.view, DepthRange::ZeroToOne)?;
+    let camera = spec.camera(&scene, viewport).map_err(|e| e.to_string())?;
     let serial_pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let mut view = args.schemes.submission(args.scene.view_at(
-        &scene,
-        args.scene.view,
-        Conventions::REFERENCE,
-    )?);
+    let mut view = args
+        .schemes
+        .submission(spec.view(&scene, viewport).map_err(|e| e.to_string())?);
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);

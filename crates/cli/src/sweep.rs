@@ -14,7 +14,7 @@ use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::judge::{ColourColumns, EffectName, Judge};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
-use fragsim_raster::Conventions;
+use fragsim_raster::{Conventions, SceneSpec};
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
 /// Options of `fragsim sweep`.
@@ -108,7 +108,9 @@ impl SweepSeries {
 /// Scene, parameter or output errors.
 pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let pool = args.schemes.pool()?;
-    let scene = args.scene.scene()?;
+    let spec = args.scene.spec(Conventions::REFERENCE);
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
+    let viewport = args.scene.viewport()?;
     let executor = args.schemes.executors()[0];
     let mut threads = 0;
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -123,10 +125,14 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         progress.set_message(format!("angle {step}"));
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
-        let orbit = args.scene.orbit(angle);
-        let view =
-            args.schemes
-                .submission(args.scene.view_at(&scene, angle, Conventions::REFERENCE)?);
+        let at_angle = SceneSpec {
+            view_degrees: angle,
+            ..spec.clone()
+        };
+        let orbit = at_angle.orbit();
+        let view = args
+            .schemes
+            .submission(at_angle.view(&scene, viewport).map_err(|e| e.to_string())?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
         let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
