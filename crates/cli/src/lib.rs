@@ -46,6 +46,7 @@ mod compare;
 mod conform;
 mod explain;
 mod export;
+mod frame_timing;
 mod hazard;
 mod judge;
 mod multisampled;
@@ -53,6 +54,7 @@ mod oracle_memory;
 mod progress;
 pub mod record;
 mod render;
+mod row_images;
 mod schemes;
 mod sweep;
 

@@ -29,8 +29,9 @@ use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
 use serde::Serialize;
 
-use crate::bench::{ms, time_frames, FrameTimes, Images};
+use crate::frame_timing::{ms, time_frames, FrameTimes};
 use crate::judge::{ColourColumns, Judge, Judged};
+use crate::row_images::Images;
 
 /// The oracle's transparency image resolved from several samples a pixel, against the
 /// single-sample image, and the multisampled schemes' rows (`--samples`).

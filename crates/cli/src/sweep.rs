@@ -165,7 +165,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         if !args.approximate.is_empty() {
             let order = PrimitiveOrder::of_view(&view);
             let raster_ms = pool
-                .install(|| crate::bench::time_raster_alone(&view))
+                .install(|| crate::frame_timing::time_raster_alone(&view))
                 .as_secs_f64()
                 * 1e3;
             let nodes = crate::approximate::nodes(args.schemes.k, &oracle);
