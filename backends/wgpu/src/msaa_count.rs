@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::scene_spec::args::{degrees, elevation, side};
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{SamplePattern, View, Viewport};
 use fragsim_wgpu::capture::engine_scene;
@@ -27,16 +28,17 @@ pub(crate) struct MsaaArgs {
     #[arg(long, default_value = "bunny")]
     scene: String,
     /// Viewport width (a power of two in replay mode).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true, value_parser = side())]
     width: u32,
     /// Viewport height (a power of two in replay mode).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true, value_parser = side())]
     height: u32,
     /// Orbit angles, degrees, comma-separated.
-    #[arg(long, default_value = "30", value_delimiter = ',')]
+    #[arg(long, default_value = "30", value_delimiter = ',', allow_negative_numbers = true,
+          value_parser = degrees)]
     view: Vec<f64>,
-    /// Elevation, degrees.
-    #[arg(long, default_value_t = 15.0)]
+    /// Elevation, degrees, within ±89.
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = elevation)]
     elevation: f64,
     /// Samples per pixel, comma-separated: 1 (the control), 2, 4, 8 (Vulkan's standard
     /// patterns; the adapter's target format must render at the count).

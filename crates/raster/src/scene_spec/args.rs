@@ -1,5 +1,6 @@
 //! The command-line options that name a scene spec, shared by every command that takes one
-//! (`fragsim`'s and `fragsim-wgpu`'s), so that each checks the same ranges.
+//! (`fragsim`'s and `fragsim-wgpu`'s), and their value parsers, for a command whose options are
+//! shaped otherwise (a list of angles), so that each checks the same ranges.
 
 use std::path::PathBuf;
 
@@ -20,14 +21,14 @@ pub struct SceneArgs {
     /// Viewport width in pixels.
     // Negative values reach the range check (and its message) instead of being taken for a flag.
     #[arg(long, default_value_t = 512, allow_negative_numbers = true,
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
+          value_parser = side())]
     pub width: u32,
     /// Viewport height in pixels.
     #[arg(long, default_value_t = 512, allow_negative_numbers = true,
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
+          value_parser = side())]
     pub height: u32,
     /// Orbit angle of the camera around the model, in degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = finite)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = degrees)]
     pub view: f64,
     /// Camera elevation above the model's equator, in degrees, within ±89 (the camera cannot
     /// look straight down its up axis).
@@ -67,7 +68,17 @@ impl SceneArgs {
     }
 }
 
-fn finite(text: &str) -> Result<f64, String> {
+/// A viewport side: 1 to [`Viewport::MAX_SIDE`] pixels.
+#[must_use]
+pub fn side() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(1..=i64::from(Viewport::MAX_SIDE))
+}
+
+/// An angle in degrees: any finite number.
+///
+/// # Errors
+/// Not a number, or not finite.
+pub fn degrees(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         _ => Err(format!("expected a finite number of degrees, got {text:?}")),
@@ -78,8 +89,12 @@ fn finite(text: &str) -> Result<f64, String> {
 /// rather than quietly clamped.
 const MAX_ELEVATION: f64 = 89.0;
 
-fn elevation(text: &str) -> Result<f64, String> {
-    let degrees = finite(text)?;
+/// An elevation in degrees, within ±89.
+///
+/// # Errors
+/// Not a finite number, or beyond ±89.
+pub fn elevation(text: &str) -> Result<f64, String> {
+    let degrees = degrees(text)?;
     if degrees.abs() > MAX_ELEVATION {
         return Err(format!(
             "the elevation must be between -{MAX_ELEVATION} and {MAX_ELEVATION} degrees \
