@@ -13,7 +13,10 @@ fn fragsim_wgpu(args: &[&str]) -> (Option<i32>, String) {
         .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
         .output()
         .unwrap();
-    (out.status.code(), String::from_utf8_lossy(&out.stderr).into())
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 /// `args` is refused with exit 2 and every one of `phrases` on stderr.
@@ -21,7 +24,10 @@ fn assert_refused(args: &[&str], phrases: &[&str]) {
     let (code, stderr) = fragsim_wgpu(args);
     assert_eq!(code, Some(2), "{args:?}: {stderr}");
     for phrase in phrases {
-        assert!(stderr.contains(phrase), "{args:?}: no {phrase:?} in {stderr}");
+        assert!(
+            stderr.contains(phrase),
+            "{args:?}: no {phrase:?} in {stderr}"
+        );
     }
 }
 

@@ -10,7 +10,7 @@
 use serde::Serialize;
 
 use crate::args::{Count, SceneArgs, SchemeArgs};
-use crate::judge::ColourColumns;
+use crate::colour_judge::ColourColumns;
 use fragsim_raster::{Conventions, SceneSpec};
 use fragsim_shade::colour_error::{colour_error_by_depth, BucketError, DEPTH_BUCKETS};
 use image::RgbImage;

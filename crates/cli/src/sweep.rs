@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
-use crate::judge::{ColourColumns, EffectName, Judge};
+use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
 use fragsim_raster::{Conventions, SceneSpec};
@@ -135,7 +135,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
             .submission(at_angle.view(&scene, viewport).map_err(|e| e.to_string())?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
-        let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+        let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
         crate::approximate::check_effect(&judge, &args.approximate)?;
         let depth_complexity = oracle.depth_complexity();
         let sizing = args.schemes.sizing();

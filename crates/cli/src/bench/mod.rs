@@ -18,8 +18,8 @@ use serde::Serialize;
 
 use crate::approximate::{ApproximateName, ApproximateRow};
 use crate::args::{SceneArgs, SchemeArgs, Shard};
+use crate::colour_judge::{AttributePass, ColourColumns, ColourJudge, EffectName, JudgedImage};
 use crate::frame_timing::{median, ms, time_frames, time_raster_alone};
-use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
 use crate::multisampled::MsaaReport;
 use crate::record::{ColourByDepth, Context};
 use crate::row_images::Images;
@@ -307,7 +307,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .collect();
     crate::oracle_memory::check(&view, sizing.memory_cap)?;
     let oracle = Oracle::build(&view);
-    let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+    let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
     crate::approximate::check_effect(&judge, &args.approximate)?;
     let covered = judge.covered;
     let depth_complexity = oracle.depth_complexity();
@@ -362,7 +362,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 &depth_complexity,
             )?;
             if let (
-                Some(Judged {
+                Some(JudgedImage {
                     image, reference, ..
                 }),
                 Some(images),
