@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use fragsim_oracle::dump::DumpError;
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::args::SceneArgs;
 use fragsim_raster::scene_spec::SceneSpec;
@@ -196,8 +197,9 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
         ),
     };
     let (width, height) = (viewport.width, viewport.height);
-    let loaded = spec.load(None)?;
-    let fragsim_view = spec.view(&loaded, viewport)?;
+    // Worded as the oracle words a dump's scene (`scene: …`), as fragsim compare says it.
+    let loaded = spec.load(None).map_err(DumpError::from)?;
+    let fragsim_view = spec.view(&loaded, viewport).map_err(DumpError::from)?;
     // An orbit around another up axis is recorded as its matrix: the dumps name the view captured.
     let spec = spec.recorded(&fragsim_view);
     let mode = match mode {

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use fragsim_oracle::dump::DumpError;
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::scene_spec::args::{degrees, elevation, side};
 use fragsim_raster::scene_spec::SceneSpec;
@@ -82,7 +83,7 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
         None => args.scene.clone(),
     };
     let viewport = Viewport::new(args.width, args.height)?;
-    let loaded = base.load(None)?;
+    let loaded = base.load(None).map_err(DumpError::from)?;
     let mut rows = Vec::new();
     let (mut identical, mut failed) = (true, 0);
     for &degrees in &args.view {
@@ -90,7 +91,7 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
             view_degrees: degrees,
             ..base.clone()
         };
-        let view = spec.view(&loaded, viewport)?;
+        let view = spec.view(&loaded, viewport).map_err(DumpError::from)?;
         // The f32 vertex stage's snap radius on this view (engine mode, when a count differs).
         let mut radius: Option<i64> = None;
         for mode in &args.mode {
@@ -98,7 +99,9 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
                 ModeArg::Replay => (Mode::Replay, view.clone()),
                 ModeArg::Engine => (
                     Mode::Engine,
-                    engine_scene(spec.clone(), &view).view(&loaded, viewport)?,
+                    engine_scene(spec.clone(), &view)
+                        .view(&loaded, viewport)
+                        .map_err(DumpError::from)?,
                 ),
             };
             for &samples in &args.samples {
