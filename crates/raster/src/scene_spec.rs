@@ -425,3 +425,6 @@ fn engine_matrix(matrix: &ViewProjection) -> Result<[f64; 16], SceneSpecError> {
     }
     Ok(entries)
 }
+
+#[cfg(test)]
+mod tests;
