@@ -33,8 +33,8 @@ use fragsim::oracle::compare::{compare_with, verdict, CompareOptions};
 use fragsim::oracle::dump::{
     ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, Payload, Words,
 };
-use fragsim::oracle::scene::{mesh_hash, ViewProjection};
 use fragsim::oracle::Oracle;
+use fragsim::raster::scene_spec::{mesh_hash, ViewProjection};
 use fragsim::raster::{DepthRange, VertexPrecision, Viewport, WindowOrigin};
 
 use super::input::Input;

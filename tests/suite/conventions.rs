@@ -9,8 +9,8 @@ use assert_cmd::Command;
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::oracle::compare::CompareOptions;
 use fragsim::oracle::dump::{Dump, DumpScheme};
-use fragsim::oracle::scene::{mesh_hash, SceneAndCamera, ViewProjection};
 use fragsim::oracle::Oracle;
+use fragsim::raster::scene_spec::{mesh_hash, SceneSpec, ViewProjection};
 use fragsim::raster::{
     Conventions, DepthRange, OrbitCamera, Scene, VertexPrecision, Viewport, WindowOrigin,
 };
@@ -35,23 +35,23 @@ const VIEWPORT: (u32, u32) = (40, 28);
 
 /// `spheres:3` as a GL engine would name it: the orbit's GL matrix, rounded to f32 as a uniform,
 /// given explicitly.
-fn engine_spec(scene: &Scene) -> SceneAndCamera {
+fn engine_spec(scene: &Scene) -> SceneSpec {
     let viewport = Viewport::new(VIEWPORT.0, VIEWPORT.1).unwrap();
     let orbit = OrbitCamera::default().at_angle(30.0);
     let camera = scene.orbit_camera(viewport, &orbit, DepthRange::MinusOneToOne);
     let row_major = camera.row_major().map(|v| f64::from(v as f32));
-    SceneAndCamera {
+    SceneSpec {
         view_projection: Some(ViewProjection {
             row_major,
             precision: VertexPrecision::F32,
         }),
         conventions: GL_F32,
-        ..SceneAndCamera::named("spheres:3", 0.0, 0.0)
+        ..SceneSpec::named("spheres:3", 0.0, 0.0)
     }
 }
 
 /// The MDTS dump of the view `spec` names, recorded by fragsim (a correct engine capture).
-fn engine_dump(spec: &SceneAndCamera) -> (Dump, Oracle) {
+fn engine_dump(spec: &SceneSpec) -> (Dump, Oracle) {
     let scene = spec.load(None).unwrap();
     let view = spec
         .view(&scene, Viewport::new(VIEWPORT.0, VIEWPORT.1).unwrap())
@@ -92,7 +92,7 @@ fn the_matrix_and_the_conventions_round_trip_to_their_bits() {
         "{text}"
     );
     let again = reparsed(&dump);
-    let bits = |s: &SceneAndCamera| s.view_projection.unwrap().row_major.map(f64::to_bits);
+    let bits = |s: &SceneSpec| s.view_projection.unwrap().row_major.map(f64::to_bits);
     assert_eq!(bits(&again.header.scene), bits(&spec));
     assert_eq!(again.header.scene.conventions, GL_F32);
     assert_eq!(again, dump);
@@ -100,7 +100,7 @@ fn the_matrix_and_the_conventions_round_trip_to_their_bits() {
 
 #[test]
 fn a_header_without_conventions_reads_as_the_reference() {
-    let spec = SceneAndCamera::named("spheres:3", 30.0, 15.0);
+    let spec = SceneSpec::named("spheres:3", 30.0, 15.0);
     let (dump, _) = engine_dump(&spec);
     let (text, _) = dump.encode().unwrap();
     assert!(
@@ -147,7 +147,7 @@ fn the_oracle_a_dump_names_is_built_under_its_matrix_and_conventions() {
     assert!(dump.compare(&rebuilt, &options).unwrap().is_equal());
     // The same matrix under the reference conventions is another picture: the conventions are
     // what makes it equal.
-    let reference = SceneAndCamera {
+    let reference = SceneSpec {
         conventions: Conventions::REFERENCE,
         ..header.scene.clone()
     };
@@ -202,7 +202,7 @@ fn a_mesh_whose_bytes_hash_otherwise_is_refused() {
     let dir = scratch("hash");
     let path = dir.join("tetra.obj");
     std::fs::write(&path, TETRAHEDRON).unwrap();
-    let spec = SceneAndCamera::hashed_mesh(&path, 30.0, 15.0).unwrap();
+    let spec = SceneSpec::hashed_mesh(&path, 30.0, 15.0).unwrap();
     let expected = mesh_hash(TETRAHEDRON.as_bytes());
     assert_eq!(spec.mesh_hash.as_deref(), Some(expected.as_str()));
     assert!(spec.load(None).is_ok());
@@ -217,7 +217,7 @@ fn a_mesh_whose_bytes_hash_otherwise_is_refused() {
 #[test]
 fn a_relative_mesh_found_nowhere_names_both_places() {
     let dir = scratch("nowhere");
-    let spec = SceneAndCamera::mesh(Path::new("no-such-mesh.obj"), 30.0, 15.0);
+    let spec = SceneSpec::mesh(Path::new("no-such-mesh.obj"), 30.0, 15.0);
     let error = spec.load(Some(&dir)).unwrap_err().to_string();
     let cwd = std::env::current_dir().unwrap();
     for place in [

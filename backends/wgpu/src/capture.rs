@@ -31,8 +31,8 @@
 use std::collections::BTreeMap;
 
 use fragsim_oracle::dump::{ArraySpec, Dtype, Dump, Header, Words, FORMAT, VERSION};
-use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
 use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::scene_spec::{SceneSpec, ViewProjection};
 use fragsim_raster::{Conventions, View};
 
 use crate::device::{Gpu, GpuError};
@@ -161,7 +161,7 @@ fn engine_geometry(view: &View<'_>) -> Geometry {
 pub fn capture(
     gpu: &Gpu,
     view: &View<'_>,
-    scene: SceneAndCamera,
+    scene: SceneSpec,
     scheme: &GpuScheme,
     mode: Mode,
 ) -> Result<Captured, GpuError> {
@@ -177,7 +177,7 @@ pub fn capture(
 pub fn capture_planted(
     gpu: &Gpu,
     view: &View<'_>,
-    scene: SceneAndCamera,
+    scene: SceneSpec,
     scheme: &GpuScheme,
     mode: Mode,
     plant: Option<Plant>,
@@ -197,7 +197,7 @@ pub fn capture_planted(
 pub fn capture_samples(
     gpu: &Gpu,
     view: &View<'_>,
-    mut scene: SceneAndCamera,
+    mut scene: SceneSpec,
     scheme: &GpuScheme,
     mode: Mode,
     plant: Option<Plant>,
@@ -291,7 +291,7 @@ fn pairs_to_u64(words: &[u32]) -> Vec<u64> {
 fn to_dump(
     gpu: &Gpu,
     view: &View<'_>,
-    scene: SceneAndCamera,
+    scene: SceneSpec,
     scheme: &GpuScheme,
     mode: Mode,
     plant: Option<Plant>,
@@ -367,7 +367,7 @@ fn to_dump(
 /// origin, depth in [0, 1]), the sample count kept; the scene fragsim rebuilds an engine
 /// capture's oracle from.
 #[must_use]
-pub fn engine_scene(mut scene: SceneAndCamera, view: &View<'_>) -> SceneAndCamera {
+pub fn engine_scene(mut scene: SceneSpec, view: &View<'_>) -> SceneSpec {
     let m = view.view_projection().as_mat4().to_cols_array();
     // Row-major, as a reader writes a matrix down (glam's arrays are column-major).
     scene.view_projection = Some(ViewProjection {

@@ -21,7 +21,7 @@
 
 use fragsim_capture::executors::Executor;
 use fragsim_capture::Guarantee;
-use fragsim_oracle::scene::mesh_hash;
+use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::VertexPrecision;
 use fragsim_testkit::{Backend, BackendError, Case, CatalogBackend, Input, Output, Params};
 

@@ -21,9 +21,9 @@ use fragsim_capture::{Capacity, Identity, Keeps};
 use fragsim_oracle::compare::Comparison;
 use fragsim_oracle::dump::{Dump, DumpError, Words};
 use fragsim_oracle::precision::{f32_reference, Bounds, Precision};
-use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Verdict};
 use fragsim_oracle::Oracle;
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{Scene, VertexPrecision, Viewport};
 
 /// The verdict and the coverage of one capture.
@@ -146,9 +146,9 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
 /// scene loaded, so that each verdict can judge samples exactly on an edge under whichever rule
 /// the capture follows (the oracle's [`Reference::with_edge_ties`]).
 pub struct Within {
-    scene: SceneAndCamera,
+    scene: SceneSpec,
     /// The scene with the exact f64 vertex stage, as the oracle was built.
-    exact: SceneAndCamera,
+    exact: SceneSpec,
     loaded: Scene,
     viewport: Viewport,
     oracle: Oracle,

@@ -23,9 +23,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::dump::DumpError;
 use fragsim_oracle::Oracle;
-use fragsim_raster::Viewport;
+use fragsim_raster::scene_spec::args::SceneArgs;
+use fragsim_raster::scene_spec::SceneSpec;
+use fragsim_raster::{Conventions, Viewport};
 use fragsim_wgpu::judge::{Within, WithinJudgement};
 use fragsim_wgpu::shaders::NAMES;
 use fragsim_wgpu::{capture_samples, judge, Gpu, GpuScheme, Mode, Plant};
@@ -68,29 +70,14 @@ struct CaptureArgs {
     /// linked-list, linked-list-nearest, kbuffer-spinlock-fixed; or all.
     #[arg(long, default_value = "abuffer,mdts,mdts32")]
     scheme: String,
-    /// A mesh file (OBJ or PLY, optionally gzipped).
-    #[arg(long, conflicts_with = "scene")]
-    mesh: Option<PathBuf>,
-    /// A named scene (bunny, bunny-spheres, spheres:N, soup, quads).
-    #[arg(long, default_value = "bunny")]
-    scene: String,
+    /// The scene and the camera, as `fragsim render` takes them.
+    #[command(flatten)]
+    scene: SceneArgs,
     /// A case directory of `fragsim conform` instead of a scene: the scene object of its
     /// `camera.json` (the case's mesh, the identity matrix) on the viewport of its
-    /// `case.json`, in place of --mesh, --scene, --width, --height, --view and --elevation.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["mesh", "scene", "width", "height"])]
+    /// `case.json`, in place of --mesh, --scene, --width, --height, --view, --elevation and --up.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["mesh", "scene", "width", "height", "up"])]
     case: Option<PathBuf>,
-    /// Viewport width.
-    #[arg(long, default_value_t = 512)]
-    width: u32,
-    /// Viewport height.
-    #[arg(long, default_value_t = 512)]
-    height: u32,
-    /// Orbit angle, degrees.
-    #[arg(long, default_value_t = 30.0)]
-    view: f64,
-    /// Elevation, degrees.
-    #[arg(long, default_value_t = 15.0)]
-    elevation: f64,
     /// replay: fragsim's snapped triangles; engine: the mesh and the f32 matrix.
     #[arg(long, value_enum, default_value = "replay")]
     mode: ModeArg,
@@ -159,13 +146,8 @@ fn run(cli: Cli) -> Result<bool, Box<dyn std::error::Error>> {
 fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::error::Error>> {
     let CaptureArgs {
         scheme,
-        mesh,
         scene,
         case,
-        width,
-        height,
-        view,
-        elevation,
         mode,
         k,
         capacity,
@@ -207,20 +189,19 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
             })
             .collect::<Result<Vec<_>, _>>()?
     };
-    let (spec, viewport) = match (&case, &mesh) {
-        (Some(dir), _) => conform_case(dir)?,
-        (None, Some(path)) => (
-            SceneAndCamera::hashed_mesh(path, view, elevation)?,
-            Viewport::new(width, height)?,
-        ),
-        (None, None) => (
-            SceneAndCamera::named(&scene, view, elevation),
-            Viewport::new(width, height)?,
+    let (spec, viewport) = match &case {
+        Some(dir) => conform_case(dir)?,
+        None => (
+            scene.spec(Conventions::REFERENCE).hashed()?,
+            scene.viewport()?,
         ),
     };
     let (width, height) = (viewport.width, viewport.height);
-    let loaded = spec.load(None)?;
-    let fragsim_view = spec.view(&loaded, viewport)?;
+    // Worded as the oracle words a dump's scene (`scene: …`), as fragsim compare says it.
+    let loaded = spec.load(None).map_err(DumpError::from)?;
+    let fragsim_view = spec.view(&loaded, viewport).map_err(DumpError::from)?;
+    // An orbit around another up axis is recorded as its matrix: the dumps name the view captured.
+    let spec = spec.recorded(&fragsim_view);
     let mode = match mode {
         ModeArg::Replay => Mode::Replay,
         ModeArg::Engine => Mode::Engine,
@@ -332,12 +313,12 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
 /// The scene object and viewport of a `fragsim conform` case directory: `camera.json` (a dump
 /// header's scene object, naming the case's mesh by its absolute path) and `case.json` (its
 /// `width` and `height`).
-fn conform_case(dir: &Path) -> Result<(SceneAndCamera, Viewport), Box<dyn std::error::Error>> {
+fn conform_case(dir: &Path) -> Result<(SceneSpec, Viewport), Box<dyn std::error::Error>> {
     let read = |name: &str| {
         let path = dir.join(name);
         std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))
     };
-    let spec: SceneAndCamera = serde_json::from_str(&read("camera.json")?)
+    let spec: SceneSpec = serde_json::from_str(&read("camera.json")?)
         .map_err(|e| format!("{}: {e}", dir.join("camera.json").display()))?;
     let about: serde_json::Value = serde_json::from_str(&read("case.json")?)
         .map_err(|e| format!("{}: {e}", dir.join("case.json").display()))?;

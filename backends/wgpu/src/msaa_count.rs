@@ -5,8 +5,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_oracle::dump::DumpError;
 use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::scene_spec::args::{degrees, elevation, side};
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{SamplePattern, View, Viewport};
 use fragsim_wgpu::capture::engine_scene;
 use fragsim_wgpu::sample_counts::{
@@ -27,16 +29,17 @@ pub(crate) struct MsaaArgs {
     #[arg(long, default_value = "bunny")]
     scene: String,
     /// Viewport width (a power of two in replay mode).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true, value_parser = side())]
     width: u32,
     /// Viewport height (a power of two in replay mode).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true, value_parser = side())]
     height: u32,
     /// Orbit angles, degrees, comma-separated.
-    #[arg(long, default_value = "30", value_delimiter = ',')]
+    #[arg(long, default_value = "30", value_delimiter = ',', allow_negative_numbers = true,
+          value_parser = degrees)]
     view: Vec<f64>,
-    /// Elevation, degrees.
-    #[arg(long, default_value_t = 15.0)]
+    /// Elevation, degrees, within ±89.
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = elevation)]
     elevation: f64,
     /// Samples per pixel, comma-separated: 1 (the control), 2, 4, 8 (Vulkan's standard
     /// patterns; the adapter's target format must render at the count).
@@ -69,8 +72,8 @@ const CHECKED: usize = 200;
 /// then a table; `Ok(false)` when any count differs.
 pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std::error::Error>> {
     let base = match &args.mesh {
-        Some(path) => SceneAndCamera::hashed_mesh(path, 0.0, args.elevation)?,
-        None => SceneAndCamera::named(&args.scene, 0.0, args.elevation),
+        Some(path) => SceneSpec::hashed_mesh(path, 0.0, args.elevation)?,
+        None => SceneSpec::named(&args.scene, 0.0, args.elevation),
     };
     let name = match &args.mesh {
         Some(path) => path.file_name().map_or_else(
@@ -80,15 +83,15 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
         None => args.scene.clone(),
     };
     let viewport = Viewport::new(args.width, args.height)?;
-    let loaded = base.load(None)?;
+    let loaded = base.load(None).map_err(DumpError::from)?;
     let mut rows = Vec::new();
     let (mut identical, mut failed) = (true, 0);
     for &degrees in &args.view {
-        let spec = SceneAndCamera {
+        let spec = SceneSpec {
             view_degrees: degrees,
             ..base.clone()
         };
-        let view = spec.view(&loaded, viewport)?;
+        let view = spec.view(&loaded, viewport).map_err(DumpError::from)?;
         // The f32 vertex stage's snap radius on this view (engine mode, when a count differs).
         let mut radius: Option<i64> = None;
         for mode in &args.mode {
@@ -96,7 +99,9 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
                 ModeArg::Replay => (Mode::Replay, view.clone()),
                 ModeArg::Engine => (
                     Mode::Engine,
-                    engine_scene(spec.clone(), &view).view(&loaded, viewport)?,
+                    engine_scene(spec.clone(), &view)
+                        .view(&loaded, viewport)
+                        .map_err(DumpError::from)?,
                 ),
             };
             for &samples in &args.samples {

@@ -13,8 +13,8 @@ use fragsim_capture::catalog::DumpLayout;
 use fragsim_capture::schemes::linked_list::Resolve;
 use fragsim_oracle::dump::{Dump, Words};
 
-use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::Oracle;
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::{judge, Judgement, Within, WithinJudgement};
 use fragsim_wgpu::{adapter_or_skip, capture, capture_planted, Gpu, GpuScheme, Mode, Plant};
@@ -30,7 +30,7 @@ fn captured(
     plant: Option<Plant>,
 ) -> (Dump, Oracle) {
     let side = 128;
-    let spec = SceneAndCamera::named(scene, 30.0, 15.0);
+    let spec = SceneSpec::named(scene, 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let view = loaded
         .view(Viewport::new(side, side).unwrap(), &spec.orbit())
@@ -174,7 +174,7 @@ fn the_kbuffer_race_is_reported_as_it_is() {
 #[test]
 fn replay_refuses_a_viewport_that_is_not_a_power_of_two() {
     let Some(gpu) = adapter_or_skip() else { return };
-    let spec = SceneAndCamera::named("bunny", 30.0, 15.0);
+    let spec = SceneSpec::named("bunny", 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let view = loaded
         .view(Viewport::new(96, 64).unwrap(), &spec.orbit())

@@ -17,8 +17,8 @@
 //! required (`adapter_or_skip`).
 
 use fragsim_oracle::dump::Dump;
-use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::verdict::{judge_sides, Side, SidesOptions, Verdict};
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{SamplePattern, VertexPrecision, Viewport};
 use fragsim_wgpu::judge::Within;
 use fragsim_wgpu::sample_counts::{
@@ -37,7 +37,7 @@ fn the_bunnys_sample_counts_are_fragsims_at_the_standard_positions() {
         }
         let pattern = SamplePattern::standard(samples).unwrap();
         for degrees in [30.0, 120.0] {
-            let spec = SceneAndCamera::named("bunny", degrees, 15.0);
+            let spec = SceneSpec::named("bunny", degrees, 15.0);
             let loaded = spec.load(None).unwrap();
             let view = spec
                 .view(&loaded, Viewport::new(side, side).unwrap())
@@ -74,7 +74,7 @@ fn triangles_drawn_alone_cover_the_samples_the_oracle_gives_them() {
         return;
     }
     let pattern = SamplePattern::standard(samples).unwrap();
-    let spec = SceneAndCamera::named("bunny", 30.0, 15.0);
+    let spec = SceneSpec::named("bunny", 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let view = spec.view(&loaded, Viewport::new(64, 64).unwrap()).unwrap();
     let reference = reference_counts(&view, pattern).unwrap();
@@ -100,7 +100,7 @@ fn per_sample_verdicts(
     scene: &str,
     samples: u32,
 ) -> Vec<(GpuScheme, Option<Plant>, Verdict)> {
-    let spec = SceneAndCamera::named(scene, 30.0, 15.0);
+    let spec = SceneSpec::named(scene, 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let viewport = Viewport::new(128, 128).unwrap();
     let view = spec.view(&loaded, viewport).unwrap();

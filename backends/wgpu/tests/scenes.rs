@@ -14,7 +14,7 @@
 use std::path::PathBuf;
 
 use fragsim_capture::schemes::linked_list::Resolve;
-use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::{judge, Within};
 use fragsim_wgpu::{adapter_or_skip, capture, say_skipped, Gpu, GpuScheme, Mode};
@@ -45,7 +45,7 @@ fn correct_schemes() -> Vec<GpuScheme> {
 
 /// Captures `name` (the scene of `spec_at(view)`) at both views in both modes and asserts the
 /// verdicts described in the module's documentation.
-fn every_scheme_is_equal(gpu: &Gpu, name: &str, spec_at: impl Fn(f64) -> SceneAndCamera) {
+fn every_scheme_is_equal(gpu: &Gpu, name: &str, spec_at: impl Fn(f64) -> SceneSpec) {
     for view in [30.0, 120.0] {
         let spec = spec_at(view);
         let loaded = spec.load(None).unwrap();
@@ -93,16 +93,14 @@ fn every_scheme_is_equal(gpu: &Gpu, name: &str, spec_at: impl Fn(f64) -> SceneAn
 #[test]
 fn the_bunny_through_every_correct_scheme_is_equal() {
     let Some(gpu) = adapter_or_skip() else { return };
-    every_scheme_is_equal(&gpu, "bunny", |view| {
-        SceneAndCamera::named("bunny", view, 15.0)
-    });
+    every_scheme_is_equal(&gpu, "bunny", |view| SceneSpec::named("bunny", view, 15.0));
 }
 
 #[test]
 fn bunny_spheres_through_every_correct_scheme_is_equal() {
     let Some(gpu) = adapter_or_skip() else { return };
     every_scheme_is_equal(&gpu, "bunny-spheres", |view| {
-        SceneAndCamera::named("bunny-spheres", view, 15.0)
+        SceneSpec::named("bunny-spheres", view, 15.0)
     });
 }
 
@@ -114,6 +112,6 @@ fn the_dragon_through_every_correct_scheme_is_equal() {
     };
     let Some(gpu) = adapter_or_skip() else { return };
     every_scheme_is_equal(&gpu, "dragon", |view| {
-        SceneAndCamera::hashed_mesh(&path, view, 15.0).unwrap()
+        SceneSpec::hashed_mesh(&path, view, 15.0).unwrap()
     });
 }

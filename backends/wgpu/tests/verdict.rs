@@ -10,14 +10,14 @@
 
 use fragsim_oracle::compare::{verdict, Comparison};
 use fragsim_oracle::dump::Dump;
-use fragsim_oracle::scene::SceneAndCamera;
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::Within;
 use fragsim_wgpu::{adapter_or_skip, capture, Gpu, GpuScheme, Mode};
 
 /// The bunny at 128², view 30°, drawn by `scheme` in engine mode.
 fn engine_capture(gpu: &Gpu, scheme: &GpuScheme) -> Dump {
-    let spec = SceneAndCamera::named("bunny", 30.0, 15.0);
+    let spec = SceneSpec::named("bunny", 30.0, 15.0);
     let loaded = spec.load(None).unwrap();
     let view = loaded
         .view(Viewport::new(128, 128).unwrap(), &spec.orbit())

@@ -4,7 +4,7 @@
 //!
 //! **What is measured.** These schemes hold colour, not fragment lists, so there is no list for
 //! the oracle to diff: each is judged by its transparency image against the oracle's
-//! ([`Judge::judge_image`]): error pixels, mean and maximum absolute error, PSNR, over the image
+//! ([`ColourJudge::judge_image`]): error pixels, mean and maximum absolute error, PSNR, over the image
 //! and per depth-complexity bucket ([`ColourByDepth`], where its error lives). Its fragments
 //! reach it in primitive order, as a GPU's blending and ordered interlock deliver them
 //! ([`PrimitiveOrder::of_view`]), so its image is the same whatever executor the catalog's
@@ -28,7 +28,7 @@ use fragsim_shade::effects::Effect;
 use image::RgbImage;
 use serde::Serialize;
 
-use crate::judge::{ColourColumns, Judge};
+use crate::colour_judge::{ColourColumns, ColourJudge};
 use crate::record::ColourByDepth;
 
 /// An approximate OIT scheme, as `--approximate` spells it.
@@ -113,7 +113,7 @@ pub fn nodes(k: Count, oracle: &Oracle) -> u32 {
 /// # Errors
 /// The judge's effect is not transparency.
 pub(crate) fn check_effect(
-    judge: &Judge<'_>,
+    judge: &ColourJudge<'_>,
     approximate: &[ApproximateName],
 ) -> Result<(), String> {
     if approximate.is_empty() || judge.effect() == Effect::Transparency {
@@ -138,7 +138,7 @@ pub(crate) fn check_effect(
 pub(crate) fn measure(
     scheme: ApproximateName,
     k: u32,
-    judge: &Judge<'_>,
+    judge: &ColourJudge<'_>,
     oracle: &Oracle,
     order: &PrimitiveOrder,
     frames: usize,

@@ -6,112 +6,12 @@ use clap::{Args, ValueEnum};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::conventions::MAX_SUBPIXEL_BITS;
-use fragsim_raster::{
-    Camera, Conventions, DepthRange, OrbitCamera, Scene, UpAxis, VertexPrecision, View, Viewport,
-    WindowOrigin, DEFAULT_SCENE_NAME,
-};
+use fragsim_raster::{Conventions, DepthRange, Scene, VertexPrecision, View, WindowOrigin};
 
 pub use fragsim_capture::catalog::Count;
 use fragsim_capture::catalog::Sizing;
 use fragsim_oracle::dump::{Encoding, ListNumbering, Payload, SlotOrder};
-
-/// The scene and the camera.
-#[derive(Debug, Clone, Args)]
-pub struct SceneArgs {
-    /// A mesh file (OBJ, or PLY: ASCII or binary, optionally gzipped) instead of a named scene.
-    #[arg(long, value_name = "PATH", conflicts_with = "scene")]
-    pub mesh: Option<PathBuf>,
-    /// A named scene: `bunny` (embedded), `bunny-spheres:N:SEED`, `spheres:N`, `soup:COUNT:SEED`, `quads:N` (parameters optional).
-    #[arg(long, value_name = "NAME", default_value = DEFAULT_SCENE_NAME)]
-    pub scene: String,
-    /// Viewport width in pixels.
-    // Negative values reach the range check (and its message) instead of being taken for a flag.
-    #[arg(long, default_value_t = 512, allow_negative_numbers = true,
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub width: u32,
-    /// Viewport height in pixels.
-    #[arg(long, default_value_t = 512, allow_negative_numbers = true,
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub height: u32,
-    /// Orbit angle of the camera around the model, in degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = finite)]
-    pub view: f64,
-    /// Camera elevation above the model's equator, in degrees, within ±89 (the camera cannot
-    /// look straight down its up axis).
-    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true, value_parser = elevation)]
-    pub elevation: f64,
-    /// The model's up axis in its file: `y` (OBJ's custom), `z` (most scanner and CAD files: a
-    /// z-up model otherwise lies on its side), `x`, `-y`, `-z` or `-x`. The camera orbits that
-    /// axis; the mesh and its primitive ids stay as they are (a dump records the turned camera as
-    /// its `view_projection`).
-    #[arg(long, value_name = "AXIS", default_value = "y", allow_hyphen_values = true,
-          value_parser = UpAxis::parse)]
-    pub up: UpAxis,
-}
-
-impl SceneArgs {
-    /// Loads the scene.
-    ///
-    /// # Errors
-    /// The mesh cannot be loaded or the scene name is unknown.
-    pub fn scene(&self) -> Result<Scene, String> {
-        match &self.mesh {
-            Some(path) => Scene::from_file(path),
-            None => Scene::procedural(&self.scene),
-        }
-        .map_err(|e| e.to_string())
-    }
-
-    /// The viewport.
-    ///
-    /// # Errors
-    /// A side out of range.
-    pub fn viewport(&self) -> Result<Viewport, String> {
-        Viewport::new(self.width, self.height)
-    }
-
-    /// The orbit camera at `angle` degrees (the `--view` angle unless overridden).
-    #[must_use]
-    pub fn orbit(&self, angle: f64) -> OrbitCamera {
-        OrbitCamera {
-            angle_degrees: angle,
-            elevation_degrees: self.elevation,
-            ..OrbitCamera::default()
-        }
-    }
-
-    /// The camera at orbit `angle` around `scene` stood on its `--up` axis, with the projection
-    /// of `depth_range`.
-    ///
-    /// # Errors
-    /// A side out of range.
-    pub fn camera(
-        &self,
-        scene: &Scene,
-        angle: f64,
-        depth_range: DepthRange,
-    ) -> Result<Camera, String> {
-        Ok(scene.orbit_camera_up(self.viewport()?, &self.orbit(angle), depth_range, self.up))
-    }
-
-    /// `scene` at orbit `angle` under `conventions`: what `render` captures and `export-scene`
-    /// writes (at more than one sample, a view rasterizing per sample whose
-    /// [`View::pixel_viewport`] is the render target).
-    ///
-    /// # Errors
-    /// A bad viewport, or conventions fragsim cannot rasterize under.
-    pub fn view_at<'s>(
-        &self,
-        scene: &'s Scene,
-        angle: f64,
-        conventions: Conventions,
-    ) -> Result<View<'s>, String> {
-        let camera = self.camera(scene, angle, conventions.depth_range)?;
-        scene
-            .view_under(self.viewport()?, &camera, conventions)
-            .map_err(|e| e.to_string())
-    }
-}
+pub use fragsim_raster::scene_spec::args::SceneArgs;
 
 /// The rasterization conventions of the view (`docs/semantics.md` §9); the defaults are
 /// fragsim's reference.
@@ -333,28 +233,6 @@ fn parse_bytes(text: &str) -> Result<u64, String> {
         Ok(n) if n < 0 => format!("a number of bytes cannot be negative, got {n}"),
         _ => format!("expected a number of bytes, got {text:?}"),
     })
-}
-
-fn finite(text: &str) -> Result<f64, String> {
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(format!("expected a finite number of degrees, got {text:?}")),
-    }
-}
-
-/// The largest elevation the orbit camera takes (`OrbitCamera` clamps beyond it): refused
-/// rather than quietly clamped.
-const MAX_ELEVATION: f64 = 89.0;
-
-fn elevation(text: &str) -> Result<f64, String> {
-    let degrees = finite(text)?;
-    if degrees.abs() > MAX_ELEVATION {
-        return Err(format!(
-            "the elevation must be between -{MAX_ELEVATION} and {MAX_ELEVATION} degrees \
-             (the camera cannot look along its up axis), got {degrees}"
-        ));
-    }
-    Ok(degrees)
 }
 
 /// Which executors run.

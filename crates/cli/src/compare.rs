@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use fragsim_oracle::compare::verdict;
-use fragsim_oracle::scene::SceneAndCamera;
 use fragsim_oracle::verdict::{judge_sides, Entry, Options, Side, SidesOptions, Summary, Verdict};
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::VertexPrecision;
 
 use crate::record::{Context, Slots};
@@ -65,7 +65,7 @@ pub struct CompareArgs {
 /// What the report prints: the verdict's totals, its scene, and the difference image written.
 struct Report<'a> {
     summary: Summary<'a>,
-    scene: &'a SceneAndCamera,
+    scene: &'a SceneSpec,
     width: u32,
     height: u32,
     image: Option<String>,

@@ -16,8 +16,8 @@ use std::time::Duration;
 
 use clap::Args;
 use fragsim_capture::catalog::SchemeName;
-use fragsim_oracle::scene::{mesh_hash, SceneAndCamera};
 use fragsim_oracle::PixelMismatch;
+use fragsim_raster::scene_spec::{mesh_hash, SceneSpec};
 use fragsim_raster::{depth_from_key, Conventions, VertexPrecision};
 use fragsim_testkit::{
     Battery, Case, CommandBackend, Counterexample, Event, Failure, Input, Limits, Params,
@@ -266,7 +266,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
                 std::fs::remove_dir_all(&saved)
                     .map_err(|e| format!("cannot remove {}: {e}", saved.display()))?;
             }
-            let spec = SceneAndCamera::named("generated", 0.0, 0.0);
+            let spec = SceneSpec::named("generated", 0.0, 0.0);
             let context = sized(
                 Context::new("conform", &spec, args.max_side, args.max_side),
                 &params,

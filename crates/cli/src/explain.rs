@@ -156,7 +156,7 @@ pub fn explain(args: &ExplainArgs) -> Result<bool, String> {
     if args.json {
         let mut context = crate::record::Context::new(
             "explain",
-            &fragsim_oracle::scene::SceneAndCamera::named("one-pixel", 0.0, 0.0),
+            &fragsim_raster::scene_spec::SceneSpec::named("one-pixel", 0.0, 0.0),
             1,
             1,
         );

@@ -6,9 +6,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_oracle::dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
-use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
 use fragsim_oracle::triangles::TriangleExport;
-use fragsim_raster::{Camera, UpAxis, VertexPrecision, View};
+use fragsim_raster::{SceneSpec, View};
 
 use crate::args::{ConventionsArgs, SceneArgs};
 use crate::schemes::{NamedRun, SchemeName};
@@ -41,36 +40,11 @@ struct ExportRecord {
     mesh_triangles: u32,
 }
 
-/// The scene description a dump or an export carries (a mesh file with the hash of its bytes).
-pub(crate) fn scene_spec(args: &SceneArgs) -> Result<SceneAndCamera, String> {
-    match &args.mesh {
-        Some(path) => {
-            SceneAndCamera::hashed_mesh(path, args.view, args.elevation).map_err(|e| e.to_string())
-        }
-        None => Ok(SceneAndCamera::named(
-            &args.scene,
-            args.view,
-            args.elevation,
-        )),
-    }
-}
-
-/// The scene a dump or an export of `view` records: [`scene_spec`] under the view's conventions.
-/// A model stood on another `--up` axis is recorded by the view's matrix, turn included, which
-/// the orbit's fields cannot describe.
-pub(crate) fn view_spec(args: &SceneArgs, view: &View<'_>) -> Result<SceneAndCamera, String> {
-    let turned = (args.up != UpAxis::Y).then(|| ViewProjection {
-        row_major: Camera {
-            view_projection: view.view_projection(),
-        }
-        .row_major(),
-        precision: VertexPrecision::F64,
-    });
-    Ok(SceneAndCamera {
-        conventions: view.conventions(),
-        view_projection: turned,
-        ..scene_spec(args)?
-    })
+/// The scene a dump or an export of `view` records: `spec` with its mesh file hashed
+/// ([`SceneSpec::hashed`]), as recorded of `view` ([`SceneSpec::recorded`]).
+fn recorded_spec(spec: &SceneSpec, view: &View<'_>) -> Result<SceneSpec, String> {
+    let hashed = spec.clone().hashed().map_err(|e| e.to_string())?;
+    Ok(hashed.recorded(view))
 }
 
 /// Runs `export-scene`.
@@ -78,11 +52,12 @@ pub(crate) fn view_spec(args: &SceneArgs, view: &View<'_>) -> Result<SceneAndCam
 /// # Errors
 /// A scene that cannot be loaded, a bad viewport, a file that cannot be written.
 pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
-    let scene = args.scene.scene()?;
-    let view = args
-        .scene
-        .view_at(&scene, args.scene.view, args.conventions.conventions())?;
-    let spec = view_spec(&args.scene, &view)?;
+    let spec = args.scene.spec(args.conventions.conventions());
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
+    let view = spec
+        .view(&scene, args.scene.viewport()?)
+        .map_err(|e| e.to_string())?;
+    let spec = recorded_spec(&spec, &view)?;
     // The records are in pixels whatever the sample count (a backend scans them at the samples
     // the scene's conventions name), so the header's size is the render target's, not the
     // sample-expanded framebuffer's.
@@ -158,7 +133,7 @@ impl DumpStage {
         name: SchemeName,
         run: &NamedRun,
         view: &View<'_>,
-        scene: &SceneArgs,
+        scene: &SceneSpec,
     ) -> Result<(), String> {
         let scheme = match DumpScheme::for_run(
             name,
@@ -173,7 +148,7 @@ impl DumpStage {
             }
         };
         let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-        let spec = view_spec(scene, view)?;
+        let spec = recorded_spec(scene, view)?;
         let (layout, ignored) = scheme.spec_in(&self.encoding);
         if !ignored.is_empty() {
             eprintln!(
@@ -216,11 +191,11 @@ impl DumpStage {
     pub(crate) fn add_masked(
         &mut self,
         view: &View<'_>,
-        scene: &SceneArgs,
+        scene: &SceneSpec,
         capacity: u32,
     ) -> Result<(), String> {
         let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-        let spec = view_spec(scene, view)?;
+        let spec = recorded_spec(scene, view)?;
         let (layout, ignored) = masked_spec(&self.encoding);
         if !ignored.is_empty() {
             eprintln!(

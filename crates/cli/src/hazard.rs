@@ -133,11 +133,10 @@ pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
             "hazard needs --threads-in-flight ≥ 1, at least one seed and one machine".into(),
         );
     }
-    let scene = args.scene.scene()?;
+    let spec = args.scene.spec(Conventions::REFERENCE);
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
     let viewport = args.scene.viewport()?;
-    let view = args
-        .scene
-        .view_at(&scene, args.scene.view, Conventions::REFERENCE)?;
+    let view = spec.view(&scene, viewport).map_err(|e| e.to_string())?;
     crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT)?;
     let oracle = Oracle::build(&view);
     let in_bucket = covered_by_bucket(&oracle);

@@ -42,17 +42,19 @@ fn write_stdout(text: std::fmt::Arguments<'_>) {
 mod approximate;
 mod args;
 mod bench;
+mod colour_judge;
 mod compare;
 mod conform;
 mod explain;
 mod export;
+mod frame_timing;
 mod hazard;
-mod judge;
 mod multisampled;
 mod oracle_memory;
 mod progress;
 pub mod record;
 mod render;
+mod row_images;
 mod schemes;
 mod sweep;
 
@@ -63,12 +65,12 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
 pub use bench::{BenchArgs, BenchReport, BenchRow};
+pub use colour_judge::{AttributePass, EffectName};
 pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
 pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
 pub use hazard::{BaselineRow, HazardArgs, HazardReport, HazardRow};
-pub use judge::{AttributePass, EffectName};
 pub use multisampled::{MsaaReport, SampledRow};
 pub use render::{RenderArgs, RunSummary, TieChoice};
 pub use schemes::{Fault, SchemeChoice, SchemeName, Sizing};

@@ -18,7 +18,7 @@
 //! fragments missing from the scheme's per-sample resolve, the samples whose list differs, and of
 //! those the misordered ones ([`SampleError`]); and the colour error of its transparency image,
 //! shaded per sample and box-resolved per pixel, against the oracle's image resolved the same
-//! way ([`Judge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
+//! way ([`ColourJudge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
 
 use fragsim_capture::catalog::{check_memory_cap_early, Count, Executors, SchemeName, Sizing};
@@ -29,8 +29,9 @@ use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
 use serde::Serialize;
 
-use crate::bench::{ms, time_frames, FrameTimes, Images};
-use crate::judge::{ColourColumns, Judge, Judged};
+use crate::colour_judge::{ColourColumns, ColourJudge, JudgedImage};
+use crate::frame_timing::{ms, time_frames, FrameTimes};
+use crate::row_images::Images;
 
 /// The oracle's transparency image resolved from several samples a pixel, against the
 /// single-sample image, and the multisampled schemes' rows (`--samples`).
@@ -137,7 +138,7 @@ pub(crate) struct Bench<'b, 'v> {
     /// The camera set each frame.
     pub camera: &'b Camera,
     /// The single-sample judge of transparency.
-    pub judge: &'b Judge<'b>,
+    pub judge: &'b ColourJudge<'b>,
     /// The catalog schemes to run per sample.
     pub schemes: &'b [SchemeName],
     /// The executors.
@@ -195,8 +196,8 @@ pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<M
     crate::oracle_memory::check(bench.view, bench.sizing.memory_cap / u64::from(samples))?;
     let oracle = SampleOracle::build(&view)?;
     let lists = oracle.oracle();
-    let judge = Judge::per_sample(
-        crate::judge::EffectName::Transparency,
+    let judge = ColourJudge::per_sample(
+        crate::colour_judge::EffectName::Transparency,
         bench.scene,
         &view,
         bench.orbit,
@@ -249,7 +250,7 @@ fn rows(
     bench: &Bench<'_, '_>,
     view: &mut View<'_>,
     oracle: &SampleOracle,
-    judge: &Judge<'_>,
+    judge: &ColourJudge<'_>,
 ) -> Result<Vec<SampledRow>, String> {
     let masked_executors: Vec<Executor> = bench
         .executors
@@ -266,7 +267,7 @@ fn rows(
     let samples = oracle.pattern().count();
     let mut rows = Vec::new();
     // The row of a first frame's per-sample lists and its times; the image unless --no-images.
-    let mut row = |common: Common, error: SampleError, judged: Option<Judged<'_>>| {
+    let mut row = |common: Common, error: SampleError, judged: Option<JudgedImage<'_>>| {
         let times = &common.times;
         if let (Some(images), Some(j)) = (bench.images, &judged) {
             images.save_with_difference(

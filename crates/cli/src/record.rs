@@ -10,8 +10,8 @@
 use serde::Serialize;
 
 use crate::args::{Count, SceneArgs, SchemeArgs};
-use crate::judge::ColourColumns;
-use fragsim_oracle::scene::SceneAndCamera;
+use crate::colour_judge::ColourColumns;
+use fragsim_raster::{Conventions, SceneSpec};
 use fragsim_shade::colour_error::{colour_error_by_depth, BucketError, DEPTH_BUCKETS};
 use image::RgbImage;
 
@@ -77,7 +77,7 @@ pub struct Context {
 impl Context {
     /// The context of `command` on the scene and camera of `spec`, at `width × height`.
     #[must_use]
-    pub fn new(command: &'static str, spec: &SceneAndCamera, width: u32, height: u32) -> Self {
+    pub fn new(command: &'static str, spec: &SceneSpec, width: u32, height: u32) -> Self {
         let scene = match (&spec.name, &spec.mesh) {
             (Some(name), _) => name.clone(),
             (None, Some(mesh)) => file_name(mesh),
@@ -105,7 +105,10 @@ impl Context {
     /// # Errors
     /// The mesh file cannot be read.
     pub fn of_scene(command: &'static str, scene: &SceneArgs) -> Result<Self, String> {
-        let spec = crate::export::scene_spec(scene)?;
+        let spec = scene
+            .spec(Conventions::REFERENCE)
+            .hashed()
+            .map_err(|e| e.to_string())?;
         Ok(Self::new(command, &spec, scene.width, scene.height))
     }
 

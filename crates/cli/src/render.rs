@@ -193,12 +193,12 @@ pub struct RunSummary {
 /// cannot be written.
 pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let pool = args.schemes.pool()?;
-    let scene = args.scene.scene()?;
-    let view = args.schemes.submission(args.scene.view_at(
-        &scene,
-        args.scene.view,
-        args.conventions.conventions(),
-    )?);
+    let spec = args.scene.spec(args.conventions.conventions());
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
+    let view = args.schemes.submission(
+        spec.view(&scene, args.scene.viewport()?)
+            .map_err(|e| e.to_string())?,
+    );
     crate::args::warn_if_empty(&scene, &view);
     // At more than one sample every scheme, the oracle and the images cover the sample-expanded
     // framebuffer (`docs/semantics.md`, "Multisampling").
@@ -299,7 +299,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             last = Some(named);
         }
         if let (Some(stage), Some(run)) = (&mut dumps, &last) {
-            stage.add(name, run, &view, &args.scene)?;
+            stage.add(name, run, &view, &spec)?;
         }
     }
     let mut masked_line = None;
@@ -307,7 +307,7 @@ pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         let (capacity, line) = masked(&view, &sizing)?;
         masked_line = Some(line);
         if let Some(stage) = &mut dumps {
-            stage.add_masked(&view, &args.scene, capacity)?;
+            stage.add_masked(&view, &spec, capacity)?;
         }
     }
     if let Some(stage) = dumps {

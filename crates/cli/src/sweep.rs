@@ -11,10 +11,10 @@ use serde::Serialize;
 
 use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
-use crate::judge::{ColourColumns, EffectName, Judge};
+use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
 use crate::schemes::{family, Executors, SchemeChoice};
-use fragsim_raster::Conventions;
+use fragsim_raster::{Conventions, SceneSpec};
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
 /// Options of `fragsim sweep`.
@@ -108,7 +108,9 @@ impl SweepSeries {
 /// Scene, parameter or output errors.
 pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let pool = args.schemes.pool()?;
-    let scene = args.scene.scene()?;
+    let spec = args.scene.spec(Conventions::REFERENCE);
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
+    let viewport = args.scene.viewport()?;
     let executor = args.schemes.executors()[0];
     let mut threads = 0;
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -123,13 +125,17 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         progress.set_message(format!("angle {step}"));
         let angle = 360.0 * f64::from(step) / f64::from(args.angles);
         angles.push(angle);
-        let orbit = args.scene.orbit(angle);
-        let view =
-            args.schemes
-                .submission(args.scene.view_at(&scene, angle, Conventions::REFERENCE)?);
+        let at_angle = SceneSpec {
+            view_degrees: angle,
+            ..spec.clone()
+        };
+        let orbit = at_angle.orbit();
+        let view = args
+            .schemes
+            .submission(at_angle.view(&scene, viewport).map_err(|e| e.to_string())?);
         crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
         let oracle = Oracle::build(&view);
-        let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+        let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
         crate::approximate::check_effect(&judge, &args.approximate)?;
         let depth_complexity = oracle.depth_complexity();
         let sizing = args.schemes.sizing();
@@ -159,7 +165,7 @@ pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         if !args.approximate.is_empty() {
             let order = PrimitiveOrder::of_view(&view);
             let raster_ms = pool
-                .install(|| crate::bench::time_raster_alone(&view))
+                .install(|| crate::frame_timing::time_raster_alone(&view))
                 .as_secs_f64()
                 * 1e3;
             let nodes = crate::approximate::nodes(args.schemes.k, &oracle);

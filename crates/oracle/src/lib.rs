@@ -21,7 +21,6 @@ pub mod dump;
 pub mod edge_ties;
 pub mod precision;
 pub mod samples;
-pub mod scene;
 pub mod triangles;
 pub mod verdict;
 

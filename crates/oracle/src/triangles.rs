@@ -6,7 +6,7 @@ use std::path::Path;
 use fragsim_raster::{ScreenTriangle, View, SUBPIXEL_BITS};
 
 use crate::dump::{err, io_err, DumpError};
-use crate::scene::SceneAndCamera;
+use fragsim_raster::scene_spec::SceneSpec;
 
 /// The magic bytes that open a triangle export.
 pub const TRIANGLES_MAGIC: [u8; 8] = *b"FRAGTRI1";
@@ -20,7 +20,7 @@ const TRIANGLES_HEADER_BYTES: usize = 40;
 #[derive(Clone, Debug, PartialEq)]
 pub struct TriangleExport {
     /// The scene and camera (copied verbatim into a backend's dump header).
-    pub scene: SceneAndCamera,
+    pub scene: SceneSpec,
     /// Viewport width.
     pub width: u32,
     /// Viewport height.
@@ -35,7 +35,7 @@ pub struct TriangleExport {
 impl TriangleExport {
     /// Every screen triangle of `view`.
     #[must_use]
-    pub fn from_view(view: &View<'_>, scene: SceneAndCamera) -> Self {
+    pub fn from_view(view: &View<'_>, scene: SceneSpec) -> Self {
         let mut triangles = Vec::new();
         for prim in 0..view.triangle_count() {
             view.screen_triangles(prim, &mut |t| triangles.push(t));
@@ -54,7 +54,7 @@ impl TriangleExport {
     ///
     /// # Errors
     /// A coordinate outside i32 (impossible within the guard band), too many triangles, or a
-    /// scene number that is not finite ([`SceneAndCamera::check_finite`]).
+    /// scene number that is not finite ([`SceneSpec::check_finite`]).
     pub fn to_bytes(&self) -> Result<Vec<u8>, DumpError> {
         self.scene.check_finite()?;
         let json = serde_json::to_string(&self.scene)
@@ -133,7 +133,7 @@ impl TriangleExport {
         let json = bytes
             .get(TRIANGLES_HEADER_BYTES..TRIANGLES_HEADER_BYTES + json_len)
             .ok_or_else(|| DumpError("triangle export truncated".into()))?;
-        let scene: SceneAndCamera = serde_json::from_slice(json)
+        let scene: SceneSpec = serde_json::from_slice(json)
             .map_err(|e| DumpError(format!("triangle export scene: {e}")))?;
         if bytes.len() != start + count * TRIANGLE_RECORD_BYTES {
             return err(format!(

@@ -28,6 +28,7 @@ mod pipeline;
 mod ply;
 mod rng;
 pub mod samples;
+pub mod scene_spec;
 mod scenes;
 
 pub use camera::{Camera, OrbitCamera};
@@ -40,4 +41,5 @@ pub use pipeline::{
 };
 pub use rng::SplitMix64;
 pub use samples::SamplePattern;
+pub use scene_spec::{mesh_hash, SceneSpec, SceneSpecError, ViewProjection};
 pub use scenes::{Scene, SceneError, DEFAULT_SCENE_NAME};

@@ -16,7 +16,7 @@
 //! interpolation) and the case shapes the proptest suite's regressions were found with.
 
 use fragsim_capture::executors::scheduled::Schedule;
-use fragsim_oracle::scene::{SceneAndCamera, ViewProjection};
+use fragsim_raster::scene_spec::{SceneSpec, ViewProjection};
 use fragsim_raster::{Camera, Mesh, Scene, VertexPrecision, Viewport};
 use proptest::collection::vec;
 use proptest::prelude::*;
@@ -132,14 +132,14 @@ impl Case {
     /// The scene object of a dump header for this case's mesh stored at `mesh` (an OBJ file)
     /// whose bytes hash to `mesh_hash`: the identity matrix in f64, the reference conventions.
     #[must_use]
-    pub fn scene_and_camera(mesh: &str, mesh_hash: String) -> SceneAndCamera {
-        SceneAndCamera {
+    pub fn scene_and_camera(mesh: &str, mesh_hash: String) -> SceneSpec {
+        SceneSpec {
             mesh_hash: Some(mesh_hash),
             view_projection: Some(ViewProjection {
                 row_major: IDENTITY,
                 precision: VertexPrecision::F64,
             }),
-            ..SceneAndCamera::mesh(std::path::Path::new(mesh), 0.0, 0.0)
+            ..SceneSpec::mesh(std::path::Path::new(mesh), 0.0, 0.0)
         }
     }
 

@@ -23,8 +23,8 @@ use std::time::{Duration, Instant};
 
 use fragsim_capture::Guarantee;
 use fragsim_oracle::dump::Dump;
-use fragsim_oracle::scene::mesh_hash;
 use fragsim_oracle::triangles::TriangleExport;
+use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::{VertexPrecision, View};
 
 use crate::backend::{Backend, BackendError, Input, Output, Params};

@@ -11,8 +11,8 @@ use std::path::PathBuf;
 
 use fragsim::oracle::dump::{Dump, DumpScheme, Words};
 use fragsim::oracle::edge_ties::{pipeline_rule, TiePoints};
-use fragsim::oracle::scene::{SceneAndCamera, ViewProjection};
 use fragsim::oracle::Oracle;
+use fragsim::raster::scene_spec::{SceneSpec, ViewProjection};
 use fragsim::raster::{EdgeTies, VertexPrecision, Viewport, WindowOrigin};
 
 use super::scratch;
@@ -53,7 +53,7 @@ fn grid_obj() -> String {
 /// A scene's oracle (fragsim's top-left rule) and the lists each rule gives.
 struct Grid {
     dir: PathBuf,
-    scene: SceneAndCamera,
+    scene: SceneSpec,
     viewport: Viewport,
     oracle: Oracle,
     ties: TiePoints,
@@ -71,7 +71,7 @@ impl Grid {
         let dir = scratch(name);
         let mesh = dir.join("mesh.obj");
         std::fs::write(&mesh, obj).unwrap();
-        let mut scene = SceneAndCamera::hashed_mesh(&mesh, 0.0, 0.0).unwrap();
+        let mut scene = SceneSpec::hashed_mesh(&mesh, 0.0, 0.0).unwrap();
         scene.view_projection = Some(ViewProjection {
             row_major: IDENTITY,
             precision: VertexPrecision::F64,

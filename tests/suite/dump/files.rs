@@ -8,9 +8,9 @@ use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Capacity, Keeps};
 use fragsim::oracle::compare;
 use fragsim::oracle::dump::{Dtype, Dump, DumpScheme};
-use fragsim::oracle::scene::SceneAndCamera;
 use fragsim::oracle::triangles::TriangleExport;
 use fragsim::oracle::Oracle;
+use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
 
 use super::{every_layout, judged, scratch, spec, with_view, HEIGHT, SCENE, WIDTH};
@@ -169,10 +169,8 @@ fn the_triangle_export_round_trips_and_rescanning_it_reproduces_the_oracle() {
             .view(Viewport::new(WIDTH, HEIGHT).unwrap(), &camera)
             .unwrap();
         let oracle = Oracle::build(&view);
-        let export = TriangleExport::from_view(
-            &view,
-            SceneAndCamera::named(scene, camera.angle_degrees, 15.0),
-        );
+        let export =
+            TriangleExport::from_view(&view, SceneSpec::named(scene, camera.angle_degrees, 15.0));
         let bytes = export.to_bytes().unwrap();
         assert_eq!(&bytes[..8], b"FRAGTRI1");
         assert_eq!(u32::from_le_bytes(bytes[12..16].try_into().unwrap()), WIDTH);

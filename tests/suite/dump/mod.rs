@@ -9,8 +9,8 @@ use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::oracle::compare::{CompareOptions, Comparison};
 use fragsim::oracle::dump::{Dump, DumpScheme, Words};
-use fragsim::oracle::scene::SceneAndCamera;
 use fragsim::oracle::Oracle;
+use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{Scene, Viewport};
 
 mod binary;
@@ -35,8 +35,8 @@ const SCENE: &str = "spheres:3";
 const WIDTH: u32 = 48;
 const HEIGHT: u32 = 36;
 
-fn spec() -> SceneAndCamera {
-    SceneAndCamera::named(SCENE, 30.0, 15.0)
+fn spec() -> SceneSpec {
+    SceneSpec::named(SCENE, 30.0, 15.0)
 }
 
 fn with_view<R>(f: impl FnOnce(&fragsim::raster::View<'_>, &Oracle) -> R) -> R {

@@ -2,14 +2,14 @@
 //! decimal parses to the nearest `f64`, and numbers JSON cannot hold are refused by name.
 
 use fragsim::oracle::dump::Dump;
-use fragsim::oracle::scene::SceneAndCamera;
 use fragsim::oracle::triangles::TriangleExport;
+use fragsim::raster::scene_spec::SceneSpec;
 use proptest::prelude::*;
 
 use super::{mdts_header, parse_recording};
 
 /// The scene's four numbers, as bits, so that `-0.0` and `0.0` differ.
-fn scene_bits(scene: &SceneAndCamera) -> [u64; 4] {
+fn scene_bits(scene: &SceneSpec) -> [u64; 4] {
     [
         scene.view_degrees,
         scene.elevation_degrees,

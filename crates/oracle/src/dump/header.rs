@@ -7,7 +7,7 @@ use fragsim_raster::Viewport;
 use serde::{Deserialize, Serialize};
 
 use super::{err, DumpError, LayoutSpec};
-use crate::scene::SceneAndCamera;
+use fragsim_raster::scene_spec::SceneSpec;
 
 /// The element type of an array file: always little-endian.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -57,7 +57,7 @@ pub struct Header {
     #[serde(default)]
     pub producer: String,
     /// The scene and camera.
-    pub scene: SceneAndCamera,
+    pub scene: SceneSpec,
     /// Viewport width in pixels.
     pub width: u32,
     /// Viewport height in pixels.
@@ -132,7 +132,7 @@ impl Header {
 
     /// The sample-expanded framebuffer of `pixels` at `scene`'s sample count.
     pub(super) fn framebuffer_of(
-        scene: &SceneAndCamera,
+        scene: &SceneSpec,
         pixels: Viewport,
     ) -> Result<Viewport, DumpError> {
         match scene.conventions.pattern().map_err(DumpError)? {

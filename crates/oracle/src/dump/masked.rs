@@ -34,8 +34,8 @@ use super::{FORMAT, VERSION};
 use crate::compare::{compare_with, verdict, CompareOptions, Comparison};
 use crate::diff::PixelMismatch;
 use crate::precision::{compare_within, Precision};
-use crate::scene::SceneAndCamera;
 use crate::Oracle;
+use fragsim_raster::scene_spec::SceneSpec;
 
 /// The header `scheme` of a masked-node dump.
 pub const MASKED_SCHEME: &str = "abuffer-masked";
@@ -450,7 +450,7 @@ impl Dump {
     /// A view that does not rasterize per sample at the conventions' count, a capacity of 0.
     pub fn record_masked(
         view: &View<'_>,
-        scene: SceneAndCamera,
+        scene: SceneSpec,
         capacity: u32,
         producer: &str,
     ) -> Result<Self, DumpError> {

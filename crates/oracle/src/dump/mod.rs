@@ -20,11 +20,11 @@
 //! use fragsim_capture::schemes::mdts::Direction;
 //! use fragsim_oracle::compare::CompareOptions;
 //! use fragsim_oracle::dump::{Dump, DumpScheme};
-//! use fragsim_oracle::scene::SceneAndCamera;
+//! use fragsim_raster::scene_spec::SceneSpec;
 //! use fragsim_oracle::Oracle;
 //! use fragsim_raster::Viewport;
 //!
-//! let spec = SceneAndCamera::named("spheres:2", 30.0, 15.0);
+//! let spec = SceneSpec::named("spheres:2", 30.0, 15.0);
 //! let scene = spec.load(None).unwrap();
 //! let view = scene.view(Viewport::new(32, 24).unwrap(), &spec.orbit()).unwrap();
 //! let oracle = Oracle::build(&view);
@@ -51,7 +51,7 @@
 //! fragsim's memory with their links checked (`lists.rs`), slot arrays in an engine's order and
 //! payload turned into fragsim's (`slots.rs`), parsing and decoding (`read.rs`),
 //! recording and writing (`write.rs`); the scene a dump names is
-//! [`crate::scene`], the comparison [`crate::compare`], the triangle export [`crate::triangles`].
+//! [`fragsim_raster::scene_spec`], the comparison [`crate::compare`], the triangle export [`crate::triangles`].
 //!
 //! Unlike the GPU, which leaves its words in device memory, [`Dump::record`] runs fragsim's scheme
 //! serially on [`SerialMemory`] and copies every word out; for MDTS the words are the same under
@@ -81,6 +81,7 @@ use std::path::Path;
 use fragsim_capture::CaptureError;
 #[cfg(doc)]
 use fragsim_capture::{Capture, SerialMemory};
+use fragsim_raster::SceneSpecError;
 
 #[cfg(doc)]
 use crate::Oracle;
@@ -113,6 +114,17 @@ impl std::error::Error for DumpError {}
 impl From<CaptureError> for DumpError {
     fn from(e: CaptureError) -> Self {
         Self(e.to_string())
+    }
+}
+
+impl From<SceneSpecError> for DumpError {
+    /// A scene that cannot be loaded or viewed says it is the dump's scene; the spec's own
+    /// errors (the mesh file, the numbers) name their field already.
+    fn from(e: SceneSpecError) -> Self {
+        match e {
+            SceneSpecError::Scene(e) => Self(format!("scene: {e}")),
+            e => Self(e.to_string()),
+        }
     }
 }
 

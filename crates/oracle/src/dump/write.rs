@@ -13,8 +13,8 @@ use super::header::{check_array, check_distinct_files, check_file_name};
 use super::{err, io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{LayoutSpec, ListNumbering};
 use super::{FORMAT, HEADER_FILE, VERSION};
-use crate::scene::SceneAndCamera;
 use fragsim_capture::catalog::SchemeVisitor;
+use fragsim_raster::scene_spec::SceneSpec;
 
 /// Runs a scheme serially over a view and copies its memory out.
 struct Record<'a, 'm> {
@@ -65,7 +65,7 @@ impl Dump {
     /// Scheme parameters out of range.
     pub fn record(
         view: &View<'_>,
-        scene: SceneAndCamera,
+        scene: SceneSpec,
         scheme: &DumpScheme,
         producer: &str,
     ) -> Result<Self, DumpError> {
@@ -82,7 +82,7 @@ impl Dump {
     /// count declares, or words of another number than the scheme's memory holds.
     pub fn of_memory(
         view: &View<'_>,
-        scene: SceneAndCamera,
+        scene: SceneSpec,
         scheme: &DumpScheme,
         words32: Vec<u32>,
         words64: Vec<u64>,
@@ -285,7 +285,7 @@ impl Dump {
     ///
     /// # Errors
     /// Arrays that disagree with the header, a file name that is not a plain name, or a scene
-    /// number that is not finite ([`SceneAndCamera::check_finite`]).
+    /// number that is not finite ([`SceneSpec::check_finite`]).
     pub fn encode(&self) -> Result<(String, BTreeMap<String, Vec<u8>>), DumpError> {
         check_distinct_files(&self.header.arrays)?;
         let mut files = BTreeMap::new();

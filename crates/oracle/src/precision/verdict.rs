@@ -21,8 +21,8 @@ use crate::compare::{
     compare_with, inferred_counter, verdict, AmbiguityCounts, CompareOptions, Comparison,
 };
 use crate::dump::{Dump, DumpError, WordCheck};
-use crate::scene::SceneAndCamera;
 use crate::{Oracle, PixelMismatch};
+use fragsim_raster::scene_spec::SceneSpec;
 use snaps::Snaps;
 
 mod snaps;
@@ -34,10 +34,10 @@ mod snaps;
 /// another f32 evaluation order. `beside` is where a dump's relative mesh path is looked up.
 ///
 /// # Errors
-/// A scene that cannot be loaded or rasterized ([`SceneAndCamera::load`],
-/// [`SceneAndCamera::view`]).
+/// A scene that cannot be loaded or rasterized ([`SceneSpec::load`],
+/// [`SceneSpec::view`]).
 pub fn f32_reference(
-    scene: &SceneAndCamera,
+    scene: &SceneSpec,
     viewport: Viewport,
     beside: Option<&Path>,
 ) -> Result<(Oracle, Precision), DumpError> {

@@ -33,8 +33,8 @@ use crate::compare::{verdict, with_identity, CompareOptions, Comparison};
 use crate::dump::{DepthFormat, Dump};
 use crate::edge_ties::TiePoints;
 use crate::precision::{compare_within, Bounds, Precision};
-use crate::scene::SceneAndCamera;
 use crate::Oracle;
+use fragsim_raster::scene_spec::SceneSpec;
 
 #[cfg(doc)]
 use crate::compare::compare_with;
@@ -75,7 +75,7 @@ pub struct Verdict {
     pub comparison: Comparison,
     /// The scene the sides name (with a `--mesh` override applied); `None` for a capture judged
     /// on a view.
-    pub scene: Option<SceneAndCamera>,
+    pub scene: Option<SceneSpec>,
     /// Viewport width, pixels.
     pub width: u32,
     /// Viewport height, pixels.

@@ -9,7 +9,7 @@ use fragsim_raster::{Conventions, VertexPrecision, Viewport};
 use serde::Serialize;
 
 use super::{judge, Candidate, Options, Reference, Verdict};
-use crate::dump::{Dump, Header, MASKED_SCHEME};
+use crate::dump::{Dump, DumpError, Header, MASKED_SCHEME};
 use crate::precision::Precision;
 use crate::samples::SampleOracle;
 use crate::Oracle;
@@ -188,14 +188,20 @@ pub fn judge_sides(
         spec.conventions.vertex_precision = VertexPrecision::F64;
     }
     let loaded = if needs_oracle {
-        Some(spec.load(Some(&beside)).map_err(|e| e.to_string())?)
+        Some(
+            spec.load(Some(&beside))
+                .map_err(|e| DumpError::from(e).to_string())?,
+        )
     } else {
         None
     };
     let view = match &loaded {
         Some(loaded) => {
             let viewport = Viewport::new(header.width, header.height)?;
-            Some(spec.view(loaded, viewport).map_err(|e| e.to_string())?)
+            Some(
+                spec.view(loaded, viewport)
+                    .map_err(|e| DumpError::from(e).to_string())?,
+            )
         }
         None => None,
     };

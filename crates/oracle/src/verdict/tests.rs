@@ -10,7 +10,7 @@ use crate::dump::{DumpScheme, Words};
 /// Calls `test` with the view of a small scene (32 × 24), its oracle and fragsim's MDTS dump
 /// of it (K = every fragment, so that the dump holds every fragment).
 fn with_scene(test: impl FnOnce(&View<'_>, &Oracle, &Dump)) {
-    let spec = SceneAndCamera::named("spheres:2", 30.0, 15.0);
+    let spec = SceneSpec::named("spheres:2", 30.0, 15.0);
     let scene = spec.load(None).unwrap();
     let view = scene
         .view(Viewport::new(32, 24).unwrap(), &spec.orbit())

@@ -30,9 +30,9 @@ use fragsim::oracle::dump::{
 };
 use fragsim::oracle::precision::{compare_within, f32_reference, Precision};
 use fragsim::oracle::samples::SampleOracle;
-use fragsim::oracle::scene::SceneAndCamera;
 use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
+use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{Conventions, Scene, SplitMix64, View, Viewport};
 
 use kinds::{mutant, Change, Pool, Site, KINDS};
@@ -363,7 +363,7 @@ fn table(layouts: &[&'static str], tallies: &[Tally]) -> String {
 fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() {
     let dir = scratch("mutation-battery");
     let mesh = scene_file(&dir);
-    let spec = SceneAndCamera::mesh(&mesh, 30.0, 15.0);
+    let spec = SceneSpec::mesh(&mesh, 30.0, 15.0);
     let scene = spec.load(None).unwrap();
     let viewport = Viewport::new(48, 36).unwrap();
     let view = spec.view(&scene, viewport).unwrap();
@@ -380,7 +380,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
     let unorm_exact =
         Precision::derive(&view, &exact_conventions).stored_as(UNORM24.depth, &oracle);
     let unorm_f32 = f32_analysis.clone().stored_as(UNORM24.depth, &oracle);
-    let record = |view: &View<'_>, spec: &SceneAndCamera, scheme: DumpScheme| {
+    let record = |view: &View<'_>, spec: &SceneSpec, scheme: DumpScheme| {
         Dump::record(view, spec.clone(), &scheme, "battery").unwrap()
     };
     let mdts = |direction| DumpScheme::Mdts { k: K, direction };

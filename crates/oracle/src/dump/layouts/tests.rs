@@ -3,14 +3,14 @@
 
 use super::*;
 use crate::dump::{Dtype, FORMAT, VERSION};
-use crate::scene::SceneAndCamera;
+use fragsim_raster::scene_spec::SceneSpec;
 
 fn header(scheme: &str) -> Header {
     Header {
         format: FORMAT.into(),
         version: VERSION,
         producer: String::new(),
-        scene: SceneAndCamera::named("quads:1", 0.0, 0.0),
+        scene: SceneSpec::named("quads:1", 0.0, 0.0),
         width: 1,
         height: 1,
         scheme: scheme.into(),

@@ -20,7 +20,7 @@ fn options() -> CompareOptions<'static> {
 /// A masked-node dump of `spheres:3` at `samples` made through the rasterizer's f32 vertex
 /// stage, with the per-sample f64 oracle and f32 analysis it is judged by.
 fn f32_masked(samples: u32) -> (Dump, Precision, Oracle) {
-    let mut spec = SceneAndCamera::named("spheres:3", 30.0, 15.0);
+    let mut spec = SceneSpec::named("spheres:3", 30.0, 15.0);
     spec.conventions = Conventions {
         vertex_precision: VertexPrecision::F32,
         samples,

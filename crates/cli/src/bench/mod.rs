@@ -4,25 +4,26 @@
 //! frame (median, min, max over `--frames`), with the split between vertex stage, rasterization
 //! and capture.
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+mod output;
+
+use std::path::PathBuf;
+use std::time::Duration;
 
 use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{Camera, Conventions, DepthRange, SamplePattern, View};
-use image::RgbImage;
-use indicatif::ProgressBar;
-use rayon::prelude::*;
+use fragsim_raster::{Conventions, SamplePattern};
 use serde::Serialize;
 
 use crate::approximate::{ApproximateName, ApproximateRow};
 use crate::args::{SceneArgs, SchemeArgs, Shard};
-use crate::judge::{AttributePass, ColourColumns, EffectName, Judge, Judged};
-use crate::multisampled::{MsaaReport, SampledRow};
-use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
-use crate::schemes::{check_memory_cap_early, family, Executors, SchemeChoice, SchemeName};
+use crate::colour_judge::{AttributePass, ColourColumns, ColourJudge, EffectName, JudgedImage};
+use crate::frame_timing::{median, ms, time_frames, time_raster_alone};
+use crate::multisampled::MsaaReport;
+use crate::record::{ColourByDepth, Context};
+use crate::row_images::Images;
+use crate::schemes::{check_memory_cap_early, Executors, SchemeChoice, SchemeName};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -239,161 +240,26 @@ pub struct BenchReport {
     pub approximate: Vec<ApproximateRow>,
 }
 
-/// One line of bench's JSON Lines: a row with what the whole bench measured.
-#[derive(Serialize)]
-struct BenchRecord<'a> {
-    #[serde(flatten)]
-    row: &'a BenchRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// One line of bench's JSON Lines for an approximate scheme: its row with what the whole bench
-/// measured.
-#[derive(Serialize)]
-struct ApproximateRecord<'a> {
-    #[serde(flatten)]
-    row: &'a ApproximateRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// One line of bench's JSON Lines for a multisampled scheme (`--samples`): its row with what the
-/// whole bench measured.
-#[derive(Serialize)]
-struct SampledRecord<'a> {
-    #[serde(flatten)]
-    row: &'a SampledRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-fn median(times: &mut [Duration]) -> Duration {
-    times.sort_unstable();
-    times[times.len() / 2]
-}
-
-pub(crate) fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-/// The times of one scheme's frames on one executor ([`time_frames`]).
-pub(crate) struct FrameTimes {
-    /// Every frame: vertex stage, geometry passes and post pass, fastest first.
-    pub frames: Vec<Duration>,
-    /// The vertex stage's median.
-    pub vertex: Duration,
-    /// The geometry passes' median.
-    pub passes: Duration,
-    /// The post pass's median.
-    pub resolve: Duration,
-}
-
-impl FrameTimes {
-    /// The median frame.
-    pub fn median(&self) -> Duration {
-        self.frames[self.frames.len() / 2]
-    }
-}
-
-/// Times `frames` frames of one scheme (at least one): each is the vertex stage (the camera set
-/// on `view`, on `vertex_pool`) and then `frame(view)`, which runs the geometry passes and the
-/// post pass and returns what it made with the two times. One progress step a frame. Returns
-/// the first frame's result and the times.
+/// The images of `args` (`None` under `--no-images`).
 ///
 /// # Errors
-/// The first error of `frame`.
-pub(crate) fn time_frames<T>(
-    view: &mut View<'_>,
-    camera: &Camera,
-    vertex_pool: &rayon::ThreadPool,
-    frames: usize,
-    progress: &ProgressBar,
-    mut frame: impl FnMut(&View<'_>) -> Result<(T, Duration, Duration), String>,
-) -> Result<(T, FrameTimes), String> {
-    let mut totals = Vec::with_capacity(frames);
-    let (mut vertex, mut passes, mut resolve) = (Vec::new(), Vec::new(), Vec::new());
-    let mut first = None;
-    for _ in 0..frames.max(1) {
-        let start = Instant::now();
-        vertex_pool.install(|| view.set_camera(camera));
-        let vertex_time = start.elapsed();
-        let (made, pass_time, resolve_time) = frame(view)?;
-        totals.push(vertex_time + pass_time + resolve_time);
-        vertex.push(vertex_time);
-        passes.push(pass_time);
-        resolve.push(resolve_time);
-        first.get_or_insert(made);
-        progress.inc(1);
+/// The mesh file cannot be read (for its name in the caption).
+fn images(args: &BenchArgs) -> Result<Option<Images<'_>>, String> {
+    if args.no_images {
+        return Ok(None);
     }
-    totals.sort_unstable();
-    let times = FrameTimes {
-        frames: totals,
-        vertex: median(&mut vertex),
-        passes: median(&mut passes),
-        resolve: median(&mut resolve),
-    };
-    Ok((first.expect("at least one frame"), times))
-}
-
-/// Where bench's images go, and the scene and view their captions name.
-pub(crate) struct Images<'a> {
-    /// The directory (`--out`).
-    pub(crate) dir: &'a Path,
-    /// The scene, view and size, as every caption opens.
-    pub(crate) scene: String,
-}
-
-impl<'a> Images<'a> {
-    /// The images of `args` (`None` under `--no-images`).
-    ///
-    /// # Errors
-    /// The mesh file cannot be read (for its name in the caption).
-    fn of(args: &'a BenchArgs) -> Result<Option<Self>, String> {
-        if args.no_images {
-            return Ok(None);
-        }
-        let context = Context::of_scene("bench", &args.scene)?;
-        Ok(Some(Self {
-            dir: &args.out,
-            scene: format!(
-                "{}, view {}°, elevation {}°, {}x{}",
-                context.scene,
-                args.scene.view,
-                args.scene.elevation,
-                args.scene.width,
-                args.scene.height
-            ),
-        }))
-    }
-
-    /// Saves the effect image `image` as `name`, as it is: pixel data that readers compare
-    /// (its file name says what it is; its figure, the difference, carries the caption).
-    ///
-    /// # Errors
-    /// A file that cannot be written.
-    pub(crate) fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
-        fragsim_shade::save_png(image, &self.dir.join(name))
-    }
-
-    /// Saves `image` as `stem.png` and its difference from `reference` (error pixels red, with
-    /// a legend and insets) as `stem-diff.png`, captioned with the scene and `what` it shows.
-    ///
-    /// # Errors
-    /// Images of different sizes, a font error, or a file that cannot be written.
-    pub(crate) fn save_with_difference(
-        &self,
-        image: &RgbImage,
-        reference: &RgbImage,
-        stem: &str,
-        what: &str,
-    ) -> Result<(), String> {
-        self.save(image, &format!("{stem}.png"))?;
-        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
-        let caption = format!("{}: {what} against the oracle's image", self.scene);
-        let figure = fragsim_shade::legend::captioned(&difference, &caption)?;
-        self.save(&figure, &format!("{stem}-diff.png"))
-    }
+    let context = Context::of_scene("bench", &args.scene)?;
+    Ok(Some(Images {
+        dir: &args.out,
+        scene: format!(
+            "{}, view {}°, elevation {}°, {}x{}",
+            context.scene,
+            args.scene.view,
+            args.scene.elevation,
+            args.scene.width,
+            args.scene.height
+        ),
+    }))
 }
 
 /// Runs `bench`.
@@ -414,24 +280,21 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         })
         .transpose()?;
     let pool = args.schemes.pool()?;
-    let scene = args.scene.scene()?;
+    let spec = args.scene.spec(Conventions::REFERENCE);
+    let scene = spec.load(None).map_err(|e| e.to_string())?;
     let viewport = args.scene.viewport()?;
-    let orbit = args.scene.orbit(args.scene.view);
+    let orbit = spec.orbit();
     let frames = args.frames as usize;
     // The camera depends on the model's bounds, a per-scene constant (a GPU application computes
     // it at load); the vertex stage proper is timed per frame, on the pool.
-    let camera = args
-        .scene
-        .camera(&scene, args.scene.view, DepthRange::ZeroToOne)?;
+    let camera = spec.camera(&scene, viewport).map_err(|e| e.to_string())?;
     let serial_pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let mut view = args.schemes.submission(args.scene.view_at(
-        &scene,
-        args.scene.view,
-        Conventions::REFERENCE,
-    )?);
+    let mut view = args
+        .schemes
+        .submission(spec.view(&scene, viewport).map_err(|e| e.to_string())?);
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -444,7 +307,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .collect();
     crate::oracle_memory::check(&view, sizing.memory_cap)?;
     let oracle = Oracle::build(&view);
-    let judge = Judge::new(args.effect, &scene, &view, orbit, &oracle);
+    let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
     crate::approximate::check_effect(&judge, &args.approximate)?;
     let covered = judge.covered;
     let depth_complexity = oracle.depth_complexity();
@@ -457,7 +320,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             * (frames + 1)) as u64,
         "bench",
     );
-    let images = Images::of(args)?;
+    let images = images(args)?;
     if let (Some(image), Some(images)) = (judge.reference(), &images) {
         images.save(image, &format!("bench-oracle-{}.png", args.effect.label()))?;
     }
@@ -499,7 +362,7 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 &depth_complexity,
             )?;
             if let (
-                Some(Judged {
+                Some(JudgedImage {
                     image, reference, ..
                 }),
                 Some(images),
@@ -633,24 +496,8 @@ pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         rows,
         approximate,
     };
-    write_outputs(&report, args)?;
+    output::write_outputs(&report, args)?;
     Ok(report)
-}
-
-/// Rasterizes every triangle on the current pool and discards the fragments.
-pub(crate) fn time_raster_alone(view: &View<'_>) -> Duration {
-    let start = Instant::now();
-    let fragments: u64 = (0..view.triangle_count())
-        .into_par_iter()
-        .with_min_len(1024)
-        .map(|prim| {
-            let mut count = 0u64;
-            view.rasterize(prim, &mut |_| count += 1);
-            count
-        })
-        .sum();
-    std::hint::black_box(fragments);
-    start.elapsed()
 }
 
 /// Classical depth peeling (64- or 32-bit words) is the papers' baseline: every row gets the
@@ -675,308 +522,4 @@ fn set_speedups(rows: &mut [BenchRow]) {
             row.speedup_vs_depth_peeling = Some(base / row.time_ms.max(1e-9));
         }
     }
-}
-
-fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let mut lines = String::new();
-    for row in &report.rows {
-        let context = report.context.on(&row.executor, row.threads);
-        let record = BenchRecord { row, bench: report };
-        lines.push_str(&crate::record::line("bench", &context, &record)?);
-        lines.push('\n');
-    }
-    for row in &report.approximate {
-        let context = report.context.on("primitive-order", row.threads);
-        let record = ApproximateRecord { row, bench: report };
-        lines.push_str(&crate::record::line(
-            "bench-approximate",
-            &context,
-            &record,
-        )?);
-        lines.push('\n');
-    }
-    for row in report.msaa.iter().flat_map(|m| &m.rows) {
-        let context = report.context.on(&row.executor, row.threads);
-        let record = SampledRecord { row, bench: report };
-        lines.push_str(&crate::record::line("bench-msaa", &context, &record)?);
-        lines.push('\n');
-    }
-    let json_path = args.out.join("bench.jsonl");
-    std::fs::write(&json_path, &lines)
-        .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
-    let markdown = markdown(report);
-    let md_path = args.out.join("bench.md");
-    std::fs::write(&md_path, &markdown)
-        .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
-    let wrote = if args.no_images {
-        format!("wrote {}: bench.jsonl, bench.md", args.out.display())
-    } else {
-        speed_accuracy_chart(report, &args.out.join("bench-speed-accuracy.png"))?;
-        format!(
-            "wrote {}: bench.jsonl, bench.md, bench-speed-accuracy.png and the effect and \
-             difference images",
-            args.out.display()
-        )
-    };
-    // Under `--json` stdout stays JSON Lines: where the files went goes to stderr.
-    if args.json {
-        out!("{lines}");
-        eprintln!("{wrote}");
-    } else {
-        out!("{}", terminal_table(report));
-        outln!("{wrote} (bench.md: every column, with their key, and the per-depth tables)");
-    }
-    Ok(())
-}
-
-/// The bench's own speed/accuracy chart: one point per scheme and executor.
-fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<(), String> {
-    let points: Vec<fragsim_shade::plot::Point> = report
-        .rows
-        .iter()
-        .filter_map(|r| {
-            Some(fragsim_shade::plot::Point {
-                label: format!("{} ({})", r.scheme, r.executor),
-                family: family(&r.scheme),
-                time_ms: r.time_ms,
-                rate: r.error_pixel_rate?,
-                mean_error: mean_of_channels(&r.colour),
-            })
-        })
-        .chain(
-            report
-                .approximate
-                .iter()
-                .map(|r| fragsim_shade::plot::Point {
-                    label: r.label(),
-                    family: family(&r.scheme),
-                    time_ms: r.time_ms,
-                    rate: r.error_pixel_rate,
-                    mean_error: mean_of_channels(&r.colour),
-                }),
-        )
-        .collect();
-    fragsim_shade::plot::speed_accuracy(
-        path,
-        &format!(
-            "{}: speed against accuracy ({}, {}x{})",
-            report.scene, report.effect, report.width, report.height
-        ),
-        "median frame time (ms, log scale)",
-        &points,
-    )
-}
-
-/// What bench.md's columns mean, printed under the table.
-const COLUMNS: &str = "
-Columns: **thr** threads; **passes** geometry passes per frame (with the counting pass that \
-sized the storage, where one ran); **memory B**, **B/px** per-pixel storage in bytes, in all and \
-per pixel; **captured** fragments kept; **overflow** fragments with no room by design (beyond K \
-or a fixed capacity: the oracle's prediction); **lost** fragments it should have kept and did \
-not; **mismatched px** pixels whose list differs from the oracle's; **EPR %** error-pixel rate: \
-pixels whose 8-bit colour of the effect differs from the oracle's image, in percent of the \
-covered pixels (JSON holds the fraction, `error_pixel_rate`; n/a: the words cannot resolve the \
-effect); **mean err**, **max err**, **PSNR dB** the colour error of that image: the mean \
-absolute error of its 8-bit channels (the mean of the three channels'; JSON holds each, \
-`mean_abs_error`), the largest of any channel, and the peak signal-to-noise ratio (inf: equal \
-images); **ops/frag** memory operations per fragment; **locked/frag** read-modify-write \
-operations per fragment (counted in one extra, untimed frame); **vertex ms**, **passes ms**, \
-**post ms** medians of the vertex stage, the geometry passes (storage initialisation, \
-rasterization, capture) and the post pass (resolve, sort); **frame ms** their median sum \
-(`time_ms`), **min**, **max** the fastest and slowest frame; **fps** frames per second at the \
-median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments per second; \
-**vs DP** depth peeling's median time over this row's (above 1: faster than depth peeling).
-";
-
-/// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
-/// first, aligned, in about 120 characters (bench.md holds all 26).
-fn terminal_table(report: &BenchReport) -> String {
-    type Cell = fn(&BenchRow) -> String;
-    let columns: [(&str, Cell); 10] = [
-        ("scheme", |r| r.scheme.clone()),
-        ("executor", |r| r.executor.clone()),
-        ("passes", |r| r.passes.to_string()),
-        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
-        ("lost", |r| r.lost.to_string()),
-        ("mismatched px", |r| r.mismatched_pixels.to_string()),
-        ("EPR %", |r| {
-            r.error_pixel_rate
-                .map_or_else(|| "n/a".into(), |e| format!("{:.3}", e * 100.0))
-        }),
-        ("PSNR dB", |r| r.colour.cells()[2].clone()),
-        ("frame ms", |r| format!("{:.2}", r.time_ms)),
-        ("vs DP", |r| {
-            r.speedup_vs_depth_peeling
-                .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
-        }),
-    ];
-    let mut rows = vec![columns
-        .iter()
-        .map(|(h, _)| (*h).to_string())
-        .collect::<Vec<_>>()];
-    rows.extend(
-        report
-            .rows
-            .iter()
-            .map(|r| columns.iter().map(|(_, cell)| cell(r)).collect()),
-    );
-    let widths: Vec<usize> = (0..columns.len())
-        .map(|c| {
-            rows.iter()
-                .map(|row| row[c].chars().count())
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
-    let mut text = markdown(report)
-        .lines()
-        .next()
-        .unwrap_or_default()
-        .to_string();
-    text.push_str("\n\n");
-    for row in &rows {
-        let cells: Vec<String> = row
-            .iter()
-            .zip(&widths)
-            .enumerate()
-            .map(|(c, (cell, &w))| {
-                if c < 2 {
-                    format!("{cell:<w$}")
-                } else {
-                    format!("{cell:>w$}")
-                }
-            })
-            .collect();
-        text.push_str(cells.join("  ").trim_end());
-        text.push('\n');
-    }
-    text.push_str(
-        "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
-         should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
-         pixels whose 8-bit colour of the effect differs, in % of the covered pixels; PSNR dB of \
-         that image; frame ms the median frame; vs DP speed-up over depth peeling.\n",
-    );
-    text
-}
-
-fn markdown(report: &BenchReport) -> String {
-    let mut text = format!(
-        "scene {}: {} triangles, {}x{}, {} fragments, max depth complexity {}, {} covered pixels; \
-         rasterization alone {:.2} ms (median of {} frames); effect {}\n\n",
-        report.scene,
-        report.triangles,
-        report.width,
-        report.height,
-        report.oracle_fragments,
-        report.max_depth_complexity,
-        report.covered_pixels,
-        report.raster_ms,
-        report.frames,
-        report.effect
-    );
-    if let Some(msaa) = &report.msaa {
-        text.push_str(&format!(
-            "The oracle's image at {n} samples a pixel (standard pattern), shaded per sample and \
-             resolved per pixel (bench-oracle-{effect}-msaa{n}.png): {} sample fragments; {} \
-             mixed pixels (samples holding different primitives), {} of them layer edges \
-             (samples holding different numbers of fragments); {} pixels whose 8-bit colour \
-             differs from the single-sample image (bench-oracle-{effect}-msaa{n}-diff.png).\n\n",
-            msaa.sample_fragments,
-            msaa.mixed_pixels,
-            msaa.layer_edge_pixels,
-            msaa.differing_pixels,
-            n = msaa.samples,
-            effect = report.effect,
-        ));
-    }
-    text.push_str(
-        "| scheme | executor | thr | passes | memory B | B/px | captured | overflow | lost | mismatched px | EPR % | mean err | max err | PSNR dB | ops/frag | locked/frag | vertex ms | passes ms | post ms | frame ms | min | max | fps | Mtri/s | Mfrag/s | vs DP |\n",
-    );
-    text.push_str(
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-    );
-    let option = |v: Option<f64>, digits: usize| {
-        v.map_or_else(|| "n/a".to_string(), |v| format!("{v:.digits$}"))
-    };
-    for r in &report.rows {
-        let [mean_error, max_error, psnr] = r.colour.cells();
-        text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {:.1} | {:.1} | {} |\n",
-            r.scheme,
-            r.executor,
-            r.threads,
-            r.passes,
-            r.memory_bytes,
-            r.bytes_per_pixel,
-            r.captured,
-            r.overflowed,
-            r.lost,
-            r.mismatched_pixels,
-            r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
-            mean_error,
-            max_error,
-            psnr,
-            r.ops_per_fragment,
-            r.locked_ops_per_fragment,
-            r.vertex_ms,
-            r.passes_ms,
-            r.resolve_ms,
-            r.time_ms,
-            r.min_ms,
-            r.max_ms,
-            r.fps,
-            r.triangles_per_second / 1e6,
-            r.fragments_per_second / 1e6,
-            option(r.speedup_vs_depth_peeling, 2),
-        ));
-    }
-    text.push_str(COLUMNS);
-    if !report.approximate.is_empty() {
-        text.push_str(&crate::approximate::markdown(&report.approximate));
-    }
-    text.push_str(&depth_markdown(report));
-    if let Some(msaa) = &report.msaa {
-        text.push_str(&crate::multisampled::markdown(msaa));
-    }
-    text
-}
-
-/// bench.md's table of the colour error per depth-complexity bucket, of every approximate image
-/// (as the chart labels them) and every catalog image that differs from the oracle's (by scheme
-/// and executor); empty when there is none.
-fn depth_markdown(report: &BenchReport) -> String {
-    let differing = report
-        .rows
-        .iter()
-        .filter(|r| r.error_pixels.is_some_and(|e| e > 0))
-        .map(|r| (format!("{} ({})", r.scheme, r.executor), &r.colour_by_depth));
-    let approximate = report
-        .approximate
-        .iter()
-        .map(|r| (r.label(), &r.colour_by_depth));
-    let mut lines = String::new();
-    for (label, by_depth) in differing.chain(approximate) {
-        for bucket in by_depth.covered() {
-            lines.push_str(&format!(
-                "| {label} | {} |\n",
-                bucket_cells(bucket).join(" | ")
-            ));
-        }
-    }
-    if lines.is_empty() {
-        return lines;
-    }
-    format!(
-        "\nThe colour error per depth-complexity bucket (fragments per pixel), of the approximate \
-         images and of every other image that differs from the oracle's\n\n\
-         | row | fragments/px | pixels | EPR % | mean err | max err | PSNR dB |\n\
-         |---|---|---|---|---|---|---|\n{lines}\n\
-         Columns: **fragments/px** the bucket (the oracle's fragments per pixel; uncovered \
-         pixels are in none); **pixels** the covered pixels in it; **EPR %** of them, those whose \
-         8-bit colour differs; **mean err**, **max err**, **PSNR dB** the colour error over them \
-         alone. JSON: `pixels_dc_5_8`, `error_pixels_dc_5_8`, `error_pixel_rate_dc_5_8`, \
-         `mean_abs_error_dc_5_8`, … for every bucket, on every record.\n"
-    )
 }

@@ -1,7 +1,10 @@
-//! The scene a dump or a triangle export names: the mesh (a named scene, or a file with the hash
-//! of its bytes), the camera (fragsim's orbit, or the engine's own view-projection matrix) and the
-//! conventions it was rasterized under: enough to rebuild the engine's view and its oracle
-//! ([`SceneAndCamera::load`], then [`SceneAndCamera::view`]).
+//! The scene spec: what a command line names and a dump or a triangle export records — the mesh
+//! (a named scene, or a file with the hash of its bytes), the camera (fragsim's orbit around the
+//! model's up axis, or the engine's own view-projection matrix) and the conventions it is
+//! rasterized under: enough to rebuild the view and its oracle ([`SceneSpec::load`], then
+//! [`SceneSpec::view`] on a viewport). Every command reads its scene through it: the command
+//! line's options (`args::SceneArgs`, with the `args` feature) and a dump header's `scene`
+//! object (its JSON, `docs/dump-format.md`) give the same value.
 //!
 //! The mesh hash is FNV-1a 64 of the file's bytes ([`mesh_hash`]), written `fnv1a64:` and 16 hex
 //! digits. It guards against a different file under the same name (a re-export, another
@@ -9,12 +12,84 @@
 //! non-cryptographic hash is enough (two different files collide with probability about 2^−64),
 //! it needs no dependency, and any backend computes it in a few lines (`docs/dump-format.md`).
 
+#[cfg(feature = "args")]
+pub mod args;
+
 use std::path::{Path, PathBuf};
 
-use fragsim_raster::{Camera, Conventions, OrbitCamera, Scene, VertexPrecision, View, Viewport};
 use serde::{Deserialize, Serialize};
 
-use crate::dump::{err, io_err, DumpError};
+use crate::{
+    Camera, Conventions, OrbitCamera, Scene, SceneError, UpAxis, VertexPrecision, View, Viewport,
+};
+
+/// Why a scene spec names no scene fragsim can load or view.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneSpecError {
+    /// The mesh file cannot be read (to hash it).
+    #[error("cannot read mesh {}: {source}", path.display())]
+    ReadMesh {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The mesh file's bytes hash otherwise than the spec says.
+    #[error(
+        "mesh {}: its bytes hash to {found}, the scene names {expected}: \
+         a different file (pass --mesh PATH to name the one it was made of)",
+        path.display()
+    )]
+    OtherMesh {
+        /// The file found.
+        path: PathBuf,
+        /// Its hash.
+        found: String,
+        /// The hash the spec names.
+        expected: String,
+    },
+    /// A relative mesh path found neither in the working directory nor beside the dump.
+    #[error(
+        "mesh {mesh}: no such file in the working directory ({working_dir}) nor beside the dump \
+         ({}); pass --mesh PATH to name it",
+        beside.display()
+    )]
+    MeshNotFound {
+        /// The path as the spec names it.
+        mesh: String,
+        /// The working directory, as displayed.
+        working_dir: String,
+        /// The path beside the dump that was tried.
+        beside: PathBuf,
+    },
+    /// Neither a mesh nor a named scene.
+    #[error("the scene names neither a mesh nor a named scene")]
+    NoScene,
+    /// The scene cannot be loaded or viewed (its own message).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A number JSON cannot hold.
+    #[error(
+        "scene {field} is {value}: numbers in a header must be finite (JSON has no NaN or infinity)"
+    )]
+    NotFinite {
+        /// The field, by name (`view_projection.row_major[i]` for a matrix entry).
+        field: String,
+        /// Its value.
+        value: f64,
+    },
+    /// An entry of an f32 matrix beyond f32's range.
+    #[error(
+        "scene view_projection.row_major[{index}] is {value}, beyond f32's range, \
+         but the matrix's precision is f32"
+    )]
+    BeyondF32 {
+        /// The entry's index, row by row.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+}
 
 /// An engine's own view-projection matrix, as its vertex shader used it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -41,19 +116,19 @@ pub fn mesh_hash(bytes: &[u8]) -> String {
     format!("{MESH_HASH_PREFIX}{hash:016x}")
 }
 
-/// The scene and camera that produced a dump: enough to rebuild the view and its oracle.
+/// The scene, camera and conventions of a view: enough to rebuild it and its oracle.
 ///
-/// Its numbers are exact across the file: serde_json is built with `float_roundtrip`, so a
+/// Its numbers are exact across a file: serde_json is built with `float_roundtrip`, so a
 /// decimal parses to the nearest f64, and writes the shortest decimal that parses back to the same
 /// bits (ryu), so encode then parse gives every finite value back bit for bit. JSON has no NaN or
-/// infinity: [`SceneAndCamera::check_finite`] refuses them before a header is written (serde_json would
+/// infinity: [`SceneSpec::check_finite`] refuses them before a header is written (serde_json would
 /// write `null`), and a decimal past the f64 range is a parse error.
 ///
 /// An unknown field is refused by name (a misspelt `fov_y_degres` would otherwise judge the dump
 /// under the default field of view).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SceneAndCamera {
+pub struct SceneSpec {
     /// A named scene (`Scene::procedural`: `bunny`, `spheres:8`, …); absent when `mesh` is set.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
@@ -75,6 +150,11 @@ pub struct SceneAndCamera {
     /// Eye distance as a multiple of the distance at which the bounding sphere fits.
     #[serde(default = "default_distance")]
     pub distance_scale: f64,
+    /// The model's up axis, which the orbit goes around (`--up`). Not in the JSON: a dump or an
+    /// export records a turned orbit as its matrix ([`SceneSpec::recorded`]), so a spec read
+    /// from a file is +y.
+    #[serde(skip)]
+    pub up: UpAxis,
     // The engine's scene: one block, so that the layout fields of the header stay apart.
     /// The content hash of the mesh file ([`mesh_hash`]); a file whose bytes hash otherwise is
     /// refused. Absent: not checked (dumps written before hashes existed).
@@ -98,7 +178,7 @@ fn default_distance() -> f64 {
     OrbitCamera::default().distance_scale
 }
 
-impl SceneAndCamera {
+impl SceneSpec {
     /// A named scene seen from the default orbit at `view_degrees` and `elevation_degrees`.
     #[must_use]
     pub fn named(name: &str, view_degrees: f64, elevation_degrees: f64) -> Self {
@@ -109,6 +189,7 @@ impl SceneAndCamera {
             elevation_degrees,
             fov_y_degrees: default_fov(),
             distance_scale: default_distance(),
+            up: UpAxis::Y,
             mesh_hash: None,
             view_projection: None,
             conventions: Conventions::REFERENCE,
@@ -116,7 +197,7 @@ impl SceneAndCamera {
     }
 
     /// A mesh file seen from the default orbit, with the hash of the file's bytes
-    /// ([`SceneAndCamera::mesh`] plus [`SceneAndCamera::mesh_hash`]).
+    /// ([`SceneSpec::mesh`] then [`SceneSpec::hashed`]).
     ///
     /// # Errors
     /// The file cannot be read.
@@ -124,12 +205,8 @@ impl SceneAndCamera {
         path: &Path,
         view_degrees: f64,
         elevation_degrees: f64,
-    ) -> Result<Self, DumpError> {
-        let bytes = std::fs::read(path).map_err(|e| io_err("read mesh", path, e))?;
-        Ok(Self {
-            mesh_hash: Some(mesh_hash(&bytes)),
-            ..Self::mesh(path, view_degrees, elevation_degrees)
-        })
+    ) -> Result<Self, SceneSpecError> {
+        Self::mesh(path, view_degrees, elevation_degrees).hashed()
     }
 
     /// A mesh file seen from the default orbit at `view_degrees` and `elevation_degrees`.
@@ -139,6 +216,44 @@ impl SceneAndCamera {
             mesh: Some(path.display().to_string()),
             name: None,
             ..Self::named("", view_degrees, elevation_degrees)
+        }
+    }
+
+    /// This spec with the hash of its mesh file's bytes (a named scene as it is).
+    ///
+    /// # Errors
+    /// The file cannot be read.
+    pub fn hashed(self) -> Result<Self, SceneSpecError> {
+        let Some(mesh) = &self.mesh else {
+            return Ok(self);
+        };
+        let path = PathBuf::from(mesh);
+        let bytes = read_mesh(&path)?;
+        Ok(Self {
+            mesh_hash: Some(mesh_hash(&bytes)),
+            ..self
+        })
+    }
+
+    /// What a dump or an export of `view` (this spec's view) records: the view's conventions, and
+    /// an orbit around another up axis as the view's matrix, turn included, which the orbit's
+    /// fields cannot describe.
+    #[must_use]
+    pub fn recorded(&self, view: &View<'_>) -> Self {
+        let turned = || {
+            (self.up != UpAxis::Y).then(|| ViewProjection {
+                row_major: Camera {
+                    view_projection: view.view_projection(),
+                }
+                .row_major(),
+                precision: VertexPrecision::F64,
+            })
+        };
+        Self {
+            conventions: view.conventions(),
+            view_projection: self.view_projection.or_else(turned),
+            up: UpAxis::Y,
+            ..self.clone()
         }
     }
 
@@ -155,56 +270,63 @@ impl SceneAndCamera {
 
     /// Loads the scene; a relative mesh path missing from the working directory is looked up in
     /// `beside` (the dump's directory). A mesh whose bytes do not hash to
-    /// [`SceneAndCamera::mesh_hash`] is refused.
+    /// [`SceneSpec::mesh_hash`] is refused.
     ///
     /// # Errors
     /// Neither a name nor a mesh, a mesh file in neither place (both named), a file of another
     /// hash, or a scene that cannot be loaded.
-    pub fn load(&self, beside: Option<&Path>) -> Result<Scene, DumpError> {
+    pub fn load(&self, beside: Option<&Path>) -> Result<Scene, SceneSpecError> {
         let scene = match (&self.mesh, &self.name) {
             (Some(mesh), _) => {
                 let path = find_mesh(mesh, beside)?;
                 if let Some(expected) = &self.mesh_hash {
-                    let bytes = std::fs::read(&path).map_err(|e| io_err("read mesh", &path, e))?;
-                    let found = mesh_hash(&bytes);
+                    let found = mesh_hash(&read_mesh(&path)?);
                     if found != *expected {
-                        return err(format!(
-                            "mesh {}: its bytes hash to {found}, the scene names {expected}: \
-                             a different file (pass --mesh PATH to name the one it was made of)",
-                            path.display()
-                        ));
+                        return Err(SceneSpecError::OtherMesh {
+                            path,
+                            found,
+                            expected: expected.clone(),
+                        });
                     }
                 }
                 Scene::from_file(&path)
             }
             (None, Some(name)) => Scene::procedural(name),
-            (None, None) => return err("the scene names neither a mesh nor a named scene"),
+            (None, None) => return Err(SceneSpecError::NoScene),
         };
-        scene.map_err(|e| DumpError(format!("scene: {e}")))
+        Ok(scene?)
     }
 
-    /// The camera on `viewport`: the engine's matrix, or the orbit's for `scene` (with the
-    /// projection of the conventions' depth range, [`OrbitCamera::camera_for`]).
+    /// The camera on `viewport`: the engine's matrix, or the orbit's for `scene` around its up
+    /// axis (with the projection of the conventions' depth range, [`OrbitCamera::camera_for`]).
     ///
     /// # Errors
     /// A matrix declared f32 with an entry beyond f32's range.
-    pub fn camera(&self, scene: &Scene, viewport: Viewport) -> Result<Camera, DumpError> {
+    pub fn camera(&self, scene: &Scene, viewport: Viewport) -> Result<Camera, SceneSpecError> {
         match &self.view_projection {
             Some(matrix) => Ok(Camera::from_row_major(engine_matrix(matrix)?)),
-            None => Ok(scene.orbit_camera(viewport, &self.orbit(), self.conventions.depth_range)),
+            None => Ok(scene.orbit_camera_up(
+                viewport,
+                &self.orbit(),
+                self.conventions.depth_range,
+                self.up,
+            )),
         }
     }
 
-    /// The view this scene names: `scene` (from [`SceneAndCamera::load`]) through
-    /// [`SceneAndCamera::camera`] on `viewport`, rasterized under the conventions.
+    /// The view this spec names: `scene` (from [`SceneSpec::load`]) through
+    /// [`SceneSpec::camera`] on `viewport`, rasterized under the conventions (at more than one
+    /// sample, a view rasterizing per sample whose [`View::pixel_viewport`] is `viewport`).
     ///
     /// # Errors
     /// A bad matrix, conventions fragsim cannot rasterize under, a scene without triangles.
-    pub fn view<'s>(&self, scene: &'s Scene, viewport: Viewport) -> Result<View<'s>, DumpError> {
+    pub fn view<'s>(
+        &self,
+        scene: &'s Scene,
+        viewport: Viewport,
+    ) -> Result<View<'s>, SceneSpecError> {
         let camera = self.camera(scene, viewport)?;
-        scene
-            .view_under(viewport, &camera, self.conventions)
-            .map_err(|e| DumpError(format!("scene: {e}")))
+        Ok(scene.view_under(viewport, &camera, self.conventions)?)
     }
 
     /// Refuses a NaN or infinite number, which JSON cannot hold (serde_json would silently write
@@ -214,7 +336,7 @@ impl SceneAndCamera {
     /// # Errors
     /// The first field that is not finite, by name (`view_projection.row_major[i]` for a matrix
     /// entry).
-    pub fn check_finite(&self) -> Result<(), DumpError> {
+    pub fn check_finite(&self) -> Result<(), SceneSpecError> {
         let orbit = [
             ("view_degrees", self.view_degrees),
             ("elevation_degrees", self.elevation_degrees),
@@ -227,9 +349,7 @@ impl SceneAndCamera {
         });
         for (field, value) in orbit.into_iter().chain(matrix) {
             if !value.is_finite() {
-                return err(format!(
-                    "scene {field} is {value}: numbers in a header must be finite (JSON has no NaN or infinity)"
-                ));
+                return Err(SceneSpecError::NotFinite { field, value });
             }
         }
         if let Some(matrix) = &self.view_projection {
@@ -257,20 +377,28 @@ impl SceneAndCamera {
     }
 }
 
+/// The bytes of the mesh file at `path`.
+fn read_mesh(path: &Path) -> Result<Vec<u8>, SceneSpecError> {
+    std::fs::read(path).map_err(|source| SceneSpecError::ReadMesh {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// The file a dump's relative mesh path names: in the working directory, else beside the dump.
-fn find_mesh(mesh: &str, beside: Option<&Path>) -> Result<PathBuf, DumpError> {
+fn find_mesh(mesh: &str, beside: Option<&Path>) -> Result<PathBuf, SceneSpecError> {
     let path = PathBuf::from(mesh);
     if path.exists() || path.is_absolute() {
         return Ok(path);
     }
     match beside {
         Some(dir) if dir.join(&path).exists() => Ok(dir.join(&path)),
-        Some(dir) => err(format!(
-            "mesh {mesh}: no such file in the working directory ({}) nor beside the dump ({}); \
-             pass --mesh PATH to name it",
-            std::env::current_dir().map_or_else(|_| "?".into(), |d| d.display().to_string()),
-            dir.join(&path).display()
-        )),
+        Some(dir) => Err(SceneSpecError::MeshNotFound {
+            mesh: mesh.into(),
+            working_dir: std::env::current_dir()
+                .map_or_else(|_| "?".into(), |d| d.display().to_string()),
+            beside: dir.join(&path),
+        }),
         // Not found: loading names the path.
         None => Ok(path),
     }
@@ -281,19 +409,22 @@ fn find_mesh(mesh: &str, beside: Option<&Path>) -> Result<PathBuf, DumpError> {
 ///
 /// # Errors
 /// An f32 matrix with an entry beyond f32's range, by index.
-fn engine_matrix(matrix: &ViewProjection) -> Result<[f64; 16], DumpError> {
+fn engine_matrix(matrix: &ViewProjection) -> Result<[f64; 16], SceneSpecError> {
     let mut entries = matrix.row_major;
     if matrix.precision == VertexPrecision::F32 {
-        for (i, value) in entries.iter_mut().enumerate() {
+        for (index, value) in entries.iter_mut().enumerate() {
             let single = *value as f32;
             if !single.is_finite() {
-                return err(format!(
-                    "scene view_projection.row_major[{i}] is {value}, beyond f32's range, \
-                     but the matrix's precision is f32"
-                ));
+                return Err(SceneSpecError::BeyondF32 {
+                    index,
+                    value: *value,
+                });
             }
             *value = f64::from(single);
         }
     }
     Ok(entries)
 }
+
+#[cfg(test)]
+mod tests;

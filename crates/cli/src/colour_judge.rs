@@ -118,7 +118,7 @@ impl ColourColumns {
 }
 
 /// A capture's image against the oracle's.
-pub(crate) struct Judged<'j> {
+pub(crate) struct JudgedImage<'j> {
     /// The capture's image.
     pub image: RgbImage,
     /// The oracle's image.
@@ -133,11 +133,11 @@ pub(crate) struct Judged<'j> {
 
 /// Shades captures and compares them with the oracle's image.
 ///
-/// A judge of a view rasterizing per sample ([`Judge::per_sample`]) shades every sample of the
+/// A judge of a view rasterizing per sample ([`ColourJudge::per_sample`]) shades every sample of the
 /// sample-expanded lists and resolves each pixel from its samples
 /// ([`effects::render_resolved`], `docs/semantics.md` §11): its images are the render target's
 /// size, its reference the per-sample oracle's resolved image.
-pub(crate) struct Judge<'a> {
+pub(crate) struct ColourJudge<'a> {
     effect: Effect,
     material: Material,
     size: (u32, u32),
@@ -152,9 +152,9 @@ pub(crate) struct Judge<'a> {
     pub covered: usize,
 }
 
-impl<'a> Judge<'a> {
+impl<'a> ColourJudge<'a> {
     /// The judge of `effect` for `view` of `scene` through `orbit` (a view rasterizing per
-    /// sample through [`Judge::per_sample`], which refuses what is not resolved per sample).
+    /// sample through [`ColourJudge::per_sample`], which refuses what is not resolved per sample).
     pub fn new(
         effect: EffectName,
         scene: &Scene,
@@ -252,10 +252,10 @@ impl<'a> Judge<'a> {
         &self,
         image: RgbImage,
         pass: Option<AttributePass>,
-    ) -> Result<Judged<'_>, String> {
+    ) -> Result<JudgedImage<'_>, String> {
         let colour = colour_error(&self.reference, &image)?;
         let errors = effects::error_pixels(&self.reference, &image) as u64;
-        Ok(Judged {
+        Ok(JudgedImage {
             image,
             reference: &self.reference,
             errors,
@@ -300,7 +300,7 @@ impl<'a> Judge<'a> {
     }
 
     /// The capture's image, compared with the oracle's.
-    pub fn judge(&self, capture: &Capture) -> Option<Judged<'_>> {
+    pub fn judge(&self, capture: &Capture) -> Option<JudgedImage<'_>> {
         let start = Instant::now();
         let (full, completed) = deferred::complete(capture, self.oracle);
         self.judge_full(&full.lists, completed, start)
@@ -308,7 +308,7 @@ impl<'a> Judge<'a> {
 
     /// The image of `lists` of full identities (depth key and primitive id, indexed like the
     /// oracle's), compared with the oracle's: the masked nodes' per-sample resolve.
-    pub fn judge_lists(&self, lists: &PixelLists) -> Option<Judged<'_>> {
+    pub fn judge_lists(&self, lists: &PixelLists) -> Option<JudgedImage<'_>> {
         self.judge_full(lists, None, Instant::now())
     }
 
@@ -318,7 +318,7 @@ impl<'a> Judge<'a> {
         full: &PixelLists,
         completed: Option<&'static str>,
         start: Instant,
-    ) -> Option<Judged<'_>> {
+    ) -> Option<JudgedImage<'_>> {
         let cosines = self.recompute(|p| full.pixel(p));
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let recomputed_entries = cosines.as_ref().map_or(0, |c| c.len() as u64);
@@ -378,7 +378,7 @@ mod tests {
             .filter(|&&n| n == 2)
             .count() as u64;
         assert!(two > 100, "{two}");
-        let judge = Judge::new(EffectName::Translucency, &scene, &view, orbit, &oracle);
+        let judge = ColourJudge::new(EffectName::Translucency, &scene, &view, orbit, &oracle);
         // Held depths equal to the true ones: nothing to see, nothing taken from the oracle.
         let held = capture_of(&oracle, Identity::PrimOnly, |_, e| e);
         let judged = judge.judge(&held).unwrap();
@@ -405,7 +405,7 @@ mod tests {
             .unwrap();
         let oracle = Oracle::build(&view);
         let keys = capture_of(&oracle, Identity::KeyOnly, |_, e| e >> 32 << 32);
-        let judge = Judge::new(EffectName::Fresnel, &scene, &view, orbit, &oracle);
+        let judge = ColourJudge::new(EffectName::Fresnel, &scene, &view, orbit, &oracle);
         let judged = judge.judge(&keys).unwrap();
         assert_eq!(judged.errors, 0);
         let pass = judged.pass.expect("completed and recomputed");

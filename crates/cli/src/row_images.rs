@@ -1,0 +1,44 @@
+//! Where `bench` saves its rows' images (its own and its multisampled rows'): each effect image
+//! as it is, and its difference from the oracle's, captioned with the scene.
+
+use std::path::Path;
+
+use image::RgbImage;
+
+/// Where bench's images go, and the scene and view their captions name.
+pub(crate) struct Images<'a> {
+    /// The directory (`--out`).
+    pub(crate) dir: &'a Path,
+    /// The scene, view and size, as every caption opens.
+    pub(crate) scene: String,
+}
+
+impl Images<'_> {
+    /// Saves the effect image `image` as `name`, as it is: pixel data that readers compare
+    /// (its file name says what it is; its figure, the difference, carries the caption).
+    ///
+    /// # Errors
+    /// A file that cannot be written.
+    pub(crate) fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
+        fragsim_shade::save_png(image, &self.dir.join(name))
+    }
+
+    /// Saves `image` as `stem.png` and its difference from `reference` (error pixels red, with
+    /// a legend and insets) as `stem-diff.png`, captioned with the scene and `what` it shows.
+    ///
+    /// # Errors
+    /// Images of different sizes, a font error, or a file that cannot be written.
+    pub(crate) fn save_with_difference(
+        &self,
+        image: &RgbImage,
+        reference: &RgbImage,
+        stem: &str,
+        what: &str,
+    ) -> Result<(), String> {
+        self.save(image, &format!("{stem}.png"))?;
+        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
+        let caption = format!("{}: {what} against the oracle's image", self.scene);
+        let figure = fragsim_shade::legend::captioned(&difference, &caption)?;
+        self.save(&figure, &format!("{stem}-diff.png"))
+    }
+}
