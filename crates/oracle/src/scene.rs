@@ -180,7 +180,7 @@ impl SceneAndCamera {
             (None, Some(name)) => Scene::procedural(name),
             (None, None) => return err("the scene names neither a mesh nor a named scene"),
         };
-        scene.map_err(|e| DumpError(format!("scene: {e}")))
+        scene.map_err(|e| DumpError::Invalid(format!("scene: {e}")))
     }
 
     /// The camera on `viewport`: the engine's matrix, or the orbit's for `scene` (with the
@@ -204,7 +204,7 @@ impl SceneAndCamera {
         let camera = self.camera(scene, viewport)?;
         scene
             .view_under(viewport, &camera, self.conventions)
-            .map_err(|e| DumpError(format!("scene: {e}")))
+            .map_err(|e| DumpError::Invalid(format!("scene: {e}")))
     }
 
     /// Refuses a NaN or infinite number, which JSON cannot hold (serde_json would silently write

@@ -90,7 +90,7 @@ impl Dump {
     pub(super) fn u32s_of(&self, name: &str, len: usize) -> Result<&[u32], DumpError> {
         let words = self
             .u32s(name)?
-            .ok_or_else(|| DumpError(format!("missing array {name:?}")))?;
+            .ok_or_else(|| DumpError::Invalid(format!("missing array {name:?}")))?;
         if words.len() == len {
             Ok(words)
         } else {

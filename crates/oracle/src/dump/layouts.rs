@@ -259,7 +259,7 @@ impl DumpScheme {
             DumpLayout::CountersAndSlots if entry.storage == Storage::Counted => {
                 Self::ABufferExact {
                     counts: counts
-                        .ok_or_else(|| DumpError(format!("{name} ran without its counting pass")))?
+                        .ok_or_else(|| DumpError::Invalid(format!("{name} ran without its counting pass")))?
                         .to_vec(),
                     sorted: false,
                 }
@@ -272,7 +272,7 @@ impl DumpScheme {
                 scheme: name,
                 k: sizes.k,
                 pool: u32::try_from(sizes.pool)
-                    .map_err(|_| DumpError(format!("{name}: a pool past 2^32 nodes")))?,
+                    .map_err(|_| DumpError::Invalid(format!("{name}: a pool past 2^32 nodes")))?,
                 spec: LayoutSpec::FRAGSIM_LISTS,
             },
             DumpLayout::LayerMajor => Self::LayerMajor {
@@ -437,7 +437,7 @@ impl DumpScheme {
                 // refused before the scheme is built (its storage would not fit a u64 count).
                 let words = header.arrays.iter().try_fold(0u64, |sum, (name, spec)| {
                     sum.checked_add(super::header::elements(name, &spec.shape)?)
-                        .ok_or_else(|| DumpError("the arrays' elements overflow 64 bits".into()))
+                        .ok_or_else(|| DumpError::Invalid("the arrays' elements overflow 64 bits".into()))
                 })?;
                 let size = |field: &str, value: Option<u32>| match value {
                     Some(0) => err(format!("{name} \"{field}\" must be at least 1")),

@@ -143,7 +143,7 @@ impl Dump {
         let nodes = self.widened("nodes", masked.dtype)?;
         let masks = self
             .u32s("masks")?
-            .ok_or_else(|| DumpError("missing array \"masks\"".into()))?;
+            .ok_or_else(|| DumpError::Invalid("missing array \"masks\"".into()))?;
         for (name, len) in [("nodes", nodes.len()), ("masks", masks.len())] {
             if len as u64 != slots {
                 return err(format!(
@@ -464,7 +464,7 @@ impl Dump {
         }
         let scheme = MaskedABuffer::new(pixels, samples, capacity, u64::MAX)?;
         let memory: SerialMemory = scheme.layout().allocate();
-        scheme.insert_all(view, &memory).map_err(DumpError)?;
+        scheme.insert_all(view, &memory).map_err(DumpError::Invalid)?;
         let n = pixels.pixels();
         let u32s: Vec<u32> = (0..WordMemory::<u32>::len(&memory))
             .map(|i| WordMemory::<u32>::load(&memory, i))

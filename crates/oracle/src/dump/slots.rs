@@ -176,7 +176,7 @@ impl Dump {
             .arrays
             .get("slots")
             .map(Words::len)
-            .ok_or_else(|| DumpError("missing array \"slots\"".into()))?;
+            .ok_or_else(|| DumpError::Invalid("missing array \"slots\"".into()))?;
         if len as u64 == total {
             Ok(())
         } else {

@@ -375,7 +375,7 @@ mod tests {
         assert!(narrow
             .pack(word)
             .unwrap_err()
-            .0
+            .to_string()
             .contains("1193046 does not fit"));
     }
 
@@ -395,7 +395,7 @@ mod tests {
         assert!(past
             .check()
             .unwrap_err()
-            .0
+            .to_string()
             .contains("does not fit a 32-bit word"));
     }
 }

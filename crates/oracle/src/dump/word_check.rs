@@ -147,7 +147,7 @@ impl Dump {
             corrupt: vec![Vec::new(); pixels],
             ..WordCheck::default()
         };
-        let missing = |n: &str| DumpError(format!("missing array {n:?}"));
+        let missing = |n: &str| DumpError::Invalid(format!("missing array {n:?}"));
         match &scheme {
             DumpScheme::Mdts { k, .. } | DumpScheme::KBuffer { k, .. } => {
                 let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;

@@ -294,13 +294,13 @@ impl Dump {
             let words = self
                 .arrays
                 .get(name)
-                .ok_or_else(|| DumpError(format!("the header names array {name:?}, absent")))?;
+                .ok_or_else(|| DumpError::Invalid(format!("the header names array {name:?}, absent")))?;
             check_array(name, spec, words.dtype(), words.len() as u64)?;
             files.insert(spec.file.clone(), words.to_le_bytes());
         }
         self.header.scene.check_finite()?;
         let text = serde_json::to_string_pretty(&self.header)
-            .map_err(|e| DumpError(format!("cannot encode the header: {e}")))?;
+            .map_err(|e| DumpError::Invalid(format!("cannot encode the header: {e}")))?;
         Ok((text + "\n", files))
     }
 
