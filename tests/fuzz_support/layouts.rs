@@ -65,7 +65,10 @@ pub fn check(data: &[u8]) {
                 dump.header.scene.check_finite().is_err(),
                 "encoding refused a dump whose scene is finite: {error}"
             );
-            assert!(error.to_string().contains("scene"), "{error} does not name the scene");
+            assert!(
+                error.to_string().contains("scene"),
+                "{error} does not name the scene"
+            );
             return;
         }
     };
@@ -195,7 +198,9 @@ struct Model {
 
 fn build(input: &mut Input<'_>) -> Built {
     let mut header = Dump::parse(NAME, BASE.as_bytes(), |f| {
-        Err(DumpError::Invalid(format!("{f}: the base header has no arrays")))
+        Err(DumpError::Invalid(format!(
+            "{f}: the base header has no arrays"
+        )))
     })
     .expect("the base header parses")
     .header;

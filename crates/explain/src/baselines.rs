@@ -17,7 +17,6 @@ use fragsim_oracle::Oracle;
 use fragsim_raster::{View, Viewport};
 use serde::Serialize;
 
-
 /// One (scheme, executor) run of the table.
 #[derive(Debug, Clone, Serialize)]
 pub struct BaselineRow {

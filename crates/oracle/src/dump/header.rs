@@ -116,7 +116,10 @@ impl Header {
     /// # Errors
     /// A count other than 1, 2, 4, 8 or 16, naming the field.
     pub fn samples(&self) -> Result<u32, DumpError> {
-        self.scene.conventions.pattern().map_err(DumpError::Invalid)?;
+        self.scene
+            .conventions
+            .pattern()
+            .map_err(DumpError::Invalid)?;
         Ok(self.scene.conventions.samples)
     }
 

@@ -259,7 +259,9 @@ impl DumpScheme {
             DumpLayout::CountersAndSlots if entry.storage == Storage::Counted => {
                 Self::ABufferExact {
                     counts: counts
-                        .ok_or_else(|| DumpError::Invalid(format!("{name} ran without its counting pass")))?
+                        .ok_or_else(|| {
+                            DumpError::Invalid(format!("{name} ran without its counting pass"))
+                        })?
                         .to_vec(),
                     sorted: false,
                 }
@@ -437,7 +439,9 @@ impl DumpScheme {
                 // refused before the scheme is built (its storage would not fit a u64 count).
                 let words = header.arrays.iter().try_fold(0u64, |sum, (name, spec)| {
                     sum.checked_add(super::header::elements(name, &spec.shape)?)
-                        .ok_or_else(|| DumpError::Invalid("the arrays' elements overflow 64 bits".into()))
+                        .ok_or_else(|| {
+                            DumpError::Invalid("the arrays' elements overflow 64 bits".into())
+                        })
                 })?;
                 let size = |field: &str, value: Option<u32>| match value {
                     Some(0) => err(format!("{name} \"{field}\" must be at least 1")),
@@ -514,6 +518,29 @@ impl DumpScheme {
             ));
         }
         Ok(())
+    }
+
+    /// Pixel `p`'s first slot and slot count in fragsim's pixel-major slot array of an MDTS or
+    /// A-buffer dump.
+    pub(super) fn pixel_slots(&self) -> impl Fn(usize) -> (usize, usize) + '_ {
+        let offsets: Vec<usize> = match self {
+            DumpScheme::ABufferExact { counts, .. } => std::iter::once(0)
+                .chain(counts.iter().scan(0usize, |sum, &c| {
+                    *sum += c as usize;
+                    Some(*sum)
+                }))
+                .collect(),
+            _ => Vec::new(),
+        };
+        move |p| match self {
+            DumpScheme::ABufferFixed {
+                capacity: slots, ..
+            }
+            | DumpScheme::Mdts { k: slots, .. }
+            | DumpScheme::KBuffer { k: slots, .. }
+            | DumpScheme::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
+            _ => (offsets[p], offsets[p + 1] - offsets[p]),
+        }
     }
 }
 

@@ -464,7 +464,9 @@ impl Dump {
         }
         let scheme = MaskedABuffer::new(pixels, samples, capacity, u64::MAX)?;
         let memory: SerialMemory = scheme.layout().allocate();
-        scheme.insert_all(view, &memory).map_err(DumpError::Invalid)?;
+        scheme
+            .insert_all(view, &memory)
+            .map_err(DumpError::Invalid)?;
         let n = pixels.pixels();
         let u32s: Vec<u32> = (0..WordMemory::<u32>::len(&memory))
             .map(|i| WordMemory::<u32>::load(&memory, i))

@@ -10,7 +10,6 @@
 //! index is taken, so a header cannot make the reader index past it or allocate more than it
 //! holds.
 
-use super::arrays::pixel_slots;
 use super::spec::{LayoutSpec, Payload, SlotOrder};
 use super::word_check::WordCheck;
 use super::{err, Dtype, Dump, DumpError, DumpScheme, Words};
@@ -222,7 +221,7 @@ impl Dump {
             "slots",
             codec.payload.map_or(own_dtype(scheme), |p| p.dtype),
         )?;
-        let first_slot = pixel_slots(scheme);
+        let first_slot = scheme.pixel_slots();
         for word in check.corrupt.iter_mut().flatten() {
             // Every corrupt word of a slot layout is a slot word (counters are judged apart).
             if let Some(&at) = stored.get(placement.stored(first_slot(word.pixel).0 + word.slot)) {

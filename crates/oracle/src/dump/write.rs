@@ -291,10 +291,9 @@ impl Dump {
         let mut files = BTreeMap::new();
         for (name, spec) in &self.header.arrays {
             check_file_name(name, &spec.file)?;
-            let words = self
-                .arrays
-                .get(name)
-                .ok_or_else(|| DumpError::Invalid(format!("the header names array {name:?}, absent")))?;
+            let words = self.arrays.get(name).ok_or_else(|| {
+                DumpError::Invalid(format!("the header names array {name:?}, absent"))
+            })?;
             check_array(name, spec, words.dtype(), words.len() as u64)?;
             files.insert(spec.file.clone(), words.to_le_bytes());
         }

@@ -59,7 +59,9 @@ fn header_names_are_the_catalogs_layouts() {
     let refused = DumpScheme::from_header(&lists, None).unwrap_err();
     assert_eq!(
         refused,
-        DumpError::Invalid("scheme linked-list dumps as linked-list, the header's layout is memory".into())
+        DumpError::Invalid(
+            "scheme linked-list dumps as linked-list, the header's layout is memory".into()
+        )
     );
 }
 
