@@ -94,7 +94,7 @@ pub fn bucket(dc: u32) -> usize {
 /// Covered pixels in each of [`BUCKETS`].
 #[must_use]
 pub fn covered_by_bucket(oracle: &Oracle) -> Vec<usize> {
-    let mut in_bucket = vec![0usize; BUCKETS.len()];
+    let mut in_bucket = vec![0_usize; BUCKETS.len()];
     for &d in oracle.depth_complexity().iter().filter(|&&d| d > 0) {
         in_bucket[bucket(d)] += 1;
     }
@@ -138,7 +138,7 @@ pub fn rate(
         misordered_pixels: 0,
         rate_by_depth_complexity: Vec::new(),
     };
-    let mut bad_in_bucket = vec![0usize; BUCKETS.len()];
+    let mut bad_in_bucket = vec![0_usize; BUCKETS.len()];
     for seed in 0..seeds {
         let schedule = Schedule {
             policy,

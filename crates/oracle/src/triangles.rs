@@ -88,7 +88,7 @@ impl TriangleExport {
                 })?;
                 bytes.extend_from_slice(&v.to_le_bytes());
             }
-            bytes.extend_from_slice(&0u32.to_le_bytes());
+            bytes.extend_from_slice(&0_u32.to_le_bytes());
             for z in t.z {
                 bytes.extend_from_slice(&z.to_le_bytes());
             }

@@ -437,7 +437,7 @@ impl DumpScheme {
                 // Each size defaults to 1, as a scheme that does not use it is built. A scheme
                 // holds at least one word per slot or layer, so a size past the dump's words is
                 // refused before the scheme is built (its storage would not fit a u64 count).
-                let words = header.arrays.iter().try_fold(0u64, |sum, (name, spec)| {
+                let words = header.arrays.iter().try_fold(0_u64, |sum, (name, spec)| {
                     sum.checked_add(super::header::elements(name, &spec.shape)?)
                         .ok_or_else(|| {
                             DumpError::Invalid("the arrays' elements overflow 64 bits".into())
@@ -524,8 +524,8 @@ impl DumpScheme {
     /// A-buffer dump.
     pub(super) fn pixel_slots(&self) -> impl Fn(usize) -> (usize, usize) + '_ {
         let offsets: Vec<usize> = match self {
-            DumpScheme::ABufferExact { counts, .. } => std::iter::once(0)
-                .chain(counts.iter().scan(0usize, |sum, &c| {
+            Self::ABufferExact { counts, .. } => std::iter::once(0)
+                .chain(counts.iter().scan(0_usize, |sum, &c| {
                     *sum += c as usize;
                     Some(*sum)
                 }))
@@ -533,12 +533,12 @@ impl DumpScheme {
             _ => Vec::new(),
         };
         move |p| match self {
-            DumpScheme::ABufferFixed {
+            Self::ABufferFixed {
                 capacity: slots, ..
             }
-            | DumpScheme::Mdts { k: slots, .. }
-            | DumpScheme::KBuffer { k: slots, .. }
-            | DumpScheme::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
+            | Self::Mdts { k: slots, .. }
+            | Self::KBuffer { k: slots, .. }
+            | Self::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
             _ => (offsets[p], offsets[p + 1] - offsets[p]),
         }
     }

@@ -215,7 +215,7 @@ impl Dump {
         let stored_nodes = self.widened("nodes", masked.dtype)?;
         let stored_masks = self.u32s("masks")?.unwrap_or_default();
         let capacity = masked.capacity as usize;
-        let samples_mask = (1u64 << masked.samples) - 1;
+        let samples_mask = (1_u64 << masked.samples) - 1;
         let mut check = WordCheck {
             corrupt: vec![Vec::new(); counters.len()],
             ..WordCheck::default()
@@ -509,7 +509,7 @@ impl Dump {
     ///
     /// # Errors
     /// A primitive id that does not fit the payload.
-    pub(super) fn masked_as(&self, spec: Option<LayoutSpec>) -> Result<Dump, DumpError> {
+    pub(super) fn masked_as(&self, spec: Option<LayoutSpec>) -> Result<Self, DumpError> {
         let masked = self.masked_checked()?;
         if self.header.layout.is_some() {
             return err("only fragsim's own encoding is re-encoded");

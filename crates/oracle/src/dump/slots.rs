@@ -191,7 +191,7 @@ impl Dump {
     /// # Errors
     /// A `slots` array of the wrong dtype (the payload's, or the scheme's own without one) or
     /// of other than the scheme's slot count.
-    pub(super) fn own_slots(&self, scheme: &DumpScheme) -> Result<Option<Dump>, DumpError> {
+    pub(super) fn own_slots(&self, scheme: &DumpScheme) -> Result<Option<Self>, DumpError> {
         let Some((placement, codec, total)) = self.slot_layout(scheme)? else {
             return Ok(None);
         };
@@ -241,7 +241,7 @@ impl Dump {
         scheme: &DumpScheme,
         order: SlotOrder,
         payload: Option<Payload>,
-    ) -> Result<Dump, DumpError> {
+    ) -> Result<Self, DumpError> {
         let own = self.widened("slots", own_dtype(scheme))?;
         let codec = SlotCodec::new(scheme, payload);
         let placement = Placement {
