@@ -80,9 +80,9 @@ fn write_out(blob: &[u8], dir: &Path) {
 
 /// A dump directory as the library reads and decodes it.
 fn decoded(dir: &Path) -> Result<(Dump, Capture, WordCheck), String> {
-    let dump = Dump::read(dir).map_err(|e| e.0)?;
-    let capture = dump.capture().map_err(|e| e.0)?;
-    let words = dump.check_words().map_err(|e| e.0)?;
+    let dump = Dump::read(dir).map_err(|e| e.to_string())?;
+    let capture = dump.capture().map_err(|e| e.to_string())?;
+    let words = dump.check_words().map_err(|e| e.to_string())?;
     Ok((dump, capture, words))
 }
 

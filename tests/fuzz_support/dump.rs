@@ -79,7 +79,7 @@ pub fn check(data: &[u8]) {
         files
             .get(file)
             .cloned()
-            .ok_or_else(|| DumpError(format!("{file} was not encoded")))
+            .ok_or_else(|| DumpError::Invalid(format!("{file} was not encoded")))
     })
     .expect("an encoded dump parses");
     assert_eq!(again, dump, "a dump differs after encoding and parsing");

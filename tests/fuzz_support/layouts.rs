@@ -65,7 +65,10 @@ pub fn check(data: &[u8]) {
                 dump.header.scene.check_finite().is_err(),
                 "encoding refused a dump whose scene is finite: {error}"
             );
-            assert!(error.0.contains("scene"), "{error} does not name the scene");
+            assert!(
+                error.to_string().contains("scene"),
+                "{error} does not name the scene"
+            );
             return;
         }
     };
@@ -73,7 +76,7 @@ pub fn check(data: &[u8]) {
         files
             .get(file)
             .cloned()
-            .ok_or_else(|| DumpError(format!("{file} was not encoded")))
+            .ok_or_else(|| DumpError::Invalid(format!("{file} was not encoded")))
     })
     .unwrap_or_else(|e| panic!("an encoded dump does not parse: {e}\n{text}"));
     assert_eq!(&again, dump, "a dump differs after encoding and parsing");
@@ -90,7 +93,7 @@ pub fn check(data: &[u8]) {
                 panic!("a dump that keeps its layout is refused: {error}\n{text}")
             });
             assert!(
-                error.0.contains(fault.as_str()),
+                error.to_string().contains(fault.as_str()),
                 "the error {error:?} does not name {fault:?}\n{text}"
             );
             return;
@@ -195,7 +198,9 @@ struct Model {
 
 fn build(input: &mut Input<'_>) -> Built {
     let mut header = Dump::parse(NAME, BASE.as_bytes(), |f| {
-        Err(DumpError(format!("{f}: the base header has no arrays")))
+        Err(DumpError::Invalid(format!(
+            "{f}: the base header has no arrays"
+        )))
     })
     .expect("the base header parses")
     .header;

@@ -39,7 +39,7 @@ use crate::device::{Gpu, GpuError};
 use crate::plant::Plant;
 use crate::shaders::{GpuScheme, Storage};
 use run::execute_geometry;
-pub(crate) use run::{RunResult, TARGET_FORMAT};
+pub(crate) use run::RunResult;
 
 mod run;
 

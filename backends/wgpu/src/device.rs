@@ -15,7 +15,10 @@
 
 use std::fmt;
 
-use crate::capture::TARGET_FORMAT;
+/// The format of every capture's colour target, which the shaders never write (write mask
+/// empty): Vulkan draws need a render area, the schemes write storage buffers only. Multisampled
+/// for the counting pass and per-sample captures, so the device reports its sample counts.
+pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
 /// Why no GPU could be used, or why a scheme cannot run on this one.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -77,7 +77,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
     let pixels = oracle.pixels();
     let dump_pixels = dump.viewport()?.pixels();
     if dump_pixels != pixels {
-        return Err(DumpError(format!(
+        return Err(DumpError::Invalid(format!(
             "the dump covers {dump_pixels} pixels, the oracle {pixels}"
         )));
     }
@@ -93,7 +93,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
         examples: 8,
     };
     let comparison = verdict::judge(&reference, Candidate::Dump(dump), &options)
-        .map_err(DumpError)?
+        .map_err(DumpError::Invalid)?
         .comparison;
     let capture = dump.capture()?;
     // The most fragments of a pixel the scheme keeps.
@@ -259,7 +259,7 @@ impl Within {
     /// As [`Within::judge`].
     pub fn verdict(&self, dump: &Dump) -> Result<Verdict, DumpError> {
         if !self.fits(dump) {
-            return Err(DumpError(
+            return Err(DumpError::Invalid(
                 "the dump names another scene or viewport than the reference's".into(),
             ));
         }
@@ -275,7 +275,7 @@ impl Within {
             (self.viewport.width, self.viewport.height),
         )
         .with_edge_ties(&view);
-        verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError)
+        verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError::Invalid)
     }
 
     /// Lists (pixels, or samples of a per-sample dump) the reference covers: what ambiguous

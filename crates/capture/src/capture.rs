@@ -119,6 +119,21 @@ impl PixelLists {
         self.offsets.windows(2).map(|w| w[1] - w[0])
     }
 
+    /// Second and later copies of an entry within one pixel's list, over every pixel: what a
+    /// torn write-back leaves (the k-buffer's hazard), and what no exact scheme may.
+    #[must_use]
+    pub fn duplicates(&self) -> u64 {
+        let mut sorted = Vec::new();
+        (0..self.pixels())
+            .map(|p| {
+                sorted.clear();
+                sorted.extend_from_slice(self.pixel(p));
+                sorted.sort_unstable();
+                sorted.windows(2).filter(|w| w[0] == w[1]).count() as u64
+            })
+            .sum()
+    }
+
     /// Sorts each pixel's list (ascending words: canonical order for `key << 32 | prim`).
     pub fn sort_each_pixel(&mut self) {
         for p in 0..self.pixels() {

@@ -17,8 +17,6 @@ use fragsim_oracle::Oracle;
 use fragsim_raster::{View, Viewport};
 use serde::Serialize;
 
-use crate::hazard::duplicates;
-
 /// One (scheme, executor) run of the table.
 #[derive(Debug, Clone, Serialize)]
 pub struct BaselineRow {
@@ -189,7 +187,7 @@ impl SchemeVisitor for Rows<'_, '_> {
                     overflowed: diff.overflowed,
                     lost: diff.lost,
                     extra: diff.extra,
-                    duplicates: duplicates(&run.capture),
+                    duplicates: run.capture.duplicates(),
                     misordered_pixels: diff.misordered_pixels,
                     error_pixels: diff.mismatched_pixels,
                     memory_bytes: run.stats.memory_bytes,

@@ -10,7 +10,6 @@
 
 use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim_capture::Capture;
 use fragsim_oracle::Oracle;
 use fragsim_raster::View;
 use serde::Serialize;
@@ -95,25 +94,11 @@ pub fn bucket(dc: u32) -> usize {
 /// Covered pixels in each of [`BUCKETS`].
 #[must_use]
 pub fn covered_by_bucket(oracle: &Oracle) -> Vec<usize> {
-    let mut in_bucket = vec![0usize; BUCKETS.len()];
+    let mut in_bucket = vec![0_usize; BUCKETS.len()];
     for &d in oracle.depth_complexity().iter().filter(|&&d| d > 0) {
         in_bucket[bucket(d)] += 1;
     }
     in_bucket
-}
-
-/// Second and later copies of a value within one pixel, over every pixel.
-#[must_use]
-pub fn duplicates(capture: &Capture) -> u64 {
-    let mut sorted = Vec::new();
-    (0..capture.pixels())
-        .map(|p| {
-            sorted.clear();
-            sorted.extend_from_slice(capture.pixel(p));
-            sorted.sort_unstable();
-            sorted.windows(2).filter(|w| w[0] == w[1]).count() as u64
-        })
-        .sum()
 }
 
 /// How rows and reports name a machine (the command line's spelling).
@@ -153,7 +138,7 @@ pub fn rate(
         misordered_pixels: 0,
         rate_by_depth_complexity: Vec::new(),
     };
-    let mut bad_in_bucket = vec![0usize; BUCKETS.len()];
+    let mut bad_in_bucket = vec![0_usize; BUCKETS.len()];
     for seed in 0..seeds {
         let schedule = Schedule {
             policy,
@@ -168,7 +153,7 @@ pub fn rate(
         row.lost += diff.lost;
         row.extra += diff.extra;
         row.misordered_pixels += diff.misordered_pixels;
-        row.duplicates += duplicates(&capture);
+        row.duplicates += capture.duplicates();
         for (p, &d) in dc.iter().enumerate().filter(|&(_, &d)| d > 0) {
             let expected = oracle.pixel(p);
             let expected = &expected[..expected.len().min(k)];

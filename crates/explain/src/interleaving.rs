@@ -112,7 +112,7 @@ pub fn nearest(fragments: &[Fragment], k: u32) -> Vec<u64> {
 #[must_use]
 pub fn interleavings(order: &[u32], limit: u64) -> Option<Vec<Vec<u32>>> {
     let threads = order.iter().max().map_or(0, |&t| t as usize + 1);
-    let mut left = vec![0usize; threads];
+    let mut left = vec![0_usize; threads];
     for &t in order {
         left[t as usize] += 1;
     }

@@ -47,16 +47,16 @@ impl Shown {
     /// of the spinlock whose loop deadlocks under lockstep warps (its fixed loop has none to
     /// show); `None` otherwise.
     #[must_use]
-    pub fn of(name: SchemeName) -> Option<Shown> {
+    pub fn of(name: SchemeName) -> Option<Self> {
         let entry = name.entry();
         let fragment_slots = DumpLayout::SlotArray(SlotWord::Fragment);
         match (entry.read_modify_write, entry.passes, entry.dump) {
-            (Some(machine), Passes::Fixed(1), _) => Some(Shown::Hazard(machine)),
-            _ if name == SchemeName::KbufferSpinlock => Some(Shown::Deadlock),
+            (Some(machine), Passes::Fixed(1), _) => Some(Self::Hazard(machine)),
+            _ if name == SchemeName::KbufferSpinlock => Some(Self::Deadlock),
             (None, Passes::Fixed(1), Some(layout))
                 if layout == fragment_slots && layout.scheme() == name =>
             {
-                Some(Shown::Invariant)
+                Some(Self::Invariant)
             }
             _ => None,
         }
@@ -64,7 +64,7 @@ impl Shown {
 
     /// The catalog's entries `explain` shows, in catalog order.
     pub fn schemes() -> impl Iterator<Item = &'static Entry> {
-        CATALOG.iter().filter(|e| Shown::of(e.scheme).is_some())
+        CATALOG.iter().filter(|e| Self::of(e.scheme).is_some())
     }
 }
 

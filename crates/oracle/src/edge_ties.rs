@@ -121,7 +121,7 @@ impl TiePoints {
                             seen.push([i, j, s]);
                             let at = [i * ONE + offset[0], j * ONE + offset[1]];
                             let e = edges.map(|(p, q)| edge(p, q, at));
-                            let covered = (0..4).fold(0u8, |bits, r| {
+                            let covered = (0..4).fold(0_u8, |bits, r| {
                                 let passes = (0..3).all(|k| e[k] >= rules[r][k]);
                                 bits | u8::from(passes) << r
                             });

@@ -50,7 +50,7 @@ impl Ties {
     pub(crate) fn mask(self, identity: Identity) -> u64 {
         match (self, identity) {
             (_, Identity::PrimOnly) => u64::from(u32::MAX),
-            (Ties::ByPrimitive, Identity::KeyAndPrim) => u64::MAX,
+            (Self::ByPrimitive, Identity::KeyAndPrim) => u64::MAX,
             _ => u64::MAX << 32,
         }
     }
@@ -59,7 +59,7 @@ impl Ties {
     pub(crate) fn expected(self, list: &[u64], mask: u64, out: &mut Vec<u64>) {
         let start = out.len();
         out.extend(list.iter().map(|e| e & mask));
-        if self == Ties::MergeEqualDepths {
+        if self == Self::MergeEqualDepths {
             let mut kept = start;
             for i in start..out.len() {
                 if i == start || out[i] != out[kept - 1] {
@@ -99,7 +99,7 @@ impl Oracle {
 
     /// Runs `stream` twice (count, then fill) and sorts every pixel's list.
     fn from_stream(pixels: usize, stream: impl Fn(&mut dyn FnMut(Fragment))) -> Self {
-        let mut counts = vec![0usize; pixels];
+        let mut counts = vec![0_usize; pixels];
         stream(&mut |f| counts[f.pixel as usize] += 1);
         let mut offsets = Vec::with_capacity(pixels + 1);
         offsets.push(0);
@@ -107,7 +107,7 @@ impl Oracle {
             offsets.push(offsets[offsets.len() - 1] + c);
         }
         let mut next = offsets[..pixels].to_vec();
-        let mut entries = vec![0u64; offsets[pixels]];
+        let mut entries = vec![0_u64; offsets[pixels]];
         stream(&mut |f| {
             let p = f.pixel as usize;
             entries[next[p]] = f.packed();

@@ -86,7 +86,7 @@ impl SampleOracle {
             .collect();
         let mut nodes: Vec<(u32, MaskedNode)> = Vec::new();
         merge_samples(n, &mut fragments, &mut |pixel, node| {
-            nodes.push((pixel, node))
+            nodes.push((pixel, node));
         });
         MaskedLists::from_nodes(n, self.pixels.pixels(), nodes)
     }

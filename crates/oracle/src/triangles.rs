@@ -58,10 +58,10 @@ impl TriangleExport {
     pub fn to_bytes(&self) -> Result<Vec<u8>, DumpError> {
         self.scene.check_finite()?;
         let json = serde_json::to_string(&self.scene)
-            .map_err(|e| DumpError(format!("cannot encode the scene: {e}")))?;
+            .map_err(|e| DumpError::Invalid(format!("cannot encode the scene: {e}")))?;
         let padded = json.len().next_multiple_of(8);
         let count = u32::try_from(self.triangles.len())
-            .map_err(|_| DumpError("more than 2^32 screen triangles".into()))?;
+            .map_err(|_| DumpError::Invalid("more than 2^32 screen triangles".into()))?;
         let mut bytes = Vec::with_capacity(
             TRIANGLES_HEADER_BYTES + padded + self.triangles.len() * TRIANGLE_RECORD_BYTES,
         );
@@ -84,11 +84,11 @@ impl TriangleExport {
             bytes.extend_from_slice(&t.prim.to_le_bytes());
             for v in t.xy.iter().flatten() {
                 let v = i32::try_from(*v).map_err(|_| {
-                    DumpError(format!("triangle {}: coordinate {v} outside i32", t.prim))
+                    DumpError::Invalid(format!("triangle {}: coordinate {v} outside i32", t.prim))
                 })?;
                 bytes.extend_from_slice(&v.to_le_bytes());
             }
-            bytes.extend_from_slice(&0u32.to_le_bytes());
+            bytes.extend_from_slice(&0_u32.to_le_bytes());
             for z in t.z {
                 bytes.extend_from_slice(&z.to_le_bytes());
             }
@@ -105,7 +105,7 @@ impl TriangleExport {
             bytes
                 .get(at..at + 4)
                 .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .ok_or_else(|| DumpError("triangle export truncated".into()))
+                .ok_or_else(|| DumpError::Invalid("triangle export truncated".into()))
         };
         if bytes.get(..8) != Some(&TRIANGLES_MAGIC[..]) {
             return err("not a fragsim triangle export (bad magic)");
@@ -132,9 +132,9 @@ impl TriangleExport {
         let start = TRIANGLES_HEADER_BYTES + json_len.next_multiple_of(8);
         let json = bytes
             .get(TRIANGLES_HEADER_BYTES..TRIANGLES_HEADER_BYTES + json_len)
-            .ok_or_else(|| DumpError("triangle export truncated".into()))?;
+            .ok_or_else(|| DumpError::Invalid("triangle export truncated".into()))?;
         let scene: SceneSpec = serde_json::from_slice(json)
-            .map_err(|e| DumpError(format!("triangle export scene: {e}")))?;
+            .map_err(|e| DumpError::Invalid(format!("triangle export scene: {e}")))?;
         if bytes.len() != start + count * TRIANGLE_RECORD_BYTES {
             return err(format!(
                 "triangle export of {} bytes, expected {} for {count} triangles",

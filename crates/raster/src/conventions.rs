@@ -157,7 +157,7 @@ fn is_one(samples: &u32) -> bool {
 }
 
 /// The most subpixel bits fragsim's fixed-point grid holds ([`crate::SUBPIXEL_BITS`]).
-pub const MAX_SUBPIXEL_BITS: u32 = crate::SUBPIXEL_BITS;
+pub const MAX_SUBPIXEL_BITS: u32 = crate::viewport::SUBPIXEL_BITS;
 
 impl Conventions {
     /// fragsim's reference conventions: upper-left, 8 subpixel bits, `[0, 1]`, f64.

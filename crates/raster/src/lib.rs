@@ -30,16 +30,18 @@ mod rng;
 pub mod samples;
 pub mod scene_spec;
 mod scenes;
+mod viewport;
 
 pub use camera::{Camera, OrbitCamera};
 pub use conventions::{Conventions, DepthRange, EdgeTies, VertexPrecision, WindowOrigin};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError, UpAxis};
 pub use pipeline::{
-    edge_function, fill_thresholds, CullMode, PixelRect, ScreenTriangle, TriangleSetup, View,
-    Viewport, GUARD_BAND_PIXELS, SUBPIXEL_BITS,
+    edge_function, fill_thresholds, CullMode, ScreenTriangle, TriangleSetup, View,
+    GUARD_BAND_PIXELS,
 };
 pub use rng::SplitMix64;
 pub use samples::SamplePattern;
 pub use scene_spec::{mesh_hash, SceneSpec, SceneSpecError, ViewProjection};
 pub use scenes::{Scene, SceneError, DEFAULT_SCENE_NAME};
+pub use viewport::{PixelRect, Viewport, SUBPIXEL_BITS};

@@ -28,8 +28,7 @@
 //! transform, outcodes, clipping, snapping), `setup` (the early reject of triangles whose box holds
 //! no pixel centre, and each survivor set up once for the scan), `scan` (rules 6–7: the covered
 //! centres of each row from the edge functions, depth), `sample_scan` (rules 6–7 at each sample of
-//! a multisampled view, `docs/semantics.md` §11) and `viewport` (the render target and pixel
-//! rectangles); this file holds the view that ties them together and rule 5 (facing).
+//! a multisampled view, `docs/semantics.md` §11); the render target and its grid are `crate::viewport`; this file holds the view that ties them together and rule 5 (facing).
 
 use glam::{DMat4, DVec4};
 
@@ -37,9 +36,11 @@ use crate::camera::Camera;
 use crate::conventions::Conventions;
 use crate::fragment::Fragment;
 use crate::mesh::Mesh;
+use crate::viewport::{PixelRect, Viewport, HALF, ONE, SUBPIXEL_BITS};
 
 #[cfg(test)]
 mod conventions_tests;
+mod edges;
 mod sample_scan;
 mod scan;
 #[cfg(test)]
@@ -49,19 +50,12 @@ mod submission;
 #[cfg(test)]
 mod tests;
 mod vertex;
-mod viewport;
 
+use edges::{bounding_box, edge};
+pub use edges::{edge as edge_function, fill_thresholds};
 use sample_scan::Sampling;
-use scan::{bounding_box, edge};
-pub use scan::{edge as edge_function, fill_thresholds};
 pub use setup::TriangleSetup;
 use vertex::{in_front, AxisPositions, CentreCells, WindowVertex};
-pub use viewport::{PixelRect, Viewport};
-
-/// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
-pub const SUBPIXEL_BITS: u32 = 8;
-const ONE: i64 = 1 << SUBPIXEL_BITS;
-const HALF: i64 = ONE / 2;
 
 /// How far outside the viewport, in pixels, vertices may lie before they are clipped.
 ///

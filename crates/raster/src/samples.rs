@@ -23,7 +23,7 @@
 //! pixel `(x, y)` is column `x * n + s`. Every consumer of a view (the oracle, every scheme, every
 //! executor, tiles included) then works per sample unchanged, with `n` times the storage.
 
-use crate::pipeline::Viewport;
+use crate::viewport::Viewport;
 
 /// A fixed set of sample positions per pixel, each in 1/16 pixel from the pixel's upper-left
 /// corner (x right, y down).

@@ -7,8 +7,9 @@ use std::path::Path;
 use crate::camera::{Camera, OrbitCamera};
 use crate::conventions::{Conventions, DepthRange};
 use crate::mesh::{is_ply, read_mesh_file, Mesh, MeshError, UpAxis};
-use crate::pipeline::{CullMode, View, Viewport};
+use crate::pipeline::{CullMode, View};
 use crate::rng::SplitMix64;
+use crate::viewport::Viewport;
 use glam::{DMat4, DVec4};
 
 /// The name of the embedded default scene.

@@ -70,9 +70,9 @@ impl Approximation {
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
-            Approximation::Wboit => "wboit",
-            Approximation::Mlab { .. } => "mlab",
-            Approximation::TailBlend { .. } => "tail-blend",
+            Self::Wboit => "wboit",
+            Self::Mlab { .. } => "mlab",
+            Self::TailBlend { .. } => "tail-blend",
         }
     }
 
@@ -80,8 +80,8 @@ impl Approximation {
     #[must_use]
     pub fn k(self) -> Option<u32> {
         match self {
-            Approximation::Wboit => None,
-            Approximation::Mlab { k } | Approximation::TailBlend { k } => Some(k),
+            Self::Wboit => None,
+            Self::Mlab { k } | Self::TailBlend { k } => Some(k),
         }
     }
 
@@ -92,9 +92,9 @@ impl Approximation {
     #[must_use]
     pub fn bytes_per_pixel(self) -> u64 {
         match self {
-            Approximation::Wboit => 10,
-            Approximation::Mlab { k } => 8 * u64::from(k),
-            Approximation::TailBlend { k } => 8 * u64::from(k) + 8,
+            Self::Wboit => 10,
+            Self::Mlab { k } => 8 * u64::from(k),
+            Self::TailBlend { k } => 8 * u64::from(k) + 8,
         }
     }
 
@@ -103,9 +103,9 @@ impl Approximation {
     #[must_use]
     pub fn shade_pixel(self, material: &Material, arrivals: &[u64]) -> [f32; 3] {
         match self {
-            Approximation::Wboit => wboit(material, arrivals),
-            Approximation::Mlab { k } => mlab(material, k as usize, arrivals),
-            Approximation::TailBlend { k } => tail_blend(material, k as usize, arrivals),
+            Self::Wboit => wboit(material, arrivals),
+            Self::Mlab { k } => mlab(material, k as usize, arrivals),
+            Self::TailBlend { k } => tail_blend(material, k as usize, arrivals),
         }
     }
 
@@ -158,7 +158,7 @@ pub fn wboit_weight(alpha: f32, d: f32) -> f32 {
 /// `C = (Σ c α w / Σ α w) (1 − Π) + background · Π` (the paper's Listing 2 resolve).
 fn wboit(material: &Material, arrivals: &[u64]) -> [f32; 3] {
     let alpha = material.opacity;
-    let (mut accum, mut weight, mut revealage) = ([0.0f32; 3], 0.0f32, 1.0f32);
+    let (mut accum, mut weight, mut revealage) = ([0.0_f32; 3], 0.0_f32, 1.0_f32);
     for &entry in arrivals {
         let c = primitive_colour(entry as u32, material.primitives);
         let w = wboit_weight(alpha, depth_of(entry));
@@ -247,7 +247,7 @@ fn composite(
     layers: impl Iterator<Item = (f32, [f32; 3])>,
     behind: Option<[f32; 3]>,
 ) -> [f32; 3] {
-    let (mut colour, mut transmittance) = ([0.0f32; 3], 1.0f32);
+    let (mut colour, mut transmittance) = ([0.0_f32; 3], 1.0_f32);
     for (alpha, c) in layers {
         for ch in 0..3 {
             colour[ch] += transmittance * alpha * c[ch];

@@ -159,7 +159,7 @@ impl Sums {
         ColourError {
             mean_abs: self.abs.map(|s| s as f64 / pixels),
             max_abs: self.max,
-            psnr_db: 10.0 * (255.0f64 * 255.0 / mse).log10(),
+            psnr_db: 10.0 * (255.0_f64 * 255.0 / mse).log10(),
         }
     }
 }
@@ -188,7 +188,7 @@ mod tests {
         let error = colour_error(&reference, &candidate).unwrap();
         assert_eq!(error.mean_abs, [2.0, 0.0, 1.0]);
         assert_eq!(error.max_abs, [8, 0, 4]);
-        let expected = 10.0 * (255.0f64 * 255.0 * 12.0 / 80.0).log10();
+        let expected = 10.0 * (255.0_f64 * 255.0 * 12.0 / 80.0).log10();
         assert!((error.psnr_db - expected).abs() < 1e-9, "{}", error.psnr_db);
         assert!((error.psnr_db - 39.89).abs() < 0.01);
         // Symmetric.

@@ -125,7 +125,7 @@ pub fn complete<'c>(
 fn prims_of_keys(list: &[u64], fragments: &[u64]) -> Vec<u64> {
     let mut order: Vec<usize> = (0..list.len()).collect();
     order.sort_by_key(|&i| list[i] >> 32);
-    let mut out = vec![0u64; list.len()];
+    let mut out = vec![0_u64; list.len()];
     let mut previous: Option<(u64, usize)> = None;
     for i in order {
         let key = list[i] >> 32;

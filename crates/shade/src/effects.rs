@@ -34,9 +34,9 @@ impl Effect {
     #[must_use]
     pub fn resolvable_from(self, entries: Entries) -> bool {
         match self {
-            Effect::Transparency => true,
-            Effect::Translucency => entries != Entries::PrimOnly,
-            Effect::Fresnel => entries == Entries::KeyAndPrim,
+            Self::Transparency => true,
+            Self::Translucency => entries != Entries::PrimOnly,
+            Self::Fresnel => entries == Entries::KeyAndPrim,
         }
     }
 }
@@ -158,7 +158,7 @@ pub fn shade_pixel(
     };
     Some(match effect {
         Effect::Transparency => {
-            let (mut colour, mut transmittance) = ([0.0f32; 3], 1.0f32);
+            let (mut colour, mut transmittance) = ([0.0_f32; 3], 1.0_f32);
             for &entry in list {
                 let c = colour_of(entry);
                 for ch in 0..3 {
@@ -236,7 +236,7 @@ pub fn render_resolved<'a>(
     }
     let n = samples as usize;
     Some(shade_image(size, |p| {
-        let mut sum = [0.0f64; 3];
+        let mut sum = [0.0_f64; 3];
         for sample in p * n..(p + 1) * n {
             let colour = shade_pixel(effect, material, entries, sample, list(sample), geometry)
                 .expect("resolvable entries shade every sample");
@@ -257,7 +257,7 @@ pub fn shade_image(
     colour: impl Fn(usize) -> [f32; 3] + Sync,
 ) -> RgbImage {
     let row = width as usize * 3;
-    let mut bytes = vec![0u8; row * height as usize];
+    let mut bytes = vec![0_u8; row * height as usize];
     bytes
         .par_chunks_mut(row.max(1))
         .enumerate()
@@ -478,7 +478,7 @@ mod tests {
             geometry,
         )
         .unwrap();
-        let ft = 1.0 - 0.5f64.powi(5);
+        let ft = 1.0 - 0.5_f64.powi(5);
         for (got, base) in two.iter().zip(m.base) {
             assert!((f64::from(*got) - ft * ft * f64::from(base)).abs() < 1e-6);
         }

@@ -89,7 +89,7 @@ pub fn heat_map_with_bar(
         }
         // Ticks at 0, ¼, ½, ¾ and the top of the scale, as whole fragment counts.
         let mut last = None;
-        for i in 0..=4u32 {
+        for i in 0..=4_u32 {
             let value = (top * i).div_ceil(4);
             if last == Some(value) {
                 continue;

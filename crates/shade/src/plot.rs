@@ -171,7 +171,7 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let within = |mantissas: &[f64]| -> Vec<f64> {
         let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
         (first..=last)
-            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10_f64.powi(e)))
             .filter(|v| (lo..=hi).contains(v))
             .collect()
     };
@@ -296,7 +296,7 @@ fn render(path: &Path, size: (u32, u32), picture: &impl Paint) -> Result<(), Str
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"))
     {
-        let mut bytes = vec![0u8; size.0 as usize * size.1 as usize * 3];
+        let mut bytes = vec![0_u8; size.0 as usize * size.1 as usize * 3];
         {
             let root = BitMapBackend::with_buffer(&mut bytes, size).into_drawing_area();
             picture.paint(&root).map_err(|e| error(&e))?;

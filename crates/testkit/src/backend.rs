@@ -60,7 +60,7 @@ pub enum BackendError {
 impl std::fmt::Display for BackendError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            BackendError::Setup(m) | BackendError::Failed(m) => f.write_str(m),
+            Self::Setup(m) | Self::Failed(m) => f.write_str(m),
         }
     }
 }

@@ -52,10 +52,10 @@ impl fmt::Display for Property {
     /// The spelling in reports and JSON: `runs`, `equal`, `order-independent`, `overflow`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
-            Property::Runs => "runs",
-            Property::Equal => "equal",
-            Property::OrderIndependent => "order-independent",
-            Property::Overflow => "overflow",
+            Self::Runs => "runs",
+            Self::Equal => "equal",
+            Self::OrderIndependent => "order-independent",
+            Self::Overflow => "overflow",
         })
     }
 }
@@ -132,6 +132,21 @@ pub struct Battery<'b> {
     seed: u64,
     max_shrink_iters: u32,
     shard: (u32, u32),
+}
+
+// By hand: the backend is a trait object with no `Debug`; what the battery runs is the rest.
+impl std::fmt::Debug for Battery<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Battery")
+            .field("params", &self.params)
+            .field("claim", &self.claim)
+            .field("limits", &self.limits)
+            .field("cases", &self.cases)
+            .field("seed", &self.seed)
+            .field("max_shrink_iters", &self.max_shrink_iters)
+            .field("shard", &self.shard)
+            .finish_non_exhaustive()
+    }
 }
 
 /// How long proptest's shrinking may run the backend, as proptest's own default (2 minutes).
@@ -249,7 +264,7 @@ impl<'b> Battery<'b> {
                 self.backend.name()
             )));
         }
-        let mut seed = [0u8; 32];
+        let mut seed = [0_u8; 32];
         seed[..8].copy_from_slice(&self.seed.to_le_bytes());
         // proptest prints "Aborting shrinking after …" on stderr whenever it reaches its own
         // caps, whatever its verbosity: they are set out of reach, and the battery keeps its
@@ -271,10 +286,10 @@ impl<'b> Battery<'b> {
         let mut runner =
             TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
         let events = RefCell::new(on_event);
-        let (cases_run, shrink_steps) = (Cell::new(0u32), Cell::new(0u32));
+        let (cases_run, shrink_steps) = (Cell::new(0_u32), Cell::new(0_u32));
         let last_found = RefCell::new(None);
         let setup = RefCell::new(None);
-        let generated = Cell::new(0u32);
+        let generated = Cell::new(0_u32);
         let (shard, shards) = self.shard;
         let result = runner.run(&case(self.case_limits()).boxed(), |case| {
             // A backend that cannot run fails every case alike: stop at once, shrink nothing.
@@ -515,7 +530,7 @@ fn candidates(case: &Case, found: &Found, power_of_two: bool) -> Vec<Case> {
 
 /// One line on a differing verdict: pixels per verdict.
 fn describe(comparison: &Comparison, fragments: usize) -> String {
-    let mut per_verdict = [0u64; verdict::NAMES.len()];
+    let mut per_verdict = [0_u64; verdict::NAMES.len()];
     for &flags in &comparison.verdicts {
         for (i, (flag, _)) in verdict::NAMES.iter().enumerate() {
             per_verdict[i] += u64::from(flags & flag != 0);

@@ -146,10 +146,10 @@ impl Case {
     /// The same triangles submitted in another order: sorted by their order keys (ties keep
     /// submission order). Primitive ids follow the new order.
     #[must_use]
-    pub fn permuted(&self) -> Case {
+    pub fn permuted(&self) -> Self {
         let mut order: Vec<usize> = (0..self.triangles.len()).collect();
         order.sort_by_key(|&i| self.order_keys.get(i).copied().unwrap_or(0));
-        Case {
+        Self {
             triangles: order.iter().map(|&i| self.triangles[i]).collect(),
             ..self.clone()
         }
@@ -159,7 +159,7 @@ impl Case {
     /// own: the viewport shrunk, every corner moved by whole pixels, so each pixel of the
     /// rectangle keeps its fragments (coverage and depth move with the grid).
     #[must_use]
-    pub fn cropped(&self, x: u32, y: u32, width: u32, height: u32) -> Option<Case> {
+    pub fn cropped(&self, x: u32, y: u32, width: u32, height: u32) -> Option<Self> {
         let viewport = Viewport::new(width, height).ok()?;
         let (dx, dy) = (2 * i32::try_from(x).ok()?, 2 * i32::try_from(y).ok()?);
         let triangles = self
@@ -170,7 +170,7 @@ impl Case {
                 ..*t
             })
             .collect();
-        Some(Case {
+        Some(Self {
             viewport,
             triangles,
             ..self.clone()
@@ -179,7 +179,7 @@ impl Case {
 
     /// The case without triangle `index` (and its order key).
     #[must_use]
-    pub fn without(&self, index: usize) -> Case {
+    pub fn without(&self, index: usize) -> Self {
         let mut case = self.clone();
         case.triangles.remove(index);
         if index < case.order_keys.len() {
@@ -225,9 +225,9 @@ fn coordinate(max_side: u32, far_corners: bool) -> BoxedStrategy<i32> {
 /// occur), any value in `[0, 1]`, or beyond the near or far plane. Shrinks towards 0.
 fn depth() -> impl Strategy<Value = f32> {
     prop_oneof![
-        3 => select(vec![0.0f32, 0.25, 0.5, 0.75, 1.0]),
-        2 => 0.0f32..=1.0,
-        1 => select(vec![-0.5f32, 1.5]),
+        3 => select(vec![0.0_f32, 0.25, 0.5, 0.75, 1.0]),
+        2 => 0.0_f32..=1.0,
+        1 => select(vec![-0.5_f32, 1.5]),
     ]
 }
 
@@ -302,7 +302,7 @@ fn shape() -> impl Strategy<Value = Shape> {
     prop_oneof![
         3 => Just(Shape::Free),
         1 => Just(Shape::OnCentres),
-        2 => (0usize..3).prop_map(Shape::SharesEdge),
+        2 => (0_usize..3).prop_map(Shape::SharesEdge),
     ]
 }
 

@@ -178,7 +178,7 @@ fn a_vulkan_samples_linked_list_reads_as_fragsims() {
             null: 1,
             node_base: 1,
         };
-        let error = dump.in_layout(Some(colliding)).unwrap_err().0;
+        let error = dump.in_layout(Some(colliding)).unwrap_err().to_string();
         assert!(error.contains("\"null\" 1 is a node's number"), "{error}");
         // The same lists with u32 nodes of a unorm24 depth over an 8-bit id: the depths are the
         // unorm's, each within its quantum of the f32 depth.

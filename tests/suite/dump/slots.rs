@@ -58,7 +58,7 @@ fn every_slot_layout_in_either_order_and_payload_round_trips_and_compares_equal(
                     let ranges = matches!(scheme, DumpScheme::ABufferExact { .. });
                     if keys && payload.is_some() || ranges && order == SlotOrder::SlotMajor {
                         let field = if keys { "\"payload\"" } else { "\"order\"" };
-                        let error = encoded.unwrap_err().0;
+                        let error = encoded.unwrap_err().to_string();
                         assert!(error.contains(field), "{scheme:?} {layout:?}: {error}");
                         continue;
                     }
@@ -158,7 +158,7 @@ fn unorm_slot_payloads_hold_the_nearest_step_of_each_depth_and_ids_must_fit() {
                 prim_bits: 8,
             }),
         };
-        let error = own.in_layout(Some(narrow)).unwrap_err().0;
+        let error = own.in_layout(Some(narrow)).unwrap_err().to_string();
         assert!(
             error.contains("does not fit the payload's 8 \"prim_bits\""),
             "{error}"
@@ -238,11 +238,11 @@ fn refused(dump: &Dump, edit: impl FnOnce(&mut serde_json::Value)) -> String {
         files
             .get(file)
             .cloned()
-            .ok_or_else(|| DumpError(format!("no {file}")))
+            .ok_or_else(|| DumpError::Invalid(format!("no {file}")))
     });
     match parsed.and_then(|dump| dump.capture().map(|_| dump)) {
         Ok(_) => panic!("accepted: {header}"),
-        Err(error) => error.0,
+        Err(error) => error.to_string(),
     }
 }
 

@@ -16,17 +16,6 @@ fn kbuffer(view: &View<'_>, k: u32, write_back: WriteBack) -> KBuffer {
     KBuffer::with_write_back(view.viewport(), k, write_back, MEMORY_CAP_DEFAULT).unwrap()
 }
 
-/// Second and later copies of a value within one pixel's list, over every pixel.
-fn duplicates(capture: &Capture) -> usize {
-    (0..capture.pixels())
-        .map(|p| {
-            let mut list = capture.pixel(p).to_vec();
-            list.sort_unstable();
-            list.windows(2).filter(|w| w[0] == w[1]).count()
-        })
-        .sum()
-}
-
 /// Whether every pixel's list is strictly increasing (sorted, no duplicates) and made of that
 /// pixel's own fragments: what render-target write-backs always leave, hazards or not.
 fn sorted_distinct_and_genuine(capture: &Capture, oracle: &Oracle) -> bool {
@@ -270,7 +259,7 @@ fn on_the_bunny_render_targets_only_lose_and_separate_stores_also_tear() {
         for write_back in MACHINES {
             let run = run_scheduled(&view, &kbuffer(&view, k, write_back), &schedule, false).run;
             let diff = oracle.diff(&run.capture);
-            let dups = duplicates(&run.capture);
+            let dups = run.capture.duplicates();
             eprintln!("K = {k}, {write_back:?}: {diff:?}, duplicates {dups}");
             match write_back {
                 WriteBack::RenderTarget => {
@@ -283,7 +272,7 @@ fn on_the_bunny_render_targets_only_lose_and_separate_stores_also_tear() {
                     rt_lost += diff.lost;
                 }
                 WriteBack::SeparateStores => {
-                    stores_torn += dups as u64 + diff.misordered_pixels;
+                    stores_torn += dups + diff.misordered_pixels;
                 }
             }
         }

@@ -7,7 +7,7 @@ use std::time::Instant;
 use fragsim_raster::View;
 
 use super::{Geometry, Mode};
-use crate::device::{Gpu, GpuError};
+use crate::device::{Gpu, GpuError, TARGET_FORMAT};
 use crate::plant::Plant;
 use crate::shaders::{GpuScheme, Pass, Storage, COMMON, PIXEL_WORKGROUP};
 
@@ -76,11 +76,6 @@ struct Run<'a> {
     /// The lists: pixels times samples.
     lists: u64,
 }
-
-/// The format of the colour target the shaders never write (write mask empty): Vulkan draws
-/// need a render area, the schemes write storage buffers only. Multisampled for the counting pass
-/// and per-sample captures.
-pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
 impl<'a> Run<'a> {
     fn new(

@@ -11,32 +11,9 @@ use super::lists::{layer_major, linked_lists, ListArrays, Translated};
 use super::spec::LayoutSpec;
 use super::{err, Dtype, Dump, DumpError, Words};
 
-/// Pixel `p`'s first slot and slot count in fragsim's pixel-major slot array of an MDTS or
-/// A-buffer dump.
-pub(super) fn pixel_slots(scheme: &DumpScheme) -> impl Fn(usize) -> (usize, usize) + '_ {
-    let offsets: Vec<usize> = match scheme {
-        DumpScheme::ABufferExact { counts, .. } => std::iter::once(0)
-            .chain(counts.iter().scan(0usize, |sum, &c| {
-                *sum += c as usize;
-                Some(*sum)
-            }))
-            .collect(),
-        _ => Vec::new(),
-    };
-    move |p| match scheme {
-        DumpScheme::ABufferFixed {
-            capacity: slots, ..
-        }
-        | DumpScheme::Mdts { k: slots, .. }
-        | DumpScheme::KBuffer { k: slots, .. }
-        | DumpScheme::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
-        _ => (offsets[p], offsets[p + 1] - offsets[p]),
-    }
-}
-
 /// A-buffer lists as the GPU's sort kernel left them: `min(counter, capacity)` slots, unsorted.
 pub(super) fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture {
-    let at = pixel_slots(scheme);
+    let at = scheme.pixel_slots();
     let capacity = match scheme {
         DumpScheme::ABufferFixed { capacity, .. } => Capacity::PerPixel(*capacity),
         _ => Capacity::Unbounded,
@@ -66,7 +43,7 @@ pub(super) fn sort_abuffer_in_place(arrays: &mut BTreeMap<String, Words>, scheme
         Some(Words::U32(c)) => c.clone(),
         _ => return,
     };
-    let at = pixel_slots(scheme);
+    let at = scheme.pixel_slots();
     if let Some(Words::U64(slots)) = arrays.get_mut("slots") {
         for (p, &count) in counters.iter().enumerate() {
             let (first, capacity) = at(p);
@@ -90,7 +67,7 @@ impl Dump {
     pub(super) fn u32s_of(&self, name: &str, len: usize) -> Result<&[u32], DumpError> {
         let words = self
             .u32s(name)?
-            .ok_or_else(|| DumpError(format!("missing array {name:?}")))?;
+            .ok_or_else(|| DumpError::Invalid(format!("missing array {name:?}")))?;
         if words.len() == len {
             Ok(words)
         } else {

@@ -108,7 +108,7 @@ impl Header {
     /// # Errors
     /// A zero or oversized side.
     pub fn pixel_viewport(&self) -> Result<Viewport, DumpError> {
-        Viewport::new(self.width, self.height).map_err(DumpError)
+        Viewport::new(self.width, self.height).map_err(DumpError::Invalid)
     }
 
     /// Samples a pixel (`scene.conventions.samples`, 1 when absent).
@@ -116,7 +116,10 @@ impl Header {
     /// # Errors
     /// A count other than 1, 2, 4, 8 or 16, naming the field.
     pub fn samples(&self) -> Result<u32, DumpError> {
-        self.scene.conventions.pattern().map_err(DumpError)?;
+        self.scene
+            .conventions
+            .pattern()
+            .map_err(DumpError::Invalid)?;
         Ok(self.scene.conventions.samples)
     }
 
@@ -135,8 +138,8 @@ impl Header {
         scene: &SceneSpec,
         pixels: Viewport,
     ) -> Result<Viewport, DumpError> {
-        match scene.conventions.pattern().map_err(DumpError)? {
-            Some(pattern) => pattern.expand(pixels).map_err(DumpError),
+        match scene.conventions.pattern().map_err(DumpError::Invalid)? {
+            Some(pattern) => pattern.expand(pixels).map_err(DumpError::Invalid),
             None => Ok(pixels),
         }
     }
@@ -226,7 +229,7 @@ pub(super) fn elements(name: &str, shape: &[u64]) -> Result<u64, DumpError> {
         .iter()
         .try_fold(1u64, |n, &d| n.checked_mul(d))
         .ok_or_else(|| {
-            DumpError(format!(
+            DumpError::Invalid(format!(
                 "array {name:?}: shape {shape:?} has more than 2^64 elements"
             ))
         })

@@ -259,7 +259,9 @@ impl DumpScheme {
             DumpLayout::CountersAndSlots if entry.storage == Storage::Counted => {
                 Self::ABufferExact {
                     counts: counts
-                        .ok_or_else(|| DumpError(format!("{name} ran without its counting pass")))?
+                        .ok_or_else(|| {
+                            DumpError::Invalid(format!("{name} ran without its counting pass"))
+                        })?
                         .to_vec(),
                     sorted: false,
                 }
@@ -272,7 +274,7 @@ impl DumpScheme {
                 scheme: name,
                 k: sizes.k,
                 pool: u32::try_from(sizes.pool)
-                    .map_err(|_| DumpError(format!("{name}: a pool past 2^32 nodes")))?,
+                    .map_err(|_| DumpError::Invalid(format!("{name}: a pool past 2^32 nodes")))?,
                 spec: LayoutSpec::FRAGSIM_LISTS,
             },
             DumpLayout::LayerMajor => Self::LayerMajor {
@@ -435,9 +437,11 @@ impl DumpScheme {
                 // Each size defaults to 1, as a scheme that does not use it is built. A scheme
                 // holds at least one word per slot or layer, so a size past the dump's words is
                 // refused before the scheme is built (its storage would not fit a u64 count).
-                let words = header.arrays.iter().try_fold(0u64, |sum, (name, spec)| {
+                let words = header.arrays.iter().try_fold(0_u64, |sum, (name, spec)| {
                     sum.checked_add(super::header::elements(name, &spec.shape)?)
-                        .ok_or_else(|| DumpError("the arrays' elements overflow 64 bits".into()))
+                        .ok_or_else(|| {
+                            DumpError::Invalid("the arrays' elements overflow 64 bits".into())
+                        })
                 })?;
                 let size = |field: &str, value: Option<u32>| match value {
                     Some(0) => err(format!("{name} \"{field}\" must be at least 1")),
@@ -514,6 +518,29 @@ impl DumpScheme {
             ));
         }
         Ok(())
+    }
+
+    /// Pixel `p`'s first slot and slot count in fragsim's pixel-major slot array of an MDTS or
+    /// A-buffer dump.
+    pub(super) fn pixel_slots(&self) -> impl Fn(usize) -> (usize, usize) + '_ {
+        let offsets: Vec<usize> = match self {
+            Self::ABufferExact { counts, .. } => std::iter::once(0)
+                .chain(counts.iter().scan(0_usize, |sum, &c| {
+                    *sum += c as usize;
+                    Some(*sum)
+                }))
+                .collect(),
+            _ => Vec::new(),
+        };
+        move |p| match self {
+            Self::ABufferFixed {
+                capacity: slots, ..
+            }
+            | Self::Mdts { k: slots, .. }
+            | Self::KBuffer { k: slots, .. }
+            | Self::Mdts32 { k: slots } => (p * *slots as usize, *slots as usize),
+            _ => (offsets[p], offsets[p + 1] - offsets[p]),
+        }
     }
 }
 

@@ -55,7 +55,7 @@ pub(super) fn linked_lists(lists: &ListArrays<'_>) -> Translated {
     };
     out.words32[pixels] = lists.counter;
     let mut visited = vec![false; pool];
-    let mut reached = 0u64;
+    let mut reached = 0_u64;
     for (p, &head) in lists.heads.iter().enumerate() {
         // Where the link to the current node goes in fragsim's memory: the head, then the
         // previous node's `next`.
@@ -159,7 +159,7 @@ impl Dump {
         &self,
         payload: Payload,
         numbering: ListNumbering,
-    ) -> Result<Dump, DumpError> {
+    ) -> Result<Self, DumpError> {
         let ListNumbering { null, node_base } = numbering;
         let pool = self.header.pool.unwrap_or_default();
         let numbers = u64::from(node_base)..u64::from(node_base) + pool;
@@ -207,7 +207,7 @@ impl Dump {
     ///
     /// # Errors
     /// A primitive id that does not fit the payload.
-    pub(super) fn layers_as(&self, payload: Payload) -> Result<Dump, DumpError> {
+    pub(super) fn layers_as(&self, payload: Payload) -> Result<Self, DumpError> {
         let layers = self
             .widened("layers", Payload::FRAGMENT.dtype)?
             .into_iter()

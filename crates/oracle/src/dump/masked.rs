@@ -143,7 +143,7 @@ impl Dump {
         let nodes = self.widened("nodes", masked.dtype)?;
         let masks = self
             .u32s("masks")?
-            .ok_or_else(|| DumpError("missing array \"masks\"".into()))?;
+            .ok_or_else(|| DumpError::Invalid("missing array \"masks\"".into()))?;
         for (name, len) in [("nodes", nodes.len()), ("masks", masks.len())] {
             if len as u64 != slots {
                 return err(format!(
@@ -215,7 +215,7 @@ impl Dump {
         let stored_nodes = self.widened("nodes", masked.dtype)?;
         let stored_masks = self.u32s("masks")?.unwrap_or_default();
         let capacity = masked.capacity as usize;
-        let samples_mask = (1u64 << masked.samples) - 1;
+        let samples_mask = (1_u64 << masked.samples) - 1;
         let mut check = WordCheck {
             corrupt: vec![Vec::new(); counters.len()],
             ..WordCheck::default()
@@ -464,7 +464,9 @@ impl Dump {
         }
         let scheme = MaskedABuffer::new(pixels, samples, capacity, u64::MAX)?;
         let memory: SerialMemory = scheme.layout().allocate();
-        scheme.insert_all(view, &memory).map_err(DumpError)?;
+        scheme
+            .insert_all(view, &memory)
+            .map_err(DumpError::Invalid)?;
         let n = pixels.pixels();
         let u32s: Vec<u32> = (0..WordMemory::<u32>::len(&memory))
             .map(|i| WordMemory::<u32>::load(&memory, i))
@@ -507,7 +509,7 @@ impl Dump {
     ///
     /// # Errors
     /// A primitive id that does not fit the payload.
-    pub(super) fn masked_as(&self, spec: Option<LayoutSpec>) -> Result<Dump, DumpError> {
+    pub(super) fn masked_as(&self, spec: Option<LayoutSpec>) -> Result<Self, DumpError> {
         let masked = self.masked_checked()?;
         if self.header.layout.is_some() {
             return err("only fragsim's own encoding is re-encoded");

@@ -76,7 +76,7 @@ mod write;
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use fragsim_capture::CaptureError;
 #[cfg(doc)]
@@ -100,21 +100,29 @@ pub const VERSION: u32 = 1;
 pub const HEADER_FILE: &str = "dump.json";
 
 /// Why a dump or a triangle export could not be read, written or decoded.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct DumpError(pub String);
-
-impl fmt::Display for DumpError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for DumpError {}
-
-impl From<CaptureError> for DumpError {
-    fn from(e: CaptureError) -> Self {
-        Self(e.to_string())
-    }
+///
+/// Callers branch on the kind: a file that cannot be read or written ([`DumpError::Io`]: a
+/// path to fix) is not a dump that is wrong ([`DumpError::Invalid`]: the backend's bug, or a
+/// header to fix), and a scheme that cannot be built for the dump's sizes
+/// ([`DumpError::Capture`]) is neither. The messages name the file, field or array at fault.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DumpError {
+    /// A file could not be read, written or listed.
+    #[error("cannot {action} {}: {reason}", path.display())]
+    Io {
+        /// What was tried: `read`, `write`, `create`, ….
+        action: String,
+        /// The file or directory.
+        path: PathBuf,
+        /// What the system said.
+        reason: String,
+    },
+    /// The dump, its header or a triangle export contradicts the format, or the run it names.
+    #[error("{0}")]
+    Invalid(String),
+    /// The scheme the header names cannot be built at the header's sizes.
+    #[error(transparent)]
+    Capture(#[from] CaptureError),
 }
 
 impl From<SceneSpecError> for DumpError {
@@ -122,18 +130,22 @@ impl From<SceneSpecError> for DumpError {
     /// errors (the mesh file, the numbers) name their field already.
     fn from(e: SceneSpecError) -> Self {
         match e {
-            SceneSpecError::Scene(e) => Self(format!("scene: {e}")),
-            e => Self(e.to_string()),
+            SceneSpecError::Scene(e) => Self::Invalid(format!("scene: {e}")),
+            e => Self::Invalid(e.to_string()),
         }
     }
 }
 
 pub(crate) fn err<T>(message: impl Into<String>) -> Result<T, DumpError> {
-    Err(DumpError(message.into()))
+    Err(DumpError::Invalid(message.into()))
 }
 
-pub(crate) fn io_err(what: &str, path: &Path, e: impl fmt::Display) -> DumpError {
-    DumpError(format!("cannot {what} {}: {e}", path.display()))
+pub(crate) fn io_err(action: &str, path: &Path, reason: impl fmt::Display) -> DumpError {
+    DumpError::Io {
+        action: action.into(),
+        path: path.to_path_buf(),
+        reason: reason.to_string(),
+    }
 }
 
 /// A dump: the header and the arrays it names.

@@ -100,7 +100,7 @@ impl Dump {
         mut read_file: impl FnMut(&str) -> Result<Vec<u8>, DumpError>,
     ) -> Result<Self, DumpError> {
         let header: Header = serde_json::from_slice(header_bytes)
-            .map_err(|e| DumpError(format!("{header_name}: {e}")))?;
+            .map_err(|e| DumpError::Invalid(format!("{header_name}: {e}")))?;
         if header.format != FORMAT {
             return err(format!(
                 "{header_name}: format {:?}, expected {FORMAT:?}",
@@ -245,6 +245,6 @@ fn required<'a, W>(
 ) -> Result<&'a [W], DumpError> {
     match name {
         None => Ok(&[]),
-        Some(n) => found?.ok_or_else(|| DumpError(format!("missing array {n:?}"))),
+        Some(n) => found?.ok_or_else(|| DumpError::Invalid(format!("missing array {n:?}"))),
     }
 }

@@ -25,7 +25,7 @@ impl Dump {
                 continue; // Decoding names a missing array.
             };
             let wanted: Vec<u64> = dims.iter().map(|d| d.size).collect();
-            let words = |shape: &[u64]| shape.iter().try_fold(1u64, |n, &d| n.checked_mul(d));
+            let words = |shape: &[u64]| shape.iter().try_fold(1_u64, |n, &d| n.checked_mul(d));
             if words(&spec.shape) == words(&wanted) {
                 continue;
             }

@@ -10,7 +10,6 @@
 //! index is taken, so a header cannot make the reader index past it or allocate more than it
 //! holds.
 
-use super::arrays::pixel_slots;
 use super::spec::{LayoutSpec, Payload, SlotOrder};
 use super::word_check::WordCheck;
 use super::{err, Dtype, Dump, DumpError, DumpScheme, Words};
@@ -176,7 +175,7 @@ impl Dump {
             .arrays
             .get("slots")
             .map(Words::len)
-            .ok_or_else(|| DumpError("missing array \"slots\"".into()))?;
+            .ok_or_else(|| DumpError::Invalid("missing array \"slots\"".into()))?;
         if len as u64 == total {
             Ok(())
         } else {
@@ -192,7 +191,7 @@ impl Dump {
     /// # Errors
     /// A `slots` array of the wrong dtype (the payload's, or the scheme's own without one) or
     /// of other than the scheme's slot count.
-    pub(super) fn own_slots(&self, scheme: &DumpScheme) -> Result<Option<Dump>, DumpError> {
+    pub(super) fn own_slots(&self, scheme: &DumpScheme) -> Result<Option<Self>, DumpError> {
         let Some((placement, codec, total)) = self.slot_layout(scheme)? else {
             return Ok(None);
         };
@@ -222,7 +221,7 @@ impl Dump {
             "slots",
             codec.payload.map_or(own_dtype(scheme), |p| p.dtype),
         )?;
-        let first_slot = pixel_slots(scheme);
+        let first_slot = scheme.pixel_slots();
         for word in check.corrupt.iter_mut().flatten() {
             // Every corrupt word of a slot layout is a slot word (counters are judged apart).
             if let Some(&at) = stored.get(placement.stored(first_slot(word.pixel).0 + word.slot)) {
@@ -242,7 +241,7 @@ impl Dump {
         scheme: &DumpScheme,
         order: SlotOrder,
         payload: Option<Payload>,
-    ) -> Result<Dump, DumpError> {
+    ) -> Result<Self, DumpError> {
         let own = self.widened("slots", own_dtype(scheme))?;
         let codec = SlotCodec::new(scheme, payload);
         let placement = Placement {

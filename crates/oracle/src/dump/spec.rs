@@ -126,7 +126,7 @@ pub(super) const LARGEST_KEY: u32 = 0x3F80_0000;
 
 impl Payload {
     /// fragsim's own fragment word: u64 `depth_key << 32 | prim`.
-    pub const FRAGMENT: Payload = Payload {
+    pub const FRAGMENT: Self = Self {
         dtype: Dtype::U64,
         depth: DepthFormat::F32,
         depth_shift: 32,
@@ -278,14 +278,14 @@ impl LayoutSpec {
     }
 
     /// fragsim's own linked lists: node 0 ends a list, nodes numbered from 1.
-    pub const FRAGSIM_LISTS: LayoutSpec = LayoutSpec::LinkedList {
+    pub const FRAGSIM_LISTS: Self = Self::LinkedList {
         payload: Payload::FRAGMENT,
         null: 0,
         node_base: 1,
     };
 
     /// fragsim's own layer-major layers.
-    pub const FRAGSIM_LAYERS: LayoutSpec = LayoutSpec::LayerMajor {
+    pub const FRAGSIM_LAYERS: Self = Self::LayerMajor {
         payload: Payload::FRAGMENT,
     };
 
@@ -338,7 +338,7 @@ mod tests {
         };
         unorm24.check().unwrap();
         let (word, possible) = unorm24.fragment(0xFF_FFFF << 8 | 0x2A);
-        assert_eq!(word, u64::from(1.0f32.to_bits()) << 32 | 0x2A);
+        assert_eq!(word, u64::from(1.0_f32.to_bits()) << 32 | 0x2A);
         assert!(possible);
         let half = unorm24.fragment(0x80_0000 << 8).0;
         assert_eq!(
@@ -349,14 +349,14 @@ mod tests {
 
     #[test]
     fn packing_inverts_decoding_for_f32_depths_and_rounds_unorm_ones_to_the_nearest_step() {
-        let word = u64::from(0.75f32.to_bits()) << 32 | 0x12_3456;
+        let word = u64::from(0.75_f32.to_bits()) << 32 | 0x12_3456;
         let over_24 = Payload {
             depth_shift: 24,
             prim_bits: 24,
             ..Payload::FRAGMENT
         };
         let packed = over_24.pack(word).unwrap();
-        assert_eq!(packed, u64::from(0.75f32.to_bits()) << 24 | 0x12_3456);
+        assert_eq!(packed, u64::from(0.75_f32.to_bits()) << 24 | 0x12_3456);
         assert_eq!(over_24.fragment(packed).0, word);
         let unorm16 = Payload {
             depth: DepthFormat::Unorm16,
@@ -375,7 +375,7 @@ mod tests {
         assert!(narrow
             .pack(word)
             .unwrap_err()
-            .0
+            .to_string()
             .contains("1193046 does not fit"));
     }
 
@@ -395,7 +395,7 @@ mod tests {
         assert!(past
             .check()
             .unwrap_err()
-            .0
+            .to_string()
             .contains("does not fit a 32-bit word"));
     }
 }

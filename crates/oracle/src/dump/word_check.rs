@@ -5,7 +5,6 @@
 use fragsim_capture::schemes::mdts::Direction;
 use serde::Serialize;
 
-use super::arrays::pixel_slots;
 use super::layouts::DumpScheme;
 use super::spec::LARGEST_KEY;
 use super::{Dump, DumpError};
@@ -147,7 +146,7 @@ impl Dump {
             corrupt: vec![Vec::new(); pixels],
             ..WordCheck::default()
         };
-        let missing = |n: &str| DumpError(format!("missing array {n:?}"));
+        let missing = |n: &str| DumpError::Invalid(format!("missing array {n:?}"));
         match &scheme {
             DumpScheme::Mdts { k, .. } | DumpScheme::KBuffer { k, .. } => {
                 let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
@@ -173,7 +172,7 @@ impl Dump {
             DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. } => {
                 let counters = self.u32s("counters")?.ok_or_else(|| missing("counters"))?;
                 let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
-                let at = pixel_slots(&scheme);
+                let at = scheme.pixel_slots();
                 let mut all = Vec::with_capacity(pixels);
                 for (p, &count) in counters.iter().enumerate() {
                     let (first, capacity) = at(p);

@@ -172,7 +172,7 @@ impl Dump {
                     DumpScheme::ABufferExact { counts, sorted: s } => {
                         sorted = *s;
                         let mut offsets = Vec::with_capacity(counts.len() + 1);
-                        offsets.push(0u32);
+                        offsets.push(0_u32);
                         for &c in counts {
                             offsets.push(offsets[offsets.len() - 1] + c);
                         }
@@ -238,7 +238,7 @@ impl Dump {
     /// A dump in another encoding than fragsim's, a description its scheme cannot have (the
     /// reader's own checks), a primitive id that does not fit the payload, or a list numbering
     /// whose terminator is a node's number.
-    pub fn in_layout(&self, spec: Option<LayoutSpec>) -> Result<Dump, DumpError> {
+    pub fn in_layout(&self, spec: Option<LayoutSpec>) -> Result<Self, DumpError> {
         if self.is_masked() {
             return self.masked_as(spec);
         }
@@ -291,16 +291,15 @@ impl Dump {
         let mut files = BTreeMap::new();
         for (name, spec) in &self.header.arrays {
             check_file_name(name, &spec.file)?;
-            let words = self
-                .arrays
-                .get(name)
-                .ok_or_else(|| DumpError(format!("the header names array {name:?}, absent")))?;
+            let words = self.arrays.get(name).ok_or_else(|| {
+                DumpError::Invalid(format!("the header names array {name:?}, absent"))
+            })?;
             check_array(name, spec, words.dtype(), words.len() as u64)?;
             files.insert(spec.file.clone(), words.to_le_bytes());
         }
         self.header.scene.check_finite()?;
         let text = serde_json::to_string_pretty(&self.header)
-            .map_err(|e| DumpError(format!("cannot encode the header: {e}")))?;
+            .map_err(|e| DumpError::Invalid(format!("cannot encode the header: {e}")))?;
         Ok((text + "\n", files))
     }
 

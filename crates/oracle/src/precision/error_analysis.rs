@@ -73,8 +73,8 @@ pub(super) fn vertex_bound(
     // The reference's unsnapped position, exactly as its snap computes it.
     let (wf, hf) = (f64::from(viewport.width), f64::from(viewport.height));
     let exact = [(nx * 0.5 + 0.5) * wf, (0.5 - ny * 0.5) * hf];
-    let grid = 1i64 << (SUBPIXEL_BITS - conventions.subpixel_bits.min(SUBPIXEL_BITS));
-    let one = f64::from(1u32 << SUBPIXEL_BITS);
+    let grid = 1_i64 << (SUBPIXEL_BITS - conventions.subpixel_bits.min(SUBPIXEL_BITS));
+    let one = f64::from(1_u32 << SUBPIXEL_BITS);
     let mut radius = 0;
     let mut reach = [[0; 2]; 2];
     for (axis, error) in [error_x, error_y].into_iter().enumerate() {
@@ -108,7 +108,7 @@ fn half_ulp(x: f64) -> f64 {
         return f64::from(f32::from_bits(1)) / 2.0;
     }
     let exponent = ((x.to_bits() >> 52) & 0x7ff) as i32 - 1023;
-    2f64.powi(exponent - 24)
+    2_f64.powi(exponent - 24)
 }
 
 /// A bound on the error of an f32 dot product `Σ p_j` of four exact products `p_j = M_rj·v_j`
@@ -126,7 +126,7 @@ pub(super) fn dot_error(p: [f64; 4]) -> f64 {
             .fold((0.0, 0.0), |(s, m), j| (s + p[j], m + p[j].abs()));
         half_ulp(sum.abs() + gamma(4.0, U32) * magnitude)
     };
-    let pairs = (0u32..16).filter(|s| s.count_ones() == 2);
+    let pairs = (0_u32..16).filter(|s| s.count_ones() == 2);
     let worst_tree = pairs
         .flat_map(|pair| {
             // A pair, then a triple holding it; or the pair and the other pair.
@@ -148,7 +148,7 @@ pub(super) fn dot_error(p: [f64; 4]) -> f64 {
 /// that may reach a half step gives both neighbours, one whose interval holds none gives one.
 pub(super) fn snap_reach(x: f64, error: f64, bits: u32) -> [i64; 2] {
     let bits = bits.min(SUBPIXEL_BITS);
-    let (scale, grid) = (f64::from(1u32 << bits), 1i64 << (SUBPIXEL_BITS - bits));
+    let (scale, grid) = (f64::from(1_u32 << bits), 1_i64 << (SUBPIXEL_BITS - bits));
     [
         ((x - error) * scale - 0.5).ceil() as i64 * grid,
         ((x + error) * scale + 0.5).floor() as i64 * grid,

@@ -257,7 +257,7 @@ impl Precision {
         let mut order: Vec<usize> = (0..found.len()).collect();
         order.sort_by_key(|&i| found[i].0);
         let pixels = view.viewport().pixels();
-        let mut offsets = vec![0usize; pixels + 1];
+        let mut offsets = vec![0_usize; pixels + 1];
         for &(p, _) in &found {
             offsets[p as usize + 1] += 1;
         }

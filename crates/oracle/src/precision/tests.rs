@@ -143,7 +143,7 @@ fn every_reachable_fragment_is_listed_and_certain_pairs_are_always_covered() {
                         .zip(&verts)
                         .map(|(d, v)| [v.snapped[0] + d[0], v.snapped[1] + d[1]])
                         .collect();
-                    for signs in 0..8u32 {
+                    for signs in 0..8_u32 {
                         let z = [0, 1, 2].map(|k| {
                             let s = if signs >> k & 1 == 1 { 1.0 } else { -1.0 };
                             verts[k].depth + s * verts[k].depth_error
@@ -306,8 +306,8 @@ fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interva
         let mut escaped = 0;
         for &(pixel, q) in found.iter().filter(|(_, q)| q.reference.is_some()) {
             let (x, y) = ((pixel % 400) as f32, (pixel / 400) as f32);
-            for moves in 0..3u32.pow(7) {
-                let step = |i: u32| f64::from((moves / 3u32.pow(i)) % 3) - 1.0;
+            for moves in 0..3_u32.pow(7) {
+                let step = |i: u32| f64::from((moves / 3_u32.pow(i)) % 3) - 1.0;
                 let xy = [0, 1, 2].map(|k| {
                     let (cx, cy, _) = corners[k];
                     [0, 1].map(|a| {
@@ -543,17 +543,17 @@ fn the_dot_product_bound_holds_every_evaluation_order_and_beats_the_standard_one
     // Engine-like f32 rows and positions (a bunny-sized mesh through an orbit camera's matrix),
     // from a fixed linear congruential sequence; each row's dot product computed in f32 in
     // several orders, with and without fused multiply-adds, against the exact f64 one.
-    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
     let mut next = |scale: f32| {
         state = state
             .wrapping_mul(6_364_136_223_846_793_005)
             .wrapping_add(1_442_695_040_888_963_407);
-        ((state >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 2.0 * scale
+        ((state >> 40) as f32 / (1_u64 << 24) as f32 - 0.5) * 2.0 * scale
     };
-    let (mut loosest, mut tighter, mut cases) = (0.0f64, 0, 0);
+    let (mut loosest, mut tighter, mut cases) = (0.0_f64, 0, 0);
     for _ in 0..20_000 {
         let m = [next(3.0), next(3.0), next(3.0), next(1.0)];
-        let v = [next(0.1), next(0.1), next(0.1), 1.0f32];
+        let v = [next(0.1), next(0.1), next(0.1), 1.0_f32];
         let products = [0, 1, 2, 3].map(|j| f64::from(m[j]) * f64::from(v[j]));
         let exact: f64 = products.iter().sum();
         let q = [0, 1, 2, 3].map(|j| m[j] * v[j]);

@@ -22,7 +22,7 @@ pub(super) fn reachable_points(b: &VertexBound) -> usize {
 /// Every snapped triangle an implementation may rasterize for `v`: each vertex at any grid
 /// point it may reach; `None` when there are more than [`MAX_COMBINATIONS`].
 pub(super) fn combinations(v: &[VertexBound; 3]) -> Option<Vec<[[i64; 2]; 3]>> {
-    let total = v.iter().try_fold(1usize, |n, b| {
+    let total = v.iter().try_fold(1_usize, |n, b| {
         n.checked_mul(axis_points(b, 0))?
             .checked_mul(axis_points(b, 1))
     });
@@ -117,7 +117,7 @@ pub(super) fn triangle(
         radius,
     };
     let grow = v.iter().map(|x| x.radius).max().unwrap_or(0);
-    let one = 1i64 << SUBPIXEL_BITS;
+    let one = 1_i64 << SUBPIXEL_BITS;
     let Target { pixels, pattern } = target;
     let lo = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).min().unwrap_or(0) - grow);
     let hi = [0, 1].map(|k| v.iter().map(|x| x.snapped[k]).max().unwrap_or(0) + grow);
@@ -155,7 +155,7 @@ pub(super) fn triangle(
         let covered = area > 0 && (0..3).all(passes);
         planes.clear();
         planes.push(unsnapped);
-        let mut covering = 0u64;
+        let mut covering = 0_u64;
         let mut on_edge = e.contains(&0) && e.iter().all(|&v| v >= 0);
         let (certain, possible) = match &reachable {
             // The reference's own triangle is one of them: `certain` implies `covered`.

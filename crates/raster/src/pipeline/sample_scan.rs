@@ -11,7 +11,7 @@
 //! Fragments index the sample-expanded framebuffer ([`crate::samples`]): sample `s` of pixel
 //! `(x, y)` is column `x * n + s`. A rectangle given to the scan (a tile) is in those columns.
 
-use super::scan::{bounding_box, edge, fill_thresholds, fragment_at};
+use super::edges::{bounding_box, edge, fill_thresholds, fragment_at};
 use super::{PixelRect, ScreenTriangle, View, Viewport, ONE};
 use crate::fragment::Fragment;
 use crate::samples::SamplePattern;

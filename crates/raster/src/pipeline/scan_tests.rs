@@ -23,7 +23,7 @@ fn under_each_window_origin() -> impl Iterator<Item = (WindowOrigin, Conventions
 /// in each row, rows top to bottom. The scan that visits only covered centres must emit exactly
 /// these fragments in this order.
 fn scan_every_centre(view: &View<'_>, tri: &ScreenTriangle, rect: PixelRect) -> Vec<Fragment> {
-    use super::scan::{fill_thresholds, fragment_at};
+    use super::edges::{fill_thresholds, fragment_at};
     let mut fragments = Vec::new();
     let [a, b, c] = tri.xy;
     let [lo, hi] = bounding_box(tri.xy);
@@ -162,8 +162,8 @@ fn a_box_of_one_centre_on_an_edge_is_decided_by_the_fill_rule() {
 /// orientations, under both fill rules, on the viewport and on rectangles that cut the box.
 #[test]
 fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
-    use super::scan::BLOCK_SIDE;
     use super::setup::ScanSetup;
+    use super::setup::BLOCK_SIDE;
     let mut rng = crate::rng::SplitMix64::new(35);
     let viewport = Viewport::new(32, 28).unwrap();
     let mesh = Mesh {

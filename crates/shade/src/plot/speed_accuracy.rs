@@ -86,7 +86,7 @@ impl Paint for SpeedAccuracy<'_> {
         let top = rates.clone().fold(0.0, f64::max).max(1e-3) * 2.0;
         let least = rates.filter(|&r| r > 0.0).fold(f64::INFINITY, f64::min);
         let floor = if least.is_finite() {
-            10f64.powf(least.log10().floor() - 1.0)
+            10_f64.powf(least.log10().floor() - 1.0)
         } else {
             1e-3
         };

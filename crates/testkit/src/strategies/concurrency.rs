@@ -40,14 +40,14 @@ pub fn policy() -> impl Strategy<Value = Policy> {
     prop_oneof![
         Just(Policy::Random),
         Just(Policy::Warps),
-        (1u32..=3).prop_map(|depth| Policy::Pct { depth }),
+        (1_u32..=3).prop_map(|depth| Policy::Pct { depth }),
     ]
 }
 
 /// A [`Concurrency`]: task sizes 1 to 8, and a [`schedule`]. Shrinks towards one triangle a task
 /// and two fragments in flight under the random policy.
 pub fn concurrency() -> impl Strategy<Value = Concurrency> {
-    (1usize..=8, schedule()).prop_map(|(task_size, schedule)| Concurrency {
+    (1_usize..=8, schedule()).prop_map(|(task_size, schedule)| Concurrency {
         task_size,
         schedule,
     })
@@ -59,7 +59,7 @@ pub fn concurrency() -> impl Strategy<Value = Concurrency> {
 pub fn schedule() -> impl Strategy<Value = Schedule> {
     (
         policy(),
-        2usize..=64,
+        2_usize..=64,
         prop_oneof![Just(Granularity::Fragment), Just(Granularity::Triangle)],
         any::<u64>(),
     )

@@ -11,10 +11,10 @@ const ONE_BITS: u32 = 0x3F80_0000;
 /// the smallest normal, 0.5, the largest float below 1, 1.0).
 pub fn unit_depth() -> impl Strategy<Value = f32> {
     prop_oneof![
-        2 => (0u32..=ONE_BITS).prop_map(f32::from_bits),
-        2 => 0.0f32..=1.0,
+        2 => (0_u32..=ONE_BITS).prop_map(f32::from_bits),
+        2 => 0.0_f32..=1.0,
         1 => select(vec![
-            0.0f32,
+            0.0_f32,
             -0.0,
             f32::from_bits(1),
             f32::MIN_POSITIVE,
@@ -29,7 +29,7 @@ pub fn unit_depth() -> impl Strategy<Value = f32> {
 pub fn unit_depth_pair() -> impl Strategy<Value = (f32, f32)> {
     prop_oneof![
         (unit_depth(), unit_depth()),
-        (0u32..ONE_BITS, 1u32..=4).prop_map(|(bits, ulps)| (
+        (0_u32..ONE_BITS, 1_u32..=4).prop_map(|(bits, ulps)| (
             f32::from_bits(bits),
             f32::from_bits((bits + ulps).min(ONE_BITS))
         )),

@@ -39,17 +39,17 @@ impl KChoice {
 pub fn k_choice() -> impl Strategy<Value = KChoice> {
     prop_oneof![
         1 => Just(KChoice::One),
-        3 => (0.0f64..1.0).prop_map(KChoice::Fraction),
+        3 => (0.0_f64..1.0).prop_map(KChoice::Fraction),
         2 => Just(KChoice::Max),
-        1 => (1u32..=3).prop_map(KChoice::AboveMax),
-        1 => (1u32..=8).prop_map(KChoice::Absolute),
+        1 => (1_u32..=3).prop_map(KChoice::AboveMax),
+        1 => (1_u32..=8).prop_map(KChoice::Absolute),
     ]
 }
 
 /// A [`KChoice`] for a small fixed capacity: 1 to 4 slots, or a fraction of the maximum.
 pub fn small_capacity() -> impl Strategy<Value = KChoice> {
     prop_oneof![
-        2 => (1u32..=4).prop_map(KChoice::Absolute),
-        1 => (0.0f64..1.0).prop_map(KChoice::Fraction),
+        2 => (1_u32..=4).prop_map(KChoice::Absolute),
+        1 => (0.0_f64..1.0).prop_map(KChoice::Fraction),
     ]
 }

@@ -17,11 +17,11 @@ use proptest::sample::select;
 /// shared diagonals, equal depths across a quad when seen face-on).
 pub fn procedural_scene_name() -> impl Strategy<Value = String> {
     prop_oneof![
-        3 => (1u32..=6).prop_map(|n| format!("spheres:{n}")),
-        3 => (1u32..=200, any::<u64>()).prop_map(|(count, seed)| format!("soup:{count}:{seed}")),
-        1 => (1025u32..=2500, any::<u64>())
+        3 => (1_u32..=6).prop_map(|n| format!("spheres:{n}")),
+        3 => (1_u32..=200, any::<u64>()).prop_map(|(count, seed)| format!("soup:{count}:{seed}")),
+        1 => (1025_u32..=2500, any::<u64>())
             .prop_map(|(count, seed)| format!("soup:{count}:{seed}")),
-        2 => (1u32..=16).prop_map(|n| format!("quads:{n}")),
+        2 => (1_u32..=16).prop_map(|n| format!("quads:{n}")),
     ]
 }
 
@@ -67,8 +67,8 @@ pub fn scene_spec() -> impl Strategy<Value = SceneSpec> {
 /// that vertices, edges and planes coincide.
 pub fn coordinate() -> impl Strategy<Value = f32> {
     prop_oneof![
-        3 => -1.0f32..=1.0,
-        1 => (-4i32..=4).prop_map(|k| k as f32 / 4.0),
+        3 => -1.0_f32..=1.0,
+        1 => (-4_i32..=4).prop_map(|k| k as f32 / 4.0),
     ]
 }
 
@@ -110,13 +110,13 @@ enum Piece {
 
 /// A tiny offset: exactly zero, or a random vector scaled by `1e-7`, `1e-5` or `1e-3`.
 fn tiny_offset() -> impl Strategy<Value = [f32; 3]> {
-    (select(vec![0.0f32, 1e-7, 1e-5, 1e-3]), point()).prop_map(|(s, p)| p.map(|c| c * s))
+    (select(vec![0.0_f32, 1e-7, 1e-5, 1e-3]), point()).prop_map(|(s, p)| p.map(|c| c * s))
 }
 
 fn piece() -> impl Strategy<Value = Piece> {
     prop_oneof![
         4 => [point(), point(), point()].prop_map(Piece::Free),
-        1 => (point(), point(), 0.0f32..=1.0, tiny_offset())
+        1 => (point(), point(), 0.0_f32..=1.0, tiny_offset())
             .prop_map(|(a, b, t, offset)| Piece::Sliver { a, b, t, offset }),
         1 => (point(), point()).prop_map(|(a, b)| Piece::Collapsed { a, b }),
         2 => (any::<usize>(), any::<bool>(), any::<bool>())
@@ -185,8 +185,8 @@ pub fn random_mesh(max_triangles: usize) -> impl Strategy<Value = Mesh> {
 pub fn random_mesh_in_box(max_triangles: usize) -> impl Strategy<Value = Mesh> {
     (
         random_mesh(max_triangles),
-        select(vec![0.01f32, 1.0, 100.0, 3000.0]),
-        [-10.0f32..10.0, -10.0f32..10.0, -10.0f32..10.0],
+        select(vec![0.01_f32, 1.0, 100.0, 3000.0]),
+        [-10.0_f32..10.0, -10.0_f32..10.0, -10.0_f32..10.0],
     )
         .prop_map(|(mut mesh, scale, offset)| {
             for p in &mut mesh.positions {
@@ -205,7 +205,7 @@ pub fn random_mesh_in_box(max_triangles: usize) -> impl Strategy<Value = Mesh> {
 /// An icosphere of radius 1: the icosahedron subdivided `level` times (20 · 4^level triangles),
 /// vertices shared, closed.
 pub fn icosphere(level: u32) -> Mesh {
-    let t = (1.0 + 5.0f64.sqrt()) / 2.0;
+    let t = (1.0 + 5.0_f64.sqrt()) / 2.0;
     let mut points: Vec<[f64; 3]> = vec![
         [-1.0, t, 0.0],
         [1.0, t, 0.0],
@@ -284,14 +284,14 @@ pub fn lattice_cube(n: u32, diagonals: &[bool]) -> Mesh {
             mesh.positions.len() as u32 - 1
         })
     };
-    let mut quad = 0usize;
+    let mut quad = 0_usize;
     for axis in 0..3 {
         for side in [0, n] {
             let (u_axis, v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
             for u in 0..n {
                 for v in 0..n {
                     let corner = |du: u32, dv: u32| {
-                        let mut lattice = [0u32; 3];
+                        let mut lattice = [0_u32; 3];
                         lattice[axis] = side;
                         lattice[u_axis] = u + du;
                         lattice[v_axis] = v + dv;
@@ -338,15 +338,15 @@ pub fn is_closed(mesh: &Mesh) -> bool {
 /// triangles, still closed). See [`is_closed`].
 pub fn closed_mesh() -> impl Strategy<Value = Mesh> {
     prop_oneof![
-        (0u32..=2).prop_map(icosphere),
-        (1u32..=3, vec(any::<bool>(), 54)).prop_map(|(n, d)| lattice_cube(n, &d)),
+        (0_u32..=2).prop_map(icosphere),
+        (1_u32..=3, vec(any::<bool>(), 54)).prop_map(|(n, d)| lattice_cube(n, &d)),
     ]
     .prop_flat_map(|mesh| {
         let n = mesh.positions.len();
-        let offset = [-1.0f32..=1.0, -1.0f32..=1.0, -1.0f32..=1.0];
+        let offset = [-1.0_f32..=1.0, -1.0_f32..=1.0, -1.0_f32..=1.0];
         (
             Just(mesh),
-            0.0f32..0.6,
+            0.0_f32..0.6,
             vec(offset, n),
             vec((0..n, 0..n), 0..=3),
         )

@@ -52,13 +52,13 @@ pub fn quantize() -> impl Strategy<Value = Quantize> {
 /// The snapped fixed-point window x (1/256 pixel) of NDC `x` through the identity camera: the
 /// pipeline's rule 4 (`docs/semantics.md`), restated.
 pub fn snap_ndc_x(x: f32, width: u32) -> i64 {
-    let one = f64::from(1u32 << SUBPIXEL_BITS);
+    let one = f64::from(1_u32 << SUBPIXEL_BITS);
     ((f64::from(x) / 1.0 * 0.5 + 0.5) * f64::from(width) * one).round() as i64
 }
 
 /// The snapped fixed-point window y (1/256 pixel, down) of NDC `y` through the identity camera.
 pub fn snap_ndc_y(y: f32, height: u32) -> i64 {
-    let one = f64::from(1u32 << SUBPIXEL_BITS);
+    let one = f64::from(1_u32 << SUBPIXEL_BITS);
     ((0.5 - f64::from(y) / 1.0 * 0.5) * f64::from(height) * one).round() as i64
 }
 
@@ -97,7 +97,7 @@ impl PlanarTiling {
             snap_ndc_y(y1, viewport.height),
             snap_ndc_y(y0, viewport.height),
         );
-        let one = 1i64 << SUBPIXEL_BITS;
+        let one = 1_i64 << SUBPIXEL_BITS;
         let mut expected = Vec::with_capacity(viewport.pixels());
         for j in 0..i64::from(viewport.height) {
             for i in 0..i64::from(viewport.width) {
@@ -178,7 +178,7 @@ impl DepthPlane {
 /// clipped there, and the dyadic coefficients with dyadic vertices (see [`Quantize::Dyadic`])
 /// make clipped vertices fall on exact halves of the fixed-point grid.
 pub fn depth_plane() -> impl Strategy<Value = DepthPlane> {
-    (-64i32..=64, -64i32..=64, -32i32..=48).prop_map(|(a, b, c)| DepthPlane {
+    (-64_i32..=64, -64_i32..=64, -32_i32..=48).prop_map(|(a, b, c)| DepthPlane {
         a: f64::from(a) / 64.0,
         b: f64::from(b) / 64.0,
         c: f64::from(c) / 64.0,
@@ -214,8 +214,8 @@ pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
     (
         window_interval(w),
         window_interval(h),
-        1usize..=6,
-        1usize..=6,
+        1_usize..=6,
+        1_usize..=6,
     )
         .prop_flat_map(|(bx, by, nx, ny)| {
             let vertices = (nx + 1) * (ny + 1);
@@ -226,7 +226,7 @@ pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
                     vertices,
                 ),
                 vec(any::<bool>(), nx * ny),
-                vec(0.1f32..0.9, vertices),
+                vec(0.1_f32..0.9, vertices),
             )
         })
         .prop_map(
@@ -288,10 +288,10 @@ pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
 /// maybe on pixel centres or corners, maybe coincident: zero-area triangles).
 pub fn fan(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
     let (w, h) = (viewport.width, viewport.height);
-    let side_points = || vec((0.0f64..=1.0, quantize()), 0..=4);
+    let side_points = || vec((0.0_f64..=1.0, quantize()), 0..=4);
     let fraction = || {
         prop_oneof![
-            3 => 0.001f64..0.999,
+            3 => 0.001_f64..0.999,
             1 => select(vec![1e-4, 1.0 - 1e-4, 0.5]),
         ]
     };
@@ -300,7 +300,7 @@ pub fn fan(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
         window_interval(h),
         [side_points(), side_points(), side_points(), side_points()],
         (fraction(), fraction(), quantize()),
-        vec(0.1f32..0.9, 21),
+        vec(0.1_f32..0.9, 21),
     )
         .prop_map(move |((x_lo, x_hi), (y_lo, y_hi), sides, (u, v, q), z)| {
             let rect = [
@@ -398,13 +398,13 @@ pub struct Hinge {
 /// With a viewport side that is not a power of two such coordinates put the clipped vertex of
 /// `a b` exactly halfway between two points of the fixed-point grid now and then.
 pub fn hinge() -> impl Strategy<Value = Hinge> {
-    let dyadic = || (-256i32..=256).prop_map(|k| k as f32 / 256.0);
-    let wing = || (0.1f32..0.9, 0.05f32..1.5, 1i32..=63);
+    let dyadic = || (-256_i32..=256).prop_map(|k| k as f32 / 256.0);
+    let wing = || (0.1_f32..0.9, 0.05_f32..1.5, 1_i32..=63);
     (
         [dyadic(), dyadic()],
-        -64i32..=-1,
+        -64_i32..=-1,
         [dyadic(), dyadic()],
-        1i32..=64,
+        1_i32..=64,
         wing(),
         wing(),
     )

@@ -30,7 +30,7 @@ pub fn viewport_with_sides(sides: RangeInclusive<u32>) -> impl Strategy<Value = 
 /// equal depths across a face).
 fn orbit_angle() -> impl Strategy<Value = f64> {
     prop_oneof![
-        3 => 0.0f64..360.0,
+        3 => 0.0_f64..360.0,
         1 => select(vec![0.0, 45.0, 90.0, 180.0, 270.0, 315.0]),
     ]
 }
@@ -39,7 +39,7 @@ fn orbit_angle() -> impl Strategy<Value = f64> {
 /// camera).
 fn orbit_elevation() -> impl Strategy<Value = f64> {
     prop_oneof![
-        3 => -89.0f64..=89.0,
+        3 => -89.0_f64..=89.0,
         1 => select(vec![0.0, 90.0, -90.0]),
     ]
 }
@@ -63,7 +63,7 @@ pub fn orbit_camera_outside() -> impl Strategy<Value = OrbitCamera> {
 
 /// A random orbit camera with `distance_scale` drawn from `distance`.
 pub fn orbit_camera_with_distance(distance: Range<f64>) -> impl Strategy<Value = OrbitCamera> {
-    (orbit_angle(), orbit_elevation(), 5.0f64..150.0, distance).prop_map(
+    (orbit_angle(), orbit_elevation(), 5.0_f64..150.0, distance).prop_map(
         |(angle_degrees, elevation_degrees, fov_y_degrees, distance_scale)| OrbitCamera {
             angle_degrees,
             elevation_degrees,

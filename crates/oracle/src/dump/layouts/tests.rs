@@ -45,12 +45,12 @@ fn header_names_are_the_catalogs_layouts() {
         assert_eq!(Some(scheme.layout()), DumpLayout::named(name));
     }
     // A scheme that dumps under another's name is no header name of its own.
-    let unknown = DumpScheme::from_header(&header("abuffer-exact"), None).unwrap_err();
+    let unknown = DumpScheme::from_header(&header("abuffer-exact"), None)
+        .unwrap_err()
+        .to_string();
     assert!(
-        unknown
-            .0
-            .starts_with("unknown scheme \"abuffer-exact\": expected mdts, mdts32, mdts-desc, ")
-            && !unknown.0.contains("abuffer-exact,"),
+        unknown.starts_with("unknown scheme \"abuffer-exact\": expected mdts, mdts32, mdts-desc, ")
+            && !unknown.contains("abuffer-exact,"),
         "{unknown}"
     );
     // A layout description of another kind than the scheme's is refused.
@@ -58,8 +58,10 @@ fn header_names_are_the_catalogs_layouts() {
     lists.layout = Some(LayoutSpec::Memory);
     let refused = DumpScheme::from_header(&lists, None).unwrap_err();
     assert_eq!(
-        refused.0,
-        "scheme linked-list dumps as linked-list, the header's layout is memory"
+        refused,
+        DumpError::Invalid(
+            "scheme linked-list dumps as linked-list, the header's layout is memory".into()
+        )
     );
 }
 
@@ -71,7 +73,7 @@ fn every_catalog_entry_with_a_layout_dumps_in_it() {
         match entry.dump {
             Some(layout) => assert_eq!(dumped.unwrap().layout(), layout, "{}", entry.name),
             None => {
-                let error = dumped.unwrap_err().0;
+                let error = dumped.unwrap_err().to_string();
                 let expected = format!(
                     "scheme {} has no dump layout; these have one: mdts, ",
                     entry.name

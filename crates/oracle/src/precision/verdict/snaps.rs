@@ -41,7 +41,7 @@ impl Snaps {
     /// (an error the final judgement reports), and so is one whose evidence contradicts what the
     /// others already pinned.
     pub(super) fn infer<'a>(precision: &Precision, pixel_of: &impl Fn(usize) -> Pixel<'a>) -> Self {
-        let mut snaps = Snaps {
+        let mut snaps = Self {
             domain: precision
                 .vertex_points
                 .iter()
@@ -87,7 +87,7 @@ impl Snaps {
                 if contradicted[i] {
                     continue;
                 }
-                let mut support = vec![0u64; vertices.len()];
+                let mut support = vec![0_u64; vertices.len()];
                 for choice in fitting.iter().filter(|c| snaps.allows(vertices, c)) {
                     for (s, &point) in support.iter_mut().zip(choice) {
                         *s |= 1 << point;
@@ -177,7 +177,7 @@ impl Snaps {
     /// Every joint snap of `vertices` (a grid point index each) within their domains; `None`
     /// past [`MAX_JOINT`].
     fn assignments(&self, vertices: &[u32]) -> Option<Vec<Vec<u8>>> {
-        let total = vertices.iter().try_fold(1usize, |n, &v| {
+        let total = vertices.iter().try_fold(1_usize, |n, &v| {
             n.checked_mul(self.domain[v as usize].count_ones() as usize)
         })?;
         if total > MAX_JOINT {
@@ -189,7 +189,7 @@ impl Snaps {
             joint = joint
                 .into_iter()
                 .flat_map(|choice| {
-                    (0..64u8)
+                    (0..64_u8)
                         .filter(move |&i| domain >> i & 1 == 1)
                         .map(move |i| {
                             let mut next = choice.clone();

@@ -1,6 +1,14 @@
-//! The render target and rectangles of whole pixels.
+//! The render target, the fixed-point grid its vertices snap to, and rectangles of whole pixels.
+//!
+//! The grid and the viewport are what every stage shares, from the vertex stage's snapping to
+//! the sample patterns and the scene's camera, so they sit apart from the pipeline's stages.
 
-use super::scan::pixel_span;
+/// Fractional bits of the fixed-point vertex grid (Vulkan's common `subPixelPrecisionBits`).
+pub const SUBPIXEL_BITS: u32 = 8;
+/// One pixel in grid units.
+pub(crate) const ONE: i64 = 1 << SUBPIXEL_BITS;
+/// Half a pixel in grid units: where a pixel's centre lies from its corner.
+pub(crate) const HALF: i64 = ONE / 2;
 
 /// The size of the render target in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,9 +78,21 @@ impl PixelRect {
     /// The pixel centres that a bounding box `[lo, hi]` (x and y in 1/256 pixel) holds inside
     /// this rectangle; `None` when there is none.
     #[inline]
-    pub(super) fn centres_within(self, lo: [i64; 2], hi: [i64; 2]) -> Option<Self> {
+    pub(crate) fn centres_within(self, lo: [i64; 2], hi: [i64; 2]) -> Option<Self> {
         let x = pixel_span(lo[0], hi[0], self.x)?;
         let y = pixel_span(lo[1], hi[1], self.y)?;
         Some(Self { x, y })
     }
+}
+
+/// The first and last pixel whose centre lies in `[lo, hi]` (1/256 pixel) and in the pixel range
+/// `[first, last]`; `None` when there is none.
+#[inline]
+fn pixel_span(lo: i64, hi: i64, (first, last): (u32, u32)) -> Option<(u32, u32)> {
+    // An arithmetic shift is the floor division by `ONE` (a power of two), in fewer instructions
+    // than `div_euclid`: this runs for every triangle of the mesh.
+    let from = ((lo - HALF + ONE - 1) >> SUBPIXEL_BITS).max(first.into());
+    let to = ((hi - HALF) >> SUBPIXEL_BITS).min(last.into());
+    // Both lie in [first, last] when they are ordered, so the conversions are lossless.
+    (from <= to).then_some((from as u32, to as u32))
 }
