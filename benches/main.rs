@@ -63,7 +63,7 @@ fn benches(c: &mut Criterion) {
     pass.bench_function("mdts/parallel", |b| b.iter(|| parallel.run(&view, &mdts)));
     pass.bench_function("abuffer/serial", |b| b.iter(|| serial.run(&view, &abuffer)));
     pass.bench_function("abuffer/parallel", |b| {
-        b.iter(|| parallel.run(&view, &abuffer))
+        b.iter(|| parallel.run(&view, &abuffer));
     });
     pass.finish();
 
@@ -130,7 +130,7 @@ fn benches(c: &mut Criterion) {
             BatchSize::LargeInput,
         );
     });
-    let mut offsets = vec![0usize; pixels + 1];
+    let mut offsets = vec![0_usize; pixels + 1];
     for p in 0..pixels {
         offsets[p + 1] = offsets[p] + counts[p] as usize;
     }
@@ -187,7 +187,7 @@ fn benches(c: &mut Criterion) {
             .steps;
         scheduled.throughput(Throughput::Elements(steps));
         scheduled.bench_function(label, |b| {
-            b.iter(|| run_scheduled(&view, &mdts, &schedule, false))
+            b.iter(|| run_scheduled(&view, &mdts, &schedule, false));
         });
     }
     scheduled.finish();

@@ -5,7 +5,7 @@ use fragsim::raster::{Camera, OrbitCamera};
 
 /// The camera whose view-projection matrix has these columns (`columns[c][r]` is row `r` of
 /// column `c`, as glam stores it).
-pub fn camera_from_columns(columns: [[f64; 4]; 4]) -> Camera {
+pub(crate) fn camera_from_columns(columns: [[f64; 4]; 4]) -> Camera {
     let mut camera = OrbitCamera::default().camera(([0.0; 3], [1.0; 3]), 1.0);
     let m = &mut camera.view_projection;
     for (axis, column) in [&mut m.x_axis, &mut m.y_axis, &mut m.z_axis, &mut m.w_axis]
@@ -21,7 +21,7 @@ pub fn camera_from_columns(columns: [[f64; 4]; 4]) -> Camera {
 }
 
 /// Clip space = model space: x and y in `[-1, 1]` span the viewport, z is the depth, w = 1.
-pub fn identity_camera() -> Camera {
+pub(crate) fn identity_camera() -> Camera {
     camera_from_columns([
         [1.0, 0.0, 0.0, 0.0],
         [0.0, 1.0, 0.0, 0.0],

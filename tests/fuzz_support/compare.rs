@@ -23,7 +23,7 @@ use fragsim_cli::CompareArgs;
 use super::dump::{is_canonical, Blob};
 
 /// Splits `data` into the two dumps, writes them out and checks the command on them.
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let (length, rest) = data.split_at(data.len().min(4));
     let mut word = [0; 4];
     word[..length.len()].copy_from_slice(length);

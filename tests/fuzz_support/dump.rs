@@ -22,7 +22,7 @@ const NAME: &str = "fuzz/dump.json";
 /// A dump as the fuzzer's bytes hold it: the header text up to the first NUL byte, then one chunk
 /// per array file the parser asks for (a little-endian `u16` length, then that many bytes, cut
 /// short where the input ends).
-pub struct Blob<'a> {
+pub(crate) struct Blob<'a> {
     /// The header's bytes.
     pub header: &'a [u8],
     input: Input<'a>,
@@ -31,7 +31,7 @@ pub struct Blob<'a> {
 
 impl<'a> Blob<'a> {
     /// The dump `data` holds.
-    pub fn new(data: &'a [u8]) -> Self {
+    pub(crate) fn new(data: &'a [u8]) -> Self {
         let (header, rest) = match data.iter().position(|&b| b == 0) {
             Some(nul) => (&data[..nul], &data[nul + 1..]),
             None => (data, &[][..]),
@@ -44,7 +44,7 @@ impl<'a> Blob<'a> {
     }
 
     /// The next chunk, as the bytes of array file `file`, which must be a plain file name.
-    pub fn file(&mut self, file: &str) -> Vec<u8> {
+    pub(crate) fn file(&mut self, file: &str) -> Vec<u8> {
         assert!(
             !file.is_empty() && file != ".." && !file.contains(['/', '\\']),
             "the parser asked for {file:?}, not a plain file name"
@@ -59,7 +59,7 @@ impl<'a> Blob<'a> {
 
 /// Whether a capture is what it promises of itself: lists in canonical order, no overflow (with
 /// overflow it claims fragments that its own lists lack).
-pub fn is_canonical(capture: &Capture) -> bool {
+pub(crate) fn is_canonical(capture: &Capture) -> bool {
     let no_overflow = match &capture.keeps {
         Keeps::All { overflow, .. } => overflow.iter().all(|&o| o == 0),
         _ => true,
@@ -68,7 +68,7 @@ pub fn is_canonical(capture: &Capture) -> bool {
 }
 
 /// Parses `data` as a dump and checks the outcome.
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let mut blob = Blob::new(data);
     let header = blob.header;
     let Ok(dump) = Dump::parse(NAME, header, |file| Ok(blob.file(file))) else {
@@ -89,7 +89,10 @@ pub fn check(data: &[u8]) {
         .header
         .samples()
         .expect("parse refuses other sample counts");
-    assert!(fragsim::raster::SamplePattern::COUNTS.contains(&samples));
+    assert!(
+        fragsim::raster::SamplePattern::COUNTS.contains(&samples),
+        "{samples} is no standard sample count"
+    );
     let pixels = dump
         .header
         .pixel_viewport()

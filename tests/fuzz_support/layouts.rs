@@ -54,7 +54,7 @@ const BASE: &str = r#"{"format": "fragsim-dump", "version": 1, "scene": {"name":
     "width": 1, "height": 1, "scheme": "mdts", "arrays": {}}"#;
 
 /// Builds a dump from `data` and checks it.
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let mut input = Input::new(data);
     let built = build(&mut input);
     let dump = &built.dump;

@@ -3,12 +3,12 @@
 //! inside `cargo test`. Every check decodes raw bytes itself, so a corpus file means the same to
 //! libFuzzer and to the replay.
 
-pub mod camera;
-pub mod compare;
-pub mod dump;
-pub mod input;
-pub mod layouts;
-pub mod obj_load;
-pub mod raster;
-pub mod schemes;
-pub mod triangles;
+pub(crate) mod camera;
+pub(crate) mod compare;
+pub(crate) mod dump;
+pub(crate) mod input;
+pub(crate) mod layouts;
+pub(crate) mod obj_load;
+pub(crate) mod raster;
+pub(crate) mod schemes;
+pub(crate) mod triangles;

@@ -13,7 +13,7 @@ const NAME: &str = "fuzz.obj";
 const RENDER_LIMIT: usize = 64;
 
 /// Loads `data` as OBJ text and checks the outcome.
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let mesh = match Mesh::read_obj(&mut &data[..], NAME) {
         Ok(mesh) => mesh,
         Err(error) => {

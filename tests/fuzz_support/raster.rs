@@ -10,10 +10,10 @@ use super::camera::{camera_from_columns, identity_camera};
 use super::input::Input;
 
 /// The key of depth 1.0, the largest a fragment may carry.
-pub const MAX_KEY: u32 = 0x3F80_0000;
+pub(crate) const MAX_KEY: u32 = 0x3F80_0000;
 
 /// Rasterizes `prim` of `view` and checks the invariants every fragment must meet.
-pub fn check_fragments(view: &View<'_>, prim: u32) -> Vec<Fragment> {
+pub(crate) fn check_fragments(view: &View<'_>, prim: u32) -> Vec<Fragment> {
     let pixels = view.viewport().pixels();
     let mut fragments = Vec::new();
     view.rasterize(prim, &mut |f| fragments.push(f));
@@ -47,7 +47,7 @@ fn depth(input: &mut Input<'_>) -> f32 {
 
 /// Decodes a viewport, a cull mode, a camera and a mesh from `data`, rasterizes every triangle
 /// and checks it.
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let mut input = Input::new(data);
     let width = 1 + u32::from(input.u8() % 64);
     let height = 1 + u32::from(input.u8() % 64);
@@ -126,7 +126,7 @@ pub fn check(data: &[u8]) {
 /// point-in-triangle test whose shared-edge rule is stated geometrically — a centre on an edge is
 /// covered when the edge is a top edge (horizontal, the triangle below it) or a left edge (the
 /// triangle to its right) — so it does not depend on the pipeline's reorientation or bias trick.
-pub fn reference_coverage(
+pub(crate) fn reference_coverage(
     corners: [[f32; 3]; 3],
     viewport: Viewport,
     cull: CullMode,
@@ -142,7 +142,7 @@ pub fn reference_coverage(
     if !unclipped {
         return None;
     }
-    let one = f64::from(1u32 << SUBPIXEL_BITS);
+    let one = f64::from(1_u32 << SUBPIXEL_BITS);
     // With w = 1, x / w = x exactly; rounding is half away from zero, as `f64::round`.
     let snap = |[x, y, _]: [f32; 3]| -> [i128; 2] {
         let wx = (f64::from(x) * 0.5 + 0.5) * width;
@@ -179,7 +179,7 @@ pub fn reference_coverage(
             (h > 0) == (dy > 0)
         }
     };
-    let full = i128::from(1u32 << SUBPIXEL_BITS);
+    let full = i128::from(1_u32 << SUBPIXEL_BITS);
     let mut covered = Vec::new();
     for j in 0..viewport.height {
         for i in 0..viewport.width {

@@ -85,7 +85,7 @@ fn decode(data: &[u8]) -> Case {
 }
 
 /// Every pixel's fragments, packed, in canonical order: the oracle, by sorting.
-pub fn sorted_lists(pixels: u32, fragments: &[Fragment]) -> Vec<Vec<u64>> {
+pub(crate) fn sorted_lists(pixels: u32, fragments: &[Fragment]) -> Vec<Vec<u64>> {
     let mut lists = vec![Vec::new(); pixels as usize];
     for f in fragments {
         lists[f.pixel as usize].push(f.packed());
@@ -100,7 +100,12 @@ pub fn sorted_lists(pixels: u32, fragments: &[Fragment]) -> Vec<Vec<u64>> {
 /// count of walks that ended in [`Step::Dropped`], which must equal the fragments missing from the
 /// capture (multi-pass schemes count overflow per pass and the z-buffer overwrites uncounted,
 /// so they give none).
-pub fn check_capture(name: &str, lists: &[Vec<u64>], capture: &Capture, dropped: Option<u64>) {
+pub(crate) fn check_capture(
+    name: &str,
+    lists: &[Vec<u64>],
+    capture: &Capture,
+    dropped: Option<u64>,
+) {
     assert_eq!(capture.pixels(), lists.len(), "{name}: pixel count");
     let mask = match capture.identity {
         Identity::KeyAndPrim => u64::MAX,
@@ -173,10 +178,10 @@ enum Runs {
 impl Runs {
     fn owed(guarantee: Guarantee, distinct_depths: bool) -> Self {
         match guarantee {
-            Guarantee::Exact | Guarantee::ExactWithinCapacity(_) => Runs::SerialAndScheduled,
-            Guarantee::ExactDistinctDepths if distinct_depths => Runs::SerialAndScheduled,
-            Guarantee::ExactWithoutHazards | Guarantee::ExactInArrivalOrder => Runs::SerialOnly,
-            Guarantee::ExactDistinctDepths | Guarantee::Approximate => Runs::Skip,
+            Guarantee::Exact | Guarantee::ExactWithinCapacity(_) => Self::SerialAndScheduled,
+            Guarantee::ExactDistinctDepths if distinct_depths => Self::SerialAndScheduled,
+            Guarantee::ExactWithoutHazards | Guarantee::ExactInArrivalOrder => Self::SerialOnly,
+            Guarantee::ExactDistinctDepths | Guarantee::Approximate => Self::Skip,
         }
     }
 }
@@ -209,7 +214,11 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
     }
     let Run { capture, stats } = run_fragments(scheme, &case.fragments, &case.schedule, false).run;
     if one_pass {
-        assert_eq!(stats.counters.fragments, case.fragments.len() as u64);
+        assert_eq!(
+            stats.counters.fragments,
+            case.fragments.len() as u64,
+            "{name}: every fragment begins one walk"
+        );
     }
     let dropped = counted_drops(one_pass, &stats.counters);
     let name = format!("{name} under {:?}", case.schedule);
@@ -250,7 +259,7 @@ fn distinct_depths(lists: &[Vec<u64>]) -> bool {
 /// and for multi-pass schemes the layers they peel); linked lists get a pool of the case's
 /// fragments; schemes whose passes grow with the layers only on cases of depth complexity up to
 /// [`MAX_MULTIPASS_LAYERS`].
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let case = decode(data);
     let lists = sorted_lists(case.pixels, &case.fragments);
     let counts: Vec<u32> = lists.iter().map(|l| l.len() as u32).collect();

@@ -17,7 +17,7 @@ fn u32_at(bytes: &[u8], at: usize) -> usize {
 }
 
 /// Reads `data` as a triangle export and checks the outcome.
-pub fn check(data: &[u8]) {
+pub(crate) fn check(data: &[u8]) {
     let export = match TriangleExport::from_bytes(data) {
         Ok(export) => export,
         Err(error) => {

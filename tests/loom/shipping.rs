@@ -35,10 +35,10 @@ fn linked_list_model(name: &str, n: usize, pool: usize, preemption_bound: Option
         for ((outcome, steps), value) in outcomes.iter().zip(&steps).zip(&values) {
             match outcome {
                 Step::Stored => {
-                    assert_eq!(*steps, 4);
+                    assert_eq!(*steps, 4, "a stored linked-list walk is four steps");
                     stored.push(*value);
                 }
-                Step::Dropped => assert_eq!(*steps, 1),
+                Step::Dropped => assert_eq!(*steps, 1, "a dropped linked-list walk is one step"),
                 other => panic!("a linked-list walk ended {other:?}"),
             }
         }
@@ -68,7 +68,7 @@ fn linked_list_2_and_3_threads_4_threads_pool_3_preemption_bound_2() {
 /// clamped back to the layer count when any was dropped.
 #[test]
 fn layer_counter_3_threads_layers_1_to_3() {
-    for layers in 1..=3u32 {
+    for layers in 1..=3_u32 {
         let scheme = LayerCounter::new(one_pixel(), layers, MEMORY_CAP_DEFAULT).unwrap();
         let scheme: &'static LayerCounter = Box::leak(Box::new(scheme));
         let list = fragments(&DISTINCT[..3]);

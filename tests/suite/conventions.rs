@@ -123,7 +123,7 @@ fn an_f32_matrix_holds_the_nearest_f32s_and_refuses_what_f32_cannot_hold() {
         matrix.row_major[5] = 0.1;
     }
     let camera = spec.camera(&scene, viewport).unwrap();
-    assert_eq!(camera.row_major()[5], f64::from(0.1f32));
+    assert_eq!(camera.row_major()[5], f64::from(0.1_f32));
     for (bad, reason) in [(1e39, "f32's range"), (f64::NAN, "finite")] {
         if let Some(matrix) = &mut spec.view_projection {
             matrix.row_major[5] = bad;

@@ -83,7 +83,7 @@ fn row<'a>(rows: &'a [serde_json::Value], scheme: &str) -> &'a serde_json::Value
 fn abuffer_is_one_pass_over_fixed_arrays_and_abuffer_exact_reports_its_count_pass() {
     let (code, rows, stderr) = render_json(&["--scheme", "abuffer,abuffer-exact,mdts"]);
     assert_eq!(code, 0, "{stderr}");
-    let pixels = 512 * 512u64;
+    let pixels = 512 * 512_u64;
     let fragments = row(&rows, "mdts")["fragments"].as_u64().unwrap();
     // The oracle's fragment count, computed here independently of any scheme's storage.
     let scene = Scene::default_scene();

@@ -138,7 +138,7 @@ fn packed_mdts_has_error_pixels_exactly_where_its_20_bit_depths_misorder_two_sur
     std::fs::create_dir_all(&out).unwrap();
     // 5·10^-7 in z is about 2.5 f32 steps of window depth here: most pixels tie in 20 bits
     // (2^-20 is 16 steps), some straddle a bucket edge. 10^-2 is thousands of buckets.
-    for (separation, near_tie) in [(5e-7f32, true), (1e-2, false)] {
+    for (separation, near_tie) in [(5e-7_f32, true), (1e-2, false)] {
         let mesh = out.join(format!("two-squares-{separation:e}.obj"));
         two_squares(&mesh, separation);
         let misordered = predicted_misorders(&mesh);
@@ -224,7 +224,7 @@ fn fresnel_of_one_fragment_is_schlicks_transmittance() {
     }
     assert!(fragments > 100, "{fragments}");
     assert_eq!(schlick_transmittance(0.0), 0.0);
-    assert_eq!(schlick_transmittance(0.5), 1.0 - 0.5f64.powi(5));
+    assert_eq!(schlick_transmittance(0.5), 1.0 - 0.5_f64.powi(5));
 }
 
 #[test]
@@ -233,7 +233,7 @@ fn srgb_encoding_is_exact_at_the_ends_and_continuous_at_the_knee() {
     assert_eq!(encode_srgb(1.0), 255);
     // At the knee 0.0031308 both branches give 0.04045 (10.31 of 255): the linear one below,
     // the power one just above.
-    let knee = 0.003_130_8f32;
+    let knee = 0.003_130_8_f32;
     assert_eq!(encode_srgb(knee), 10);
     assert_eq!(encode_srgb(knee.next_up()), 10);
     assert_eq!(encode_srgb(knee.next_down()), 10);

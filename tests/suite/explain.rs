@@ -189,7 +189,7 @@ fn fragments_named(text: &str) -> Vec<(f32, usize)> {
 /// the `i`-th of `--depths`, on thread `Ti`), and the key's example is one of the run's own.
 #[test]
 fn explain_keeps_the_users_fragment_numbering_after_shrinking() {
-    let depths = [0.1f32, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9];
+    let depths = [0.1_f32, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9];
     let list: Vec<String> = depths.iter().map(f32::to_string).collect();
     for machine in ["render-target", "separate-stores"] {
         let (ok, text) = explain(&["--depths", &list.join(","), "--write-back", machine]);

@@ -25,7 +25,7 @@ fn fragsim_in(dir: &Path, args: &[&str]) -> Output {
 
 fn help(command: &str) -> String {
     let output = fragsim_in(Path::new("."), &[command, "--help"]);
-    assert!(output.status.success());
+    assert!(output.status.success(), "the command failed: {output:?}");
     String::from_utf8(output.stdout).unwrap()
 }
 

@@ -1,7 +1,7 @@
 //! Issue 20, item 9: one output model. Every command's `--json` prints JSON Lines, one record a
 //! line, each opening with the same context fields (`docs/json-schema.md`), and a quantity has one
 //! name everywhere. Each command runs through the binary on a small scene, and its stdout is read
-//! line by line with serde_json.
+//! line by line with `serde_json`.
 
 use std::path::{Path, PathBuf};
 

@@ -22,8 +22,8 @@ use proptest::prelude::*;
 /// Fragments on `pixels` pixels, primitive ids in submission order, depth keys from six values;
 /// at most one warp's worth.
 fn stream() -> impl Strategy<Value = (usize, Vec<Fragment>)> {
-    (1usize..=3).prop_flat_map(|pixels| {
-        proptest::collection::vec((0..pixels as u32, 0u32..6), 0..=WARP_LANES).prop_map(
+    (1_usize..=3).prop_flat_map(|pixels| {
+        proptest::collection::vec((0..pixels as u32, 0_u32..6), 0..=WARP_LANES).prop_map(
             move |list| {
                 let fragments = list
                     .into_iter()
@@ -44,7 +44,7 @@ fn independent_policy() -> impl Strategy<Value = Policy> {
     prop_oneof![
         Just(Policy::Random),
         Just(Policy::Warps),
-        (1u32..=3).prop_map(|depth| Policy::Pct { depth }),
+        (1_u32..=3).prop_map(|depth| Policy::Pct { depth }),
     ]
 }
 
@@ -70,7 +70,7 @@ proptest! {
     #[test]
     fn both_loops_are_exact_under_independent_scheduling(
         (pixels, fragments) in stream(),
-        k in 1u32..=5,
+        k in 1_u32..=5,
         policy in independent_policy(),
         seed in any::<u64>(),
     ) {
@@ -90,7 +90,7 @@ proptest! {
     #[test]
     fn the_locked_64_bit_emulation_is_exact_everywhere_and_the_torn_one_without_hazards(
         (pixels, fragments) in stream(),
-        k in 1u32..=5,
+        k in 1_u32..=5,
         policy in prop_oneof![independent_policy(), Just(Policy::Lockstep)],
         seed in any::<u64>(),
     ) {
@@ -117,7 +117,7 @@ proptest! {
     #[test]
     fn under_lockstep_the_naive_loop_deadlocks_iff_a_pixel_is_contended(
         (pixels, fragments) in stream(),
-        k in 1u32..=5,
+        k in 1_u32..=5,
     ) {
         let oracle = Oracle::from_fragments(pixels, &fragments);
         let viewport = Viewport::new(pixels as u32, 1).unwrap();

@@ -50,7 +50,7 @@ fn loop64_is_exact_on_every_executor() {
 /// fewer than 5 fragments (the control: the stream does repeat keys among the nearest).
 #[test]
 fn equal_depths_stay_apart_under_every_schedule() {
-    let fragments: Vec<Fragment> = (0..24u32)
+    let fragments: Vec<Fragment> = (0..24_u32)
         .map(|prim| Fragment {
             pixel: 0,
             depth_key: depth_key((prim % 3) as f32 / 4.0).unwrap(),

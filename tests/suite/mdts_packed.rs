@@ -117,7 +117,7 @@ fn depth20_is_monotone_below_one_wraps_the_two_largest_depths_and_rounds_once() 
         if k <= KEY_LAST_UNWRAPPED {
             // A 20-bit fixed-point depth: ⌊d · 2^20⌋, or one more where d' rounded up onto a
             // multiple of 2^-21.
-            let floor = (f64::from(d) * f64::from(1u32 << 20)).floor() as u32;
+            let floor = (f64::from(d) * f64::from(1_u32 << 20)).floor() as u32;
             assert!(q == floor || q == floor + 1, "{d}: {q} vs {floor}");
             assert_eq!(q == 0xF_FFFF, k >= KEY_FIRST_ALL_ONES, "{d}");
             if k < KEY_LAST_UNWRAPPED {
@@ -223,8 +223,9 @@ fn each_entry_carries_the_depth_its_20_bits_hold() {
         if remapped >= 1.0 {
             return 0; // exponent 127: the shift leaves 20 zero bits, depth 0.0
         }
-        let buckets = (f64::from(remapped) * f64::from(1u32 << 21)).floor() - f64::from(1u32 << 20);
-        ((buckets / f64::from(1u32 << 20)) as f32).to_bits()
+        let buckets =
+            (f64::from(remapped) * f64::from(1_u32 << 21)).floor() - f64::from(1_u32 << 20);
+        ((buckets / f64::from(1_u32 << 20)) as f32).to_bits()
     };
     let keys = [
         key(0.75) + 3,
@@ -319,7 +320,7 @@ fn depths_differing_below_20_bits_are_ordered_by_colour_not_depth() {
     // Depths 2^-24 and 2^-21 apart in [0.5, 1), and far closer near 0 (f32 is finer there).
     for (near, far) in [
         (key(0.75), key(0.75) + 1),
-        (key(0.75), key(0.75 + 0.5f32.powi(21)) - 1),
+        (key(0.75), key(0.75 + 0.5_f32.powi(21)) - 1),
         (key(0.001), key(0.001) + 500),
     ] {
         assert!(near < far);
@@ -335,7 +336,7 @@ fn depths_differing_below_20_bits_are_ordered_by_colour_not_depth() {
     }
     // One 20-bit step apart, the depth decides again.
     let near = key(0.75);
-    let far = key(0.75 + 0.5f32.powi(20));
+    let far = key(0.75 + 0.5_f32.powi(20));
     assert_eq!(depth20(near) + 1, depth20(far));
     let fragments = [fragment(0, near, 0x000_002), fragment(0, far, 0x000_001)];
     assert_eq!(
@@ -378,7 +379,7 @@ fn depth_one_and_the_depth_below_it_sort_as_nearest() {
 /// is never stored, the arrays hold different counts, and the fragment is lost.
 #[test]
 fn a_word_equal_to_the_empty_sentinel_is_lost() {
-    let top = key(1.0 - 0.5f32.powi(20));
+    let top = key(1.0 - 0.5_f32.powi(20));
     assert_eq!(depth20(top), 0xF_FFFF);
     let scheme = packed(2);
     // Low half 0xFFF: array B's word is 0xFFFF_FFFF.
@@ -408,7 +409,7 @@ fn the_packed_capture_is_the_same_under_every_schedule() {
         fragment(0, KEY_ONE, 5),
         fragment(0, key(0.8), 6),
         fragment(0, key(0.9), 7),
-        fragment(1, key(1.0 - 0.5f32.powi(20)), 0xFFF),
+        fragment(1, key(1.0 - 0.5_f32.powi(20)), 0xFFF),
         fragment(1, key(0.2), 8),
         fragment(1, key(0.6), 0xFFF),
     ];

@@ -58,9 +58,9 @@ proptest! {
     /// and for the view shuffled by `seed`.
     #[test]
     fn every_scheme_promising_order_independence_captures_the_same_lists_in_any_order(
-        spheres in 1u32..=4,
+        spheres in 1_u32..=4,
         seed in any::<u64>(),
-        k in 1u32..=3,
+        k in 1_u32..=3,
     ) {
         let scene = Scene::procedural(&format!("spheres:{spheres}")).unwrap();
         let view = scene
@@ -210,9 +210,9 @@ struct Disagreement {
 /// `distinct`, no two equal) with two submission orders that `name` captures differently,
 /// searching scenes of up to 3 fragments, smallest first.
 fn smallest_disagreement(name: &str, distinct: bool) -> Option<Disagreement> {
-    let depths = [0.25f32, 0.5];
-    for n in 1..=3usize {
-        for bits in 0..1u32 << n {
+    let depths = [0.25_f32, 0.5];
+    for n in 1..=3_usize {
+        for bits in 0..1_u32 << n {
             let pick = |i: usize| ((bits >> i) & 1) as usize;
             if distinct && (0..n).any(|i| (0..i).any(|j| pick(i) == pick(j))) {
                 continue;

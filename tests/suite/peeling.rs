@@ -52,15 +52,20 @@ fn dual_passes(layers: u32) -> u32 {
 fn assert_exact(oracle: &Oracle, run: &Run, passes: u32) {
     let diff = oracle.diff(&run.capture);
     assert!(diff.is_exact(), "{diff:?}");
-    assert_eq!(diff.overflowed, 0);
-    assert_eq!(run.stats.passes, passes);
+    assert_eq!(diff.overflowed, 0, "nothing overflows");
+    assert_eq!(run.stats.passes, passes, "the passes the layers need");
     let counters = run.stats.counters;
     assert_eq!(
         counters.fragments,
-        u64::from(passes) * oracle.fragments() as u64
+        u64::from(passes) * oracle.fragments() as u64,
+        "every pass sees every fragment"
     );
-    assert_eq!(counters.dropped, 0);
-    assert_eq!(counters.stored + counters.discarded, counters.fragments);
+    assert_eq!(counters.dropped, 0, "peeling drops nothing");
+    assert_eq!(
+        counters.stored + counters.discarded,
+        counters.fragments,
+        "each fragment of a pass is stored or discarded"
+    );
 }
 
 /// Checks one run of a depth-key (`u32`) scheme: exactly the equal-depth duplicates are lost,
@@ -70,9 +75,10 @@ fn assert_merges_equal_depths(oracle: &Oracle, run: &Run, passes: u32) {
     assert_eq!(diff.lost, equal_depth_duplicates(oracle), "{diff:?}");
     assert_eq!(
         (diff.extra, diff.misordered_pixels, diff.overflowed),
-        (0, 0, 0)
+        (0, 0, 0),
+        "nothing extra, misordered or overflowed: {diff:?}"
     );
-    assert_eq!(run.stats.passes, passes);
+    assert_eq!(run.stats.passes, passes, "the passes the layers need");
 }
 
 /// `scheme` on `view` with the serial executor and, if asked, the parallel one.
@@ -111,8 +117,12 @@ fn check_every_scheme(view: &View<'_>, parallel: bool) -> u32 {
     for run in runs(view, &zbuffer, parallel) {
         let diff = oracle.diff(&run.capture);
         assert!(diff.is_exact(), "{diff:?}");
-        assert_eq!(run.stats.passes, 1);
-        assert_eq!(run.stats.counters.steps, oracle.fragments() as u64);
+        assert_eq!(run.stats.passes, 1, "one pass");
+        assert_eq!(
+            run.stats.counters.steps,
+            oracle.fragments() as u64,
+            "one step per fragment"
+        );
     }
     n
 }
@@ -149,9 +159,9 @@ fn every_exact_scheme_equals_the_oracle_on_nested_spheres_and_soups() {
 
 fn random_scene() -> impl Strategy<Value = String> {
     prop_oneof![
-        (1u32..5).prop_map(|n| format!("spheres:{n}")),
-        (1u32..300, any::<u64>()).prop_map(|(count, seed)| format!("soup:{count}:{}", seed | 1)),
-        (1u32..9).prop_map(|n| format!("quads:{n}")),
+        (1_u32..5).prop_map(|n| format!("spheres:{n}")),
+        (1_u32..300, any::<u64>()).prop_map(|(count, seed)| format!("soup:{count}:{}", seed | 1)),
+        (1_u32..9).prop_map(|n| format!("quads:{n}")),
     ]
 }
 
@@ -164,9 +174,9 @@ proptest! {
     #[test]
     fn peeling_schemes_match_the_oracle_on_random_scenes(
         spec in random_scene(),
-        width in 16u32..48,
-        height in 16u32..48,
-        angle in 0.0f64..360.0,
+        width in 16_u32..48,
+        height in 16_u32..48,
+        angle in 0.0_f64..360.0,
         parallel in any::<bool>(),
     ) {
         let scene = Scene::procedural(&spec).unwrap();
@@ -177,10 +187,10 @@ proptest! {
     /// operation and a pass only needs per-location atomicity.
     #[test]
     fn peeling_is_exact_under_every_schedule(
-        policy in prop_oneof![Just(Policy::Random), Just(Policy::Warps), (1u32..4).prop_map(|depth| Policy::Pct { depth })],
-        in_flight in prop_oneof![Just(1usize), Just(32), 2usize..300],
+        policy in prop_oneof![Just(Policy::Random), Just(Policy::Warps), (1_u32..4).prop_map(|depth| Policy::Pct { depth })],
+        in_flight in prop_oneof![Just(1_usize), Just(32), 2_usize..300],
         seed in any::<u64>(),
-        spheres in 1u32..4,
+        spheres in 1_u32..4,
     ) {
         let scene = Scene::procedural(&format!("spheres:{spheres}")).unwrap();
         let view = view_of(&scene, 24, 24, 30.0);

@@ -68,7 +68,10 @@ fn engine_like(view: &View<'_>) -> Vec<Vec<u64>> {
     let mut fragments: Vec<Fragment> = Vec::new();
     for prim in 0..view.triangle_count() {
         let indices = view.mesh().triangles[prim as usize];
-        assert!(indices.iter().all(|&i| view.vertex_window(i).is_some()));
+        assert!(
+            indices.iter().all(|&i| view.vertex_window(i).is_some()),
+            "the triangle's vertices are in front of the camera"
+        );
         let [(a, za), (mut b, mut zb), (mut c, mut zc)] = indices.map(|i| f32_vertex(view, i));
         let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         if area == 0 {

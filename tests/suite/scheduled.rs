@@ -15,7 +15,7 @@ fn policy() -> impl Strategy<Value = Policy> {
     prop_oneof![
         Just(Policy::Random),
         Just(Policy::Warps),
-        (1u32..5).prop_map(|depth| Policy::Pct { depth })
+        (1_u32..5).prop_map(|depth| Policy::Pct { depth })
     ]
 }
 
@@ -32,10 +32,10 @@ proptest! {
     fn atomic_schemes_equal_the_oracle_under_every_schedule(
         policy in policy(),
         granularity in granularity(),
-        in_flight in prop_oneof![Just(1usize), Just(32), Just(1024), 2usize..200],
+        in_flight in prop_oneof![Just(1_usize), Just(32), Just(1024), 2_usize..200],
         seed in any::<u64>(),
-        spheres in 1u32..4,
-        k_short in 1u32..3,
+        spheres in 1_u32..4,
+        k_short in 1_u32..3,
     ) {
         let scene = Scene::procedural(&format!("spheres:{spheres}")).unwrap();
         let view = scene.view(Viewport::new(24, 24).unwrap(), &OrbitCamera::default()).unwrap();

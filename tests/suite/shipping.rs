@@ -39,8 +39,8 @@ struct Stream {
 }
 
 fn stream() -> impl Strategy<Value = Stream> {
-    (1usize..=3).prop_flat_map(|pixels| {
-        proptest::collection::vec((0..pixels as u32, 0u32..6), 0..=20).prop_map(move |list| {
+    (1_usize..=3).prop_flat_map(|pixels| {
+        proptest::collection::vec((0..pixels as u32, 0_u32..6), 0..=20).prop_map(move |list| {
             let fragments = list
                 .into_iter()
                 .enumerate()
@@ -60,11 +60,11 @@ fn schedule() -> impl Strategy<Value = Schedule> {
     let policy = prop_oneof![
         Just(Policy::Random),
         Just(Policy::Warps),
-        (1u32..=3).prop_map(|depth| Policy::Pct { depth }),
+        (1_u32..=3).prop_map(|depth| Policy::Pct { depth }),
     ];
     prop_oneof![
         1 => Just(serial()),
-        3 => (policy, 2usize..=16, any::<u64>()).prop_map(|(policy, in_flight, seed)| Schedule {
+        3 => (policy, 2_usize..=16, any::<u64>()).prop_map(|(policy, in_flight, seed)| Schedule {
             policy,
             in_flight,
             granularity: Granularity::Fragment,
@@ -129,7 +129,7 @@ proptest! {
     #[test]
     fn loop32_differs_iff_a_kept_depth_repeats(
         stream in stream(),
-        k in 1u32..=5,
+        k in 1_u32..=5,
         schedule in schedule(),
     ) {
         let oracle = Oracle::from_fragments(stream.pixels, &stream.fragments);
@@ -159,7 +159,7 @@ proptest! {
     #[test]
     fn layer_counter_loses_exactly_the_excess(
         stream in stream(),
-        layers in 1u32..=5,
+        layers in 1_u32..=5,
         schedule in schedule(),
     ) {
         let oracle = Oracle::from_fragments(stream.pixels, &stream.fragments);
@@ -198,7 +198,7 @@ proptest! {
     #[test]
     fn linked_list_keep_first_differs_iff_recent_are_not_nearest(
         stream in stream(),
-        n in 1u32..=5,
+        n in 1_u32..=5,
         schedule in schedule(),
     ) {
         let oracle = Oracle::from_fragments(stream.pixels, &stream.fragments);
@@ -239,7 +239,7 @@ proptest! {
     #[test]
     fn linked_list_pool_loses_exactly_the_fragments_past_it(
         stream in stream(),
-        pool in 1usize..=24,
+        pool in 1_usize..=24,
         schedule in schedule(),
     ) {
         let oracle = Oracle::from_fragments(stream.pixels, &stream.fragments);

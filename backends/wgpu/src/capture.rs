@@ -111,7 +111,7 @@ fn replay_geometry_of(
         128.0 * f64::from(viewport.height),
     );
     let mut vertices = Vec::new();
-    let mut count = 0u32;
+    let mut count = 0_u32;
     for prim in prims {
         view.screen_triangles(prim, &mut |t| {
             for (xy, z) in t.xy.iter().zip(t.z) {
@@ -287,7 +287,6 @@ fn pairs_to_u64(words: &[u32]) -> Vec<u64> {
         .collect()
 }
 
-#[allow(clippy::too_many_arguments)]
 fn to_dump(
     gpu: &Gpu,
     view: &View<'_>,

@@ -31,6 +31,7 @@ use crate::plant::Plant;
 use crate::shaders::GpuScheme;
 
 /// The wgpu backend on one adapter, in one mode, with the correct shaders or one planted bug.
+#[derive(Debug)]
 pub struct WgpuBackend<'g> {
     /// The device the cases are drawn on.
     pub gpu: &'g Gpu,

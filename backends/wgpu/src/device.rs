@@ -33,6 +33,7 @@ impl fmt::Display for GpuError {
 impl std::error::Error for GpuError {}
 
 /// An open device and what its adapter is.
+#[derive(Debug)]
 pub struct Gpu {
     /// The device.
     pub device: wgpu::Device,

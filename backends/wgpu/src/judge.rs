@@ -105,7 +105,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
         },
     };
     let key_only = capture.identity == Identity::KeyOnly;
-    let (mut checked, mut differs) = (0u64, 0u64);
+    let (mut checked, mut differs) = (0_u64, 0_u64);
     for p in 0..pixels {
         let reference = oracle.pixel(p);
         if reference.len() > keeps {
@@ -145,6 +145,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
 /// scene's conventions and what an f32 vertex stage may produce ([`f32_reference`]), with the
 /// scene loaded, so that each verdict can judge samples exactly on an edge under whichever rule
 /// the capture follows (the oracle's [`Reference::with_edge_ties`]).
+#[derive(Debug)]
 pub struct Within {
     scene: SceneSpec,
     /// The scene with the exact f64 vertex stage, as the oracle was built.

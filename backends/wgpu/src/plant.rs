@@ -47,13 +47,13 @@ pub const NAMES: [&str; 6] = [
 
 impl Plant {
     /// Every plant.
-    pub const ALL: [Plant; 6] = [
-        Plant::Dropped,
-        Plant::WrongId,
-        Plant::OffByOneCapacity,
-        Plant::Unsorted,
-        Plant::LostNode,
-        Plant::CentreDepth,
+    pub const ALL: [Self; 6] = [
+        Self::Dropped,
+        Self::WrongId,
+        Self::OffByOneCapacity,
+        Self::Unsorted,
+        Self::LostNode,
+        Self::CentreDepth,
     ];
 
     /// The plant called `name` ([`NAMES`]).

@@ -204,7 +204,7 @@ pub fn nearest_boundaries(
     sample: usize,
     count: usize,
 ) -> Vec<Boundary> {
-    let one = f64::from(1u32 << SUBPIXEL_BITS);
+    let one = f64::from(1_u32 << SUBPIXEL_BITS);
     let [ox, oy] = pattern.fixed_offset(sample);
     let p = [
         f64::from(x) * one + ox as f64,
@@ -432,7 +432,7 @@ mod tests {
         let (a, b) = ([0.0, 0.0], [4.0, 0.0]);
         assert_eq!(segment_distance([2.0, 3.0], a, b), 3.0);
         assert_eq!(segment_distance([7.0, 4.0], a, b), 5.0);
-        assert_eq!(segment_distance([1.0, 1.0], a, a), 2f64.sqrt());
+        assert_eq!(segment_distance([1.0, 1.0], a, a), 2_f64.sqrt());
     }
 
     #[test]

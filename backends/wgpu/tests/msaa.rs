@@ -135,7 +135,10 @@ fn per_sample_verdicts(
             )
             .unwrap();
             let dump = &captured.dump;
-            assert_eq!(dump.header.scene.conventions.samples, samples);
+            assert_eq!(
+                dump.header.scene.conventions.samples, samples,
+                "the dump records the sample count it was captured at"
+            );
             if !reference.as_ref().is_some_and(|r| r.fits(dump)) {
                 reference = Some(Within::of(dump).unwrap());
             }
@@ -168,8 +171,8 @@ fn same_through_the_files(dump: &Dump, judged: &Verdict, what: &str) {
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(verdict.equal, judged.equal, "{what}");
     assert_eq!(
-        verdict.lists_per_pixel,
-        dump.header.scene.conventions.samples
+        verdict.lists_per_pixel, dump.header.scene.conventions.samples,
+        "one list per sample"
     );
     assert_eq!(
         verdict

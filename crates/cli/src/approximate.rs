@@ -46,9 +46,9 @@ impl ApproximateName {
     /// The scheme with `k` nodes where it takes a number.
     pub fn with_k(self, k: u32) -> Approximation {
         match self {
-            ApproximateName::Wboit => Approximation::Wboit,
-            ApproximateName::Mlab => Approximation::Mlab { k },
-            ApproximateName::TailBlend => Approximation::TailBlend { k },
+            Self::Wboit => Approximation::Wboit,
+            Self::Mlab => Approximation::Mlab { k },
+            Self::TailBlend => Approximation::TailBlend { k },
         }
     }
 }
@@ -101,7 +101,7 @@ impl ApproximateRow {
 }
 
 /// `--k` resolved for the approximate schemes: `auto` is the scene's maximum depth complexity.
-pub fn nodes(k: Count, oracle: &Oracle) -> u32 {
+pub(crate) fn nodes(k: Count, oracle: &Oracle) -> u32 {
     match k {
         Count::Fixed(n) => n,
         Count::Auto => oracle.max_depth_complexity().max(1),
@@ -185,7 +185,7 @@ pub(crate) fn measure(
 }
 
 /// bench.md's table of the approximate schemes, with what its columns mean.
-pub fn markdown(rows: &[ApproximateRow]) -> String {
+pub(crate) fn markdown(rows: &[ApproximateRow]) -> String {
     let mut text = String::from(
         "\nApproximate OIT (judged by the image: their storage holds colour, not lists)\n\n\
          | scheme | nodes | memory B | B/px | px beyond nodes | EPR % | mean err | max err | PSNR dB | blend ms | frame ms |\n\

@@ -68,7 +68,7 @@ pub struct DumpArgs {
     pub dump_order: Option<SlotOrder>,
     /// The payload word of slots, list nodes and layers, `DTYPE:DEPTH:SHIFT:PRIM_BITS`: `u64` or
     /// `u32`; `f32`, `unorm24` or `unorm16` depth from bit SHIFT; the primitive id in the low
-    /// PRIM_BITS bits (fragsim's: `u64:f32:32:32`; a D24 depth over an 8-bit id: `u32:unorm24:8:8`).
+    /// `PRIM_BITS` bits (fragsim's: `u64:f32:32:32`; a D24 depth over an 8-bit id: `u32:unorm24:8:8`).
     #[arg(long, value_name = "PAYLOAD", requires = "dir", value_parser = parse_payload)]
     pub dump_payload: Option<Payload>,
     /// Linked lists' node numbering `NULL:NODE_BASE`: `0:1` (fragsim, nvpro-samples) or

@@ -47,9 +47,9 @@ impl EffectName {
     #[must_use]
     pub fn effect(self) -> Effect {
         match self {
-            EffectName::Transparency => Effect::Transparency,
-            EffectName::Translucency => Effect::Translucency,
-            EffectName::Fresnel => Effect::Fresnel,
+            Self::Transparency => Effect::Transparency,
+            Self::Translucency => Effect::Translucency,
+            Self::Fresnel => Effect::Fresnel,
         }
     }
 
@@ -57,9 +57,9 @@ impl EffectName {
     #[must_use]
     pub fn label(self) -> &'static str {
         match self {
-            EffectName::Transparency => "transparency",
-            EffectName::Translucency => "translucency",
-            EffectName::Fresnel => "fresnel",
+            Self::Transparency => "transparency",
+            Self::Translucency => "translucency",
+            Self::Fresnel => "fresnel",
         }
     }
 }
@@ -155,7 +155,7 @@ pub(crate) struct ColourJudge<'a> {
 impl<'a> ColourJudge<'a> {
     /// The judge of `effect` for `view` of `scene` through `orbit` (a view rasterizing per
     /// sample through [`ColourJudge::per_sample`], which refuses what is not resolved per sample).
-    pub fn new(
+    pub(crate) fn new(
         effect: EffectName,
         scene: &Scene,
         view: &View<'a>,
@@ -204,7 +204,7 @@ impl<'a> ColourJudge<'a> {
     /// # Errors
     /// A view at one sample, or Fresnel: its normals are recomputed per pixel centre, not per
     /// sample.
-    pub fn per_sample(
+    pub(crate) fn per_sample(
         effect: EffectName,
         scene: &Scene,
         view: &View<'a>,
@@ -224,22 +224,22 @@ impl<'a> ColourJudge<'a> {
     }
 
     /// The oracle's image.
-    pub fn reference(&self) -> Option<&RgbImage> {
+    pub(crate) fn reference(&self) -> Option<&RgbImage> {
         Some(&self.reference)
     }
 
     /// The effect judged.
-    pub fn effect(&self) -> Effect {
+    pub(crate) fn effect(&self) -> Effect {
         self.effect
     }
 
     /// The material every image is shaded with.
-    pub fn material(&self) -> &Material {
+    pub(crate) fn material(&self) -> &Material {
         &self.material
     }
 
     /// The images' width and height.
-    pub fn size(&self) -> (u32, u32) {
+    pub(crate) fn size(&self) -> (u32, u32) {
         self.size
     }
 
@@ -248,7 +248,7 @@ impl<'a> ColourJudge<'a> {
     ///
     /// # Errors
     /// The image is not the judge's size.
-    pub fn judge_image(
+    pub(crate) fn judge_image(
         &self,
         image: RgbImage,
         pass: Option<AttributePass>,
@@ -300,7 +300,7 @@ impl<'a> ColourJudge<'a> {
     }
 
     /// The capture's image, compared with the oracle's.
-    pub fn judge(&self, capture: &Capture) -> Option<JudgedImage<'_>> {
+    pub(crate) fn judge(&self, capture: &Capture) -> Option<JudgedImage<'_>> {
         let start = Instant::now();
         let (full, completed) = deferred::complete(capture, self.oracle);
         self.judge_full(&full.lists, completed, start)
@@ -308,7 +308,7 @@ impl<'a> ColourJudge<'a> {
 
     /// The image of `lists` of full identities (depth key and primitive id, indexed like the
     /// oracle's), compared with the oracle's: the masked nodes' per-sample resolve.
-    pub fn judge_lists(&self, lists: &PixelLists) -> Option<JudgedImage<'_>> {
+    pub(crate) fn judge_lists(&self, lists: &PixelLists) -> Option<JudgedImage<'_>> {
         self.judge_full(lists, None, Instant::now())
     }
 

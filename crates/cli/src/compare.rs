@@ -143,7 +143,7 @@ fn legend(v: &Verdict) -> Vec<(image::Rgb<u8>, String)> {
         (0, 1, "equal, covered"),
         (0, 0, "no fragment"),
     ];
-    let mut counts = [0u64; 9];
+    let mut counts = [0_u64; 9];
     for (&flags, &n) in v.comparison.verdicts.iter().zip(&v.reference_fragments) {
         let c = colour(flags, n as usize);
         if let Some(i) = meanings.iter().position(|&(f, n, _)| colour(f, n) == c) {

@@ -42,11 +42,7 @@ impl ValueEnum for ExplainedScheme {
     fn value_variants<'a>() -> &'a [Self] {
         // The catalog's explainable entries, listed once for clap's lifetime.
         static VARIANTS: std::sync::OnceLock<Vec<ExplainedScheme>> = std::sync::OnceLock::new();
-        VARIANTS.get_or_init(|| {
-            Shown::schemes()
-                .map(|e| ExplainedScheme(e.scheme))
-                .collect()
-        })
+        VARIANTS.get_or_init(|| Shown::schemes().map(|e| Self(e.scheme)).collect())
     }
 
     fn to_possible_value(&self) -> Option<PossibleValue> {
@@ -132,8 +128,8 @@ impl WriteBackArg {
     #[must_use]
     pub fn machine(self) -> WriteBack {
         match self {
-            WriteBackArg::RenderTarget => WriteBack::RenderTarget,
-            WriteBackArg::SeparateStores => WriteBack::SeparateStores,
+            Self::RenderTarget => WriteBack::RenderTarget,
+            Self::SeparateStores => WriteBack::SeparateStores,
         }
     }
 }
@@ -151,7 +147,7 @@ fn machine_label(machine: WriteBack) -> &'static str {
 ///
 /// # Errors
 /// Bad depths or parameters.
-pub fn explain(args: &ExplainArgs) -> Result<bool, String> {
+pub(crate) fn explain(args: &ExplainArgs) -> Result<bool, String> {
     let (text, shown) = explain_text(args)?;
     if args.json {
         let mut context = crate::record::Context::new(
@@ -184,7 +180,7 @@ pub fn explain(args: &ExplainArgs) -> Result<bool, String> {
 ///
 /// # Errors
 /// Bad depths or parameters, or a `--write-back` other than the `-stores` scheme's machine.
-pub fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String> {
+pub(crate) fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String> {
     let fragments = one_pixel(&args.depths)?;
     let k = args.k.unwrap_or(fragments.len() as u32);
     let viewport = Viewport::new(1, 1)?;

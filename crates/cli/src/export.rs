@@ -51,7 +51,7 @@ fn recorded_spec(spec: &SceneSpec, view: &View<'_>) -> Result<SceneSpec, String>
 ///
 /// # Errors
 /// A scene that cannot be loaded, a bad viewport, a file that cannot be written.
-pub fn export_scene(args: &ExportArgs) -> Result<(), String> {
+pub(crate) fn export_scene(args: &ExportArgs) -> Result<(), String> {
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;
     let view = spec

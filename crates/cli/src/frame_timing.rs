@@ -32,7 +32,7 @@ pub(crate) struct FrameTimes {
 
 impl FrameTimes {
     /// The median frame.
-    pub fn median(&self) -> Duration {
+    pub(crate) fn median(&self) -> Duration {
         self.frames[self.frames.len() / 2]
     }
 }
@@ -84,7 +84,7 @@ pub(crate) fn time_raster_alone(view: &View<'_>) -> Duration {
         .into_par_iter()
         .with_min_len(1024)
         .map(|prim| {
-            let mut count = 0u64;
+            let mut count = 0_u64;
             view.rasterize(prim, &mut |_| count += 1);
             count
         })

@@ -127,7 +127,7 @@ struct BaselineRecord<'a> {
 ///
 /// # Errors
 /// Scene, parameter or output errors.
-pub fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
+pub(crate) fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
     if args.threads_in_flight.contains(&0) || args.seeds == 0 || args.write_back.is_empty() {
         return Err(
             "hazard needs --threads-in-flight ≥ 1, at least one seed and one machine".into(),

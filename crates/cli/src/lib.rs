@@ -63,17 +63,19 @@ use std::process::ExitCode;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
-pub use args::{Count, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
-pub use bench::{BenchArgs, BenchReport, BenchRow};
-pub use colour_judge::{AttributePass, EffectName};
+pub use approximate::{ApproximateName, ApproximateRow};
+pub use args::{ConventionsArgs, Count, DumpArgs, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
+pub use bench::{BenchArgs, BenchReport, BenchRow, StageShares};
+pub use colour_judge::{AttributePass, ColourColumns, EffectName};
 pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
 pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
+pub use fragsim_capture::catalog::{SchemeName, Sizing};
 pub use hazard::{BaselineRow, HazardArgs, HazardReport, HazardRow};
 pub use multisampled::{MsaaReport, SampledRow};
-pub use render::{RenderArgs, RunSummary, TieChoice};
-pub use schemes::{Fault, SchemeChoice, SchemeName, Sizing};
+pub use render::{RenderArgs, RenderScheme, RunSummary, TieChoice};
+pub use schemes::{Fault, SchemeChoice};
 pub use sweep::{SweepArgs, SweepSeries};
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.

@@ -24,7 +24,7 @@ const SUBPIXELS: f64 = 256.0;
 #[must_use]
 pub(crate) fn fragments_at_most(view: &View<'_>) -> u64 {
     let viewport = view.viewport();
-    let mut total = 0u64;
+    let mut total = 0_u64;
     for prim in 0..view.triangle_count() {
         view.screen_triangles(prim, &mut |tri| {
             total = total.saturating_add(triangle_bound(&tri, viewport.width, viewport.height));

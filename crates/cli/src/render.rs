@@ -80,8 +80,8 @@ impl ValueEnum for RenderScheme {
         VARIANTS.get_or_init(|| {
             SchemeChoice::value_variants()
                 .iter()
-                .map(|&c| RenderScheme::Catalog(c))
-                .chain([RenderScheme::Masked])
+                .map(|&c| Self::Catalog(c))
+                .chain([Self::Masked])
                 .collect()
         })
     }
@@ -111,9 +111,9 @@ pub enum TieChoice {
 impl From<TieChoice> for Ties {
     fn from(choice: TieChoice) -> Self {
         match choice {
-            TieChoice::ByPrimitive => Ties::ByPrimitive,
-            TieChoice::KeepDuplicates => Ties::KeepDuplicates,
-            TieChoice::MergeEqualDepths => Ties::MergeEqualDepths,
+            TieChoice::ByPrimitive => Self::ByPrimitive,
+            TieChoice::KeepDuplicates => Self::KeepDuplicates,
+            TieChoice::MergeEqualDepths => Self::MergeEqualDepths,
         }
     }
 }
@@ -191,7 +191,7 @@ pub struct RunSummary {
 /// # Errors
 /// A scene that cannot be loaded, bad parameters, storage beyond the memory cap, an image that
 /// cannot be written.
-pub fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
+pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let pool = args.schemes.pool()?;
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;

@@ -5,8 +5,8 @@ use clap::builder::PossibleValue;
 use clap::ValueEnum;
 use std::sync::OnceLock;
 
-pub use fragsim_capture::catalog::{
-    check_memory_cap_early, Executors, NamedRun, SchemeName, Sizing, CATALOG,
+pub(crate) use fragsim_capture::catalog::{
+    check_memory_cap_early, Executors, NamedRun, SchemeName, CATALOG,
 };
 
 /// A `--scheme` value: one catalog entry, or `all` of them.
@@ -21,13 +21,13 @@ pub enum SchemeChoice {
 impl SchemeChoice {
     /// `choices` with `all` expanded and duplicates removed, in the order given.
     #[must_use]
-    pub fn expand(choices: &[SchemeChoice]) -> Vec<SchemeName> {
-        if choices.contains(&SchemeChoice::All) {
+    pub fn expand(choices: &[Self]) -> Vec<SchemeName> {
+        if choices.contains(&Self::All) {
             return CATALOG.iter().map(|e| e.scheme).collect();
         }
         let mut unique = Vec::new();
         for &choice in choices {
-            if let SchemeChoice::One(name) = choice {
+            if let Self::One(name) = choice {
                 if !unique.contains(&name) {
                     unique.push(name);
                 }
@@ -43,18 +43,16 @@ impl ValueEnum for SchemeChoice {
         VARIANTS.get_or_init(|| {
             CATALOG
                 .iter()
-                .map(|e| SchemeChoice::One(e.scheme))
-                .chain([SchemeChoice::All])
+                .map(|e| Self::One(e.scheme))
+                .chain([Self::All])
                 .collect()
         })
     }
 
     fn to_possible_value(&self) -> Option<PossibleValue> {
         Some(match self {
-            SchemeChoice::One(name) => {
-                PossibleValue::new(name.name()).help(name.entry().description)
-            }
-            SchemeChoice::All => PossibleValue::new("all").help("Every scheme above."),
+            Self::One(name) => PossibleValue::new(name.name()).help(name.entry().description),
+            Self::All => PossibleValue::new("all").help("Every scheme above."),
         })
     }
 }
@@ -65,7 +63,7 @@ impl ValueEnum for SchemeChoice {
 /// (bucket and adaptive depth peeling), `approximate` (WBOIT, MLAB, tail blending:
 /// `--approximate`).
 #[must_use]
-pub fn family(scheme: &str) -> &'static str {
+pub(crate) fn family(scheme: &str) -> &'static str {
     const FAMILIES: [(&str, &str); 15] = [
         ("mdts", "mdts"),
         ("abuffer", "a-buffer"),
@@ -99,7 +97,7 @@ pub enum Fault {
 impl From<Fault> for fragsim_capture::catalog::Fault {
     fn from(fault: Fault) -> Self {
         match fault {
-            Fault::MiscountOverflow => fragsim_capture::catalog::Fault::MiscountOverflow,
+            Fault::MiscountOverflow => Self::MiscountOverflow,
         }
     }
 }

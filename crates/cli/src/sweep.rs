@@ -106,7 +106,7 @@ impl SweepSeries {
 ///
 /// # Errors
 /// Scene, parameter or output errors.
-pub fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
+pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let pool = args.schemes.pool()?;
     let spec = args.scene.spec(Conventions::REFERENCE);
     let scene = spec.load(None).map_err(|e| e.to_string())?;
@@ -340,7 +340,7 @@ fn print_summary(
 
 /// The mean of `values` (`None`: there are none).
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    let (sum, n) = values.fold((0.0, 0_usize), |(s, n), x| (s + x, n + 1));
     (n > 0).then(|| sum / n as f64)
 }
 

@@ -150,8 +150,10 @@ pub struct Conventions {
     pub edge_ties: Option<EdgeTies>,
 }
 
-// serde's `skip_serializing_if` takes a reference.
-#[allow(clippy::trivially_copy_pass_by_ref)]
+#[allow(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde's `skip_serializing_if` takes a reference"
+)]
 fn is_one(samples: &u32) -> bool {
     *samples == 1
 }

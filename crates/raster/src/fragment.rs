@@ -65,7 +65,7 @@ mod tests {
     #[test]
     fn key_order_is_float_order_at_the_ends() {
         let depths = [
-            0.0f32,
+            0.0_f32,
             f32::from_bits(1),
             1e-30,
             0.5,

@@ -175,7 +175,7 @@ impl Mesh {
             path: name.into(),
             reason: e.to_string(),
         })?;
-        let mut mesh = Mesh::default();
+        let mut mesh = Self::default();
         for model in models {
             let m = model.mesh;
             if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
@@ -330,7 +330,7 @@ impl UpAxis {
 /// # Errors
 /// The file cannot be read ([`MeshError::Io`]) or its gzip stream is corrupt
 /// ([`MeshError::Gzip`]), naming the file.
-pub fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
+pub(crate) fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
     let name = || path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
         path: name(),
@@ -353,7 +353,7 @@ pub fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
 /// Whether `bytes` (decompressed) are a PLY file: its first line is `ply` (ASCII and binary
 /// PLY alike start with a text header).
 #[must_use]
-pub fn is_ply(bytes: &[u8]) -> bool {
+pub(crate) fn is_ply(bytes: &[u8]) -> bool {
     bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")
 }
 
@@ -397,13 +397,13 @@ fn check_faces(text: &str) -> Result<(), String> {
         ("vn", "normal", "normals"),
     ];
     let kind_of = |tag: &str| KINDS.iter().position(|&(t, _, _)| t == tag);
-    let mut totals = [0usize; 3];
+    let mut totals = [0_usize; 3];
     for line in text.lines() {
         if let Some(k) = line.split_whitespace().next().and_then(kind_of) {
             totals[k] += 1;
         }
     }
-    let mut before = [0usize; 3];
+    let mut before = [0_usize; 3];
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let Some(tag) = words.next() else { continue };

@@ -166,7 +166,7 @@ impl Mesh {
                 bad(format!("{what}: {}", one_line(&e, binary)))
             }
         };
-        let mut mesh = Mesh::default();
+        let mut mesh = Self::default();
         let mut faces: Vec<Vec<i64>> = Vec::new();
         let mut strips: Vec<Vec<i64>> = Vec::new();
         // Elements come in header order; each must be read (or skipped) in turn.

@@ -1,10 +1,10 @@
 //! A tiny seeded generator for procedural scenes.
 //!
 //! Scenes must be a pure function of their seed across versions and platforms so that a seed in a
-//! bug report replays forever; `rand`'s `StdRng` makes no such promise across releases. SplitMix64
+//! bug report replays forever; `rand`'s `StdRng` makes no such promise across releases. `SplitMix64`
 //! (Steele, Lea & Flood 2014) is fixed, public and five lines long.
 
-/// SplitMix64: `next` returns the reference sequence of Steele et al. for a given seed.
+/// `SplitMix64`: `next` returns the reference sequence of Steele et al. for a given seed.
 #[derive(Clone, Debug)]
 pub struct SplitMix64 {
     state: u64,
@@ -28,7 +28,7 @@ impl SplitMix64 {
 
     /// A uniform float in `[0, 1)` with 53 random bits.
     pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        (self.next_u64() >> 11) as f64 / (1_u64 << 53) as f64
     }
 }
 

@@ -110,7 +110,7 @@ pub const MESH_HASH_PREFIX: &str = "fnv1a64:";
 /// prime `0x100000001b3`), as `fnv1a64:` and 16 lower-case hex digits.
 #[must_use]
 pub fn mesh_hash(bytes: &[u8]) -> String {
-    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |hash, &byte| {
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |hash, &byte| {
         (hash ^ u64::from(byte)).wrapping_mul(0x100_0000_01b3)
     });
     format!("{MESH_HASH_PREFIX}{hash:016x}")
@@ -118,10 +118,10 @@ pub fn mesh_hash(bytes: &[u8]) -> String {
 
 /// The scene, camera and conventions of a view: enough to rebuild it and its oracle.
 ///
-/// Its numbers are exact across a file: serde_json is built with `float_roundtrip`, so a
+/// Its numbers are exact across a file: `serde_json` is built with `float_roundtrip`, so a
 /// decimal parses to the nearest f64, and writes the shortest decimal that parses back to the same
 /// bits (ryu), so encode then parse gives every finite value back bit for bit. JSON has no NaN or
-/// infinity: [`SceneSpec::check_finite`] refuses them before a header is written (serde_json would
+/// infinity: [`SceneSpec::check_finite`] refuses them before a header is written (`serde_json` would
 /// write `null`), and a decimal past the f64 range is a parse error.
 ///
 /// An unknown field is refused by name (a misspelt `fov_y_degres` would otherwise judge the dump
@@ -329,7 +329,7 @@ impl SceneSpec {
         Ok(scene.view_under(viewport, &camera, self.conventions)?)
     }
 
-    /// Refuses a NaN or infinite number, which JSON cannot hold (serde_json would silently write
+    /// Refuses a NaN or infinite number, which JSON cannot hold (`serde_json` would silently write
     /// `null`, which then fails to parse as a number far from its cause), and an f32 matrix entry
     /// beyond f32's range.
     ///

@@ -254,7 +254,7 @@ impl Scene {
 
 /// `count` closed UV spheres centred at the origin with radii `1/count, 2/count, …, 1`.
 #[must_use]
-pub fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
+pub(crate) fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
     let mut mesh = Mesh::default();
     for s in 1..=count {
         let radius = f64::from(s) / f64::from(count);
@@ -297,7 +297,7 @@ pub fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
 /// The paper gives neither the spheres' sizes nor their placement; these make a scene of high
 /// depth complexity around and through the bunny.
 #[must_use]
-pub fn bunny_with_spheres(bunny: &Mesh, count: u32, seed: u64) -> Mesh {
+pub(crate) fn bunny_with_spheres(bunny: &Mesh, count: u32, seed: u64) -> Mesh {
     let (lo, hi) = bunny.bounds();
     let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
     let unit = nested_spheres(1, 16, 8);
@@ -320,7 +320,7 @@ pub fn bunny_with_spheres(bunny: &Mesh, count: u32, seed: u64) -> Mesh {
 
 /// `count` triangles with vertices uniform in the unit cube, from `seed`.
 #[must_use]
-pub fn triangle_soup(count: u32, seed: u64) -> Mesh {
+pub(crate) fn triangle_soup(count: u32, seed: u64) -> Mesh {
     let mut rng = SplitMix64::new(seed);
     let mut mesh = Mesh::default();
     for t in 0..count {
@@ -335,7 +335,7 @@ pub fn triangle_soup(count: u32, seed: u64) -> Mesh {
 
 /// `count` unit squares parallel to the xy plane, stacked along z in `[0, 1]`.
 #[must_use]
-pub fn stacked_quads(count: u32) -> Mesh {
+pub(crate) fn stacked_quads(count: u32) -> Mesh {
     let mut mesh = Mesh::default();
     for q in 0..count {
         let z = if count == 1 {

@@ -112,7 +112,7 @@ pub(super) fn slots(
         header.filled = input.u8() & 1 != 0;
         header.sorted = input.u8() & 1 != 0;
     }
-    let mut offsets = vec![0u32];
+    let mut offsets = vec![0_u32];
     if scheme == SlotScheme::ABufferExact {
         for &c in &counts {
             offsets.push(offsets[offsets.len() - 1] + c);

@@ -21,7 +21,7 @@ const BUCKETS: [(&str, u64); 6] = [
 /// The mean squared error a PSNR stands for (`null`: 0, an equal image or bucket).
 fn mse(psnr: &Value) -> f64 {
     psnr.as_f64()
-        .map_or(0.0, |db| 255.0 * 255.0 / 10f64.powf(db / 10.0))
+        .map_or(0.0, |db| 255.0 * 255.0 / 10_f64.powf(db / 10.0))
 }
 
 fn close(a: f64, b: f64) -> bool {
@@ -73,7 +73,11 @@ fn assert_buckets_add_up(record: &Value) -> u64 {
         let bucket_max = field("max_abs_error", suffix);
         max = (0..3).fold(max, |m, c| m.max(bucket_max[c].as_u64().unwrap()));
     }
-    assert_eq!(errors, record["error_pixels"].as_u64().unwrap_or(errors));
+    assert_eq!(
+        errors,
+        record["error_pixels"].as_u64().unwrap_or(errors),
+        "error pixels summed over buckets: {record}"
+    );
     for (c, sum) in abs.iter().enumerate() {
         let whole = record["mean_abs_error"][c].as_f64().unwrap() * all_pixels;
         assert!(close(*sum, whole), "channel {c}: {sum} ≠ {whole}: {record}");

@@ -69,7 +69,7 @@ fn orders() -> Vec<Vec<u64>> {
 #[test]
 fn mlab_and_tail_blend_are_exact_up_to_k_fragments_and_only_then() {
     let m = material();
-    for k in 1..=4u32 {
+    for k in 1..=4_u32 {
         for approximation in [Approximation::Mlab { k }, Approximation::TailBlend { k }] {
             let mut differ = false;
             for order in orders() {

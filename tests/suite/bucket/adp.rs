@@ -30,7 +30,7 @@ fn close_pair_scene(gap: f32) -> Scene {
 
 #[test]
 fn adp_is_exact_when_layers_are_farther_apart_than_a_subinterval() {
-    for quads in [16u32, 40, 64] {
+    for quads in [16_u32, 40, 64] {
         let scene = Scene::procedural(&format!("quads:{quads}")).unwrap();
         let view = view_of(&scene, 32);
         let oracle = Oracle::build(&view);

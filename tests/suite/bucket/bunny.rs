@@ -15,9 +15,9 @@ fn bunny_error_rates_are_small_and_ordered() {
     let scene = Scene::default_scene();
     let vp = Viewport::new(512, 512).unwrap();
     let names = ["bdp", "bdp-single", "bdp2", "adp"];
-    let mut lost = [0u64; 4];
-    let mut error_pixels = [0u64; 4];
-    let (mut fragments, mut covered, mut unround) = (0u64, 0u64, 0u64);
+    let mut lost = [0_u64; 4];
+    let mut error_pixels = [0_u64; 4];
+    let (mut fragments, mut covered, mut unround) = (0_u64, 0_u64, 0_u64);
     println!("angle  fragments  covered  max-depth  lost(bdp bdp-single bdp2 adp)");
     for angle in (0..8).map(|i| f64::from(i) * 45.0) {
         let view = scene

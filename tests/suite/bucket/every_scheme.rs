@@ -19,10 +19,10 @@ proptest! {
     /// singles, ADP per 1/1024 subinterval) of each bucket's distinct values.
     #[test]
     fn losses_are_exactly_the_bucket_overflows_on_random_soups(
-        count in 50u32..600,
+        count in 50_u32..600,
         seed in any::<u64>(),
-        side in 8u32..40,
-        angle in 0.0f64..360.0,
+        side in 8_u32..40,
+        angle in 0.0_f64..360.0,
     ) {
         let scene = Scene::procedural(&format!("soup:{count}:{seed}")).unwrap();
         let view = scene

@@ -45,7 +45,10 @@ fn both<S: Scheme>(view: &View<'_>, scheme: &S) -> [Run; 2] {
     let serial = run_serial(view, scheme);
     let parallel = run_parallel(view, scheme);
     assert_eq!(serial.capture, parallel.capture, "{}", scheme.name());
-    assert_eq!(serial.stats.passes, parallel.stats.passes);
+    assert_eq!(
+        serial.stats.passes, parallel.stats.passes,
+        "the executors run as many passes"
+    );
     [serial, parallel]
 }
 
@@ -112,7 +115,7 @@ fn predicted_loss_routed(
     key_only: bool,
     route: Router,
 ) -> (u64, usize) {
-    let (mut lost, mut most) = (0u64, 0usize);
+    let (mut lost, mut most) = (0_u64, 0_usize);
     for p in 0..oracle.pixels() {
         let list = oracle.pixel(p);
         let (Some(&first), Some(&last)) = (list.first(), list.last()) else {

@@ -13,7 +13,7 @@ fn the_exact_router_agrees_with_eq_2_worked_by_hand() {
     let key = |d: f32| d.to_bits();
     let (near, far) = (key(0.25), key(0.75));
     // 0.25 + 0.5 · j / 16 is exact in f32: bound j itself opens subinterval j.
-    for j in 0..16u32 {
+    for j in 0..16_u32 {
         let bound = 0.25 + 0.5 * j as f32 / 16.0;
         assert_eq!(exact_subinterval(key(bound), near, far, 16), j, "bound {j}");
         if j > 0 {
@@ -29,12 +29,12 @@ fn the_exact_router_agrees_with_eq_2_worked_by_hand() {
     assert_eq!(exact_subinterval(key(0.5), key(0.5), key(0.5), 16), 0);
     // Count 5, range [0, 1]: 0.6 is 3/5 only approximately; the f32 nearest 0.6 is
     // 10066330 · 2^-24, and 5 · 10066330 = 50331650 ≥ 3 · 2^24 = 50331648, so subinterval 3.
-    assert_eq!(0.6f32.to_bits() & 0x7F_FFFF | 0x80_0000, 10_066_330);
+    assert_eq!(0.6_f32.to_bits() & 0x7F_FFFF | 0x80_0000, 10_066_330);
     assert_eq!(exact_subinterval(key(0.6), key(0.0), key(1.0), 5), 3);
     // The next f32 below it, 10066329 · 2^-24: 5 · 10066329 = 50331645 < 50331648, so 2.
     assert_eq!(exact_subinterval(key(0.6) - 1, key(0.0), key(1.0), 5), 2);
     // Subnormal and normal depths in one range: [2^-149, 2^-126 · 1.5], midpoint-ish.
-    let (tiny, small) = (1u32, key(1.5 * f32::MIN_POSITIVE));
+    let (tiny, small) = (1_u32, key(1.5 * f32::MIN_POSITIVE));
     assert_eq!(exact_subinterval(tiny, tiny, small, 2), 0);
     assert_eq!(exact_subinterval(key(f32::MIN_POSITIVE), tiny, small, 2), 1);
 }

@@ -5,7 +5,7 @@ use super::{assert_obj_refused, assert_refused, fragsim, obj_file, TRIANGLE_VERT
 
 /// `data` gzipped as one stored (uncompressed) deflate block: gzip without a compressor.
 fn gzip_stored(data: &[u8]) -> Vec<u8> {
-    let crc = !data.iter().fold(!0u32, |crc, &byte| {
+    let crc = !data.iter().fold(!0_u32, |crc, &byte| {
         (0..8).fold(crc ^ u32::from(byte), |c, _| {
             (c >> 1) ^ (0xEDB8_8320 & (c & 1).wrapping_neg())
         })

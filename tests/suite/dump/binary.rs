@@ -152,7 +152,7 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
         let slots = path.join(file);
         let mut bytes = std::fs::read(&slots).unwrap();
         let word = |bytes: &[u8], i: usize| {
-            let mut le = [0u8; 8];
+            let mut le = [0_u8; 8];
             le[..width].copy_from_slice(&bytes[i * width..(i + 1) * width]);
             u64::from_le_bytes(le)
         };

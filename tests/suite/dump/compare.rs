@@ -273,7 +273,7 @@ fn a_stored_depth_key_above_one_is_corrupt() {
     with_view(|view, oracle| {
         let k = oracle.max_depth_complexity();
         let p = pixel_with(oracle, 1, usize::MAX);
-        let impossible = (0x3F80_0001u64 << 32) | (oracle.pixel(p)[0] & 0xFFFF_FFFF);
+        let impossible = (0x3F80_0001_u64 << 32) | (oracle.pixel(p)[0] & 0xFFFF_FFFF);
         let mdts = DumpScheme::Mdts {
             k,
             direction: Direction::Ascending,
@@ -301,7 +301,7 @@ fn a_stored_depth_key_above_one_is_corrupt() {
 #[test]
 fn an_abuffer_counter_other_than_the_pixels_fragment_count_is_overflow_miscounted() {
     with_view(|view, oracle| {
-        let capacity = 3u32;
+        let capacity = 3_u32;
         let counts = oracle.depth_complexity();
         let predicted: u64 = counts
             .iter()
@@ -426,7 +426,7 @@ fn depth_ulps_accepts_keys_within_the_tolerance_and_no_further() {
             .find(|&p| oracle.pixel(p).len() == 2)
             .unwrap();
         for (nudge, tolerance, equal) in [
-            (1u64, 0u32, false),
+            (1_u64, 0_u32, false),
             (1, 1, true),
             (3, 2, false),
             (3, 3, true),

@@ -110,7 +110,7 @@ impl Grid {
         let c = CAPACITY as usize;
         let mut slots = vec![u64::MAX; lists.len() * c];
         for (p, list) in lists.iter().enumerate() {
-            assert!(list.len() <= c);
+            assert!(list.len() <= c, "pixel {p} holds more than {c} fragments");
             slots[p * c..p * c + list.len()].copy_from_slice(list);
         }
         let counters = lists.iter().map(|l| l.len() as u32).collect();

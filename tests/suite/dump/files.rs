@@ -97,7 +97,7 @@ fn malformed_dumps_are_clear_errors() {
             direction: Direction::Ascending,
         };
         let good = Dump::record(view, spec(), &scheme, "test").unwrap();
-        let cases: Vec<(&str, Breaker)> = vec![
+        let cases: Vec<(&str, Breaker<'_>)> = vec![
             (
                 "version",
                 Box::new(|d: &Path| edit_header(d, "\"version\": 1", "\"version\": 9")),

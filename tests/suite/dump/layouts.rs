@@ -103,7 +103,11 @@ fn u32s<'a>(dump: &'a mut Dump, name: &str) -> &'a mut Vec<u32> {
 /// The corrupt words that the comparison found at pixel `p`, which it must call corrupt.
 fn corrupt_at(dump: &Dump, oracle: &Oracle, p: usize) -> Vec<Corruption> {
     let comparison = judged(dump, oracle);
-    assert_ne!(comparison.verdicts[p] & verdict::CORRUPT, 0);
+    assert_ne!(
+        comparison.verdicts[p] & verdict::CORRUPT,
+        0,
+        "pixel {p} is not flagged corrupt"
+    );
     let check = dump.check_words().unwrap();
     check.corrupt[p].iter().map(|c| c.why).collect()
 }
@@ -139,7 +143,7 @@ fn links_out_of_the_pool_or_to_unallocated_nodes_are_corrupt() {
         // A node whose depth key is above 1.0.
         let mut key = dump.clone();
         if let Some(Words::U64(nodes)) = key.arrays.get_mut("nodes") {
-            nodes[head as usize - 1] = u64::from(2.0f32.to_bits()) << 32;
+            nodes[head as usize - 1] = u64::from(2.0_f32.to_bits()) << 32;
         }
         assert_eq!(corrupt_at(&key, oracle, p), vec![Corruption::ImpossibleKey]);
         // A lost node: unlinked from its list, allocated, reached by no list.

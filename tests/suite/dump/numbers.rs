@@ -112,8 +112,8 @@ proptest! {
     fn any_decimal_in_a_header_parses_to_the_nearest_f64(
         negative in any::<bool>(),
         digits in "[0-9]{1,40}",
-        point in 0usize..41,
-        exponent in -360i32..360,
+        point in 0_usize..41,
+        exponent in -360_i32..360,
     ) {
         let point = point.min(digits.len());
         let sign = if negative { "-" } else { "" };

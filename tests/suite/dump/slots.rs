@@ -112,7 +112,7 @@ fn every_slot_layout_in_either_order_and_payload_round_trips_and_compares_equal(
 /// `depth_key << 32 | prim` with the depth rounded to the nearest of `bits`-bit unorm steps and
 /// read back as the nearest f32, as the format decodes a unorm payload.
 fn quantised(word: u64, bits: u32) -> u64 {
-    let steps = f64::from((1u32 << bits) - 1);
+    let steps = f64::from((1_u32 << bits) - 1);
     let depth = f64::from(f32::from_bits((word >> 32) as u32));
     let back = ((depth * steps).round() / steps) as f32;
     u64::from(back.to_bits()) << 32 | (word & 0xFFFF_FFFF)
@@ -310,7 +310,7 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
         let keys = record(&DumpScheme::Mdts32 { k: 3 });
         let error = refused(&keys, |h| {
             h["layout"] = json!({"kind": "slots", "order": "slot-major",
-                "payload": {"dtype": "u32", "depth": "f32", "depth_shift": 0, "prim_bits": 0}})
+                "payload": {"dtype": "u32", "depth": "f32", "depth_shift": 0, "prim_bits": 0}});
         });
         assert!(error.contains("its layout takes no \"payload\""), "{error}");
         let exact = record(&DumpScheme::ABufferExact {
@@ -392,7 +392,7 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
         (word >> 32) << 24 | (word & 0xFF_FFFF)
     );
     assert_eq!(header("abuffer")["layout"]["payload"]["depth_shift"], 24);
-    assert_eq!(header("linked-list")["layout"]["null"], 4_294_967_295u64);
+    assert_eq!(header("linked-list")["layout"]["null"], 4_294_967_295_u64);
     assert_eq!(
         header("layer-counter")["layout"]["payload"]["prim_bits"],
         24

@@ -66,7 +66,7 @@ fn cuda_atomic_inc_past_capacity_overwrites_silently_where_fetch_add_counts_the_
 
 #[test]
 fn atomic_inc_on_ten_thousand_coincident_fragments_keeps_only_the_remainder() {
-    let n = 10_000u32;
+    let n = 10_000_u32;
     let mesh = Mesh {
         positions: vec![[-1.0, -1.0, 0.5], [3.0, -1.0, 0.5], [-1.0, 3.0, 0.5]],
         triangles: vec![[0, 1, 2]; n as usize],

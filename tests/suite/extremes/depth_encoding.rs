@@ -17,7 +17,7 @@ fn negative_zero_has_the_key_of_positive_zero_not_0x80000000() {
     assert_eq!(depth_key(-0.0), Some(0));
     // Unmapped, its bit pattern would sort after every depth up to 1.0: the library's MDTS,
     // handed the raw bits, keeps the nearest depth there is behind depth 1.0.
-    let raw = (-0.0f32).to_bits();
+    let raw = (-0.0_f32).to_bits();
     assert_eq!(
         mdts32_run::<SerialMemory>(&[raw, MAX_KEY]).0,
         [MAX_KEY, raw]
@@ -127,8 +127,8 @@ fn a_triangle_touching_depth_zero_from_below_is_clipped_away() {
 proptest! {
     #[test]
     fn depth_key_order_equals_depth_order_on_the_unit_interval(
-        a in prop_oneof![0u32..=MAX_KEY, Just(0x8000_0000u32)],
-        b in prop_oneof![0u32..=MAX_KEY, Just(0x8000_0000u32)],
+        a in prop_oneof![0_u32..=MAX_KEY, Just(0x8000_0000_u32)],
+        b in prop_oneof![0_u32..=MAX_KEY, Just(0x8000_0000_u32)],
     ) {
         // Including -0.0, which equals +0.0 as a float and as a key.
         let (x, y) = (f32::from_bits(a), f32::from_bits(b));

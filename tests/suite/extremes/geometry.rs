@@ -103,7 +103,10 @@ fn scaled_spheres(scale: f32) -> Vec<u32> {
     let k = oracle.max_depth_complexity();
     assert_eq!(k, 6, "scale {scale:e}");
     let mdts = Mdts::<u64>::ascending(view.viewport(), k).unwrap();
-    assert!(oracle.diff(&run_serial(&view, &mdts).capture).is_exact());
+    assert!(
+        oracle.diff(&run_serial(&view, &mdts).capture).is_exact(),
+        "MDTS is not exact on the extreme scene"
+    );
     oracle.depth_complexity()
 }
 
@@ -263,7 +266,7 @@ fn a_near_far_ratio_of_1e_minus_7_merges_distinct_layers_ordered_by_primitive() 
 fn two_layers_closer_than_one_ulp_keep_both_in_primitive_order() {
     let camera = perspective(1.0, 100.0);
     // Eye-space distances one f32 ulp apart; the farther layer has the lower primitive ids.
-    let far = 50.0f32;
+    let far = 50.0_f32;
     let near = f32::from_bits(far.to_bits() - 1);
     let (keys, mesh) = keys_of_layers(&camera, &[far, near]);
     assert_eq!(keys[0], keys[1], "one depth key for both layers");
@@ -290,7 +293,7 @@ fn two_layers_closer_than_one_ulp_keep_both_in_primitive_order() {
 
 #[test]
 fn ten_thousand_coincident_triangles_on_one_pixel_are_ordered_by_primitive_id() {
-    let n = 10_000u32;
+    let n = 10_000_u32;
     let mesh = Mesh {
         positions: vec![[-1.0, -1.0, 0.5], [3.0, -1.0, 0.5], [-1.0, 3.0, 0.5]],
         triangles: vec![[0, 1, 2]; n as usize],

@@ -28,8 +28,8 @@ fn depth_keys_exist_only_up_to_0x3f800000_so_neither_sentinel_collides() {
     // Both signs, every exponent, the 4,096 smallest and largest mantissas of each: every
     // boundary of the float format (0, subnormals, 1.0, infinity, the NaNs) is covered exactly;
     // the proptest below samples the rest.
-    for sign in [0, 0x8000_0000u32] {
-        for exponent in 0..256u32 {
+    for sign in [0, 0x8000_0000_u32] {
+        for exponent in 0..256_u32 {
             let base = sign | exponent << 23;
             for mantissa in (0..4096).chain((1 << 23) - 4096..1 << 23) {
                 let bits = base | mantissa;
@@ -42,7 +42,7 @@ fn depth_keys_exist_only_up_to_0x3f800000_so_neither_sentinel_collides() {
         }
     }
     // The only bit patterns equal to the sentinels are NaNs, which have no key.
-    for sentinel in [0x7FFF_FFFFu32, 0xFFFF_FFFF] {
+    for sentinel in [0x7FFF_FFFF_u32, 0xFFFF_FFFF] {
         assert!(f32::from_bits(sentinel).is_nan());
         assert_eq!(depth_key(f32::from_bits(sentinel)), None);
     }
@@ -141,7 +141,7 @@ impl Memory for SignedMin {
 /// it stores nothing, and every walk, handed back the empty value, takes itself for stored.
 #[test]
 fn a_signed_atomic_min_sees_the_librarys_empty_value_as_minus_one_and_keeps_nothing() {
-    let depths = [0.5f32, 1.0, 0.0, f32::from_bits(1)];
+    let depths = [0.5_f32, 1.0, 0.0, f32::from_bits(1)];
     let keys: Vec<u32> = depths.iter().map(|&d| depth_key(d).unwrap()).collect();
     let (kept, outcomes) = mdts32_run::<SerialMemory>(&keys);
     let mut sorted = depths.to_vec();

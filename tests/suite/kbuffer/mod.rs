@@ -171,9 +171,9 @@ fn constructors_reject_k_zero_no_passes_and_too_much_memory() {
 
 fn scene_name() -> impl Strategy<Value = String> {
     prop_oneof![
-        (1u32..4).prop_map(|n| format!("spheres:{n}")),
-        (1u32..120, any::<u64>()).prop_map(|(count, seed)| format!("soup:{count}:{seed}")),
-        (1u32..20).prop_map(|n| format!("quads:{n}")),
+        (1_u32..4).prop_map(|n| format!("spheres:{n}")),
+        (1_u32..120, any::<u64>()).prop_map(|(count, seed)| format!("soup:{count}:{seed}")),
+        (1_u32..20).prop_map(|n| format!("quads:{n}")),
     ]
 }
 
@@ -186,11 +186,11 @@ proptest! {
     #[test]
     fn serial_kbuffers_and_srab_keep_what_they_promise_on_random_scenes(
         name in scene_name(),
-        width in 3u32..24,
-        height in 3u32..24,
-        angle in 0.0f64..360.0,
-        k in 1u32..6,
-        srab_passes in 1u32..4,
+        width in 3_u32..24,
+        height in 3_u32..24,
+        angle in 0.0_f64..360.0,
+        k in 1_u32..6,
+        srab_passes in 1_u32..4,
     ) {
         let scene = Scene::procedural(&name).unwrap();
         let view = scene.view(viewport(width, height), &OrbitCamera::default().at_angle(angle)).unwrap();

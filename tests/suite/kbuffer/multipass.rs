@@ -52,7 +52,7 @@ fn multipass_kbuffer_is_exact_serially_with_the_output_predicted_pass_by_pass() 
     let quads8_view = quads8.view(viewport(8, 8), &head_on()).unwrap();
     let quads9_view = quads9.view(viewport(8, 8), &head_on()).unwrap();
     for (view, ks) in [
-        (&bunny_view, &[1u32, 4, 7][..]),
+        (&bunny_view, &[1_u32, 4, 7][..]),
         (&quads8_view, &[4, 3, 8][..]),
         (&quads9_view, &[4, 9, 10][..]),
     ] {
@@ -113,7 +113,7 @@ fn multipass_under_random_interleavings_is_exact_in_at_least_the_serial_passes()
                 let memory: SerialMemory = scheme.layout().allocate();
                 let mut rng = SplitMix64::new(seed);
                 let pixels = view.viewport().pixels();
-                let mut before = vec![0usize; pixels];
+                let mut before = vec![0_usize; pixels];
                 let mut pass = 0;
                 loop {
                     // Every walk of the pass in flight at once, stepped in random order.

@@ -31,7 +31,11 @@ fn with_sampled_bunny(
         ..Conventions::REFERENCE
     };
     let view = scene.view_under(viewport, &camera, conventions).unwrap();
-    assert_eq!(view.samples().map(SamplePattern::count), Some(samples));
+    assert_eq!(
+        view.samples().map(SamplePattern::count),
+        Some(samples),
+        "the view samples at the asked count"
+    );
     test(&view);
 }
 
@@ -52,7 +56,10 @@ fn engine_like_samples(view: &View<'_>) -> Vec<Vec<u64>> {
     let top_left = |a: [i64; 2], b: [i64; 2]| b[1] < a[1] || (b[1] == a[1] && b[0] > a[0]);
     for prim in 0..view.triangle_count() {
         let indices = view.mesh().triangles[prim as usize];
-        assert!(indices.iter().all(|&i| view.vertex_window(i).is_some()));
+        assert!(
+            indices.iter().all(|&i| view.vertex_window(i).is_some()),
+            "the triangle's vertices are in front of the camera"
+        );
         let [(a, za), (mut b, mut zb), (mut c, mut zc)] = indices.map(|i| f32_vertex(view, i));
         let mut area = edge(a, b, c);
         if area == 0 {
@@ -107,7 +114,11 @@ fn with_f32_samples(
         with_sampled_bunny(size, samples, VertexPrecision::F64, |view| {
             let oracle = Oracle::build(view);
             let precision = Precision::derive(view, &Conventions { samples, ..F32 });
-            assert_eq!(precision.pixels(), oracle.pixels());
+            assert_eq!(
+                precision.pixels(),
+                oracle.pixels(),
+                "the precision reference covers the oracle's samples"
+            );
             test(&oracle, &precision, [own, engine_like_samples(view)]);
         });
     });

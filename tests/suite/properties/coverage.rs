@@ -71,7 +71,7 @@ proptest! {
     /// `closed_scenes_are_in_view` for a case that is not vacuous.)
     #[test]
     fn nested_spheres_cover_every_pixel_an_even_number_of_times(
-        n in 1u32..=3,
+        n in 1_u32..=3,
         camera in orbit_camera_outside(),
         viewport in viewport(),
     ) {

@@ -103,7 +103,7 @@ fn with_view(
 
 /// Fragments per pixel, counted straight from the rasterizer.
 fn coverage(view: &View<'_>) -> Vec<u32> {
-    let mut counts = vec![0u32; view.viewport().pixels()];
+    let mut counts = vec![0_u32; view.viewport().pixels()];
     for prim in 0..view.triangle_count() {
         view.rasterize(prim, &mut |f| counts[f.pixel as usize] += 1);
     }

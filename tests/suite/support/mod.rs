@@ -6,11 +6,11 @@
 //! - [`json_lines`]: the records of a `--json` output (`docs/json-schema.md`).
 //! - [`scratch`]: a fresh directory for a test's files.
 
-pub use fragsim_testkit::strategies;
+pub(crate) use fragsim_testkit::strategies;
 
 /// The records of a `--json` output, one JSON object a line (`docs/json-schema.md`); panics
 /// naming the line that is not one.
-pub fn json_lines(stdout: &[u8]) -> Vec<serde_json::Value> {
+pub(crate) fn json_lines(stdout: &[u8]) -> Vec<serde_json::Value> {
     String::from_utf8_lossy(stdout)
         .lines()
         .map(|line| {
@@ -24,7 +24,7 @@ pub fn json_lines(stdout: &[u8]) -> Vec<serde_json::Value> {
 
 /// A fresh, empty directory `GROUP/NAME` under cargo's per-test-target temporary directory, where
 /// a test writes its files: emptied first, so that nothing of an earlier run is read back.
-pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
+pub(crate) fn scratch(group: &str, name: &str) -> std::path::PathBuf {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(group)
         .join(name);

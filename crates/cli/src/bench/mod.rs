@@ -266,7 +266,7 @@ fn images(args: &BenchArgs) -> Result<Option<Images<'_>>, String> {
 ///
 /// # Errors
 /// Scene, parameter or output errors.
-pub fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
+pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let pattern = args
         .samples
         .map(|count| {

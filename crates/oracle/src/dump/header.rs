@@ -227,7 +227,7 @@ pub(super) fn check_file_name(name: &str, file: &str) -> Result<(), DumpError> {
 pub(super) fn elements(name: &str, shape: &[u64]) -> Result<u64, DumpError> {
     shape
         .iter()
-        .try_fold(1u64, |n, &d| n.checked_mul(d))
+        .try_fold(1_u64, |n, &d| n.checked_mul(d))
         .ok_or_else(|| {
             DumpError::Invalid(format!(
                 "array {name:?}: shape {shape:?} has more than 2^64 elements"

@@ -8,7 +8,7 @@ use crate::{OrbitCamera, Scene};
 
 /// FNV-1a 64 over every fragment's pixel, depth key and primitive id, in emission order.
 fn fingerprint(view: &View<'_>) -> (u64, u64) {
-    let (mut hash, mut count) = (0xcbf2_9ce4_8422_2325u64, 0u64);
+    let (mut hash, mut count) = (0xcbf2_9ce4_8422_2325_u64, 0_u64);
     for prim in 0..view.triangle_count() {
         view.rasterize(prim, &mut |f| {
             count += 1;
@@ -244,7 +244,7 @@ fn four_subpixel_bits_snap_to_sixteenths_rounding_half_away() {
 fn four_subpixel_bits_move_a_centre_onto_an_edge() {
     // A vertical left edge at window x 1.53: right of the centres of column 1 (x 1.5) at 8
     // bits, on them at 4 bits, where the left edge owns them.
-    let x = (1.53f64 / 2.0 - 1.0) as f32;
+    let x = (1.53_f64 / 2.0 - 1.0) as f32;
     let mesh = Mesh {
         positions: vec![[x, -1.0, 0.5], [3.0, -1.0, 0.5], [x, 3.0, 0.5]],
         triangles: vec![[0, 1, 2]],
@@ -277,7 +277,7 @@ fn minus_one_to_one_keeps_what_lies_between_minus_w_and_zero() {
     assert!(keys.is_empty());
     let gl = with(|c| c.depth_range = DepthRange::MinusOneToOne);
     identity_view(&mesh, 4, gl).rasterize(0, &mut |f| keys.push(f.depth_key));
-    assert_eq!(keys, vec![0.25f32.to_bits(); 16]);
+    assert_eq!(keys, vec![0.25_f32.to_bits(); 16]);
 }
 
 #[test]
@@ -314,7 +314,7 @@ fn the_f32_vertex_stage_rounds_as_a_vertex_shader() {
         0.0, 0.0, third, 0.1, //
         0.0, 0.0, 0.0, 1.0,
     ]);
-    let p = [0.7f32, -0.3, 0.77];
+    let p = [0.7_f32, -0.3, 0.77];
     let mesh = Mesh {
         positions: vec![p, [2.9, -2.9, 0.77], [0.7, 2.9, 0.77]],
         triangles: vec![[0, 1, 2]],
@@ -325,7 +325,7 @@ fn the_f32_vertex_stage_rounds_as_a_vertex_shader() {
         let view = View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions);
         view.unwrap().snapped(0).1
     };
-    let expected = f64::from(((third as f32) * p[2] + 0.1f32) / 1.0f32);
+    let expected = f64::from(((third as f32) * p[2] + 0.1_f32) / 1.0_f32);
     assert_eq!(depth_of_vertex_0(f32_stage).to_bits(), expected.to_bits());
     let reference = third * f64::from(p[2]) + 0.1;
     assert_eq!(depth_of_vertex_0(Conventions::REFERENCE), reference);

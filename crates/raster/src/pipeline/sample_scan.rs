@@ -114,13 +114,16 @@ impl View<'_> {
         };
         let [a, b, c] = tri.xy;
         let area = edge(a, b, c);
-        debug_assert!(area > 0);
+        debug_assert!(
+            area > 0,
+            "set-up triangles are oriented with a positive area"
+        );
         // Edge i is opposite vertex i, so its value is the barycentric weight of vertex i.
         let edges = [(b, c), (c, a), (a, b)];
         let threshold = fill_thresholds(edges, self.conventions.window_origin);
         // The gradient of edge (p, q) is (−(q_y − p_y), q_x − p_x) per 1/256 pixel.
         let gradient = edges.map(|(p, q)| [-(q[1] - p[1]), q[0] - p[0]]);
-        let mut offsets = [[0i64; 3]; MAX_SAMPLES];
+        let mut offsets = [[0_i64; 3]; MAX_SAMPLES];
         for (s, offset) in offsets.iter_mut().enumerate().take(n as usize) {
             let [ox, oy] = pattern.fixed_offset(s);
             *offset = gradient.map(|[gx, gy]| gx * ox + gy * oy);

@@ -145,7 +145,7 @@ impl ScanSetup {
             u64::from((edge(0) & edge(1) & edge(2)).bitmask())
         };
         let wide = last_column >= 4;
-        let mut covered = 0u64;
+        let mut covered = 0_u64;
         // Four rows always, without a branch (most boxes have at most four), four more when the
         // box has them; rows past the last are masked off below.
         for rows in [0..4, 4..8] {
@@ -164,7 +164,7 @@ impl ScanSetup {
                 }
             }
         }
-        let columns = ((1u64 << (last_column + 1)) - 1) * 0x0101_0101_0101_0101;
+        let columns = ((1_u64 << (last_column + 1)) - 1) * 0x0101_0101_0101_0101;
         covered & columns & (u64::MAX >> (BLOCK_SIDE * (BLOCK_SIDE - 1 - last_row)))
     }
 

@@ -50,7 +50,7 @@ fn depth_is_interpolated_and_keyed() {
     let mut keys = Vec::new();
     view.rasterize(0, &mut |f| keys.push(f.depth_key));
     assert_eq!(keys.len(), 16);
-    assert!(keys.iter().all(|&k| k == 0.25f32.to_bits()));
+    assert!(keys.iter().all(|&k| k == 0.25_f32.to_bits()));
 }
 
 #[test]
@@ -104,7 +104,7 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
             .planes
             .iter()
             .enumerate()
-            .fold(0u8, |code, (i, plane)| {
+            .fold(0_u8, |code, (i, plane)| {
                 code | (u8::from(plane.dot(clip) < 0.0) << i)
             });
         if DVec4::new(0.0, 0.0, -1.0, 1.0).dot(clip) < 0.0 {
@@ -115,7 +115,7 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
         }
         code
     };
-    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    let mut x = 0x2545_F491_4F6C_DD1D_u64;
     let mut next = || {
         x ^= x << 13;
         x ^= x >> 7;
@@ -128,7 +128,7 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
             let bits = next();
             match bits % 4 {
                 0 => specials[(bits >> 8) as usize % specials.len()],
-                1 => (bits >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0,
+                1 => (bits >> 11) as f64 / (1_u64 << 53) as f64 * 4.0 - 2.0,
                 _ => f64::from_bits(bits).clamp(-1e300, 1e300),
             }
         };
@@ -144,8 +144,10 @@ fn the_written_out_outcode_equals_the_plane_dot_products() {
 }
 
 #[test]
-// NaN is rounded as `max` and `min` take it, which `f64::clamp` does not.
-#[allow(clippy::manual_clamp)]
+#[allow(
+    clippy::manual_clamp,
+    reason = "NaN is rounded as `max` and `min` take it, which `f64::clamp` does not"
+)]
 fn rounding_without_libm_equals_f64_round() {
     let mut values = vec![
         0.5,
@@ -177,7 +179,7 @@ fn rounding_without_libm_equals_f64_round() {
         let half = f64::from(i) + 0.5;
         values.extend([half, half.next_up(), half.next_down()]);
     }
-    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    let mut x = 0x9E37_79B9_7F4A_7C15_u64;
     for _ in 0..100_000 {
         x ^= x << 13;
         x ^= x >> 7;
@@ -308,7 +310,7 @@ fn the_batched_vertex_stage_equals_rules_1_and_3_vertex_by_vertex() {
     use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
     let scene = crate::Scene::procedural("soup:300:7").unwrap();
     let viewport = Viewport::new(97, 61).unwrap();
-    let mut checked = [0usize; 2];
+    let mut checked = [0_usize; 2];
     for distance_scale in [40.0, 1.1, 0.3, 0.01] {
         let orbit = crate::OrbitCamera {
             distance_scale,
@@ -403,7 +405,7 @@ fn expected_window(view: &View<'_>, matrix: DMat4, p: [f32; 3]) -> Option<([i64;
     };
     let bits = c.subpixel_bits;
     let grid =
-        |v: f64| (v * f64::from(1u32 << bits)).round() as i64 * (1 << (SUBPIXEL_BITS - bits));
+        |v: f64| (v * f64::from(1_u32 << bits)).round() as i64 * (1 << (SUBPIXEL_BITS - bits));
     let y = if lower_left {
         (i64::from(height) << SUBPIXEL_BITS) - grid(y)
     } else {

@@ -351,7 +351,7 @@ fn snap_fixed<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_
     let grid = |value: f64| {
         // Round on the coarser grid, then express the grid point in 1/256 pixel (a multiple of
         // 2^(8 − bits)), so that the scan is the same for every grid.
-        round_half_away(value * f64::from(1u32 << bits)).wrapping_shl(SUBPIXEL_BITS - bits)
+        round_half_away(value * f64::from(1_u32 << bits)).wrapping_shl(SUBPIXEL_BITS - bits)
     };
     let y = if LOWER_LEFT {
         // Snapped in the API's own y-up window, then flipped into fragsim's rows: row r of the
@@ -412,7 +412,7 @@ fn window<T: Real, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
 
 /// The largest magnitude [`round_half_away`] rounds exactly: 2^30, far beyond the guard band's
 /// 2^24 and leaving room for the rounding's step of one inside `i32`.
-pub(super) const ROUNDING_BOUND: f64 = (1u32 << 30) as f64;
+pub(super) const ROUNDING_BOUND: f64 = (1_u32 << 30) as f64;
 
 /// `value.round() as i32` (half away from zero) for `|value| ≤` [`ROUNDING_BOUND`]; a value
 /// beyond is first clamped to it, and NaN to its negative. No libm call, no conversion
@@ -426,10 +426,12 @@ pub(super) const ROUNDING_BOUND: f64 = (1u32 << 30) as f64;
 /// a tie, where rounding half away from zero differs from rounding to even by one when to even
 /// went toward zero.
 #[inline]
-// `f64::clamp` keeps NaN, which the sum below would carry into the integer's bits.
-#[allow(clippy::manual_clamp)]
+#[allow(
+    clippy::manual_clamp,
+    reason = "`f64::clamp` keeps NaN, which the sum below would carry into the integer's bits"
+)]
 pub(super) fn round_half_away(value: f64) -> i32 {
-    const SHIFT: f64 = (3u64 << 51) as f64;
+    const SHIFT: f64 = (3_u64 << 51) as f64;
     // `max` and `min` return the number when one side is NaN (`f64::clamp` keeps NaN).
     let value = value.max(-ROUNDING_BOUND).min(ROUNDING_BOUND);
     let shifted = value + SHIFT;

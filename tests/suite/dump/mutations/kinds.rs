@@ -249,7 +249,7 @@ pub(super) fn mutant(
             let Storage::Masked { samples, .. } = storage else {
                 return None;
             };
-            let all = (1u32 << samples) - 1;
+            let all = (1_u32 << samples) - 1;
             let mask = items.first()?.mask;
             // A sample added where one is free, else one taken away.
             items[0].mask = if mask == all {
