@@ -82,4 +82,6 @@ pub use guarantee::Guarantee;
 pub use memory::{
     AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, SpanVisitor, Word, WordMemory,
 };
-pub use scheme::{CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+pub use scheme::{
+    CaptureError, Descriptor, PixelRun, Promise, Scheme, Simt, Step, MEMORY_CAP_DEFAULT,
+};

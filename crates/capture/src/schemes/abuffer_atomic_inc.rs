@@ -29,14 +29,14 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::abuffer::Claim;
 use crate::schemes::common::sort::insertion_sort;
 
 /// An A-buffer with `capacity` slots per pixel whose slot counter is CUDA's wrapping `atomicInc`.
 #[derive(Clone, Debug)]
 pub struct ABufferAtomicInc {
-    pixels: usize,
+    descriptor: Descriptor,
     capacity: usize,
     bound: u32,
 }
@@ -64,13 +64,23 @@ impl ABufferAtomicInc {
                 "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
             ));
         }
-        let scheme = Self {
+        let descriptor = Descriptor {
+            name: format!("abuffer-atomicinc-{bound}"),
+            layout: Layout::counters_and_slots(
+                viewport.pixels(),
+                viewport.pixels() * capacity as usize,
+            ),
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::ExactWithinCapacity(capacity),
+            promise: Promise::All(Capacity::PerPixel(capacity)),
             pixels: viewport.pixels(),
+            counts_every_drop: false,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
             capacity: capacity as usize,
             bound,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        })
     }
 
     /// The usual GPU choice: `bound = capacity − 1`, so that the slot index never leaves the
@@ -90,24 +100,8 @@ impl ABufferAtomicInc {
 impl Scheme for ABufferAtomicInc {
     type State = Claim;
 
-    fn name(&self) -> String {
-        format!("abuffer-atomicinc-{}", self.bound)
-    }
-
-    fn layout(&self) -> Layout {
-        Layout::counters_and_slots(self.pixels, self.pixels * self.capacity)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactWithinCapacity(self.capacity as u32)
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.capacity as u32))
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Claim {
@@ -149,10 +143,6 @@ impl Scheme for ABufferAtomicInc {
         out.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
         insertion_sort(&mut out[start..]);
         (count - stored) as u32
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 }
 

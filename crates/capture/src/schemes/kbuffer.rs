@@ -78,7 +78,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// The value of an empty slot: larger than every packed fragment.
 pub const EMPTY: u64 = u64::MAX;
@@ -110,7 +110,7 @@ impl WriteBack {
 /// The single-pass k-buffer over `u64` slots.
 #[derive(Clone, Debug)]
 pub struct KBuffer {
-    pixels: usize,
+    descriptor: Descriptor,
     slots: Slots,
 }
 
@@ -179,6 +179,33 @@ impl Slots {
             )));
         }
         Ok(Self { k, write_back })
+    }
+
+    /// The descriptor of a scheme keeping these slots for `pixels` pixels, its `u32` words
+    /// (locks, tickets) `words32`: whole fragments in `u64` slots, all empty at first, the `K`
+    /// nearest promised, and every fragment that falls off a walk's end counted as dropped.
+    pub fn descriptor(
+        self,
+        name: String,
+        pixels: usize,
+        words32: usize,
+        guarantee: Guarantee,
+    ) -> Descriptor {
+        Descriptor {
+            name,
+            layout: Layout {
+                words32,
+                init32: 0,
+                words64: self.words(pixels),
+                init64: EMPTY,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyAndPrim,
+            guarantee,
+            promise: Promise::Nearest(self.k),
+            pixels,
+            counts_every_drop: true,
+        }
     }
 
     /// `u64` words of `pixels` pixels' slots.
@@ -350,12 +377,18 @@ impl KBuffer {
         write_back: WriteBack,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new("the k-buffer", k, write_back)?,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        let slots = Slots::new("the k-buffer", k, write_back)?;
+        let pixels = viewport.pixels();
+        let descriptor = slots.descriptor(
+            format!("kbuffer{}", write_back.suffix()),
+            pixels,
+            slots.sync_words(pixels),
+            Guarantee::ExactWithoutHazards,
+        );
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
+        })
     }
 
     /// Like [`KBuffer::new`] with the default memory cap.
@@ -382,34 +415,8 @@ impl KBuffer {
 impl Scheme for KBuffer {
     type State = Insert;
 
-    fn name(&self) -> String {
-        format!("kbuffer{}", self.slots.write_back.suffix())
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: self.slots.sync_words(self.pixels),
-            init32: 0,
-            words64: self.slots.words(self.pixels),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactWithoutHazards
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.slots.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Insert {
@@ -424,10 +431,6 @@ impl Scheme for KBuffer {
             Outcome::Stored | Outcome::Overtaken => Step::Stored,
             Outcome::Evicted | Outcome::FellOff => Step::Dropped,
         }
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

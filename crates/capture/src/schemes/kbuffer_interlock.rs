@@ -53,10 +53,9 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
 
 /// What a critical section keeps of a full pixel.
@@ -100,7 +99,7 @@ pub(crate) fn section<M: Memory>(
 /// The k-buffer whose read–insert–write-back is one critical section per fragment.
 #[derive(Clone, Debug)]
 pub struct KBufferInterlock {
-    pixels: usize,
+    descriptor: Descriptor,
     /// The k-buffer's slots and insertion. Only its `K`, begin, insertion and read-back are used:
     /// the machine field is the render-target one because a critical section, like the ROP,
     /// touches all `K` slots at once, but none of its ticket bookkeeping is allocated or run.
@@ -113,12 +112,15 @@ impl KBufferInterlock {
     /// # Errors
     /// `k == 0`, or storage beyond `memory_cap`.
     pub fn new(viewport: Viewport, k: u32, memory_cap: u64) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new("kbuffer-interlock", k, WriteBack::RenderTarget)?,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        let slots = Slots::new("kbuffer-interlock", k, WriteBack::RenderTarget)?;
+        let pixels = viewport.pixels();
+        // `u32` word `p`: pixel `p`'s lock.
+        let descriptor =
+            slots.descriptor("kbuffer-interlock".into(), pixels, pixels, Guarantee::Exact);
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
+        })
     }
 
     /// Like [`KBufferInterlock::new`] with the default memory cap.
@@ -139,35 +141,8 @@ impl KBufferInterlock {
 impl Scheme for KBufferInterlock {
     type State = Insert;
 
-    fn name(&self) -> String {
-        "kbuffer-interlock".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            // `u32` word `p`: pixel `p`'s lock.
-            words32: self.pixels,
-            init32: 0,
-            words64: self.slots.words(self.pixels),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.slots.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Insert {
@@ -182,10 +157,6 @@ impl Scheme for KBufferInterlock {
         let end = section(self.slots, Keep::Nearest, insert, memory);
         memory.unlock(lock);
         end
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
