@@ -27,12 +27,12 @@
 //!
 //! **Sources.** FreePipe (Liu et al. 2010) for MDTS; the WebGPU specification (W3C, 2024: WGSL
 //! atomics are `atomic<u32>` and `atomic<i32>` only) for why the emulation exists; the lock is
-//! the per-slot form of nvpro-samples' spinlock (`kbuffer_spinlock`).
+//! the per-slot form of nvpro-samples' spinlock (`kbuffer::spinlock`).
 //!
 //! **Departures.** The words hold the halves complemented (`!hi`, `!lo`), so that the zeroed
 //! buffer WebGPU allocates is every slot empty (`u64::MAX`) and every lock free; the lock's
 //! compare-and-swap is [`Memory::try_lock`] (an exchange of 1, the same on a 0/1 word). The lock
-//! loop has the fixed shape of `kbuffer_spinlock` (the section inside the loop body), so lockstep
+//! loop has the fixed shape of `kbuffer::spinlock` (the section inside the loop body), so lockstep
 //! warps do not deadlock on it.
 
 use fragsim_raster::{Fragment, Viewport};

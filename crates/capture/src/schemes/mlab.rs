@@ -6,7 +6,7 @@
 //! depth of the nearest fragment it holds (here, as everywhere in the catalog, that fragment's
 //! `u64` `depth_key << 32 | prim`, so that ties order as the oracle orders them) and how many
 //! fragments were merged into it. A fragment's walk is **one** step, the critical section: take
-//! the pixel's lock ([`Memory::lock`], as [`kbuffer_interlock`](crate::schemes::kbuffer_interlock)
+//! the pixel's lock ([`Memory::lock`], as [`kbuffer::interlock`](crate::schemes::kbuffer::interlock)
 //! does), load the `K` nodes, insert the fragment as a node of one in depth order, and if that
 //! makes `K + 1` nodes merge the last two (the farther node's fragments join the nearer one,
 //! which keeps its depth), store the `K` nodes, unlock. A step that merged ends

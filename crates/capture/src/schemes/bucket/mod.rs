@@ -56,13 +56,13 @@
 //! buffer starts at 0, as the paper's MRTs do (Layout has one initial value per word width): a
 //! pair's min channel stores the complement (never 0), a single bucket stores value + 1.
 
-mod adaptive;
-mod two_pass;
-mod uniform;
+mod adp;
+mod bdp;
+mod bdp2;
 
-pub use adaptive::{Adp, AdpStage, ADP_BATCH, ADP_SUBINTERVALS};
-pub use two_pass::{Bdp2, Bdp2Stage};
-pub use uniform::{Bdp, Buckets};
+pub use adp::{Adp, AdpStage, ADP_BATCH, ADP_SUBINTERVALS};
+pub use bdp::{Bdp, Buckets};
+pub use bdp2::{Bdp2, Bdp2Stage};
 
 use fragsim_raster::{Fragment, Viewport};
 

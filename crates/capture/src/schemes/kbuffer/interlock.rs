@@ -45,7 +45,7 @@
 //! **Departures.** This is the **unordered** mode (`PixelInterlockUnorderedEXT`: mutual
 //! exclusion, critical sections in any order). The ordered mode (`PixelInterlockOrderedEXT`,
 //! ROVs: a pixel's critical sections in primitive order) is
-//! [`kbuffer_interlock_ordered`](crate::schemes::kbuffer_interlock_ordered); for the `K` nearest
+//! [`kbuffer::interlock_ordered`](crate::schemes::kbuffer::interlock_ordered); for the `K` nearest
 //! both keep identical lists (the `K` nearest of a set do not depend on the order its members
 //! arrive in), order matters only to order-dependent policies (keep-first, [`Keep::First`]).
 //! As in the k-buffer, a slot is one `u64` `depth_key << 32 | prim` rather than the samples'
@@ -161,9 +161,7 @@ impl Scheme for KBufferInterlock {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every step leaves the slots sorted.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What fell off is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 

@@ -4,7 +4,7 @@
 //! one at a time **in primitive order**.
 //!
 //! **Algorithm.** As the unordered interlock
-//! ([`kbuffer_interlock`](crate::schemes::kbuffer_interlock)): each pixel owns `K` slots; a
+//! ([`kbuffer::interlock`](crate::schemes::kbuffer::interlock)): each pixel owns `K` slots; a
 //! fragment's critical section reads them, inserts itself in registers and writes them back, one
 //! step. What is added is the order: a fragment enters only once every fragment of its pixel
 //! submitted before it has left its section. Each pixel counts the sections that have left
@@ -64,9 +64,9 @@ use crate::memory::{Memory, WordMemory};
 use crate::primitive_order::PrimitiveOrder;
 use crate::scheme::Simt;
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::kbuffer::interlock::section;
+pub use crate::schemes::kbuffer::interlock::Keep;
 use crate::schemes::kbuffer::{Insert, Slots, WriteBack};
-use crate::schemes::kbuffer_interlock::section;
-pub use crate::schemes::kbuffer_interlock::Keep;
 
 /// The k-buffer whose critical sections run one at a time per pixel, in primitive order.
 #[derive(Clone, Debug)]
@@ -190,9 +190,7 @@ impl Scheme for KBufferInterlockOrdered<'_> {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every section leaves the slots sorted.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What was dropped is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 

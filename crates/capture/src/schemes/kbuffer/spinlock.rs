@@ -43,7 +43,7 @@
 //! off: the compare-and-swap, `K` loads, `K` stores, the release), of which **1 locked operation**
 //! (the lock's); each failed attempt is one step and one locked operation more. Memory: `8 K + 4`
 //! bytes per pixel (the slots and the lock word). The interlock
-//! ([`kbuffer_interlock`](crate::schemes::kbuffer_interlock)) does the same work in one step with
+//! ([`kbuffer::interlock`](crate::schemes::kbuffer::interlock)) does the same work in one step with
 //! no spinning, because the hardware queues the waiting invocations.
 //!
 //! **Sources.** nvpro-samples' `vk_order_independent_transparency` (NVIDIA, 2020), its spinlock
@@ -245,9 +245,7 @@ impl Scheme for KBufferSpinlock {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every critical section leaves the slots sorted.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What fell off is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 
