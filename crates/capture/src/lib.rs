@@ -34,7 +34,7 @@
 //! ```text
 //! lib.rs          this map, and the re-exports of the core types (Scheme, Memory, Capture, ...)
 //! scheme.rs       the Scheme trait: begin, step, end pass, resolve; the Descriptor each scheme
-                builds once; Step, Promise, Simt, CaptureError
+//!                 builds once; Step, Promise, Simt, CaptureError
 //! guarantee.rs    what a scheme guarantees against the oracle
 //! capture.rs      the per-pixel lists a run returns, and what they keep
 //! depth_count.rs  the counting pass that sizes exact storage
@@ -45,7 +45,7 @@
 //! memory/         the memory seam: Word, WordMemory, Memory, SerialMemory, AtomicMemory,
 //!                 Layout (the words a scheme asks for), CountingMemory (counts locked ops)
 //! schemes/        one file per scheme, named after it; bucket/ holds bucket peeling's three,
-                kbuffer/ the k-buffer (mod.rs), its shared slots (slots.rs) and its four siblings
+//!                 kbuffer/ the k-buffer (mod.rs), its shared slots (slots.rs) and its four siblings
 //!   common/       what several schemes share: the fragment words (MdtsWord), the post passes'
 //!                 sorts, the peeling schemes' layer storage and depth test
 //! executors/      frame.rs (the one frame loop: passes, resolve, stats), serial.rs,
