@@ -53,9 +53,11 @@
 //! ```
 //!
 //! Imports go one way: `memory` needs nothing else of the crate; `scheme` needs `memory`,
-//! `capture` and `guarantee`; `schemes` need those and `schemes::common`, never another scheme's
-//! module (a scheme built on another, as the packed MDTS on MDTS's walks, names it); the
-//! executors need `scheme` and `memory`; the catalog needs everything.
+//! `capture` and `guarantee` (and `post_pass`, whose serial form its default `resolve` runs: the
+//! one circle left, explained in `post_pass.rs`); `schemes` need those and `schemes::common`, never
+//! another scheme's module (a scheme built on another, as the packed MDTS on MDTS's walks, names
+//! it; a family's members share their folder's common part, as `kbuffer/slots.rs`); the executors
+//! need `scheme` and `memory`; the catalog needs everything.
 //!
 //! ```
 //! use fragsim_capture::{executors, schemes::mdts::Mdts};
