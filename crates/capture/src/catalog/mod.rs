@@ -8,9 +8,13 @@
 //! [`Executors::run`] is the visitor that runs one frame). What a scheme guarantees is
 //! never listed here: it comes from the built scheme
 //! ([`Scheme::guarantee`](crate::Scheme::guarantee)). Front ends (the command line, the dump
-//! reader and writer, the property tests) iterate this list, so adding a scheme means its module
-//! plus one `catalog!` line here (`kbuffer-interlock` was added so: its module, its `pub mod` line
-//! and its entry).
+//! reader and writer, the property tests, the fuzz targets) iterate this list, so adding a scheme
+//! takes three places: its module (a type implementing [`Scheme`](crate::Scheme), whose
+//! constructor builds its [`Descriptor`](crate::Descriptor) once), that module's `pub mod` line
+//! (in `schemes/mod.rs`, or in its family's folder, as `schemes/kbuffer/mod.rs`), and one
+//! `catalog!` line here. A scheme no named dump layout fits dumps its raw words
+//! ([`DumpLayout::Memory`]); the CUDA and wgpu backends keep their own lists of the schemes they
+//! mirror, which a new scheme need not join.
 //!
 //! **What is not here: weighted blended OIT and tail blending**. An entry is a
 //! capture: per-pixel storage of fragments that the oracle judges list by list. WBOIT keeps no
