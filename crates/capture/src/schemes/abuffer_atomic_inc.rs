@@ -64,16 +64,14 @@ impl ABufferAtomicInc {
                 "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
             ));
         }
+        let pixels = viewport.pixels();
         let descriptor = Descriptor {
             name: format!("abuffer-atomicinc-{bound}"),
-            layout: Layout::counters_and_slots(
-                viewport.pixels(),
-                viewport.pixels() * capacity as usize,
-            ),
+            layout: Layout::counters_and_slots(pixels, pixels * capacity as usize),
             identity: Identity::KeyAndPrim,
             guarantee: Guarantee::ExactWithinCapacity(capacity),
             promise: Promise::All(Capacity::PerPixel(capacity)),
-            pixels: viewport.pixels(),
+            pixels,
             counts_every_drop: false,
         };
         Ok(Self {

@@ -79,16 +79,14 @@ impl LayerCounter {
                 "the layer counter needs a layer_count of at least 1".into(),
             ));
         }
+        let pixels = viewport.pixels();
         let descriptor = Descriptor {
             name: "layer-counter".into(),
-            layout: Layout::counters_and_slots(
-                viewport.pixels(),
-                viewport.pixels() * layer_count as usize,
-            ),
+            layout: Layout::counters_and_slots(pixels, pixels * layer_count as usize),
             identity: Identity::KeyAndPrim,
             guarantee: Guarantee::ExactWithinCapacity(layer_count),
             promise: Promise::All(Capacity::PerPixelUncounted(layer_count)),
-            pixels: viewport.pixels(),
+            pixels,
             counts_every_drop: true,
         };
         Ok(Self {
