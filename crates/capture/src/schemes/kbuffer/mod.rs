@@ -72,6 +72,11 @@
 //! Unlike the GPU, whose hazard window is the time between the texture fetch and the ROP's write,
 //! the window here is whatever the executor puts between the read and the write-back; the serial
 //! executor puts nothing, the scheduled executor anything its policy picks.
+//!
+//! **The family.** This folder holds the k-buffer (this module) and the schemes built on its
+//! slots: [`interlock`] and [`interlock_ordered`] (the read–insert–write as one critical section),
+//! [`spinlock`] (the section under a spinlock) and [`multipass`] (peeling `K` layers a pass);
+//! `slots.rs` holds what they share, the `K` slots of a pixel and one fragment's insertion.
 
 pub mod interlock;
 pub mod interlock_ordered;

@@ -3,7 +3,7 @@
 //! and FreePipe (Liu et al., I3D 2010, Table 3, "Liu") describe and measure it.
 //!
 //! **Algorithm.** Depth peeling `K` layers at a time with the k-buffer's read–insert–write
-//! (`crate::schemes::kbuffer`, shared code, on either [`WriteBack`] machine). Each pixel has a *boundary*
+//! (`kbuffer/slots.rs`, shared code, on either [`WriteBack`] machine). Each pixel has a *boundary*
 //! `c` (every fragment below it is in the output list) and may have a *tentative* list: the `K`
 //! or fewer fragments the previous pass captured, waiting to be checked, which span `[c, t)`.
 //! In pass `p` a fragment first `load`s `c` and `t` (pass 0 has neither: `c = t = 0`), then:
