@@ -123,13 +123,23 @@ pub struct Descriptor {
 }
 
 impl Descriptor {
-    /// The descriptor, once what its layout allocates before any fragment fits `memory_cap`
-    /// bytes ([`check_cap`], under the descriptor's name).
+    /// The descriptor, once what its layout allocates before any fragment
+    /// ([`Layout::least_bytes`]: its tables and page tables) fits `memory_cap` bytes. The pages
+    /// of words are allocated as writes reach them, and checked against the cap then: a frame
+    /// whose pages exceed it is reported over the cap (`RunStats::over_cap`), never returned as
+    /// a result.
     ///
     /// # Errors
-    /// [`CaptureError::TooMuchMemory`].
+    /// [`CaptureError::TooMuchMemory`], under the descriptor's name.
     pub fn within(self, memory_cap: u64) -> Result<Self, CaptureError> {
-        check_cap(&self.name, &self.layout, memory_cap)?;
+        let needed = self.layout.least_bytes();
+        if needed > memory_cap {
+            return Err(CaptureError::TooMuchMemory {
+                scheme: self.name,
+                needed,
+                cap: memory_cap,
+            });
+        }
         Ok(self)
     }
 }
@@ -280,20 +290,4 @@ pub(crate) fn walk_to_end(steps: &mut u64, mut step: impl FnMut() -> Step) -> St
             done => return done,
         }
     }
-}
-
-/// Fails with [`CaptureError::TooMuchMemory`] when what `layout` allocates before any fragment
-/// ([`Layout::least_bytes`]: its tables and page tables) exceeds `cap`. The pages of words are
-/// allocated as writes reach them, and checked against the cap then: a frame whose pages exceed
-/// it is reported over the cap (`RunStats::over_cap`), never returned as a result.
-pub(crate) fn check_cap(scheme: &str, layout: &Layout, cap: u64) -> Result<(), CaptureError> {
-    let needed = layout.least_bytes();
-    if needed > cap {
-        return Err(CaptureError::TooMuchMemory {
-            scheme: scheme.into(),
-            needed,
-            cap,
-        });
-    }
-    Ok(())
 }
