@@ -35,7 +35,7 @@ pub struct NamedRun {
     pub memory: Option<MemoryWords>,
 }
 
-/// Every word of a scheme's memory, in the order of its [`Layout`].
+/// Every word of a scheme's memory, in the order of its [`Layout`](crate::Layout).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct MemoryWords {
     /// The u32 words.
@@ -176,7 +176,7 @@ impl Executors {
 /// refusal must not wait for them. Every catalog entry is built at its smallest (one slot or
 /// layer, the least pool, no fragments) and refused if even that exceeds the cap; what a build
 /// checks is what is allocated before any fragment (tables and page tables,
-/// [`Layout::least_bytes`]: the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
+/// [`Layout::least_bytes`](crate::Layout::least_bytes): the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
 /// being checked as a frame writes them.
 ///
 /// # Errors

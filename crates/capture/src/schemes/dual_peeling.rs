@@ -26,7 +26,7 @@
 //! value of the pixel, so the front list grows ascending from the nearest and the back list
 //! descending from the farthest until they meet; per-location atomicity of `atomicMin` suffices,
 //! under any interleaving. With `DualDepthPeeling<u64>` (default, `depth_key << 32 | prim`) every
-//! fragment is a distinct value: exact, fragment for fragment ([`Promise::All`]). With
+//! fragment is a distinct value: exact, fragment for fragment ([`Promise::All`](crate::Promise::All)). With
 //! `DualDepthPeeling<u32>` (depth keys, as the paper's float depths) **equal depths merge**: all
 //! fragments sharing the nearest (or farthest) depth are one layer, peeled together, and the
 //! capture holds that depth once; the oracle's diff reports the duplicates as lost. (The paper's

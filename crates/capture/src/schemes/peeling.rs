@@ -17,11 +17,11 @@
 //! this needs, so it holds under any interleaving (`tests/suite/peeling.rs` runs the serial, parallel and
 //! scheduled executors). What the value is decides what is exact:
 //! - `DepthPeeling<u64>` (default): `depth_key << 32 | prim`. Every fragment is distinct, so every
-//!   fragment is one layer: exact, fragment for fragment ([`Promise::All`]).
+//!   fragment is one layer: exact, fragment for fragment ([`Promise::All`](crate::Promise::All)).
 //! - `DepthPeeling<u32>`: the depth key alone, as the classical algorithm. Fragments of one pixel
 //!   with **equal depths merge**: the pass keeps one key for all of them, and the next pass's
 //!   strict test peels them all away together. The capture holds each distinct depth once;
-//!   [`Identity::KeyOnly`] keeps the promise of every fragment, so the oracle's diff reports the
+//!   [`Identity::KeyOnly`](crate::Identity::KeyOnly) keeps the promise of every fragment, so the oracle's diff reports the
 //!   merged duplicates as lost, which is the truth about this variant.
 //!
 //! **Passes.** `L + 1` geometry passes, where `L` is the largest number of layers at any pixel:

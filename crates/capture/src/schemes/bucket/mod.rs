@@ -16,7 +16,7 @@
 //!   one subinterval per occupied bit, then a routing pass (exact when no two fragments share one
 //!   of the 1024 uniform subintervals); batches of 32 layers for deeper scenes.
 //!
-//! None of them is exact in general: each promises [`Promise::All`](crate::Promise::All) and
+//! None of them is exact in general: each promises [`Promise::All`] and
 //! reports no overflow, so the oracle's diff counts every fragment lost to a collision as `lost`.
 //! (ADP's storage, sized to the scene's depth complexity, can also be too small when the caller
 //! under-states it: those fragments are counted as overflow, see [`Adp`].) A walk ends `Dropped`

@@ -21,7 +21,7 @@
 //! anyway, and on the parallel executor a waiting thread waits only for a step already running.
 //!
 //! **Guarantee.** Under **any** interleaving each pixel ends with exactly its `K` nearest fragments
-//! in canonical order: [`Guarantee::Exact`], [`Promise::Nearest`]`(K)`. Every step is one
+//! in canonical order: [`Guarantee::Exact`], [`Promise::Nearest`](crate::Promise::Nearest)`(K)`. Every step is one
 //! fragment's sorted insertion into the pixel's current slots, so the slots after any set of
 //! steps are the `K` nearest of the fragments inserted so far, whatever their order (the `K`
 //! nearest of a set do not depend on the order its members arrive in; packed values are distinct,

@@ -23,7 +23,7 @@
 //!   write-backs), which the render-target machine cannot produce.
 //!
 //! **Guarantee.** On the serial executor each walk runs alone, so each pixel ends with exactly its
-//! `K` nearest fragments in canonical order: [`Promise::Nearest`]`(K)`, exact up to `K`, on both
+//! `K` nearest fragments in canonical order: [`Promise::Nearest`](crate::Promise::Nearest)`(K)`, exact up to `K`, on both
 //! machines. Under any other interleaving it is **not** safe: this is the read–modify–write hazard
 //! the papers name. Nothing here hides it: the post pass reports the slots as they are, and
 //! `Oracle::diff` counts the lost, extra and misordered fragments (`tests/suite/kbuffer.rs` drives each

@@ -21,7 +21,7 @@
 //! ```
 //!
 //! **Guarantee.** Under independent thread scheduling (every executor, and the scheduled one's
-//! random, warps and PCT policies), [`Guarantee::Exact`], [`Promise::Nearest`]`(K)`, in both
+//! random, warps and PCT policies), [`Guarantee::Exact`], [`Promise::Nearest`](crate::Promise::Nearest)`(K)`, in both
 //! loops: the lock makes each fragment's `2 K` steps a critical section, so the slots after any
 //! set of critical sections hold the `K` nearest of the fragments inserted (the `K` nearest of a set
 //! do not depend on their order; packed values are distinct); each fragment beyond the `K` kept
