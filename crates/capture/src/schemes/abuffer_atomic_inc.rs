@@ -26,11 +26,9 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
-use crate::schemes::abuffer::Claim;
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step};
+use crate::schemes::abuffer::{ABuffer, Claim, PostSort};
 use crate::schemes::common::sort::insertion_sort;
 
 /// An A-buffer with `capacity` slots per pixel whose slot counter is CUDA's wrapping `atomicInc`.
@@ -59,20 +57,14 @@ impl ABufferAtomicInc {
         bound: u32,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        if capacity == 0 {
-            return Err(CaptureError::BadParameter(
-                "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
-            ));
-        }
-        let pixels = viewport.pixels();
+        // The fixed A-buffer's storage, identity, guarantee and promise (its parameter check
+        // too); only the name and the drops differ: a wrapped counter overwrites a slot, and no
+        // walk counts what it overwrote.
+        let abuffer = ABuffer::fixed(viewport, capacity, PostSort::Insertion, u64::MAX)?;
         let descriptor = Descriptor {
             name: format!("abuffer-atomicinc-{bound}"),
-            layout: Layout::counters_and_slots(pixels, pixels * capacity as usize),
-            identity: Identity::KeyAndPrim,
-            guarantee: Guarantee::ExactWithinCapacity(capacity),
-            promise: Promise::All(Capacity::PerPixel(capacity)),
-            pixels,
             counts_every_drop: false,
+            ..abuffer.descriptor().clone()
         };
         Ok(Self {
             descriptor: descriptor.within(memory_cap)?,
