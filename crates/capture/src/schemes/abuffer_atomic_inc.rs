@@ -1,6 +1,6 @@
 //! The A-buffer as GPU code often writes it, with CUDA's wrapping `atomicInc(addr, bound)` for
 //! the slot counter: a model of what goes wrong when storage overflows, next to
-//! [`ABuffer`](crate::schemes::abuffer::ABuffer), which uses `fetch_add` and counts every drop.
+//! [`ABuffer`], which uses `fetch_add` and counts every drop.
 //!
 //! **CUDA's `atomicInc(addr, bound)`** reads `old = *addr`, stores `old >= bound ? 0 : old + 1`
 //! and returns `old`, in one atomic operation. Started from 0 and applied only with one `bound`
