@@ -83,7 +83,7 @@ fn kbuffer_model(
 }
 
 /// The negative control (2 threads, K = 3, exhaustive): the library's k-buffer with separate
-/// stores (`crates/capture/src/schemes/kbuffer.rs`: `K` loads, an insertion in registers, `K` stores, one
+/// stores (`crates/capture/src/schemes/kbuffer/mod.rs`: `K` loads, an insertion in registers, `K` stores, one
 /// memory operation per step) is correct when its two walks run one after the other, but loom
 /// finds interleavings that lose a fragment, and the very checker that passes MDTS
 /// (`check_k_best`) panics on them.

@@ -1,4 +1,4 @@
-//! The ordered interlock (`crates/capture/src/schemes/kbuffer_interlock_ordered.rs`): a pixel's
+//! The ordered interlock (`crates/capture/src/schemes/kbuffer/interlock_ordered.rs`): a pixel's
 //! critical sections under its lock, entered in primitive order. Two fragments of one pixel,
 //! submitted in list order, every interleaving of their attempts with at most
 //! [`PREEMPTIONS`] preemptions (a walk that finds an earlier fragment still to come yields before
@@ -30,7 +30,7 @@ use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
 use fragsim::capture::primitive_order::PrimitiveOrder;
-use fragsim::capture::schemes::kbuffer_interlock_ordered::{KBufferInterlockOrdered, Keep};
+use fragsim::capture::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, WordMemory, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;

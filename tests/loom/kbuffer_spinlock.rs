@@ -1,4 +1,4 @@
-//! The spinlocked k-buffer (`crates/capture/src/schemes/kbuffer_spinlock.rs`), both loop shapes:
+//! The spinlocked k-buffer (`crates/capture/src/schemes/kbuffer/spinlock.rs`), both loop shapes:
 //! the lock held across the critical section's `2 K` steps. Two fragments of one pixel, every
 //! interleaving (loom's threads are independently scheduled, as since Volta): mutual exclusion
 //! (never two walks between their lock and their release) and no fragment lost; the same
@@ -14,8 +14,8 @@
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
+use fragsim::capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Lock, Loop, SpinInsert};
 use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Lock, Loop, SpinInsert};
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;

@@ -4,7 +4,9 @@ use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
 use fragsim::capture::schemes::mdts::Direction;
-use fragsim::capture::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory};
+use fragsim::capture::{
+    Descriptor, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory,
+};
 use fragsim::raster::Fragment;
 
 use super::{explore, k_best_error, keyed, run_threads, Walks, TIES};
@@ -15,40 +17,48 @@ use super::{explore, k_best_error, keyed, run_threads, Walks, TIES};
 /// carrying `init` dropped nothing.
 #[derive(Clone, Debug)]
 struct Table1 {
+    descriptor: Descriptor,
     k: u32,
     init: u32,
     stop_on: u32,
     stop_on_equal: bool,
 }
 
+impl Table1 {
+    /// The variant with `k` slots of one pixel starting at `init`, its walks stopping on
+    /// `stop_on` (and on an equal value where `stop_on_equal`).
+    fn new(k: u32, init: u32, stop_on: u32, stop_on_equal: bool) -> Self {
+        let descriptor = Descriptor {
+            name: "table1".into(),
+            layout: Layout {
+                words32: k as usize,
+                init32: init,
+                words64: 0,
+                init64: 0,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyOnly,
+            // What the paper claims for it; the tests show where the literal reading breaks it.
+            guarantee: Guarantee::Exact,
+            promise: Promise::Nearest(k),
+            pixels: 1,
+            counts_every_drop: false,
+        };
+        Self {
+            descriptor,
+            k,
+            init,
+            stop_on,
+            stop_on_equal,
+        }
+    }
+}
+
 impl Scheme for Table1 {
     type State = (u32, u32);
 
-    fn name(&self) -> String {
-        "table1".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: self.k as usize,
-            init32: self.init,
-            words64: 0,
-            init64: 0,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyOnly
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k)
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        // What the paper claims for it; the tests show where the literal reading breaks it.
-        Guarantee::Exact
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> (u32, u32) {
@@ -78,10 +88,6 @@ impl Scheme for Table1 {
                 .map(|w| u64::from(w) << 32),
         );
         0
-    }
-
-    fn pixels(&self) -> usize {
-        1
     }
 }
 
@@ -138,12 +144,7 @@ fn table1_model(
 #[test]
 fn table1_as_printed_never_exits_early_3_threads_k1_to_k3() {
     for k in 1..=3 {
-        let scheme = Table1 {
-            k,
-            init: 0xFFFF_FFFF,
-            stop_on: 0x7FFF_FFFF,
-            stop_on_equal: false,
-        };
+        let scheme = Table1::new(k, 0xFFFF_FFFF, 0x7FFF_FFFF, false);
         let name = format!("table1_as_printed_3_threads_k{k}");
         let (explored, wrong, lengths) = table1_model(&name, scheme, &keyed(&TIES[..3]), None);
         assert!(explored > 1);
@@ -159,12 +160,7 @@ fn table1_as_printed_never_exits_early_3_threads_k1_to_k3() {
 /// both 10s are kept.
 #[test]
 fn tie_merging_variant_loses_a_duplicate_4_threads_k4_preemption_bound_3() {
-    let merging = |k| Table1 {
-        k,
-        init: u32::MAX,
-        stop_on: u32::MAX,
-        stop_on_equal: true,
-    };
+    let merging = |k| Table1::new(k, u32::MAX, u32::MAX, true);
     let (explored, wrong, _) = table1_model(
         "tie_merging_3_threads_k3",
         merging(3),

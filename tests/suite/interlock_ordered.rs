@@ -10,7 +10,7 @@ use fragsim::capture::catalog::{Count, Executors, SchemeName, Sizing};
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::executors::{Executor, ParallelExecutor};
 use fragsim::capture::primitive_order::PrimitiveOrder;
-use fragsim::capture::schemes::kbuffer_interlock_ordered::{KBufferInterlockOrdered, Keep};
+use fragsim::capture::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
 use fragsim::capture::schemes::layer_counter::LayerCounter;
 use fragsim::capture::{Capture, Guarantee, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;

@@ -12,7 +12,7 @@ use fragsim::capture::executors::scheduled::{
     run_fragments, Granularity, Policy, Schedule, WARP_LANES,
 };
 use fragsim::capture::executors::Executor;
-use fragsim::capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Loop};
+use fragsim::capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
 use fragsim::capture::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
 use fragsim::capture::{Guarantee, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;

@@ -529,8 +529,8 @@ mod tests {
     #[test]
     fn the_kbuffers_bind_the_catalog_schemes_words_and_dump_its_slot_layout() {
         use fragsim_capture::catalog::DumpLayout;
+        use fragsim_capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
         use fragsim_capture::schemes::kbuffer::KBuffer;
-        use fragsim_capture::schemes::kbuffer_spinlock::{KBufferSpinlock, Loop};
         use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
         use fragsim_raster::Viewport;
 

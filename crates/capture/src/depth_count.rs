@@ -29,12 +29,12 @@ use crate::capture::{Capacity, Identity};
 use crate::executors::Run;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{Promise, Scheme, Step};
+use crate::scheme::{Descriptor, Promise, Scheme, Step};
 
 /// The counting pass as a scheme: its capture holds one entry per pixel, the pixel's count.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct DepthCount {
-    pixels: usize,
+    descriptor: Descriptor,
 }
 
 impl DepthCount {
@@ -42,7 +42,15 @@ impl DepthCount {
     #[must_use]
     pub fn new(viewport: Viewport) -> Self {
         Self {
-            pixels: viewport.pixels(),
+            descriptor: Descriptor {
+                name: "count".into(),
+                layout: Layout::counters_and_slots(viewport.pixels(), 0),
+                identity: Identity::KeyAndPrim,
+                guarantee: Guarantee::Exact,
+                promise: Promise::All(Capacity::Unbounded),
+                pixels: viewport.pixels(),
+                counts_every_drop: false,
+            },
         }
     }
 }
@@ -51,24 +59,8 @@ impl Scheme for DepthCount {
     /// The pixel whose counter the fragment increments.
     type State = u32;
 
-    fn name(&self) -> String {
-        "count".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout::counters_and_slots(self.pixels, 0)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::Unbounded)
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> u32 {
@@ -83,10 +75,6 @@ impl Scheme for DepthCount {
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         out.push(u64::from(WordMemory::<u32>::load(memory, pixel)));
         0
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 }
 

@@ -13,9 +13,9 @@
 //!   overwrite on overflow, not a scheme to use);
 //! - the baselines the papers measure: [`zbuffer`](schemes::zbuffer) (opaque), [`peeling`](schemes::peeling) (Everitt 2001),
 //!   [`dual_peeling`](schemes::dual_peeling) (Bavoil & Myers 2008), [`kbuffer`](schemes::kbuffer) (Bavoil et al. 2007),
-//!   [`kbuffer_interlock`](schemes::kbuffer_interlock) (the k-buffer inside a fragment-shader
+//!   [`kbuffer::interlock`](schemes::kbuffer::interlock) (the k-buffer inside a fragment-shader
 //!   interlock: nvpro-samples' interlock mode, exact under any interleaving),
-//!   [`kbuffer_multipass`](schemes::kbuffer_multipass) (Liu et al. 2006), [`stencil_routed`](schemes::stencil_routed) (Myers & Bavoil 2007) and
+//!   [`kbuffer::multipass`](schemes::kbuffer::multipass) (Liu et al. 2006), [`stencil_routed`](schemes::stencil_routed) (Myers & Bavoil 2007) and
 //!   [`bucket`](schemes::bucket) (bucket depth peeling, Liu et al. HPG 2009: uniform, two-pass, adaptive);
 //! - shipping OIT backends (`docs/baselines/shipping.md`): [`loop32`](schemes::loop32) (nvpro-samples, equal
 //!   depths merge), [`layer_counter`](schemes::layer_counter) (Bevy 0.15) and [`linked_list`](schemes::linked_list) (per-pixel linked lists,
@@ -33,7 +33,8 @@
 //!
 //! ```text
 //! lib.rs          this map, and the re-exports of the core types (Scheme, Memory, Capture, ...)
-//! scheme.rs       the Scheme trait: begin, step, end pass, resolve; Step, Promise, CaptureError
+//! scheme.rs       the Scheme trait: begin, step, end pass, resolve; the Descriptor each scheme
+//!                 builds once; Step, Promise, Simt, CaptureError
 //! guarantee.rs    what a scheme guarantees against the oracle
 //! capture.rs      the per-pixel lists a run returns, and what they keep
 //! depth_count.rs  the counting pass that sizes exact storage
@@ -43,7 +44,8 @@
 //!                 building it for a visitor (build.rs), running it (run.rs), dump layouts
 //! memory/         the memory seam: Word, WordMemory, Memory, SerialMemory, AtomicMemory,
 //!                 Layout (the words a scheme asks for), CountingMemory (counts locked ops)
-//! schemes/        one file per scheme, named after it; bucket/ holds bucket peeling's three
+//! schemes/        one file per scheme, named after it; bucket/ holds bucket peeling's three,
+//!                 kbuffer/ the k-buffer (mod.rs), its shared slots (slots.rs) and its four siblings
 //!   common/       what several schemes share: the fragment words (MdtsWord), the post passes'
 //!                 sorts, the peeling schemes' layer storage and depth test
 //! executors/      frame.rs (the one frame loop: passes, resolve, stats), serial.rs,
@@ -51,9 +53,11 @@
 //! ```
 //!
 //! Imports go one way: `memory` needs nothing else of the crate; `scheme` needs `memory`,
-//! `capture` and `guarantee`; `schemes` need those and `schemes::common`, never another scheme's
-//! module (a scheme built on another, as the packed MDTS on MDTS's walks, names it); the
-//! executors need `scheme` and `memory`; the catalog needs everything.
+//! `capture` and `guarantee` (and `post_pass`, whose serial form its default `resolve` runs: the
+//! one circle left, explained in `post_pass.rs`); `schemes` need those and `schemes::common`, never
+//! another scheme's module (a scheme built on another, as the packed MDTS on MDTS's walks, names
+//! it; a family's members share their folder's common part, as `kbuffer/slots.rs`); the executors
+//! need `scheme` and `memory`; the catalog needs everything.
 //!
 //! ```
 //! use fragsim_capture::{executors, schemes::mdts::Mdts};
@@ -82,4 +86,6 @@ pub use guarantee::Guarantee;
 pub use memory::{
     AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, SpanVisitor, Word, WordMemory,
 };
-pub use scheme::{CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+pub use scheme::{
+    CaptureError, Descriptor, PixelRun, Promise, Scheme, Simt, Step, MEMORY_CAP_DEFAULT,
+};

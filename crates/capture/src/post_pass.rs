@@ -11,6 +11,11 @@
 //! reached; the capture's offsets are then written once, each range's own in parallel, an empty
 //! pixel's offset being its predecessor's. The parallel form is FreePipe's post-sort kernel (one
 //! GPU thread per pixel), cut into ranges of pixels on the rayon pool.
+//!
+//! The one import circle left in the crate is this module's with `scheme.rs`: the post pass reads
+//! the [`Scheme`] trait, and the trait's default [`Scheme::resolve`] runs the serial form written
+//! here. Both are the post pass, one concern; the circle keeps its serial and parallel forms in
+//! one implementation instead of a copy in the trait.
 
 use std::ops::Range;
 

@@ -1,5 +1,5 @@
 //! The order a GPU's rasterizer hands a pixel its fragments in: submission order. The ordered
-//! fragment-shader interlock ([`kbuffer_interlock_ordered`](crate::schemes::kbuffer_interlock_ordered))
+//! fragment-shader interlock ([`kbuffer::interlock_ordered`](crate::schemes::kbuffer::interlock_ordered))
 //! runs a pixel's critical sections in this order.
 //!
 //! **What it is.** For each pixel, the primitives that cover it, in the order they were

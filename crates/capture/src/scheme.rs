@@ -5,7 +5,6 @@ use std::fmt::Debug;
 use fragsim_raster::Fragment;
 
 use crate::capture::{Capacity, Capture, Identity, Keeps};
-use crate::executors::scheduled::Simt;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory};
 
@@ -68,6 +67,18 @@ impl PixelRun {
     }
 }
 
+/// Where a walk stands for a SIMT scheduler ([`Scheme::simt`], read by the scheduled executor): all `false` for a scheme
+/// without locks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Simt {
+    /// The walk's last step failed to take a lock and its next step retries it: no progress.
+    pub spinning: bool,
+    /// The walk stands at a reconvergence point (the exit of a loop, the end of a divergent
+    /// branch): under [`Policy::Lockstep`](crate::executors::scheduled::Policy::Lockstep) its next step runs only once every other active lane of
+    /// its warp stands at one too.
+    pub reconverging: bool,
+}
+
 /// Why a scheme could not be set up.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum CaptureError {
@@ -89,6 +100,50 @@ pub enum CaptureError {
     },
 }
 
+/// What a scheme is, as the rest of the simulator sees it: written once, by the scheme's
+/// constructor ([`Descriptor::within`] checks it against the memory cap there), and read through
+/// [`Scheme::descriptor`] by the trait's accessors ([`Scheme::name`], [`Scheme::layout`], ...).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Descriptor {
+    /// A short name, e.g. `mdts` or `abuffer`: the catalog's spelling.
+    pub name: String,
+    /// The storage the scheme needs.
+    pub layout: Layout,
+    /// What the captured words identify.
+    pub identity: Identity,
+    /// What the scheme guarantees against the oracle (each module's header says why).
+    pub guarantee: Guarantee,
+    /// Which fragments the scheme promises to keep.
+    pub promise: Promise,
+    /// Number of pixels the scheme's storage covers.
+    pub pixels: usize,
+    /// Whether every fragment a one-pass frame does not keep ends some walk as
+    /// [`Step::Dropped`] ([`Scheme::counts_every_drop`]).
+    pub counts_every_drop: bool,
+}
+
+impl Descriptor {
+    /// The descriptor, once what its layout allocates before any fragment
+    /// ([`Layout::least_bytes`]: its tables and page tables) fits `memory_cap` bytes. The pages
+    /// of words are allocated as writes reach them, and checked against the cap then: a frame
+    /// whose pages exceed it is reported over the cap (`RunStats::over_cap`), never returned as
+    /// a result.
+    ///
+    /// # Errors
+    /// [`CaptureError::TooMuchMemory`], under the descriptor's name.
+    pub fn within(self, memory_cap: u64) -> Result<Self, CaptureError> {
+        let needed = self.layout.least_bytes();
+        if needed > memory_cap {
+            return Err(CaptureError::TooMuchMemory {
+                scheme: self.name,
+                needed,
+                cap: memory_cap,
+            });
+        }
+        Ok(self)
+    }
+}
+
 /// A capture scheme: how a fragment walks per-pixel memory, and how the memory is read back.
 ///
 /// Contract: [`Scheme::step`] performs **exactly one** indivisible operation on `memory` per call:
@@ -100,29 +155,48 @@ pub trait Scheme: Sync {
     /// A fragment's progress between steps.
     type State: Send + Clone + Debug;
 
-    /// A short name, e.g. `mdts` or `abuffer`.
-    fn name(&self) -> String;
+    /// What the scheme is: its name, storage, identity, guarantee, promise and pixels, built
+    /// once by its constructor. The accessors below read it.
+    fn descriptor(&self) -> &Descriptor;
 
-    /// The storage the scheme needs.
-    fn layout(&self) -> Layout;
+    /// A short name, e.g. `mdts` or `abuffer` ([`Descriptor::name`]).
+    fn name(&self) -> String {
+        self.descriptor().name.clone()
+    }
 
-    /// What the captured words identify.
-    fn identity(&self) -> Identity;
+    /// The storage the scheme needs ([`Descriptor::layout`]).
+    fn layout(&self) -> Layout {
+        self.descriptor().layout
+    }
 
-    /// Which fragments the scheme promises to keep.
-    fn promise(&self) -> Promise;
+    /// What the captured words identify ([`Descriptor::identity`]).
+    fn identity(&self) -> Identity {
+        self.descriptor().identity
+    }
 
-    /// What the scheme guarantees against the oracle (each module's header says why).
-    fn guarantee(&self) -> Guarantee;
+    /// Which fragments the scheme promises to keep ([`Descriptor::promise`]).
+    fn promise(&self) -> Promise {
+        self.descriptor().promise
+    }
+
+    /// What the scheme guarantees against the oracle ([`Descriptor::guarantee`]).
+    fn guarantee(&self) -> Guarantee {
+        self.descriptor().guarantee
+    }
 
     /// Whether every fragment a one-pass frame does not keep ends some walk as [`Step::Dropped`]
     /// (MDTS carries each evicted value to the end of its slots, the A-buffer and the layer
     /// counter drop past their storage, the k-buffer drops what falls off its K slots), so that
-    /// the frame's counted drops equal what its capture lacks. Schemes that lose values with no
-    /// walk to count them say no, the default: a z-buffer's `atomicMin` overwrites the farther
-    /// value, a linked list's resolve stops after its `K` nodes.
+    /// the frame's counted drops equal what its capture lacks ([`Descriptor::counts_every_drop`]).
+    /// Schemes that lose values with no walk to count them say no: a z-buffer's `atomicMin`
+    /// overwrites the farther value, a linked list's resolve stops after its `K` nodes.
     fn counts_every_drop(&self) -> bool {
-        false
+        self.descriptor().counts_every_drop
+    }
+
+    /// Number of pixels the scheme's storage covers ([`Descriptor::pixels`]).
+    fn pixels(&self) -> usize {
+        self.descriptor().pixels
     }
 
     /// The state of a fragment before its first step in the first geometry pass.
@@ -179,9 +253,6 @@ pub trait Scheme: Sync {
         PixelRun::Resolve(end - pixel)
     }
 
-    /// Number of pixels the scheme's storage covers.
-    fn pixels(&self) -> usize;
-
     /// The post pass over every pixel, serially (`crate::post_pass`: the empty parts of the frame
     /// skipped in bulk, [`Scheme::pixel_run`]).
     fn resolve<M: Memory>(&self, memory: &M) -> Capture {
@@ -219,20 +290,4 @@ pub(crate) fn walk_to_end(steps: &mut u64, mut step: impl FnMut() -> Step) -> St
             done => return done,
         }
     }
-}
-
-/// Fails with [`CaptureError::TooMuchMemory`] when what `layout` allocates before any fragment
-/// ([`Layout::least_bytes`]: its tables and page tables) exceeds `cap`. The pages of words are
-/// allocated as writes reach them, and checked against the cap then: a frame whose pages exceed
-/// it is reported over the cap (`RunStats::over_cap`), never returned as a result.
-pub(crate) fn check_cap(scheme: &str, layout: &Layout, cap: u64) -> Result<(), CaptureError> {
-    let needed = layout.least_bytes();
-    if needed > cap {
-        return Err(CaptureError::TooMuchMemory {
-            scheme: scheme.into(),
-            needed,
-            cap,
-        });
-    }
-    Ok(())
 }

@@ -4,8 +4,8 @@
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
-    Guarantee, Identity, Layout, Memory, Promise, Scheme, SerialMemory, Step, WordMemory,
-    MEMORY_CAP_DEFAULT,
+    Descriptor, Guarantee, Identity, Layout, Memory, Promise, Scheme, SerialMemory, Step,
+    WordMemory, MEMORY_CAP_DEFAULT,
 };
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, EMPTY_KEY};
@@ -182,8 +182,31 @@ fn a_unorm_depth_one_equals_the_empty_value_and_vanishes_from_the_librarys_mdts(
 /// loop stops when `atomicMin` returns `MAX_INTEGER` (`0x7FFFFFFF`, line 13). The returned value
 /// is never `0x7FFFFFFF`, so every walk runs to the end of the array.
 struct Table1Mdts {
-    pixels: usize,
+    descriptor: Descriptor,
     k: u32,
+}
+
+impl Table1Mdts {
+    /// The literal Table 1 with `k` slots for each of `pixels` pixels.
+    fn new(pixels: usize, k: u32) -> Self {
+        let descriptor = Descriptor {
+            name: "mdts32-table1".into(),
+            layout: Layout {
+                words32: pixels * k as usize,
+                init32: 0xFFFF_FFFF,
+                words64: 0,
+                init64: 0,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyOnly,
+            // What the paper claims for it; the tests show where the literal reading breaks it.
+            guarantee: Guarantee::Exact,
+            promise: Promise::Nearest(k),
+            pixels,
+            counts_every_drop: false,
+        };
+        Self { descriptor, k }
+    }
 }
 
 /// The slot the walk tests next and the value it carries.
@@ -197,31 +220,8 @@ struct Table1Walk {
 impl Scheme for Table1Mdts {
     type State = Table1Walk;
 
-    fn name(&self) -> String {
-        "mdts32-table1".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: self.pixels * self.k as usize,
-            init32: 0xFFFF_FFFF,
-            words64: 0,
-            init64: 0,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyOnly
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k)
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        // What the paper claims for it; the tests show where the literal reading breaks it.
-        Guarantee::Exact
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Table1Walk {
@@ -258,10 +258,6 @@ impl Scheme for Table1Mdts {
         );
         0
     }
-
-    fn pixels(&self) -> usize {
-        self.pixels
-    }
 }
 
 #[test]
@@ -273,10 +269,7 @@ fn freepipe_table1_mixed_sentinels_are_correct_but_never_exit_early() {
     let oracle = Oracle::build(&view);
     let k = oracle.max_depth_complexity();
     assert_eq!(k, 8);
-    let table1 = Table1Mdts {
-        pixels: view.viewport().pixels(),
-        k,
-    };
+    let table1 = Table1Mdts::new(view.viewport().pixels(), k);
     let mdts =
         Mdts::<u32>::new(view.viewport(), k, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
     let (mixed, ours) = (run_serial(&view, &table1), run_serial(&view, &mdts));

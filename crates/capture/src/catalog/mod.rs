@@ -8,9 +8,13 @@
 //! [`Executors::run`] is the visitor that runs one frame). What a scheme guarantees is
 //! never listed here: it comes from the built scheme
 //! ([`Scheme::guarantee`](crate::Scheme::guarantee)). Front ends (the command line, the dump
-//! reader and writer, the property tests) iterate this list, so adding a scheme means its module
-//! plus one `catalog!` line here (`kbuffer-interlock` was added so: its module, its `pub mod` line
-//! and its entry).
+//! reader and writer, the property tests, the fuzz targets) iterate this list, so adding a scheme
+//! takes three places: its module (a type implementing [`Scheme`](crate::Scheme), whose
+//! constructor builds its [`Descriptor`](crate::Descriptor) once), that module's `pub mod` line
+//! (in `schemes/mod.rs`, or in its family's folder, as `schemes/kbuffer/mod.rs`), and one
+//! `catalog!` line here. A scheme no named dump layout fits dumps its raw words
+//! ([`DumpLayout::Memory`]); the CUDA and wgpu backends keep their own lists of the schemes they
+//! mirror, which a new scheme need not join.
 //!
 //! **What is not here: weighted blended OIT and tail blending**. An entry is a
 //! capture: per-pixel storage of fragments that the oracle judges list by list. WBOIT keeps no
@@ -42,12 +46,12 @@ use crate::schemes::abuffer::{
 };
 use crate::schemes::bucket::{Adp, Bdp, Bdp2, Buckets};
 use crate::schemes::dual_peeling::DualDepthPeeling;
+use crate::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
+use crate::schemes::kbuffer::multipass::KBufferMultipass;
 use crate::schemes::kbuffer::{
     KBuffer, WriteBack,
     WriteBack::{RenderTarget, SeparateStores},
 };
-use crate::schemes::kbuffer_interlock_ordered::{KBufferInterlockOrdered, Keep};
-use crate::schemes::kbuffer_multipass::KBufferMultipass;
 use crate::schemes::layer_counter::LayerCounter;
 use crate::schemes::linked_list::{
     LinkedList,
@@ -288,7 +292,7 @@ catalog! {
         |b| (KBuffer::with_write_back(b.viewport, b.k, SeparateStores, b.memory_cap)?, Some(b.k));
     KbufferInterlock "kbuffer-interlock" Fixed(1), K, Some(KBufferSlots),
         "The k-buffer's read–insert–write of K slots as one fragment-shader-interlock critical section (unordered; nvpro-samples' interlock mode): exact under any interleaving.";
-        |b| (crate::schemes::kbuffer_interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
+        |b| (crate::schemes::kbuffer::interlock::KBufferInterlock::new(b.viewport, b.k, b.memory_cap)?, Some(b.k));
     KbufferInterlockOrdered "kbuffer-interlock-ordered" Fixed(1), K, Some(KBufferSlots),
         "The interlocked k-buffer with ordered critical sections (a pixel's in primitive order: Vulkan's ordered interlock, D3D's ROVs): exact under any interleaving.";
         in-primitive-order true;
@@ -299,10 +303,10 @@ catalog! {
         |b| (KBufferInterlockOrdered::new(b.viewport, b.k, Keep::First, b.order, b.memory_cap)?, Some(b.k));
     KbufferSpinlock "kbuffer-spinlock" Fixed(1), K, Some(KBufferSlots),
         "The k-buffer's read–insert–write of K slots under a per-pixel spinlock (compare-and-swap, critical section after the spin loop; nvpro-samples' spinlock mode): exact under independent thread scheduling, deadlocks lockstep warps.";
-        |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
+        |b| (crate::schemes::kbuffer::spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer::spinlock::Loop::Naive, b.memory_cap)?, Some(b.k));
     KbufferSpinlockFixed "kbuffer-spinlock-fixed" Fixed(1), K, Some(KBufferSlots),
         "The spinlocked k-buffer with the critical section and release inside the lock loop's body: exact, and terminates under lockstep warps too.";
-        |b| (crate::schemes::kbuffer_spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer_spinlock::Loop::Fixed, b.memory_cap)?, Some(b.k));
+        |b| (crate::schemes::kbuffer::spinlock::KBufferSpinlock::new(b.viewport, b.k, crate::schemes::kbuffer::spinlock::Loop::Fixed, b.memory_cap)?, Some(b.k));
     KbufferMultipass "kbuffer-multipass" UntilConfirmed, Counted, Some(Memory),
         "The multi-pass k-buffer: k-buffer passes beyond the confirmed boundary until every fragment is confirmed by a count (render-target write-backs).";
         read-modify-write RenderTarget;

@@ -9,7 +9,7 @@ use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use crate::primitive_order::PrimitiveOrder;
-use crate::{Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory};
+use crate::{Descriptor, Guarantee, Memory, Scheme, Step, WordMemory};
 use fragsim_raster::{Fragment, View, Viewport};
 use std::sync::Mutex;
 
@@ -35,7 +35,7 @@ pub struct NamedRun {
     pub memory: Option<MemoryWords>,
 }
 
-/// Every word of a scheme's memory, in the order of its [`Layout`].
+/// Every word of a scheme's memory, in the order of its [`Layout`](crate::Layout).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct MemoryWords {
     /// The u32 words.
@@ -176,7 +176,7 @@ impl Executors {
 /// refusal must not wait for them. Every catalog entry is built at its smallest (one slot or
 /// layer, the least pool, no fragments) and refused if even that exceeds the cap; what a build
 /// checks is what is allocated before any fragment (tables and page tables,
-/// [`Layout::least_bytes`]: the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
+/// [`Layout::least_bytes`](crate::Layout::least_bytes): the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
 /// being checked as a frame writes them.
 ///
 /// # Errors
@@ -317,23 +317,8 @@ struct Instrumented<'a, S> {
 impl<S: Scheme> Scheme for Instrumented<'_, S> {
     type State = S::State;
 
-    fn name(&self) -> String {
-        self.scheme.name()
-    }
-    fn layout(&self) -> Layout {
-        self.scheme.layout()
-    }
-    fn identity(&self) -> Identity {
-        self.scheme.identity()
-    }
-    fn promise(&self) -> Promise {
-        self.scheme.promise()
-    }
-    fn guarantee(&self) -> Guarantee {
-        self.scheme.guarantee()
-    }
-    fn counts_every_drop(&self) -> bool {
-        self.scheme.counts_every_drop()
+    fn descriptor(&self) -> &Descriptor {
+        self.scheme.descriptor()
     }
     fn begin(&self, fragment: Fragment) -> S::State {
         self.scheme.begin(fragment)
@@ -344,7 +329,7 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
     fn step<M: Memory>(&self, state: &mut S::State, memory: &M) -> Step {
         self.scheme.step(state, memory)
     }
-    fn simt(&self, state: &S::State) -> crate::executors::scheduled::Simt {
+    fn simt(&self, state: &S::State) -> crate::Simt {
         self.scheme.simt(state)
     }
     fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
@@ -359,8 +344,5 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let overflow = self.scheme.resolve_pixel(memory, pixel, out);
         overflow + u32::from(self.miscount && pixel == 0)
-    }
-    fn pixels(&self) -> usize {
-        self.scheme.pixels()
     }
 }

@@ -47,7 +47,7 @@ use fragsim_raster::{Fragment, View};
 use super::frame::{self, Counters, Run};
 use crate::memory::recording::RecordingMemory;
 use crate::memory::SerialMemory;
-use crate::scheme::{Scheme, Step};
+use crate::scheme::{Scheme, Simt, Step};
 use policy::Chooser;
 pub use policy::{Granularity, Policy, Schedule, WARP_LANES};
 pub use trace::{Op, Trace, TraceEvent};
@@ -58,18 +58,6 @@ mod trace;
 /// The deadlock bound: a run stops with a [`Deadlock`] after this many consecutive spins per
 /// thread in flight (module doc: why no run that can progress reaches it).
 pub const DEADLOCK_SPINS_PER_THREAD: u64 = 64;
-
-/// Where a walk stands for a SIMT scheduler ([`Scheme::simt`]): all `false` for a scheme
-/// without locks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Simt {
-    /// The walk's last step failed to take a lock and its next step retries it: no progress.
-    pub spinning: bool,
-    /// The walk stands at a reconvergence point (the exit of a loop, the end of a divergent
-    /// branch): under [`Policy::Lockstep`] its next step runs only once every other active lane of
-    /// its warp stands at one too.
-    pub reconverging: bool,
-}
 
 /// A lane stuck when a [`Deadlock`] was detected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

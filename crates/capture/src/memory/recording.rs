@@ -1,11 +1,57 @@
 //! Memory that records every operation ([`RecordingMemory`]): the serial memory plus a log of
 //! [`TraceEvent`]s, each stamped with the step, thread, fragment, pixel and pass the scheduled
-//! executor sets before the step runs.
+//! executor sets before the step runs. The events are defined here, beside what records them, so
+//! that `memory` needs nothing else of the crate; the scheduled executor's `Trace` is made of
+//! them and re-exports them.
 
 use std::cell::{Cell, RefCell};
 
 use super::{Memory, SerialMemory, WordMemory};
-use crate::executors::scheduled::{Op, TraceEvent};
+
+/// A memory operation, as recorded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// Plain load.
+    Load,
+    /// Plain store.
+    Store,
+    /// `atomicMin`.
+    FetchMin,
+    /// `atomicMax`.
+    FetchMax,
+    /// `atomicAdd`.
+    FetchAdd,
+    /// `atomicOr`.
+    FetchOr,
+    /// `atomicExch`.
+    Swap,
+}
+
+/// One recorded memory operation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceEvent {
+    /// Index of the step in the whole run.
+    pub step: u64,
+    /// The logical thread (slot) that ran it.
+    pub thread: u32,
+    /// Index of the fragment in the pass's stream.
+    pub fragment: u64,
+    /// The fragment's pixel.
+    pub pixel: u32,
+    /// Geometry pass.
+    pub pass: u32,
+    /// Word width in bits (32 or 64).
+    pub width: u8,
+    /// Word index in its array.
+    pub word: usize,
+    /// The operation.
+    pub op: Op,
+    /// The value passed in (0 for a load).
+    pub operand: u64,
+    /// The value returned (the old value of a read-modify-write, the value of a load; the value
+    /// overwritten, for a store).
+    pub returned: u64,
+}
 
 /// Storage that can record every operation: plain memory plus a log.
 pub(crate) struct RecordingMemory {

@@ -29,7 +29,9 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{
+    CaptureError, Descriptor, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
+};
 use crate::schemes::common::sort::{bitonic_sort, insertion_sort};
 
 /// The post pass's sort.
@@ -45,6 +47,7 @@ pub enum PostSort {
 /// The A-buffer scheme.
 #[derive(Clone, Debug)]
 pub struct ABuffer {
+    descriptor: Descriptor,
     storage: Storage,
     sort: PostSort,
 }
@@ -53,7 +56,7 @@ pub struct ABuffer {
 #[derive(Clone, Debug)]
 enum Storage {
     /// `capacity` slots per pixel, pixel `p`'s starting at `p * capacity`.
-    Fixed { pixels: usize, capacity: usize },
+    Fixed { capacity: usize },
     /// `offsets[p]..offsets[p + 1]` are pixel `p`'s slots.
     Exact { offsets: Vec<usize> },
 }
@@ -93,15 +96,10 @@ impl ABuffer {
                 "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
             ));
         }
-        let scheme = Self {
-            storage: Storage::Fixed {
-                pixels: viewport.pixels(),
-                capacity: capacity as usize,
-            },
-            sort,
+        let storage = Storage::Fixed {
+            capacity: capacity as usize,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Self::on(storage, viewport.pixels(), sort, memory_cap)
     }
 
     /// Exactly `counts[p]` slots for pixel `p` (the counts of a counting pass), in one flat array.
@@ -116,12 +114,56 @@ impl ABuffer {
             total += c as usize;
             offsets.push(total);
         }
-        let scheme = Self {
-            storage: Storage::Exact { offsets },
-            sort,
+        Self::on(Storage::Exact { offsets }, counts.len(), sort, memory_cap)
+    }
+
+    /// The A-buffer on `storage` for `pixels` pixels, sorted by `sort`, within `memory_cap`
+    /// bytes.
+    fn on(
+        storage: Storage,
+        pixels: usize,
+        sort: PostSort,
+        memory_cap: u64,
+    ) -> Result<Self, CaptureError> {
+        let sort_name = match sort {
+            PostSort::Insertion => "",
+            PostSort::Bitonic => "-bitonic",
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        // FreePipe's A-buffer is the fixed-array one; exact storage is the variant.
+        let (storage_name, slots, table_bytes, guarantee, capacity) = match &storage {
+            Storage::Fixed { capacity } => (
+                "",
+                pixels * capacity,
+                0,
+                Guarantee::ExactWithinCapacity(*capacity as u32),
+                Capacity::PerPixel(*capacity as u32),
+            ),
+            // A GPU would keep 32-bit offsets: that is what is counted.
+            Storage::Exact { offsets } => (
+                "-exact",
+                offsets[offsets.len() - 1],
+                offsets.len() * 4,
+                Guarantee::Exact,
+                Capacity::Unbounded,
+            ),
+        };
+        let descriptor = Descriptor {
+            name: format!("abuffer{storage_name}{sort_name}"),
+            layout: Layout {
+                table_bytes,
+                ..Layout::counters_and_slots(pixels, slots)
+            },
+            identity: Identity::KeyAndPrim,
+            guarantee,
+            promise: Promise::All(capacity),
+            pixels,
+            counts_every_drop: true,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            storage,
+            sort,
+        })
     }
 
     /// Like [`ABuffer::exact`] with insertion sort and the default cap.
@@ -140,41 +182,13 @@ impl ABuffer {
             Storage::Exact { offsets } => (offsets[pixel], offsets[pixel + 1] - offsets[pixel]),
         }
     }
-
-    fn pixel_count(&self) -> usize {
-        match &self.storage {
-            Storage::Fixed { pixels, .. } => *pixels,
-            Storage::Exact { offsets } => offsets.len() - 1,
-        }
-    }
 }
 
 impl Scheme for ABuffer {
     type State = Claim;
 
-    fn name(&self) -> String {
-        let sort = match self.sort {
-            PostSort::Insertion => "",
-            PostSort::Bitonic => "-bitonic",
-        };
-        // FreePipe's A-buffer is the fixed-array one; exact storage is the variant.
-        let storage = match self.storage {
-            Storage::Fixed { .. } => "",
-            Storage::Exact { .. } => "-exact",
-        };
-        format!("abuffer{storage}{sort}")
-    }
-
-    fn layout(&self) -> Layout {
-        let (slots, table_bytes) = match &self.storage {
-            Storage::Fixed { pixels, capacity } => (pixels * capacity, 0),
-            // A GPU would keep 32-bit offsets: that is what is counted.
-            Storage::Exact { offsets } => (offsets[offsets.len() - 1], offsets.len() * 4),
-        };
-        Layout {
-            table_bytes,
-            ..Layout::counters_and_slots(self.pixels(), slots)
-        }
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Claim {
@@ -210,32 +224,6 @@ impl Scheme for ABuffer {
                 Step::Stored
             }
         }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        match self.storage {
-            Storage::Fixed { capacity, .. } => Guarantee::ExactWithinCapacity(capacity as u32),
-            Storage::Exact { .. } => Guarantee::Exact,
-        }
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(match self.storage {
-            Storage::Fixed { capacity, .. } => Capacity::PerPixel(capacity as u32),
-            Storage::Exact { .. } => Capacity::Unbounded,
-        })
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixel_count()
     }
 
     fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {

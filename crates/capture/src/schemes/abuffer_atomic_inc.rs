@@ -1,6 +1,6 @@
 //! The A-buffer as GPU code often writes it, with CUDA's wrapping `atomicInc(addr, bound)` for
 //! the slot counter: a model of what goes wrong when storage overflows, next to
-//! [`ABuffer`](crate::schemes::abuffer::ABuffer), which uses `fetch_add` and counts every drop.
+//! [`ABuffer`], which uses `fetch_add` and counts every drop.
 //!
 //! **CUDA's `atomicInc(addr, bound)`** reads `old = *addr`, stores `old >= bound ? 0 : old + 1`
 //! and returns `old`, in one atomic operation. Started from 0 and applied only with one `bound`
@@ -26,17 +26,15 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
-use crate::schemes::abuffer::Claim;
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step};
+use crate::schemes::abuffer::{ABuffer, Claim, PostSort};
 use crate::schemes::common::sort::insertion_sort;
 
 /// An A-buffer with `capacity` slots per pixel whose slot counter is CUDA's wrapping `atomicInc`.
 #[derive(Clone, Debug)]
 pub struct ABufferAtomicInc {
-    pixels: usize,
+    descriptor: Descriptor,
     capacity: usize,
     bound: u32,
 }
@@ -59,18 +57,20 @@ impl ABufferAtomicInc {
         bound: u32,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        if capacity == 0 {
-            return Err(CaptureError::BadParameter(
-                "the A-buffer needs a capacity of at least 1 slot per pixel".into(),
-            ));
-        }
-        let scheme = Self {
-            pixels: viewport.pixels(),
+        // The fixed A-buffer's storage, identity, guarantee and promise (its parameter check
+        // too); only the name and the drops differ: a wrapped counter overwrites a slot, and no
+        // walk counts what it overwrote.
+        let abuffer = ABuffer::fixed(viewport, capacity, PostSort::Insertion, u64::MAX)?;
+        let descriptor = Descriptor {
+            name: format!("abuffer-atomicinc-{bound}"),
+            counts_every_drop: false,
+            ..abuffer.descriptor().clone()
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
             capacity: capacity as usize,
             bound,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        })
     }
 
     /// The usual GPU choice: `bound = capacity − 1`, so that the slot index never leaves the
@@ -90,24 +90,8 @@ impl ABufferAtomicInc {
 impl Scheme for ABufferAtomicInc {
     type State = Claim;
 
-    fn name(&self) -> String {
-        format!("abuffer-atomicinc-{}", self.bound)
-    }
-
-    fn layout(&self) -> Layout {
-        Layout::counters_and_slots(self.pixels, self.pixels * self.capacity)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactWithinCapacity(self.capacity as u32)
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.capacity as u32))
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Claim {
@@ -149,10 +133,6 @@ impl Scheme for ABufferAtomicInc {
         out.extend((0..stored).map(|i| WordMemory::<u64>::load(memory, first + i)));
         insertion_sort(&mut out[start..]);
         (count - stored) as u32
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 }
 

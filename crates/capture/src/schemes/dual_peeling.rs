@@ -26,7 +26,7 @@
 //! value of the pixel, so the front list grows ascending from the nearest and the back list
 //! descending from the farthest until they meet; per-location atomicity of `atomicMin` suffices,
 //! under any interleaving. With `DualDepthPeeling<u64>` (default, `depth_key << 32 | prim`) every
-//! fragment is a distinct value: exact, fragment for fragment ([`Promise::All`]). With
+//! fragment is a distinct value: exact, fragment for fragment ([`Promise::All`](crate::Promise::All)). With
 //! `DualDepthPeeling<u32>` (depth keys, as the paper's float depths) **equal depths merge**: all
 //! fragments sharing the nearest (or farthest) depth are one layer, peeled together, and the
 //! capture holds that depth once; the oracle's diff reports the duplicates as lost. (The paper's
@@ -56,10 +56,8 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, Word, WordMemory};
-use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Memory, Word, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::LayerStorage;
 use crate::schemes::common::MdtsWord;
 
@@ -112,9 +110,8 @@ impl<W: MdtsWord> DualDepthPeeling<W> {
     /// # Errors
     /// `max_layers == 0`, or storage beyond `memory_cap`.
     pub fn new(viewport: Viewport, max_layers: u32, memory_cap: u64) -> Result<Self, CaptureError> {
-        let name = LayerStorage::<W>::name("dual-peeling");
         Ok(Self {
-            storage: LayerStorage::new(&name, viewport, 4, max_layers, memory_cap)?,
+            storage: LayerStorage::new("dual-peeling", viewport, 4, max_layers, memory_cap)?,
         })
     }
 
@@ -153,28 +150,8 @@ fn complement<W: Word>(value: W) -> W {
 impl<W: MdtsWord> Scheme for DualDepthPeeling<W> {
     type State = DualPeel<W>;
 
-    fn name(&self) -> String {
-        LayerStorage::<W>::name("dual-peeling")
-    }
-
-    fn layout(&self) -> Layout {
-        self.storage.layout()
-    }
-
-    fn identity(&self) -> Identity {
-        W::IDENTITY
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        // 32-bit depth keys merge equal depths into one layer; 64-bit words are all distinct.
-        match W::IDENTITY {
-            Identity::KeyOnly => Guarantee::ExactDistinctDepths,
-            _ => Guarantee::Exact,
-        }
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.storage.layers() as u32))
+    fn descriptor(&self) -> &Descriptor {
+        self.storage.descriptor()
     }
 
     fn begin(&self, fragment: Fragment) -> DualPeel<W> {
@@ -256,9 +233,5 @@ impl<W: MdtsWord> Scheme for DualDepthPeeling<W> {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         self.storage.resolve(memory, pixel, out)
-    }
-
-    fn pixels(&self) -> usize {
-        self.storage.pixels()
     }
 }

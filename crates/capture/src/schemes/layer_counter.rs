@@ -30,13 +30,13 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::common::sort::insertion_sort;
 
 /// Bevy 0.15's layer-counter A-buffer.
 #[derive(Clone, Debug)]
 pub struct LayerCounter {
-    pixels: usize,
+    descriptor: Descriptor,
     layer_count: u32,
 }
 
@@ -79,12 +79,20 @@ impl LayerCounter {
                 "the layer counter needs a layer_count of at least 1".into(),
             ));
         }
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            layer_count,
+        let pixels = viewport.pixels();
+        let descriptor = Descriptor {
+            name: "layer-counter".into(),
+            layout: Layout::counters_and_slots(pixels, pixels * layer_count as usize),
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::ExactWithinCapacity(layer_count),
+            promise: Promise::All(Capacity::PerPixelUncounted(layer_count)),
+            pixels,
+            counts_every_drop: true,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            layer_count,
+        })
     }
 
     /// Layers per pixel.
@@ -97,28 +105,8 @@ impl LayerCounter {
 impl Scheme for LayerCounter {
     type State = LayerStep;
 
-    fn name(&self) -> String {
-        "layer-counter".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout::counters_and_slots(self.pixels, self.pixels * self.layer_count as usize)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactWithinCapacity(self.layer_count)
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixelUncounted(self.layer_count))
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> LayerStep {
@@ -134,7 +122,7 @@ impl Scheme for LayerCounter {
                 let layer_id = WordMemory::<u32>::fetch_add(memory, pixel as usize, 1);
                 *state = if layer_id < self.layer_count {
                     LayerStep::Write {
-                        word: pixel as usize + layer_id as usize * self.pixels,
+                        word: pixel as usize + layer_id as usize * self.descriptor.pixels,
                         value,
                     }
                 } else {
@@ -153,15 +141,13 @@ impl Scheme for LayerCounter {
         }
     }
 
-    fn pixels(&self) -> usize {
-        self.pixels
-    }
-
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let count = WordMemory::<u32>::load(memory, pixel).min(self.layer_count) as usize;
         let start = out.len();
         out.extend(
-            (0..count).map(|layer| WordMemory::<u64>::load(memory, pixel + layer * self.pixels)),
+            (0..count).map(|layer| {
+                WordMemory::<u64>::load(memory, pixel + layer * self.descriptor.pixels)
+            }),
         );
         insertion_sort(&mut out[start..]);
         // The clamped counter hides the discarded fragments: nothing is reported as overflow.

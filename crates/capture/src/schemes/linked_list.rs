@@ -36,7 +36,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 
 /// Which of a long list the resolve keeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,7 +50,7 @@ pub enum Resolve {
 /// Per-pixel linked lists with a fixed node pool.
 #[derive(Clone, Debug)]
 pub struct LinkedList {
-    pixels: usize,
+    descriptor: Descriptor,
     pool: usize,
     sorted_max: u32,
     resolve: Resolve,
@@ -117,14 +117,30 @@ impl LinkedList {
                 u32::MAX - 1
             )));
         }
-        let scheme = Self {
+        let descriptor = Descriptor {
+            name: match resolve {
+                Resolve::KeepFirst => "linked-list",
+                Resolve::KeepNearest => "linked-list-nearest",
+            }
+            .into(),
+            // Heads, the counter, then the `next` of nodes 1..=pool.
+            layout: Layout::counters_and_slots(viewport.pixels() + 1 + pool, pool),
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::ExactWithinCapacity(sorted_max),
+            promise: match resolve {
+                // The resolve stops after N nodes and never learns the list's length.
+                Resolve::KeepFirst => Promise::All(Capacity::PerPixelUncounted(sorted_max)),
+                Resolve::KeepNearest => Promise::Nearest(sorted_max),
+            },
             pixels: viewport.pixels(),
+            counts_every_drop: false,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
             pool,
             sorted_max,
             resolve,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        })
     }
 
     /// Nodes in the pool.
@@ -141,40 +157,15 @@ impl LinkedList {
 
     /// The 32-bit word of the global counter; node `n`'s `next` is at `counter() + n`.
     fn counter(&self) -> usize {
-        self.pixels
+        self.descriptor.pixels
     }
 }
 
 impl Scheme for LinkedList {
     type State = Node;
 
-    fn name(&self) -> String {
-        match self.resolve {
-            Resolve::KeepFirst => "linked-list",
-            Resolve::KeepNearest => "linked-list-nearest",
-        }
-        .into()
-    }
-
-    fn layout(&self) -> Layout {
-        // Heads, the counter, then the `next` of nodes 1..=pool.
-        Layout::counters_and_slots(self.pixels + 1 + self.pool, self.pool)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactWithinCapacity(self.sorted_max)
-    }
-
-    fn promise(&self) -> Promise {
-        match self.resolve {
-            // The resolve stops after N nodes and never learns the list's length.
-            Resolve::KeepFirst => Promise::All(Capacity::PerPixelUncounted(self.sorted_max)),
-            Resolve::KeepNearest => Promise::Nearest(self.sorted_max),
-        }
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Node {
@@ -213,10 +204,6 @@ impl Scheme for LinkedList {
                 Step::Stored
             }
         }
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

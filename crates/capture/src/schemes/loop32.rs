@@ -36,7 +36,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 
 /// The empty depth slot.
 const EMPTY: u32 = u32::MAX;
@@ -44,7 +44,7 @@ const EMPTY: u32 = u32::MAX;
 /// nvpro-samples' loop32: two passes, equal depths merge.
 #[derive(Clone, Debug)]
 pub struct Loop32 {
-    pixels: usize,
+    descriptor: Descriptor,
     k: u32,
 }
 
@@ -116,12 +116,25 @@ impl Loop32 {
                 "loop32 needs K ≥ 1 layers per pixel, got K = 0".into(),
             ));
         }
-        let scheme = Self {
+        let descriptor = Descriptor {
+            name: "loop32".into(),
+            layout: Layout {
+                words32: 2 * k as usize * viewport.pixels(),
+                init32: EMPTY,
+                words64: 0,
+                init64: 0,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::ExactDistinctDepths,
+            promise: Promise::Nearest(k),
             pixels: viewport.pixels(),
-            k,
+            counts_every_drop: false,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            k,
+        })
     }
 
     /// Slots per pixel.
@@ -132,12 +145,12 @@ impl Loop32 {
 
     /// The depth word of `pixel`'s slot `slot`.
     fn depth_word(&self, pixel: u32, slot: u32) -> usize {
-        pixel as usize + slot as usize * self.pixels
+        pixel as usize + slot as usize * self.descriptor.pixels
     }
 
     /// The colour word of `pixel`'s slot `slot`.
     fn colour_word(&self, pixel: u32, slot: u32) -> usize {
-        self.depth_word(pixel, slot) + self.k as usize * self.pixels
+        self.depth_word(pixel, slot) + self.k as usize * self.descriptor.pixels
     }
 
     /// The depth key in `pixel`'s slot `slot` (a plain load).
@@ -167,30 +180,8 @@ impl Loop32 {
 impl Scheme for Loop32 {
     type State = Loop32Step;
 
-    fn name(&self) -> String {
-        "loop32".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: 2 * self.k as usize * self.pixels,
-            init32: EMPTY,
-            words64: 0,
-            init64: 0,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactDistinctDepths
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Loop32Step {
@@ -278,10 +269,6 @@ impl Scheme for Loop32 {
             }
         }
         Step::Continue
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

@@ -34,7 +34,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 
 /// An empty slot.
 const EMPTY: u64 = u64::MAX;
@@ -42,7 +42,7 @@ const EMPTY: u64 = u64::MAX;
 /// nvpro-samples' loop64.
 #[derive(Clone, Debug)]
 pub struct Loop64 {
-    pixels: usize,
+    descriptor: Descriptor,
     k: u32,
 }
 
@@ -85,17 +85,30 @@ impl Loop64 {
                 "loop64 needs K ≥ 1 layers per pixel, got K = 0".into(),
             ));
         }
-        let scheme = Self {
+        let descriptor = Descriptor {
+            name: "loop64".into(),
+            layout: Layout {
+                words32: 0,
+                init32: 0,
+                words64: k as usize * viewport.pixels(),
+                init64: EMPTY,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::Exact,
+            promise: Promise::Nearest(k),
             pixels: viewport.pixels(),
-            k,
+            counts_every_drop: true,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            k,
+        })
     }
 
     /// The word of `pixel`'s slot `slot`.
     fn word(&self, pixel: u32, slot: u32) -> usize {
-        pixel as usize + slot as usize * self.pixels
+        pixel as usize + slot as usize * self.descriptor.pixels
     }
 
     /// `pixel`'s slot `slot` (a plain load).
@@ -107,34 +120,8 @@ impl Loop64 {
 impl Scheme for Loop64 {
     type State = Loop64Step;
 
-    fn name(&self) -> String {
-        "loop64".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: 0,
-            init32: 0,
-            words64: self.k as usize * self.pixels,
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Loop64Step {
@@ -177,10 +164,6 @@ impl Scheme for Loop64 {
             }
         }
         Step::Continue
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

@@ -36,7 +36,7 @@ use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, SpanVisitor, WordMemory};
 use crate::scheme::{
-    check_cap, walk_to_end, CaptureError, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
+    walk_to_end, CaptureError, Descriptor, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
 };
 
 pub use crate::schemes::common::MdtsWord;
@@ -53,7 +53,7 @@ pub enum Direction {
 /// The multi-depth test scheme over words of type `W` (default: `u64`, fragment identity kept).
 #[derive(Clone, Debug)]
 pub struct Mdts<W: MdtsWord = u64> {
-    pixels: usize,
+    descriptor: Descriptor,
     k: u32,
     direction: Direction,
     probe: bool,
@@ -90,15 +90,54 @@ impl<W: MdtsWord> Mdts<W> {
                 "MDTS needs K ≥ 1 slots per pixel, got K = 0".into(),
             ));
         }
-        let scheme = Self {
-            pixels: viewport.pixels(),
+        let pixels = viewport.pixels();
+        let words = pixels * k as usize;
+        let (words32, words64) = if W::IDENTITY == Identity::KeyOnly {
+            (words, 0)
+        } else {
+            (0, words)
+        };
+        let empty = Self::empty_in(direction).decode();
+        let descriptor = Descriptor {
+            name: Self::name_of(direction, false),
+            layout: Layout {
+                words32,
+                init32: (empty >> 32) as u32,
+                words64,
+                init64: empty,
+                table_bytes: 0,
+            },
+            identity: W::IDENTITY,
+            guarantee: Guarantee::Exact,
+            promise: match direction {
+                Direction::Ascending => Promise::Nearest(k),
+                Direction::Descending => Promise::Farthest(k),
+            },
+            pixels,
+            counts_every_drop: true,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
             k,
             direction,
             probe: false,
             _word: std::marker::PhantomData,
+        })
+    }
+
+    /// The catalog's name of MDTS on `W` words sorted in `direction`, probing or not.
+    fn name_of(direction: Direction, probe: bool) -> String {
+        let word = if W::IDENTITY == Identity::KeyOnly {
+            "32"
+        } else {
+            "64"
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        let probe = if probe { "-probe" } else { "" };
+        match direction {
+            Direction::Ascending => format!("mdts{word}{probe}"),
+            Direction::Descending => format!("mdts{word}-desc{probe}"),
+        }
+        .replace("mdts64", "mdts")
     }
 
     /// Ascending MDTS (the paper's main form) with the default memory cap.
@@ -113,6 +152,10 @@ impl<W: MdtsWord> Mdts<W> {
     #[must_use]
     pub fn probing(self) -> Self {
         Self {
+            descriptor: Descriptor {
+                name: Self::name_of(self.direction, true),
+                ..self.descriptor
+            },
             probe: true,
             ..self
         }
@@ -126,7 +169,12 @@ impl<W: MdtsWord> Mdts<W> {
 
     /// The empty value of a slot.
     fn empty(&self) -> W {
-        match self.direction {
+        Self::empty_in(self.direction)
+    }
+
+    /// The empty value of a slot of an array sorted in `direction`.
+    fn empty_in(direction: Direction) -> W {
+        match direction {
             Direction::Ascending => W::MAX,
             Direction::Descending => W::ZERO,
         }
@@ -240,35 +288,8 @@ impl<W: MdtsWord> SpanVisitor<W> for ReadList<'_, W> {
 impl<W: MdtsWord> Scheme for Mdts<W> {
     type State = Walk<W>;
 
-    fn name(&self) -> String {
-        let word = if W::IDENTITY == Identity::KeyOnly {
-            "32"
-        } else {
-            "64"
-        };
-        let probe = if self.probe { "-probe" } else { "" };
-        match self.direction {
-            Direction::Ascending => format!("mdts{word}{probe}"),
-            Direction::Descending => format!("mdts{word}-desc{probe}"),
-        }
-        .replace("mdts64", "mdts")
-    }
-
-    fn layout(&self) -> Layout {
-        let words = self.pixels * self.k as usize;
-        let (bytes32, bytes64) = if W::IDENTITY == Identity::KeyOnly {
-            (words, 0)
-        } else {
-            (0, words)
-        };
-        let empty = self.empty().decode();
-        Layout {
-            words32: bytes32,
-            init32: (empty >> 32) as u32,
-            words64: bytes64,
-            init64: empty,
-            table_bytes: 0,
-        }
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Walk<W> {
@@ -297,29 +318,6 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
             steps,
         };
         W::words(memory).with_span(walk.base, self.k as usize, walk_on)
-    }
-
-    fn identity(&self) -> Identity {
-        W::IDENTITY
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        match self.direction {
-            Direction::Ascending => Promise::Nearest(self.k),
-            Direction::Descending => Promise::Farthest(self.k),
-        }
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {

@@ -27,21 +27,21 @@
 //!
 //! **Sources.** FreePipe (Liu et al. 2010) for MDTS; the WebGPU specification (W3C, 2024: WGSL
 //! atomics are `atomic<u32>` and `atomic<i32>` only) for why the emulation exists; the lock is
-//! the per-slot form of nvpro-samples' spinlock (`kbuffer_spinlock`).
+//! the per-slot form of nvpro-samples' spinlock (`kbuffer::spinlock`).
 //!
 //! **Departures.** The words hold the halves complemented (`!hi`, `!lo`), so that the zeroed
 //! buffer WebGPU allocates is every slot empty (`u64::MAX`) and every lock free; the lock's
 //! compare-and-swap is [`Memory::try_lock`] (an exchange of 1, the same on a 0/1 word). The lock
-//! loop has the fixed shape of `kbuffer_spinlock` (the section inside the loop body), so lockstep
+//! loop has the fixed shape of `kbuffer::spinlock` (the section inside the loop body), so lockstep
 //! warps do not deadlock on it.
 
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
-use crate::executors::scheduled::Simt;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::Simt;
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// An empty slot's value.
 const EMPTY: u64 = u64::MAX;
@@ -69,7 +69,7 @@ impl Emulation {
 /// MDTS with each slot's 64-bit `atomicMin` emulated on two 32-bit words.
 #[derive(Clone, Debug)]
 pub struct MdtsEmulated64 {
-    pixels: usize,
+    descriptor: Descriptor,
     k: u32,
     emulation: Emulation,
 }
@@ -136,13 +136,36 @@ impl MdtsEmulated64 {
                 emulation.scheme_name()
             )));
         }
-        let scheme = Self {
+        let slots = viewport.pixels() * k as usize;
+        let locks = match emulation {
+            Emulation::Torn => 0,
+            Emulation::Locked => slots,
+        };
+        let descriptor = Descriptor {
+            name: emulation.scheme_name().into(),
+            layout: Layout {
+                // Words `2 s`, `2 s + 1`: slot `s`'s complemented halves; then slot `s`'s lock at
+                // `2 slots + s` (locked only). All zero: empty and free.
+                words32: 2 * slots + locks,
+                init32: 0,
+                words64: 0,
+                init64: 0,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyAndPrim,
+            guarantee: match emulation {
+                Emulation::Torn => Guarantee::ExactWithoutHazards,
+                Emulation::Locked => Guarantee::Exact,
+            },
+            promise: Promise::Nearest(k),
             pixels: viewport.pixels(),
+            counts_every_drop: false,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
             k,
             emulation,
-        };
-        check_cap(emulation.scheme_name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        })
     }
 
     /// Like [`MdtsEmulated64::new`] with the default memory cap.
@@ -154,7 +177,7 @@ impl MdtsEmulated64 {
     }
 
     fn slots(&self) -> usize {
-        self.pixels * self.k as usize
+        self.descriptor.pixels * self.k as usize
     }
 
     /// The 64-bit value of slot `slot` (what the post pass reads; a torn slot reads as torn).
@@ -203,39 +226,8 @@ impl MdtsEmulated64 {
 impl Scheme for MdtsEmulated64 {
     type State = Walk64;
 
-    fn name(&self) -> String {
-        self.emulation.scheme_name().into()
-    }
-
-    fn layout(&self) -> Layout {
-        let locks = match self.emulation {
-            Emulation::Torn => 0,
-            Emulation::Locked => self.slots(),
-        };
-        Layout {
-            // Words `2 s`, `2 s + 1`: slot `s`'s complemented halves; then slot `s`'s lock at
-            // `2 slots + s` (locked only). All zero: empty and free.
-            words32: 2 * self.slots() + locks,
-            init32: 0,
-            words64: 0,
-            init64: 0,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        match self.emulation {
-            Emulation::Torn => Guarantee::ExactWithoutHazards,
-            Emulation::Locked => Guarantee::Exact,
-        }
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Walk64 {
@@ -300,10 +292,6 @@ impl Scheme for MdtsEmulated64 {
             },
             _ => Simt::default(),
         }
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

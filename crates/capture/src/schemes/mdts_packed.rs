@@ -61,7 +61,7 @@ use fragsim_raster::{depth_from_key, Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::mdts::{Direction, Mdts, MdtsWord, Walk};
 
 /// Depth bits a packed word keeps (the top of the word).
@@ -171,7 +171,7 @@ pub struct MdtsPacked {
     /// The walk of one array: ascending MDTS over `u32` words, re-based onto array A or B.
     mdts: Mdts<u32>,
     colours: Colours,
-    pixels: usize,
+    descriptor: Descriptor,
 }
 
 /// A fragment's progress: the walk of array A, then the walk of array B.
@@ -197,13 +197,31 @@ impl MdtsPacked {
     ) -> Result<Self, CaptureError> {
         // The cap is checked below on both arrays, under this scheme's name.
         let mdts = Mdts::new(viewport, k, Direction::Ascending, u64::MAX)?;
-        let scheme = Self {
+        let array_words = viewport.pixels() * k as usize;
+        let descriptor = Descriptor {
+            name: match colours {
+                Colours::Prim => "mdts-packed",
+                Colours::Scrambled => "mdts-packed-scrambled",
+            }
+            .into(),
+            layout: Layout {
+                words32: 2 * array_words,
+                init32: EMPTY,
+                words64: 0,
+                init64: u64::MAX,
+                table_bytes: 0,
+            },
+            identity: Identity::PrimOnly,
+            guarantee: Guarantee::Approximate,
+            promise: Promise::Nearest(k),
+            pixels: viewport.pixels(),
+            counts_every_drop: false,
+        };
+        Ok(Self {
             mdts,
             colours,
-            pixels: viewport.pixels(),
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+            descriptor: descriptor.within(memory_cap)?,
+        })
     }
 
     /// Slots per pixel in each array.
@@ -228,41 +246,15 @@ impl MdtsPacked {
 
     /// Words in one array; array B starts here.
     fn array_words(&self) -> usize {
-        self.pixels * self.k() as usize
+        self.descriptor.pixels * self.k() as usize
     }
 }
 
 impl Scheme for MdtsPacked {
     type State = PackedWalk;
 
-    fn name(&self) -> String {
-        match self.colours {
-            Colours::Prim => "mdts-packed",
-            Colours::Scrambled => "mdts-packed-scrambled",
-        }
-        .into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: 2 * self.array_words(),
-            init32: EMPTY,
-            words64: 0,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::PrimOnly
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Approximate
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k())
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> PackedWalk {
@@ -294,10 +286,6 @@ impl Scheme for MdtsPacked {
             }
             None => end,
         }
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

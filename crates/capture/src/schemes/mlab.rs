@@ -6,7 +6,7 @@
 //! depth of the nearest fragment it holds (here, as everywhere in the catalog, that fragment's
 //! `u64` `depth_key << 32 | prim`, so that ties order as the oracle orders them) and how many
 //! fragments were merged into it. A fragment's walk is **one** step, the critical section: take
-//! the pixel's lock ([`Memory::lock`], as [`kbuffer_interlock`](crate::schemes::kbuffer_interlock)
+//! the pixel's lock ([`Memory::lock`], as [`kbuffer::interlock`](crate::schemes::kbuffer::interlock)
 //! does), load the `K` nodes, insert the fragment as a node of one in depth order, and if that
 //! makes `K + 1` nodes merge the last two (the farther node's fragments join the nearer one,
 //! which keeps its depth), store the `K` nodes, unlock. A step that merged ends
@@ -54,13 +54,13 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::EMPTY;
 
 /// MLAB's `K` nodes per pixel, merged when full, inside a per-pixel critical section.
 #[derive(Clone, Debug)]
 pub struct Mlab {
-    pixels: usize,
+    descriptor: Descriptor,
     k: u32,
 }
 
@@ -75,12 +75,26 @@ impl Mlab {
                 "mlab needs at least one node per pixel (K ≥ 1)".into(),
             ));
         }
-        let scheme = Self {
+        let descriptor = Descriptor {
+            name: "mlab".into(),
+            layout: Layout {
+                // `u32` words: `p` is pixel `p`'s lock, then `K` counts a pixel.
+                words32: viewport.pixels() * (1 + k as usize),
+                init32: 0,
+                words64: viewport.pixels() * k as usize,
+                init64: EMPTY,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::Exact,
+            promise: Promise::Nearest(k),
             pixels: viewport.pixels(),
-            k,
+            counts_every_drop: true,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            k,
+        })
     }
 
     /// Like [`Mlab::new`] with the default memory cap.
@@ -93,7 +107,7 @@ impl Mlab {
 
     /// The `u32` word of node `node` of pixel `pixel`'s count (words `0..pixels` are the locks).
     fn count_word(&self, pixel: usize, node: usize) -> usize {
-        self.pixels + pixel * self.k as usize + node
+        self.descriptor.pixels + pixel * self.k as usize + node
     }
 
     /// Pixel `pixel`'s nodes as `(depth, fragments merged into it)`, nearest first, empty nodes
@@ -116,35 +130,8 @@ impl Mlab {
 impl Scheme for Mlab {
     type State = Fragment;
 
-    fn name(&self) -> String {
-        "mlab".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            // `u32` words: `p` is pixel `p`'s lock, then `K` counts a pixel.
-            words32: self.pixels * (1 + self.k as usize),
-            init32: 0,
-            words64: self.pixels * self.k as usize,
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Fragment {
@@ -176,10 +163,6 @@ impl Scheme for Mlab {
         } else {
             Step::Stored
         }
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

@@ -17,11 +17,11 @@
 //! this needs, so it holds under any interleaving (`tests/suite/peeling.rs` runs the serial, parallel and
 //! scheduled executors). What the value is decides what is exact:
 //! - `DepthPeeling<u64>` (default): `depth_key << 32 | prim`. Every fragment is distinct, so every
-//!   fragment is one layer: exact, fragment for fragment ([`Promise::All`]).
+//!   fragment is one layer: exact, fragment for fragment ([`Promise::All`](crate::Promise::All)).
 //! - `DepthPeeling<u32>`: the depth key alone, as the classical algorithm. Fragments of one pixel
 //!   with **equal depths merge**: the pass keeps one key for all of them, and the next pass's
 //!   strict test peels them all away together. The capture holds each distinct depth once;
-//!   [`Identity::KeyOnly`] keeps the promise of every fragment, so the oracle's diff reports the
+//!   [`Identity::KeyOnly`](crate::Identity::KeyOnly) keeps the promise of every fragment, so the oracle's diff reports the
 //!   merged duplicates as lost, which is the truth about this variant.
 //!
 //! **Passes.** `L + 1` geometry passes, where `L` is the largest number of layers at any pixel:
@@ -44,10 +44,8 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::{depth_test, LayerStorage, MdtsWord};
 
 /// Classical depth peeling over words of type `W` (default `u64`: exact fragment for fragment;
@@ -89,9 +87,8 @@ impl<W: MdtsWord> DepthPeeling<W> {
     /// # Errors
     /// `max_layers == 0`, or storage beyond `memory_cap`.
     pub fn new(viewport: Viewport, max_layers: u32, memory_cap: u64) -> Result<Self, CaptureError> {
-        let name = LayerStorage::<W>::name("peeling");
         Ok(Self {
-            storage: LayerStorage::new(&name, viewport, 2, max_layers, memory_cap)?,
+            storage: LayerStorage::new("peeling", viewport, 2, max_layers, memory_cap)?,
         })
     }
 
@@ -113,28 +110,8 @@ impl<W: MdtsWord> DepthPeeling<W> {
 impl<W: MdtsWord> Scheme for DepthPeeling<W> {
     type State = Peel<W>;
 
-    fn name(&self) -> String {
-        LayerStorage::<W>::name("peeling")
-    }
-
-    fn layout(&self) -> Layout {
-        self.storage.layout()
-    }
-
-    fn identity(&self) -> Identity {
-        W::IDENTITY
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        // 32-bit depth keys merge equal depths into one layer; 64-bit words are all distinct.
-        match W::IDENTITY {
-            Identity::KeyOnly => Guarantee::ExactDistinctDepths,
-            _ => Guarantee::Exact,
-        }
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.max_layers()))
+    fn descriptor(&self) -> &Descriptor {
+        self.storage.descriptor()
     }
 
     fn begin(&self, fragment: Fragment) -> Peel<W> {
@@ -195,9 +172,5 @@ impl<W: MdtsWord> Scheme for DepthPeeling<W> {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         self.storage.resolve(memory, pixel, out)
-    }
-
-    fn pixels(&self) -> usize {
-        self.storage.pixels()
     }
 }

@@ -42,7 +42,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::sort::bitonic_sort;
 
 /// MSAA samples per pixel: the most D3D10 hardware offered, and the sketch's limit.
@@ -51,7 +51,7 @@ pub const SAMPLES: u32 = 8;
 /// The stencil-routed A-buffer.
 #[derive(Clone, Debug)]
 pub struct StencilRouted {
-    pixels: usize,
+    descriptor: Descriptor,
     passes: u32,
 }
 
@@ -87,12 +87,24 @@ impl StencilRouted {
                 "the stencil-routed A-buffer needs at least 1 pass of 8 samples, got 0".into(),
             ));
         }
-        let scheme = Self {
+        let descriptor = Descriptor {
+            // The pass count is a parameter, like MDTS's K: the catalog's one spelling for every
+            // configuration (runs report their passes and slots beside it).
+            name: "srab".into(),
+            layout: Layout::counters_and_slots(
+                viewport.pixels(),
+                viewport.pixels() * (SAMPLES * passes) as usize,
+            ),
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::ExactInArrivalOrder,
+            promise: Promise::All(Capacity::PerPixel(SAMPLES * passes)),
             pixels: viewport.pixels(),
-            passes,
+            counts_every_drop: false,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            passes,
+        })
     }
 
     /// The sketch's form: one pass, 8 samples, the default memory cap.
@@ -113,26 +125,8 @@ impl StencilRouted {
 impl Scheme for StencilRouted {
     type State = Route;
 
-    fn name(&self) -> String {
-        // The pass count is a parameter, like MDTS's K: the catalog's one spelling for every
-        // configuration (runs report their passes and slots beside it).
-        "srab".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout::counters_and_slots(self.pixels, self.pixels * self.capacity() as usize)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactInArrivalOrder
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.capacity()))
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Route {
@@ -178,19 +172,16 @@ impl Scheme for StencilRouted {
 
     fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
         let routed = (pass + 1) * SAMPLES;
-        let overflowed = (0..self.pixels).any(|p| WordMemory::<u32>::load(memory, p) > routed);
+        let overflowed =
+            (0..self.descriptor.pixels).any(|p| WordMemory::<u32>::load(memory, p) > routed);
         let more = overflowed && pass + 1 < self.passes;
         if more {
             // The next pass's stencil clear.
-            for p in 0..self.pixels {
+            for p in 0..self.descriptor.pixels {
                 WordMemory::<u32>::store(memory, p, 0);
             }
         }
         more
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

@@ -21,13 +21,13 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::depth_test;
 
 /// The z-buffer over packed `depth_key << 32 | prim` words.
 #[derive(Clone, Debug)]
 pub struct ZBuffer {
-    pixels: usize,
+    descriptor: Descriptor,
 }
 
 /// A fragment's one step: its pixel's word and its packed value.
@@ -45,11 +45,18 @@ impl ZBuffer {
     /// # Errors
     /// Storage beyond `memory_cap`.
     pub fn new(viewport: Viewport, memory_cap: u64) -> Result<Self, CaptureError> {
-        let scheme = Self {
+        let descriptor = Descriptor {
+            name: "zbuffer".into(),
+            layout: Layout::counters_and_slots(0, viewport.pixels()),
+            identity: Identity::KeyAndPrim,
+            guarantee: Guarantee::Exact,
+            promise: Promise::Nearest(1),
             pixels: viewport.pixels(),
+            counts_every_drop: false,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+        })
     }
 
     /// A z-buffer with the default memory cap.
@@ -64,24 +71,8 @@ impl ZBuffer {
 impl Scheme for ZBuffer {
     type State = DepthTest;
 
-    fn name(&self) -> String {
-        "zbuffer".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout::counters_and_slots(0, self.pixels)
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(1)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> DepthTest {
@@ -105,9 +96,5 @@ impl Scheme for ZBuffer {
             out.push(nearest);
         }
         0
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 }

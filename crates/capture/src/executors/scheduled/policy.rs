@@ -7,9 +7,9 @@ use std::collections::VecDeque;
 
 use fragsim_raster::SplitMix64;
 
-#[cfg(doc)]
-use super::Simt;
 use super::Thread;
+#[cfg(doc)]
+use crate::scheme::Simt;
 
 /// Lanes of a warp in [`Policy::Warps`] and [`Policy::Lockstep`].
 pub const WARP_LANES: usize = 32;

@@ -16,7 +16,7 @@
 //!   one subinterval per occupied bit, then a routing pass (exact when no two fragments share one
 //!   of the 1024 uniform subintervals); batches of 32 layers for deeper scenes.
 //!
-//! None of them is exact in general: each promises [`Promise::All`](crate::Promise::All) and
+//! None of them is exact in general: each promises [`Promise::All`] and
 //! reports no overflow, so the oracle's diff counts every fragment lost to a collision as `lost`.
 //! (ADP's storage, sized to the scene's depth complexity, can also be too small when the caller
 //! under-states it: those fragments are counted as overflow, see [`Adp`].) A walk ends `Dropped`
@@ -56,19 +56,20 @@
 //! buffer starts at 0, as the paper's MRTs do (Layout has one initial value per word width): a
 //! pair's min channel stores the complement (never 0), a single bucket stores value + 1.
 
-mod adaptive;
-mod two_pass;
-mod uniform;
+mod adp;
+mod bdp;
+mod bdp2;
 
-pub use adaptive::{Adp, AdpStage, ADP_BATCH, ADP_SUBINTERVALS};
-pub use two_pass::{Bdp2, Bdp2Stage};
-pub use uniform::{Bdp, Buckets};
+pub use adp::{Adp, AdpStage, ADP_BATCH, ADP_SUBINTERVALS};
+pub use bdp::{Bdp, Buckets};
+pub use bdp2::{Bdp2, Bdp2Stage};
 
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
+use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Step};
 use crate::schemes::common::MdtsWord;
 
 /// u32 words of the depth-range pass per pixel: the near word (complemented key) and the far word.
@@ -95,10 +96,11 @@ pub fn subinterval(key: u32, near: u32, far: u32, count: u32) -> u32 {
 
 /// Where a bucket scheme's words are: per pixel, `aux` u32 words (the range, and ADP's histogram
 /// and bounds) and `buckets` words of the bucket type, which share the u32 array when the buckets
-/// are u32 and fill the u64 array otherwise. Every word starts at 0.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// are u32 and fill the u64 array otherwise. Every word starts at 0. It holds the scheme's
+/// descriptor: every bucket scheme is approximate, on the words `W` identify.
+#[derive(Clone, Debug, PartialEq, Eq)]
 struct Plan {
-    pixels: usize,
+    descriptor: Descriptor,
     aux: usize,
     buckets: usize,
     wide: bool,
@@ -106,9 +108,11 @@ struct Plan {
 }
 
 impl Plan {
-    /// The plan, or the error when its storage exceeds `cap` bytes.
+    /// The plan of the scheme `scheme` keeping `promise`, or the error when its storage exceeds
+    /// `cap` bytes.
     fn new<W: MdtsWord>(
-        scheme: &str,
+        scheme: String,
+        promise: Promise,
         viewport: Viewport,
         aux: usize,
         buckets: usize,
@@ -122,35 +126,38 @@ impl Plan {
         let needed = pixels as u128 * (aux as u128 * 4 + buckets as u128 * bucket_bytes);
         if needed > u128::from(cap) && needed > isize::MAX as u128 {
             return Err(CaptureError::TooMuchMemory {
-                scheme: scheme.into(),
+                scheme,
                 needed: u64::try_from(needed).unwrap_or(u64::MAX),
                 cap,
             });
         }
-        let plan = Self {
+        let (words32, words64) = if wide {
+            (pixels * aux, pixels * buckets)
+        } else {
+            (pixels * (aux + buckets), 0)
+        };
+        let descriptor = Descriptor {
+            name: scheme,
+            layout: Layout {
+                words32,
+                init32: 0,
+                words64,
+                init64: 0,
+                table_bytes: 0,
+            },
+            identity: W::IDENTITY,
+            guarantee: Guarantee::Approximate,
+            promise,
             pixels,
+            counts_every_drop: false,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(cap)?,
             aux,
             buckets,
             wide,
             bucket_base: if wide { 0 } else { pixels * aux },
-        };
-        check_cap(scheme, &plan.layout(), cap)?;
-        Ok(plan)
-    }
-
-    fn layout(&self) -> Layout {
-        let (words32, words64) = if self.wide {
-            (self.pixels * self.aux, self.pixels * self.buckets)
-        } else {
-            (self.pixels * (self.aux + self.buckets), 0)
-        };
-        Layout {
-            words32,
-            init32: 0,
-            words64,
-            init64: 0,
-            table_bytes: 0,
-        }
+        })
     }
 
     /// Index of aux word `i` of `pixel` in the u32 array.

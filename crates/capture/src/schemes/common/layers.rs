@@ -7,9 +7,10 @@ use std::marker::PhantomData;
 use fragsim_raster::Viewport;
 
 use super::MdtsWord;
-use crate::capture::Identity;
+use crate::capture::{Capacity, Identity};
+use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, Word, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Step};
 
 /// The storage of a peeling scheme: per pixel, `working` words of type `W` that the geometry
 /// passes compete on, `layers` output slots that the between-pass kernel fills, and a `u32`
@@ -20,45 +21,71 @@ use crate::scheme::{check_cap, CaptureError, Step};
 /// word, no fragment's value reaches it, and the counter is kept complemented so that it reads 0.
 #[derive(Clone, Debug)]
 pub(crate) struct LayerStorage<W> {
-    pixels: usize,
+    descriptor: Descriptor,
     working: usize,
     layers: usize,
     _word: PhantomData<W>,
 }
 
 impl<W: MdtsWord> LayerStorage<W> {
-    /// Storage for `viewport` with `working` words and `max_layers` slots per pixel.
+    /// Storage for `viewport` with `working` words and `max_layers` slots per pixel, for the
+    /// peeling scheme named `base` (`base32` on `u32` words), whose descriptor it holds.
     ///
     /// # Errors
     /// `max_layers == 0`, or storage beyond `memory_cap` bytes.
     pub(crate) fn new(
-        scheme: &str,
+        base: &str,
         viewport: Viewport,
         working: usize,
         max_layers: u32,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
+        let name = match W::IDENTITY {
+            Identity::KeyOnly => format!("{base}32"),
+            _ => base.into(),
+        };
         if max_layers == 0 {
             return Err(CaptureError::BadParameter(format!(
-                "{scheme} needs storage for at least 1 layer per pixel, got 0 layers"
+                "{name} needs storage for at least 1 layer per pixel, got 0 layers"
             )));
         }
-        let storage = Self {
-            pixels: viewport.pixels(),
+        let pixels = viewport.pixels();
+        let words = pixels * (working + max_layers as usize);
+        // With `u32` words the counters follow the words of type `W`.
+        let (words32, words64) = match W::IDENTITY {
+            Identity::KeyOnly => (words + pixels, 0),
+            _ => (pixels, words),
+        };
+        let descriptor = Descriptor {
+            name,
+            layout: Layout {
+                words32,
+                init32: u32::MAX,
+                words64,
+                init64: u64::MAX,
+                table_bytes: 0,
+            },
+            identity: W::IDENTITY,
+            // 32-bit depth keys merge equal depths into one layer; 64-bit words are all distinct.
+            guarantee: match W::IDENTITY {
+                Identity::KeyOnly => Guarantee::ExactDistinctDepths,
+                _ => Guarantee::Exact,
+            },
+            promise: Promise::All(Capacity::PerPixel(max_layers)),
+            pixels,
+            counts_every_drop: false,
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
             working,
             layers: max_layers as usize,
             _word: PhantomData,
-        };
-        check_cap(scheme, &storage.layout(), memory_cap)?;
-        Ok(storage)
+        })
     }
 
-    /// The scheme's name: `base` for `u64` words, `base32` for `u32` words.
-    pub(crate) fn name(base: &str) -> String {
-        match W::IDENTITY {
-            Identity::KeyOnly => format!("{base}32"),
-            _ => base.into(),
-        }
+    /// The peeling scheme's descriptor.
+    pub(crate) fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn stride(&self) -> usize {
@@ -67,25 +94,11 @@ impl<W: MdtsWord> LayerStorage<W> {
 
     /// Words of type `W` before the counters: with `u32` words the counters follow them.
     fn words(&self) -> usize {
-        self.pixels * self.stride()
-    }
-
-    pub(crate) fn layout(&self) -> Layout {
-        let (words32, words64) = match W::IDENTITY {
-            Identity::KeyOnly => (self.words() + self.pixels, 0),
-            _ => (self.pixels, self.words()),
-        };
-        Layout {
-            words32,
-            init32: u32::MAX,
-            words64,
-            init64: u64::MAX,
-            table_bytes: 0,
-        }
+        self.pixels() * self.stride()
     }
 
     pub(crate) fn pixels(&self) -> usize {
-        self.pixels
+        self.descriptor.pixels
     }
 
     /// Output slots per pixel.

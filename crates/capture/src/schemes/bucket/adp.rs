@@ -58,10 +58,9 @@ use std::marker::PhantomData;
 use fragsim_raster::{Fragment, Viewport};
 
 use super::{positive, read_single, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS};
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::capture::Capacity;
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::MdtsWord;
 
 /// Subintervals of the depth histogram: 8 MRTs × 4 channels × 32 bits.
@@ -124,8 +123,14 @@ impl<W: MdtsWord> Adp<W> {
     pub fn new(viewport: Viewport, max_depth: u32, memory_cap: u64) -> Result<Self, CaptureError> {
         positive("ADP's depth complexity (buckets per pixel)", max_depth)?;
         let aux = LOWER_EDGE + 1 + max_depth.min(ADP_BATCH) as usize;
-        let name = format!("adp{}", word_suffix::<W>());
-        let plan = Plan::new::<W>(&name, viewport, aux, max_depth as usize, memory_cap)?;
+        let plan = Plan::new::<W>(
+            format!("adp{}", word_suffix::<W>()),
+            Promise::All(Capacity::PerPixel(max_depth)),
+            viewport,
+            aux,
+            max_depth as usize,
+            memory_cap,
+        )?;
         Ok(Self {
             plan,
             slots: max_depth,
@@ -166,7 +171,7 @@ impl<W: MdtsWord> Adp<W> {
         let len = self.batch_len(batch) as usize;
         let mut any = false;
         let mut bounds = Vec::with_capacity(len);
-        for pixel in 0..self.plan.pixels {
+        for pixel in 0..self.plan.descriptor.pixels {
             bounds.clear();
             // With no set bit in the batch, the edge is past every subinterval: all discard.
             let mut lower = if batch == 0 { 0 } else { ADP_SUBINTERVALS };
@@ -225,24 +230,8 @@ impl<W: MdtsWord> Adp<W> {
 impl<W: MdtsWord> Scheme for Adp<W> {
     type State = Walk<W, AdpStage>;
 
-    fn name(&self) -> String {
-        format!("adp{}", word_suffix::<W>())
-    }
-
-    fn layout(&self) -> Layout {
-        self.plan.layout()
-    }
-
-    fn identity(&self) -> Identity {
-        W::IDENTITY
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Approximate
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.slots))
+    fn descriptor(&self) -> &Descriptor {
+        &self.plan.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Self::State {
@@ -316,10 +305,6 @@ impl<W: MdtsWord> Scheme for Adp<W> {
                 self.batch_len(next) > 0 && self.equalise(memory, next)
             }
         }
-    }
-
-    fn pixels(&self) -> usize {
-        self.plan.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

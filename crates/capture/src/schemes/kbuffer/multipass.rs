@@ -3,7 +3,7 @@
 //! and FreePipe (Liu et al., I3D 2010, Table 3, "Liu") describe and measure it.
 //!
 //! **Algorithm.** Depth peeling `K` layers at a time with the k-buffer's read–insert–write
-//! (`crate::schemes::kbuffer`, shared code, on either [`WriteBack`] machine). Each pixel has a *boundary*
+//! (`kbuffer/slots.rs`, shared code, on either [`WriteBack`] machine). Each pixel has a *boundary*
 //! `c` (every fragment below it is in the output list) and may have a *tentative* list: the `K`
 //! or fewer fragments the previous pass captured, waiting to be checked, which span `[c, t)`.
 //! In pass `p` a fragment first `load`s `c` and `t` (pass 0 has neither: `c = t = 0`), then:
@@ -58,7 +58,7 @@ use fragsim_raster::{Fragment, Viewport};
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
 use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
 
 /// The boundary of a pixel that needs no more passes: every fragment is below it.
@@ -67,7 +67,7 @@ const COMPLETE: u64 = u64::MAX;
 /// The multi-pass k-buffer over `u64` words.
 #[derive(Clone, Debug)]
 pub struct KBufferMultipass {
-    pixels: usize,
+    descriptor: Descriptor,
     slots: Slots,
     capacity: u32,
 }
@@ -133,13 +133,29 @@ impl KBufferMultipass {
         write_back: WriteBack,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new("the multi-pass k-buffer", k, write_back)?,
-            capacity: layers,
+        let slots = Slots::new("the multi-pass k-buffer", k, write_back)?;
+        let pixels = viewport.pixels();
+        let descriptor = Descriptor {
+            name: format!("kbuffer-multipass{}", write_back.suffix()),
+            layout: Layout {
+                words32: slots.sync_words(pixels) + pixels * COUNTERS,
+                init32: 0,
+                words64: 2 * slots.words(pixels) + pixels * (BOUNDS + layers as usize),
+                init64: EMPTY,
+                table_bytes: 0,
+            },
+            identity: Identity::KeyAndPrim,
+            // Every output fragment is confirmed by an atomic count: hazards cost passes only.
+            guarantee: Guarantee::Exact,
+            promise: Promise::All(Capacity::PerPixel(layers)),
+            pixels,
+            counts_every_drop: false,
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
+            capacity: layers,
+        })
     }
 
     /// Slots per pixel.
@@ -156,23 +172,25 @@ impl KBufferMultipass {
 
     /// `u32` word `i` (of [`COUNTERS`]) of `pixel`: 0 output count, 1 passed, 2 window.
     fn counter(&self, pixel: usize, i: usize) -> usize {
-        self.slots.sync_words(self.pixels) + pixel * COUNTERS + i
+        self.slots.sync_words(self.descriptor.pixels) + pixel * COUNTERS + i
     }
 
     /// The first word of `pixel`'s tentative list.
     fn tentative(&self, pixel: usize) -> usize {
-        self.slots.words(self.pixels) + pixel * self.slots.k as usize
+        self.slots.words(self.descriptor.pixels) + pixel * self.slots.k as usize
     }
 
     /// `u64` word `i` (of [`BOUNDS`]) of `pixel`: 0 the boundary `c`, 1 the tentative end `t`,
     /// 2 the window's nearest.
     fn bound(&self, pixel: usize, i: usize) -> usize {
-        2 * self.slots.words(self.pixels) + pixel * BOUNDS + i
+        2 * self.slots.words(self.descriptor.pixels) + pixel * BOUNDS + i
     }
 
     /// The first word of `pixel`'s output list.
     fn output(&self, pixel: usize) -> usize {
-        2 * self.slots.words(self.pixels) + self.pixels * BOUNDS + pixel * self.capacity as usize
+        2 * self.slots.words(self.descriptor.pixels)
+            + self.descriptor.pixels * BOUNDS
+            + pixel * self.capacity as usize
     }
 
     /// Appends `values` to `pixel`'s output list, counting those past its capacity.
@@ -267,32 +285,8 @@ impl KBufferMultipass {
 impl Scheme for KBufferMultipass {
     type State = Peel;
 
-    fn name(&self) -> String {
-        format!("kbuffer-multipass{}", self.slots.write_back.suffix())
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: self.slots.sync_words(self.pixels) + self.pixels * COUNTERS,
-            init32: 0,
-            words64: 2 * self.slots.words(self.pixels)
-                + self.pixels * (BOUNDS + self.capacity as usize),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        // Every output fragment is confirmed by an atomic count: hazards cost passes only.
-        Guarantee::Exact
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::PerPixel(self.capacity))
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Peel {
@@ -358,7 +352,7 @@ impl Scheme for KBufferMultipass {
 
     fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
         let mut more = false;
-        for pixel in 0..self.pixels {
+        for pixel in 0..self.descriptor.pixels {
             // Before the first pass the boundary words hold nothing meaningful.
             if pass > 0 && WordMemory::<u64>::load(memory, self.bound(pixel, 0)) == COMPLETE {
                 continue;
@@ -366,10 +360,6 @@ impl Scheme for KBufferMultipass {
             more |= self.end_pass_pixel(pass, memory, pixel);
         }
         more
-    }
-
-    fn pixels(&self) -> usize {
-        self.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

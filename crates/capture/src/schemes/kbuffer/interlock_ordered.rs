@@ -4,7 +4,7 @@
 //! one at a time **in primitive order**.
 //!
 //! **Algorithm.** As the unordered interlock
-//! ([`kbuffer_interlock`](crate::schemes::kbuffer_interlock)): each pixel owns `K` slots; a
+//! ([`kbuffer::interlock`](crate::schemes::kbuffer::interlock)): each pixel owns `K` slots; a
 //! fragment's critical section reads them, inserts itself in registers and writes them back, one
 //! step. What is added is the order: a fragment enters only once every fragment of its pixel
 //! submitted before it has left its section. Each pixel counts the sections that have left
@@ -58,20 +58,20 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::{Capacity, Identity};
-use crate::executors::scheduled::Simt;
+use crate::capture::Capacity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
+use crate::memory::{Memory, WordMemory};
 use crate::primitive_order::PrimitiveOrder;
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
-use crate::schemes::kbuffer::{Insert, Slots, WriteBack, EMPTY};
-use crate::schemes::kbuffer_interlock::section;
-pub use crate::schemes::kbuffer_interlock::Keep;
+use crate::scheme::Simt;
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::kbuffer::interlock::section;
+pub use crate::schemes::kbuffer::interlock::Keep;
+use crate::schemes::kbuffer::{Insert, Slots, WriteBack};
 
 /// The k-buffer whose critical sections run one at a time per pixel, in primitive order.
 #[derive(Clone, Debug)]
 pub struct KBufferInterlockOrdered<'o> {
-    pixels: usize,
+    descriptor: Descriptor,
     slots: Slots,
     keep: Keep,
     order: Option<&'o PrimitiveOrder>,
@@ -102,14 +102,27 @@ impl<'o> KBufferInterlockOrdered<'o> {
         order: Option<&'o PrimitiveOrder>,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new(Self::name_of(keep), k, WriteBack::RenderTarget)?,
+        let slots = Slots::new(Self::name_of(keep), k, WriteBack::RenderTarget)?;
+        let pixels = viewport.pixels();
+        let (guarantee, promise) = match keep {
+            Keep::Nearest => (Guarantee::Exact, Promise::Nearest(k)),
+            // What is dropped is not in memory: the oracle supplies the count.
+            Keep::First => (
+                Guarantee::ExactWithinCapacity(k),
+                Promise::All(Capacity::PerPixelUncounted(k)),
+            ),
+        };
+        let descriptor = Descriptor {
+            promise,
+            // `u32` words `2 p` (pixel `p`'s lock) and `2 p + 1` (its sections done).
+            ..slots.descriptor(Self::name_of(keep).into(), pixels, 2 * pixels, guarantee)
+        };
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
             keep,
             order,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        })
     }
 
     /// Like [`KBufferInterlockOrdered::new`] with the default memory cap.
@@ -137,42 +150,8 @@ impl<'o> KBufferInterlockOrdered<'o> {
 impl Scheme for KBufferInterlockOrdered<'_> {
     type State = Ordered;
 
-    fn name(&self) -> String {
-        Self::name_of(self.keep).into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            // `u32` words `2 p` (pixel `p`'s lock) and `2 p + 1` (its sections done).
-            words32: 2 * self.pixels,
-            init32: 0,
-            words64: self.slots.words(self.pixels),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        match self.keep {
-            Keep::Nearest => Guarantee::Exact,
-            Keep::First => Guarantee::ExactWithinCapacity(self.slots.k),
-        }
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        match self.keep {
-            Keep::Nearest => Promise::Nearest(self.slots.k),
-            // What is dropped is not in memory: the oracle supplies the count.
-            Keep::First => Promise::All(Capacity::PerPixelUncounted(self.slots.k)),
-        }
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Ordered {
@@ -209,15 +188,9 @@ impl Scheme for KBufferInterlockOrdered<'_> {
         }
     }
 
-    fn pixels(&self) -> usize {
-        self.pixels
-    }
-
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every section leaves the slots sorted.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What was dropped is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 

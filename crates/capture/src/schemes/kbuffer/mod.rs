@@ -23,7 +23,7 @@
 //!   write-backs), which the render-target machine cannot produce.
 //!
 //! **Guarantee.** On the serial executor each walk runs alone, so each pixel ends with exactly its
-//! `K` nearest fragments in canonical order: [`Promise::Nearest`]`(K)`, exact up to `K`, on both
+//! `K` nearest fragments in canonical order: [`Promise::Nearest`](crate::Promise::Nearest)`(K)`, exact up to `K`, on both
 //! machines. Under any other interleaving it is **not** safe: this is the read–modify–write hazard
 //! the papers name. Nothing here hides it: the post pass reports the slots as they are, and
 //! `Oracle::diff` counts the lost, extra and misordered fragments (`tests/suite/kbuffer.rs` drives each
@@ -72,261 +72,32 @@
 //! Unlike the GPU, whose hazard window is the time between the texture fetch and the ROP's write,
 //! the window here is whatever the executor puts between the read and the write-back; the serial
 //! executor puts nothing, the scheduled executor anything its policy picks.
+//!
+//! **The family.** This folder holds the k-buffer (this module) and the schemes built on its
+//! slots: [`interlock`] and [`interlock_ordered`] (the read–insert–write as one critical section),
+//! [`spinlock`] (the section under a spinlock) and [`multipass`] (peeling `K` layers a pass);
+//! `slots.rs` holds what they share, the `K` slots of a pixel and one fragment's insertion.
+
+pub mod interlock;
+pub mod interlock_ordered;
+pub mod multipass;
+mod slots;
+pub mod spinlock;
+
+pub use slots::{Insert, Phase, WriteBack, EMPTY};
+pub(crate) use slots::{Outcome, Slots};
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
-
-/// The value of an empty slot: larger than every packed fragment.
-pub const EMPTY: u64 = u64::MAX;
-
-/// How a fragment's read and write-back reach the pixel's `K` slots: the machine modelled.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum WriteBack {
-    /// Render targets, as on the papers' GPUs: the read of the `K` slots is one step, the
-    /// write-back one step, and write-backs to a pixel commit in order. Only the read
-    /// can be stale, so the only failure is a lost fragment.
-    #[default]
-    RenderTarget,
-    /// `K` loads, then `K` stores, one step each, as CUDA code does: write-backs can tear, so the
-    /// slots can also hold duplicates and be out of order.
-    SeparateStores,
-}
-
-impl WriteBack {
-    /// The suffix of a scheme's name on this machine: none for render targets (the default).
-    #[must_use]
-    pub fn suffix(self) -> &'static str {
-        match self {
-            WriteBack::RenderTarget => "",
-            WriteBack::SeparateStores => "-stores",
-        }
-    }
-}
+use crate::memory::Memory;
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// The single-pass k-buffer over `u64` slots.
 #[derive(Clone, Debug)]
 pub struct KBuffer {
-    pixels: usize,
+    descriptor: Descriptor,
     slots: Slots,
-}
-
-/// Where a fragment's read–insert–write is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Phase {
-    /// Slot `i` is loaded next (with render targets, `Read(0)`: all `K` slots in one step).
-    Read(u32),
-    /// Slot `i` is stored next (with render targets, `Write(0)`: all `K` slots in one step).
-    Write(u32),
-}
-
-/// A fragment's read–insert–write.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Insert {
-    /// First word of the pixel's `K` slots.
-    pub base: usize,
-    /// The fragment, packed `depth_key << 32 | prim`.
-    pub value: u64,
-    /// The next memory operation.
-    pub phase: Phase,
-    /// While reading, the slots read so far; from the first write on, the `K` words to write.
-    pub local: Vec<u64>,
-    /// Whether the insertion pushed a value off the end.
-    pub evicted: bool,
-    /// Render targets: the fragment's place in the pixel's commit order, taken with its read.
-    pub ticket: u32,
-}
-
-/// How a step of [`Slots::step`] ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Outcome {
-    /// More steps follow.
-    Continue,
-    /// The write-back is done; nothing fell off.
-    Stored,
-    /// The write-back is done; the value that was `K`-th fell off.
-    Evicted,
-    /// The fragment was farther than all `K` values read: it writes nothing.
-    FellOff,
-    /// Render targets only: the write-back of a fragment that read later had already committed,
-    /// so in commit order this one came first and was overwritten; nothing was written.
-    Overtaken,
-}
-
-/// `K` slots per pixel and the read–insert–write on them, shared by the single-pass k-buffer and
-/// the multi-pass one (`kbuffer_multipass`), which peels with it.
-///
-/// The slots of pixel `p` are `u64` words `p K .. (p + 1) K`; with render targets, `u32` words
-/// `3 p` (the lock), `3 p + 1` (the next ticket) and `3 p + 2` (the last committed ticket + 1) are
-/// the pixel's too.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Slots {
-    /// Slots per pixel.
-    pub k: u32,
-    /// The machine.
-    pub write_back: WriteBack,
-}
-
-impl Slots {
-    /// Fails on `k == 0`, naming `scheme`.
-    pub fn new(scheme: &str, k: u32, write_back: WriteBack) -> Result<Self, CaptureError> {
-        if k == 0 {
-            return Err(CaptureError::BadParameter(format!(
-                "{scheme} needs K ≥ 1 slots per pixel, got K = 0"
-            )));
-        }
-        Ok(Self { k, write_back })
-    }
-
-    /// `u64` words of `pixels` pixels' slots.
-    pub fn words(self, pixels: usize) -> usize {
-        pixels * self.k as usize
-    }
-
-    /// `u32` words of `pixels` pixels' render-target bookkeeping (none for separate stores):
-    /// the lock, the next ticket, the last committed ticket + 1.
-    pub fn sync_words(self, pixels: usize) -> usize {
-        match self.write_back {
-            WriteBack::RenderTarget => 3 * pixels,
-            WriteBack::SeparateStores => 0,
-        }
-    }
-
-    /// A fragment's walk before its first read.
-    pub fn begin(self, fragment: Fragment) -> Insert {
-        Insert {
-            base: fragment.pixel as usize * self.k as usize,
-            value: fragment.packed(),
-            phase: Phase::Read(0),
-            local: Vec::with_capacity(self.k as usize + 1),
-            evicted: false,
-            ticket: 0,
-        }
-    }
-
-    /// One step of the walk: one load or one store with separate stores; the whole read or the
-    /// whole write-back with render targets.
-    pub fn step<M: Memory>(self, insert: &mut Insert, memory: &M) -> Outcome {
-        match self.write_back {
-            WriteBack::SeparateStores => self.step_separate(insert, memory),
-            WriteBack::RenderTarget => self.step_render_target(insert, memory),
-        }
-    }
-
-    fn step_separate<M: Memory>(self, insert: &mut Insert, memory: &M) -> Outcome {
-        let k = self.k;
-        match insert.phase {
-            Phase::Read(i) => {
-                insert
-                    .local
-                    .push(WordMemory::<u64>::load(memory, insert.base + i as usize));
-                if i + 1 < k {
-                    insert.phase = Phase::Read(i + 1);
-                    return Outcome::Continue;
-                }
-                self.insert_in_registers(insert)
-            }
-            Phase::Write(i) => {
-                WordMemory::<u64>::store(
-                    memory,
-                    insert.base + i as usize,
-                    insert.local[i as usize],
-                );
-                if i + 1 < k {
-                    insert.phase = Phase::Write(i + 1);
-                    Outcome::Continue
-                } else if insert.evicted {
-                    Outcome::Evicted
-                } else {
-                    Outcome::Stored
-                }
-            }
-        }
-    }
-
-    fn step_render_target<M: Memory>(self, insert: &mut Insert, memory: &M) -> Outcome {
-        let k = self.k as usize;
-        let pixel = insert.base / k;
-        let (lock, next_ticket, last_writer) = (3 * pixel, 3 * pixel + 1, 3 * pixel + 2);
-        match insert.phase {
-            Phase::Read(_) => {
-                memory.lock(lock);
-                insert.ticket = WordMemory::<u32>::load(memory, next_ticket);
-                WordMemory::<u32>::store(memory, next_ticket, insert.ticket.wrapping_add(1));
-                insert.local.extend(
-                    (insert.base..insert.base + k).map(|w| WordMemory::<u64>::load(memory, w)),
-                );
-                memory.unlock(lock);
-                self.insert_in_registers(insert)
-            }
-            Phase::Write(_) => {
-                // `ticket + 1`, so that 0 means "no write-back yet".
-                let mine = insert.ticket.saturating_add(1);
-                memory.lock(lock);
-                let commits = mine > WordMemory::<u32>::load(memory, last_writer);
-                if commits {
-                    for (i, &v) in insert.local.iter().enumerate() {
-                        WordMemory::<u64>::store(memory, insert.base + i, v);
-                    }
-                    WordMemory::<u32>::store(memory, last_writer, mine);
-                }
-                memory.unlock(lock);
-                if !commits {
-                    Outcome::Overtaken
-                } else if insert.evicted {
-                    Outcome::Evicted
-                } else {
-                    Outcome::Stored
-                }
-            }
-        }
-    }
-
-    /// The insertion, in registers, after the last read: no memory operation. Under a hazard the
-    /// values read may hold gaps, duplicates or be out of order (separate stores only); they are
-    /// sorted as they are, as a shader sorting its `K + 1` registers would.
-    pub(crate) fn insert_in_registers(self, insert: &mut Insert) -> Outcome {
-        let k = self.k as usize;
-        insert.local.retain(|&v| v != EMPTY);
-        let full = insert.local.len() == k;
-        if full && insert.local.iter().all(|&v| v < insert.value) {
-            return Outcome::FellOff;
-        }
-        insert.local.push(insert.value);
-        insert.local.sort_unstable();
-        insert.evicted = insert.local.len() > k;
-        insert.local.resize(k, EMPTY);
-        insert.phase = Phase::Write(0);
-        Outcome::Continue
-    }
-
-    /// Empties `pixel`'s slots and forgets its last writer (between geometry passes).
-    pub fn clear<M: Memory>(self, memory: &M, pixel: usize) {
-        let base = pixel * self.k as usize;
-        for w in base..base + self.k as usize {
-            WordMemory::<u64>::store(memory, w, EMPTY);
-        }
-        if self.write_back == WriteBack::RenderTarget {
-            WordMemory::<u32>::store(memory, 3 * pixel + 1, 0);
-            WordMemory::<u32>::store(memory, 3 * pixel + 2, 0);
-        }
-    }
-
-    /// The non-empty slots of `pixel`, in slot order: gaps, duplicates and disorder left by a
-    /// hazard are kept, for the diff to see.
-    pub fn occupied(
-        self,
-        slots: &impl WordMemory<u64>,
-        pixel: usize,
-    ) -> impl Iterator<Item = u64> + '_ {
-        let base = pixel * self.k as usize;
-        (0..self.k as usize)
-            .map(move |i| slots.load(base + i))
-            .filter(|&v| v != EMPTY)
-    }
 }
 
 impl KBuffer {
@@ -350,12 +121,18 @@ impl KBuffer {
         write_back: WriteBack,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new("the k-buffer", k, write_back)?,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        let slots = Slots::new("the k-buffer", k, write_back)?;
+        let pixels = viewport.pixels();
+        let descriptor = slots.descriptor(
+            format!("kbuffer{}", write_back.suffix()),
+            pixels,
+            slots.sync_words(pixels),
+            Guarantee::ExactWithoutHazards,
+        );
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
+        })
     }
 
     /// Like [`KBuffer::new`] with the default memory cap.
@@ -382,34 +159,8 @@ impl KBuffer {
 impl Scheme for KBuffer {
     type State = Insert;
 
-    fn name(&self) -> String {
-        format!("kbuffer{}", self.slots.write_back.suffix())
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            words32: self.slots.sync_words(self.pixels),
-            init32: 0,
-            words64: self.slots.words(self.pixels),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::ExactWithoutHazards
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.slots.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Insert {
@@ -426,15 +177,9 @@ impl Scheme for KBuffer {
         }
     }
 
-    fn pixels(&self) -> usize {
-        self.pixels
-    }
-
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // No sort: the slots are reported as the hazards left them.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What fell off is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 

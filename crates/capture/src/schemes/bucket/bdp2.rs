@@ -33,10 +33,9 @@ use fragsim_raster::{Fragment, Viewport};
 use super::{
     positive, push_distinct, read_pair, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS,
 };
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::capture::Capacity;
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::MdtsWord;
 
 /// BDP2's own stages.
@@ -79,7 +78,8 @@ impl<W: MdtsWord> Bdp2<W> {
     pub fn new(viewport: Viewport, buckets: u32, memory_cap: u64) -> Result<Self, CaptureError> {
         positive("BDP2's bucket count", buckets)?;
         let plan = Plan::new::<W>(
-            &Self::name_of(buckets),
+            Self::name_of(buckets),
+            Promise::All(Capacity::Unbounded),
             viewport,
             RANGE_WORDS,
             4 * buckets as usize,
@@ -119,24 +119,8 @@ impl<W: MdtsWord> Bdp2<W> {
 impl<W: MdtsWord> Scheme for Bdp2<W> {
     type State = Walk<W, Bdp2Stage<W>>;
 
-    fn name(&self) -> String {
-        Self::name_of(self.buckets)
-    }
-
-    fn layout(&self) -> Layout {
-        self.plan.layout()
-    }
-
-    fn identity(&self) -> Identity {
-        W::IDENTITY
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Approximate
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::Unbounded)
+    fn descriptor(&self) -> &Descriptor {
+        &self.plan.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Self::State {
@@ -187,10 +171,6 @@ impl<W: MdtsWord> Scheme for Bdp2<W> {
 
     fn end_pass<M: Memory>(&self, pass: u32, _memory: &M) -> bool {
         pass < 2
-    }
-
-    fn pixels(&self) -> usize {
-        self.plan.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

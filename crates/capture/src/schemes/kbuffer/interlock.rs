@@ -21,7 +21,7 @@
 //! anyway, and on the parallel executor a waiting thread waits only for a step already running.
 //!
 //! **Guarantee.** Under **any** interleaving each pixel ends with exactly its `K` nearest fragments
-//! in canonical order: [`Guarantee::Exact`], [`Promise::Nearest`]`(K)`. Every step is one
+//! in canonical order: [`Guarantee::Exact`], [`Promise::Nearest`](crate::Promise::Nearest)`(K)`. Every step is one
 //! fragment's sorted insertion into the pixel's current slots, so the slots after any set of
 //! steps are the `K` nearest of the fragments inserted so far, whatever their order (the `K`
 //! nearest of a set do not depend on the order its members arrive in; packed values are distinct,
@@ -45,7 +45,7 @@
 //! **Departures.** This is the **unordered** mode (`PixelInterlockUnorderedEXT`: mutual
 //! exclusion, critical sections in any order). The ordered mode (`PixelInterlockOrderedEXT`,
 //! ROVs: a pixel's critical sections in primitive order) is
-//! [`kbuffer_interlock_ordered`](crate::schemes::kbuffer_interlock_ordered); for the `K` nearest
+//! [`kbuffer::interlock_ordered`](crate::schemes::kbuffer::interlock_ordered); for the `K` nearest
 //! both keep identical lists (the `K` nearest of a set do not depend on the order its members
 //! arrive in), order matters only to order-dependent policies (keep-first, [`Keep::First`]).
 //! As in the k-buffer, a slot is one `u64` `depth_key << 32 | prim` rather than the samples'
@@ -53,10 +53,9 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::memory::{Memory, WordMemory};
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
 
 /// What a critical section keeps of a full pixel.
@@ -100,7 +99,7 @@ pub(crate) fn section<M: Memory>(
 /// The k-buffer whose read–insert–write-back is one critical section per fragment.
 #[derive(Clone, Debug)]
 pub struct KBufferInterlock {
-    pixels: usize,
+    descriptor: Descriptor,
     /// The k-buffer's slots and insertion. Only its `K`, begin, insertion and read-back are used:
     /// the machine field is the render-target one because a critical section, like the ROP,
     /// touches all `K` slots at once, but none of its ticket bookkeeping is allocated or run.
@@ -113,12 +112,15 @@ impl KBufferInterlock {
     /// # Errors
     /// `k == 0`, or storage beyond `memory_cap`.
     pub fn new(viewport: Viewport, k: u32, memory_cap: u64) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new("kbuffer-interlock", k, WriteBack::RenderTarget)?,
-        };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        let slots = Slots::new("kbuffer-interlock", k, WriteBack::RenderTarget)?;
+        let pixels = viewport.pixels();
+        // `u32` word `p`: pixel `p`'s lock.
+        let descriptor =
+            slots.descriptor("kbuffer-interlock".into(), pixels, pixels, Guarantee::Exact);
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
+        })
     }
 
     /// Like [`KBufferInterlock::new`] with the default memory cap.
@@ -139,35 +141,8 @@ impl KBufferInterlock {
 impl Scheme for KBufferInterlock {
     type State = Insert;
 
-    fn name(&self) -> String {
-        "kbuffer-interlock".into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            // `u32` word `p`: pixel `p`'s lock.
-            words32: self.pixels,
-            init32: 0,
-            words64: self.slots.words(self.pixels),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn counts_every_drop(&self) -> bool {
-        true
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.slots.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Insert {
@@ -184,15 +159,9 @@ impl Scheme for KBufferInterlock {
         end
     }
 
-    fn pixels(&self) -> usize {
-        self.pixels
-    }
-
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every step leaves the slots sorted.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What fell off is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 

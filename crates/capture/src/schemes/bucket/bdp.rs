@@ -37,10 +37,9 @@ use super::{
     positive, push_distinct, read_pair, read_single, word_suffix, Blend, Plan, Stage, Walk,
     RANGE_WORDS,
 };
-use crate::capture::{Capacity, Identity};
-use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory};
-use crate::scheme::{CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::capture::Capacity;
+use crate::memory::Memory;
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::MdtsWord;
 
 /// How a pixel's bucket words are used.
@@ -96,8 +95,15 @@ impl<W: MdtsWord> Bdp<W> {
     ) -> Result<Self, CaptureError> {
         positive("BDP's bucket count", buckets.count())?;
         let words = buckets.count() as usize * buckets.width();
-        let name = Self::name_of(buckets);
-        let plan = Plan::new::<W>(&name, viewport, RANGE_WORDS, words, memory_cap)?;
+        let promise = Promise::All(Capacity::Unbounded);
+        let plan = Plan::new::<W>(
+            Self::name_of(buckets),
+            promise,
+            viewport,
+            RANGE_WORDS,
+            words,
+            memory_cap,
+        )?;
         Ok(Self {
             plan,
             buckets,
@@ -141,24 +147,8 @@ impl<W: MdtsWord> Bdp<W> {
 impl<W: MdtsWord> Scheme for Bdp<W> {
     type State = Walk<W, Blend>;
 
-    fn name(&self) -> String {
-        Self::name_of(self.buckets)
-    }
-
-    fn layout(&self) -> Layout {
-        self.plan.layout()
-    }
-
-    fn identity(&self) -> Identity {
-        W::IDENTITY
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Approximate
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::All(Capacity::Unbounded)
+    fn descriptor(&self) -> &Descriptor {
+        &self.plan.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> Self::State {
@@ -187,10 +177,6 @@ impl<W: MdtsWord> Scheme for Bdp<W> {
 
     fn end_pass<M: Memory>(&self, pass: u32, _memory: &M) -> bool {
         pass == 0
-    }
-
-    fn pixels(&self) -> usize {
-        self.plan.pixels
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {

@@ -21,7 +21,7 @@
 //! ```
 //!
 //! **Guarantee.** Under independent thread scheduling (every executor, and the scheduled one's
-//! random, warps and PCT policies), [`Guarantee::Exact`], [`Promise::Nearest`]`(K)`, in both
+//! random, warps and PCT policies), [`Guarantee::Exact`], [`Promise::Nearest`](crate::Promise::Nearest)`(K)`, in both
 //! loops: the lock makes each fragment's `2 K` steps a critical section, so the slots after any
 //! set of critical sections hold the `K` nearest of the fragments inserted (the `K` nearest of a set
 //! do not depend on their order; packed values are distinct); each fragment beyond the `K` kept
@@ -43,7 +43,7 @@
 //! off: the compare-and-swap, `K` loads, `K` stores, the release), of which **1 locked operation**
 //! (the lock's); each failed attempt is one step and one locked operation more. Memory: `8 K + 4`
 //! bytes per pixel (the slots and the lock word). The interlock
-//! ([`kbuffer_interlock`](crate::schemes::kbuffer_interlock)) does the same work in one step with
+//! ([`kbuffer::interlock`](crate::schemes::kbuffer::interlock)) does the same work in one step with
 //! no spinning, because the hardware queues the waiting invocations.
 //!
 //! **Sources.** nvpro-samples' `vk_order_independent_transparency` (NVIDIA, 2020), its spinlock
@@ -63,12 +63,11 @@
 
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::capture::Identity;
-use crate::executors::scheduled::Simt;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory};
-use crate::scheme::{check_cap, CaptureError, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
-use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
+use crate::memory::Memory;
+use crate::scheme::Simt;
+use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
+use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack};
 
 /// Where the critical section sits in the lock loop (module doc: the GLSL of each).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -93,7 +92,7 @@ impl Loop {
 /// The k-buffer whose read–insert–write-back runs under a per-pixel spinlock.
 #[derive(Clone, Debug)]
 pub struct KBufferSpinlock {
-    pixels: usize,
+    descriptor: Descriptor,
     /// The k-buffer's slots and insertion on separate loads and stores (the critical section's
     /// `2 K` steps).
     slots: Slots,
@@ -142,13 +141,19 @@ impl KBufferSpinlock {
         shape: Loop,
         memory_cap: u64,
     ) -> Result<Self, CaptureError> {
-        let scheme = Self {
-            pixels: viewport.pixels(),
-            slots: Slots::new(shape.scheme_name(), k, WriteBack::SeparateStores)?,
-            shape,
+        let slots = Slots::new(shape.scheme_name(), k, WriteBack::SeparateStores)?;
+        let pixels = viewport.pixels();
+        let descriptor = Descriptor {
+            // Not claimed: its frames' drops are not checked against what their capture lacks.
+            counts_every_drop: false,
+            // `u32` word `p`: pixel `p`'s lock.
+            ..slots.descriptor(shape.scheme_name().into(), pixels, pixels, Guarantee::Exact)
         };
-        check_cap(&scheme.name(), &scheme.layout(), memory_cap)?;
-        Ok(scheme)
+        Ok(Self {
+            descriptor: descriptor.within(memory_cap)?,
+            slots,
+            shape,
+        })
     }
 
     /// Like [`KBufferSpinlock::new`] with the default memory cap.
@@ -175,31 +180,8 @@ impl KBufferSpinlock {
 impl Scheme for KBufferSpinlock {
     type State = SpinInsert;
 
-    fn name(&self) -> String {
-        self.shape.scheme_name().into()
-    }
-
-    fn layout(&self) -> Layout {
-        Layout {
-            // `u32` word `p`: pixel `p`'s lock.
-            words32: self.pixels,
-            init32: 0,
-            words64: self.slots.words(self.pixels),
-            init64: EMPTY,
-            table_bytes: 0,
-        }
-    }
-
-    fn identity(&self) -> Identity {
-        Identity::KeyAndPrim
-    }
-
-    fn guarantee(&self) -> Guarantee {
-        Guarantee::Exact
-    }
-
-    fn promise(&self) -> Promise {
-        Promise::Nearest(self.slots.k)
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
     }
 
     fn begin(&self, fragment: Fragment) -> SpinInsert {
@@ -261,15 +243,9 @@ impl Scheme for KBufferSpinlock {
         }
     }
 
-    fn pixels(&self) -> usize {
-        self.pixels
-    }
-
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // Already in canonical order: every critical section leaves the slots sorted.
-        out.extend(self.slots.occupied(memory, pixel));
-        // What fell off is not in memory: the executors count it from the walks.
-        0
+        self.slots.resolve_pixel(memory, pixel, out)
     }
 }
 
