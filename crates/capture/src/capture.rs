@@ -53,10 +53,8 @@ impl Capacity {
     #[must_use]
     pub fn overflow(self, fragments: usize) -> usize {
         match self {
-            Capacity::Unbounded => 0,
-            Capacity::PerPixel(c) | Capacity::PerPixelUncounted(c) => {
-                fragments.saturating_sub(c as usize)
-            }
+            Self::Unbounded => 0,
+            Self::PerPixel(c) | Self::PerPixelUncounted(c) => fragments.saturating_sub(c as usize),
         }
     }
 
@@ -65,7 +63,7 @@ impl Capacity {
     #[must_use]
     pub fn reported_overflow(self, fragments: usize) -> usize {
         match self {
-            Capacity::PerPixelUncounted(_) => 0,
+            Self::PerPixelUncounted(_) => 0,
             _ => self.overflow(fragments),
         }
     }

@@ -34,10 +34,10 @@ impl Guarantee {
     #[must_use]
     pub fn owes_exactness(self, pixels_serialised: bool) -> bool {
         match self {
-            Guarantee::Exact | Guarantee::ExactWithinCapacity(_) => true,
-            Guarantee::ExactDistinctDepths => true,
-            Guarantee::ExactWithoutHazards | Guarantee::ExactInArrivalOrder => pixels_serialised,
-            Guarantee::Approximate => false,
+            Self::Exact | Self::ExactWithinCapacity(_) => true,
+            Self::ExactDistinctDepths => true,
+            Self::ExactWithoutHazards | Self::ExactInArrivalOrder => pixels_serialised,
+            Self::Approximate => false,
         }
     }
 
@@ -45,7 +45,7 @@ impl Guarantee {
     /// [`Guarantee::ExactDistinctDepths`]).
     #[must_use]
     pub fn merges_equal_depths(self) -> bool {
-        self == Guarantee::ExactDistinctDepths
+        self == Self::ExactDistinctDepths
     }
 }
 
@@ -53,12 +53,12 @@ impl fmt::Display for Guarantee {
     /// The spelling used in tables and JSON: `exact`, `exact-within-capacity(8)`, …
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Guarantee::Exact => f.write_str("exact"),
-            Guarantee::ExactWithinCapacity(c) => write!(f, "exact-within-capacity({c})"),
-            Guarantee::ExactDistinctDepths => f.write_str("exact-distinct-depths"),
-            Guarantee::ExactWithoutHazards => f.write_str("exact-without-hazards"),
-            Guarantee::ExactInArrivalOrder => f.write_str("exact-in-arrival-order"),
-            Guarantee::Approximate => f.write_str("approximate"),
+            Self::Exact => f.write_str("exact"),
+            Self::ExactWithinCapacity(c) => write!(f, "exact-within-capacity({c})"),
+            Self::ExactDistinctDepths => f.write_str("exact-distinct-depths"),
+            Self::ExactWithoutHazards => f.write_str("exact-without-hazards"),
+            Self::ExactInArrivalOrder => f.write_str("exact-in-arrival-order"),
+            Self::Approximate => f.write_str("approximate"),
         }
     }
 }

@@ -61,8 +61,8 @@ impl PixelRun {
         // The pixels whose first word lies in a run of `n` words from `first`.
         let pixels = |n: usize| n.div_ceil(words_per_pixel);
         match words.untouched_run(first, last) {
-            0 => PixelRun::Resolve(pixels(words.written_run(first, last)).max(1)),
-            untouched => PixelRun::Empty(pixels(untouched)),
+            0 => Self::Resolve(pixels(words.written_run(first, last)).max(1)),
+            untouched => Self::Empty(pixels(untouched)),
         }
     }
 }

@@ -51,10 +51,7 @@ impl DumpLayout {
     /// need that scheme's own resolve) rather than the name of the layout's first entry.
     #[must_use]
     pub fn names_its_scheme(self) -> bool {
-        matches!(
-            self,
-            DumpLayout::LinkedLists | DumpLayout::KBufferSlots | DumpLayout::Memory
-        )
+        matches!(self, Self::LinkedLists | Self::KBufferSlots | Self::Memory)
     }
 
     /// The scheme whose name a dump of this layout carries in its header, for a layout that
@@ -88,7 +85,7 @@ impl DumpLayout {
     /// The layout a dump header's `scheme` names: `name` must be the catalog name that a dump of
     /// the layout carries ([`DumpLayout::header_scheme`]).
     #[must_use]
-    pub fn named(name: &str) -> Option<DumpLayout> {
+    pub fn named(name: &str) -> Option<Self> {
         let scheme = SchemeName::from_name(name)?;
         (Self::header_scheme(scheme)? == scheme).then(|| scheme.entry().dump)?
     }

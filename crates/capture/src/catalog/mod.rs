@@ -136,13 +136,13 @@ impl Passes {
     #[must_use]
     pub fn bounds(self, layers: u32) -> (u32, Option<u32>) {
         match self {
-            Passes::Fixed(n) => (n, Some(n)),
-            Passes::UpTo(n) => (1, Some(n)),
-            Passes::PerLayers { before, per, after } => {
+            Self::Fixed(n) => (n, Some(n)),
+            Self::UpTo(n) => (1, Some(n)),
+            Self::PerLayers { before, per, after } => {
                 let n = before + layers.div_ceil(per) + after;
                 (n, Some(n))
             }
-            Passes::UntilConfirmed => (1, None),
+            Self::UntilConfirmed => (1, None),
         }
     }
 }
@@ -357,7 +357,7 @@ impl SchemeName {
 
     /// The scheme spelled `name`, if the catalog has one.
     #[must_use]
-    pub fn from_name(name: &str) -> Option<SchemeName> {
+    pub fn from_name(name: &str) -> Option<Self> {
         CATALOG.iter().find(|e| e.name == name).map(|e| e.scheme)
     }
 

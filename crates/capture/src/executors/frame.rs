@@ -109,9 +109,9 @@ impl Run {
     /// memory is the larger of the two (the counters are freed, or reused as the A-buffer's,
     /// before the sized storage is allocated).
     #[must_use]
-    pub fn after_count_pass(self, count: &Run) -> Run {
+    pub fn after_count_pass(self, count: &Self) -> Self {
         let counted = count.stats.pass_time + count.stats.resolve_time;
-        Run {
+        Self {
             stats: RunStats {
                 counters: count.stats.counters.merge(self.stats.counters),
                 passes: count.stats.passes + self.stats.passes,
@@ -315,19 +315,19 @@ pub(crate) trait ReusableStorage: Memory + Sized {
 
 impl ReusableStorage for SerialMemory {
     fn fits(&self, layout: &Layout) -> bool {
-        SerialMemory::fits(self, layout)
+        Self::fits(self, layout)
     }
     fn reset(&mut self, layout: &Layout, cap: u64) {
-        SerialMemory::reset(self, layout, cap);
+        Self::reset(self, layout, cap);
     }
 }
 
 impl ReusableStorage for AtomicMemory {
     fn fits(&self, layout: &Layout) -> bool {
-        AtomicMemory::fits(self, layout)
+        Self::fits(self, layout)
     }
     fn reset(&mut self, layout: &Layout, cap: u64) {
-        AtomicMemory::reset(self, layout, cap);
+        Self::reset(self, layout, cap);
     }
 }
 

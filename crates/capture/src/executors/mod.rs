@@ -43,21 +43,16 @@ pub enum Executor {
 
 impl Executor {
     /// Every executor.
-    pub const EVERY: [Executor; 4] = [
-        Executor::Serial,
-        Executor::Parallel,
-        Executor::Tiled,
-        Executor::Scheduled,
-    ];
+    pub const EVERY: [Self; 4] = [Self::Serial, Self::Parallel, Self::Tiled, Self::Scheduled];
 
     /// The name used on the command line and in reports.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
-            Executor::Serial => "serial",
-            Executor::Parallel => "parallel",
-            Executor::Tiled => "tiled",
-            Executor::Scheduled => "scheduled",
+            Self::Serial => "serial",
+            Self::Parallel => "parallel",
+            Self::Tiled => "tiled",
+            Self::Scheduled => "scheduled",
         }
     }
 
@@ -65,7 +60,7 @@ impl Executor {
     /// read–modify–write hazard can happen, and the guarantees that exclude hazards are owed.
     #[must_use]
     pub fn serialises_pixels(self) -> bool {
-        matches!(self, Executor::Serial | Executor::Tiled)
+        matches!(self, Self::Serial | Self::Tiled)
     }
 }
 

@@ -142,7 +142,7 @@ impl ScheduledRun {
     ///
     /// # Errors
     /// The [`Deadlock`] the run stopped on.
-    pub fn checked(self) -> Result<ScheduledRun, Deadlock> {
+    pub fn checked(self) -> Result<Self, Deadlock> {
         match self.deadlock {
             Some(deadlock) => Err(deadlock),
             None => Ok(self),
@@ -297,8 +297,8 @@ fn run_pass<S: Scheme>(
     first_step: u64,
 ) -> (Counters, Option<Deadlock>) {
     let mut counters = Counters::default();
-    let mut next_triangle = 0u32;
-    let mut next_fragment_index = 0u64;
+    let mut next_triangle = 0_u32;
+    let mut next_fragment_index = 0_u64;
     let mut pending: VecDeque<(Fragment, u64)> = VecDeque::new();
     // Hands a thread its next unit of work: a fragment, or a whole triangle's fragments.
     let mut refill = |queue: &mut VecDeque<(Fragment, u64)>| -> bool {

@@ -123,7 +123,7 @@ impl ChunkBins {
         }
         self.indices.clear();
         self.indices.resize(self.starts[tiles.count()] as usize, 0);
-        for (index, setup) in (0u32..).zip(&self.setups) {
+        for (index, setup) in (0_u32..).zip(&self.setups) {
             for tile in tiles.overlapped(setup.pixels()) {
                 self.indices[self.starts[tile] as usize] = index;
                 self.starts[tile] += 1;

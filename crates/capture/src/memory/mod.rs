@@ -43,25 +43,25 @@ pub trait Word: Copy + Eq + Ord + Debug + Send + Sync + 'static {
 
 impl Word for u32 {
     const ZERO: Self = 0;
-    const MAX: Self = u32::MAX;
+    const MAX: Self = Self::MAX;
     const ONE: Self = 1;
     fn wrapping_add(self, other: Self) -> Self {
-        u32::wrapping_add(self, other)
+        Self::wrapping_add(self, other)
     }
     fn wrapping_sub(self, other: Self) -> Self {
-        u32::wrapping_sub(self, other)
+        Self::wrapping_sub(self, other)
     }
 }
 
 impl Word for u64 {
     const ZERO: Self = 0;
-    const MAX: Self = u64::MAX;
+    const MAX: Self = Self::MAX;
     const ONE: Self = 1;
     fn wrapping_add(self, other: Self) -> Self {
-        u64::wrapping_add(self, other)
+        Self::wrapping_add(self, other)
     }
     fn wrapping_sub(self, other: Self) -> Self {
-        u64::wrapping_sub(self, other)
+        Self::wrapping_sub(self, other)
     }
 }
 
@@ -343,7 +343,7 @@ mod tests {
         // empty run at word 0 of an array with no page.
         let layout = Layout::counters_and_slots(4, 0);
         let memory: AtomicMemory = layout.allocate();
-        let mut out = vec![7u64];
+        let mut out = vec![7_u64];
         WordMemory::<u64>::load_into(&memory, 0, 0, &mut out);
         assert_eq!(out, [7], "nothing appended");
         let mut out32 = Vec::new();

@@ -25,27 +25,30 @@ use super::Word;
 /// Words per page: 32 KiB of `u64` words, a few hundred pixels of K slots, large enough that the
 /// page table (one entry a page) is a fraction of a percent of the storage, small enough that a
 /// sparse frame leaves most pages unallocated.
-pub const PAGE_WORDS: usize = 4096;
+pub(crate) const PAGE_WORDS: usize = 4096;
 
 /// Words per block of a page's written flags: 64 words, four or eight cache lines, a few pixels
 /// of K slots.
-pub const BLOCK_WORDS: usize = 64;
+pub(crate) const BLOCK_WORDS: usize = 64;
 
 /// Written flags per page: one bit of a page's `u64` mask each, so that a page's unwritten
 /// blocks are found a mask at a time.
 const BLOCKS: usize = PAGE_WORDS / BLOCK_WORDS;
-const _: () = assert!(BLOCKS == u64::BITS as usize);
+const _: () = assert!(
+    BLOCKS == u64::BITS as usize,
+    "a page's written mask is one u64, a bit a block"
+);
 
 /// Bytes of the page table of an array of `words` words: one entry a page, allocated with the
 /// array whether or not its pages are.
 #[must_use]
-pub fn page_table_bytes(words: usize) -> u64 {
+pub(crate) fn page_table_bytes(words: usize) -> u64 {
     // An entry's size does not depend on the cell type (a pointer, a length, two flags).
     (words.div_ceil(PAGE_WORDS) * std::mem::size_of::<OnceLock<Page<AtomicU64>>>()) as u64
 }
 
 /// A cell of one word: `Cell` for one thread, an atomic for several.
-pub trait WordCell<W: Word>: Send {
+pub(crate) trait WordCell<W: Word>: Send {
     /// A cell holding `value`.
     fn new(value: W) -> Self;
     /// Sets the value through exclusive access (a reset, no memory operation of the GPU).
@@ -57,7 +60,7 @@ pub trait WordCell<W: Word>: Send {
 /// One page: its words and, bit `b` of `written` for block `b` of them, whether a write reached
 /// the block since the last reset.
 #[derive(Debug)]
-pub struct Page<C> {
+pub(crate) struct Page<C> {
     written: AtomicU64,
     words: Box<[C]>,
 }
@@ -101,7 +104,7 @@ impl<C> Page<C> {
 /// The byte budget of a memory's pages, shared by its arrays: what is allocated, the cap, and
 /// whether a page was refused for lack of budget since the last reset.
 #[derive(Debug)]
-pub struct Budget {
+pub(crate) struct Budget {
     allocated: AtomicU64,
     cap: u64,
     refused: AtomicBool,
@@ -110,7 +113,7 @@ pub struct Budget {
 impl Budget {
     /// A budget of `cap` bytes, nothing allocated.
     #[must_use]
-    pub fn new(cap: u64) -> Self {
+    pub(crate) fn new(cap: u64) -> Self {
         Self {
             allocated: AtomicU64::new(0),
             cap,
@@ -120,19 +123,19 @@ impl Budget {
 
     /// Bytes of pages allocated.
     #[must_use]
-    pub fn allocated(&self) -> u64 {
+    pub(crate) fn allocated(&self) -> u64 {
         self.allocated.load(Relaxed)
     }
 
     /// Whether a page was refused since the last reset: the frame's results are not to be used.
     #[must_use]
     #[inline]
-    pub fn refused(&self) -> bool {
+    pub(crate) fn refused(&self) -> bool {
         self.refused.load(Relaxed)
     }
 
     /// Sets the cap for the next frames (pages already allocated stay) and forgets refusals.
-    pub fn reset(&mut self, cap: u64) {
+    pub(crate) fn reset(&mut self, cap: u64) {
         self.cap = cap;
         *self.refused.get_mut() = false;
     }
@@ -168,7 +171,7 @@ impl Clone for Budget {
 /// operations on words that one page holds, without finding the page for each
 /// ([`crate::WordMemory::with_span`]). A write marks its block written, as the array's does.
 #[derive(Debug)]
-pub struct Span<'a, W, C> {
+pub(crate) struct Span<'a, W, C> {
     page: &'a Page<C>,
     /// The array's index of the page's first word.
     first: usize,
@@ -179,7 +182,7 @@ pub struct Span<'a, W, C> {
 
 /// Where a memory's operations find the cell of a word: the memory's whole array (its
 /// [`Pages`] within its [`Budget`]) or one page's [`Span`].
-pub trait Cells<W, C> {
+pub(crate) trait Cells<W, C> {
     /// The array's length.
     fn len(&self) -> usize;
     /// The array's initial value.
@@ -211,7 +214,7 @@ impl<W: Word, C> Cells<W, C> for Span<'_, W, C> {
 
 /// An array of `len` words of initial value `init`, allocated a page at a time.
 #[derive(Debug)]
-pub struct Pages<W, C> {
+pub(crate) struct Pages<W, C> {
     len: usize,
     init: W,
     pages: Vec<OnceLock<Page<C>>>,
@@ -239,7 +242,7 @@ impl<W: Word, C: WordCell<W>> Clone for Pages<W, C> {
 
 impl<W: Word, C: WordCell<W>> Pages<W, C> {
     /// `len` words of `init`, no page allocated.
-    pub fn new(len: usize, init: W) -> Self {
+    pub(crate) fn new(len: usize, init: W) -> Self {
         Self {
             len,
             init,
@@ -252,25 +255,25 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
 
     /// Number of words.
     #[inline]
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.len
     }
 
     /// The value of every word not written since the last reset.
     #[inline]
-    pub fn init(&self) -> W {
+    pub(crate) fn init(&self) -> W {
         self.init
     }
 
     /// Bytes of the page table itself, allocated with the array.
-    pub fn table_bytes(&self) -> u64 {
+    pub(crate) fn table_bytes(&self) -> u64 {
         page_table_bytes(self.len)
     }
 
     /// The cell of word `index` for a read, or `None` where its page holds the initial value
     /// (never written, and no page refused).
     #[inline]
-    pub fn read(&self, index: usize, budget: &Budget) -> Option<&C> {
+    pub(crate) fn read(&self, index: usize, budget: &Budget) -> Option<&C> {
         debug_assert!(index < self.len, "word {index} of {}", self.len);
         match self.pages[index / PAGE_WORDS].get() {
             Some(page) => Some(&page.words[index % PAGE_WORDS]),
@@ -291,7 +294,7 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     /// The cell of word `index` for a write: its page allocated if it was not, and marked
     /// written.
     #[inline]
-    pub fn write(&self, index: usize, budget: &Budget) -> &C {
+    pub(crate) fn write(&self, index: usize, budget: &Budget) -> &C {
         debug_assert!(index < self.len, "word {index} of {}", self.len);
         let page = match self.pages[index / PAGE_WORDS].get() {
             Some(page) => page,
@@ -308,7 +311,7 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     /// allocated (its first write allocates it, which the span leaves to the array), or start
     /// at or past the array's end (an empty array has no page to lend).
     #[inline]
-    pub fn span(&self, start: usize, len: usize) -> Option<Span<'_, W, C>> {
+    pub(crate) fn span(&self, start: usize, len: usize) -> Option<Span<'_, W, C>> {
         let page = self.pages.get(start / PAGE_WORDS)?.get()?;
         let first = start / PAGE_WORDS * PAGE_WORDS;
         (start - first + len <= page.words.len()).then_some(Span {
@@ -349,7 +352,7 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     /// Whether word `index` holds its initial value for certain: its block not written since
     /// the last reset (and no page refused).
     #[inline]
-    pub fn untouched(&self, index: usize, budget: &Budget) -> bool {
+    pub(crate) fn untouched(&self, index: usize, budget: &Budget) -> bool {
         match self.pages[index / PAGE_WORDS].get() {
             Some(page) => page.written.load(Relaxed) >> (index % PAGE_WORDS / BLOCK_WORDS) & 1 == 0,
             None => !budget.refused(),
@@ -359,7 +362,7 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     /// How many words from `index` on, up to `end`, hold their initial value for certain: the
     /// run of blocks not written since the last reset (and pages never allocated, while no page
     /// was refused) that starts at `index`'s block, a page's mask at a time.
-    pub fn untouched_run(&self, index: usize, end: usize, budget: &Budget) -> usize {
+    pub(crate) fn untouched_run(&self, index: usize, end: usize, budget: &Budget) -> usize {
         let end = end.min(self.len);
         let mut at = index;
         while at < end {
@@ -385,7 +388,7 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
     /// How many words from `index` on, up to `end`, lie in blocks written since the last reset,
     /// from `index`'s block on, a page's mask at a time: where [`Pages::untouched_run`] is 0, the
     /// words a post pass reads before it need ask again.
-    pub fn written_run(&self, index: usize, end: usize) -> usize {
+    pub(crate) fn written_run(&self, index: usize, end: usize) -> usize {
         let end = end.min(self.len);
         let mut at = index;
         while at < end {
@@ -404,7 +407,7 @@ impl<W: Word, C: WordCell<W>> Pages<W, C> {
 
     /// Sets every word to `init`: the blocks written since the last reset (every allocated page
     /// when the initial value changes), one rayon task a few pages; drops the scratch page.
-    pub fn reset(&mut self, init: W) {
+    pub(crate) fn reset(&mut self, init: W) {
         use rayon::prelude::*;
         let all = init != self.init;
         self.pages

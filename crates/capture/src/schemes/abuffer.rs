@@ -108,7 +108,7 @@ impl ABuffer {
     /// Storage beyond `memory_cap` bytes.
     pub fn exact(counts: &[u32], sort: PostSort, memory_cap: u64) -> Result<Self, CaptureError> {
         let mut offsets = Vec::with_capacity(counts.len() + 1);
-        let mut total = 0usize;
+        let mut total = 0_usize;
         offsets.push(0);
         for &c in counts {
             total += c as usize;

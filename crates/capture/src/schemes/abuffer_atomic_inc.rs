@@ -167,7 +167,7 @@ mod tests {
 
     #[test]
     fn wrap_is_atomic_inc_from_zero() {
-        let mut word = 0u32;
+        let mut word = 0_u32;
         for count in 0..50 {
             // CUDA: old = *addr; *addr = old >= bound ? 0 : old + 1.
             assert_eq!(wrap(count, 7), word);

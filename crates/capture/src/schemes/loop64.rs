@@ -191,7 +191,7 @@ mod tests {
     fn the_two_smallest_words_are_kept_in_every_round_robin_order() {
         let fragments = [fragment(4, 0), fragment(4, 1), fragment(9, 2)];
         let scheme = Loop64::new(Viewport::new(1, 1).unwrap(), 2, u64::MAX).unwrap();
-        for first in 0..3u32 {
+        for first in 0..3_u32 {
             for second in (0..3).filter(|&s| s != first) {
                 let third = 3 - first - second;
                 let order: Vec<u32> = [first, second, third].repeat(4);

@@ -86,7 +86,7 @@ pub fn merge_samples(
             .count();
         let mask = rest[..same]
             .iter()
-            .fold(0u32, |mask, f| mask | 1 << (f.pixel % samples));
+            .fold(0_u32, |mask, f| mask | 1 << (f.pixel % samples));
         // Sorted by depth key within the group: the first is the nearest.
         emit(
             pixel,

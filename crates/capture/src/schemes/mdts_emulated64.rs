@@ -60,8 +60,8 @@ impl Emulation {
     #[must_use]
     pub fn scheme_name(self) -> &'static str {
         match self {
-            Emulation::Torn => "mdts-emulated64-torn",
-            Emulation::Locked => "mdts-emulated64",
+            Self::Torn => "mdts-emulated64-torn",
+            Self::Locked => "mdts-emulated64",
         }
     }
 }

@@ -108,7 +108,7 @@ pub fn depth20(depth_key: u32) -> u32 {
 #[must_use]
 pub fn held_depth(depth20: u32) -> f32 {
     // 20 bits fit f32's 24-bit significand, and the scale is a power of two: no rounding.
-    (depth20 & ((1 << DEPTH_BITS) - 1)) as f32 / (1u32 << DEPTH_BITS) as f32
+    (depth20 & ((1 << DEPTH_BITS) - 1)) as f32 / (1_u32 << DEPTH_BITS) as f32
 }
 
 /// How a primitive's 24-bit colour is made from its id: a bijection on `[0, 2^24)`, so the post
@@ -132,7 +132,7 @@ const UNSCRAMBLE: u32 = {
     let mut x = SCRAMBLE;
     let mut i = 0;
     while i < 4 {
-        x = x.wrapping_mul(2u32.wrapping_sub(SCRAMBLE.wrapping_mul(x)));
+        x = x.wrapping_mul(2_u32.wrapping_sub(SCRAMBLE.wrapping_mul(x)));
         i += 1;
     }
     x % COLOURS
@@ -149,8 +149,8 @@ impl Colours {
     pub fn colour(self, prim: u32) -> u32 {
         let prim = prim % COLOURS;
         match self {
-            Colours::Prim => prim,
-            Colours::Scrambled => fold(fold(prim).wrapping_mul(SCRAMBLE) % COLOURS),
+            Self::Prim => prim,
+            Self::Scrambled => fold(fold(prim).wrapping_mul(SCRAMBLE) % COLOURS),
         }
     }
 
@@ -159,8 +159,8 @@ impl Colours {
     pub fn prim(self, colour: u32) -> u32 {
         let colour = colour % COLOURS;
         match self {
-            Colours::Prim => colour,
-            Colours::Scrambled => fold(fold(colour).wrapping_mul(UNSCRAMBLE) % COLOURS),
+            Self::Prim => colour,
+            Self::Scrambled => fold(fold(colour).wrapping_mul(UNSCRAMBLE) % COLOURS),
         }
     }
 }

@@ -196,7 +196,7 @@ mod tests {
         ];
         let mut sorted: Vec<u64> = stream.iter().map(|f| f.packed()).collect();
         sorted.sort_unstable();
-        for k in 1..=6u32 {
+        for k in 1..=6_u32 {
             let scheme = Mlab::with_k(one_pixel(), k).unwrap();
             // The 120 permutations: `n` in mixed radix 5·4·3·2·1, each digit a rotation of one
             // prefix (the longest fixes the last place, and so on down).

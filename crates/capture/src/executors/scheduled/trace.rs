@@ -28,8 +28,8 @@ impl Trace {
 
     /// The events that touched `pixel`'s fragments.
     #[must_use]
-    pub fn pixel(&self, pixel: u32) -> Trace {
-        Trace {
+    pub fn pixel(&self, pixel: u32) -> Self {
+        Self {
             events: self
                 .events
                 .iter()

@@ -175,7 +175,7 @@ impl<W: MdtsWord> Adp<W> {
             bounds.clear();
             // With no set bit in the batch, the edge is past every subinterval: all discard.
             let mut lower = if batch == 0 { 0 } else { ADP_SUBINTERVALS };
-            let mut rank = 0u32;
+            let mut rank = 0_u32;
             'scan: for i in 0..HISTOGRAM_WORDS {
                 let mut bits = self.histogram(memory, pixel, i);
                 while bits != 0 {

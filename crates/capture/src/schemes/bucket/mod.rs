@@ -287,23 +287,23 @@ impl Blend {
     fn step<W: MdtsWord, M: Memory>(&mut self, value: W, memory: &M) -> Step {
         let words = W::words(memory);
         match *self {
-            Blend::PairMin { word } => {
+            Self::PairMin { word } => {
                 let code = W::MAX.wrapping_sub(value);
                 let kept = words.fetch_max(word, code) < code;
-                *self = Blend::PairMax {
+                *self = Self::PairMax {
                     word: word + 1,
                     kept,
                 };
                 Step::Continue
             }
-            Blend::PairMax { word, kept } => {
+            Self::PairMax { word, kept } => {
                 if words.fetch_max(word, value) < value || kept {
                     Step::Stored
                 } else {
                     Step::Dropped
                 }
             }
-            Blend::Single { word } => {
+            Self::Single { word } => {
                 let code = value.wrapping_add(W::ONE);
                 if words.fetch_max(word, code) < code {
                     Step::Stored
@@ -365,13 +365,13 @@ mod tests {
 
     #[test]
     fn one_minus_d_does_not_round_trip_but_the_complement_does() {
-        let d = 0.1f32;
+        let d = 0.1_f32;
         assert_ne!(1.0 - (1.0 - d), d, "1 − d rounds below 0.5");
         // Two depths one ulp apart share one 1 − d, so MAX blending could not tell them apart.
         let next = f32::from_bits(d.to_bits() + 1);
         assert_eq!(1.0 - d, 1.0 - next);
         assert!(!d.to_bits() > !next.to_bits());
-        for d in [0.0f32, 1e-30, 0.1, 0.499, 0.5, 0.75, 1.0] {
+        for d in [0.0_f32, 1e-30, 0.1, 0.499, 0.5, 0.75, 1.0] {
             assert_eq!(!!d.to_bits(), d.to_bits());
             assert!(!d.to_bits() > 0);
         }

@@ -246,7 +246,7 @@ mod tests {
         ];
         let scheme = KBufferInterlock::with_k(one_pixel(), 2).unwrap();
         let mut orders = 0;
-        for a in 0..4u32 {
+        for a in 0..4_u32 {
             for b in (0..4).filter(|&b| b != a) {
                 for c in (0..4).filter(|&c| c != a && c != b) {
                     let d = 6 - a - b - c;

@@ -32,8 +32,8 @@ impl WriteBack {
     #[must_use]
     pub fn suffix(self) -> &'static str {
         match self {
-            WriteBack::RenderTarget => "",
-            WriteBack::SeparateStores => "-stores",
+            Self::RenderTarget => "",
+            Self::SeparateStores => "-stores",
         }
     }
 }
@@ -96,7 +96,7 @@ pub(crate) struct Slots {
 
 impl Slots {
     /// Fails on `k == 0`, naming `scheme`.
-    pub fn new(scheme: &str, k: u32, write_back: WriteBack) -> Result<Self, CaptureError> {
+    pub(crate) fn new(scheme: &str, k: u32, write_back: WriteBack) -> Result<Self, CaptureError> {
         if k == 0 {
             return Err(CaptureError::BadParameter(format!(
                 "{scheme} needs K ≥ 1 slots per pixel, got K = 0"
@@ -108,7 +108,7 @@ impl Slots {
     /// The descriptor of a scheme keeping these slots for `pixels` pixels, its `u32` words
     /// (locks, tickets) `words32`: whole fragments in `u64` slots, all empty at first, the `K`
     /// nearest promised, and every fragment that falls off a walk's end counted as dropped.
-    pub fn descriptor(
+    pub(crate) fn descriptor(
         self,
         name: String,
         pixels: usize,
@@ -133,13 +133,13 @@ impl Slots {
     }
 
     /// `u64` words of `pixels` pixels' slots.
-    pub fn words(self, pixels: usize) -> usize {
+    pub(crate) fn words(self, pixels: usize) -> usize {
         pixels * self.k as usize
     }
 
     /// `u32` words of `pixels` pixels' render-target bookkeeping (none for separate stores):
     /// the lock, the next ticket, the last committed ticket + 1.
-    pub fn sync_words(self, pixels: usize) -> usize {
+    pub(crate) fn sync_words(self, pixels: usize) -> usize {
         match self.write_back {
             WriteBack::RenderTarget => 3 * pixels,
             WriteBack::SeparateStores => 0,
@@ -147,7 +147,7 @@ impl Slots {
     }
 
     /// A fragment's walk before its first read.
-    pub fn begin(self, fragment: Fragment) -> Insert {
+    pub(crate) fn begin(self, fragment: Fragment) -> Insert {
         Insert {
             base: fragment.pixel as usize * self.k as usize,
             value: fragment.packed(),
@@ -160,7 +160,7 @@ impl Slots {
 
     /// One step of the walk: one load or one store with separate stores; the whole read or the
     /// whole write-back with render targets.
-    pub fn step<M: Memory>(self, insert: &mut Insert, memory: &M) -> Outcome {
+    pub(crate) fn step<M: Memory>(self, insert: &mut Insert, memory: &M) -> Outcome {
         match self.write_back {
             WriteBack::SeparateStores => self.step_separate(insert, memory),
             WriteBack::RenderTarget => self.step_render_target(insert, memory),
@@ -255,7 +255,7 @@ impl Slots {
     }
 
     /// Empties `pixel`'s slots and forgets its last writer (between geometry passes).
-    pub fn clear<M: Memory>(self, memory: &M, pixel: usize) {
+    pub(crate) fn clear<M: Memory>(self, memory: &M, pixel: usize) {
         let base = pixel * self.k as usize;
         for w in base..base + self.k as usize {
             WordMemory::<u64>::store(memory, w, EMPTY);
@@ -269,14 +269,19 @@ impl Slots {
     /// The post pass of a pixel whose slots hold its list: appends the occupied slots to `out`
     /// and returns no overflow, since what fell off (or was dropped) is not in memory: the
     /// executors count it from the walks.
-    pub fn resolve_pixel<M: Memory>(self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+    pub(crate) fn resolve_pixel<M: Memory>(
+        self,
+        memory: &M,
+        pixel: usize,
+        out: &mut Vec<u64>,
+    ) -> u32 {
         out.extend(self.occupied(memory, pixel));
         0
     }
 
     /// The non-empty slots of `pixel`, in slot order: gaps, duplicates and disorder left by a
     /// hazard are kept, for the diff to see.
-    pub fn occupied(
+    pub(crate) fn occupied(
         self,
         slots: &impl WordMemory<u64>,
         pixel: usize,

@@ -83,8 +83,8 @@ impl Loop {
     #[must_use]
     pub fn scheme_name(self) -> &'static str {
         match self {
-            Loop::Naive => "kbuffer-spinlock",
-            Loop::Fixed => "kbuffer-spinlock-fixed",
+            Self::Naive => "kbuffer-spinlock",
+            Self::Fixed => "kbuffer-spinlock-fixed",
         }
     }
 }
