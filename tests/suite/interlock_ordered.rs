@@ -6,7 +6,7 @@
 //! `K` nearest then and only then when the first `K` submitted are not the `K` nearest. A different
 //! submission order (`--shuffle`) keeps different fragments, as on a GPU.
 
-use fragsim::capture::catalog::{Count, Executors, SchemeName, Sizing};
+use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::executors::{Executor, ParallelExecutor};
 use fragsim::capture::primitive_order::PrimitiveOrder;
@@ -65,19 +65,19 @@ fn on_every_executor_nearest_is_exact_and_keep_first_keeps_the_first_submitted()
     let scene = spheres();
     let view = view(&scene);
     let oracle = Oracle::build(&view);
-    let mut executors = Executors::default();
+    let mut runner = SchemeRunner::default();
     let nearest = SchemeName::from_name("kbuffer-interlock-ordered").unwrap();
     let first = SchemeName::from_name("kbuffer-interlock-ordered-first").unwrap();
     for k in [2, 16] {
         let expected = first_submitted(&view, k);
         for executor in Executor::EVERY {
-            let run = executors.run(nearest, executor, &view, &sizing(k)).unwrap();
+            let run = runner.run(nearest, executor, &view, &sizing(k)).unwrap();
             assert_eq!(run.guarantee, Guarantee::Exact);
             assert!(
                 oracle.diff(&run.run.capture).is_exact(),
                 "K = {k}, {executor}"
             );
-            let run = executors.run(first, executor, &view, &sizing(k)).unwrap();
+            let run = runner.run(first, executor, &view, &sizing(k)).unwrap();
             assert_eq!(run.guarantee, Guarantee::ExactWithinCapacity(k));
             assert!(lists(&run.run.capture) == expected, "K = {k}, {executor}");
         }
@@ -152,7 +152,7 @@ fn a_shuffled_submission_keeps_the_first_of_the_new_order() {
     let scene = spheres();
     let shuffled = view(&scene).shuffled(1);
     let first = SchemeName::from_name("kbuffer-interlock-ordered-first").unwrap();
-    let run = Executors::default()
+    let run = SchemeRunner::default()
         .run(first, Executor::Serial, &shuffled, &sizing(K))
         .unwrap();
     assert!(lists(&run.run.capture) == first_submitted(&shuffled, K));

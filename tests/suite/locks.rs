@@ -7,7 +7,7 @@
 //! executor with every fragment in flight at once in one warp (so which fragments contend is
 //! known); the real-scene test runs each catalog entry on every executor through the catalog.
 
-use fragsim::capture::catalog::{Count, Executors, SchemeName, Sizing};
+use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::capture::executors::scheduled::{
     run_fragments, Granularity, Policy, Schedule, WARP_LANES,
 };
@@ -155,7 +155,7 @@ fn the_lock_based_entries_are_exact_on_every_executor() {
         .view(Viewport::new(48, 48).unwrap(), &OrbitCamera::default())
         .unwrap();
     let oracle = Oracle::build(&view);
-    let mut executors = Executors::default();
+    let mut runner = SchemeRunner::default();
     let names = [
         "kbuffer-interlock",
         "kbuffer-spinlock",
@@ -171,7 +171,7 @@ fn the_lock_based_entries_are_exact_on_every_executor() {
                 memory_cap: MEMORY_CAP_DEFAULT,
             };
             for executor in Executor::EVERY {
-                let run = executors.run(scheme, executor, &view, &sizing).unwrap();
+                let run = runner.run(scheme, executor, &view, &sizing).unwrap();
                 assert_eq!(run.guarantee, Guarantee::Exact, "{name}");
                 assert!(
                     oracle.diff(&run.run.capture).is_exact(),

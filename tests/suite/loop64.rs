@@ -5,7 +5,7 @@
 //! the oracle's `K` nearest and its drops the fragments it lacks; on streams with many equal
 //! depths under GPU-like schedules, the `K` nearest every time, where loop32 loses some.
 
-use fragsim::capture::catalog::{Count, Executors, SchemeName, Sizing};
+use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::schemes::loop32::Loop32;
@@ -21,7 +21,7 @@ fn loop64_is_exact_on_every_executor() {
         .view(Viewport::new(48, 48).unwrap(), &OrbitCamera::default())
         .unwrap();
     let oracle = Oracle::build(&view);
-    let mut executors = Executors::default();
+    let mut runner = SchemeRunner::default();
     let scheme = SchemeName::from_name("loop64").unwrap();
     for k in [3, 16] {
         let sizing = Sizing {
@@ -30,7 +30,7 @@ fn loop64_is_exact_on_every_executor() {
             memory_cap: MEMORY_CAP_DEFAULT,
         };
         for executor in Executor::EVERY {
-            let run = executors.run(scheme, executor, &view, &sizing).unwrap();
+            let run = runner.run(scheme, executor, &view, &sizing).unwrap();
             assert_eq!(run.guarantee, Guarantee::Exact);
             let diff = oracle.diff(&run.run.capture);
             assert!(diff.is_exact(), "K = {k}, {executor}");

@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use fragsim::capture::catalog::{Count, Executors, Sizing, CATALOG};
+use fragsim::capture::catalog::{Count, SchemeRunner, Sizing, CATALOG};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::schemes::masked_abuffer::MaskedABuffer;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
@@ -168,7 +168,7 @@ fn every_scheme_run_at_one_sample_captures_bit_for_bit_what_it_captures_today() 
         let scene = Scene::procedural(spec).unwrap();
         let view = view_of(&scene, side, 30.0);
         let centre = view.clone().with_samples(SamplePattern::CENTRE).unwrap();
-        let mut executors = Executors::default();
+        let mut runner = SchemeRunner::default();
         for entry in CATALOG {
             for count in [Count::Fixed(2), Count::Auto] {
                 let sizing = Sizing {
@@ -177,11 +177,7 @@ fn every_scheme_run_at_one_sample_captures_bit_for_bit_what_it_captures_today() 
                     memory_cap: MEMORY_CAP_DEFAULT,
                 };
                 for &executor in executors_used {
-                    let mut run = |view| {
-                        executors
-                            .run(entry.scheme, executor, view, &sizing)
-                            .unwrap()
-                    };
+                    let mut run = |view| runner.run(entry.scheme, executor, view, &sizing).unwrap();
                     let (today, sampled) = (run(&view), run(&centre));
                     assert_eq!(
                         today.run.capture, sampled.run.capture,
@@ -207,7 +203,7 @@ fn mdts_and_the_abuffer_run_per_sample_equal_the_per_sample_oracle_on_every_exec
             .with_samples(SamplePattern::standard(count).unwrap())
             .unwrap();
         let oracle = SampleOracle::build(&sampled).unwrap();
-        let mut executors = Executors::default();
+        let mut runner = SchemeRunner::default();
         let sizing = Sizing {
             k: Count::Auto,
             capacity: Count::Auto,
@@ -216,7 +212,7 @@ fn mdts_and_the_abuffer_run_per_sample_equal_the_per_sample_oracle_on_every_exec
         for name in ["mdts", "abuffer", "abuffer-exact"] {
             let scheme = fragsim::capture::catalog::SchemeName::from_name(name).unwrap();
             for executor in [Executor::Serial, Executor::Parallel, Executor::Tiled] {
-                let run = executors.run(scheme, executor, &sampled, &sizing).unwrap();
+                let run = runner.run(scheme, executor, &sampled, &sizing).unwrap();
                 let diff = oracle.oracle().diff(&run.run.capture);
                 assert!(
                     diff.is_exact(),

@@ -13,7 +13,7 @@
 //! without them.
 
 use fragsim::capture::catalog::{
-    Build, Count, Executors, SchemeName, SchemeVisitor, Sizing, Storage, CATALOG,
+    Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing, Storage, CATALOG,
 };
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
@@ -69,7 +69,7 @@ proptest! {
         let shuffled = view.clone().shuffled(seed);
         let oracle = Oracle::build(&view);
         let (deepest, ties) = (oracle.max_depth_complexity(), has_ties(&oracle));
-        let mut executors = Executors::default();
+        let mut runner = SchemeRunner::default();
         let mut checked = 0;
         for entry in CATALOG {
             for count in [Count::Fixed(k), Count::Auto] {
@@ -79,7 +79,7 @@ proptest! {
                 let sizing = Sizing { k: count, capacity, memory_cap: MEMORY_CAP_DEFAULT };
                 for executor in [Executor::Serial, Executor::Scheduled] {
                     let mut run =
-                        |view| executors.run(entry.scheme, executor, view, &sizing).unwrap();
+                        |view| runner.run(entry.scheme, executor, view, &sizing).unwrap();
                     let a = run(&view);
                     let owed = promises_order_independence(
                         a.guarantee, &a.run.capture.keeps, deepest, ties,
@@ -114,7 +114,7 @@ fn the_order_dependent_schemes_capture_a_shuffled_view_differently() {
         capacity: Count::Auto,
         memory_cap: MEMORY_CAP_DEFAULT,
     };
-    let mut executors = Executors::default();
+    let mut runner = SchemeRunner::default();
     for name in [
         "layer-counter",
         "linked-list",
@@ -122,7 +122,7 @@ fn the_order_dependent_schemes_capture_a_shuffled_view_differently() {
     ] {
         let scheme = SchemeName::from_name(name).unwrap();
         let mut run = |view| {
-            executors
+            runner
                 .run(scheme, Executor::Serial, view, &sizing)
                 .unwrap()
                 .run

@@ -21,7 +21,7 @@
 //! way ([`ColourJudge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
 
-use fragsim_capture::catalog::{check_memory_cap_early, Count, Executors, SchemeName, Sizing};
+use fragsim_capture::catalog::{check_memory_cap_early, Count, SchemeName, SchemeRunner, Sizing};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
 use fragsim_oracle::samples::{SampleError, SampleOracle};
@@ -315,7 +315,7 @@ fn rows(
     for &name in bench.schemes {
         for &executor in bench.executors {
             progress.set_message(format!("{name} per sample on the {executor} executor"));
-            let mut runner = Executors::default();
+            let mut runner = SchemeRunner::default();
             let (named, times) = time_frames(
                 view,
                 bench.camera,

@@ -16,7 +16,7 @@ use fragsim_raster::{depth_from_key, View};
 use serde::Serialize;
 
 use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
-use crate::schemes::{check_memory_cap_early, Executors, Fault, SchemeChoice};
+use crate::schemes::{check_memory_cap_early, Fault, SchemeChoice, SchemeRunner};
 
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
@@ -223,7 +223,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let oracle_ms = oracle_start.elapsed().as_secs_f64() * 1e3;
     progress.inc(1);
     let max_dc = oracle.max_depth_complexity();
-    let mut runner = Executors::default();
+    let mut runner = SchemeRunner::default();
     runner.fault = args.inject_fault.map(Into::into);
     // A dump holds the memory of the run it reports, not a serial re-run's.
     runner.keep_memory = args.dump.dir.is_some();

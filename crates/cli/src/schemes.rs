@@ -1,12 +1,12 @@
 //! The command line's names for schemes: exactly the catalog's ([`fragsim_capture::catalog`]),
-//! plus `all`. Building and running them is the library's ([`Executors::run`]).
+//! plus `all`. Building and running them is the library's ([`SchemeRunner::run`]).
 
 use clap::builder::PossibleValue;
 use clap::ValueEnum;
 use std::sync::OnceLock;
 
 pub(crate) use fragsim_capture::catalog::{
-    check_memory_cap_early, Executors, NamedRun, SchemeName, CATALOG,
+    check_memory_cap_early, NamedRun, SchemeName, SchemeRunner, CATALOG,
 };
 
 /// A `--scheme` value: one catalog entry, or `all` of them.

@@ -13,7 +13,7 @@ use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
 use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
-use crate::schemes::{family, Executors, SchemeChoice};
+use crate::schemes::{family, SchemeChoice, SchemeRunner};
 use fragsim_raster::{Conventions, SceneSpec};
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 
@@ -139,7 +139,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         crate::approximate::check_effect(&judge, &args.approximate)?;
         let depth_complexity = oracle.depth_complexity();
         let sizing = args.schemes.sizing();
-        let mut runner = Executors::default();
+        let mut runner = SchemeRunner::default();
         for (i, &name) in schemes.iter().enumerate() {
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             if series.len() <= i {

@@ -6,7 +6,7 @@
 //! is judged by [`crate::judge`], the code `fragsim compare` judges dumps with. Source: the
 //! catalog (`fragsim_capture::catalog`) and the dump format (`docs/dump-format.md`).
 
-use fragsim_capture::catalog::{Build, Count, Executors, SchemeName, SchemeVisitor, Sizing};
+use fragsim_capture::catalog::{Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing};
 use fragsim_capture::executors::scheduled::run_scheduled;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::{Capture, Guarantee, Scheme, MEMORY_CAP_DEFAULT};
@@ -184,7 +184,7 @@ impl Backend for CatalogBackend {
         let params = input.params;
         let sizing = sizing(params);
         if self.executor != Executor::Scheduled {
-            let run = Executors::default()
+            let run = SchemeRunner::default()
                 .run(params.scheme, self.executor, input.view, &sizing)
                 .map_err(BackendError::Setup)?;
             return Ok(Output::Capture(run.run.capture));

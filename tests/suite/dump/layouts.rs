@@ -3,7 +3,7 @@
 //! compares equal with the oracle; linked-list and layer-major dumps in another engine's
 //! encoding read the same; each rule of their words names a corrupted word, a cycle included.
 
-use fragsim::capture::catalog::{Count, DumpLayout, Executors, SchemeName, Sizing, CATALOG};
+use fragsim::capture::catalog::{Count, DumpLayout, SchemeName, SchemeRunner, Sizing, CATALOG};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::Capture;
 use fragsim::oracle::compare::{self, verdict};
@@ -18,7 +18,7 @@ use super::{judged, pixel_with, scratch, spec, with_view};
 /// `render --dump`'s path for one scheme: a serial run sized by `sizing`, then its dump.
 fn dumped(name: &str, view: &View<'_>, sizing: &Sizing) -> (Dump, Capture) {
     let scheme = SchemeName::from_name(name).unwrap();
-    let named = Executors::default()
+    let named = SchemeRunner::default()
         .run(scheme, Executor::Serial, view, sizing)
         .unwrap();
     let layout = DumpScheme::for_run(

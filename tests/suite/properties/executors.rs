@@ -1,7 +1,7 @@
 //! The schemes against the serial oracle on concurrent executors, every catalog entry tiled against
 //! serial, serial against concurrent, and the control that the concurrency settings interleave.
 
-use fragsim::capture::catalog::{Count, Executors, SchemeName, Sizing, Storage, CATALOG};
+use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing, Storage, CATALOG};
 use fragsim::capture::depth_count::DepthCount;
 use fragsim::capture::executors::tiled::run_tiled;
 use fragsim::capture::executors::{run_serial, Executor, Run};
@@ -106,7 +106,7 @@ fn every_catalog_entry_is_what_it_builds() {
         capacity: Count::Fixed(2),
         memory_cap: MEMORY_CAP_DEFAULT,
     };
-    let mut executors = Executors::default();
+    let mut runner = SchemeRunner::default();
     for (i, entry) in CATALOG.iter().enumerate() {
         assert_eq!(entry.scheme.entry(), entry);
         assert_eq!(SchemeName::from_name(entry.name), Some(entry.scheme));
@@ -115,7 +115,7 @@ fn every_catalog_entry_is_what_it_builds() {
             "{}",
             entry.name
         );
-        let named = executors
+        let named = runner
             .run(entry.scheme, Executor::Serial, &view, &sizing)
             .unwrap();
         assert_eq!(named.name, entry.name);
@@ -188,11 +188,11 @@ proptest! {
             // pool holds every fragment here (`auto`); their resolve still keeps K.
             let pooled = Sizing { capacity: Count::Auto, ..sizing };
             check_tiled_equals_serial(view, &DepthCount::new(viewport))?;
-            let mut executors = Executors::default();
+            let mut runner = SchemeRunner::default();
             for entry in CATALOG {
                 let sizing = if entry.storage == Storage::KAndPool { &pooled } else { &sizing };
                 let mut run = |executor| {
-                    executors
+                    runner
                         .run(entry.scheme, executor, view, sizing)
                         .map_err(TestCaseError::fail)
                 };

@@ -4,7 +4,7 @@
 //! Each entry of the `catalog!` table carries its constructor, so the table is the only place a
 //! scheme is named and built. A scheme's type differs per entry, and Rust has no generic
 //! closures, so the built scheme is handed to a visitor whose `visit` is generic: the executors'
-//! run ([`Executors::run`](super::Executors::run)), the dump recorder and reader, the fuzz
+//! run ([`SchemeRunner::run`](super::SchemeRunner::run)), the dump recorder and reader, the fuzz
 //! targets' checks and `explain`'s replays are each one visitor, statically dispatched.
 
 use crate::primitive_order::PrimitiveOrder;

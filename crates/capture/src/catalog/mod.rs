@@ -5,7 +5,7 @@
 //! returns), its geometry passes, how it sizes its storage, its memory's layout in a dump
 //! ([`DumpLayout`], where it has one), a one-line description, and its constructor: the sizes of
 //! a [`Build`] to the scheme, handed to a [`SchemeVisitor`] ([`SchemeName::build`];
-//! [`Executors::run`] is the visitor that runs one frame). What a scheme guarantees is
+//! [`SchemeRunner::run`] is the visitor that runs one frame). What a scheme guarantees is
 //! never listed here: it comes from the built scheme
 //! ([`Scheme::guarantee`](crate::Scheme::guarantee)). Front ends (the command line, the dump
 //! reader and writer, the property tests, the fuzz targets) iterate this list, so adding a scheme
@@ -38,7 +38,7 @@ mod run;
 
 pub use build::{Build, SchemeVisitor};
 pub use dump_layout::{DumpLayout, SlotWord};
-pub use run::{check_memory_cap_early, Executors, Fault, MemoryWords, NamedRun};
+pub use run::{check_memory_cap_early, Fault, MemoryWords, NamedRun, SchemeRunner};
 
 use crate::schemes::abuffer::{
     ABuffer,

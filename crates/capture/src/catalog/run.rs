@@ -1,5 +1,5 @@
 //! Running a catalog entry: its constructor from a [`Sizing`], its counting pass where it needs
-//! one, and one frame on an executor ([`Executors::run`]); the memory cap checked before any of it
+//! one, and one frame on an executor ([`SchemeRunner::run`]); the memory cap checked before any of it
 //! ([`check_memory_cap_early`]).
 
 use super::{Build, Count, SchemeName, SchemeVisitor, Sizing};
@@ -30,7 +30,7 @@ pub struct NamedRun {
     /// dump of its memory needs to rebuild it.
     pub sizes: Build<'static>,
     /// The run's own memory after its last pass, before the post pass, where
-    /// [`Executors::keep_memory`] asked for it: what `render --dump` writes, so that a dump holds
+    /// [`SchemeRunner::keep_memory`] asked for it: what `render --dump` writes, so that a dump holds
     /// the words of the run it reports (a racy run's included).
     pub memory: Option<MemoryWords>,
 }
@@ -65,9 +65,10 @@ pub enum Fault {
     MiscountOverflow,
 }
 
-/// Executors that keep their storage between frames of the same scheme.
+/// Runs catalog schemes by name on any executor, keeping each executor's storage between frames
+/// of the same scheme (the executors themselves are [`crate::executors`]).
 #[derive(Debug, Default)]
-pub struct Executors {
+pub struct SchemeRunner {
     serial: SerialExecutor,
     parallel: ParallelExecutor,
     tiled: TiledExecutor,
@@ -80,7 +81,7 @@ pub struct Executors {
     pub keep_memory: bool,
 }
 
-impl Executors {
+impl SchemeRunner {
     /// Builds scheme `name` sized by `sizing` and runs one frame of it on `executor` (on the
     /// current rayon pool where it is parallel): first its counting pass where it needs one,
     /// then its own passes.
@@ -142,7 +143,7 @@ impl Executors {
             .build(
                 &build,
                 RunOn {
-                    executors: self,
+                    runner: self,
                     executor,
                     view,
                     sizes: Build {
@@ -237,7 +238,7 @@ const SCHEDULE: Schedule = Schedule {
 
 /// The catalog visitor that runs one frame of the built scheme on an executor.
 struct RunOn<'e, 'v, 'm> {
-    executors: &'e mut Executors,
+    runner: &'e mut SchemeRunner,
     executor: Executor,
     view: &'v View<'m>,
     sizes: Build<'static>,
@@ -246,14 +247,8 @@ struct RunOn<'e, 'v, 'm> {
 impl SchemeVisitor for RunOn<'_, '_, '_> {
     type Output = NamedRun;
     fn visit<S: Scheme>(self, scheme: &S, slots: Option<u32>) -> NamedRun {
-        let kept = self.executors.keep_memory.then(|| Mutex::new(None));
-        let run = run_with_fault(
-            scheme,
-            self.executors,
-            self.executor,
-            self.view,
-            kept.as_ref(),
-        );
+        let kept = self.runner.keep_memory.then(|| Mutex::new(None));
+        let run = run_with_fault(scheme, self.runner, self.executor, self.view, kept.as_ref());
         NamedRun {
             run,
             name: scheme.name(),
@@ -266,41 +261,41 @@ impl SchemeVisitor for RunOn<'_, '_, '_> {
     }
 }
 
-/// One frame of `scheme` on `executor`, with the executors' fault injected where one is set and
+/// One frame of `scheme` on `executor`, with the runner's fault injected where one is set and
 /// its memory after the last pass copied into `keep` where given.
 fn run_with_fault<S: Scheme>(
     scheme: &S,
-    executors: &mut Executors,
+    runner: &mut SchemeRunner,
     executor: Executor,
     view: &View<'_>,
     keep: Option<&Mutex<Option<MemoryWords>>>,
 ) -> Run {
-    let miscount = executors.fault == Some(Fault::MiscountOverflow);
+    let miscount = runner.fault == Some(Fault::MiscountOverflow);
     if !miscount && keep.is_none() {
-        return run_on(scheme, executors, executor, view);
+        return run_on(scheme, runner, executor, view);
     }
     let instrumented = Instrumented {
         scheme,
         miscount,
         keep,
     };
-    run_on(&instrumented, executors, executor, view)
+    run_on(&instrumented, runner, executor, view)
 }
 
 /// One frame of `scheme` on `executor`.
 fn run_on<S: Scheme>(
     scheme: &S,
-    executors: &mut Executors,
+    runner: &mut SchemeRunner,
     executor: Executor,
     view: &View<'_>,
 ) -> Run {
-    if executors.count_locked_ops {
+    if runner.count_locked_ops {
         return executors::count_locked_ops(view, scheme, executor != Executor::Serial);
     }
     match executor {
-        Executor::Serial => executors.serial.run(view, scheme),
-        Executor::Parallel => executors.parallel.run(view, scheme),
-        Executor::Tiled => executors.tiled.run(view, scheme),
+        Executor::Serial => runner.serial.run(view, scheme),
+        Executor::Parallel => runner.parallel.run(view, scheme),
+        Executor::Tiled => runner.tiled.run(view, scheme),
         Executor::Scheduled => run_scheduled(view, scheme, &SCHEDULE, false).run,
     }
 }

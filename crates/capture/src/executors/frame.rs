@@ -82,7 +82,7 @@ pub struct RunStats {
     /// reached (`memory/pages.rs`), at most [`RunStats::memory_bytes`] and the page tables.
     pub allocated_bytes: u64,
     /// Whether a write found no storage within the memory cap: the capture is not to be used
-    /// (`Executors::run` reports the run as over the cap).
+    /// (`SchemeRunner::run` reports the run as over the cap).
     pub over_cap: bool,
     /// Threads that ran the pass.
     pub threads: usize,

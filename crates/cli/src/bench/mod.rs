@@ -23,7 +23,7 @@ use crate::frame_timing::{median, ms, time_frames, time_raster_alone};
 use crate::multisampled::MsaaReport;
 use crate::record::{ColourByDepth, Context};
 use crate::row_images::Images;
-use crate::schemes::{check_memory_cap_early, Executors, SchemeChoice, SchemeName};
+use crate::schemes::{check_memory_cap_early, SchemeChoice, SchemeName, SchemeRunner};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -334,7 +334,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 continue;
             }
             progress.set_message(format!("{name} on the {executor} executor"));
-            let mut runner = Executors::default();
+            let mut runner = SchemeRunner::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial
             // executor's vertex stage runs on one thread too.
             let frame_pool = if executor == Executor::Serial {
