@@ -35,6 +35,7 @@ mod mdts_packed;
 mod mesh_files;
 mod meshes;
 mod multisampling;
+mod new_scheme;
 mod order_independence;
 mod peeling;
 mod pictures;
