@@ -101,7 +101,7 @@ fn replay_geometry_of(
 ) -> Result<Geometry, GpuError> {
     let viewport = view.viewport();
     if !viewport.width.is_power_of_two() || !viewport.height.is_power_of_two() {
-        return Err(GpuError(format!(
+        return Err(GpuError::Refused(format!(
             "replay mode needs power-of-two viewport sides (exact clip coordinates), not {}x{}",
             viewport.width, viewport.height
         )));
@@ -204,19 +204,19 @@ pub fn capture_samples(
     samples: u32,
 ) -> Result<Captured, GpuError> {
     if let GpuScheme::SampleCounts = scheme {
-        return Err(GpuError(format!(
+        return Err(GpuError::Refused(format!(
             "{} is a pass, not a capture scheme: it has no dump layout",
             scheme.name()
         )));
     }
     if !scheme.captures_at(samples) {
-        return Err(GpuError(format!(
+        return Err(GpuError::Refused(format!(
             "{} has no per-sample variant: it captures at 1 sample a pixel, not {samples}",
             scheme.name()
         )));
     }
     if view.samples().is_some() {
-        return Err(GpuError(
+        return Err(GpuError::Refused(
             "a per-sample capture draws a single-sample view into a multisampled target".into(),
         ));
     }

@@ -26,7 +26,7 @@ use fragsim_raster::VertexPrecision;
 use fragsim_testkit::{Backend, BackendError, Case, CatalogBackend, Input, Output, Params};
 
 use crate::capture::{capture_planted, Mode};
-use crate::device::Gpu;
+use crate::device::{Gpu, GpuError};
 use crate::plant::Plant;
 use crate::shaders::GpuScheme;
 
@@ -44,7 +44,7 @@ pub struct WgpuBackend<'g> {
 impl WgpuBackend<'_> {
     /// The GPU scheme for the catalog scheme and sizes of `params`.
     fn scheme(params: &Params) -> Result<GpuScheme, String> {
-        GpuScheme::parse(params.scheme.name(), params.k, params.capacity).map_err(|e| e.0)
+        GpuScheme::parse(params.scheme.name(), params.k, params.capacity).map_err(|e| e.to_string())
     }
 }
 
@@ -64,9 +64,9 @@ impl Backend for WgpuBackend<'_> {
         let scheme = Self::scheme(params)?;
         self.gpu
             .check(scheme.name(), scheme.needs())
-            .map_err(|e| e.0)?;
+            .map_err(|e| e.to_string())?;
         if let Some(plant) = self.plant {
-            plant.check(&scheme).map_err(|e| e.0)?;
+            plant.check(&scheme).map_err(|e| e.to_string())?;
         }
         CatalogBackend::on(Executor::Parallel).guarantee(params)
     }
@@ -87,6 +87,44 @@ impl Backend for WgpuBackend<'_> {
         let scene = Case::scene_and_camera("mesh.obj", mesh_hash(obj.as_bytes()));
         capture_planted(self.gpu, input.view, scene, &scheme, self.mode, self.plant)
             .map(|captured| Output::Dump(Box::new(captured.dump)))
-            .map_err(|e| BackendError::Failed(e.0))
+            .map_err(battery_error)
+    }
+}
+
+/// What the battery makes of a GPU error: a run the device failed is this case's failure, shrunk
+/// like any other; no GPU, an adapter without what the case needs, or a request it refuses means
+/// the backend cannot run the case at all, which shrinking would only hide.
+fn battery_error(e: GpuError) -> BackendError {
+    match e {
+        GpuError::Device(message) => BackendError::Failed(message),
+        GpuError::NoGpu(message) | GpuError::Unsupported(message) | GpuError::Refused(message) => {
+            BackendError::Setup(message)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_a_failed_run_is_a_failing_case_the_rest_stop_the_battery() {
+        let failed = battery_error(GpuError::Device("read-back: lost".into()));
+        assert!(
+            matches!(&failed, BackendError::Failed(m) if m == "read-back: lost"),
+            "{failed}"
+        );
+        for e in [
+            GpuError::NoGpu("no Vulkan adapter".into()),
+            GpuError::Unsupported("no 64-bit atomics".into()),
+            GpuError::Refused("unknown scheme".into()),
+        ] {
+            let message = e.to_string();
+            let mapped = battery_error(e);
+            assert!(
+                matches!(&mapped, BackendError::Setup(m) if *m == message),
+                "{mapped}"
+            );
+        }
     }
 }

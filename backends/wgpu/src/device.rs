@@ -13,24 +13,32 @@
 //! code, which the workspace forbids (`crate::sample_counts` says how the positions are checked
 //! instead).
 
-use std::fmt;
-
 /// The format of every capture's colour target, which the shaders never write (write mask
 /// empty): Vulkan draws need a render area, the schemes write storage buffers only. Multisampled
 /// for the counting pass and per-sample captures, so the device reports its sample counts.
 pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
-/// Why no GPU could be used, or why a scheme cannot run on this one.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct GpuError(pub String);
-
-impl fmt::Display for GpuError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
+/// Why no GPU could be used, or why a capture cannot run on this one. Callers branch on the
+/// kind: tests skip where there is no GPU or the adapter lacks what a case needs, and the
+/// conformance battery stops on those and on a refused request, but shrinks a case the device
+/// failed ([`crate::conform`]). Each message names what is missing or wrong.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum GpuError {
+    /// No Vulkan adapter, or none whose device opens.
+    #[error("{0}")]
+    NoGpu(String),
+    /// The adapter lacks what the request needs: a feature, a sample count, a buffer within its
+    /// limits, node numbers that fit.
+    #[error("{0}")]
+    Unsupported(String),
+    /// The request is wrong whatever the adapter: an unknown scheme or plant, a plant that does not
+    /// apply, a view the mode cannot draw.
+    #[error("{0}")]
+    Refused(String),
+    /// The device failed a run: validation refused it, or waiting or reading back failed.
+    #[error("{0}")]
+    Device(String),
 }
-
-impl std::error::Error for GpuError {}
 
 /// An open device and what its adapter is.
 #[derive(Debug)]
@@ -88,7 +96,7 @@ impl Gpu {
             apply_limit_buckets: false,
         }))
         .map_err(|e| {
-            GpuError(format!(
+            GpuError::NoGpu(format!(
                 "no Vulkan adapter ({e}); install a driver, e.g. `apt-get install -y mesa-vulkan-drivers libvulkan1` for lavapipe"
             ))
         })?;
@@ -98,7 +106,7 @@ impl Gpu {
             .fold(wgpu::Features::empty(), |all, &(_, f)| all | f);
         let features = adapter.features() & wanted;
         if !features.contains(wgpu::Features::PRIMITIVE_INDEX) {
-            return Err(GpuError(format!(
+            return Err(GpuError::Unsupported(format!(
                 "adapter {} has no PRIMITIVE_INDEX (the shaders' primitive id)",
                 info.name
             )));
@@ -109,7 +117,9 @@ impl Gpu {
             required_limits: adapter.limits(),
             ..Default::default()
         }))
-        .map_err(|e| GpuError(format!("adapter {}: cannot open a device: {e}", info.name)))?;
+        .map_err(|e| {
+            GpuError::NoGpu(format!("adapter {}: cannot open a device: {e}", info.name))
+        })?;
         let sample_counts =
             if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
                 adapter
@@ -136,7 +146,7 @@ impl Gpu {
         if self.sample_counts.contains(&samples) {
             Ok(())
         } else {
-            Err(GpuError(format!(
+            Err(GpuError::Unsupported(format!(
                 "adapter {} renders {TARGET_FORMAT:?} targets at {:?} samples a pixel, not {samples}",
                 self.info.name, self.sample_counts
             )))
@@ -162,7 +172,7 @@ impl Gpu {
         if missing.is_empty() {
             Ok(())
         } else {
-            Err(GpuError(format!(
+            Err(GpuError::Unsupported(format!(
                 "{what} needs {}, which adapter {} does not have",
                 missing.join(" and "),
                 self.info.name

@@ -66,7 +66,7 @@ impl Plant {
             .position(|&n| n == name)
             .map(|i| Self::ALL[i])
             .ok_or_else(|| {
-                GpuError(format!(
+                GpuError::Refused(format!(
                     "unknown plant {name:?}: expected {}",
                     NAMES.join(", ")
                 ))
@@ -134,7 +134,7 @@ impl Plant {
         } else {
             fits.join(", ")
         };
-        Err(GpuError(format!(
+        Err(GpuError::Refused(format!(
             "plant {} does not apply to {} at {samples} sample(s) a pixel: it applies to {fits}",
             self.name(),
             scheme.name(),
@@ -152,7 +152,7 @@ mod tests {
             assert_eq!(Plant::parse(plant.name()), Ok(plant));
         }
         let e = Plant::parse("typo").unwrap_err();
-        assert!(e.0.contains("expected dropped, wrong-id"), "{e}");
+        assert!(e.to_string().contains("expected dropped, wrong-id"), "{e}");
     }
 
     #[test]
@@ -160,13 +160,14 @@ mod tests {
         let mdts = GpuScheme::Mdts { k: 4 };
         let e = Plant::LostNode.check(&mdts).unwrap_err();
         assert!(
-            e.0.ends_with("applies to linked-list, linked-list-nearest"),
+            e.to_string()
+                .ends_with("applies to linked-list, linked-list-nearest"),
             "{e}"
         );
         let e = Plant::WrongId
             .check(&GpuScheme::Mdts32 { k: 4 })
             .unwrap_err();
-        assert!(e.0.contains("mdts32"), "{e}");
+        assert!(e.to_string().contains("mdts32"), "{e}");
         assert!(Plant::Unsorted.check(&GpuScheme::ABufferExact).is_ok());
         assert!(Plant::Dropped.check(&mdts).is_ok());
     }
@@ -175,11 +176,14 @@ mod tests {
     fn the_centre_depth_plant_needs_samples_and_a_per_sample_variant() {
         let mdts = GpuScheme::Mdts { k: 4 };
         let e = Plant::CentreDepth.check(&mdts).unwrap_err();
-        assert!(e.0.ends_with("none at this sample count"), "{e}");
+        assert!(e.to_string().ends_with("none at this sample count"), "{e}");
         assert!(Plant::CentreDepth.check_at(&mdts, 4).is_ok());
         let e = Plant::CentreDepth
             .check_at(&GpuScheme::Kbuffer { k: 4 }, 4)
             .unwrap_err();
-        assert!(e.0.contains("abuffer, abuffer-exact, mdts"), "{e}");
+        assert!(
+            e.to_string().contains("abuffer, abuffer-exact, mdts"),
+            "{e}"
+        );
     }
 }

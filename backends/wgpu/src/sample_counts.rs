@@ -86,7 +86,7 @@ pub fn count_samples(
     samples: u32,
 ) -> Result<SampleCounts, GpuError> {
     if view.samples().is_some() {
-        return Err(GpuError(
+        return Err(GpuError::Refused(
             "the counting pass draws a single-sample view into a multisampled target".into(),
         ));
     }
@@ -124,7 +124,7 @@ impl SampleCounts {
     ) -> Result<Self, GpuError> {
         let mut counts = words
             .pop()
-            .ok_or_else(|| GpuError("the counting pass read nothing back".into()))?;
+            .ok_or_else(|| GpuError::Device("the counting pass read nothing back".into()))?;
         let n = counts.len() / 3;
         let shader_depth_bits = counts.split_off(2 * n);
         let shader_depth_outside = counts.split_off(n);

@@ -175,7 +175,7 @@ impl GpuScheme {
             "linked-list-nearest" => list(Resolve::KeepNearest),
             "kbuffer-spinlock-fixed" => Self::KbufferSpinlock { k },
             _ => {
-                return Err(GpuError(format!(
+                return Err(GpuError::Refused(format!(
                     "unknown scheme {name:?}: the wgpu backend has {}",
                     NAMES.join(", ")
                 )))
@@ -183,7 +183,7 @@ impl GpuScheme {
         };
         let sizes = [scheme.k(), scheme.capacity(), scheme.pool_per_pixel()];
         if sizes.contains(&Some(0)) {
-            return Err(GpuError(format!(
+            return Err(GpuError::Refused(format!(
                 "{name}: slots, nodes kept and pool nodes per pixel must be at least 1"
             )));
         }
@@ -464,7 +464,7 @@ mod tests {
         assert!(GpuScheme::parse("abuffer", 8, 0).is_err());
         assert!(GpuScheme::parse("linked-list", 0, 4).is_err());
         let e = GpuScheme::parse("mdts64", 8, 4).unwrap_err();
-        assert!(e.0.contains("abuffer, abuffer-exact"), "{e}");
+        assert!(e.to_string().contains("abuffer, abuffer-exact"), "{e}");
     }
 
     #[test]

@@ -28,7 +28,7 @@ pub(super) fn execute_geometry(
     let lists = viewport.pixels() as u64 * u64::from(samples);
     if let Some(pool) = scheme.pool(lists) {
         if pool >= u64::from(u32::MAX) {
-            return Err(GpuError(format!(
+            return Err(GpuError::Unsupported(format!(
                 "{}: a pool of {pool} nodes does not fit 32-bit node numbers",
                 scheme.name()
             )));
@@ -38,7 +38,7 @@ pub(super) fn execute_geometry(
     let run = Run::new(gpu, viewport, geometry, scheme, mode, plant, samples);
     let result = run.all();
     if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(GpuError(format!(
+        return Err(GpuError::Device(format!(
             "{}: the device refused: {e}",
             scheme.name()
         )));
@@ -185,7 +185,7 @@ impl<'a> Run<'a> {
                 .zip(&counting)
                 .find(|(_, s)| s.name == "offsets")
                 .map(|((_, b), _)| b)
-                .ok_or_else(|| GpuError("the counting passes bind no offsets".into()))?;
+                .ok_or_else(|| GpuError::Device("the counting passes bind no offsets".into()))?;
             let bound: Vec<(&Storage, &wgpu::Buffer)> = counting
                 .iter()
                 .zip(buffers.iter().map(|(_, b)| b))
@@ -233,7 +233,7 @@ impl<'a> Run<'a> {
         let bytes = s.words().max(2) * 4;
         let limits = self.gpu.device.limits();
         if bytes > limits.max_storage_buffer_binding_size || bytes > limits.max_buffer_size {
-            return Err(GpuError(format!(
+            return Err(GpuError::Unsupported(format!(
                 "{}: buffer {:?} of {bytes} bytes is past adapter {}'s limit ({} bytes per storage binding)",
                 self.scheme.name(),
                 s.name,
@@ -392,12 +392,12 @@ impl<'a> Run<'a> {
         }
         device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError(format!("{name}: waiting for the GPU: {e}")))?;
+            .map_err(|e| GpuError::Device(format!("{name}: waiting for the GPU: {e}")))?;
         let mut words = Vec::with_capacity(staging.len());
         for (buffer, &(_, _, size)) in staging.iter().zip(&sources) {
             let view = buffer
                 .get_mapped_range(..)
-                .map_err(|e| GpuError(format!("{name}: read-back: {e}")))?;
+                .map_err(|e| GpuError::Device(format!("{name}: read-back: {e}")))?;
             words.push(
                 view[..size as usize]
                     .chunks_exact(4)
