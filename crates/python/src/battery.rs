@@ -15,10 +15,10 @@ use fragsim_capture::Guarantee;
 use fragsim_oracle::dump::Dump;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::VertexPrecision;
+use fragsim_testkit::Case;
 use fragsim_testkit::{
     Backend, BackendError, Battery, CatalogBackend, Failure, Input, Limits, Output, Params,
 };
-use fragsim_testkit::Case;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use std::collections::HashMap;
@@ -109,10 +109,7 @@ fn parse_claim(claim: &str, capacity: u32) -> PyResult<Guarantee> {
         .copied()
         .ok_or_else(|| {
             let names: Vec<String> = all.iter().map(spelled).collect();
-            BatteryRefused::new_err(format!(
-                "claim {claim:?}: one of {}",
-                names.join(", ")
-            ))
+            BatteryRefused::new_err(format!("claim {claim:?}: one of {}", names.join(", ")))
         })
 }
 

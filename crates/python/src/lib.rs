@@ -1,7 +1,7 @@
 //! fragsim from Python: the native half of the `fragsim` package (`fragsim._fragsim`), built by
 //! maturin into an abi3 wheel for Python 3.10 and later (`pyproject.toml`).
 //!
-//! Python users write their capture kernels in Warp, CuPy, PyTorch or Slang and hold the results
+//! Python users write their capture kernels in Warp, `CuPy`, `PyTorch` or Slang and hold the results
 //! as arrays. This module lets them judge those arrays with fragsim's oracle without writing a
 //! dump directory: a scene ([`scene::SceneCore`]: a named scene, a mesh file or vertex and index
 //! arrays, through the orbit camera or an engine's matrix), its screen triangles, its fragment

@@ -26,9 +26,7 @@ use fragsim_oracle::triangles::TriangleExport;
 use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Side, SideReport};
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::{mesh_hash, SceneSpec};
-use fragsim_raster::{
-    Conventions, Fragment, Mesh, Scene, UpAxis, VertexPrecision, View, Viewport,
-};
+use fragsim_raster::{Conventions, Fragment, Mesh, Scene, UpAxis, VertexPrecision, View, Viewport};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -176,8 +174,8 @@ impl SceneCore {
                         "{what} must have shape [n, 3], not {shape:?}"
                     ))),
                 };
-                rows(vertices.shape(), "vertices")?;
-                rows(indices.shape(), "indices")?;
+                rows(vertices.as_array().shape(), "vertices")?;
+                rows(indices.as_array().shape(), "indices")?;
                 let flat = |v: &[f32]| -> Vec<[f32; 3]> {
                     v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
                 };
@@ -207,7 +205,10 @@ impl SceneCore {
                 if spec.mesh.is_some() && spec.mesh_hash.is_none() {
                     spec = spec.hashed().map_err(scene_spec_error)?;
                 }
-                (spec.load(beside.as_deref()).map_err(scene_spec_error)?, None)
+                (
+                    spec.load(beside.as_deref()).map_err(scene_spec_error)?,
+                    None,
+                )
             }
             _ => {
                 return Err(SceneError::new_err(
