@@ -347,7 +347,7 @@ impl SceneCore {
             examples,
         };
         let verdict = verdict::judge(&reference, Candidate::Dump(&dump), &options)
-            .map_err(JudgeError::new_err)?;
+            .map_err(|message| refusal(&dump, message))?;
         let candidate = SideReport {
             source: "arrays".into(),
             scheme: dump.header.scheme.clone(),
@@ -379,6 +379,16 @@ impl SceneCore {
             })?;
         }
         Ok(())
+    }
+}
+
+/// The typed error behind the verdict's refusal `message`: the dump's own [`DumpError`] where
+/// decoding or checking its words fails (a malformed dump, not a refusal to compare), else a
+/// [`JudgeError`]. Run only on the error path, so a verdict decodes the words once.
+fn refusal(dump: &Dump, message: String) -> PyErr {
+    match dump.capture().and_then(|_| dump.check_words()) {
+        Err(e) => dump_error(e),
+        Ok(_) => JudgeError::new_err(message),
     }
 }
 
