@@ -105,12 +105,15 @@ impl SceneCore {
 
     /// The oracle of [`SceneCore::view`], built once.
     fn oracle(&self, f64_stage: bool) -> PyResult<&Oracle> {
-        let cell = &self.oracles[usize::from(f64_stage)];
-        if let Some(oracle) = cell.get() {
-            return Ok(oracle);
+        match self.oracles[usize::from(f64_stage)].get() {
+            Some(oracle) => Ok(oracle),
+            None => Ok(self.oracle_of(&self.view(f64_stage)?, f64_stage)),
         }
-        let oracle = Oracle::build(&self.view(f64_stage)?);
-        Ok(cell.get_or_init(|| oracle))
+    }
+
+    /// The oracle of `view` (this scene's [`SceneCore::view`] of `f64_stage`), built once.
+    fn oracle_of(&self, view: &View<'_>, f64_stage: bool) -> &Oracle {
+        self.oracles[usize::from(f64_stage)].get_or_init(|| Oracle::build(view))
     }
 
     /// Parses a header and the arrays' bytes as a dump read from files would be.
@@ -139,9 +142,53 @@ impl SceneCore {
         Ok(fragments)
     }
 
-    /// The oracle this scene keeps under its declared vertex stage.
-    pub(crate) fn declared_oracle(&self) -> PyResult<&Oracle> {
-        self.oracle(false)
+    /// The verdict on `dump` against this scene's oracle, owed by a vertex stage of
+    /// `vertex_precision` (`f64`: every bit; `f32`: within the bounds derived for it).
+    fn verdict<'py>(
+        &self,
+        py: Python<'py>,
+        dump: &Dump,
+        vertex_precision: &str,
+        options: Options,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let stage = match vertex_precision {
+            "f64" => VertexPrecision::F64,
+            "f32" => VertexPrecision::F32,
+            other => {
+                return Err(JudgeError::new_err(format!(
+                    "vertex_precision {other:?}: f64 or f32"
+                )))
+            }
+        };
+        let f32_stage = stage == VertexPrecision::F32;
+        let view = self.view(f32_stage)?;
+        let size = (self.viewport.width, self.viewport.height);
+        let reference = if dump.is_masked() {
+            let sampled = SampleOracle::build(&view).map_err(SceneError::new_err)?;
+            let reference = Reference::masked(sampled.per_pixel(), size);
+            if f32_stage {
+                let conventions = Conventions {
+                    vertex_precision: VertexPrecision::F32,
+                    ..view.conventions()
+                };
+                let precision = fragsim_oracle::precision::Precision::derive(&view, &conventions);
+                reference.masked_within(sampled.oracle().clone(), precision)
+            } else {
+                reference
+            }
+        } else {
+            Reference::of_view(self.oracle_of(&view, f32_stage), &view, stage)
+        };
+        let verdict = verdict::judge(&reference, Candidate::Dump(dump), &options)
+            .map_err(|message| refusal(dump, message))?;
+        let candidate = SideReport {
+            source: "arrays".into(),
+            scheme: dump.header.scheme.clone(),
+            producer: dump.header.producer.clone(),
+            k: dump.header.k,
+            capacity: dump.header.capacity,
+        };
+        crate::reference::verdict_dict(py, &verdict, Side::Oracle.describe(), candidate)
     }
 }
 
@@ -313,49 +360,31 @@ impl SceneCore {
         depth_ulps: u32,
         examples: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let stage = match vertex_precision {
-            "f64" => VertexPrecision::F64,
-            "f32" => VertexPrecision::F32,
-            other => {
-                return Err(JudgeError::new_err(format!(
-                    "vertex_precision {other:?}: f64 or f32"
-                )))
-            }
-        };
         let dump = Self::dump(header, &files)?;
-        let f32_stage = stage == VertexPrecision::F32;
-        let view = self.view(f32_stage)?;
-        let size = (self.viewport.width, self.viewport.height);
-        let reference = if dump.is_masked() {
-            let sampled = SampleOracle::build(&view).map_err(SceneError::new_err)?;
-            let reference = Reference::masked(sampled.per_pixel(), size);
-            if f32_stage {
-                let conventions = Conventions {
-                    vertex_precision: VertexPrecision::F32,
-                    ..view.conventions()
-                };
-                let precision = fragsim_oracle::precision::Precision::derive(&view, &conventions);
-                reference.masked_within(sampled.oracle().clone(), precision)
-            } else {
-                reference
-            }
-        } else {
-            Reference::of_view(self.oracle(f32_stage)?, &view, stage)
-        };
         let options = Options {
             depth_ulps,
             examples,
         };
-        let verdict = verdict::judge(&reference, Candidate::Dump(&dump), &options)
-            .map_err(|message| refusal(&dump, message))?;
-        let candidate = SideReport {
-            source: "arrays".into(),
-            scheme: dump.header.scheme.clone(),
-            producer: dump.header.producer.clone(),
-            k: dump.header.k,
-            capacity: dump.header.capacity,
+        self.verdict(py, &dump, vertex_precision, options)
+    }
+
+    /// [`SceneCore::judge`] on the dump directory (or `dump.json`) at `path`, read as `fragsim
+    /// compare` reads it.
+    #[pyo3(signature = (path, vertex_precision="f64", depth_ulps=0, examples=8))]
+    fn judge_dir<'py>(
+        &self,
+        py: Python<'py>,
+        path: PathBuf,
+        vertex_precision: &str,
+        depth_ulps: u32,
+        examples: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let dump = Dump::read(&path).map_err(dump_error)?;
+        let options = Options {
+            depth_ulps,
+            examples,
         };
-        crate::reference::verdict_dict(py, &verdict, Side::Oracle.describe(), candidate)
+        self.verdict(py, &dump, vertex_precision, options)
     }
 
     /// Writes a dump (its header's JSON and arrays' bytes, as for [`SceneCore::judge`]) into

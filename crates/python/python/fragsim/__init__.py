@@ -601,10 +601,24 @@ def read_dump(path: str | os.PathLike[str]) -> Dump:
     return Dump(header, arrays, directory)
 
 
-def judge_dump(path: str | os.PathLike[str], **options: Any) -> Verdict:
-    """The verdict on a dump directory against the oracle of the scene it names (``fragsim
-    compare oracle PATH``); ``options`` are :func:`judge`'s."""
-    dump = read_dump(path)
-    scene = Scene.from_spec(dump.header["scene"], dump.header["width"], dump.header["height"], dump.directory)
-    return judge(scene, dump.header["scheme"], dump.arrays, **dump.layout, **options)
-
+def judge_dump(
+    path: str | os.PathLike[str],
+    *,
+    vertex_precision: str = "f64",
+    depth_ulps: int = 0,
+    examples: int = 8,
+) -> Verdict:
+    """The verdict on a dump directory (or its ``dump.json``) against the oracle of the scene it
+    names: what ``fragsim compare oracle PATH`` decides, the dump read once, in Rust."""
+    path = os.fspath(path)
+    directory = path if os.path.isdir(path) else (os.path.dirname(path) or ".")
+    header_path = os.path.join(directory, "dump.json") if os.path.isdir(path) else path
+    try:
+        with open(header_path, "rb") as f:
+            header = json.loads(f.read())
+    except OSError as e:
+        raise DumpIoError(f"cannot read {header_path}: {e.strerror}") from e
+    except ValueError as e:
+        raise DumpError(f"{header_path}: {e}") from e
+    scene = Scene.from_spec(header["scene"], header["width"], header["height"], directory)
+    return Verdict(scene._core.judge_dir(path, vertex_precision, depth_ulps, examples))
