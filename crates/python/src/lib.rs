@@ -6,7 +6,7 @@
 //! dump directory: a scene ([`scene::SceneCore`]: a named scene, a mesh file or vertex and index
 //! arrays, through the orbit camera or an engine's matrix), its screen triangles, its fragment
 //! stream and its exact reference as numpy arrays, the oracle's one verdict on arrays in memory
-//! ([`scene::SceneCore::judge`]), dump directories read and written, and the conformance battery
+//! (`SceneCore::judge`), dump directories read and written, and the conformance battery
 //! run on a Python callable ([`battery`]).
 //!
 //! The pure-Python half (`python/fragsim/`) holds the public API: it names the keyword
