@@ -292,6 +292,11 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
         &self.descriptor
     }
 
+    fn tile_local(&self) -> bool {
+        // One pass, K words a pixel at `pixel · K`, read back from there alone.
+        true
+    }
+
     fn begin(&self, fragment: Fragment) -> Walk<W> {
         Walk {
             base: fragment.pixel as usize * self.k as usize,
