@@ -259,3 +259,44 @@ fn tile_local_frame<S: Scheme>(
 pub fn run_tiled<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
     TiledExecutor::default().run(view, scheme)
 }
+
+#[cfg(test)]
+mod tests {
+    use fragsim_raster::{OrbitCamera, Scene, Viewport};
+
+    use super::*;
+    use crate::executors::run_serial;
+    use crate::schemes::abuffer::{ABuffer, PostSort};
+    use crate::schemes::mdts::{Direction, Mdts};
+
+    /// The tile-local schemes' frames on storage numbered by tile give the serial executor's
+    /// lists, overflow counts and counters, on viewports whose sides are not multiples of a
+    /// tile's (narrow last column and row of tiles) and with lists that overflow.
+    #[test]
+    fn storage_laid_out_by_tile_gives_the_serial_executors_lists() {
+        let scene = Scene::procedural("spheres:4").unwrap();
+        for (width, height) in [(70, 45), (97, 33), (31, 31)] {
+            let view = scene
+                .view(Viewport::new(width, height).unwrap(), &OrbitCamera::default())
+                .unwrap();
+            let viewport = view.viewport();
+            let mdts = Mdts::<u64>::new(viewport, 3, Direction::Ascending, MEMORY_CAP_DEFAULT)
+                .unwrap();
+            let desc = Mdts::<u32>::new(viewport, 5, Direction::Descending, MEMORY_CAP_DEFAULT)
+                .unwrap();
+            let abuffer =
+                ABuffer::fixed(viewport, 3, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
+            let mut tiled = TiledExecutor::default();
+            for (scheme, serial, run) in [
+                (mdts.name(), run_serial(&view, &mdts), tiled.run(&view, &mdts)),
+                (desc.name(), run_serial(&view, &desc), tiled.run(&view, &desc)),
+                (abuffer.name(), run_serial(&view, &abuffer), tiled.run(&view, &abuffer)),
+            ] {
+                assert!(serial.stats.counters.dropped > 0, "{scheme}: a case that overflows");
+                assert_eq!(serial.capture, run.capture, "{scheme} at {width} × {height}");
+                assert_eq!(serial.stats.counters, run.stats.counters, "{scheme}");
+            }
+            assert!(mdts.tile_local() && desc.tile_local() && abuffer.tile_local());
+        }
+    }
+}
