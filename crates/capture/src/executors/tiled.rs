@@ -277,23 +277,44 @@ mod tests {
         let scene = Scene::procedural("spheres:4").unwrap();
         for (width, height) in [(70, 45), (97, 33), (31, 31)] {
             let view = scene
-                .view(Viewport::new(width, height).unwrap(), &OrbitCamera::default())
+                .view(
+                    Viewport::new(width, height).unwrap(),
+                    &OrbitCamera::default(),
+                )
                 .unwrap();
             let viewport = view.viewport();
-            let mdts = Mdts::<u64>::new(viewport, 3, Direction::Ascending, MEMORY_CAP_DEFAULT)
-                .unwrap();
-            let desc = Mdts::<u32>::new(viewport, 5, Direction::Descending, MEMORY_CAP_DEFAULT)
-                .unwrap();
+            let mdts =
+                Mdts::<u64>::new(viewport, 3, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
+            let desc =
+                Mdts::<u32>::new(viewport, 5, Direction::Descending, MEMORY_CAP_DEFAULT).unwrap();
             let abuffer =
                 ABuffer::fixed(viewport, 3, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
             let mut tiled = TiledExecutor::default();
             for (scheme, serial, run) in [
-                (mdts.name(), run_serial(&view, &mdts), tiled.run(&view, &mdts)),
-                (desc.name(), run_serial(&view, &desc), tiled.run(&view, &desc)),
-                (abuffer.name(), run_serial(&view, &abuffer), tiled.run(&view, &abuffer)),
+                (
+                    mdts.name(),
+                    run_serial(&view, &mdts),
+                    tiled.run(&view, &mdts),
+                ),
+                (
+                    desc.name(),
+                    run_serial(&view, &desc),
+                    tiled.run(&view, &desc),
+                ),
+                (
+                    abuffer.name(),
+                    run_serial(&view, &abuffer),
+                    tiled.run(&view, &abuffer),
+                ),
             ] {
-                assert!(serial.stats.counters.dropped > 0, "{scheme}: a case that overflows");
-                assert_eq!(serial.capture, run.capture, "{scheme} at {width} × {height}");
+                assert!(
+                    serial.stats.counters.dropped > 0,
+                    "{scheme}: a case that overflows"
+                );
+                assert_eq!(
+                    serial.capture, run.capture,
+                    "{scheme} at {width} × {height}"
+                );
                 assert_eq!(serial.stats.counters, run.stats.counters, "{scheme}");
             }
             assert!(mdts.tile_local() && desc.tile_local() && abuffer.tile_local());

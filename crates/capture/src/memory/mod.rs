@@ -354,10 +354,19 @@ mod tests {
         // Each on its own page: a minimum not below the word (equal, then above), a maximum not
         // above it, an or of bits already set.
         assert_eq!(WordMemory::<u64>::fetch_min(&memory, 0, u64::MAX), u64::MAX);
-        assert_eq!(WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 0b0110), 0b0110);
+        assert_eq!(
+            WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 0b0110),
+            0b0110
+        );
         assert_eq!(WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 3), 0b0110);
-        assert_eq!(WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 0b0100), 0b0110);
-        assert_eq!(WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 0), 0b0110);
+        assert_eq!(
+            WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 0b0100),
+            0b0110
+        );
+        assert_eq!(
+            WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 0),
+            0b0110
+        );
         assert_eq!(memory.allocated_bytes(), tables, "nothing was written");
         assert!(WordMemory::<u64>::untouched(&memory, 0));
         // A written word, then a minimum above it: the word's value back, the word kept.
@@ -371,10 +380,16 @@ mod tests {
         assert_eq!(WordMemory::<u64>::load(&memory, 5), 39);
         // The control: values that change the words write, a page each.
         assert_eq!(WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 7), 0b0110);
-        assert_eq!(WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 1), 0b0110);
+        assert_eq!(
+            WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 1),
+            0b0110
+        );
         assert_eq!(WordMemory::<u32>::load(&memory, PAGE_WORDS), 7);
         assert_eq!(WordMemory::<u32>::load(&memory, 2 * PAGE_WORDS), 0b0111);
-        assert!(memory.allocated_bytes() > one_page, "changing operations write");
+        assert!(
+            memory.allocated_bytes() > one_page,
+            "changing operations write"
+        );
     }
 
     #[test]

@@ -61,7 +61,10 @@ impl TileStorage {
     #[inline]
     pub(super) fn index_of(self, pixel: u32) -> u32 {
         let (x, y) = (pixel % self.screen_width, pixel / self.screen_width);
-        debug_assert!(x >= self.x0 && y >= self.y0, "pixel {pixel} outside the tile");
+        debug_assert!(
+            x >= self.x0 && y >= self.y0,
+            "pixel {pixel} outside the tile"
+        );
         self.first + (y - self.y0) * self.width + (x - self.x0)
     }
 
@@ -184,7 +187,11 @@ mod tests {
             let mut next = 0;
             for tile in 0..tiles.count() {
                 let storage = TileStorage::of(tiles, tile);
-                assert_eq!(storage.indices().start, next, "tile {tile} follows the last");
+                assert_eq!(
+                    storage.indices().start,
+                    next,
+                    "tile {tile} follows the last"
+                );
                 next = storage.indices().end;
                 let rect = tiles.rect(tile);
                 for y in rect.y.0..=rect.y.1 {
