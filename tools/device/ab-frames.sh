@@ -36,11 +36,11 @@ for spec in $ROWS; do
     esac
     order=(BASE NEW)
     [ $((row % 2)) -eq 1 ] && order=(NEW BASE)
-    for side in "${order[@]}"; do
-        binary=${!side}
+    for which in "${order[@]}"; do
+        binary=${!which}
         "$binary" bench "${args[@]}" --width "$side" --height "$side" --scheme mdts,abuffer \
             --executor "$executor" --threads "$threads" --frames "$FRAMES" --json --no-images \
-            --quiet --out "$OUT/$row-$side" > /dev/null
+            --quiet --out "$OUT/$row-$which" > /dev/null
     done
     python3 - "$OUT/$row" "$spec" <<'EOF'
 import json, sys
