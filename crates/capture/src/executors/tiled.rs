@@ -187,18 +187,52 @@ impl TiledExecutor {
             (0..tiles.count())
                 .into_par_iter()
                 .map(|tile| {
-                    let rect = tiles.rect(tile);
                     let mut counters = Counters::default();
-                    for setup in chunks.iter().flat_map(|chunk| chunk.list(tile)) {
-                        view.scan_within(setup, rect, &mut |fragment| {
-                            walk(scheme, memory, pass, fragment, &mut counters);
-                        });
-                    }
+                    let fragments = TileFragments {
+                        view,
+                        tiles,
+                        chunks,
+                    };
+                    fragments.walk(tile, scheme, memory, pass, |pixel| pixel, &mut counters);
                     counters
                 })
                 .reduce(Counters::default, Counters::merge)
         };
         rayon_frame(scheme, memory, start, geometry_pass)
+    }
+}
+
+/// What a tile's task scans: the view and its records binned by tile.
+#[derive(Clone, Copy)]
+struct TileFragments<'a, 'v> {
+    view: &'a View<'v>,
+    tiles: Tiles,
+    chunks: &'a [ChunkBins],
+}
+
+impl TileFragments<'_, '_> {
+    /// Scans tile `tile`'s records, chunk after chunk, and runs each fragment's walk of pass
+    /// `pass` to its end, the fragment's pixel given to the scheme as `index(pixel)` (its
+    /// storage index), counting into `counters`.
+    fn walk<S: Scheme>(
+        self,
+        tile: usize,
+        scheme: &S,
+        memory: &AtomicMemory,
+        pass: u32,
+        index: impl Fn(u32) -> u32,
+        counters: &mut Counters,
+    ) {
+        let rect = self.tiles.rect(tile);
+        for setup in self.chunks.iter().flat_map(|chunk| chunk.list(tile)) {
+            self.view.scan_within(setup, rect, &mut |fragment| {
+                let stored = Fragment {
+                    pixel: index(fragment.pixel),
+                    ..fragment
+                };
+                walk(scheme, memory, pass, stored, counters);
+            });
+        }
     }
 }
 
@@ -219,18 +253,15 @@ fn tile_local_frame<S: Scheme>(
         let (counters, lists): (Vec<Counters>, Vec<Resolved>) = (0..tiles.count())
             .into_par_iter()
             .map(|tile| {
-                let rect = tiles.rect(tile);
                 let storage = TileStorage::of(tiles, tile);
                 let mut counters = Counters::default();
-                for setup in chunks.iter().flat_map(|chunk| chunk.list(tile)) {
-                    view.scan_within(setup, rect, &mut |fragment| {
-                        let stored = Fragment {
-                            pixel: storage.index_of(fragment.pixel),
-                            ..fragment
-                        };
-                        walk(scheme, memory, pass, stored, &mut counters);
-                    });
-                }
+                let fragments = TileFragments {
+                    view,
+                    tiles,
+                    chunks,
+                };
+                let index = |pixel| storage.index_of(pixel);
+                fragments.walk(tile, scheme, memory, pass, index, &mut counters);
                 // A tile no fragment reached holds its storage's initial, empty lists.
                 let lists = if counters.fragments == 0 {
                     Resolved::default()
