@@ -29,20 +29,21 @@ use crate::scheme::{PixelRun, Promise, Scheme};
 /// balance a frame whose covered pixels gather in a few places.
 const PIXELS_PER_TASK: usize = 4096;
 
-/// One range of pixels resolved: what the capture's offsets and entries are assembled from.
+/// One range of pixels resolved: what the capture's offsets and entries are assembled from (here,
+/// and by the tiled executor from its tiles, `executors/tiled/storage.rs`).
 #[derive(Debug, Default)]
-struct Resolved {
+pub(crate) struct Resolved {
     /// The range's entries, pixel after pixel.
-    entries: Vec<u64>,
+    pub(crate) entries: Vec<u64>,
     /// For each pixel whose list is not empty, its index within the range and the end of its
     /// list within `entries`, in pixel order.
-    ends: Vec<(usize, usize)>,
+    pub(crate) ends: Vec<(usize, usize)>,
     /// For each pixel that overflowed, its index within the range and the count.
-    overflow: Vec<(usize, u32)>,
+    pub(crate) overflow: Vec<(usize, u32)>,
 }
 
 /// Resolves the pixels of `range`, stepping over those the scheme knows empty.
-fn resolve_range<S: Scheme + ?Sized, M: Memory>(
+pub(crate) fn resolve_range<S: Scheme + ?Sized, M: Memory>(
     scheme: &S,
     memory: &M,
     range: Range<usize>,

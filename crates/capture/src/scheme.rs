@@ -199,6 +199,18 @@ pub trait Scheme: Sync {
         self.descriptor().pixels
     }
 
+    /// Whether the scheme's frame is one geometry pass with no between-pass kernel (the default
+    /// [`Scheme::end_pass`]) and its words are addressed by the pixel's index alone: a
+    /// fragment's walk and a pixel's resolve use `Fragment::pixel` and `pixel` only to find the
+    /// pixel's own words, the same number for every pixel, and no table or other pixel's words
+    /// are involved. An executor may then number the pixels in an order of its own and resolve
+    /// a group of pixels as soon as their fragments are in: the tiled executor numbers them
+    /// tile by tile, so that a tile's words are contiguous, and resolves each tile in its own
+    /// task (`executors/tiled/storage.rs`). `false`, the default, is always correct.
+    fn tile_local(&self) -> bool {
+        false
+    }
+
     /// The state of a fragment before its first step in the first geometry pass.
     fn begin(&self, fragment: Fragment) -> Self::State;
 

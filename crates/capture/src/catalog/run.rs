@@ -315,6 +315,10 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
     fn descriptor(&self) -> &Descriptor {
         self.scheme.descriptor()
     }
+    fn tile_local(&self) -> bool {
+        // The memory kept for a dump is read in the layout it declares, screen-ordered.
+        self.keep.is_none() && self.scheme.tile_local()
+    }
     fn begin(&self, fragment: Fragment) -> S::State {
         self.scheme.begin(fragment)
     }

@@ -15,22 +15,35 @@
 //!    the part of its records inside the tile ([`View::scan_within`]), chunk after chunk, and runs
 //!    each fragment's walk to its end, so that the tile's storage stays in its cache.
 //!
+//! A scheme whose words are addressed by the pixel's index alone ([`Scheme::tile_local`]: MDTS,
+//! the fixed A-buffer) gets its storage laid out by tile (`tiled/storage.rs`): its fragments are
+//! numbered tile by tile, so that a tile's words are one contiguous run, and each tile's task
+//! resolves the tile's lists as soon as its fragments are in, while its words are in that core's
+//! cache; the lists are then put back in screen order. A tile is owned by one core from its
+//! capture to its resolve.
+//!
 //! Every pixel is written by one thread only, so each pixel sees its fragments in primitive order:
 //! the serial executor's order, which FreePipe's per-triangle model can also produce. An atomic
 //! scheme's result does not depend on the interleaving (`docs/proof.md`) and a hazard-prone one
 //! meets no concurrent writer, so every scheme gives the serial executor's lists here, checked by
 //! the tests. The tiled executor changes which interleavings happen, never the result.
 
+use std::cell::RefCell;
 use std::ops::Range;
 use std::time::Instant;
 
-use fragsim_raster::{PixelRect, TriangleSetup, View, Viewport};
+use fragsim_raster::{Fragment, PixelRect, TriangleSetup, View, Viewport};
 use rayon::prelude::*;
 
-use super::frame::{reuse_storage, walk, Counters, Run};
+use super::frame::{self, reuse_storage, walk, Counters, Run};
 use super::parallel::rayon_frame;
 use crate::memory::AtomicMemory;
+use crate::post_pass::{resolve_range, Resolved};
 use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
+
+mod storage;
+
+use storage::TileStorage;
 
 /// Pixels on a side of a tile: 32 × 32 pixels make 256 tiles at 512 × 512, enough to balance 16
 /// threads over a model that covers the middle of the screen.
@@ -167,17 +180,20 @@ impl TiledExecutor {
             });
         let chunks = &self.chunks;
         let memory = &*memory;
+        if scheme.tile_local() && scheme.pixels() == view.viewport().pixels() {
+            return tile_local_frame(view, scheme, memory, tiles, chunks, start);
+        }
         let geometry_pass = |pass| {
             (0..tiles.count())
                 .into_par_iter()
                 .map(|tile| {
-                    let rect = tiles.rect(tile);
                     let mut counters = Counters::default();
-                    for setup in chunks.iter().flat_map(|chunk| chunk.list(tile)) {
-                        view.scan_within(setup, rect, &mut |fragment| {
-                            walk(scheme, memory, pass, fragment, &mut counters);
-                        });
-                    }
+                    let fragments = TileFragments {
+                        view,
+                        tiles,
+                        chunks,
+                    };
+                    fragments.walk(tile, scheme, memory, pass, |pixel| pixel, &mut counters);
                     counters
                 })
                 .reduce(Counters::default, Counters::merge)
@@ -186,7 +202,153 @@ impl TiledExecutor {
     }
 }
 
+/// What a tile's task scans: the view and its records binned by tile.
+#[derive(Clone, Copy)]
+struct TileFragments<'a, 'v> {
+    view: &'a View<'v>,
+    tiles: Tiles,
+    chunks: &'a [ChunkBins],
+}
+
+impl TileFragments<'_, '_> {
+    /// Scans tile `tile`'s records, chunk after chunk, and runs each fragment's walk of pass
+    /// `pass` to its end, the fragment's pixel given to the scheme as `index(pixel)` (its
+    /// storage index), counting into `counters`.
+    fn walk<S: Scheme>(
+        self,
+        tile: usize,
+        scheme: &S,
+        memory: &AtomicMemory,
+        pass: u32,
+        index: impl Fn(u32) -> u32,
+        counters: &mut Counters,
+    ) {
+        let rect = self.tiles.rect(tile);
+        for setup in self.chunks.iter().flat_map(|chunk| chunk.list(tile)) {
+            self.view.scan_within(setup, rect, &mut |fragment| {
+                let stored = Fragment {
+                    pixel: index(fragment.pixel),
+                    ..fragment
+                };
+                walk(scheme, memory, pass, stored, counters);
+            });
+        }
+    }
+}
+
+/// The frame of a [`Scheme::tile_local`] scheme: its storage numbered tile by tile, each tile's
+/// task capturing the tile's fragments and then resolving its lists, the lists put back in
+/// screen order after. The pass time includes the tiles' resolves; the resolve time is the
+/// assembly in screen order.
+fn tile_local_frame<S: Scheme>(
+    view: &View<'_>,
+    scheme: &S,
+    memory: &AtomicMemory,
+    tiles: Tiles,
+    chunks: &[ChunkBins],
+    start: Instant,
+) -> Run {
+    let resolved = RefCell::new(Vec::new());
+    let geometry_pass = |pass| {
+        let (counters, lists): (Vec<Counters>, Vec<Resolved>) = (0..tiles.count())
+            .into_par_iter()
+            .map(|tile| {
+                let storage = TileStorage::of(tiles, tile);
+                let mut counters = Counters::default();
+                let fragments = TileFragments {
+                    view,
+                    tiles,
+                    chunks,
+                };
+                let index = |pixel| storage.index_of(pixel);
+                fragments.walk(tile, scheme, memory, pass, index, &mut counters);
+                // A tile no fragment reached holds its storage's initial, empty lists.
+                let lists = if counters.fragments == 0 {
+                    Resolved::default()
+                } else {
+                    resolve_range(scheme, memory, storage.indices())
+                };
+                (counters, lists)
+            })
+            .unzip();
+        *resolved.borrow_mut() = lists;
+        counters
+            .into_iter()
+            .fold(Counters::default(), Counters::merge)
+    };
+    frame::run(
+        scheme,
+        memory,
+        start,
+        rayon::current_num_threads(),
+        geometry_pass,
+        |_| storage::assemble(scheme, tiles, &resolved.take()),
+    )
+}
+
 /// Runs `scheme` over `view` on the tiled executor, on the current rayon pool, on fresh storage.
 pub fn run_tiled<S: Scheme>(view: &View<'_>, scheme: &S) -> Run {
     TiledExecutor::default().run(view, scheme)
+}
+
+#[cfg(test)]
+mod tests {
+    use fragsim_raster::{OrbitCamera, Scene, Viewport};
+
+    use super::*;
+    use crate::executors::run_serial;
+    use crate::schemes::abuffer::{ABuffer, PostSort};
+    use crate::schemes::mdts::{Direction, Mdts};
+
+    /// The tile-local schemes' frames on storage numbered by tile give the serial executor's
+    /// lists, overflow counts and counters, on viewports whose sides are not multiples of a
+    /// tile's (narrow last column and row of tiles) and with lists that overflow.
+    #[test]
+    fn storage_laid_out_by_tile_gives_the_serial_executors_lists() {
+        let scene = Scene::procedural("spheres:4").unwrap();
+        for (width, height) in [(70, 45), (97, 33), (31, 31)] {
+            let view = scene
+                .view(
+                    Viewport::new(width, height).unwrap(),
+                    &OrbitCamera::default(),
+                )
+                .unwrap();
+            let viewport = view.viewport();
+            let mdts =
+                Mdts::<u64>::new(viewport, 3, Direction::Ascending, MEMORY_CAP_DEFAULT).unwrap();
+            let desc =
+                Mdts::<u32>::new(viewport, 5, Direction::Descending, MEMORY_CAP_DEFAULT).unwrap();
+            let abuffer =
+                ABuffer::fixed(viewport, 3, PostSort::Insertion, MEMORY_CAP_DEFAULT).unwrap();
+            let mut tiled = TiledExecutor::default();
+            for (scheme, serial, run) in [
+                (
+                    mdts.name(),
+                    run_serial(&view, &mdts),
+                    tiled.run(&view, &mdts),
+                ),
+                (
+                    desc.name(),
+                    run_serial(&view, &desc),
+                    tiled.run(&view, &desc),
+                ),
+                (
+                    abuffer.name(),
+                    run_serial(&view, &abuffer),
+                    tiled.run(&view, &abuffer),
+                ),
+            ] {
+                assert!(
+                    serial.stats.counters.dropped > 0,
+                    "{scheme}: a case that overflows"
+                );
+                assert_eq!(
+                    serial.capture, run.capture,
+                    "{scheme} at {width} × {height}"
+                );
+                assert_eq!(serial.stats.counters, run.stats.counters, "{scheme}");
+            }
+            assert!(mdts.tile_local() && desc.tile_local() && abuffer.tile_local());
+        }
+    }
 }

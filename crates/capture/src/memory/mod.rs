@@ -238,11 +238,14 @@ mod tests {
     /// the pages of the `u64` array written, in order.
     fn write_pages_apart<M: Memory>(memory: &M) -> [usize; 3] {
         WordMemory::<u32>::fetch_add(memory, 0, 1);
+        WordMemory::<u32>::fetch_max(memory, 1, 5);
         WordMemory::<u32>::store(memory, 5 * PAGE_WORDS + 2, 9);
         WordMemory::<u32>::swap(memory, 2 * PAGE_WORDS, 4);
+        WordMemory::<u32>::fetch_or(memory, 2 * PAGE_WORDS + 1, 2);
+        // The u64 words start at all ones: only a minimum, an add or a swap changes them.
         WordMemory::<u64>::fetch_min(memory, PAGE_WORDS + 1, 3);
-        WordMemory::<u64>::fetch_max(memory, 3 * PAGE_WORDS, 8);
-        WordMemory::<u64>::fetch_or(memory, 7 * PAGE_WORDS, 2);
+        WordMemory::<u64>::fetch_add(memory, 3 * PAGE_WORDS, 8);
+        WordMemory::<u64>::swap(memory, 7 * PAGE_WORDS, 2);
         [1, 3, 7]
     }
 
@@ -335,6 +338,68 @@ mod tests {
         pages_are_allocated_on_first_write_and_reset_to_their_initial_values::<SerialMemory>(
             |memory, layout| memory.reset(layout, u64::MAX),
         );
+    }
+
+    /// A read-modify-write that cannot change its word is answered by a load: it returns the
+    /// word's value and writes nothing, so the page stays unallocated (a write would allocate
+    /// it); one that changes the word writes as before. The allocation is the control: the
+    /// same operations with values that change the word allocate a page each.
+    fn unchanging_read_modify_writes_write_nothing<M: Memory>() {
+        let layout = Layout {
+            init32: 0b0110,
+            ..Layout::counters_and_slots(4 * PAGE_WORDS, 4 * PAGE_WORDS)
+        };
+        let memory: M = layout.allocate();
+        let tables = memory.allocated_bytes();
+        // Each on its own page: a minimum not below the word (equal, then above), a maximum not
+        // above it, an or of bits already set.
+        assert_eq!(WordMemory::<u64>::fetch_min(&memory, 0, u64::MAX), u64::MAX);
+        assert_eq!(
+            WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 0b0110),
+            0b0110
+        );
+        assert_eq!(WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 3), 0b0110);
+        assert_eq!(
+            WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 0b0100),
+            0b0110
+        );
+        assert_eq!(
+            WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 0),
+            0b0110
+        );
+        assert_eq!(memory.allocated_bytes(), tables, "nothing was written");
+        assert!(WordMemory::<u64>::untouched(&memory, 0));
+        // A written word, then a minimum above it: the word's value back, the word kept.
+        assert_eq!(WordMemory::<u64>::fetch_min(&memory, 5, 40), u64::MAX);
+        let one_page = memory.allocated_bytes();
+        assert_ne!(one_page, tables, "a changing minimum writes");
+        assert_eq!(WordMemory::<u64>::fetch_min(&memory, 5, 41), 40);
+        assert_eq!(WordMemory::<u64>::fetch_min(&memory, 5, 40), 40);
+        assert_eq!(WordMemory::<u64>::load(&memory, 5), 40);
+        assert_eq!(WordMemory::<u64>::fetch_min(&memory, 5, 39), 40);
+        assert_eq!(WordMemory::<u64>::load(&memory, 5), 39);
+        // The control: values that change the words write, a page each.
+        assert_eq!(WordMemory::<u32>::fetch_max(&memory, PAGE_WORDS, 7), 0b0110);
+        assert_eq!(
+            WordMemory::<u32>::fetch_or(&memory, 2 * PAGE_WORDS, 1),
+            0b0110
+        );
+        assert_eq!(WordMemory::<u32>::load(&memory, PAGE_WORDS), 7);
+        assert_eq!(WordMemory::<u32>::load(&memory, 2 * PAGE_WORDS), 0b0111);
+        assert!(
+            memory.allocated_bytes() > one_page,
+            "changing operations write"
+        );
+    }
+
+    #[test]
+    fn atomic_read_modify_writes_that_change_nothing_write_nothing() {
+        unchanging_read_modify_writes_write_nothing::<AtomicMemory>();
+    }
+
+    #[test]
+    fn serial_read_modify_writes_that_change_nothing_write_nothing() {
+        unchanging_read_modify_writes_write_nothing::<SerialMemory>();
     }
 
     #[test]

@@ -73,6 +73,15 @@ macro_rules! memory_cells {
 /// `WordMemory<$word>` for `$words`, whose cells of type `$cell` it finds through [`Cells`]: `$get`
 /// reads a cell, `$set` writes one, `$rmw!` applies a read-modify-write to one and returns the
 /// old value; `$extra` are further methods (the memories' own).
+///
+/// `fetch_min`, `fetch_max` and `fetch_or` load the word first and return what they saw, writing
+/// nothing, when the operation could not change it (a value at or above the word for a minimum,
+/// at or below it for a maximum, bits all set already for an or): the read-modify-write that
+/// reads that value writes it back unchanged and returns it, so the load *is* that operation,
+/// linearised where the load read (`docs/proof.md`, "A read-modify-write decided by a load"). No
+/// locked instruction runs, the cache line is only read, and a page is neither allocated nor
+/// marked written. It is still one operation of the GPU algorithm: the counting memory
+/// ([`super::CountingMemory`]) counts it above this, and the scheduled executor steps it.
 macro_rules! word_ops {
     ($words:ty, $word:ty, $cell:ty, $get:expr, $set:expr, $rmw:ident { $($extra:item)* }) => {
         impl WordMemory<$word> for $words {
@@ -91,10 +100,18 @@ macro_rules! word_ops {
             }
             #[inline]
             fn fetch_min(&self, i: usize, v: $word) -> $word {
+                let seen = WordMemory::<$word>::load(self, i);
+                if seen <= v {
+                    return seen;
+                }
                 $rmw!(Cells::<$word, $cell>::write_cell(self, i), fetch_min, Ord::min, v)
             }
             #[inline]
             fn fetch_max(&self, i: usize, v: $word) -> $word {
+                let seen = WordMemory::<$word>::load(self, i);
+                if seen >= v {
+                    return seen;
+                }
                 $rmw!(Cells::<$word, $cell>::write_cell(self, i), fetch_max, Ord::max, v)
             }
             #[inline]
@@ -108,6 +125,10 @@ macro_rules! word_ops {
             }
             #[inline]
             fn fetch_or(&self, i: usize, v: $word) -> $word {
+                let seen = WordMemory::<$word>::load(self, i);
+                if seen | v == seen {
+                    return seen;
+                }
                 $rmw!(
                     Cells::<$word, $cell>::write_cell(self, i),
                     fetch_or,

@@ -191,6 +191,12 @@ impl Scheme for ABuffer {
         &self.descriptor
     }
 
+    fn tile_local(&self) -> bool {
+        // Fixed arrays: a counter at `pixel`, `capacity` slots at `pixel · capacity`. Storage
+        // sized exactly finds a pixel's slots through offsets in screen order.
+        matches!(self.storage, Storage::Fixed { .. })
+    }
+
     fn begin(&self, fragment: Fragment) -> Claim {
         Claim::Count {
             pixel: fragment.pixel,

@@ -22,8 +22,11 @@
 //! run the `atomicMin`. A slot only ever decreases, so a slot seen at or below the carried value
 //! would have made the `atomicMin` a no-op returning that value: the load *is* that `atomicMin`,
 //! linearised at the load. The lists are therefore those of the plain walk under some
-//! interleaving (proof in `docs/proof.md`; loom checks it in `tests/loom/`), with fewer locked
-//! instructions (`fetch_min` is a `lock cmpxchg` loop on x86): `fragsim bench` reports both.
+//! interleaving (proof in `docs/proof.md`; loom checks it in `tests/loom/`), with fewer
+//! read-modify-writes counted: `fragsim bench` reports both. The memories themselves answer an
+//! `atomicMin` that cannot change its word with a load (`memory/serial_atomic.rs`), so on the CPU
+//! the plain walk runs no more locked instructions than this one; the probing walk is the GPU
+//! algorithm that does the same in its steps.
 //!
 //! Unlike the paper's Table 1, which initialises to `0xFFFFFFFF` but stops on `0x7FFFFFFF`, the
 //! sentinel tested is the one stored (`u32::MAX` / `u64::MAX`); no depth key reaches it, since the
@@ -290,6 +293,11 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor
+    }
+
+    fn tile_local(&self) -> bool {
+        // One pass, K words a pixel at `pixel · K`, read back from there alone.
+        true
     }
 
     fn begin(&self, fragment: Fragment) -> Walk<W> {
