@@ -1,7 +1,8 @@
 //! The `compare` target: two arbitrary dumps through `fragsim compare REFERENCE CANDIDATE`
 //! ([`fragsim_cli::compare`], the command's own code, run on two dump directories), never a
 //! panic. The input is a little-endian `u32` length, then that many bytes of the reference's
-//! [`Blob`] (as `dump_parse` reads one), then the candidate's; each is written out as a
+//! [`Blob`] (as `dump_parse` reads one), then the candidate's; the length's top bit set
+//! ([`ORACLE`]), the candidate is also compared with the oracle. Each is written out as a
 //! directory, the header as `dump.json` and each array file the parser asks for beside it, so
 //! that the command reads them as it reads a backend's.
 //!
@@ -36,7 +37,8 @@ pub(crate) fn check(data: &[u8]) {
     let (length, rest) = data.split_at(data.len().min(4));
     let mut word = [0; 4];
     word[..length.len()].copy_from_slice(length);
-    let (reference, candidate) = rest.split_at((u32::from_le_bytes(word) as usize).min(rest.len()));
+    let word = u32::from_le_bytes(word);
+    let (reference, candidate) = rest.split_at(((word & !ORACLE) as usize).min(rest.len()));
     let scratch = Scratch::new();
     let (a, b) = (scratch.0.join("reference"), scratch.0.join("candidate"));
     write_out(reference, &a);
@@ -44,6 +46,29 @@ pub(crate) fn check(data: &[u8]) {
     check_pair(&a, &b);
     if decoded(&a).is_ok() {
         check_pair(&a, &a);
+    }
+    if word & ORACLE != 0 {
+        check_against_oracle(&b);
+    }
+}
+
+/// The length word's top bit: the candidate is also compared with the oracle of its scene,
+/// which makes the scene (its mesh beside the dump, or a named scene within the memory cap).
+const ORACLE: u32 = 1 << 31;
+
+/// `fragsim compare oracle CANDIDATE`: a verdict only for a candidate that decodes, "equal"
+/// only without a corrupt word; any refusal with a message.
+fn check_against_oracle(candidate: &Path) {
+    let got = run(Path::new("oracle"), candidate);
+    match (got, decoded(candidate)) {
+        (Ok(true), Ok((_, _, words))) => assert_eq!(
+            words.corrupt_words(),
+            0,
+            "compare called a dump with corrupt words equal to the oracle"
+        ),
+        (Ok(_), Ok(_)) => {}
+        (Ok(_), Err(error)) => panic!("compare judged a dump that does not decode: {error}"),
+        (Err(error), _) => assert!(!error.is_empty(), "an error without a message"),
     }
 }
 
