@@ -81,11 +81,12 @@ fn a_header_naming_a_huge_procedural_scene_is_refused_from_its_name() {
         &mut compare(&dir, &[]),
         &["scene soup:10000000:1", "10000000 triangles", "memory cap"],
     );
-    // A cap the oracle of the small scene exceeds: refused by the bound from its triangles.
+    // A cap the arrays fit (32,768 bytes) and the oracle of the small scene does not (24 bytes
+    // for each of 4,096 pixels alone): refused by the bound from its triangles.
     name_scene(&dir, "quads:4");
     refused(
-        &mut compare(&dir, &["--memory-cap", "2000"]),
-        &["the oracle of this view", "memory cap of 2000 bytes"],
+        &mut compare(&dir, &["--memory-cap", "50000"]),
+        &["the oracle of this view", "memory cap of 50000 bytes"],
     );
 }
 
@@ -118,11 +119,8 @@ fn links_to_dev_zero_are_refused_unread_as_array_header_or_mesh() {
     refused(&mut compare(&mesh, &[]), &["zero.obj", "character device"]);
     // The control: a regular mesh file there is read and judged (every list empty: DIFFERENT).
     std::fs::remove_file(mesh.join("zero.obj")).unwrap();
-    std::fs::write(
-        mesh.join("zero.obj"),
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
-    )
-    .unwrap();
+    let tetrahedron = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    std::fs::write(mesh.join("zero.obj"), tetrahedron).unwrap();
     stdout_of(&mut compare(&mesh, &[]), 1);
 }
 
@@ -171,7 +169,7 @@ fn an_array_file_of_another_size_than_its_shape_is_refused_from_its_metadata() {
     // Short by a word: read (it is within the bound) and named by its shape.
     bytes.truncate(size - 8);
     std::fs::write(&slots, &bytes).unwrap();
-    refused(&mut compare(&dir, &[]), &["\"slots\"", "shape [192, 4]"]);
+    refused(&mut compare(&dir, &[]), &["\"slots\"", "shape [4096, 1]"]);
 }
 
 #[test]
@@ -179,15 +177,15 @@ fn arrays_past_the_memory_cap_are_refused_before_any_is_read() {
     let out = scratch("bounded-cap");
     quads_dump(&out);
     let dir = out.join("mdts");
-    // 192 pixels × 4 slots × 8 bytes = 6,144 bytes of slots.
+    // 4,096 pixels × 1 slot × 8 bytes = 32,768 bytes of slots.
     refused(
-        &mut compare(&dir, &["--memory-cap", "6143"]),
-        &["6144 bytes", "memory cap of 6143 bytes"],
+        &mut compare(&dir, &["--memory-cap", "32767"]),
+        &["32768 bytes", "memory cap of 32767 bytes"],
     );
     // A shape past the cap with no file behind it: refused before the file is looked for.
     edit_header(&dir, |h| {
         h["k"] = 4_000_000_000_u32.into();
-        h["arrays"]["slots"]["shape"] = serde_json::json!([192, 4_000_000_000_u32]);
+        h["arrays"]["slots"]["shape"] = serde_json::json!([4096, 4_000_000_000_u32]);
     });
     std::fs::remove_file(dir.join("slots.u64")).unwrap();
     refused(&mut compare(&dir, &[]), &["memory cap"]);
