@@ -112,7 +112,8 @@ fn write_out(blob: &[u8], dir: &Path) {
     // The scene's mesh, where the header names one by a plain name.
     let scene = serde_json::from_slice::<serde_json::Value>(header).ok();
     let mesh = scene.as_ref().and_then(|h| h["scene"]["mesh"].as_str());
-    let plain = |m: &&str| !m.is_empty() && *m != "." && *m != ".." && !m.contains(['/', '\\', '\0']);
+    let plain =
+        |m: &&str| !m.is_empty() && *m != "." && *m != ".." && !m.contains(['/', '\\', '\0']);
     if let Some(mesh) = mesh.filter(plain) {
         write_file(&dir.join(mesh), TETRAHEDRON.as_bytes());
     }
@@ -120,7 +121,8 @@ fn write_out(blob: &[u8], dir: &Path) {
 }
 
 /// A small closed mesh, the mesh file of a header that names one.
-const TETRAHEDRON: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+const TETRAHEDRON: &str =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
 
 /// Writes `bytes` to `path`, or the kind of file its name's prefix asks for (the module's doc);
 /// one the file system refuses is left out: reading it fails, as a backend's directory would.
