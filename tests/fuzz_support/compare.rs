@@ -1,16 +1,26 @@
 //! The `compare` target: two arbitrary dumps through `fragsim compare REFERENCE CANDIDATE`
 //! ([`fragsim_cli::compare`], the command's own code, run on two dump directories), never a
 //! panic. The input is a little-endian `u32` length, then that many bytes of the reference's
-//! [`Blob`] (as `dump_parse` reads one), then the candidate's; each is written out as a
+//! [`Blob`] (as `dump_parse` reads one), then the candidate's; the length's top bit set
+//! ([`ORACLE`]), the candidate is also compared with the oracle. Each is written out as a
 //! directory, the header as `dump.json` and each array file the parser asks for beside it, so
 //! that the command reads them as it reads a backend's.
 //!
+//! What is written for a file is chosen by its name, so that the fuzzer reaches the reader's
+//! refusals through the header's text: an array file whose name starts `zero` is a link to
+//! `/dev/zero`, `fifo` a FIFO, `sock` a socket, `dir` a directory; a mesh the scene names is a
+//! small regular OBJ file beside the dump, or the same kinds by the same prefixes. The command
+//! runs under `--memory-cap` [`MEMORY_CAP`], so that scenes and arrays past it are refused rather
+//! than made (a runaway read or a wait on a FIFO is a fuzz crash: libFuzzer's RSS and time
+//! limits).
+//!
 //! Checked against what the library makes of each directory ([`Dump::read`], then
 //! [`Dump::capture`] and [`Dump::check_words`]): the command fails (exit code 2) with a message
-//! exactly when a side does not read or decode, or the two cover different viewports or name
-//! different scenes; otherwise it gives a verdict (exit code 0 or 1), and "equal" (0) only when
-//! neither side holds a word its layout says cannot be there. A dump that decodes to lists in
-//! canonical order, with no overflow and no corrupt word, compared with itself is equal.
+//! exactly when a side does not read or decode, the two cover different viewports or name
+//! different scenes, or the memory cap refuses the work; otherwise it gives a verdict (exit code
+//! 0 or 1), and "equal" (0) only when neither side holds a word its layout says cannot be there.
+//! A dump that decodes to lists in canonical order, with no overflow and no corrupt word,
+//! compared with itself is equal.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -27,7 +37,8 @@ pub(crate) fn check(data: &[u8]) {
     let (length, rest) = data.split_at(data.len().min(4));
     let mut word = [0; 4];
     word[..length.len()].copy_from_slice(length);
-    let (reference, candidate) = rest.split_at((u32::from_le_bytes(word) as usize).min(rest.len()));
+    let word = u32::from_le_bytes(word);
+    let (reference, candidate) = rest.split_at(((word & !ORACLE) as usize).min(rest.len()));
     let scratch = Scratch::new();
     let (a, b) = (scratch.0.join("reference"), scratch.0.join("candidate"));
     write_out(reference, &a);
@@ -35,6 +46,29 @@ pub(crate) fn check(data: &[u8]) {
     check_pair(&a, &b);
     if decoded(&a).is_ok() {
         check_pair(&a, &a);
+    }
+    if word & ORACLE != 0 {
+        check_against_oracle(&b);
+    }
+}
+
+/// The length word's top bit: the candidate is also compared with the oracle of its scene,
+/// which makes the scene (its mesh beside the dump, or a named scene within the memory cap).
+const ORACLE: u32 = 1 << 31;
+
+/// `fragsim compare oracle CANDIDATE`: a verdict only for a candidate that decodes, "equal"
+/// only without a corrupt word; any refusal with a message.
+fn check_against_oracle(candidate: &Path) {
+    let got = run(Path::new("oracle"), candidate);
+    match (got, decoded(candidate)) {
+        (Ok(true), Ok((_, _, words))) => assert_eq!(
+            words.corrupt_words(),
+            0,
+            "compare called a dump with corrupt words equal to the oracle"
+        ),
+        (Ok(_), Ok(_)) => {}
+        (Ok(_), Err(error)) => panic!("compare judged a dump that does not decode: {error}"),
+        (Err(error), _) => assert!(!error.is_empty(), "an error without a message"),
     }
 }
 
@@ -73,10 +107,55 @@ fn write_out(blob: &[u8], dir: &Path) {
         Ok(bytes)
     });
     for (file, bytes) in files.iter().filter(|(file, _)| file != HEADER_FILE) {
-        let _ = std::fs::write(dir.join(file), bytes);
+        write_file(&dir.join(file), bytes);
+    }
+    // The scene's mesh, where the header names one by a plain name.
+    let scene = serde_json::from_slice::<serde_json::Value>(header).ok();
+    let mesh = scene.as_ref().and_then(|h| h["scene"]["mesh"].as_str());
+    let plain =
+        |m: &&str| !m.is_empty() && *m != "." && *m != ".." && !m.contains(['/', '\\', '\0']);
+    if let Some(mesh) = mesh.filter(plain) {
+        write_file(&dir.join(mesh), TETRAHEDRON.as_bytes());
     }
     std::fs::write(dir.join(HEADER_FILE), header).expect("the header is written");
 }
+
+/// A small closed mesh, the mesh file of a header that names one.
+const TETRAHEDRON: &str =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+
+/// Writes `bytes` to `path`, or the kind of file its name's prefix asks for (the module's doc);
+/// one the file system refuses is left out: reading it fails, as a backend's directory would.
+fn write_file(path: &Path, bytes: &[u8]) {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    #[cfg(unix)]
+    {
+        if name.starts_with("zero") {
+            let _ = std::os::unix::fs::symlink("/dev/zero", path);
+            return;
+        }
+        if name.starts_with("fifo") {
+            let _ = std::process::Command::new("mkfifo").arg(path).status();
+            return;
+        }
+        if name.starts_with("sock") {
+            // The socket file stays when the listener is dropped.
+            let _ = std::os::unix::net::UnixListener::bind(path);
+            return;
+        }
+    }
+    if name.starts_with("dir") {
+        let _ = std::fs::create_dir(path);
+        return;
+    }
+    let _ = std::fs::write(path, bytes);
+}
+
+/// The memory cap `compare` runs under: 64 MiB.
+const MEMORY_CAP: &str = "67108864";
 
 /// A dump directory as the library reads and decodes it.
 fn decoded(dir: &Path) -> Result<(Dump, Capture, WordCheck), String> {
@@ -97,6 +176,8 @@ fn run(reference: &Path, candidate: &Path) -> Result<bool, String> {
         "--no-images".as_ref(),
         "--show".as_ref(),
         "0".as_ref(),
+        "--memory-cap".as_ref(),
+        MEMORY_CAP.as_ref(),
     ];
     let matches = command
         .try_get_matches_from(argv)
@@ -123,7 +204,12 @@ fn check_pair(reference: &Path, candidate: &Path) {
         );
         return;
     }
-    let equal = got.unwrap_or_else(|e| panic!("compare refused two dumps that decode: {e}"));
+    let equal = match got {
+        Ok(equal) => equal,
+        // The scene, or its oracle, could exceed the cap: refused before it is made.
+        Err(error) if error.contains("memory cap") => return,
+        Err(error) => panic!("compare refused two dumps that decode: {error}"),
+    };
     if equal {
         assert_eq!(
             words_a.corrupt_words() + words_b.corrupt_words(),

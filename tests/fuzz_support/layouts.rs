@@ -11,8 +11,9 @@
 //! - the header encodes, and parses back to the same dump with every number bit for bit, or
 //!   encoding refuses a non-finite number (one of the scene's own checks);
 //! - a dump that breaks its layout (an array of the wrong size or type, `k` of 0, a payload whose
-//!   fields overlap) is refused with an error naming what is wrong, by decoding and by the word
-//!   check alike;
+//!   fields overlap, a list's `null` that is a node's number) is refused with an error naming
+//!   what is wrong: by parsing where the header alone contradicts itself, else by decoding and
+//!   by the word check alike;
 //! - any other dump decodes, and its word check and lists are what a model of the layout's rules
 //!   written here gives: each linked list walked from its head once, cut at its first link out of
 //!   the pool, to a node the counter never handed out, or to a node already reached (at most
@@ -72,13 +73,27 @@ pub(crate) fn check(data: &[u8]) {
             return;
         }
     };
-    let again = Dump::parse(NAME, text.as_bytes(), |file| {
+    let parsed = Dump::parse(NAME, text.as_bytes(), |file| {
         files
             .get(file)
             .cloned()
             .ok_or_else(|| DumpError::Invalid(format!("{file} was not encoded")))
-    })
-    .unwrap_or_else(|e| panic!("an encoded dump does not parse: {e}\n{text}"));
+    });
+    // What the header alone contradicts (an array's size, the list numbering) is refused before
+    // the arrays are read, naming the fault as decoding would.
+    let again = match parsed {
+        Ok(again) => again,
+        Err(error) => {
+            let fault = built.expected.as_ref().err().unwrap_or_else(|| {
+                panic!("an encoded dump that keeps its layout does not parse: {error}\n{text}")
+            });
+            assert!(
+                error.to_string().contains(fault.as_str()),
+                "the parse error {error:?} does not name {fault:?}\n{text}"
+            );
+            return;
+        }
+    };
     assert_eq!(&again, dump, "a dump differs after encoding and parsing");
     // Text equality pins every number to its bits (`==` would let -0.0 pass for 0.0).
     assert_eq!(

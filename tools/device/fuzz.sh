@@ -7,10 +7,12 @@
 # workers' logs, any crash and the minimised corpora come back as one archive, $OUT/fuzz.tgz.
 # Every input gets at most 10 s and 2 GiB (`-timeout`, `-rss_limit_mb`: a hang or a runaway
 # allocation is a crash); stdout is closed (`-close_fd_mask=1`), since `compare` prints the
-# command's report for each pair of dumps that decode.
+# command's report for each pair of dumps that decode. MERGE=0 skips the minimising (a run that
+# only looks for crashes within a time budget).
 set -u
 SECONDS_EACH=${SECONDS_EACH:-540}
 WORKERS=${WORKERS:-4}
+MERGE=${MERGE:-1}
 OUT=${OUT:-/tmp/fuzz-out}
 root=$PWD
 mkdir -p "$OUT" /tmp/fz
@@ -26,7 +28,9 @@ done
 wait
 for bin in fuzzbin/*; do
   target=$(basename "$bin")
-  "$bin" -merge=1 -close_fd_mask=1 /tmp/fz/$target/min /tmp/fz/$target/corpus > /tmp/fz/$target/merge.log 2>&1
+  if [ "$MERGE" = 1 ]; then
+    "$bin" -merge=1 -close_fd_mask=1 /tmp/fz/$target/min /tmp/fz/$target/corpus > /tmp/fz/$target/merge.log 2>&1
+  fi
   echo "$target: $(ls /tmp/fz/$target/corpus | wc -l) working, $(ls /tmp/fz/$target/min | wc -l) minimised"
   grep -h "stat::number_of_executed_units\|stat::peak_rss" /tmp/fz/$target/run/fuzz-*.log
   grep -l "SUMMARY\|panicked\|deadly signal" /tmp/fz/$target/run/fuzz-*.log

@@ -228,7 +228,7 @@ fn parse_count(text: &str) -> Result<Count, String> {
     }
 }
 
-fn parse_bytes(text: &str) -> Result<u64, String> {
+pub(crate) fn parse_bytes(text: &str) -> Result<u64, String> {
     text.parse::<u64>().map_err(|_| match text.parse::<i128>() {
         Ok(n) if n < 0 => format!("a number of bytes cannot be negative, got {n}"),
         _ => format!("expected a number of bytes, got {text:?}"),

@@ -16,7 +16,9 @@ use fragsim_oracle::verdict::{judge_sides, Entry, Options, Side, SidesOptions, S
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::VertexPrecision;
 
+use crate::args::parse_bytes;
 use crate::record::{Context, Slots};
+use fragsim_capture::MEMORY_CAP_DEFAULT;
 
 /// Options of `fragsim compare`.
 #[derive(Debug, Clone, Args)]
@@ -60,6 +62,15 @@ pub struct CompareArgs {
     /// Compare two dumps that name different scenes (refused otherwise, exit 2).
     #[arg(long)]
     pub allow_different_scenes: bool,
+    /// `--mesh` replaces the named scene (`bunny`, `quads:8`, …) a dump's header gives; without
+    /// it, `--mesh` on a dump of a named scene is refused.
+    #[arg(long, requires = "mesh")]
+    pub mesh_replaces_scene: bool,
+    /// Refuse dumps whose arrays, and scenes whose mesh and oracle, could exceed this many
+    /// bytes, before reading or making them (as `render --memory-cap`).
+    #[arg(long, default_value_t = MEMORY_CAP_DEFAULT, allow_negative_numbers = true,
+          value_parser = parse_bytes)]
+    pub memory_cap: u64,
 }
 
 /// What the report prints: the verdict's totals, its scene, and the difference image written.
@@ -77,8 +88,9 @@ struct Report<'a> {
 /// Unreadable or inconsistent dumps, a scene that cannot be rebuilt, an image that cannot be
 /// written.
 pub fn compare(args: &CompareArgs) -> Result<bool, String> {
-    let reference = Side::open(&args.reference)?;
-    let candidate = Side::open(&args.candidate)?;
+    let reference = Side::open_within(&args.reference, args.memory_cap)?;
+    let candidate = Side::open_within(&args.candidate, args.memory_cap)?;
+    check_mesh_replaces(args, [&reference, &candidate])?;
     let options = SidesOptions {
         options: Options {
             depth_ulps: args.depth_ulps,
@@ -90,6 +102,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         },
         mesh: args.mesh.as_deref(),
         allow_different_scenes: args.allow_different_scenes,
+        memory_cap: Some(args.memory_cap),
     };
     let verdict = judge_sides(&reference, &candidate, &options)?;
     let image = if args.no_image {
@@ -111,6 +124,27 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         print_report(&report);
     }
     Ok(verdict.equal)
+}
+
+/// Refuses `--mesh` on a dump of a named scene unless `--mesh-replaces-scene` says so: the file
+/// would silently replace the scene the dump was made of.
+fn check_mesh_replaces(args: &CompareArgs, sides: [&Side; 2]) -> Result<(), String> {
+    let (Some(mesh), false) = (&args.mesh, args.mesh_replaces_scene) else {
+        return Ok(());
+    };
+    for side in sides {
+        if let Side::Dump(dump, path) = side {
+            if let Some(name) = &dump.header.scene.name {
+                return Err(format!(
+                    "--mesh {}: {} is a dump of the named scene {name:?}, not of a mesh file; \
+                     pass --mesh-replaces-scene to judge it against the file instead",
+                    mesh.display(),
+                    path.display()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Colour of a pixel's verdict in the difference image.

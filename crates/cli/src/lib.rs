@@ -50,7 +50,7 @@ mod export;
 mod frame_timing;
 mod hazard;
 mod multisampled;
-mod oracle_memory;
+use fragsim_oracle::memory_cap as oracle_memory;
 mod progress;
 pub mod record;
 mod render;

@@ -19,6 +19,7 @@ pub mod compare;
 mod diff;
 pub mod dump;
 pub mod edge_ties;
+pub mod memory_cap;
 pub mod precision;
 pub mod samples;
 pub mod triangles;

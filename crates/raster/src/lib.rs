@@ -22,6 +22,7 @@
 pub mod attributes;
 mod camera;
 pub mod conventions;
+pub mod files;
 mod fragment;
 mod mesh;
 mod pipeline;
@@ -35,7 +36,7 @@ mod viewport;
 pub use camera::{Camera, OrbitCamera};
 pub use conventions::{Conventions, DepthRange, EdgeTies, VertexPrecision, WindowOrigin};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
-pub use mesh::{Mesh, MeshError, UpAxis};
+pub use mesh::{Mesh, MeshError, UpAxis, MESH_BYTES_LIMIT};
 pub use pipeline::{
     edge_function, fill_thresholds, CullMode, ScreenTriangle, TriangleSetup, View,
     GUARD_BAND_PIXELS,
@@ -43,5 +44,5 @@ pub use pipeline::{
 pub use rng::SplitMix64;
 pub use samples::SamplePattern;
 pub use scene_spec::{mesh_hash, SceneSpec, SceneSpecError, ViewProjection};
-pub use scenes::{Scene, SceneError, DEFAULT_SCENE_NAME};
+pub use scenes::{Scene, SceneError, SceneSize, DEFAULT_SCENE_NAME};
 pub use viewport::{PixelRect, Viewport, SUBPIXEL_BITS};

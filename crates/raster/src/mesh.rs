@@ -3,9 +3,29 @@
 use std::io::{BufRead, Read};
 use std::path::Path;
 
+use crate::files::{read_regular, FileError};
+
 /// The first two bytes of every gzip stream (RFC 1952): files are decompressed by content, so a
 /// gzipped mesh loads whatever its name.
 const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// The most bytes a mesh file, or its text once decompressed, may hold: fragsim's default memory
+/// cap, so that a file (or a gzip stream that inflates without end) cannot exhaust memory.
+pub const MESH_BYTES_LIMIT: u64 = 4 << 30;
+
+impl From<FileError> for MeshError {
+    /// A file the system cannot read keeps [`MeshError::Io`]'s message; one refused unread
+    /// (no regular file, too large) says why.
+    fn from(e: FileError) -> Self {
+        match e {
+            FileError::Io { path, source } => Self::Io {
+                path: path.display().to_string(),
+                source,
+            },
+            e => Self::Unreadable(e),
+        }
+    }
+}
 
 /// Why a mesh could not be loaded or used.
 #[derive(Debug, thiserror::Error)]
@@ -18,6 +38,10 @@ pub enum MeshError {
         /// The reason the OS gave.
         source: std::io::Error,
     },
+    /// The path is no regular file, or the file (or its decompressed text) is larger than
+    /// [`MESH_BYTES_LIMIT`]: refused before it is read.
+    #[error("mesh file {0}")]
+    Unreadable(FileError),
     /// The file starts as gzip but does not decompress.
     #[error("cannot decompress gzipped mesh file {path}: {source}")]
     Gzip {
@@ -328,25 +352,33 @@ impl UpAxis {
 /// file's name: fragsim's own `stanford-bunny.obj.gz` is gzipped OBJ).
 ///
 /// # Errors
-/// The file cannot be read ([`MeshError::Io`]) or its gzip stream is corrupt
+/// The file cannot be read ([`MeshError::Io`]), is no regular file or too large
+/// ([`MeshError::Unreadable`], before a byte is read), or its gzip stream is corrupt
 /// ([`MeshError::Gzip`]), naming the file.
 pub(crate) fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
     let name = || path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: name(),
-        source,
-    })?;
+    let bytes = read_regular(path, MESH_BYTES_LIMIT, "a mesh file may have")?;
     if !bytes.starts_with(&GZIP_MAGIC) {
         return Ok(bytes);
     }
     let mut text = Vec::new();
-    // Multi-member: `cat a.gz b.gz` is valid gzip, and gzip(1) decompresses it whole.
+    // Multi-member: `cat a.gz b.gz` is valid gzip, and gzip(1) decompresses it whole. One byte
+    // past the limit is read, to tell a stream that inflates past it.
     flate2::read::MultiGzDecoder::new(bytes.as_slice())
+        .take(MESH_BYTES_LIMIT + 1)
         .read_to_end(&mut text)
         .map_err(|source| MeshError::Gzip {
             path: name(),
             source,
         })?;
+    if text.len() as u64 > MESH_BYTES_LIMIT {
+        return Err(MeshError::Unreadable(FileError::TooLarge {
+            path: path.to_path_buf(),
+            bytes: text.len() as u64,
+            limit: MESH_BYTES_LIMIT,
+            what: "a mesh file's decompressed text may have".into(),
+        }));
+    }
     Ok(text)
 }
 

@@ -19,21 +19,15 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::files::read_regular;
 use crate::{
     Camera, Conventions, OrbitCamera, Scene, SceneError, UpAxis, VertexPrecision, View, Viewport,
+    MESH_BYTES_LIMIT,
 };
 
 /// Why a scene spec names no scene fragsim can load or view.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneSpecError {
-    /// The mesh file cannot be read (to hash it).
-    #[error("cannot read mesh {}: {source}", path.display())]
-    ReadMesh {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
     /// The mesh file's bytes hash otherwise than the spec says.
     #[error(
         "mesh {}: its bytes hash to {found}, the scene names {expected}: \
@@ -48,10 +42,10 @@ pub enum SceneSpecError {
         /// The hash the spec names.
         expected: String,
     },
-    /// A relative mesh path found neither in the working directory nor beside the dump.
+    /// A relative mesh path found neither beside the dump nor in the working directory.
     #[error(
-        "mesh {mesh}: no such file in the working directory ({working_dir}) nor beside the dump \
-         ({}); pass --mesh PATH to name it",
+        "mesh {mesh}: no such file beside the dump ({}) nor in the working directory \
+         ({working_dir}); pass --mesh PATH to name it",
         beside.display()
     )]
     MeshNotFound {
@@ -132,8 +126,8 @@ pub struct SceneSpec {
     /// A named scene (`Scene::procedural`: `bunny`, `spheres:8`, …); absent when `mesh` is set.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// A mesh file (OBJ or PLY), as given to `--mesh`; a relative path is looked up from the working
-    /// directory, then from the dump's directory.
+    /// A mesh file (OBJ or PLY), as given to `--mesh`; a relative path in a dump is looked up
+    /// beside the dump, then from the working directory.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<String>,
     /// Orbit angle around the model, degrees (`--view`); may be left out (0) with a
@@ -268,8 +262,8 @@ impl SceneSpec {
         }
     }
 
-    /// Loads the scene; a relative mesh path missing from the working directory is looked up in
-    /// `beside` (the dump's directory). A mesh whose bytes do not hash to
+    /// Loads the scene; a relative mesh path is looked up in `beside` (the dump's directory)
+    /// first, then in the working directory. A mesh whose bytes do not hash to
     /// [`SceneSpec::mesh_hash`] is refused.
     ///
     /// # Errors
@@ -379,29 +373,33 @@ impl SceneSpec {
 
 /// The bytes of the mesh file at `path`.
 fn read_mesh(path: &Path) -> Result<Vec<u8>, SceneSpecError> {
-    std::fs::read(path).map_err(|source| SceneSpecError::ReadMesh {
-        path: path.to_path_buf(),
-        source,
-    })
+    read_regular(path, MESH_BYTES_LIMIT, "a mesh file may have")
+        .map_err(|e| SceneSpecError::Scene(SceneError::Mesh(e.into())))
 }
 
-/// The file a dump's relative mesh path names: in the working directory, else beside the dump.
+/// The file a dump's relative mesh path names: beside the dump (the file it was made with,
+/// when the dump travelled with its mesh), else in the working directory.
 fn find_mesh(mesh: &str, beside: Option<&Path>) -> Result<PathBuf, SceneSpecError> {
     let path = PathBuf::from(mesh);
-    if path.exists() || path.is_absolute() {
+    if path.is_absolute() {
         return Ok(path);
     }
-    match beside {
-        Some(dir) if dir.join(&path).exists() => Ok(dir.join(&path)),
-        Some(dir) => Err(SceneSpecError::MeshNotFound {
-            mesh: mesh.into(),
-            working_dir: std::env::current_dir()
-                .map_or_else(|_| "?".into(), |d| d.display().to_string()),
-            beside: dir.join(&path),
-        }),
+    let Some(dir) = beside else {
         // Not found: loading names the path.
-        None => Ok(path),
+        return Ok(path);
+    };
+    if dir.join(&path).exists() {
+        return Ok(dir.join(&path));
     }
+    if path.exists() {
+        return Ok(path);
+    }
+    Err(SceneSpecError::MeshNotFound {
+        mesh: mesh.into(),
+        working_dir: std::env::current_dir()
+            .map_or_else(|_| "?".into(), |d| d.display().to_string()),
+        beside: dir.join(&path),
+    })
 }
 
 /// The matrix the engine's vertex shader held: an f32 matrix's entries each rounded to the nearest

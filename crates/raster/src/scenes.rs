@@ -108,46 +108,51 @@ impl Scene {
     /// # Errors
     /// An unknown name or a parameter out of range.
     pub fn procedural(spec: &str) -> Result<Self, SceneError> {
-        let mut parts = spec.split(':');
-        let kind = parts.next().unwrap_or_default();
-        let params: Vec<&str> = parts.collect();
-        let param = |i: usize, default: u64, max: u64| -> Result<u64, SceneError> {
-            let value = match params.get(i) {
-                None => default,
-                Some(text) => text.parse::<u64>().map_err(|_| SceneError::BadParameter {
-                    name: spec.into(),
-                    reason: format!(
-                        "parameter {} is not a non-negative integer: {text:?}",
-                        i + 1
-                    ),
-                })?,
-            };
-            if value == 0 && i == 0 || value > max {
-                return Err(SceneError::BadParameter {
-                    name: spec.into(),
-                    reason: format!(
-                        "parameter {} must be between 1 and {max}, got {value}",
-                        i + 1
-                    ),
-                });
+        let mesh = match Procedural::parse(spec)? {
+            Procedural::Bunny => return Ok(Self::default_scene()),
+            Procedural::BunnySpheres { count, seed } => {
+                bunny_with_spheres(&Self::default_scene().mesh, count, seed)
             }
-            Ok(value)
-        };
-        let mesh = match kind {
-            "bunny" if params.is_empty() => return Ok(Self::default_scene()),
-            "bunny-spheres" => bunny_with_spheres(
-                &Self::default_scene().mesh,
-                param(0, 500, 100_000)? as u32,
-                param(1, 1, u64::MAX)?,
-            ),
-            "spheres" => nested_spheres(param(0, 4, 256)? as u32, 48, 24),
-            "soup" => triangle_soup(param(0, 2000, 10_000_000)? as u32, param(1, 1, u64::MAX)?),
-            "quads" => stacked_quads(param(0, 8, 1_000_000)? as u32),
-            _ => return Err(SceneError::Unknown(spec.into())),
+            Procedural::Spheres { count } => nested_spheres(count, SPHERE_SLICES, SPHERE_STACKS),
+            Procedural::Soup { count, seed } => triangle_soup(count, seed),
+            Procedural::Quads { count } => stacked_quads(count),
         };
         Ok(Self {
             name: spec.into(),
             mesh,
+        })
+    }
+
+    /// What the scene `spec` names would hold, from its name alone: nothing is built, so a
+    /// caller can bound a scene's memory before making it.
+    ///
+    /// # Errors
+    /// As [`Scene::procedural`].
+    pub fn procedural_size(spec: &str) -> Result<SceneSize, SceneError> {
+        let (vertices, triangles) = match Procedural::parse(spec)? {
+            Procedural::Bunny => (BUNNY_VERTICES, BUNNY_TRIANGLES),
+            Procedural::BunnySpheres { count, .. } => {
+                let (v, t) = sphere_size(BALL_SLICES, BALL_STACKS);
+                let count = u64::from(count);
+                (BUNNY_VERTICES + count * v, BUNNY_TRIANGLES + count * t)
+            }
+            Procedural::Spheres { count } => {
+                let (v, t) = sphere_size(SPHERE_SLICES, SPHERE_STACKS);
+                (u64::from(count) * v, u64::from(count) * t)
+            }
+            Procedural::Soup { count, .. } => (3 * u64::from(count), u64::from(count)),
+            Procedural::Quads { count } => (4 * u64::from(count), 2 * u64::from(count)),
+        };
+        // A quad's two triangles share its diagonal, whose samples the fill rule gives to one of
+        // them (clipped pieces tile the quad alike): a sample is in at most one of them.
+        let layers = match Procedural::parse(spec)? {
+            Procedural::Quads { count } => u64::from(count),
+            _ => triangles,
+        };
+        Ok(SceneSize {
+            vertices,
+            triangles,
+            layers,
         })
     }
 
@@ -252,6 +257,103 @@ impl Scene {
     }
 }
 
+/// Vertices of the embedded bunny that its faces use.
+const BUNNY_VERTICES: u64 = 34_834;
+/// Triangles of the embedded bunny.
+const BUNNY_TRIANGLES: u64 = 69_451;
+/// Slices and stacks of each sphere of `spheres:N`.
+const SPHERE_SLICES: u32 = 48;
+const SPHERE_STACKS: u32 = 24;
+/// Slices and stacks of each sphere `bunny-spheres:N` adds.
+const BALL_SLICES: u32 = 16;
+const BALL_STACKS: u32 = 8;
+
+/// Vertices and triangles of one sphere of [`nested_spheres`].
+fn sphere_size(slices: u32, stacks: u32) -> (u64, u64) {
+    let (slices, stacks) = (u64::from(slices), u64::from(stacks));
+    (2 + (stacks - 1) * slices, slices * (2 + 2 * (stacks - 2)))
+}
+
+/// What a named scene holds, known from its name ([`Scene::procedural_size`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneSize {
+    /// Vertices of its mesh.
+    pub vertices: u64,
+    /// Triangles of its mesh.
+    pub triangles: u64,
+    /// At most how many of its triangles cover one sample: a bound on any list's fragments.
+    pub layers: u64,
+}
+
+impl SceneSize {
+    /// Bytes of its mesh: the positions and the vertex indices.
+    #[must_use]
+    pub fn mesh_bytes(&self) -> u64 {
+        let vertex = std::mem::size_of::<[f32; 3]>() as u64;
+        let triangle = std::mem::size_of::<[u32; 3]>() as u64;
+        self.vertices
+            .saturating_mul(vertex)
+            .saturating_add(self.triangles.saturating_mul(triangle))
+    }
+}
+
+/// A scene name parsed, its parameters checked.
+enum Procedural {
+    Bunny,
+    BunnySpheres { count: u32, seed: u64 },
+    Spheres { count: u32 },
+    Soup { count: u32, seed: u64 },
+    Quads { count: u32 },
+}
+
+impl Procedural {
+    fn parse(spec: &str) -> Result<Self, SceneError> {
+        let mut parts = spec.split(':');
+        let kind = parts.next().unwrap_or_default();
+        let params: Vec<&str> = parts.collect();
+        let param = |i: usize, default: u64, max: u64| -> Result<u64, SceneError> {
+            let value = match params.get(i) {
+                None => default,
+                Some(text) => text.parse::<u64>().map_err(|_| SceneError::BadParameter {
+                    name: spec.into(),
+                    reason: format!(
+                        "parameter {} is not a non-negative integer: {text:?}",
+                        i + 1
+                    ),
+                })?,
+            };
+            if value == 0 && i == 0 || value > max {
+                return Err(SceneError::BadParameter {
+                    name: spec.into(),
+                    reason: format!(
+                        "parameter {} must be between 1 and {max}, got {value}",
+                        i + 1
+                    ),
+                });
+            }
+            Ok(value)
+        };
+        Ok(match kind {
+            "bunny" if params.is_empty() => Self::Bunny,
+            "bunny-spheres" => Self::BunnySpheres {
+                count: param(0, 500, 100_000)? as u32,
+                seed: param(1, 1, u64::MAX)?,
+            },
+            "spheres" => Self::Spheres {
+                count: param(0, 4, 256)? as u32,
+            },
+            "soup" => Self::Soup {
+                count: param(0, 2000, 10_000_000)? as u32,
+                seed: param(1, 1, u64::MAX)?,
+            },
+            "quads" => Self::Quads {
+                count: param(0, 8, 1_000_000)? as u32,
+            },
+            _ => return Err(SceneError::Unknown(spec.into())),
+        })
+    }
+}
+
 /// `count` closed UV spheres centred at the origin with radii `1/count, 2/count, …, 1`.
 #[must_use]
 pub(crate) fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
@@ -300,7 +402,7 @@ pub(crate) fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
 pub(crate) fn bunny_with_spheres(bunny: &Mesh, count: u32, seed: u64) -> Mesh {
     let (lo, hi) = bunny.bounds();
     let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
-    let unit = nested_spheres(1, 16, 8);
+    let unit = nested_spheres(1, BALL_SLICES, BALL_STACKS);
     let mut rng = SplitMix64::new(seed);
     let mut mesh = bunny.clone();
     for _ in 0..count {
@@ -388,6 +490,26 @@ mod tests {
             spheres.mesh,
             Scene::procedural("bunny-spheres:3:5").unwrap().mesh
         );
+        for name in [
+            "bunny",
+            "bunny-spheres:3:2",
+            "spheres:3",
+            "quads:5",
+            "soup:7:9",
+        ] {
+            let mesh = Scene::procedural(name).unwrap().mesh;
+            let size = Scene::procedural_size(name).unwrap();
+            assert_eq!(
+                (size.vertices, size.triangles),
+                (mesh.positions.len() as u64, mesh.triangles.len() as u64),
+                "{name}"
+            );
+        }
+        assert_eq!(
+            Scene::procedural_size("quads:1000000").unwrap().layers,
+            1_000_000
+        );
+        assert!(Scene::procedural_size("soup:10000001").is_err());
         assert!(Scene::procedural("spheres:0").is_err());
         assert!(Scene::procedural("cubes").is_err());
         assert!(Scene::procedural("soup:x").is_err());

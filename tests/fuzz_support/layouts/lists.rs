@@ -56,9 +56,12 @@ pub(super) fn linked_lists(
         null,
         node_base,
     });
-    // What the reader refuses first: the payload, then `k`, then the arrays (the nodes, whose
-    // count the header's pool sets, before the heads and links).
+    // What the reader refuses first: a `null` that numbers a node of the header's pool (the
+    // header alone says it), the payload, then `k`, then the arrays (the nodes, whose count the
+    // header's pool sets, before the heads and links).
+    let numbered = u64::from(node_base)..u64::from(node_base) + length(pool, fault, 3) as u64;
     let fault = match fault {
+        _ if numbered.contains(&u64::from(null)) => "\"null\"",
         _ if payload.check().is_err() => "payload",
         _ if k == 0 => "\"k\"",
         0 => "\"heads\"",

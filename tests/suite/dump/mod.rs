@@ -14,9 +14,11 @@ use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{Scene, Viewport};
 
 mod binary;
+mod bounded_input;
 mod compare;
 mod edge_ties;
 mod files;
+mod header_lies;
 mod layouts;
 mod mutations;
 mod numbers;

@@ -6,7 +6,9 @@ use std::collections::BTreeMap;
 use fragsim_raster::Viewport;
 use serde::{Deserialize, Serialize};
 
+use super::masked::MASKED_SCHEME;
 use super::{err, DumpError, LayoutSpec};
+use fragsim_capture::catalog::DumpLayout;
 use fragsim_raster::scene_spec::SceneSpec;
 
 /// The element type of an array file: always little-endian.
@@ -145,6 +147,84 @@ impl Header {
     }
 }
 
+impl Header {
+    /// Refuses the fields that contradict one another or the layout, before any array is read,
+    /// each by name: a header cannot say two things and have one of them silently win.
+    ///
+    /// - An array the layout does not use (`junk`, or `heads` on an `mdts` dump): its words would
+    ///   be read and never judged.
+    /// - An A-buffer's `capacity` beside an `offsets` array: fixed storage or storage sized by a
+    ///   counting pass, not both.
+    /// - A scene with both `name` and `mesh`.
+    /// - Linked-list numbering out of range: nodes numbered past 2^32 (`node_base + pool`), or a
+    ///   `null` that is some node's number, which would end a list at that node.
+    ///
+    /// A scheme this format does not name is left to decoding, which lists those it does.
+    ///
+    /// # Errors
+    /// The first contradiction, naming the fields.
+    pub(super) fn check_fields(&self) -> Result<(), DumpError> {
+        if let (Some(name), Some(mesh)) = (&self.scene.name, &self.scene.mesh) {
+            return err(format!(
+                "scene: both \"name\" {name:?} and \"mesh\" {mesh:?}; a scene is a named scene \
+                 or a mesh file, not both"
+            ));
+        }
+        let layout = DumpLayout::named(&self.scheme);
+        let used: &[&str] = match layout {
+            _ if self.scheme == MASKED_SCHEME => &["counters", "nodes", "masks"],
+            None => return Ok(()),
+            Some(DumpLayout::SlotArray(_) | DumpLayout::KBufferSlots) => &["slots"],
+            Some(DumpLayout::CountersAndSlots) => &["counters", "slots", "offsets"],
+            Some(DumpLayout::LinkedLists) => &["heads", "next", "nodes", "counter"],
+            Some(DumpLayout::LayerMajor) => &["counters", "layers"],
+            Some(DumpLayout::Memory) => &["words32", "words64"],
+        };
+        if let Some(unused) = self
+            .arrays
+            .keys()
+            .find(|name| !used.contains(&name.as_str()))
+        {
+            return err(format!(
+                "array {unused:?}: a {} dump has no such array (its arrays: {})",
+                self.scheme,
+                used.join(", ")
+            ));
+        }
+        if layout == Some(DumpLayout::CountersAndSlots) && self.arrays.contains_key("offsets") {
+            if let Some(capacity) = self.capacity {
+                return err(format!(
+                    "\"capacity\" {capacity} beside an \"offsets\" array: an A-buffer has fixed \
+                     storage (capacity) or storage sized by its counting pass (offsets), not both"
+                ));
+            }
+        }
+        if let (
+            Some(LayoutSpec::LinkedList {
+                null, node_base, ..
+            }),
+            Some(pool),
+        ) = (self.layout, self.pool)
+        {
+            let end = u64::from(node_base) + pool;
+            if end > 1 << 32 {
+                return err(format!(
+                    "layout: {pool} nodes (\"pool\") numbered from \"node_base\" {node_base} pass \
+                     2^32: node numbers are u32"
+                ));
+            }
+            if (u64::from(node_base)..end).contains(&u64::from(null)) {
+                return err(format!(
+                    "layout: \"null\" {null} is the number of a node (\"node_base\" {node_base} to \
+                     {}): a list would end at that node",
+                    end - 1
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The contents of one array file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Words {
@@ -221,6 +301,19 @@ pub(super) fn check_file_name(name: &str, file: &str) -> Result<(), DumpError> {
             "array {name:?}: file {file:?} must be a plain file name in the dump's directory"
         ))
     }
+}
+
+/// The bytes of array `name`'s file: its shape's elements times its dtype's width, refused when
+/// either overflows 64 bits.
+pub(super) fn array_bytes(name: &str, spec: &ArraySpec) -> Result<u64, DumpError> {
+    elements(name, &spec.shape)?
+        .checked_mul(u64::from(spec.dtype.bits() / 8))
+        .ok_or_else(|| {
+            DumpError::Invalid(format!(
+                "array {name:?}: shape {:?} of {:?} words is more than 2^64 bytes",
+                spec.shape, spec.dtype
+            ))
+        })
 }
 
 /// The element count of a shape, refused when it overflows 64 bits.

@@ -89,6 +89,7 @@ use crate::Oracle;
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::DumpScheme;
 pub use masked::{masked_spec, node_capture, MaskedComparison, WrongMask, MASKED_SCHEME};
+pub use read::HEADER_BYTES_LIMIT;
 pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
 pub use word_check::{CorruptWord, Corruption, Counter, WordCheck};
 

@@ -8,10 +8,27 @@ use fragsim_capture::{Capture, Scheme, SerialMemory, WordMemory};
 use fragsim_raster::Viewport;
 
 use super::arrays::stored_lists;
-use super::header::{check_array, check_distinct_files, check_file_name, elements};
+use super::header::{array_bytes, check_array, check_distinct_files, check_file_name};
+use super::shapes::check_shapes;
 use super::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use super::{FORMAT, HEADER_FILE, VERSION};
 use fragsim_capture::catalog::{SchemeName, SchemeVisitor};
+use fragsim_capture::MEMORY_CAP_DEFAULT;
+use fragsim_raster::files::{read_regular, FileError};
+
+/// The most bytes a dump header may have: a header is a few kilobytes, its `extra` included.
+pub const HEADER_BYTES_LIMIT: u64 = 4 << 20;
+
+/// The UTF-8 byte-order mark some editors and Windows tools put before JSON text: skipped.
+const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// A file refused or unreadable, as a dump error: the system's refusal stays [`DumpError::Io`].
+fn file_error(e: FileError) -> DumpError {
+    match e {
+        FileError::Io { path, source } => io_err("read", &path, source),
+        e => DumpError::Invalid(e.to_string()),
+    }
+}
 
 fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W]) {
     for (i, &w) in words.iter().enumerate() {
@@ -60,12 +77,25 @@ impl SchemeVisitor for Resolve<'_> {
 }
 
 impl Dump {
-    /// Reads a dump from its directory (or from the path of its `dump.json`).
+    /// Reads a dump from its directory (or from the path of its `dump.json`), its arrays holding
+    /// at most fragsim's default memory cap ([`Dump::read_within`]).
     ///
     /// # Errors
-    /// Missing files, a malformed header, another format or version, or array files whose size
-    /// disagrees with their shape.
+    /// As [`Dump::read_within`].
     pub fn read(path: &Path) -> Result<Self, DumpError> {
+        Self::read_within(path, MEMORY_CAP_DEFAULT)
+    }
+
+    /// Reads a dump from its directory (or from the path of its `dump.json`) whose arrays hold
+    /// at most `limit` bytes together (`--memory-cap`). Only regular files are read (links
+    /// followed; a FIFO or a device is refused by its kind, unopened: [`fragsim_raster::files`]),
+    /// the header at most [`HEADER_BYTES_LIMIT`] bytes, and each array file only once its size
+    /// (the file's metadata) is what its shape makes.
+    ///
+    /// # Errors
+    /// Missing, irregular or oversized files, a malformed header, another format or version,
+    /// array files whose size disagrees with their shape, or arrays over `limit` bytes.
+    pub fn read_within(path: &Path, limit: u64) -> Result<Self, DumpError> {
         let (dir, header_path) = if path.is_dir() {
             (path.to_path_buf(), path.join(HEADER_FILE))
         } else {
@@ -74,31 +104,59 @@ impl Dump {
                 path.to_path_buf(),
             )
         };
-        let text = std::fs::read(&header_path).map_err(|e| io_err("read", &header_path, e))?;
-        Self::parse(&header_path.display().to_string(), &text, |file| {
-            let path = dir.join(file);
-            std::fs::read(&path).map_err(|e| io_err("read", &path, e))
-        })
+        let text = read_regular(&header_path, HEADER_BYTES_LIMIT, "a dump header may have")
+            .map_err(file_error)?;
+        Self::parse_within(
+            &header_path.display().to_string(),
+            &text,
+            limit,
+            |file, bytes| {
+                read_regular(&dir.join(file), bytes, "its array's shape makes").map_err(file_error)
+            },
+        )
     }
 
     /// Decodes a dump from its header's bytes (`dump.json`, named `header_name` in errors) and
     /// `read_file`, which returns an array file's bytes by its name in the header. Never touches
     /// the file system itself: [`Dump::read`] passes a reader of the dump's directory, the
-    /// `dump_parse` fuzz target one over its input.
-    ///
-    /// Array file names must be plain names (no directory part, not `.` or `..`), so that a
-    /// header cannot make the reader open a file outside the dump's directory; shapes whose
-    /// element count overflows 64 bits are refused before anything is read.
+    /// `dump_parse` fuzz target one over its input. [`Dump::parse_within`] with no limit.
     ///
     /// # Errors
-    /// A malformed header, another format or version, a bad viewport, an array file name that is
-    /// not plain, a shape that overflows, `read_file`'s own errors, or array files whose size
-    /// disagrees with their shape.
+    /// As [`Dump::parse_within`].
     pub fn parse(
         header_name: &str,
         header_bytes: &[u8],
         mut read_file: impl FnMut(&str) -> Result<Vec<u8>, DumpError>,
     ) -> Result<Self, DumpError> {
+        Self::parse_within(header_name, header_bytes, u64::MAX, |file, _| {
+            read_file(file)
+        })
+    }
+
+    /// Decodes a dump from its header's bytes and `read_file`, which is handed each array
+    /// file's name and the bytes its shape makes (so that a reader of files can refuse one of
+    /// another size before reading it), the arrays holding at most `limit` bytes together.
+    ///
+    /// Everything the header alone can contradict is refused before any array is read: a
+    /// UTF-8 byte-order mark is skipped; array file names must be plain names (no directory part,
+    /// not `.` or `..`), so that a header cannot make the reader open a file outside the dump's
+    /// directory; shapes whose element count or bytes overflow 64 bits are refused, and so are
+    /// the fields that contradict one another or the layout (`Header::check_fields`: an array
+    /// the layout does not use, `capacity` beside `offsets`, a scene with both `name` and `mesh`,
+    /// list numbering out of range) and shapes the header's fields contradict (`check_shapes`,
+    /// where the header alone fixes them).
+    ///
+    /// # Errors
+    /// A malformed header, another format or version, a bad viewport, an array file name that is
+    /// not plain, a shape that overflows, contradictory fields, arrays over `limit` bytes,
+    /// `read_file`'s own errors, or array files whose size disagrees with their shape.
+    pub fn parse_within(
+        header_name: &str,
+        header_bytes: &[u8],
+        limit: u64,
+        mut read_file: impl FnMut(&str, u64) -> Result<Vec<u8>, DumpError>,
+    ) -> Result<Self, DumpError> {
+        let header_bytes = header_bytes.strip_prefix(UTF8_BOM).unwrap_or(header_bytes);
         let header: Header = serde_json::from_slice(header_bytes)
             .map_err(|e| DumpError::Invalid(format!("{header_name}: {e}")))?;
         if header.format != FORMAT {
@@ -115,11 +173,25 @@ impl Dump {
         }
         header.framebuffer()?;
         check_distinct_files(&header.arrays)?;
-        let mut arrays = BTreeMap::new();
+        let mut sizes = Vec::with_capacity(header.arrays.len());
+        let mut total = 0_u64;
         for (name, spec) in &header.arrays {
             check_file_name(name, &spec.file)?;
-            elements(name, &spec.shape)?;
-            let bytes = read_file(&spec.file)?;
+            let bytes = array_bytes(name, spec)?;
+            total = total.saturating_add(bytes);
+            sizes.push(bytes);
+        }
+        header.check_fields()?;
+        check_shapes(&header)?;
+        if total > limit {
+            return err(format!(
+                "{header_name}: the arrays' shapes make {total} bytes, over the memory cap of \
+                 {limit} bytes (--memory-cap raises it)"
+            ));
+        }
+        let mut arrays = BTreeMap::new();
+        for ((name, spec), expected) in header.arrays.iter().zip(sizes) {
+            let bytes = read_file(&spec.file, expected)?;
             let width = match spec.dtype {
                 Dtype::U32 => 4,
                 Dtype::U64 => 8,

@@ -62,11 +62,20 @@ impl Side {
     /// # Errors
     /// A dump that cannot be read.
     pub fn open(text: &str) -> Result<Self, String> {
+        Self::open_within(text, fragsim_capture::MEMORY_CAP_DEFAULT)
+    }
+
+    /// [`Side::open`] with the dump's arrays holding at most `limit` bytes together
+    /// ([`Dump::read_within`]).
+    ///
+    /// # Errors
+    /// A dump that cannot be read, or arrays over `limit`.
+    pub fn open_within(text: &str, limit: u64) -> Result<Self, String> {
         if text == "oracle" {
             return Ok(Self::Oracle);
         }
         let path = PathBuf::from(text);
-        let dump = Dump::read(&path).map_err(|e| e.to_string())?;
+        let dump = Dump::read_within(&path, limit).map_err(|e| e.to_string())?;
         Ok(Self::Dump(Box::new(dump), path))
     }
 
@@ -116,6 +125,9 @@ pub struct SidesOptions<'a> {
     pub mesh: Option<&'a Path>,
     /// Compare two dumps that name different scenes (a note) instead of refusing them.
     pub allow_different_scenes: bool,
+    /// The most bytes the scene and the oracle may take (`--memory-cap`), bounded before either
+    /// is made ([`crate::memory_cap`]); `None`: no bound.
+    pub memory_cap: Option<u64>,
 }
 
 /// Judges `candidate` against `reference` ([`super::judge`]), the oracle rebuilt from the scene
@@ -187,6 +199,12 @@ pub fn judge_sides(
     if judged_f32 {
         spec.conventions.vertex_precision = VertexPrecision::F64;
     }
+    if let (true, Some(cap), Some(name), None) =
+        (needs_oracle, options.memory_cap, &spec.name, &spec.mesh)
+    {
+        let lists = header.framebuffer().map_err(|e| e.to_string())?.pixels() as u64;
+        crate::memory_cap::check_named_scene(name, lists, cap)?;
+    }
     let loaded = if needs_oracle {
         Some(
             spec.load(Some(&beside))
@@ -205,6 +223,9 @@ pub fn judge_sides(
         }
         None => None,
     };
+    if let (Some(view), Some(cap)) = (&view, options.memory_cap) {
+        crate::memory_cap::check(view, cap)?;
+    }
     let oracle = match &view {
         None => None,
         Some(view) if masked => {
