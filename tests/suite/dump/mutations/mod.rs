@@ -5,7 +5,9 @@
 //! fragment dropped at each list position, a list emptied, a duplicate, a swap in sorted layouts,
 //! a nearby triangle's id, a depth past its derived interval, a counter off by one, a node
 //! unlinked or orphaned, a node past k lost, a torn word, a stray word past the counter with
-//! `filled`, a K-nearest list short at coplanar fragments), and in ways some conforming
+//! `filled`, a K-nearest list short at coplanar fragments, exact storage's room cut, grown or
+//! taken away, a K-slot list holding another K than its promise names, a list counter off at a
+//! full pool, bits set outside a payload's fields), and in ways some conforming
 //! implementation could (another arrival order in unsorted layouts, a depth moved inside its
 //! interval, a key-only triangle swap at a shared edge). Each mutant is judged bit-exactly and
 //! within the precision of an f32 vertex stage: every non-conforming one must be DIFFERENT, every
