@@ -179,7 +179,8 @@ pub(super) enum Change {
     Reordered,
     /// One fragment's depth moved: EQUAL exactly where the judge's interval holds it.
     Moved(Item),
-    /// Another triangle's key at a shared edge: DIFFERENT bit for bit, EQUAL under f32.
+    /// What only an f32 vertex stage may store (another triangle's key at a shared edge, a
+    /// list counter one past a full pool): DIFFERENT bit for bit, EQUAL under f32.
     OtherSnap,
 }
 
@@ -317,7 +318,16 @@ pub(super) fn mutant(
         | Kind::Stray
         | Kind::CounterDoubled
         | Kind::CounterAllOnes => {
-            return counted(&mut out, storage, p, kind, &list).map(|()| (out, Change::Broken));
+            // One more at a full pool: an f32 vertex stage may produce one fragment more than
+            // the exact one (a fragment in doubt), dropped past the pool's end.
+            let full = matches!(storage, Storage::Lists)
+                && words(&out, "counter")[0] >= words(&out, "nodes").len() as u64;
+            let change = if full && kind == Kind::CounterPlusOne {
+                Change::OtherSnap
+            } else {
+                Change::Broken
+            };
+            return counted(&mut out, storage, p, kind, &list).map(|()| (out, change));
         }
         Kind::RoomCut | Kind::RoomGrown | Kind::NoRoom => {
             return roomed(&mut out, storage, p, kind).map(|()| (out, Change::Broken));
