@@ -153,6 +153,9 @@ pub struct Comparison {
     /// Each is a fragment lost from the lists (missing at its pixel, where the node held one) or
     /// a counter that handed out a node no fragment took: never equal.
     pub unreachable_nodes: u64,
+    /// Linked lists: a node counter other than any the reference's fragments allow
+    /// ([`crate::verdict::MiscountedCounter`]): never equal.
+    pub miscounted_counter: Option<crate::verdict::MiscountedCounter>,
 }
 
 /// The joint judgement of the pixels whose coverage hangs on a vertex's snap: every triangle
@@ -220,6 +223,7 @@ impl Comparison {
             ambiguity: AmbiguityCounts::default(),
             snaps: SnapCounts::default(),
             unreachable_nodes: words.map_or(0, |w| w.unreachable),
+            miscounted_counter: None,
         }
     }
 
@@ -281,11 +285,11 @@ impl Comparison {
             .count() as u64;
     }
 
-    /// Whether every pixel is equal (overflow by design allowed) and every node a linked list's
-    /// counter handed out is in a list.
+    /// Whether every pixel is equal (overflow by design allowed), every node a linked list's
+    /// counter handed out is in a list, and the counter is one the reference allows.
     #[must_use]
     pub fn is_equal(&self) -> bool {
-        self.diff.is_exact() && self.unreachable_nodes == 0
+        self.diff.is_exact() && self.unreachable_nodes == 0 && self.miscounted_counter.is_none()
     }
 }
 
@@ -530,6 +534,7 @@ pub fn compare_with(
             })
         });
     }
+    crate::verdict::hold_to_reference(&mut comparison, candidate, words, reference, None, options);
     comparison
 }
 

@@ -13,6 +13,7 @@ use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{Scene, Viewport};
 
+mod allowances;
 mod binary;
 mod bounded_input;
 mod compare;

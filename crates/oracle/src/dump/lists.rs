@@ -11,7 +11,7 @@
 
 use super::slots::words_of;
 use super::spec::{LayoutSpec, ListNumbering, Payload};
-use super::word_check::{CorruptWord, Corruption};
+use super::word_check::{outside_fields, CorruptWord, Corruption};
 use super::{err, Dump, DumpError, Words};
 
 /// Fragsim's memory of a scheme built from a dump's arrays, and what the translation found.
@@ -83,13 +83,13 @@ pub(super) fn linked_lists(lists: &ListArrays<'_>) -> Translated {
             visited[i] = true;
             reached += 1;
             out.words32[link] = i as u32 + 1;
-            let (fragment, possible) = lists.payload.fragment(lists.nodes[i]);
-            if !possible {
+            let (fragment, why) = read_payload(lists.payload, lists.nodes[i]);
+            if let Some(why) = why {
                 out.corrupt[p].push(CorruptWord {
                     pixel: p,
                     slot,
                     word: lists.nodes[i],
-                    why: Corruption::ImpossibleKey,
+                    why,
                 });
             }
             out.words64[i] = fragment;
@@ -102,6 +102,20 @@ pub(super) fn linked_lists(lists: &ListArrays<'_>) -> Translated {
     // Nodes past the counter hold whatever the pool held: undefined.
     out.unchecked = 2 * (pool - allocated) as u64;
     out
+}
+
+/// The fragment word a payload word read as a fragment holds, and what is wrong with it: a depth
+/// key above 1.0's, or a bit set outside the payload's fields.
+fn read_payload(payload: Payload, word: u64) -> (u64, Option<Corruption>) {
+    let (fragment, possible) = payload.fragment(word);
+    let why = if !possible {
+        Some(Corruption::ImpossibleKey)
+    } else if word & outside_fields(&payload) != 0 {
+        Some(Corruption::OutsideFields)
+    } else {
+        None
+    };
+    (fragment, why)
 }
 
 /// fragsim's layer-counter memory (counters, then the layers layer-major) from a layer-major
@@ -134,12 +148,12 @@ pub(super) fn layer_major(
         let stored = count.min(k) as usize;
         for layer in 0..stored {
             let word = layers[layer * pixels + p];
-            if !payload.fragment(word).1 {
+            if let (_, Some(why)) = read_payload(payload, word) {
                 out.corrupt[p].push(CorruptWord {
                     pixel: p,
                     slot: layer,
                     word,
-                    why: Corruption::ImpossibleKey,
+                    why,
                 });
             }
         }

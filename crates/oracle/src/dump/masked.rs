@@ -370,7 +370,7 @@ impl Dump {
                 .collect(),
             counters: None,
             unchecked: words.unchecked,
-            unreachable: 0,
+            ..WordCheck::default()
         };
         let mut capture = Capture::with_pixels(
             samples,

@@ -11,7 +11,7 @@
 //! holds.
 
 use super::spec::{LayoutSpec, Payload, SlotOrder};
-use super::word_check::WordCheck;
+use super::word_check::{outside_fields, Corruption, WordCheck};
 use super::{err, Dtype, Dump, DumpError, DumpScheme, Words};
 use fragsim_capture::schemes::mdts::Direction;
 
@@ -222,10 +222,68 @@ impl Dump {
             codec.payload.map_or(own_dtype(scheme), |p| p.dtype),
         )?;
         let first_slot = scheme.pixel_slots();
-        for word in check.corrupt.iter_mut().flatten() {
-            // Every corrupt word of a slot layout is a slot word (counters are judged apart).
+        // Every other corrupt word of a slot layout is a slot word (counters are judged apart).
+        let slot_words = check
+            .corrupt
+            .iter_mut()
+            .flatten()
+            .filter(|word| word.why != Corruption::RoomNotCount);
+        for word in slot_words {
             if let Some(&at) = stored.get(placement.stored(first_slot(word.pixel).0 + word.slot)) {
                 word.word = at;
+            }
+        }
+        Ok(())
+    }
+
+    /// Names each slot word that is read as a fragment (below an A-buffer counter; any full
+    /// MDTS or k-buffer slot) and has a bit set outside its payload's fields
+    /// ([`Corruption::OutsideFields`]): the translation to fragsim's words drops those bits, so
+    /// they are read here, as stored. A slot already named corrupt is not named twice.
+    pub(super) fn flag_bits_outside_fields(
+        &self,
+        scheme: &DumpScheme,
+        check: &mut WordCheck,
+    ) -> Result<(), DumpError> {
+        let Some((placement, codec, _)) = self.slot_layout(scheme)? else {
+            return Ok(());
+        };
+        let Some(payload) = codec.payload else {
+            return Ok(());
+        };
+        let outside = outside_fields(&payload);
+        if outside == 0 {
+            return Ok(());
+        }
+        let stored = self.widened("slots", payload.dtype)?;
+        let counters = match scheme {
+            DumpScheme::ABufferFixed { .. } | DumpScheme::ABufferExact { .. } => {
+                self.u32s("counters")?
+            }
+            _ => None,
+        };
+        let empty = if codec.plus_one {
+            0
+        } else {
+            all_ones(payload.dtype)
+        };
+        let at = scheme.pixel_slots();
+        for p in 0..placement.pixels {
+            let (first, room) = at(p);
+            let read = counters.map_or(room, |c| room.min(c[p] as usize));
+            for slot in 0..read {
+                let word = stored[placement.stored(first + slot)];
+                let fields = if codec.plus_one {
+                    word.wrapping_sub(1)
+                } else {
+                    word
+                };
+                let named = check.corrupt[p]
+                    .iter()
+                    .any(|c| c.slot == slot && c.why != Corruption::RoomNotCount);
+                if word != empty && fields & outside != 0 && !named {
+                    check.flag(p, slot, word, Some(Corruption::OutsideFields));
+                }
             }
         }
         Ok(())

@@ -2,11 +2,12 @@
 //! what the decoded lists cannot show, each corrupt word named with its reason ([`Corruption`]),
 //! an A-buffer's counters beside their capacities.
 
+use fragsim_capture::catalog::SchemeName;
 use fragsim_capture::schemes::mdts::Direction;
 use serde::Serialize;
 
 use super::layouts::DumpScheme;
-use super::spec::LARGEST_KEY;
+use super::spec::{Payload, LARGEST_KEY};
 use super::{Dump, DumpError};
 
 /// Why a stored word is one that its layout says cannot be there.
@@ -38,6 +39,13 @@ pub enum Corruption {
     /// A masked node's coverage mask (below its pixel's counter) that is empty or holds a bit
     /// at or past the sample count: a node is stored for at least one covered sample.
     ImpossibleMask,
+    /// Exact storage (an A-buffer with `offsets`) whose room for the pixel is not its counter:
+    /// the counting pass and the storing pass see the same fragments, so the prefix sum gives
+    /// each pixel room for exactly the fragments its counter counts. The word is the room.
+    RoomNotCount,
+    /// A payload word read as a fragment with a bit set outside its declared depth and id
+    /// fields: those bits are never written, so they hold 0.
+    OutsideFields,
 }
 
 impl Corruption {
@@ -54,6 +62,8 @@ impl Corruption {
             Self::Revisited => "link to a node already in a list (a cycle)",
             Self::CounterPastStorage => "counter past its storage",
             Self::ImpossibleMask => "coverage mask empty or past the sample count",
+            Self::RoomNotCount => "exact storage's room other than the pixel's counter",
+            Self::OutsideFields => "a bit set outside the payload's fields",
         }
     }
 }
@@ -71,12 +81,14 @@ pub struct CorruptWord {
     pub why: Corruption,
 }
 
-/// An A-buffer pixel's counter and how many slots it has.
+/// An A-buffer pixel's counter and the capacity its declared scheme owes it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Counter {
     /// The counter's value: how many fragments took a slot number.
     pub count: u32,
-    /// The pixel's slots (the fixed capacity, or its share of exact storage).
+    /// The fragments the pixel's storage must hold before any may overflow: the header's fixed
+    /// capacity, or `u32::MAX` for exact storage, which is sized to hold every fragment (the
+    /// room its `offsets` give is a word checked against the counter, never an allowance).
     pub capacity: u32,
 }
 
@@ -96,6 +108,13 @@ pub struct WordCheck {
     /// Linked lists: nodes the counter handed out that no list reaches (a lost node; its
     /// fragment is missing from the lists, which the comparison counts).
     pub unreachable: u64,
+    /// Linked lists: the node counter as stored, which the comparison checks against the
+    /// fragments the reference owes (it counts every allocation, past the pool's end too).
+    pub list_counter: Option<u32>,
+    /// Schemes that keep each pixel's first K fragments in primitive order
+    /// (`kbuffer-interlock-ordered-first`): K, for the comparison to check that the fragments
+    /// kept are those, not any K.
+    pub first_in_primitive_order: Option<u32>,
 }
 
 impl WordCheck {
@@ -136,6 +155,7 @@ impl Dump {
         if let Some(own) = self.own_slots(&scheme)? {
             let mut check = own.check_words()?;
             self.name_stored_words(&scheme, &mut check)?;
+            self.flag_bits_outside_fields(&scheme, &mut check)?;
             return Ok(check);
         }
         // Decoding validates the arrays against the scheme's layout; the check then indexes them
@@ -161,6 +181,13 @@ impl Dump {
                     Direction::Descending => (0, |w| (w.wrapping_sub(1) >> 32) as u32),
                 };
                 check_mdts(&mut check, slots, *k as usize, empty, key);
+                if let DumpScheme::KBuffer {
+                    scheme: SchemeName::KbufferInterlockOrderedFirst,
+                    k,
+                } = &scheme
+                {
+                    check.first_in_primitive_order = Some(*k);
+                }
             }
             DumpScheme::Mdts32 { k } => {
                 let slots = self.u32s("slots")?.ok_or_else(|| missing("slots"))?;
@@ -173,9 +200,14 @@ impl Dump {
                 let counters = self.u32s("counters")?.ok_or_else(|| missing("counters"))?;
                 let slots = self.u64s("slots")?.ok_or_else(|| missing("slots"))?;
                 let at = scheme.pixel_slots();
+                let exact = matches!(scheme, DumpScheme::ABufferExact { .. });
                 let mut all = Vec::with_capacity(pixels);
                 for (p, &count) in counters.iter().enumerate() {
                     let (first, capacity) = at(p);
+                    // Exact storage holds every fragment: its room is owed, not allowed.
+                    if exact && count as usize != capacity {
+                        check.flag(p, 0, capacity as u64, Some(Corruption::RoomNotCount));
+                    }
                     let stored = (count as usize).min(capacity);
                     for (slot, &word) in slots[first..first + capacity].iter().enumerate() {
                         let why = if slot < stored {
@@ -195,7 +227,7 @@ impl Dump {
                     }
                     all.push(Counter {
                         count,
-                        capacity: capacity as u32,
+                        capacity: if exact { u32::MAX } else { capacity as u32 },
                     });
                 }
                 check.counters = Some(all);
@@ -205,6 +237,9 @@ impl Dump {
                 check.corrupt = translated.corrupt;
                 check.unchecked = translated.unchecked;
                 check.unreachable = translated.unreachable;
+                if matches!(scheme, DumpScheme::LinkedLists { .. }) {
+                    check.list_counter = translated.words32.get(pixels).copied();
+                }
             }
             DumpScheme::Memory { .. } => {
                 check.unchecked = self.arrays.values().map(|w| w.len() as u64).sum();
@@ -231,4 +266,12 @@ fn check_mdts(check: &mut WordCheck, slots: &[u64], k: usize, empty: u64, key: f
             check.flag(p, slot, word, why);
         }
     }
+}
+
+/// The bits of a `payload` word outside its depth and id fields: never written by a shader that
+/// packs the two fields, so a word read as a fragment holds 0 there.
+pub(super) fn outside_fields(payload: &Payload) -> u64 {
+    let bits = |n: u32| if n >= 64 { u64::MAX } else { (1 << n) - 1 };
+    let fields = bits(payload.prim_bits) | bits(payload.depth.bits()) << payload.depth_shift;
+    bits(payload.dtype.bits()) & !fields
 }

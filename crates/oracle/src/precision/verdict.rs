@@ -154,6 +154,14 @@ pub fn compare_within(
             }
         });
     }
+    crate::verdict::hold_to_reference(
+        &mut comparison,
+        candidate,
+        words,
+        reference,
+        Some(precision),
+        options,
+    );
     comparison
 }
 

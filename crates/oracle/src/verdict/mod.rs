@@ -18,6 +18,7 @@
 //! candidate, how a unorm depth is owed) being written in this module alone; the comparisons
 //! themselves are [`compare_with`], [`compare_within`] and [`Dump::compare_masked`].
 
+mod allowance;
 mod reference;
 mod report;
 mod sides;
@@ -39,6 +40,8 @@ use fragsim_raster::scene_spec::SceneSpec;
 #[cfg(doc)]
 use crate::compare::compare_with;
 
+pub(crate) use allowance::hold_to_reference;
+pub use allowance::MiscountedCounter;
 pub use reference::Reference;
 pub use report::{Corrupt, Entry, Example, FragmentTotals, SampleCounts, Summary, WordTotals};
 pub use sides::{judge_sides, Side, SideReport, SidesOptions};
@@ -314,6 +317,7 @@ pub fn judge(
         .filter(|p| !p.is_exact())
         .map(Precision::bounds);
     notes.extend(overflow_notes(&comparison, &capture));
+    notes.extend(allowance::counter_note(&comparison));
     let lists_per_pixel = reference.lists_per_pixel();
     let (width, height) = (reference.width, reference.height);
     let vertex_precision = reference.vertex_precision();

@@ -1,7 +1,7 @@
 //! The mutation kinds: each a change to one pixel's stored list (or to a list's pool) that no
 //! conforming implementation could make, or, for the conforming kinds, one that some could.
 
-use fragsim::oracle::dump::Dump;
+use fragsim::oracle::dump::{Dump, LayoutSpec, SlotOrder, Words};
 use fragsim::oracle::precision::Possible;
 
 use super::storage::{links, set, words, Item, Storage};
@@ -56,9 +56,30 @@ pub(super) enum Kind {
     /// A key-only word of a triangle at a shared edge replaced by a key of the triangle across
     /// the edge, which a conforming snap may give the pixel: conforming under f32 precision.
     EdgeKeySwap,
+    /// Exact storage (`offsets`): the pixel's room cut by one and its last fragment dropped,
+    /// its counter left at n.
+    RoomCut,
+    /// Exact storage: the pixel's room one more, an empty slot after its fragments, its
+    /// counter left at n.
+    RoomGrown,
+    /// Exact storage: every offset 0 and nothing stored, the counters left as they were.
+    NoRoom,
+    /// A K-slot list holding the pixel's K nearest fragments.
+    NearestK,
+    /// A K-slot list holding the pixel's first K fragments in primitive order.
+    FirstK,
+    /// A K-slot list holding the pixel's last K fragments in primitive order.
+    LastK,
+    /// A linked list's node counter doubled.
+    CounterDoubled,
+    /// A linked list's node counter all ones.
+    CounterAllOnes,
+    /// 0xAB in the bits of the pixel's first stored payload word outside its declared fields
+    /// (applied to the dump as encoded, [`outside_fields`]).
+    OutsideBits,
 }
 
-pub(super) const KINDS: [Kind; 25] = [
+pub(super) const KINDS: [Kind; 34] = [
     Kind::DropAt(0),
     Kind::DropAt(1),
     Kind::DropAt(2),
@@ -84,6 +105,15 @@ pub(super) const KINDS: [Kind; 25] = [
     Kind::Stray,
     Kind::EdgeKeySwap,
     Kind::DropAt(3),
+    Kind::RoomCut,
+    Kind::RoomGrown,
+    Kind::NoRoom,
+    Kind::NearestK,
+    Kind::FirstK,
+    Kind::LastK,
+    Kind::CounterDoubled,
+    Kind::CounterAllOnes,
+    Kind::OutsideBits,
 ];
 
 impl Kind {
@@ -116,8 +146,14 @@ impl Kind {
 
     /// Whether it changes the whole dump rather than a pixel (a list pool's counter): tried once.
     pub(super) fn global(self, storage: &Storage) -> bool {
-        matches!(storage, Storage::Lists)
-            && matches!(self, Self::CounterPlusOne | Self::CounterMinusOne)
+        let counter = matches!(
+            self,
+            Self::CounterPlusOne
+                | Self::CounterMinusOne
+                | Self::CounterDoubled
+                | Self::CounterAllOnes
+        );
+        (matches!(storage, Storage::Lists) && counter) || self == Self::NoRoom
     }
 }
 
@@ -143,7 +179,8 @@ pub(super) enum Change {
     Reordered,
     /// One fragment's depth moved: EQUAL exactly where the judge's interval holds it.
     Moved(Item),
-    /// Another triangle's key at a shared edge: DIFFERENT bit for bit, EQUAL under f32.
+    /// What only an f32 vertex stage may store (another triangle's key at a shared edge, a
+    /// list counter one past a full pool): DIFFERENT bit for bit, EQUAL under f32.
     OtherSnap,
 }
 
@@ -276,9 +313,49 @@ pub(super) fn mutant(
             items.sort_unstable_by_key(|item| item.word);
             Change::OtherSnap
         }
-        Kind::CounterPlusOne | Kind::CounterMinusOne | Kind::Stray => {
-            return counted(&mut out, storage, p, kind, &list).map(|()| (out, Change::Broken));
+        Kind::CounterPlusOne
+        | Kind::CounterMinusOne
+        | Kind::Stray
+        | Kind::CounterDoubled
+        | Kind::CounterAllOnes => {
+            // One more at a full pool: an f32 vertex stage may produce one fragment more than
+            // the exact one (a fragment in doubt), dropped past the pool's end.
+            let full = matches!(storage, Storage::Lists)
+                && words(&out, "counter")[0] >= words(&out, "nodes").len() as u64;
+            let change = if full && kind == Kind::CounterPlusOne {
+                Change::OtherSnap
+            } else {
+                Change::Broken
+            };
+            return counted(&mut out, storage, p, kind, &list).map(|()| (out, change));
         }
+        Kind::RoomCut | Kind::RoomGrown | Kind::NoRoom => {
+            return roomed(&mut out, storage, p, kind).map(|()| (out, Change::Broken));
+        }
+        Kind::NearestK | Kind::FirstK | Kind::LastK => {
+            let Storage::Slots { k, .. } = *storage else {
+                return None;
+            };
+            let mut all: Vec<Item> = site
+                .reference
+                .iter()
+                .map(|&word| Item { word, mask: 0 })
+                .collect();
+            match kind {
+                Kind::NearestK => {}
+                Kind::FirstK => all.sort_by_key(|item| item.prim()),
+                _ => all.sort_by_key(|item| std::cmp::Reverse(item.prim())),
+            }
+            all.truncate(k);
+            all.sort_by_key(|item| item.word);
+            if !storage.has_ids() || all == list {
+                return None;
+            }
+            items = all;
+            Change::Broken
+        }
+        // Applied to the dump as encoded (`outside_fields`): here it only says where.
+        Kind::OutsideBits if n >= 1 => Change::Broken,
         Kind::Unlink | Kind::Orphan | Kind::PastK if matches!(storage, Storage::Lists) => {
             return unlinked(&mut out, p, kind, &list).map(|()| (out, Change::Broken));
         }
@@ -347,9 +424,14 @@ fn counted(out: &mut Dump, storage: &Storage, p: usize, kind: Kind, list: &[Item
         p
     };
     let mut counters = words(out, name);
+    let lists = matches!(storage, Storage::Lists);
     match kind {
-        Kind::CounterPlusOne if room || !matches!(storage, Storage::Lists) => counters[at] += 1,
+        // A list counter counts every allocation, past the pool's end too: one more is wrong
+        // at a full pool as at a larger one.
+        Kind::CounterPlusOne => counters[at] += 1,
         Kind::CounterMinusOne if counters[at] > 0 => counters[at] -= 1,
+        Kind::CounterDoubled if lists && counters[at] > 0 => counters[at] *= 2,
+        Kind::CounterAllOnes if lists => counters[at] = u64::from(u32::MAX),
         Kind::Stray if room && out.header.filled && !list.is_empty() => {
             // A word where the empty marker must be, the counter unchanged.
             let mut stored = list.to_vec();
@@ -393,5 +475,78 @@ fn unlinked(out: &mut Dump, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
     }
     set(out, "heads", &heads);
     set(out, "next", &next);
+    Some(())
+}
+
+/// The room exact storage (`offsets`) gives: pixel `p`'s cut by one (its last fragment
+/// dropped) or grown by one (an empty slot), or every pixel's taken away; the counters are
+/// left as they were.
+fn roomed(out: &mut Dump, storage: &Storage, p: usize, kind: Kind) -> Option<()> {
+    if !matches!(storage, Storage::ABuffer { .. }) || !out.arrays.contains_key("offsets") {
+        return None;
+    }
+    let (mut offsets, mut slots) = (words(out, "offsets"), words(out, "slots"));
+    let end = offsets[p + 1] as usize;
+    match kind {
+        Kind::RoomCut if end > offsets[p] as usize => {
+            slots.remove(end - 1);
+            offsets[p + 1..].iter_mut().for_each(|o| *o -= 1);
+        }
+        Kind::RoomGrown => {
+            slots.insert(end, u64::MAX);
+            offsets[p + 1..].iter_mut().for_each(|o| *o += 1);
+        }
+        Kind::NoRoom => {
+            slots.clear();
+            offsets.fill(0);
+        }
+        _ => return None,
+    }
+    let total = slots.len() as u64;
+    let shape = vec![offsets.len() as u64];
+    out.set_array(
+        "offsets",
+        Words::U32(offsets.iter().map(|&o| o as u32).collect()),
+        shape,
+    );
+    out.set_array("slots", Words::U64(slots), vec![total]);
+    Some(())
+}
+
+/// `encoded` (a mutant as its layout stores it) with 0xAB in the bits outside its payload's
+/// fields of pixel `p`'s first stored word; `None` where the layout declares no payload or its
+/// fields fill the word.
+pub(super) fn outside_fields(encoded: &mut Dump, p: usize) -> Option<()> {
+    let (array, at) = match encoded.header.layout? {
+        LayoutSpec::Slots {
+            order: SlotOrder::PixelMajor,
+            payload: Some(payload),
+        } => {
+            let k = encoded.header.k? as usize;
+            ("slots", (payload, p * k))
+        }
+        LayoutSpec::LinkedList {
+            payload,
+            null,
+            node_base,
+        } => {
+            let head = words(encoded, "heads")[p] as u32;
+            (head != null).then_some(())?;
+            ("nodes", (payload, (head - node_base) as usize))
+        }
+        _ => return None,
+    };
+    let (payload, index) = at;
+    let bits = |n: u32| if n >= 64 { u64::MAX } else { (1 << n) - 1 };
+    let fields = bits(payload.prim_bits) | bits(payload.depth.bits()) << payload.depth_shift;
+    let outside = bits(payload.dtype.bits()) & !fields;
+    // 0xAB repeated over the spare bits.
+    let stray = outside & 0xABAB_ABAB_ABAB_ABAB;
+    let mut stored = words(encoded, array);
+    if stray == 0 || stored[index] == bits(payload.dtype.bits()) {
+        return None;
+    }
+    stored[index] |= stray;
+    set(encoded, array, &stored);
     Some(())
 }

@@ -5,7 +5,9 @@
 //! fragment dropped at each list position, a list emptied, a duplicate, a swap in sorted layouts,
 //! a nearby triangle's id, a depth past its derived interval, a counter off by one, a node
 //! unlinked or orphaned, a node past k lost, a torn word, a stray word past the counter with
-//! `filled`, a K-nearest list short at coplanar fragments), and in ways some conforming
+//! `filled`, a K-nearest list short at coplanar fragments, exact storage's room cut, grown or
+//! taken away, a K-slot list holding another K than its promise names, a list counter off at a
+//! full pool, bits set outside a payload's fields), and in ways some conforming
 //! implementation could (another arrival order in unsorted layouts, a depth moved inside its
 //! interval, a key-only triangle swap at a shared edge). Each mutant is judged bit-exactly and
 //! within the precision of an f32 vertex stage: every non-conforming one must be DIFFERENT, every
@@ -35,7 +37,7 @@ use fragsim::raster::conventions::VertexPrecision;
 use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{Conventions, Scene, SplitMix64, View, Viewport};
 
-use kinds::{mutant, Change, Pool, Site, KINDS};
+use kinds::{mutant, Change, Kind, Pool, Site, KINDS};
 use storage::{Item, Storage};
 
 use super::scratch;
@@ -280,8 +282,11 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
             ) else {
                 continue;
             };
+            let mut changed = encoded(&changed);
+            if kind == Kind::OutsideBits && kinds::outside_fields(&mut changed, p).is_none() {
+                continue;
+            }
             tried += 1;
-            let changed = encoded(&changed);
             for ((judge_name, judge), count) in layout.judges.iter().zip(&mut counts) {
                 let expected = match change {
                     Change::Broken => false,
@@ -404,7 +409,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         order: SlotOrder::SlotMajor,
         payload: None,
     };
-    let single: [(&str, DumpScheme, Option<LayoutSpec>); 16] = [
+    let single: [(&str, DumpScheme, Option<LayoutSpec>); 19] = [
         ("mdts", mdts(Direction::Ascending), None),
         ("mdts-desc", mdts(Direction::Descending), None),
         ("mdts32", DumpScheme::Mdts32 { k: K }, None),
@@ -420,6 +425,23 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             "kbuffer",
             DumpScheme::KBuffer {
                 scheme: SchemeName::Kbuffer,
+                k: K,
+            },
+            None,
+        ),
+        // The ordered interlocks: the K nearest, and the first K in primitive order.
+        (
+            "kbuf-ordered",
+            DumpScheme::KBuffer {
+                scheme: SchemeName::KbufferInterlockOrdered,
+                k: K,
+            },
+            None,
+        ),
+        (
+            "kbuf-first",
+            DumpScheme::KBuffer {
+                scheme: SchemeName::KbufferInterlockOrderedFirst,
                 k: K,
             },
             None,
@@ -449,6 +471,17 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             Some(engine_numbering),
         ),
         ("list-nearest", lists(SchemeName::LinkedListNearest), None),
+        // A pool of exactly the scene's fragments, as `--capacity auto` sizes it.
+        (
+            "list-full",
+            DumpScheme::LinkedLists {
+                scheme: SchemeName::LinkedList,
+                k: K,
+                pool: oracle.fragments() as u32,
+                spec: LayoutSpec::FRAGSIM_LISTS,
+            },
+            None,
+        ),
         (
             "layer-major",
             DumpScheme::LayerMajor {
