@@ -205,6 +205,10 @@ pub fn judge_sides(
         }
         None => None,
     };
+    if let (true, Some(view)) = (judged_f32, &view) {
+        // The f32 stage judged is not the view's (f64 here): its range is checked all the same.
+        view.check_f32_range().map_err(|e| format!("scene: {e}"))?;
+    }
     let oracle = match &view {
         None => None,
         Some(view) if masked => {
