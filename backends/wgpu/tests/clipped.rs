@@ -50,7 +50,9 @@ fn ground_capture(gpu: &fragsim_wgpu::Gpu) -> Dump {
     spec.mesh = Some(mesh.display().to_string());
     spec.view_projection = Some(engine_matrix());
     let loaded = spec.load(None).unwrap();
-    let view = spec.view(&loaded, Viewport::new(128, 128).unwrap()).unwrap();
+    let view = spec
+        .view(&loaded, Viewport::new(128, 128).unwrap())
+        .unwrap();
     capture(gpu, &view, spec, &GpuScheme::Mdts { k: 4 }, Mode::Engine)
         .unwrap()
         .dump
@@ -93,7 +95,10 @@ fn with_ground(dump: &Dump, change: impl Fn(u64) -> Option<u64>) -> Dump {
 /// Pixels whose verdict is an error.
 fn errors(judgement: &WithinJudgement) -> usize {
     let verdicts = &judgement.comparison.verdicts;
-    verdicts.iter().filter(|&&v| v & verdict::DIFFERS != 0).count()
+    verdicts
+        .iter()
+        .filter(|&&v| v & verdict::DIFFERS != 0)
+        .count()
 }
 
 #[test]
@@ -108,7 +113,12 @@ fn a_real_capture_of_a_ground_plane_through_the_near_plane_is_judged_within_prec
     assert!(correct.comparison.is_equal(), "{}", correct.summary());
     let capture = dump.capture().unwrap();
     let ground_pixels = (0..capture.pixels())
-        .filter(|&p| capture.pixel(p).iter().any(|&w| GROUND.contains(&(w as u32))))
+        .filter(|&p| {
+            capture
+                .pixel(p)
+                .iter()
+                .any(|&w| GROUND.contains(&(w as u32)))
+        })
         .count();
     assert!(
         ground_pixels * 4 > capture.pixels() * 3,

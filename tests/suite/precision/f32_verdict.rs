@@ -99,7 +99,11 @@ fn matrix_entries_whose_f32_products_leave_the_normal_range_are_refused_by_name(
             for args in [&["--vertex-precision", "f32"][..], &[]] {
                 let (_, err) = compare(&dump, args, 2);
                 let lines: Vec<&str> = err.lines().filter(|l| !l.is_empty()).collect();
-                assert_eq!(lines.len(), 1, "scale {scale}, {precision}, {args:?}: {err}");
+                assert_eq!(
+                    lines.len(),
+                    1,
+                    "scale {scale}, {precision}, {args:?}: {err}"
+                );
                 assert!(
                     lines[0].contains("view_projection.row_major[")
                         && lines[0].contains("normal range"),

@@ -79,7 +79,11 @@ pub(super) fn pieces(
     for i in 1..polygon.len().saturating_sub(1) {
         let corners = [0, i, i + 1];
         // A piece with a vertex not in front of the eye is dropped, as the pipeline drops it.
-        let Some(at) = corners.iter().map(|&k| located[k]).collect::<Option<Vec<_>>>() else {
+        let Some(at) = corners
+            .iter()
+            .map(|&k| located[k])
+            .collect::<Option<Vec<_>>>()
+        else {
             continue;
         };
         let mut verts = Vec::with_capacity(3);
@@ -171,8 +175,7 @@ fn crossing_error(ends: [([f64; 4], [f64; 4]); 2], plane: [f64; 4]) -> Option<[f
     let (da, db) = (distance(&plane, a), distance(&plane, b));
     let (epsilon_a, epsilon_b) = (distance_error(&plane, a, ea), distance_error(&plane, b, eb));
     let denominator = da - db;
-    let epsilon_d =
-        epsilon_a + epsilon_b + gamma_both(1.0) * (denominator + epsilon_a + epsilon_b);
+    let epsilon_d = epsilon_a + epsilon_b + gamma_both(1.0) * (denominator + epsilon_a + epsilon_b);
     if denominator - epsilon_d <= 0.0 {
         return None;
     }

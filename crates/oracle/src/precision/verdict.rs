@@ -370,7 +370,9 @@ fn judge_pixel(
                 let (a, b) = (possible[j].prim, possible[f].prim);
                 let same = identity != Identity::KeyOnly
                     && a != b
-                    && twins.get(a as usize).is_some_and(|&t| twins.get(b as usize) == Some(&t));
+                    && twins
+                        .get(a as usize)
+                        .is_some_and(|&t| twins.get(b as usize) == Some(&t));
                 same.then_some(if nearest { a < b } else { a > b })
             };
             let mut owed = 0;

@@ -123,7 +123,9 @@ impl View<'_> {
     /// # Errors
     /// The first such entry, by its row-major index, with the vertex and the product.
     pub fn check_f32_range(&self) -> Result<(), String> {
-        let normal = |x: f64| x == 0.0 || (f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs());
+        let normal = |x: f64| {
+            x == 0.0 || (f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs())
+        };
         let m = self.view_projection.to_cols_array_2d();
         let out_of_range = |row: usize, column: usize, vertex: Option<usize>, product: f64| {
             let times = vertex.map_or(String::new(), |v| {

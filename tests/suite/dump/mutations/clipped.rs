@@ -75,7 +75,8 @@ fn clipped_triangles_are_judged_under_f32_as_exactly() {
     let bounds = f32_analysis.bounds();
     assert_eq!(bounds.clipped_triangles, 4, "{bounds:?}");
     assert_eq!(bounds.unanalysed_triangles, 0);
-    let record = |scheme: DumpScheme| Dump::record(&view, spec.clone(), &scheme, "battery").unwrap();
+    let record =
+        |scheme: DumpScheme| Dump::record(&view, spec.clone(), &scheme, "battery").unwrap();
     let layouts: Vec<Layout<'_>> = [
         (
             "mdts",
