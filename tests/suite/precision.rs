@@ -12,6 +12,7 @@ use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
 use fragsim::raster::{Conventions, Fragment, OrbitCamera, Scene, ScreenTriangle, View, Viewport};
 
+mod f32_verdict;
 mod per_sample;
 
 /// A planted bug: an edit of one pixel's list.

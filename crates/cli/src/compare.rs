@@ -310,8 +310,8 @@ fn print_report(report: &Report<'_>) {
             "precision ({}): vertex error up to {:.3} subpixels (snapped radius {}), \
              depth intervals up to {} ulps, {} ambiguous (pixel, triangle) pairs ({} may be \
              present, {} covered with coverage undecided, {} covered with depth leaving [0, 1], \
-             {} of clipped triangles), {} clipped triangles not analysed, {} judged by the edge \
-             bound",
+             {} of clipped triangles not analysed), {} clipped triangles analysed piece by \
+             piece, {} not analysed, {} judged by the edge bound",
             match (r.vertex_precision, r.stored_depth) {
                 ("f32", "f32") => "f32 vertex stage".to_string(),
                 ("f32", stored) => format!("f32 vertex stage, {stored} depth"),
@@ -325,6 +325,7 @@ fn print_report(report: &Report<'_>) {
             b.coverage_undecided_pairs,
             b.depth_undecided_pairs,
             b.clipped_pairs,
+            b.clipped_triangles,
             b.unanalysed_triangles,
             b.bounded_triangles
         );

@@ -38,8 +38,8 @@ pub use conventions::{Conventions, DepthRange, EdgeTies, VertexPrecision, Window
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
 pub use mesh::{Mesh, MeshError, UpAxis, MESH_BYTES_LIMIT};
 pub use pipeline::{
-    edge_function, fill_thresholds, CullMode, ScreenTriangle, TriangleSetup, View,
-    GUARD_BAND_PIXELS,
+    edge_function, fill_thresholds, ClipOrigin, ClipTrace, Clipped, CullMode, ScreenTriangle,
+    TriangleSetup, View, GUARD_BAND_PIXELS,
 };
 pub use rng::SplitMix64;
 pub use samples::SamplePattern;

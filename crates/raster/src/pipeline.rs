@@ -33,7 +33,7 @@
 use glam::{DMat4, DVec4};
 
 use crate::camera::Camera;
-use crate::conventions::Conventions;
+use crate::conventions::{Conventions, VertexPrecision};
 use crate::fragment::Fragment;
 use crate::mesh::Mesh;
 use crate::viewport::{PixelRect, Viewport, HALF, ONE, SUBPIXEL_BITS};
@@ -56,6 +56,7 @@ pub use edges::{edge as edge_function, fill_thresholds};
 use sample_scan::Sampling;
 pub use setup::TriangleSetup;
 use vertex::{in_front, AxisPositions, CentreCells, WindowVertex};
+pub use vertex::{ClipOrigin, ClipTrace, Clipped};
 
 /// How far outside the viewport, in pixels, vertices may lie before they are clipped.
 ///
@@ -158,6 +159,9 @@ impl<'mesh> View<'mesh> {
     ) -> Result<Self, String> {
         conventions.check()?;
         let view = Self::build(mesh, camera, viewport, cull, conventions);
+        if conventions.vertex_precision == VertexPrecision::F32 {
+            view.check_f32_range()?;
+        }
         match conventions.pattern()? {
             Some(pattern) => view.with_samples(pattern),
             None => Ok(view),

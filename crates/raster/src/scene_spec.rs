@@ -72,9 +72,10 @@ pub enum SceneSpecError {
         /// Its value.
         value: f64,
     },
-    /// An entry of an f32 matrix beyond f32's range.
+    /// A nonzero entry of an f32 matrix outside f32's normal range (infinite, zero or
+    /// subnormal as an f32).
     #[error(
-        "scene view_projection.row_major[{index}] is {value}, beyond f32's range, \
+        "scene view_projection.row_major[{index}] is {value}, outside f32's normal range, \
          but the matrix's precision is f32"
     )]
     BeyondF32 {
@@ -295,7 +296,7 @@ impl SceneSpec {
     /// axis (with the projection of the conventions' depth range, [`OrbitCamera::camera_for`]).
     ///
     /// # Errors
-    /// A matrix declared f32 with an entry beyond f32's range.
+    /// A matrix declared f32 with a nonzero entry outside f32's normal range.
     pub fn camera(&self, scene: &Scene, viewport: Viewport) -> Result<Camera, SceneSpecError> {
         match &self.view_projection {
             Some(matrix) => Ok(Camera::from_row_major(engine_matrix(matrix)?)),
@@ -324,8 +325,8 @@ impl SceneSpec {
     }
 
     /// Refuses a NaN or infinite number, which JSON cannot hold (`serde_json` would silently write
-    /// `null`, which then fails to parse as a number far from its cause), and an f32 matrix entry
-    /// beyond f32's range.
+    /// `null`, which then fails to parse as a number far from its cause), and a nonzero f32 matrix
+    /// entry outside f32's normal range.
     ///
     /// # Errors
     /// The first field that is not finite, by name (`view_projection.row_major[i]` for a matrix
@@ -406,13 +407,15 @@ fn find_mesh(mesh: &str, beside: Option<&Path>) -> Result<PathBuf, SceneSpecErro
 /// f32 (exact for the shortest f32 decimal an engine prints, or any with 9 significant digits).
 ///
 /// # Errors
-/// An f32 matrix with an entry beyond f32's range, by index.
+/// An f32 matrix with a nonzero entry outside f32's normal range, by index.
 fn engine_matrix(matrix: &ViewProjection) -> Result<[f64; 16], SceneSpecError> {
     let mut entries = matrix.row_major;
     if matrix.precision == VertexPrecision::F32 {
         for (index, value) in entries.iter_mut().enumerate() {
             let single = *value as f32;
-            if !single.is_finite() {
+            // Infinite, or a nonzero value that f32 holds as zero or a subnormal (which a GPU
+            // may flush to zero).
+            if !single.is_finite() || (*value != 0.0 && !single.is_normal()) {
                 return Err(SceneSpecError::BeyondF32 {
                     index,
                     value: *value,

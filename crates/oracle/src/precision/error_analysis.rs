@@ -17,7 +17,18 @@ pub(super) fn vertex_bound(
     bounds: &mut Bounds,
 ) -> Option<VertexBound> {
     let (snapped, depth) = view.vertex_window(index)?;
-    let clip = view.vertex_clip(index);
+    let at = Located {
+        clip: view.vertex_clip(index).to_array(),
+        error: clip_error(view, index),
+        snapped,
+        depth,
+    };
+    window_bound(view, conventions, at, bounds)
+}
+
+/// A bound on each clip coordinate's error (x, y, z, w) of vertex `index` as an f32 vertex stage
+/// computes it, against the reference's f64 transform (`docs/semantics.md` §10, step 1).
+pub(super) fn clip_error(view: &View<'_>, index: u32) -> [f64; 4] {
     let m = view.view_projection().to_cols_array();
     let p = view.mesh().positions[index as usize];
     let v = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2]), 1.0];
@@ -35,8 +46,35 @@ pub(super) fn vertex_bound(
             dot_error(products) + gamma(4.0, U64) * magnitude
         }
     };
-    let [ex, ey, ez, ew] = [0, 1, 2, 3].map(transform_error);
-    let w = clip.w;
+    [0, 1, 2, 3].map(transform_error)
+}
+
+/// A point of the pipeline in clip space as the reference computed it, a bound on each of its
+/// coordinates' error in an f32 implementation, and the reference's snapped window position and
+/// depth of it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Located {
+    pub(super) clip: [f64; 4],
+    pub(super) error: [f64; 4],
+    pub(super) snapped: [i64; 2],
+    pub(super) depth: f64,
+}
+
+/// The error bounds of a point in the window, from its clip position and that position's error
+/// (`docs/semantics.md` §10, steps 2–4): `None` when its `w` is not bounded away from 0.
+pub(super) fn window_bound(
+    view: &View<'_>,
+    conventions: &Conventions,
+    at: Located,
+    bounds: &mut Bounds,
+) -> Option<VertexBound> {
+    let Located {
+        clip,
+        error: [ex, ey, ez, ew],
+        snapped,
+        depth,
+    } = at;
+    let [cx, cy, cz, w] = clip;
     if w.abs() <= ew {
         return None;
     }
@@ -46,12 +84,8 @@ pub(super) fn vertex_bound(
         let e = (e + q.abs() * ew) / (w.abs() - ew);
         e + half_ulp(q.abs() + e) + gamma(1.0, U64) * (q.abs() + e)
     };
-    let (nx, ny, nz) = (clip.x / w, clip.y / w, clip.z / w);
-    let (enx, eny, enz) = (
-        ndc_error(clip.x, ex),
-        ndc_error(clip.y, ey),
-        ndc_error(clip.z, ez),
-    );
+    let (nx, ny, nz) = (cx / w, cy / w, cz / w);
+    let (enx, eny, enz) = (ndc_error(cx, ex), ndc_error(cy, ey), ndc_error(cz, ez));
     // X = (ndc·½ + ½)·width, or the spec's (width/2)·ndc + width/2: the error scaled by
     // width/2, and two more roundings of results no larger than these (the halving is exact).
     // The render target in pixels: a view rasterizing per sample maps positions to pixels too.

@@ -84,7 +84,9 @@ pub enum Doubt {
     Coverage,
     /// Coverage is certain but the depth interval leaves `[0, 1]`: the fragment may be clipped.
     Depth,
-    /// The reference clips the triangle (near plane or guard band): not analysed.
+    /// The reference clips the triangle (near plane or guard band) and its pieces cannot be
+    /// bounded (a vertex whose `w`, or whose side of a clipping plane, its error leaves open):
+    /// not analysed.
     Clipped,
 }
 
@@ -107,10 +109,14 @@ pub struct Bounds {
     pub coverage_undecided_pairs: u64,
     /// Of those, pairs whose coverage is certain but whose depth interval leaves `[0, 1]`.
     pub depth_undecided_pairs: u64,
-    /// Of those, pairs of triangles the reference clips ([`Bounds::unanalysed_triangles`]).
+    /// Of those, pairs of clipped triangles not analysed ([`Bounds::unanalysed_triangles`]).
     pub clipped_pairs: u64,
-    /// Triangles the reference clips (near plane or guard band): not analysed, their fragments
-    /// taken as ambiguous with any depth.
+    /// Triangles the reference clips (near plane or guard band) analysed piece by piece, every
+    /// vertex the clipping makes bounded as the implementation may compute it.
+    pub clipped_triangles: u64,
+    /// Triangles the reference clips whose pieces cannot be bounded (a vertex whose `w`, or whose
+    /// side of a clipping plane, its error leaves open): not analysed, their fragments taken as
+    /// ambiguous with any depth.
     pub unanalysed_triangles: u64,
     /// Triangles whose vertices may reach more than 64 combinations of snapped positions: their
     /// coverage judged by the bilinear edge bound over the radius instead of by enumeration.
@@ -133,6 +139,10 @@ pub struct Precision {
     /// Per mesh vertex, how many snapped positions it may reach (1: its snap is decided; 0: not
     /// analysed).
     vertex_points: Vec<u8>,
+    /// Per primitive, the first primitive with the very same vertex indices in the same order
+    /// (itself when none): such twins have the same depth at every sample in any implementation,
+    /// so a tie between them is decided by primitive id as exactly (empty when exact).
+    twins: Vec<u32>,
     bounds: Bounds,
 }
 
@@ -162,6 +172,66 @@ impl Dependence {
         let [_, n1, n2] = self.points.map(u64::from);
         self.covering >> ((a * n1 + b) * n2 + c) & 1 == 1
     }
+}
+
+/// One (sample, triangle) the analysis lists: what the implementation may emit there, and
+/// whether the reference's snapped triangle covers the sample (what tells a fragment that may be
+/// present from one that may be absent).
+#[derive(Clone, Copy, Debug)]
+struct Found {
+    pixel: u32,
+    possible: Possible,
+    covered: bool,
+}
+
+impl Found {
+    /// Counts it in `bounds` by the cause of its doubt, if any.
+    fn tally(&self, bounds: &mut Bounds) {
+        let Some(doubt) = self.possible.doubt else {
+            return;
+        };
+        bounds.ambiguous_pairs += 1;
+        let cause = match doubt {
+            _ if self.possible.reference.is_none() && !self.covered => {
+                &mut bounds.may_be_present_pairs
+            }
+            Doubt::Coverage => &mut bounds.coverage_undecided_pairs,
+            Doubt::Depth => &mut bounds.depth_undecided_pairs,
+            Doubt::Clipped => &mut bounds.clipped_pairs,
+        };
+        *cause += 1;
+    }
+}
+
+/// Per primitive of `view`, the first primitive with the same vertex indices in the same order.
+fn twins(view: &View<'_>) -> Vec<u32> {
+    let mut first = std::collections::HashMap::new();
+    view.mesh()
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(prim, ids)| *first.entry(*ids).or_insert(prim as u32))
+        .collect()
+}
+
+/// Triangle `prim`, which the reference clips and whose pieces cannot be bounded (a vertex whose
+/// `w` or side of a clipping plane its error leaves open): its reference fragments listed as
+/// ambiguous with any depth.
+fn not_analysed(view: &View<'_>, prim: u32, found: &mut Vec<Found>, bounds: &mut Bounds) {
+    bounds.unanalysed_triangles += 1;
+    view.rasterize(prim, &mut |f| {
+        found.push(Found {
+            pixel: f.pixel,
+            possible: Possible {
+                prim,
+                key_lo: 0,
+                key_hi: KEY_ONE,
+                doubt: Some(Doubt::Clipped),
+                reference: Some(f.depth_key),
+            },
+            covered: true,
+        });
+    });
 }
 
 /// A vertex's error bounds: the snapped positions it may reach, their radius (subpixels) and the
@@ -216,7 +286,7 @@ impl Precision {
             .iter()
             .map(|v| v.map_or(0, |v| u8::try_from(reachable_points(&v)).unwrap_or(0)))
             .collect();
-        let mut found: Vec<(u32, Possible)> = Vec::new();
+        let mut found: Vec<Found> = Vec::new();
         let mut dependent: Vec<(usize, Dependence)> = Vec::new();
         for prim in 0..view.triangle_count() {
             let ids = view.mesh().triangles[prim as usize];
@@ -226,45 +296,43 @@ impl Precision {
                         prim,
                         ids,
                         verts: [a, b, c],
+                        shared: true,
                     };
                     if !triangle(target, rule, tri, &mut found, &mut dependent, &mut bounds) {
                         bounds.bounded_triangles += 1;
                     }
                 }
                 _ => {
-                    bounds.unanalysed_triangles += 1;
-                    view.rasterize(prim, &mut |f| {
-                        bounds.ambiguous_pairs += 1;
-                        bounds.clipped_pairs += 1;
-                        found.push((
-                            f.pixel,
-                            Possible {
-                                prim,
-                                key_lo: 0,
-                                key_hi: KEY_ONE,
-                                doubt: Some(Doubt::Clipped),
-                                reference: Some(f.depth_key),
-                            },
-                        ));
-                    });
+                    let analysed = clipped::pieces(view, conventions, prim, &mut bounds)
+                        .map(|pieces| clipped::analyse(target, rule, prim, &pieces, &mut bounds));
+                    match analysed {
+                        Some(entries) => {
+                            bounds.clipped_triangles += 1;
+                            found.extend(entries);
+                        }
+                        None => not_analysed(view, prim, &mut found, &mut bounds),
+                    }
                 }
             }
+        }
+        for f in &found {
+            f.tally(&mut bounds);
         }
         let mut dependency_of: Vec<Option<Dependence>> = vec![None; found.len()];
         for (entry, dependence) in dependent {
             dependency_of[entry] = Some(dependence);
         }
         let mut order: Vec<usize> = (0..found.len()).collect();
-        order.sort_by_key(|&i| found[i].0);
+        order.sort_by_key(|&i| found[i].pixel);
         let pixels = view.viewport().pixels();
         let mut offsets = vec![0_usize; pixels + 1];
-        for &(p, _) in &found {
-            offsets[p as usize + 1] += 1;
+        for f in &found {
+            offsets[f.pixel as usize + 1] += 1;
         }
         for i in 0..pixels {
             offsets[i + 1] += offsets[i];
         }
-        let entries: Vec<Possible> = order.iter().map(|&i| found[i].1).collect();
+        let entries: Vec<Possible> = order.iter().map(|&i| found[i].possible).collect();
         let dependencies: Vec<Option<Dependence>> =
             order.iter().map(|&i| dependency_of[i]).collect();
         for e in &entries {
@@ -279,6 +347,7 @@ impl Precision {
             entries,
             dependencies,
             vertex_points,
+            twins: twins(view),
             bounds,
         }
     }
@@ -334,6 +403,7 @@ impl Precision {
             dependencies: vec![None; entries.len()],
             entries,
             vertex_points: Vec::new(),
+            twins: Vec::new(),
             bounds: Bounds::default(),
         }
     }
@@ -348,6 +418,7 @@ impl Precision {
             entries: Vec::new(),
             dependencies: Vec::new(),
             vertex_points: Vec::new(),
+            twins: Vec::new(),
             bounds: Bounds::default(),
         }
     }
@@ -389,6 +460,7 @@ impl Precision {
     }
 }
 
+mod clipped;
 mod error_analysis;
 #[cfg(test)]
 mod tests;

@@ -42,7 +42,7 @@ fn rasterize(viewport: Viewport, xy: [[i64; 2]; 3], z: [f64; 3]) -> Vec<(u32, f6
     out
 }
 
-/// [`triangle`] on vertices 0, 1, 2 of a mesh of their own.
+/// [`triangle`] on vertices 0, 1, 2 of a mesh of their own, its entries tallied in `bounds`.
 fn analyse(
     viewport: Viewport,
     origin: WindowOrigin,
@@ -55,19 +55,26 @@ fn analyse(
         prim,
         ids: [0, 1, 2],
         verts,
+        shared: true,
     };
     let target = Target {
         pixels: viewport,
         pattern: SamplePattern::CENTRE,
     };
-    triangle(
+    let mut entries = Vec::new();
+    let enumerated = triangle(
         target,
         pipeline_rule(origin),
         tri,
-        found,
+        &mut entries,
         &mut Vec::new(),
         bounds,
-    )
+    );
+    for f in entries {
+        f.tally(bounds);
+        found.push((f.pixel, f.possible));
+    }
+    enumerated
 }
 
 /// A vertex that may reach every grid point within `radius` of `(x, y)` (1/256-pixel grid).

@@ -6,7 +6,7 @@ use fragsim_raster::samples::SamplePattern;
 use fragsim_raster::{depth_key, edge_function as edge, EdgeTies, Viewport, SUBPIXEL_BITS};
 
 use super::error_analysis::{depth_interval, edge_bound, real, Plane};
-use super::{Bounds, Dependence, Doubt, Possible, VertexBound, MAX_COMBINATIONS};
+use super::{Bounds, Dependence, Doubt, Found, Possible, VertexBound, MAX_COMBINATIONS};
 use crate::edge_ties::thresholds;
 
 /// How many grid points vertex `b` may reach along `axis`.
@@ -79,11 +79,16 @@ pub(super) fn triangle(
     target: Target,
     rule: EdgeTies,
     tri: Triangle,
-    found: &mut Vec<(u32, Possible)>,
+    found: &mut Vec<Found>,
     dependent: &mut Vec<(usize, Dependence)>,
     bounds: &mut Bounds,
 ) -> bool {
-    let Triangle { prim, ids, verts } = tri;
+    let Triangle {
+        prim,
+        ids,
+        verts,
+        shared,
+    } = tri;
     let [a, mut b, mut c] = verts;
     let [ia, mut ib, mut ic] = ids;
     let mut area = edge(a.snapped, b.snapped, c.snapped);
@@ -220,7 +225,7 @@ pub(super) fn triangle(
             / area_f;
         let reference = if covered { depth_key(z as f32) } else { None };
         let (key_lo, key_hi, inside) = depth_interval(pixels, &v, &planes, p, z);
-        if !certain && !clipped_tie && reachable.is_some() {
+        if shared && !certain && !clipped_tie && reachable.is_some() {
             dependent.push((
                 found.len(),
                 Dependence {
@@ -238,26 +243,17 @@ pub(super) fn triangle(
         } else {
             None
         };
-        if doubt.is_some() {
-            bounds.ambiguous_pairs += 1;
-            if reference.is_none() && !covered {
-                bounds.may_be_present_pairs += 1;
-            } else if doubt == Some(Doubt::Coverage) {
-                bounds.coverage_undecided_pairs += 1;
-            } else {
-                bounds.depth_undecided_pairs += 1;
-            }
-        }
-        found.push((
-            ((y * i64::from(pixels.width) + x) * samples + s) as u32,
-            Possible {
+        found.push(Found {
+            pixel: ((y * i64::from(pixels.width) + x) * samples + s) as u32,
+            possible: Possible {
                 prim,
                 key_lo,
                 key_hi,
                 doubt,
                 reference,
             },
-        ));
+            covered,
+        });
     }
     reachable.is_some()
 }
@@ -272,10 +268,13 @@ pub(super) struct Target {
     pub(super) pattern: SamplePattern,
 }
 
-/// A triangle to analyse: its primitive id, its vertices' mesh indices and their bounds.
+/// A triangle to analyse: its primitive id, its vertices' indices and their bounds.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Triangle {
     pub(super) prim: u32,
     pub(super) ids: [u32; 3],
     pub(super) verts: [VertexBound; 3],
+    /// Whether `ids` are mesh vertices, each snapped once for every triangle that uses it (a
+    /// piece of a clipped triangle has vertices of its own: its fragments are judged one by one).
+    pub(super) shared: bool,
 }

@@ -35,7 +35,8 @@ mod snaps;
 ///
 /// # Errors
 /// A scene that cannot be loaded or rasterized ([`SceneSpec::load`],
-/// [`SceneSpec::view`]).
+/// [`SceneSpec::view`]), or whose f32 vertex stage would leave f32's normal range
+/// ([`fragsim_raster::View::check_f32_range`]).
 pub fn f32_reference(
     scene: &SceneSpec,
     viewport: Viewport,
@@ -45,6 +46,8 @@ pub fn f32_reference(
     exact.conventions.vertex_precision = VertexPrecision::F64;
     let loaded = exact.load(beside)?;
     let view = exact.view(&loaded, viewport)?;
+    view.check_f32_range()
+        .map_err(|e| DumpError::Invalid(format!("scene: {e}")))?;
     let f32_stage = Conventions {
         vertex_precision: VertexPrecision::F32,
         ..exact.conventions
@@ -121,6 +124,7 @@ pub fn compare_within(
         candidate,
         words,
         widen: options.depth_ulps,
+        twins: &precision.twins,
     };
     let snaps = Snaps::infer(precision, &pixel_of);
     comparison.snaps = snaps.counts;
@@ -173,6 +177,8 @@ struct Pixel<'a> {
     candidate: &'a Capture,
     words: Option<&'a WordCheck>,
     widen: u32,
+    /// Per primitive, its first twin ([`Precision`]'s `twins`).
+    twins: &'a [u32],
 }
 
 impl Pixel<'_> {
@@ -185,6 +191,7 @@ impl Pixel<'_> {
             self.p,
             self.words,
             self.widen,
+            self.twins,
         )
     }
 
@@ -313,6 +320,7 @@ fn judge_pixel(
     p: usize,
     words: Option<&WordCheck>,
     widen: u32,
+    twins: &[u32],
 ) -> Judged {
     let identity = candidate.identity;
     let mut judged = Judged::default();
@@ -363,13 +371,27 @@ fn judge_pixel(
             // ahead but are not in the list excuse nothing (a list of fewer than K fragments
             // left nothing out).
             let held: Vec<usize> = assigned.iter().flatten().copied().collect();
+            // Twins (the same vertex indices) have the same depth in any implementation: which
+            // one is ahead is the tie rule's, by primitive id, as the exact verdict has it. Words
+            // without ids cannot tell them apart.
+            let twin_ahead = |j: usize, f: usize| {
+                let (a, b) = (possible[j].prim, possible[f].prim);
+                let same = identity != Identity::KeyOnly
+                    && a != b
+                    && twins
+                        .get(a as usize)
+                        .is_some_and(|&t| twins.get(b as usize) == Some(&t));
+                same.then_some(if nearest { a < b } else { a > b })
+            };
             let mut owed = 0;
             for &f in &absent_certain {
                 let (f_lo, f_hi) = widened(&possible[f]);
                 let (mut surely, mut maybe) = (0, 0);
                 for &j in &held {
                     let (lo, hi) = widened(&possible[j]);
-                    let (sure, could) = if nearest {
+                    let (sure, could) = if let Some(ahead) = twin_ahead(j, f) {
+                        (ahead, ahead)
+                    } else if nearest {
                         (hi < f_lo, lo <= f_hi)
                     } else {
                         (lo > f_hi, hi >= f_lo)

@@ -223,6 +223,10 @@ pub fn judge_sides(
         }
         None => None,
     };
+    if let (true, Some(view)) = (judged_f32, &view) {
+        // The f32 stage judged is not the view's (f64 here): its range is checked all the same.
+        view.check_f32_range().map_err(|e| format!("scene: {e}"))?;
+    }
     if let (Some(view), Some(cap)) = (&view, options.memory_cap) {
         crate::memory_cap::check(view, cap)?;
     }

@@ -56,23 +56,108 @@ impl View<'_> {
     /// Clips a triangle in homogeneous space against the near plane and the guard band (rule 3);
     /// fewer than 3 vertices when nothing is left.
     pub(super) fn clip(&self, triangle: [DVec4; 3]) -> Vec<DVec4> {
-        let mut polygon = triangle.to_vec();
-        for plane in self.planes() {
-            polygon = clip_polygon(&polygon, plane);
-            if polygon.len() < 3 {
-                return polygon;
+        let trace = ClipTrace::of(triangle, &self.planes());
+        self.clamped(&trace)
+    }
+
+    /// The polygon `trace` leaves, as the pipeline uses it: each vertex clamped to the guard band.
+    ///
+    /// An intersection between vertices far apart (|x| near 1e38, say) cancels catastrophically
+    /// and may land far outside the band it was clipped to; clamping restores the bound that
+    /// keeps fixed-point coordinates and edge functions from overflowing (rule 3). It moves
+    /// nothing that the clipping left inside.
+    fn clamped(&self, trace: &ClipTrace) -> Vec<DVec4> {
+        if trace.polygon.len() < 3 {
+            return trace.polygon.iter().map(|&i| trace.points[i]).collect();
+        }
+        let [gx, gy] = self.guard;
+        trace
+            .polygon
+            .iter()
+            .map(|&i| {
+                let mut v = trace.points[i];
+                v.x = v.x.max(-gx * v.w).min(gx * v.w);
+                v.y = v.y.max(-gy * v.w).min(gy * v.w);
+                v
+            })
+            .collect()
+    }
+
+    /// Triangle `prim` as the pipeline clips it (rule 3), every step recorded, with the polygon's
+    /// vertices as the pipeline uses them (clamped, in clip space) and their snapped window
+    /// positions and depths (rule 4): what a precision analysis of a clipped triangle starts
+    /// from. `None` when the triangle takes no clipping (no vertex outside the near plane or the
+    /// guard band) or is rejected whole by one plane.
+    #[must_use]
+    pub fn clipped(&self, prim: u32) -> Option<Clipped> {
+        let indices = self.mesh.triangles[prim as usize];
+        let [ca, cb, cc] = indices.map(|i| self.outcode(i));
+        if ca & cb & cc != 0 || (ca | cb | cc) & CLIP_BITS == 0 {
+            return None;
+        }
+        let trace = ClipTrace::of(indices.map(|i| self.clip_position(i)), &self.planes());
+        let polygon = self.clamped(&trace);
+        let stage = self.stage();
+        let snapped = polygon.iter().map(|&v| stage.snap(v)).collect();
+        Some(Clipped {
+            trace,
+            polygon,
+            snapped,
+        })
+    }
+
+    /// The clipping planes as `p · v ≥ 0`, in the order the pipeline clips against them: near
+    /// (`z ≥ 0`, or `z ≥ −w` for [`DepthRange::MinusOneToOne`]) then the four guard-band planes.
+    #[must_use]
+    pub fn clip_planes(&self) -> [DVec4; 5] {
+        self.planes()
+    }
+
+    /// Refuses a view whose f32 vertex stage would leave f32's normal range: a nonzero product of
+    /// a matrix entry and a position coordinate (or a nonzero translation entry) below
+    /// `f32::MIN_POSITIVE` or above `f32::MAX` in magnitude. A GPU may flush a subnormal to zero
+    /// (Vulkan allows it) and an overflow is infinite, so neither fragsim's f32 stage nor the
+    /// bounds of `docs/semantics.md` §10 say what such an implementation computes, whatever
+    /// precision the matrix was declared in.
+    ///
+    /// # Errors
+    /// The first such entry, by its row-major index, with the vertex and the product.
+    pub fn check_f32_range(&self) -> Result<(), String> {
+        let normal = |x: f64| {
+            x == 0.0 || (f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs())
+        };
+        let m = self.view_projection.to_cols_array_2d();
+        let out_of_range = |row: usize, column: usize, vertex: Option<usize>, product: f64| {
+            let times = vertex.map_or(String::new(), |v| {
+                format!(" times vertex {v}'s {}", ["x", "y", "z"][column])
+            });
+            format!(
+                "view_projection.row_major[{}] is {}: under an f32 vertex stage its product{times}                  is {product:e}, outside f32's normal range ({:e} to {:e}; a GPU may flush                  subnormals to zero)",
+                row * 4 + column,
+                m[column][row],
+                f32::MIN_POSITIVE,
+                f32::MAX
+            )
+        };
+        for row in 0..4 {
+            if !normal(m[3][row]) {
+                return Err(out_of_range(row, 3, None, m[3][row]));
+            }
+            for column in 0..3 {
+                let entry = m[column][row];
+                if entry == 0.0 {
+                    continue;
+                }
+                let bad = self.mesh.positions.iter().enumerate().find_map(|(v, p)| {
+                    let product = entry * f64::from(p[column]);
+                    (!normal(product)).then_some((v, product))
+                });
+                if let Some((v, product)) = bad {
+                    return Err(out_of_range(row, column, Some(v), product));
+                }
             }
         }
-        // An intersection between vertices far apart (|x| near 1e38, say) cancels catastrophically
-        // and may land far outside the band it was clipped to; clamping restores the bound that
-        // keeps fixed-point coordinates and edge functions from overflowing (rule 3). It moves
-        // nothing that the clipping left inside.
-        let [gx, gy] = self.guard;
-        for v in &mut polygon {
-            v.x = v.x.max(-gx * v.w).min(gx * v.w);
-            v.y = v.y.max(-gy * v.w).min(gy * v.w);
-        }
-        polygon
+        Ok(())
     }
 
     /// The vertex stage of this view's camera, viewport and conventions.
@@ -443,27 +528,101 @@ pub(super) fn round_half_away(value: f64) -> i32 {
     rounded + i32::from(tie == 0.5 && value > 0.0) - i32::from(tie == -0.5 && value < 0.0)
 }
 
-/// Sutherland–Hodgman against one plane `p · v ≥ 0`.
-fn clip_polygon(polygon: &[DVec4], plane: DVec4) -> Vec<DVec4> {
-    let mut out = Vec::with_capacity(polygon.len() + 1);
-    for (i, &current) in polygon.iter().enumerate() {
-        let next = polygon[(i + 1) % polygon.len()];
-        let (dc, dn) = (plane.dot(current), plane.dot(next));
-        if dc >= 0.0 {
-            out.push(current);
+/// How a vertex of a clipped polygon was made (rule 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClipOrigin {
+    /// Corner `k` (0, 1 or 2) of the triangle, as the vertex stage transformed it.
+    Corner(usize),
+    /// Where the segment from point `inside` to point `outside` of the trace (indices into
+    /// [`ClipTrace::points`]) crosses plane `plane` ([`View::clip_planes`]), computed from the
+    /// inside end: `inside + (outside − inside) · t` with `t = d_in / (d_in − d_out)`.
+    Crossing {
+        /// The end inside the plane.
+        inside: usize,
+        /// The end outside it.
+        outside: usize,
+        /// The plane, by index.
+        plane: usize,
+    },
+}
+
+/// Sutherland–Hodgman on one triangle, every step recorded: the points made and how, and the
+/// polygon left.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClipTrace {
+    /// Every point made, in clip space, before the pipeline's clamp ([`Clipped::polygon`]).
+    pub points: Vec<DVec4>,
+    /// How each point was made.
+    pub origins: Vec<ClipOrigin>,
+    /// The polygon left, as indices into `points`, in order; fewer than 3: nothing is left.
+    pub polygon: Vec<usize>,
+}
+
+impl ClipTrace {
+    /// Clips `triangle` against `planes` in order (`p · v ≥ 0` inside), stopping when fewer than
+    /// 3 vertices are left.
+    fn of(triangle: [DVec4; 3], planes: &[DVec4]) -> Self {
+        let mut trace = Self {
+            points: triangle.to_vec(),
+            origins: (0..3).map(ClipOrigin::Corner).collect(),
+            polygon: vec![0, 1, 2],
+        };
+        for (index, &plane) in planes.iter().enumerate() {
+            trace.polygon = trace.clip_against(index, plane);
+            if trace.polygon.len() < 3 {
+                break;
+            }
         }
-        if (dc >= 0.0) != (dn >= 0.0) {
-            // From the inside end toward the outside end, whichever way this polygon walks the
-            // edge: two triangles sharing the edge then compute the very same f64 point, snap it
-            // to the same grid point, and the shared clipped edge stays watertight.
-            let (inside, d_in, outside, d_out) = if dc >= 0.0 {
-                (current, dc, next, dn)
-            } else {
-                (next, dn, current, dc)
-            };
-            let t = d_in / (d_in - d_out);
-            out.push(inside + (outside - inside) * t);
-        }
+        trace
     }
-    out
+
+    /// Sutherland–Hodgman against plane `index`, `plane · v ≥ 0`: the new polygon, the crossings
+    /// added to the points.
+    fn clip_against(&mut self, index: usize, plane: DVec4) -> Vec<usize> {
+        let polygon = std::mem::take(&mut self.polygon);
+        let mut out = Vec::with_capacity(polygon.len() + 1);
+        for (i, &current) in polygon.iter().enumerate() {
+            let next = polygon[(i + 1) % polygon.len()];
+            let (dc, dn) = (
+                plane.dot(self.points[current]),
+                plane.dot(self.points[next]),
+            );
+            if dc >= 0.0 {
+                out.push(current);
+            }
+            if (dc >= 0.0) != (dn >= 0.0) {
+                // From the inside end toward the outside end, whichever way this polygon walks the
+                // edge: two triangles sharing the edge then compute the very same f64 point, snap
+                // it to the same grid point, and the shared clipped edge stays watertight.
+                let (inside, d_in, outside, d_out) = if dc >= 0.0 {
+                    (current, dc, next, dn)
+                } else {
+                    (next, dn, current, dc)
+                };
+                let (a, b) = (self.points[inside], self.points[outside]);
+                let t = d_in / (d_in - d_out);
+                out.push(self.points.len());
+                self.points.push(a + (b - a) * t);
+                self.origins.push(ClipOrigin::Crossing {
+                    inside,
+                    outside,
+                    plane: index,
+                });
+            }
+        }
+        out
+    }
+}
+
+/// A triangle as the pipeline clips it ([`View::clipped`]); its pieces are the fan
+/// `(polygon[0], polygon[i], polygon[i + 1])` of those whose three vertices have `w > 0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clipped {
+    /// The clipping, step by step.
+    pub trace: ClipTrace,
+    /// The polygon's vertices as the pipeline uses them: `trace.polygon`'s points clamped to the
+    /// guard band.
+    pub polygon: Vec<DVec4>,
+    /// Their snapped window positions (1/256 pixel, y down) and window depths.
+    pub snapped: Vec<([i64; 2], f64)>,
 }
