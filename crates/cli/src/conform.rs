@@ -73,8 +73,8 @@ pub struct ConformArgs {
     #[arg(long, value_name = "N", default_value_t = 8,
           value_parser = clap::value_parser!(u32).range(1..=64))]
     pub max_side: u32,
-    /// The most triangles a case holds (default: 6, or 2 more than the larger of K and the
-    /// capacity where that is more, so that cases can overflow both).
+    /// The most triangles a case holds (default: 7, or 4 more than the larger of K and the
+    /// capacity where that is more, so that most cases overflow both).
     #[arg(long, value_name = "N",
           value_parser = clap::value_parser!(u32).range(1..=64))]
     pub max_triangles: Option<u32>,
@@ -249,8 +249,9 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         },
         power_of_two: args.power_of_two,
     };
-    let depth = args.k.max(args.capacity) + 1;
-    let max_triangles = args.max_triangles.unwrap_or((depth + 1).clamp(6, 64));
+    let max_triangles = args
+        .max_triangles
+        .unwrap_or((args.k.max(args.capacity) + 4).clamp(7, 64));
     let battery = Battery::new(&backend, params)
         .cases(args.cases)
         .seed(args.seed)

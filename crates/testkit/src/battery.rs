@@ -524,7 +524,7 @@ impl<'b> Battery<'b> {
     /// viewports ([`Backend::power_of_two_viewports`]).
     fn case_limits(&self) -> Limits {
         let depth = match self.limits.depth {
-            0 => self.params.k.max(self.params.capacity) as usize + 1,
+            0 => self.params.k.max(self.params.capacity) as usize + 2,
             depth => depth,
         };
         Limits {

@@ -3,9 +3,10 @@
 //! ([`case`]).
 //!
 //! Guarantee: most cases are **deep**: three in four hold at least [`Limits::depth`] triangles
-//! (one more than the larger of K and the capacity, as the battery sets it), most of them stacked
-//! on the footprint of the triangle before (at their own depths, crossing its plane, or as an
-//! exact coplanar duplicate) or covering the whole viewport, so that the depth complexity passes
+//! (two more than the larger of K and the capacity, as the battery sets it), most of them layers
+//! on one footprint (the first triangle's, which then covers the viewport: stacked on it at
+//! their own depths, crossing the plane of the one before, an exact coplanar duplicate of it) or
+//! covering the whole viewport, so that the depth complexity passes
 //! K and the capacity and fixed storage overflows: what a scheme's guarantee is about. Every case
 //! also makes the rasterizer's hard decisions often: its corners lie on the half-pixel grid
 //! (pixel centres and pixel edges), so edges pass exactly through pixel centres (the fill rule;
@@ -81,7 +82,7 @@ pub struct Limits {
     /// (the wgpu backend on lavapipe: `backends/wgpu/tests/conform.rs`).
     pub far_corners: bool,
     /// How many triangles a deep case holds at least (three cases in four are deep; capped at
-    /// `max_triangles`). 0, the default, lets the battery set it from the scheme's sizes: one
+    /// `max_triangles`). 0, the default, lets the battery set it from the scheme's sizes: two
     /// more than the larger of K and the capacity, so that most cases overflow both.
     pub depth: usize,
 }
@@ -259,15 +260,27 @@ fn depth() -> impl Strategy<Value = f32> {
     ]
 }
 
-/// A [`CaseTriangle`]. Shrinks towards a degenerate triangle at the top-left corner.
-fn triangle(max_side: u32, far_corners: bool) -> impl Strategy<Value = CaseTriangle> {
+/// A corner depth of a deep case's layer: as [`depth`], but beyond the near or far plane one
+/// time in twelve (a layer clipped away adds no depth). Shrinks towards 0.
+fn layer_depth() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        6 => select(vec![0.0_f32, 0.25, 0.5, 0.75, 1.0]),
+        5 => 0.0_f32..=1.0,
+        1 => select(vec![-0.5_f32, 1.5]),
+    ]
+}
+
+/// A [`CaseTriangle`] (with `layer`, its depths those of a deep case's layer). Shrinks towards a
+/// degenerate triangle at the top-left corner.
+fn triangle(max_side: u32, far_corners: bool, layer: bool) -> impl Strategy<Value = CaseTriangle> {
     let corner = || {
         [
             coordinate(max_side, far_corners),
             coordinate(max_side, far_corners),
         ]
     };
-    ([corner(), corner(), corner()], [depth(), depth(), depth()])
+    let z = move || if layer { layer_depth().boxed() } else { depth().boxed() };
+    ([corner(), corner(), corner()], [z(), z(), z()])
         .prop_map(|(corners, depths)| CaseTriangle { corners, depths })
 }
 
@@ -294,10 +307,10 @@ pub fn case(limits: Limits) -> impl Strategy<Value = Case> {
     let max_triangles = limits.max_triangles.max(1);
     let deep = limits.depth.clamp(1, max_triangles);
     let side = || side(limits.max_side, limits.power_of_two);
-    let triangle = || triangle(limits.max_side, limits.far_corners);
+    let triangle = |layer| triangle(limits.max_side, limits.far_corners, layer);
     let drawn = prop_oneof![
-        1 => vec((triangle(), shape()), 1..=max_triangles),
-        3 => vec((triangle(), deep_shape()), deep..=max_triangles),
+        1 => vec((triangle(false), shape()), 1..=max_triangles),
+        3 => vec((triangle(true), deep_shape()), deep..=max_triangles),
     ];
     (
         (side(), side()),
@@ -331,8 +344,8 @@ enum Shape {
     /// through the edge's midpoint (a parallelogram split along the shared edge), so that the
     /// centres on the edge belong to exactly one of the two.
     SharesEdge(usize),
-    /// On the corners of the triangle before it at its own depths: a layer more over the same
-    /// pixels (parallel, tilted against it, or coplanar where the depths agree).
+    /// On the corners of the case's first triangle at its own depths: a layer more over the
+    /// same pixels (parallel, tilted against it, or coplanar where the depths agree).
     Stacked,
     /// On the corners of the triangle before it with that triangle's depths turned one corner
     /// on: the two planes cross inside the footprint (interpenetrating), unless it is flat.
@@ -356,23 +369,24 @@ fn shape() -> impl Strategy<Value = Shape> {
 }
 
 /// A [`Shape`] of a deep case: a layer on the triangle before (stacked, crossing or duplicated)
-/// seven times in fourteen, covering the viewport twice, the shallow shapes the rest. Shrinks
+/// nine times in sixteen, covering the viewport four times, the shallow shapes the rest. Shrinks
 /// towards [`Shape::Free`].
 fn deep_shape() -> impl Strategy<Value = Shape> {
     prop_oneof![
-        2 => Just(Shape::Free),
+        1 => Just(Shape::Free),
         1 => Just(Shape::OnCentres),
-        2 => (0_usize..3).prop_map(Shape::SharesEdge),
-        4 => Just(Shape::Stacked),
+        1 => (0_usize..3).prop_map(Shape::SharesEdge),
+        6 => Just(Shape::Stacked),
         2 => Just(Shape::Crossing),
         1 => Just(Shape::Duplicate),
-        2 => Just(Shape::Covering),
+        4 => Just(Shape::Covering),
     ]
 }
 
-/// The triangles `drawn` placed by their shapes in `viewport`, in order (the first has no
-/// triangle to share an edge with or lie on, and stays where it was drawn unless it covers the
-/// viewport).
+/// The triangles `drawn` placed by their shapes in `viewport`, in order. The first has no
+/// triangle to share an edge with or lie on: it stays where it was drawn, or covers the viewport
+/// where it was to be a layer (stacked, crossing, a duplicate), so that the layers after it lie
+/// on the viewport's every pixel.
 fn placed(drawn: &[(CaseTriangle, Shape)], viewport: Viewport) -> Vec<CaseTriangle> {
     let mut placed: Vec<CaseTriangle> = Vec::with_capacity(drawn.len());
     // The centre line nearest a coordinate in half pixels: centres lie at odd ones.
@@ -383,6 +397,7 @@ fn placed(drawn: &[(CaseTriangle, Shape)], viewport: Viewport) -> Vec<CaseTriang
         i32::try_from(viewport.width).unwrap_or(i32::MAX / 8),
         i32::try_from(viewport.height).unwrap_or(i32::MAX / 8),
     );
+    let covering = [[-1, -1], [4 * w + 1, -1], [-1, 4 * h + 1]];
     for &(t, shape) in drawn {
         let next = match (shape, placed.last()) {
             (Shape::OnCentres, _) => {
@@ -397,8 +412,9 @@ fn placed(drawn: &[(CaseTriangle, Shape)], viewport: Viewport) -> Vec<CaseTriang
                     ..t
                 }
             }
-            (Shape::Covering, _) => CaseTriangle {
-                corners: [[-1, -1], [4 * w + 1, -1], [-1, 4 * h + 1]],
+            (Shape::Covering | Shape::Stacked | Shape::Crossing | Shape::Duplicate, None)
+            | (Shape::Covering, _) => CaseTriangle {
+                corners: covering,
                 ..t
             },
             (Shape::SharesEdge(k), Some(before)) => {
@@ -413,8 +429,8 @@ fn placed(drawn: &[(CaseTriangle, Shape)], viewport: Viewport) -> Vec<CaseTriang
                     depths: [before.depths[q], before.depths[p], t.depths[2]],
                 }
             }
-            (Shape::Stacked, Some(before)) => CaseTriangle {
-                corners: before.corners,
+            (Shape::Stacked, Some(_)) => CaseTriangle {
+                corners: placed[0].corners,
                 ..t
             },
             (Shape::Crossing, Some(before)) => {
