@@ -27,8 +27,7 @@ use fragsim_raster::scene_spec::{mesh_hash, SceneSpec};
 use fragsim_raster::{depth_from_key, Conventions, VertexPrecision};
 use fragsim_testkit::command::write_case;
 use fragsim_testkit::{
-    Battery, Case, CommandBackend, Counterexample, Event, Exercised, Failure, Input, Limits,
-    Params,
+    Battery, Case, CommandBackend, Counterexample, Event, Exercised, Failure, Input, Limits, Params,
 };
 use serde::Serialize;
 
@@ -547,7 +546,10 @@ fn print_counterexample(
         outln!("    backend: [{}]", show(&p.candidate));
     }
     if found.exercised.cases > 0 {
-        outln!("  the {} cases that passed before it:", found.exercised.cases);
+        outln!(
+            "  the {} cases that passed before it:",
+            found.exercised.cases
+        );
         for line in exercised_lines(&found.exercised, args.k, args.capacity) {
             outln!("    {line}");
         }

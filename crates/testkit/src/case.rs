@@ -279,7 +279,13 @@ fn triangle(max_side: u32, far_corners: bool, layer: bool) -> impl Strategy<Valu
             coordinate(max_side, far_corners),
         ]
     };
-    let z = move || if layer { layer_depth().boxed() } else { depth().boxed() };
+    let z = move || {
+        if layer {
+            layer_depth().boxed()
+        } else {
+            depth().boxed()
+        }
+    };
     ([corner(), corner(), corner()], [z(), z(), z()])
         .prop_map(|(corners, depths)| CaseTriangle { corners, depths })
 }

@@ -17,7 +17,8 @@ use fragsim_oracle::dump::{Dump, DumpScheme, Words};
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_testkit::{
-    Backend, BackendError, Battery, Case, Failure, Input, Limits, Output, Params, Property,
+    Backend, BackendError, Battery, Case, Exercised, Failure, Input, Limits, Output, Params,
+    Property,
 };
 
 /// A bug planted in [`UserABuffer`].
@@ -119,11 +120,7 @@ impl Backend for UserABuffer {
         let mut dump = Dump::record(view, spec, &scheme, "plant")
             .map_err(|e| BackendError::Setup(e.to_string()))?;
         dump.set_array("counters", Words::U32(counters), vec![pixels as u64]);
-        dump.set_array(
-            "slots",
-            Words::U64(slots),
-            vec![pixels as u64, cap as u64],
-        );
+        dump.set_array("slots", Words::U64(slots), vec![pixels as u64, cap as u64]);
         Ok(Output::Dump(Box::new(dump)))
     }
 }
@@ -139,6 +136,7 @@ fn params() -> Params {
 
 #[test]
 fn the_correct_abuffer_passes_and_most_cases_overflow_its_capacity() {
+    let mut all = Exercised::default();
     for seed in 0..5 {
         let backend = UserABuffer { plant: None };
         let passed = Battery::new(&backend, params())
@@ -149,12 +147,15 @@ fn the_correct_abuffer_passes_and_most_cases_overflow_its_capacity() {
         let e = passed.exercised;
         println!("seed {seed}: {e:?}");
         assert_eq!(e.cases, 100);
-        assert!(e.overflow_cases > 50, "seed {seed}: {e:?}");
-        assert!(e.k_cut_cases > 60, "seed {seed}: {e:?}");
-        assert!(e.tie_cases > 10, "seed {seed}: {e:?}");
-        assert!(e.empty_cases < 10, "seed {seed}: {e:?}");
+        assert!(e.overflow_cases >= 40, "seed {seed}: {e:?}");
+        assert!(e.tie_cases >= 5, "seed {seed}: {e:?}");
+        assert!(e.empty_cases <= 15, "seed {seed}: {e:?}");
         assert!(e.deepest_pixel > 4, "seed {seed}: {e:?}");
+        all = all.and(e);
     }
+    // Most of the 500: past the capacity (3), and so past K (2).
+    assert!(all.overflow_cases > 250, "{all:?}");
+    assert!(all.k_cut_cases > 250, "{all:?}");
 }
 
 #[test]
@@ -162,10 +163,7 @@ fn each_plant_is_caught_within_100_cases_on_seeds_0_to_4_and_shrunk_small() {
     for plant in PLANTS {
         for seed in 0..5 {
             let backend = UserABuffer { plant: Some(plant) };
-            let result = Battery::new(&backend, params())
-                .cases(100)
-                .seed(seed)
-                .run();
+            let result = Battery::new(&backend, params()).cases(100).seed(seed).run();
             let Err(Failure::Counterexample(found)) = result else {
                 panic!("{plant:?} seed {seed}: not caught: {result:?}");
             };
@@ -259,8 +257,7 @@ fn a_backend_failing_on_every_case_stops_at_once_and_one_failing_on_deep_cases_i
         from: 2,
         runs: Cell::new(0),
     };
-    let Err(Failure::Counterexample(found)) = Battery::new(&deep, params()).cases(100).run()
-    else {
+    let Err(Failure::Counterexample(found)) = Battery::new(&deep, params()).cases(100).run() else {
         panic!("the backend failing on deep cases passed");
     };
     assert!(!found.case_independent, "{found:?}");
