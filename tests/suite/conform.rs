@@ -1,8 +1,10 @@
-//! `fragsim conform` against the Python backend of `crates/testkit/python/backend.py` (issue
-//! 21): the correct backend passes, and each of its three planted bugs (a scan missing pixel
-//! centres exactly on a top edge, an A-buffer dropping the 3rd fragment of a pixel, an MDTS walk
-//! stopping one slot early) is found within 200 cases and shrunk to at most 3 triangles and 4×4
-//! pixels, with the smallest case saved and its replay written.
+//! `fragsim conform` against the Python backend of `crates/testkit/python/backend.py`: the
+//! correct backend passes and the report says what its cases exercised; its planted bugs (a scan
+//! missing pixel centres exactly on a top edge, an A-buffer dropping the 3rd fragment of a pixel,
+//! an MDTS walk stopping one slot early) are found within 200 cases and shrunk to at most 3
+//! triangles and 4×4 pixels, with the smallest case saved and its replay written; the clamped
+//! and the racy A-buffer counters are caught within 100 cases; a backend that always fails stops
+//! within 5 seconds.
 //!
 //! Each run launches Python once a case and submission order. The correct backend's test is
 //! cheap (24 cases). The planted bugs are found in the first 7 cases of seed 0; proptest's
@@ -70,12 +72,80 @@ fn conform(
 }
 
 #[test]
-fn the_correct_python_backend_passes() {
+fn the_correct_python_backend_passes_and_says_what_its_cases_exercised() {
     for scheme in ["mdts", "abuffer"] {
         let (code, records) = conform("correct", &python(""), scheme, 12, 2048);
         assert_eq!(code, 0, "{scheme}: {records:?}");
-        assert_eq!(records[0]["record"], "conform");
-        assert_eq!(records[0]["passed"], true);
+        let summary = &records[0];
+        assert_eq!(summary["record"], "conform");
+        assert_eq!(summary["passed"], true);
+        assert_eq!(summary["exercised_cases"], 12, "{summary}");
+        // Most cases are deeper than K (2) and the capacity (3), so they overflow.
+        let count = |key: &str| summary[key].as_u64().unwrap();
+        assert!(count("overflow_cases") > 0, "{scheme}: {summary}");
+        assert!(count("over_capacity_cases") > 0, "{scheme}: {summary}");
+        assert!(count("deepest_pixel") > 3, "{scheme}: {summary}");
+        assert!(count("exercised_fragments") > 0, "{scheme}: {summary}");
+    }
+}
+
+/// Plants of `docs/testing.md` written as a user would, through the binary with conform's
+/// defaults but for the shrinking's cap (the full table over seeds 0 to 4 is measured in
+/// `docs/testing.md`; `crates/testkit/tests/plants.rs` runs all four on those seeds in
+/// process): caught within 100 cases, shrunk to at most 4 triangles (a capacity of 3 overflows
+/// at 4 fragments) and 2 pixels.
+#[test]
+fn the_clamped_counters_and_the_racy_counter_are_caught_within_100_cases() {
+    for bug in ["clamp-counters", "racy-counter"] {
+        let (code, records) = conform(bug, &python(&format!("--bug {bug}")), "abuffer", 100, 32);
+        assert_eq!(code, 1, "{bug}: {records:?}");
+        let summary = &records[0];
+        assert_eq!(summary["case_independent"], false, "{bug}: {summary}");
+        assert!(
+            summary["case_number"].as_u64().unwrap() <= 100,
+            "{bug}: {summary}"
+        );
+        assert!(
+            summary["triangles"].as_u64().unwrap() <= 4,
+            "{bug}: {summary}"
+        );
+        let pixels = summary["width"].as_u64().unwrap() * summary["height"].as_u64().unwrap();
+        assert!(pixels <= 2, "{bug}: {summary}");
+    }
+}
+
+/// A backend that fails on every case (exit 3, or past its timeout) fails on the smallest case
+/// too: the run stops at once, unshrunk, within 5 seconds. Control: the same run's report of a
+/// backend that fails on a case's content is shrunk (`each_planted_bug_…` above).
+#[test]
+fn a_backend_that_always_fails_stops_within_five_seconds_unshrunk() {
+    for (name, backend, timeout) in [
+        ("exit", "exit 3 # {out}", "30"),
+        ("timeout", "sleep 20 # {out}", "1"),
+    ] {
+        let save = std::env::temp_dir().join(format!(
+            "fragsim-conform-always-{name}-{}",
+            std::process::id()
+        ));
+        let start = std::time::Instant::now();
+        let output = Command::cargo_bin("fragsim")
+            .unwrap()
+            .args(["conform", "--json", "--scheme", "abuffer"])
+            .args(["--backend", backend, "--timeout", timeout, "--save"])
+            .arg(&save)
+            .output()
+            .unwrap();
+        let elapsed = start.elapsed();
+        let _ = std::fs::remove_dir_all(&save);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{name}: {stderr}");
+        assert!(elapsed.as_secs_f64() < 5.0, "{name}: {elapsed:?}");
+        let records = crate::support::json_lines(&output.stdout);
+        let summary = &records[0];
+        assert_eq!(summary["case_independent"], true, "{name}: {summary}");
+        assert_eq!(summary["shrink_steps"], 0, "{name}: {summary}");
+        assert_eq!(summary["case_number"], 1, "{name}: {summary}");
+        assert_eq!(summary["property"], "runs", "{name}: {summary}");
     }
 }
 

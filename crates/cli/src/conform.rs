@@ -10,6 +10,12 @@
 //! printed and saved: its scene files, the dump the backend wrote, both lists of the first
 //! differing pixels, and the commands that replay it. Exit code 0 when every case passes, 1 on
 //! a counterexample, 2 on errors (bad arguments, a command that cannot run), as `compare`.
+//!
+//! Most cases are deep (past K and the capacity: `fragsim_testkit::case`), and the report claims
+//! only what the cases exercised: how many overflowed as the oracle predicts, the deepest pixel,
+//! the fragments, the cases past K and the capacity, with ties, and empty; a claim no case
+//! exercised is said to be so. A backend that fails to run on the smallest case too fails
+//! whatever the case: the run stops at once with that, unshrunk.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -19,8 +25,9 @@ use fragsim_capture::catalog::SchemeName;
 use fragsim_oracle::PixelMismatch;
 use fragsim_raster::scene_spec::{mesh_hash, SceneSpec};
 use fragsim_raster::{depth_from_key, Conventions, VertexPrecision};
+use fragsim_testkit::command::write_case;
 use fragsim_testkit::{
-    Battery, Case, CommandBackend, Counterexample, Event, Failure, Input, Limits, Params,
+    Battery, Case, CommandBackend, Counterexample, Event, Exercised, Failure, Input, Limits, Params,
 };
 use serde::Serialize;
 
@@ -65,10 +72,11 @@ pub struct ConformArgs {
     #[arg(long, value_name = "N", default_value_t = 8,
           value_parser = clap::value_parser!(u32).range(1..=64))]
     pub max_side: u32,
-    /// The most triangles a case holds.
-    #[arg(long, value_name = "N", default_value_t = 6,
+    /// The most triangles a case holds (default: 7, or 4 more than the larger of K and the
+    /// capacity where that is more, so that most cases overflow both).
+    #[arg(long, value_name = "N",
           value_parser = clap::value_parser!(u32).range(1..=64))]
-    pub max_triangles: u32,
+    pub max_triangles: Option<u32>,
     /// The most simplifications proptest tries on a failing case before fragsim's own crop to
     /// the differing pixels and triangle dropping finish the shrinking (each one runs the
     /// backend once).
@@ -128,6 +136,37 @@ fn entries(words: &[u64]) -> Vec<Entry> {
         .collect()
 }
 
+/// What the checked cases exercised, as the `conform` record carries it.
+#[derive(Debug, Serialize)]
+struct ExercisedRecord {
+    /// Cases counted: those that passed.
+    exercised_cases: u32,
+    exercised_fragments: u64,
+    deepest_pixel: u32,
+    k_cut_cases: u32,
+    over_capacity_cases: u32,
+    overflow_cases: u32,
+    overflow_fragments: u64,
+    tie_cases: u32,
+    empty_cases: u32,
+}
+
+impl From<Exercised> for ExercisedRecord {
+    fn from(e: Exercised) -> Self {
+        Self {
+            exercised_cases: e.cases,
+            exercised_fragments: e.fragments,
+            deepest_pixel: e.deepest_pixel,
+            k_cut_cases: e.k_cut_cases,
+            over_capacity_cases: e.over_capacity_cases,
+            overflow_cases: e.overflow_cases,
+            overflow_fragments: e.overflow_fragments,
+            tie_cases: e.tie_cases,
+            empty_cases: e.empty_cases,
+        }
+    }
+}
+
 /// The `conform` record.
 #[derive(Debug, Serialize)]
 struct Summary {
@@ -150,6 +189,10 @@ struct Summary {
     fragments: Option<usize>,
     saved: Option<String>,
     replay: Option<Vec<String>>,
+    /// On a failure, whether the backend failed to run on the smallest case too (not shrunk).
+    case_independent: Option<bool>,
+    #[serde(flatten)]
+    exercised: ExercisedRecord,
 }
 
 /// One differing pixel of the counterexample, both lists.
@@ -205,6 +248,9 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         },
         power_of_two: args.power_of_two,
     };
+    let max_triangles = args
+        .max_triangles
+        .unwrap_or((args.k.max(args.capacity) + 4).clamp(7, 64));
     let battery = Battery::new(&backend, params)
         .cases(args.cases)
         .seed(args.seed)
@@ -212,7 +258,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         .shrink_steps(args.shrink_steps)
         .limits(Limits {
             max_side: args.max_side,
-            max_triangles: args.max_triangles as usize,
+            max_triangles: max_triangles as usize,
             power_of_two: args.power_of_two,
             ..Limits::default()
         });
@@ -257,10 +303,12 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         fragments: None,
         saved: None,
         replay: None,
+        case_independent: None,
+        exercised: Exercised::default().into(),
     };
     let saved = args.save.join("case");
     let found = match result {
-        Ok(_) => {
+        Ok(passed) => {
             // A failing case saved by an earlier run no longer describes this backend.
             if saved.exists() {
                 std::fs::remove_dir_all(&saved)
@@ -271,6 +319,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
                 Context::new("conform", &spec, args.max_side, args.max_side),
                 &params,
             );
+            summary.exercised = passed.exercised.into();
             if args.json {
                 record::emit("conform", &context, &summary)?;
             } else {
@@ -280,7 +329,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
                 };
                 outln!(
                     "conform: {} passes {cases} of {} (k {}, capacity {}, seed {}, {} vertex \
-                     stage): equal to the oracle, order-independent, overflow as predicted",
+                     stage):",
                     args.backend,
                     scheme.name(),
                     args.k,
@@ -288,6 +337,9 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
                     args.seed,
                     args.vertex_precision
                 );
+                for line in exercised_lines(&passed.exercised, args.k, args.capacity) {
+                    outln!("  {line}");
+                }
             }
             return Ok(true);
         }
@@ -295,6 +347,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         Err(Failure::Counterexample(found)) => found,
     };
     let replay = save(&backend, &found, &params, &saved)?;
+    summary.exercised = found.exercised.into();
     let spec = Case::scene_and_camera(
         &saved.join("scene").join("mesh.obj").display().to_string(),
         mesh_hash(found.submitted.obj().as_bytes()),
@@ -315,6 +368,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         fragments: Some(found.fragments),
         saved: Some(saved.display().to_string()),
         replay: Some(replay.clone()),
+        case_independent: Some(found.case_independent),
         ..summary
     };
     let pixels: Vec<PixelRecord> = found
@@ -375,8 +429,21 @@ fn save(
         params,
     };
     // The dump may be missing when the failure is the backend's own (a crash, a timeout):
-    // the scene files are saved all the same.
-    let rerun = backend.run_in(&input, dir);
+    // the scene files are saved all the same. A backend that fails whatever the case is not run
+    // again (a timeout would cost its whole length once more).
+    let rerun = if found.case_independent {
+        let scene = dir.join("scene");
+        if dir.exists() {
+            std::fs::remove_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+        for d in [&scene, &dir.join("out")] {
+            std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
+        }
+        write_case(case, &view, params, &scene)?;
+        Err(found.message.clone())
+    } else {
+        backend.run_in(&input, dir).map_err(|e| e.to_string())
+    };
     let absolute = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     // Every path absolute, so that the script runs from any directory: the backend's command
     // from the directory conform ran in (its own paths may be relative to it), and this very
@@ -400,7 +467,11 @@ fn save(
         "#!/bin/sh\n# Replays fragsim conform's smallest failing case (from any directory).\n",
     );
     if let Err(e) = rerun {
-        script.push_str(&format!("# On saving, the backend failed again: {e}\n"));
+        script.push_str(&if found.case_independent {
+            format!("# The backend failed whatever the case, this one too: {e}\n")
+        } else {
+            format!("# On saving, the backend failed again: {e}\n")
+        });
     }
     for line in &replay {
         script.push_str(line);
@@ -424,15 +495,27 @@ fn print_counterexample(
     replay: &[String],
 ) {
     let case = &found.submitted;
-    outln!(
-        "conform: {} FAILS `{}` on case {} of {} (seed {}), shrunk in {} steps to:",
-        args.backend,
-        found.property,
-        found.case_number,
-        args.cases,
-        args.seed,
-        found.shrink_steps
-    );
+    if found.case_independent {
+        outln!(
+            "conform: {} FAILS `{}` whatever the case: on case {} of {} (seed {}) and on the \
+             smallest case, not shrunk:",
+            args.backend,
+            found.property,
+            found.case_number,
+            args.cases,
+            args.seed,
+        );
+    } else {
+        outln!(
+            "conform: {} FAILS `{}` on case {} of {} (seed {}), shrunk in {} steps to:",
+            args.backend,
+            found.property,
+            found.case_number,
+            args.cases,
+            args.seed,
+            found.shrink_steps
+        );
+    }
     outln!("  {}", found.message);
     outln!(
         "  viewport {}x{}, {} triangles, {} fragments (corners in half pixels, y down: (1, 1) is \
@@ -462,6 +545,15 @@ fn print_counterexample(
         outln!("    oracle:  [{}]", show(&p.reference));
         outln!("    backend: [{}]", show(&p.candidate));
     }
+    if found.exercised.cases > 0 {
+        outln!(
+            "  the {} cases that passed before it:",
+            found.exercised.cases
+        );
+        for line in exercised_lines(&found.exercised, args.k, args.capacity) {
+            outln!("    {line}");
+        }
+    }
     outln!(
         "  saved in {} (scene/, out/, conform.jsonl); replay:",
         saved.display()
@@ -469,4 +561,40 @@ fn print_counterexample(
     for line in replay {
         outln!("    {line}");
     }
+}
+
+/// What the cases exercised, in lines: each claim of a pass with the cases that exercised it,
+/// or said never to have been exercised.
+fn exercised_lines(e: &Exercised, k: u32, capacity: u32) -> Vec<String> {
+    let of = |n: u32| format!("{n} of {}", e.cases);
+    let mut lines = vec![format!(
+        "equal to the oracle and order-independent in {} cases ({} fragments, {} empty cases)",
+        e.cases, e.fragments, e.empty_cases
+    )];
+    lines.push(if e.overflow_cases > 0 {
+        format!(
+            "overflow as predicted in {} cases ({} fragments overflowed)",
+            of(e.overflow_cases),
+            e.overflow_fragments
+        )
+    } else {
+        format!(
+            "overflow: never exercised (no case exceeded the scheme's storage: deepest pixel {}, \
+             k {k}, capacity {capacity})",
+            e.deepest_pixel
+        )
+    });
+    lines.push(format!(
+        "deepest pixel {} fragments; deeper than K ({k}) in {} cases, than the capacity \
+         ({capacity}) in {}",
+        e.deepest_pixel,
+        of(e.k_cut_cases),
+        of(e.over_capacity_cases)
+    ));
+    lines.push(if e.tie_cases > 0 {
+        format!("ties (fragments at one depth) in {} cases", of(e.tie_cases))
+    } else {
+        "ties: never exercised (no pixel held two fragments at one depth)".to_string()
+    });
+    lines
 }

@@ -1,15 +1,23 @@
 #!/usr/bin/env python3
 """A fragsim backend in plain Python, written from docs/dump-format.md and docs/semantics.md.
 
-Usage: backend.py SCENE_DIR OUT_DIR [--bug top-edge|third-fragment|early-break]
+Usage: backend.py SCENE_DIR OUT_DIR [--bug BUG]
 
 Reads the case `fragsim conform` wrote into SCENE_DIR (case.json, scene.tri: the triangle
 export), scans every screen triangle with the top-left rule, interpolates depth in f64 and
 rounds it once to f32, runs MDTS (`mdts`: FreePipe's atomicMin walk over K slots) or the fixed
 A-buffer (`abuffer`: fetch-and-add, `capacity` slots), and writes the dump into OUT_DIR.
-`--bug` plants one of three bugs for `conform` to find: a scan that misses pixel centres exactly
-on a top edge, an A-buffer whose 3rd fragment of a pixel is never written, an MDTS walk that
-stops one slot early.
+`--bug` plants a bug for `conform` to find:
+  top-edge        a scan that misses pixel centres exactly on a top edge;
+  third-fragment  an A-buffer whose 3rd fragment of a pixel is never written;
+  early-break     an MDTS walk that stops one slot early;
+  clamp-counters  an A-buffer whose counters stop at the capacity (counters = min(counters, C));
+  deepest-third   an A-buffer that loses the 3rd fragment of its deepest pixel only;
+  off-by-one      an A-buffer that stores while index <= C (the overflowing fragment lands in
+                  the next pixel's first slot);
+  racy-counter    an A-buffer whose counter is read and written back non-atomically: the
+                  fragments run in waves of 32 in flight, each reads its pixel's counter before
+                  any of the wave writes it back, so two of a wave at one pixel get one slot.
 """
 import json, os, struct, sys
 
@@ -68,11 +76,23 @@ if case["scheme"] == "mdts":
 elif case["scheme"] == "abuffer":
     cap = case["capacity"]
     counters, slots = [0] * (W * H), [EMPTY] * (W * H * cap)
-    for p, word in fragments():
-        index = counters[p]                                      # atomicAdd
-        counters[p] += 1
-        if index < cap and not (bug == "third-fragment" and index == 2):
-            slots[p * cap + index] = word
+    stream = list(fragments())
+    depth = [0] * (W * H)
+    for p, _ in stream:
+        depth[p] += 1
+    deepest = depth.index(max(depth)) if stream else -1
+    wave = 32 if bug == "racy-counter" else 1
+    for start in range(0, len(stream), wave):
+        batch = stream[start:start + wave]
+        read = [counters[p] for p, _ in batch]                   # atomicAdd's read ...
+        for (p, word), index in zip(batch, read):
+            counters[p] = index + 1                              # ... and its write
+            lost = (bug == "third-fragment" and index == 2) or \
+                   (bug == "deepest-third" and p == deepest and index == 2)
+            if (index <= cap if bug == "off-by-one" else index < cap) and not lost:
+                slots[p * cap + index] = word
+    if bug == "clamp-counters":
+        counters = [min(c, cap) for c in counters]
     header.update(scheme="abuffer", capacity=cap, filled=True)
     arrays = {"counters": ("u32", counters, [W * H]), "slots": ("u64", slots, [W * H, cap])}
 else:

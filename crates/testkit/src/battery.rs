@@ -15,6 +15,13 @@
 //!   for its capacity (`Σ max(0, n − capacity)`);
 //! - **runs**: the backend returns an output at all (no crash, no timeout, a readable dump).
 //!
+//! A pass claims only what its cases exercised: [`Exercised`] counts the cases that overflowed
+//! (as the oracle predicts for the scheme), the deepest pixel, the fragments, the cases deeper
+//! than K and than the capacity, the cases with ties and the empty ones. A backend that fails
+//! to run on a case and on the smallest case too ([`Case::smallest`]) fails whatever the case:
+//! the battery stops at once and reports that, shrinking nothing
+//! ([`Counterexample::case_independent`]).
+//!
 //! Guarantee: a claim that owes exactness ([`Guarantee::owes_exactness`] on the backend's
 //! executor) owes all four. A claim that owes nothing there is refused, as is one judged with
 //! equal depths merged ([`Guarantee::ExactDistinctDepths`]): the battery judges canonical ties.
@@ -82,6 +89,11 @@ pub struct Counterexample {
     pub case_number: u32,
     /// The simplifications proptest tried while shrinking.
     pub shrink_steps: u32,
+    /// Whether the backend failed to run on the smallest case too ([`Case::smallest`], which
+    /// `case` then is): a failure that does not depend on the case, not shrunk.
+    pub case_independent: bool,
+    /// What the cases checked before the failure exercised (the failing one not included).
+    pub exercised: Exercised,
 }
 
 impl Counterexample {
@@ -111,6 +123,77 @@ pub struct Passed {
     pub cases: u32,
     /// The claim checked.
     pub claim: Guarantee,
+    /// What those cases exercised: a claim is made only of what they reached.
+    pub exercised: Exercised,
+}
+
+/// What the checked cases exercised, from the oracle of each case as generated (in its
+/// submission order; the other order has the same fragments): a pass says "overflow as
+/// predicted" only of the cases that overflowed, and that overflow was never exercised where
+/// none did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Exercised {
+    /// Cases counted.
+    pub cases: u32,
+    /// The oracle's fragments over those cases.
+    pub fragments: u64,
+    /// The most fragments any pixel of any case held.
+    pub deepest_pixel: u32,
+    /// Cases with a pixel holding more fragments than K (where a K-sized scheme cuts).
+    pub k_cut_cases: u32,
+    /// Cases with a pixel holding more fragments than the capacity.
+    pub over_capacity_cases: u32,
+    /// Cases whose overflow, as the oracle predicts it for the scheme (beyond K, past the
+    /// capacity, a pool exhausted), is not 0.
+    pub overflow_cases: u32,
+    /// The predicted overflow over those cases, in fragments.
+    pub overflow_fragments: u64,
+    /// Cases with a pixel holding two fragments at one depth (a tie, judged by primitive id).
+    pub tie_cases: u32,
+    /// Cases with no fragment at all.
+    pub empty_cases: u32,
+}
+
+impl Exercised {
+    /// What one case exercised: its `oracle` under `params`, and the overflow the verdict
+    /// predicted for the scheme.
+    fn of_case(oracle: &Oracle, params: &Params, predicted_overflow: u64) -> Self {
+        let deepest_pixel = oracle.max_depth_complexity();
+        let tie = (0..oracle.pixels()).any(|p| {
+            oracle
+                .pixel(p)
+                .windows(2)
+                .any(|pair| pair[0] >> 32 == pair[1] >> 32)
+        });
+        let fragments = oracle.fragments() as u64;
+        Self {
+            cases: 1,
+            fragments,
+            deepest_pixel,
+            k_cut_cases: u32::from(deepest_pixel > params.k),
+            over_capacity_cases: u32::from(deepest_pixel > params.capacity),
+            overflow_cases: u32::from(predicted_overflow > 0),
+            overflow_fragments: predicted_overflow,
+            tie_cases: u32::from(tie),
+            empty_cases: u32::from(fragments == 0),
+        }
+    }
+
+    /// `self` and `other` together.
+    #[must_use]
+    pub fn and(self, other: Self) -> Self {
+        Self {
+            cases: self.cases + other.cases,
+            fragments: self.fragments + other.fragments,
+            deepest_pixel: self.deepest_pixel.max(other.deepest_pixel),
+            k_cut_cases: self.k_cut_cases + other.k_cut_cases,
+            over_capacity_cases: self.over_capacity_cases + other.over_capacity_cases,
+            overflow_cases: self.overflow_cases + other.overflow_cases,
+            overflow_fragments: self.overflow_fragments + other.overflow_fragments,
+            tie_cases: self.tie_cases + other.tie_cases,
+            empty_cases: self.empty_cases + other.empty_cases,
+        }
+    }
 }
 
 /// What the battery is doing, for a progress display.
@@ -290,13 +373,18 @@ impl<'b> Battery<'b> {
         let last_found = RefCell::new(None);
         let setup = RefCell::new(None);
         let generated = Cell::new(0_u32);
+        let exercised = Cell::new(Exercised::default());
+        // The smallest case's failure, where the backend fails to run on it too.
+        let everywhere = RefCell::new(None::<Found>);
         let (shard, shards) = self.shard;
         let result = runner.run(&case(self.case_limits()).boxed(), |case| {
-            // A backend that cannot run fails every case alike: stop at once, shrink nothing.
-            if setup.borrow().is_some() {
+            // A backend that cannot run, or fails to run whatever the case, fails every case
+            // alike: stop at once, shrink nothing.
+            if setup.borrow().is_some() || everywhere.borrow().is_some() {
                 return Ok(());
             }
-            if last_found.borrow().is_none() {
+            let shrinking = last_found.borrow().is_some();
+            if !shrinking {
                 generated.set(generated.get() + 1);
                 // Another shard's case: generated (so the cases after it are the same in every
                 // shard), not checked.
@@ -315,13 +403,30 @@ impl<'b> Battery<'b> {
                 (events.borrow_mut())(Event::Shrink(shrink_steps.get()));
             }
             match self.check(&case) {
-                Ok(()) => Ok(()),
+                Ok(seen) => {
+                    if !shrinking {
+                        exercised.set(exercised.get().and(seen));
+                    }
+                    Ok(())
+                }
                 Err(Stop::Setup(message)) => {
                     *setup.borrow_mut() = Some(message.clone());
                     Err(TestCaseError::fail(message))
                 }
                 Err(Stop::Found(found)) => {
                     let message = format!("{}: {}", found.property, found.message);
+                    // A backend that does not run on a generated case: on the smallest case
+                    // too, and the failure is not the case's.
+                    if !shrinking && found.property == Property::Runs {
+                        let smallest = Case::smallest(case.schedule);
+                        match self.check_submitted(&smallest, Property::Runs) {
+                            Err(Stop::Found(f)) if f.property == Property::Runs => {
+                                *everywhere.borrow_mut() = Some(*f);
+                            }
+                            Err(Stop::Setup(m)) => *setup.borrow_mut() = Some(m),
+                            _ => {}
+                        }
+                    }
                     *last_found.borrow_mut() = Some(*found);
                     Err(TestCaseError::fail(message))
                 }
@@ -330,10 +435,29 @@ impl<'b> Battery<'b> {
         if let Some(message) = setup.into_inner() {
             return Err(Failure::Refused(message));
         }
+        if let Some(found) = everywhere.into_inner() {
+            return Err(Failure::Counterexample(Box::new(Counterexample {
+                case: found.submitted.clone(),
+                submitted: found.submitted,
+                property: found.property,
+                message: format!(
+                    "the backend fails whatever the case, the smallest (1x1, one triangle) too: {}",
+                    found.message
+                ),
+                comparison: None,
+                fragments: found.fragments,
+                cases_run: cases_run.get(),
+                case_number: generated.get(),
+                shrink_steps: 0,
+                case_independent: true,
+                exercised: exercised.get(),
+            })));
+        }
         match result {
             Ok(()) => Ok(Passed {
                 cases: cases_run.get(),
                 claim,
+                exercised: exercised.get(),
             }),
             Err(TestError::Fail(reason, case)) => {
                 // The last case that failed is the shrunk one: proptest keeps each failing
@@ -358,6 +482,8 @@ impl<'b> Battery<'b> {
                     cases_run: cases_run.get(),
                     case_number: generated.get(),
                     shrink_steps: shrink_steps.get(),
+                    case_independent: false,
+                    exercised: exercised.get(),
                 })))
             }
             Err(TestError::Abort(reason)) => Err(Failure::Refused(reason.to_string())),
@@ -397,24 +523,31 @@ impl<'b> Battery<'b> {
     /// The limits cases are generated and shrunk within: the battery's, with the backend's
     /// viewports ([`Backend::power_of_two_viewports`]).
     fn case_limits(&self) -> Limits {
+        let depth = match self.limits.depth {
+            0 => self.params.k.max(self.params.capacity) as usize + 2,
+            depth => depth,
+        };
         Limits {
             power_of_two: self.limits.power_of_two || self.backend.power_of_two_viewports(),
+            depth,
             ..self.limits
         }
     }
 
-    /// Every property on `case`: as generated, then in its other submission order.
-    fn check(&self, case: &Case) -> Result<(), Stop> {
-        self.check_submitted(case, Property::Equal)?;
+    /// Every property on `case`: as generated, then in its other submission order; what the
+    /// case exercised.
+    fn check(&self, case: &Case) -> Result<Exercised, Stop> {
+        let seen = self.check_submitted(case, Property::Equal)?;
         let permuted = case.permuted();
         if permuted.triangles != case.triangles {
             self.check_submitted(&permuted, Property::OrderIndependent)?;
         }
-        Ok(())
+        Ok(seen)
     }
 
     /// The backend's output on `submitted` against its oracle; a difference breaks `property`.
-    fn check_submitted(&self, submitted: &Case, property: Property) -> Result<(), Stop> {
+    /// Returns what the case exercised.
+    fn check_submitted(&self, submitted: &Case, property: Property) -> Result<Exercised, Stop> {
         let scene = submitted.scene();
         let found = |property, message: String, comparison, fragments| {
             Stop::Found(Box::new(Found {
@@ -461,7 +594,11 @@ impl<'b> Battery<'b> {
             };
             return Err(found(property, message, Some(comparison), fragments));
         }
-        Ok(())
+        Ok(Exercised::of_case(
+            &oracle,
+            &self.params,
+            comparison.diff.overflowed,
+        ))
     }
 }
 

@@ -2,18 +2,26 @@
 //! view-projection), a viewport, a submission order and a schedule, and its proptest strategy
 //! ([`case`]).
 //!
-//! Guarantee: a case's corners lie on the half-pixel grid (pixel centres and pixel edges), so a
-//! case makes the rasterizer's hard decisions often: edges exactly through pixel centres (the
-//! fill rule; some triangles are drawn with their legs on the centre lines), triangles sharing
-//! edges and vertices (some are drawn sharing an edge with the triangle before them, as a mesh's
-//! quads do: a hole or a double there is wrong under every edge-tie rule), coplanar triangles at
-//! equal depths (the tie policy), depths exactly 0 and 1, triangles crossing the near plane (`z < 0`) and the far
-//! one, and a few corners far beyond the guard band. The snapped corners are exact: a corner at
-//! `h` half pixels is `h / width − 1` in normalised device coordinates, which f32 holds to far
-//! below the 1/256-pixel snapping grid at these viewport sizes, so snapping gives back `128 · h`.
+//! Guarantee: most cases are **deep**: three in four hold at least [`Limits::depth`] triangles
+//! (two more than the larger of K and the capacity, as the battery sets it), most of them layers
+//! on one footprint (the first triangle's, which then covers the viewport: stacked on it at
+//! their own depths, crossing the plane of the one before, an exact coplanar duplicate of it) or
+//! covering the whole viewport, so that the depth complexity passes
+//! K and the capacity and fixed storage overflows: what a scheme's guarantee is about. Every case
+//! also makes the rasterizer's hard decisions often: its corners lie on the half-pixel grid
+//! (pixel centres and pixel edges), so edges pass exactly through pixel centres (the fill rule;
+//! some triangles are drawn with their legs on the centre lines), triangles share edges and
+//! vertices (some are drawn sharing an edge with the triangle before them, as a mesh's quads do:
+//! a hole or a double there is wrong under every edge-tie rule), coplanar triangles lie at equal
+//! depths (the tie policy), depths are exactly 0 and 1, triangles cross the near plane (`z < 0`)
+//! and the far one, and a few corners lie far beyond the guard band. The snapped corners are
+//! exact: a corner at `h` half pixels is `h / width − 1` in normalised device coordinates, which
+//! f32 holds to far below the 1/256-pixel snapping grid at these viewport sizes, so snapping
+//! gives back `128 · h`.
 //!
 //! Source: the rules of `docs/semantics.md` §1–6 (what is hard for a scan and a depth
-//! interpolation) and the case shapes the proptest suite's regressions were found with.
+//! interpolation), the case shapes the proptest suite's regressions were found with, and the
+//! plants of `docs/testing.md` (an A-buffer bug that only overflow or a third fragment shows).
 
 use fragsim_capture::executors::scheduled::Schedule;
 use fragsim_raster::scene_spec::{SceneSpec, ViewProjection};
@@ -73,6 +81,10 @@ pub struct Limits {
     /// before snapping). On by default; off only to look past a known difference in clipping
     /// (the wgpu backend on lavapipe: `backends/wgpu/tests/conform.rs`).
     pub far_corners: bool,
+    /// How many triangles a deep case holds at least (three cases in four are deep; capped at
+    /// `max_triangles`). 0, the default, lets the battery set it from the scheme's sizes: two
+    /// more than the larger of K and the capacity, so that most cases overflow both.
+    pub depth: usize,
 }
 
 impl Default for Limits {
@@ -84,6 +96,7 @@ impl Default for Limits {
             max_triangles: 6,
             power_of_two: false,
             far_corners: true,
+            depth: 0,
         }
     }
 }
@@ -140,6 +153,22 @@ impl Case {
                 precision: VertexPrecision::F64,
             }),
             ..SceneSpec::mesh(std::path::Path::new(mesh), 0.0, 0.0)
+        }
+    }
+
+    /// The smallest case a backend can be given: a 1×1 viewport and one triangle covering its
+    /// pixel at depth 0.5 (one fragment), under `schedule`. A backend that fails this case too
+    /// fails whatever the case ([`crate::Battery`] stops at once and shrinks nothing).
+    #[must_use]
+    pub fn smallest(schedule: Schedule) -> Self {
+        Self {
+            viewport: Viewport::new(1, 1).expect("a 1x1 viewport"),
+            triangles: vec![CaseTriangle {
+                corners: [[-1, -1], [5, -1], [-1, 5]],
+                depths: [0.5; 3],
+            }],
+            order_keys: vec![0],
+            schedule,
         }
     }
 
@@ -231,15 +260,33 @@ fn depth() -> impl Strategy<Value = f32> {
     ]
 }
 
-/// A [`CaseTriangle`]. Shrinks towards a degenerate triangle at the top-left corner.
-fn triangle(max_side: u32, far_corners: bool) -> impl Strategy<Value = CaseTriangle> {
+/// A corner depth of a deep case's layer: as [`depth`], but beyond the near or far plane one
+/// time in twelve (a layer clipped away adds no depth). Shrinks towards 0.
+fn layer_depth() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        6 => select(vec![0.0_f32, 0.25, 0.5, 0.75, 1.0]),
+        5 => 0.0_f32..=1.0,
+        1 => select(vec![-0.5_f32, 1.5]),
+    ]
+}
+
+/// A [`CaseTriangle`] (with `layer`, its depths those of a deep case's layer). Shrinks towards a
+/// degenerate triangle at the top-left corner.
+fn triangle(max_side: u32, far_corners: bool, layer: bool) -> impl Strategy<Value = CaseTriangle> {
     let corner = || {
         [
             coordinate(max_side, far_corners),
             coordinate(max_side, far_corners),
         ]
     };
-    ([corner(), corner(), corner()], [depth(), depth(), depth()])
+    let z = move || {
+        if layer {
+            layer_depth().boxed()
+        } else {
+            depth().boxed()
+        }
+    };
+    ([corner(), corner(), corner()], [z(), z(), z()])
         .prop_map(|(corners, depths)| CaseTriangle { corners, depths })
 }
 
@@ -254,29 +301,37 @@ fn side(max_side: u32, power_of_two: bool) -> BoxedStrategy<u32> {
 }
 
 /// A [`Case`] within `limits`: a viewport of sides 1 to `max_side` (powers of two with
-/// `power_of_two`), 1 to `max_triangles` triangles, another submission order, a [`schedule`].
-/// Shrinks towards fewer triangles, a 1×1 viewport, corners at the top-left, depth 0, submission
-/// order, and the schedule's own simplest.
+/// `power_of_two`), another submission order, a [`schedule`], and triangles: one case in four
+/// shallow (1 to `max_triangles` triangles, most placed freely), three in four deep (from
+/// [`Limits::depth`], at least 1, to `max_triangles` triangles, most stacked on the one before or
+/// covering the viewport). Shrinks towards fewer triangles, each placed freely, a 1×1 viewport,
+/// corners at the top-left, depth 0, submission order, and the schedule's own simplest.
 ///
 /// # Panics
 /// (When sampled) if `limits.max_side` is 0 or above [`Viewport::MAX_SIDE`].
 pub fn case(limits: Limits) -> impl Strategy<Value = Case> {
     let max_triangles = limits.max_triangles.max(1);
+    let deep = limits.depth.clamp(1, max_triangles);
     let side = || side(limits.max_side, limits.power_of_two);
+    let triangle = |layer| triangle(limits.max_side, limits.far_corners, layer);
+    let drawn = prop_oneof![
+        1 => vec((triangle(false), shape()), 1..=max_triangles),
+        3 => vec((triangle(true), deep_shape()), deep..=max_triangles),
+    ];
     (
         (side(), side()),
-        vec(
-            (triangle(limits.max_side, limits.far_corners), shape()),
-            1..=max_triangles,
-        ),
+        drawn,
         vec(any::<u8>(), max_triangles),
         schedule(),
     )
-        .prop_map(|((w, h), drawn, order_keys, schedule)| Case {
-            viewport: Viewport::new(w, h).expect("valid viewport side"),
-            triangles: placed(&drawn),
-            order_keys,
-            schedule,
+        .prop_map(|((w, h), drawn, order_keys, schedule)| {
+            let viewport = Viewport::new(w, h).expect("valid viewport side");
+            Case {
+                viewport,
+                triangles: placed(&drawn, viewport),
+                order_keys,
+                schedule,
+            }
         })
 }
 
@@ -295,9 +350,22 @@ enum Shape {
     /// through the edge's midpoint (a parallelogram split along the shared edge), so that the
     /// centres on the edge belong to exactly one of the two.
     SharesEdge(usize),
+    /// On the corners of the case's first triangle at its own depths: a layer more over the
+    /// same pixels (parallel, tilted against it, or coplanar where the depths agree).
+    Stacked,
+    /// On the corners of the triangle before it with that triangle's depths turned one corner
+    /// on: the two planes cross inside the footprint (interpenetrating), unless it is flat.
+    Crossing,
+    /// The triangle before it again, corners and depths: a coplanar duplicate, tied at every
+    /// pixel and ordered by primitive id.
+    Duplicate,
+    /// Covering every pixel of the viewport, at its own depths: its corners just outside the
+    /// top-left corner and past twice the viewport's sides, inside the guard band.
+    Covering,
 }
 
-/// A [`Shape`]: a triangle placed freely three times in six. Shrinks towards [`Shape::Free`].
+/// A [`Shape`] of a shallow case: a triangle placed freely three times in six. Shrinks towards
+/// [`Shape::Free`].
 fn shape() -> impl Strategy<Value = Shape> {
     prop_oneof![
         3 => Just(Shape::Free),
@@ -306,12 +374,36 @@ fn shape() -> impl Strategy<Value = Shape> {
     ]
 }
 
-/// The triangles `drawn` placed by their shapes, in order (the first has no triangle to share
-/// an edge with, and stays where it was drawn).
-fn placed(drawn: &[(CaseTriangle, Shape)]) -> Vec<CaseTriangle> {
+/// A [`Shape`] of a deep case: a layer on the triangle before (stacked, crossing or duplicated)
+/// nine times in sixteen, covering the viewport four times, the shallow shapes the rest. Shrinks
+/// towards [`Shape::Free`].
+fn deep_shape() -> impl Strategy<Value = Shape> {
+    prop_oneof![
+        1 => Just(Shape::Free),
+        1 => Just(Shape::OnCentres),
+        1 => (0_usize..3).prop_map(Shape::SharesEdge),
+        6 => Just(Shape::Stacked),
+        2 => Just(Shape::Crossing),
+        1 => Just(Shape::Duplicate),
+        4 => Just(Shape::Covering),
+    ]
+}
+
+/// The triangles `drawn` placed by their shapes in `viewport`, in order. The first has no
+/// triangle to share an edge with or lie on: it stays where it was drawn, or covers the viewport
+/// where it was to be a layer (stacked, crossing, a duplicate), so that the layers after it lie
+/// on the viewport's every pixel.
+fn placed(drawn: &[(CaseTriangle, Shape)], viewport: Viewport) -> Vec<CaseTriangle> {
     let mut placed: Vec<CaseTriangle> = Vec::with_capacity(drawn.len());
     // The centre line nearest a coordinate in half pixels: centres lie at odd ones.
     let centre_line = |h: i32| h | 1;
+    // Past twice the sides: the hypotenuse from (4w + 1, −1) to (−1, 4h + 1) passes the last
+    // pixel's centre (2w − 1, 2h − 1) by a pixel or more.
+    let (w, h) = (
+        i32::try_from(viewport.width).unwrap_or(i32::MAX / 8),
+        i32::try_from(viewport.height).unwrap_or(i32::MAX / 8),
+    );
+    let covering = [[-1, -1], [4 * w + 1, -1], [-1, 4 * h + 1]];
     for &(t, shape) in drawn {
         let next = match (shape, placed.last()) {
             (Shape::OnCentres, _) => {
@@ -326,6 +418,11 @@ fn placed(drawn: &[(CaseTriangle, Shape)]) -> Vec<CaseTriangle> {
                     ..t
                 }
             }
+            (Shape::Covering | Shape::Stacked | Shape::Crossing | Shape::Duplicate, None)
+            | (Shape::Covering, _) => CaseTriangle {
+                corners: covering,
+                ..t
+            },
             (Shape::SharesEdge(k), Some(before)) => {
                 let (p, q, r) = (k, (k + 1) % 3, (k + 2) % 3);
                 let [p_at, q_at, r_at] = [p, q, r].map(|i| before.corners[i]);
@@ -338,6 +435,18 @@ fn placed(drawn: &[(CaseTriangle, Shape)]) -> Vec<CaseTriangle> {
                     depths: [before.depths[q], before.depths[p], t.depths[2]],
                 }
             }
+            (Shape::Stacked, Some(_)) => CaseTriangle {
+                corners: placed[0].corners,
+                ..t
+            },
+            (Shape::Crossing, Some(before)) => {
+                let [a, b, c] = before.depths;
+                CaseTriangle {
+                    corners: before.corners,
+                    depths: [b, c, a],
+                }
+            }
+            (Shape::Duplicate, Some(before)) => *before,
             _ => t,
         };
         placed.push(next);

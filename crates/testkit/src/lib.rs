@@ -37,6 +37,6 @@ pub mod judge;
 pub mod strategies;
 
 pub use backend::{Backend, BackendError, CatalogBackend, Input, Output, Params};
-pub use battery::{Battery, Counterexample, Event, Failure, Passed, Property};
+pub use battery::{Battery, Counterexample, Event, Exercised, Failure, Passed, Property};
 pub use case::{Case, CaseTriangle, Limits};
 pub use command::CommandBackend;
