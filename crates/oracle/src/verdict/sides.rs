@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use fragsim_raster::{Conventions, VertexPrecision, Viewport};
 use serde::Serialize;
 
-use super::{judge, Candidate, Options, Reference, Verdict};
-use crate::dump::{Dump, DumpError, Header, MASKED_SCHEME};
+use super::{judge, Candidate, Options, Reference, Verdict, VerdictError};
+use crate::dump::{Dump, DumpError, Header};
 use crate::precision::Precision;
 use crate::samples::SampleOracle;
 use crate::Oracle;
@@ -61,12 +61,12 @@ impl Side {
     ///
     /// # Errors
     /// A dump that cannot be read.
-    pub fn open(text: &str) -> Result<Self, String> {
+    pub fn open(text: &str) -> Result<Self, VerdictError> {
         if text == "oracle" {
             return Ok(Self::Oracle);
         }
         let path = PathBuf::from(text);
-        let dump = Dump::read(&path).map_err(|e| e.to_string())?;
+        let dump = Dump::read(&path)?;
         Ok(Self::Dump(Box::new(dump), path))
     }
 
@@ -130,14 +130,12 @@ pub fn judge_sides(
     reference: &Side,
     candidate: &Side,
     options: &SidesOptions<'_>,
-) -> Result<Verdict, String> {
+) -> Result<Verdict, VerdictError> {
     let (mut header, beside) = match (reference, candidate) {
         (Side::Dump(dump, path), _) | (Side::Oracle, Side::Dump(dump, path)) => {
             (dump.header.clone(), dump_dir(path))
         }
-        (Side::Oracle, Side::Oracle) => {
-            return Err("compare needs at least one dump: both sides are `oracle`".into())
-        }
+        (Side::Oracle, Side::Oracle) => return Err(VerdictError::NoDump),
     };
     if let Some(mesh) = options.mesh {
         (header.scene.mesh, header.scene.name) = (Some(mesh.display().to_string()), None);
@@ -145,36 +143,27 @@ pub fn judge_sides(
     let mut notes = Vec::new();
     if let (Some(a), Some(b)) = (reference.header(), candidate.header()) {
         if (a.width, a.height) != (b.width, b.height) {
-            return Err(format!(
-                "the dumps cover different viewports: {}x{} and {}x{}",
-                a.width, a.height, b.width, b.height
-            ));
+            return Err(VerdictError::DumpViewports {
+                a: (a.width, a.height),
+                b: (b.width, b.height),
+            });
         }
         if a.scene != b.scene {
-            let which = format!(
-                "the dumps name different scenes: {} and {}",
-                a.scene.describe(),
-                b.scene.describe()
-            );
+            let (a, b) = (a.scene.describe(), b.scene.describe());
             if !options.allow_different_scenes {
-                return Err(format!(
-                    "{which} (--allow-different-scenes compares them anyway)"
-                ));
+                return Err(VerdictError::DifferentScenes { a, b });
             }
-            notes.push(which);
+            notes.push(format!("the dumps name different scenes: {a} and {b}"));
         }
     }
     let judged_f32 = options.vertex_precision == VertexPrecision::F32;
     // The precision bounds are derived per sample; the sample count is checked here all the same.
-    header.samples().map_err(|e| e.to_string())?;
+    header.samples()?;
     // A masked-node dump is judged against the per-pixel view of the per-sample oracle, which
     // only the oracle side can give.
     let masked = candidate.is_masked();
     if reference.is_masked() || (masked && !matches!(reference, Side::Oracle)) {
-        return Err(format!(
-            "a masked-node dump ({MASKED_SCHEME}) is compared as the candidate against the \
-             oracle: `fragsim compare oracle DUMP`"
-        ));
+        return Err(VerdictError::MaskedSide);
     }
     let size = (header.width, header.height);
     // The oracle is built only when a side asks for it (the scene may be a large mesh). Without
@@ -188,27 +177,22 @@ pub fn judge_sides(
         spec.conventions.vertex_precision = VertexPrecision::F64;
     }
     let loaded = if needs_oracle {
-        Some(
-            spec.load(Some(&beside))
-                .map_err(|e| DumpError::from(e).to_string())?,
-        )
+        Some(spec.load(Some(&beside)).map_err(DumpError::from)?)
     } else {
         None
     };
     let view = match &loaded {
         Some(loaded) => {
-            let viewport = Viewport::new(header.width, header.height)?;
-            Some(
-                spec.view(loaded, viewport)
-                    .map_err(|e| DumpError::from(e).to_string())?,
-            )
+            let viewport =
+                Viewport::new(header.width, header.height).map_err(VerdictError::View)?;
+            Some(spec.view(loaded, viewport).map_err(DumpError::from)?)
         }
         None => None,
     };
     let oracle = match &view {
         None => None,
         Some(view) if masked => {
-            let sampled = SampleOracle::build(view)?;
+            let sampled = SampleOracle::build(view).map_err(VerdictError::View)?;
             let reference = Reference::masked(sampled.per_pixel(), size);
             Some(if judged_f32 {
                 // The exact per-sample oracle (the view's vertex stage is f64 here) and the
@@ -242,11 +226,7 @@ pub fn judge_sides(
         }
     };
     if judged_f32 && !matches!(reference, Side::Oracle) {
-        return Err(
-            "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
-             to derive bounds from"
-                .into(),
-        );
+        return Err(VerdictError::F32NeedsOracle);
     }
     // The oracle is the reference, or (against a reference dump) the candidate.
     let (mut reference, oracle) = match (reference, oracle) {
