@@ -42,7 +42,7 @@ use std::borrow::Cow;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::{EdgeTies, VertexPrecision};
 
-use crate::compare::{verdict, CompareOptions, Comparison};
+use crate::compare::{flags, CompareOptions, Comparison};
 use crate::dump::{DepthFormat, Dump, WordCheck};
 use crate::precision::{Bounds, Precision};
 use crate::Oracle;
@@ -336,7 +336,7 @@ fn errors(comparison: &Comparison) -> usize {
     comparison
         .verdicts
         .iter()
-        .filter(|&&v| v & verdict::DIFFERS != 0)
+        .filter(|&&v| v & flags::DIFFERS != 0)
         .count()
 }
 
@@ -357,7 +357,7 @@ fn overflow_notes(comparison: &Comparison, capture: &Capture) -> Vec<String> {
         let pixels = comparison
             .verdicts
             .iter()
-            .filter(|&&v| v & verdict::OVERFLOWED != 0)
+            .filter(|&&v| v & flags::OVERFLOWED != 0)
             .count();
         if pixels > 0 {
             notes.push(format!(
