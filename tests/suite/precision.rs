@@ -325,10 +325,7 @@ fn a_keep_first_list_may_keep_any_arrivals_but_not_lose_more() {
         };
         let judged = keep_first(&kept);
         assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
-        assert_eq!(
-            judged.verdicts[p] & flags::OVERFLOWED,
-            flags::OVERFLOWED
-        );
+        assert_eq!(judged.verdicts[p] & flags::OVERFLOWED, flags::OVERFLOWED);
         assert_eq!(judged.diff.lost, 0);
         // One more fragment gone than the capacity allows is missing, whichever arrived first.
         let mut planted = kept.clone();

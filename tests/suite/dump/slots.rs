@@ -201,14 +201,8 @@ fn a_mutated_slot_major_word_is_caught_and_named_as_stored() {
         assert_eq!((corrupt.slot, corrupt.why), (2, Corruption::AfterEmpty));
         assert_eq!(corrupt.word, after_hole, "the word as the dump stores it");
         let comparison = judged(&mutated, oracle);
-        assert_eq!(
-            comparison.verdicts[holed],
-            flags::MISSING | flags::CORRUPT
-        );
-        assert_eq!(
-            comparison.verdicts[renamed],
-            flags::MISSING | flags::EXTRA
-        );
+        assert_eq!(comparison.verdicts[holed], flags::MISSING | flags::CORRUPT);
+        assert_eq!(comparison.verdicts[renamed], flags::MISSING | flags::EXTRA);
         assert_eq!(comparison.counts.equal, pixels as u64 - 2);
         // An A-buffer's counted slot holding the empty marker, slot-major.
         let abuffer = DumpScheme::ABufferFixed {

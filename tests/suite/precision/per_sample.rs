@@ -176,11 +176,7 @@ fn a_dropped_sample_and_a_sample_depth_past_its_interval_are_different_per_sampl
             deeper[p].sort_unstable();
             for (name, bugged, expected) in [
                 ("dropped", dropped, flags::MISSING | flags::MISCOUNTED),
-                (
-                    "past its interval",
-                    deeper,
-                    flags::MISSING | flags::EXTRA,
-                ),
+                ("past its interval", deeper, flags::MISSING | flags::EXTRA),
             ] {
                 let judged = judge(precision, oracle, &bugged);
                 let wrong: Vec<usize> = (0..bugged.len())
@@ -217,11 +213,7 @@ fn per_sample_joint_snaps_decide_shared_edges_and_catch_a_dropped_or_doubled_sam
             let mut dropped = lists.clone();
             dropped[p].retain(|&w| w as u32 != present);
             let flags = judge(precision, oracle, &dropped).verdicts[p];
-            assert_ne!(
-                flags & flags::MISSING,
-                0,
-                "sample {p} dropped: {flags:#b}"
-            );
+            assert_ne!(flags & flags::MISSING, 0, "sample {p} dropped: {flags:#b}");
             let key_lo = precision
                 .pixel(p)
                 .iter()

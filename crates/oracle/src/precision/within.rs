@@ -18,7 +18,7 @@ use fragsim_raster::{Conventions, Viewport};
 
 use super::{Bounds, Doubt, Possible, Precision};
 use crate::compare::{
-    compare_with, inferred_counter, flags, AmbiguityCounts, CompareOptions, Comparison,
+    compare_with, flags, inferred_counter, AmbiguityCounts, CompareOptions, Comparison,
 };
 use crate::dump::{Dump, DumpError, WordCheck};
 use crate::{Oracle, PixelMismatch};

@@ -169,9 +169,7 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
             spans.windows(2).all(|w| w[0].1 < w[1].0)
         });
         let decided = correct.iter().all(doubtless);
-        let equal = correct
-            .iter()
-            .all(|c| c.verdicts[p] & flags::DIFFERS == 0);
+        let equal = correct.iter().all(|c| c.verdicts[p] & flags::DIFFERS == 0);
         if certain && disjoint && decided {
             pools[0].push(p);
         }
