@@ -192,7 +192,7 @@ struct Outcome<'p> {
     wrong_masks: Option<u64>,
 }
 
-impl<'p> Outcome<'p> {
+impl Outcome<'_> {
     /// A comparison of every bit, with nothing else to say.
     fn exact(comparison: Comparison) -> Self {
         Self {

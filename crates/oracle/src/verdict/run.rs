@@ -72,7 +72,7 @@ mod tests {
         let oracle = Oracle::from_fragments(1, &[fragment(1), fragment(2)]);
         let mut merged =
             Capture::with_pixels(1, fragsim_capture::Identity::KeyAndPrim, Keeps::Nearest(2));
-        merged.push_pixel([10 << 32 | 2]);
+        merged.push_pixel([(10 << 32) | 2]);
         let judge =
             |guarantee, serialised, ties| judge_run(&oracle, &merged, guarantee, serialised, ties);
         // Merging equal depths is what a distinct-depths guarantee promises, whatever the

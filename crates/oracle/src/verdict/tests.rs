@@ -118,13 +118,12 @@ fn masked_dump_merged_by(
     let merged = MaskedLists::from_nodes(4, pixels, nodes);
     let capacity = (0..pixels).map(|p| merged.pixel(p).len()).max().unwrap();
     let mut dump = Dump::record_masked(&view, spec, capacity as u32, "test").unwrap();
-    let (mut counters, mut words, mut masks) = (
-        vec![0; pixels],
+    let counters: Vec<u32> = (0..pixels).map(|p| merged.pixel(p).len() as u32).collect();
+    let (mut words, mut masks) = (
         vec![u64::MAX; pixels * capacity],
         vec![0; pixels * capacity],
     );
     for p in 0..pixels {
-        counters[p] = merged.pixel(p).len() as u32;
         for (i, node) in merged.pixel(p).iter().enumerate() {
             words[p * capacity + i] = node.packed();
             masks[p * capacity + i] = node.mask;
@@ -175,8 +174,8 @@ fn merge_keeping_the_farthest(
 #[test]
 fn a_bug_planted_in_the_schemes_merge_is_caught_by_the_oracles_own_merge() {
     // The control: the schemes' merge, as it is, holds the per-pixel view exactly.
-    let (dump, reference) = masked_dump_merged_by(|samples, fragments, emit| {
-        merge_samples(samples, fragments, &mut |pixel, node| emit(pixel, node));
+    let (dump, reference) = masked_dump_merged_by(|samples, fragments, mut emit| {
+        merge_samples(samples, fragments, &mut emit);
     });
     let verdict = judge(&reference, Candidate::Dump(&dump), &OPTIONS).unwrap();
     assert!(verdict.equal, "{:?}", verdict.comparison.counts);
