@@ -134,7 +134,7 @@ impl Verdict {
 }
 
 /// Judges `candidate` against `reference` (see the module documentation): the candidate
-/// prepared once ([`Judged::of`]), compared as the kind of reference asks (the oracle, exactly or
+/// prepared once, compared as the kind of reference asks (the oracle, exactly or
 /// within precision; the per-sample oracle's per-pixel view; another dump), the verdict
 /// assembled from the outcome.
 ///
