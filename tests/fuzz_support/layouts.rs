@@ -30,7 +30,7 @@
 
 use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::Capture;
-use fragsim::oracle::compare::{compare_with, verdict, CompareOptions};
+use fragsim::oracle::compare::{compare_with, flags, CompareOptions};
 use fragsim::oracle::dump::{
     ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, Payload, Words,
 };
@@ -159,7 +159,7 @@ pub(crate) fn check(data: &[u8]) {
         let corrupt = !words.corrupt[p].is_empty();
         let flags = comparison.verdicts[p];
         assert_eq!(
-            flags & verdict::CORRUPT != 0,
+            flags & flags::CORRUPT != 0,
             corrupt,
             "pixel {p}: verdict {flags:#x}, corrupt words {:?}",
             words.corrupt[p]
@@ -171,7 +171,7 @@ pub(crate) fn check(data: &[u8]) {
             matches!(&built.expected, Ok(Some(model)) if model.judged_against_itself);
         if !corrupt && in_order(&capture, p) && judged_against_itself {
             assert_eq!(
-                flags & verdict::DIFFERS,
+                flags & flags::DIFFERS,
                 0,
                 "pixel {p} differs from itself\n{text}"
             );

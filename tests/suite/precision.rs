@@ -6,7 +6,7 @@
 //! same holds at every sample of the standard 4× and 8× patterns (`per_sample`).
 
 use fragsim::capture::{Capacity, Capture, Identity, Keeps};
-use fragsim::oracle::compare::{compare_with, verdict, CompareOptions, Comparison};
+use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
 use fragsim::oracle::precision::{compare_within, Doubt, Precision};
 use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
@@ -200,18 +200,18 @@ fn planted_bugs_in_an_f32_capture_are_errors_not_ambiguities() {
                 Box::new(|l| {
                     l.remove(0);
                 }),
-                verdict::MISSING | verdict::MISCOUNTED,
+                flags::MISSING | flags::MISCOUNTED,
             ),
             (
                 "wrong primitive id",
                 Box::new(move |l| l[0] = (l[0] & !u64::from(u32::MAX)) | u64::from(foreign)),
-                verdict::MISSING | verdict::EXTRA,
+                flags::MISSING | flags::EXTRA,
             ),
-            ("unsorted", Box::new(|l| l.swap(0, 1)), verdict::MISORDERED),
+            ("unsorted", Box::new(|l| l.swap(0, 1)), flags::MISORDERED),
             (
                 "extra",
                 Box::new(move |l| l.insert(width - 1, l[width - 1])),
-                verdict::EXTRA | verdict::MISCOUNTED,
+                flags::EXTRA | flags::MISCOUNTED,
             ),
         ];
         for (name, plant, expected) in bugs {
@@ -219,12 +219,12 @@ fn planted_bugs_in_an_f32_capture_are_errors_not_ambiguities() {
             plant(&mut bugged[p]);
             let judged = judge(&precision, oracle, &bugged);
             let wrong: Vec<usize> = (0..bugged.len())
-                .filter(|&q| judged.verdicts[q] & verdict::DIFFERS != 0)
+                .filter(|&q| judged.verdicts[q] & flags::DIFFERS != 0)
                 .collect();
             assert_eq!(wrong, [p], "{name}: the error is the planted pixel's alone");
             let flags = judged.verdicts[p];
-            assert_eq!(flags & verdict::DIFFERS, expected, "{name}");
-            assert_eq!(flags & verdict::AMBIGUOUS, 0, "{name} excused as ambiguous");
+            assert_eq!(flags & flags::DIFFERS, expected, "{name}");
+            assert_eq!(flags & flags::AMBIGUOUS, 0, "{name} excused as ambiguous");
         }
     });
 }
@@ -255,7 +255,7 @@ fn a_depth_at_its_bound_passes_and_one_ulp_past_fails() {
                 "key {key:#x} of {q:?}"
             );
             if !passes {
-                assert_eq!(judged.verdicts[p], verdict::MISSING | verdict::EXTRA);
+                assert_eq!(judged.verdicts[p], flags::MISSING | flags::EXTRA);
             }
         }
     });
@@ -326,16 +326,13 @@ fn a_keep_first_list_may_keep_any_arrivals_but_not_lose_more() {
         };
         let judged = keep_first(&kept);
         assert_eq!(judged.diff.mismatched_pixels, 0, "{:?}", judged.diff);
-        assert_eq!(
-            judged.verdicts[p] & verdict::OVERFLOWED,
-            verdict::OVERFLOWED
-        );
+        assert_eq!(judged.verdicts[p] & flags::OVERFLOWED, flags::OVERFLOWED);
         assert_eq!(judged.diff.lost, 0);
         // One more fragment gone than the capacity allows is missing, whichever arrived first.
         let mut planted = kept.clone();
         planted[p].remove(0);
         let bugged = keep_first(&planted);
-        assert_eq!(bugged.verdicts[p] & verdict::MISSING, verdict::MISSING);
+        assert_eq!(bugged.verdicts[p] & flags::MISSING, flags::MISSING);
         assert_eq!(bugged.diff.lost, 1);
     });
 }
@@ -377,11 +374,11 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
         let shared = shared_edge_pixels(precision, lists);
         assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
         for &(p, present, absent) in shared.iter().take(8) {
-            assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
+            assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "pixel {p}");
             let mut dropped = lists.to_vec();
             dropped[p].retain(|&w| w as u32 != present);
             let flags = judge(precision, oracle, &dropped).verdicts[p];
-            assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
+            assert_ne!(flags & flags::MISSING, 0, "pixel {p} dropped: {flags:#b}");
             let key_lo = precision
                 .pixel(p)
                 .iter()
@@ -392,7 +389,7 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
             doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
             doubled[p].sort_unstable();
             let flags = judge(precision, oracle, &doubled).verdicts[p];
-            assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+            assert_ne!(flags & flags::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
         }
     });
 }
@@ -418,17 +415,17 @@ fn key_only_words_leave_the_triangle_unnamed_and_still_catch_a_dropped_or_double
         let shared = shared_edge_pixels(precision, lists);
         assert!(shared.len() >= 8, "{} shared-edge pixels", shared.len());
         for &(p, present, _) in shared.iter().take(8) {
-            assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "pixel {p}");
+            assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "pixel {p}");
             let mut dropped = lists.to_vec();
             dropped[p].retain(|&w| w as u32 != present);
             let flags = key_only(&dropped).verdicts[p];
-            assert_ne!(flags & verdict::MISSING, 0, "pixel {p} dropped: {flags:#b}");
+            assert_ne!(flags & flags::MISSING, 0, "pixel {p} dropped: {flags:#b}");
             let mut doubled = lists.to_vec();
             let kept = *doubled[p].iter().find(|&&w| w as u32 == present).unwrap();
             doubled[p].push(kept);
             doubled[p].sort_unstable();
             let flags = key_only(&doubled).verdicts[p];
-            assert_ne!(flags & verdict::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+            assert_ne!(flags & flags::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
         }
     });
 }

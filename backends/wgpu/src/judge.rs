@@ -92,9 +92,7 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
         depth_ulps,
         examples: 8,
     };
-    let comparison = verdict::judge(&reference, Candidate::Dump(dump), &options)
-        .map_err(DumpError::Invalid)?
-        .comparison;
+    let comparison = verdict::judge(&reference, Candidate::Dump(dump), &options)?.comparison;
     let capture = dump.capture()?;
     // The most fragments of a pixel the scheme keeps.
     let keeps = match &capture.keeps {
@@ -276,7 +274,7 @@ impl Within {
             (self.viewport.width, self.viewport.height),
         )
         .with_edge_ties(&view);
-        verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError::Invalid)
+        verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(DumpError::from)
     }
 
     /// Lists (pixels, or samples of a per-sample dump) the reference covers: what ambiguous

@@ -8,7 +8,7 @@
 //! is an error (ambiguous only where MDTS's own pixel is), elsewhere its verdict is MDTS's. Without an adapter each test prints one line
 //! saying it was skipped; with `CI=true` or `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
-use fragsim_oracle::compare::{verdict, Comparison};
+use fragsim_oracle::compare::{flags, Comparison};
 use fragsim_oracle::dump::Dump;
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::Viewport;
@@ -72,12 +72,12 @@ fn a_correct_engine_capture_has_no_error_and_one_dropped_fragment_is_one_error()
         .expect("a decided pixel of depth complexity 2 or more");
     let (bugged, _) = judged(&without_first_fragment(&dump, p));
     let wrong: Vec<usize> = (0..bugged.verdicts.len())
-        .filter(|&q| bugged.verdicts[q] & verdict::DIFFERS != 0)
+        .filter(|&q| bugged.verdicts[q] & flags::DIFFERS != 0)
         .collect();
     assert_eq!(wrong, [p], "the error is the planted pixel's alone");
     assert_eq!(
-        bugged.verdicts[p] & (verdict::DIFFERS | verdict::AMBIGUOUS),
-        verdict::MISSING | verdict::MISCOUNTED
+        bugged.verdicts[p] & (flags::DIFFERS | flags::AMBIGUOUS),
+        flags::MISSING | flags::MISCOUNTED
     );
 }
 
@@ -100,10 +100,10 @@ fn the_kbuffer_is_judged_as_what_it_stored() {
             // the list does not hold. Where MDTS's own pixel is ambiguous (a fragment whose
             // coverage or depth a conforming implementation may decide either way), so may
             // the k-buffer's be.
-            let expected = if mdts_flags & verdict::AMBIGUOUS == 0 {
-                verdict::DIFFERS
+            let expected = if mdts_flags & flags::AMBIGUOUS == 0 {
+                flags::DIFFERS
             } else {
-                verdict::DIFFERS | verdict::AMBIGUOUS
+                flags::DIFFERS | flags::AMBIGUOUS
             };
             assert_ne!(
                 flags & expected,

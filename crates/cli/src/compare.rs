@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_oracle::compare::verdict;
+use fragsim_oracle::compare::flags;
 use fragsim_oracle::verdict::{judge_sides, Entry, Options, Side, SidesOptions, Summary, Verdict};
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::VertexPrecision;
@@ -149,15 +149,15 @@ fn check_mesh_replaces(args: &CompareArgs, sides: [&Side; 2]) -> Result<(), Stri
 
 /// Colour of a pixel's verdict in the difference image.
 fn colour(flags: u8, fragments: usize) -> [u8; 3] {
-    let wrong = flags & (verdict::MISSING | verdict::EXTRA);
+    let wrong = flags & (flags::MISSING | flags::EXTRA);
     match () {
-        () if flags & verdict::CORRUPT != 0 => [40, 220, 40],
-        () if wrong == verdict::MISSING | verdict::EXTRA => [220, 50, 220],
-        () if wrong == verdict::MISSING => [230, 40, 40],
-        () if wrong == verdict::EXTRA => [60, 90, 255],
-        () if flags & verdict::MISORDERED != 0 => [250, 220, 0],
-        () if flags & verdict::MISCOUNTED != 0 => [255, 140, 0],
-        () if flags & verdict::OVERFLOWED != 0 => [0, 90, 90],
+        () if flags & flags::CORRUPT != 0 => [40, 220, 40],
+        () if wrong == flags::MISSING | flags::EXTRA => [220, 50, 220],
+        () if wrong == flags::MISSING => [230, 40, 40],
+        () if wrong == flags::EXTRA => [60, 90, 255],
+        () if flags & flags::MISORDERED != 0 => [250, 220, 0],
+        () if flags & flags::MISCOUNTED != 0 => [255, 140, 0],
+        () if flags & flags::OVERFLOWED != 0 => [0, 90, 90],
         () if fragments > 0 => [70, 70, 70],
         () => [0, 0, 0],
     }
@@ -167,13 +167,13 @@ fn colour(flags: u8, fragments: usize) -> [u8; 3] {
 /// many pixels have it.
 fn legend(v: &Verdict) -> Vec<(image::Rgb<u8>, String)> {
     let meanings: [(u8, usize, &str); 9] = [
-        (verdict::CORRUPT, 0, "corrupt word"),
-        (verdict::MISSING | verdict::EXTRA, 0, "missing and extra"),
-        (verdict::MISSING, 0, "missing"),
-        (verdict::EXTRA, 0, "extra"),
-        (verdict::MISORDERED, 0, "misordered"),
-        (verdict::MISCOUNTED, 0, "overflow miscounted"),
-        (verdict::OVERFLOWED, 0, "overflowed (by design)"),
+        (flags::CORRUPT, 0, "corrupt word"),
+        (flags::MISSING | flags::EXTRA, 0, "missing and extra"),
+        (flags::MISSING, 0, "missing"),
+        (flags::EXTRA, 0, "extra"),
+        (flags::MISORDERED, 0, "misordered"),
+        (flags::MISCOUNTED, 0, "overflow miscounted"),
+        (flags::OVERFLOWED, 0, "overflowed (by design)"),
         (0, 1, "equal, covered"),
         (0, 0, "no fragment"),
     ];
@@ -207,7 +207,7 @@ fn write_image(v: &Verdict, path: &Path) -> Result<(), String> {
         .verdicts
         .iter()
         .enumerate()
-        .filter(|&(_, &v)| v & verdict::DIFFERS != 0)
+        .filter(|&(_, &v)| v & flags::DIFFERS != 0)
         .map(|(p, _)| ((p % width as usize) as u32, (p / width as usize) as u32));
     // Rings only where differences are sparse: dense ones show alone, and rings would hide some.
     let ring = differing.clone().count() <= fragsim_shade::legend::MARKS;

@@ -9,9 +9,11 @@ use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
 use fragsim_capture::catalog::Count;
 use fragsim_capture::schemes::masked_abuffer::MaskedABuffer;
-use fragsim_oracle::dump::MASKED_SCHEME;
+use fragsim_oracle::dump::{Dump, MASKED_SCHEME};
 use fragsim_oracle::samples::SampleOracle;
+use fragsim_oracle::verdict::{judge, judge_run, Candidate, Options, Reference, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{depth_from_key, View};
 use serde::Serialize;
 
@@ -241,12 +243,11 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             progress.set_message(format!("{name} on the {executor} executor"));
             let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             let run = &named.run;
-            let diff = oracle.diff_with(&run.capture, args.ties.into());
-            let keeps_guarantee = oracle.keeps_guarantee_given(
+            let RunVerdict { diff, owed, kept } = judge_run(
+                &oracle,
                 &run.capture,
                 named.guarantee,
                 executor.serialises_pixels(),
-                &diff,
                 args.ties.into(),
             );
             if !args.no_images && !nearest_written {
@@ -270,8 +271,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             rows.push(RunSummary {
                 scheme: named.name.clone(),
                 guarantee: named.guarantee.to_string(),
-                keeps_guarantee,
-                guarantee_owed: named.guarantee.owes_exactness(executor.serialises_pixels()),
+                keeps_guarantee: kept,
+                guarantee_owed: owed,
                 executor: executor.name().into(),
                 threads: run.stats.threads,
                 triangles: view.triangle_count(),
@@ -304,7 +305,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     }
     let mut masked_line = None;
     if args.scheme.contains(&RenderScheme::Masked) {
-        let (capacity, line) = masked(&view, &sizing)?;
+        let (capacity, line) = masked(&view, &spec, &sizing)?;
         masked_line = Some(line);
         if let Some(stage) = &mut dumps {
             stage.add_masked(&view, &spec, capacity)?;
@@ -358,11 +359,14 @@ fn caption(args: &RenderArgs, what: &str) -> Result<String, String> {
     ))
 }
 
-/// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample); returns
-/// its capacity (`--capacity`, or under `auto` the most nodes a pixel of that view has) and the
-/// line saying whether it holds the per-pixel view of the per-sample oracle.
+/// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample, at the
+/// sample count `spec` declares) and judges the memory it leaves as `compare oracle DUMP` judges
+/// its dump ([`fragsim_oracle::verdict::judge`] against the per-pixel view of the per-sample
+/// oracle: nodes beyond the capacity overflow by design). Returns its capacity (`--capacity`, or
+/// under `auto` the most nodes a pixel of that view has) and the line saying the verdict.
 fn masked(
     view: &View<'_>,
+    spec: &SceneSpec,
     sizing: &fragsim_capture::catalog::Sizing,
 ) -> Result<(u32, String), String> {
     let Some(pattern) = view.samples() else {
@@ -380,16 +384,27 @@ fn masked(
             .unwrap_or(0)
             .max(1),
     };
-    let scheme = MaskedABuffer::new(
+    // The run's memory is refused beyond the cap before anything is allocated.
+    MaskedABuffer::new(
         view.pixel_viewport(),
         pattern.count(),
         capacity,
         sizing.memory_cap,
     )
     .map_err(|e| e.to_string())?;
-    let lists = scheme.capture(view, false)?;
+    let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
+    let dump =
+        Dump::record_masked(view, spec.clone(), capacity, &producer).map_err(|e| e.to_string())?;
+    let pixels = view.pixel_viewport();
+    let reference = Reference::masked(per_pixel, (pixels.width, pixels.height));
+    let options = Options {
+        depth_ulps: 0,
+        examples: 0,
+    };
+    let verdict = judge(&reference, Candidate::Dump(&dump), &options)?;
+    let lists = dump.masked_lists().map_err(|e| e.to_string())?;
     let overflowed: u64 = lists.overflow.iter().map(|&o| u64::from(o)).sum();
-    let holds = if lists == per_pixel {
+    let holds = if verdict.equal {
         "equal to"
     } else {
         "differs from"

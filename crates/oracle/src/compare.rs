@@ -25,8 +25,8 @@ pub fn with_identity(capture: &Capture, identity: Identity) -> Capture {
     }
 }
 
-/// Per-pixel verdict flags of a comparison (a pixel with none of [`verdict::DIFFERS`] is equal).
-pub mod verdict {
+/// Per-pixel verdict flags of a comparison (a pixel with none of [`flags::DIFFERS`] is equal).
+pub mod flags {
     /// Fragments the reference has and the candidate should have kept are missing.
     pub const MISSING: u8 = 1;
     /// The candidate has fragments the reference does not.
@@ -102,19 +102,19 @@ impl VerdictCounts {
     /// Counts one pixel's flags.
     pub(crate) fn add(&mut self, flags: u8) {
         let counters = [
-            (verdict::MISSING, &mut self.missing),
-            (verdict::EXTRA, &mut self.extra),
-            (verdict::MISORDERED, &mut self.misordered),
-            (verdict::OVERFLOWED, &mut self.overflowed),
-            (verdict::MISCOUNTED, &mut self.miscounted),
-            (verdict::CORRUPT, &mut self.corrupt),
-            (verdict::WITHIN_PRECISION, &mut self.within_precision),
-            (verdict::AMBIGUOUS, &mut self.ambiguous),
+            (flags::MISSING, &mut self.missing),
+            (flags::EXTRA, &mut self.extra),
+            (flags::MISORDERED, &mut self.misordered),
+            (flags::OVERFLOWED, &mut self.overflowed),
+            (flags::MISCOUNTED, &mut self.miscounted),
+            (flags::CORRUPT, &mut self.corrupt),
+            (flags::WITHIN_PRECISION, &mut self.within_precision),
+            (flags::AMBIGUOUS, &mut self.ambiguous),
         ];
         for (flag, count) in counters {
             *count += u64::from(flags & flag != 0);
         }
-        self.equal += u64::from(flags & verdict::DIFFERS == 0);
+        self.equal += u64::from(flags & flags::DIFFERS == 0);
     }
 }
 
@@ -124,7 +124,7 @@ pub struct Comparison {
     /// Totals over every pixel (the sum of one [`Oracle::diff`] per pixel), with the first
     /// `examples` differing pixels. `overflowed` is the overflow the reference predicts where it
     /// knows the pixel's fragment count (`max(0, n − capacity)`), not what counters claim;
-    /// `mismatched_pixels` counts every pixel with a [`verdict::DIFFERS`] flag.
+    /// `mismatched_pixels` counts every pixel with a [`flags::DIFFERS`] flag.
     pub diff: Diff,
     /// Per pixel, `verdict` flags.
     pub verdicts: Vec<u8>,
@@ -143,7 +143,7 @@ pub struct Comparison {
     pub words_checked: bool,
     /// The corrupt words of the pixels in `diff.first_mismatches`.
     pub first_corrupt: Vec<CorruptWord>,
-    /// Of the [`verdict::AMBIGUOUS`] pixels, how many each cause made so (a pixel may have
+    /// Of the [`flags::AMBIGUOUS`] pixels, how many each cause made so (a pixel may have
     /// several); all 0 outside a verdict within precision.
     pub ambiguity: AmbiguityCounts,
     /// What the capture told of the vertices' snaps (`docs/semantics.md` §10, "One snap per
@@ -239,7 +239,7 @@ impl Comparison {
         example: impl FnOnce() -> PixelMismatch,
     ) {
         self.counts.add(flags);
-        if flags & verdict::DIFFERS != 0 {
+        if flags & flags::DIFFERS != 0 {
             self.diff.mismatched_pixels += 1;
             if self.diff.first_mismatches.len() < examples {
                 self.diff.first_mismatches.push(PixelMismatch {
@@ -268,7 +268,7 @@ impl Comparison {
             let before = self.verdicts[p];
             self.verdicts[p] |= flags;
             let shown = self.diff.first_mismatches.iter().any(|m| m.pixel == p);
-            if before & verdict::DIFFERS == 0 && flags & verdict::DIFFERS != 0 && !shown {
+            if before & flags::DIFFERS == 0 && flags & flags::DIFFERS != 0 && !shown {
                 self.diff.first_mismatches.push(example(p));
             }
         }
@@ -281,7 +281,7 @@ impl Comparison {
         self.diff.mismatched_pixels = self
             .verdicts
             .iter()
-            .filter(|&&v| v & verdict::DIFFERS != 0)
+            .filter(|&&v| v & flags::DIFFERS != 0)
             .count() as u64;
     }
 
@@ -376,13 +376,13 @@ pub(crate) fn inferred_counter(stored: usize, overflow: u32) -> Counter {
 
 /// Compares `candidate` with `reference` pixel by pixel under the candidate's promise, with
 /// [`Oracle::diff`] on each pixel, and adds what `words` (the candidate dump's
-/// [`WordCheck`]) found: a pixel with a corrupt word is [`verdict::CORRUPT`] whatever its list,
+/// [`WordCheck`]) found: a pixel with a corrupt word is [`flags::CORRUPT`] whatever its list,
 /// and an A-buffer slot holding the empty marker is taken out of the list (it is no fragment,
 /// so it is corrupt, not extra).
 ///
 /// An A-buffer counter must equal its pixel's fragment count `n`, which the reference knows
 /// (where `options.complete` says so): every fragment adds one and the counter never wraps. A
-/// counter that differs is [`verdict::MISCOUNTED`]: larger than the pixel could have, or an
+/// counter that differs is [`flags::MISCOUNTED`]: larger than the pixel could have, or an
 /// overflow `counter − capacity` other than `max(0, n − capacity)`. The overflow allowed to be
 /// missing is then `max(0, n − capacity)`, never what the counter claims; without `words` the
 /// counter and capacity are inferred from the capture ([`Keeps::All`]'s overflow).
@@ -459,7 +459,7 @@ pub fn compare_with(
                     .extend(got.iter().filter(|&&e| !marker_is_corrupt || e != u64::MAX));
                 let (capacity, allowed) = if knows_n {
                     if counter.count as usize != n {
-                        flags |= verdict::MISCOUNTED;
+                        flags |= flags::MISCOUNTED;
                     }
                     let allowed = n.saturating_sub(counter.capacity as usize) as u32;
                     (Capacity::PerPixel(counter.capacity), allowed)
@@ -491,27 +491,27 @@ pub fn compare_with(
         one.offsets[1] = one.entries.len();
         let d = one_ref.diff(&one);
         if words.is_some_and(|w| !w.corrupt[p].is_empty()) {
-            flags |= verdict::CORRUPT;
+            flags |= flags::CORRUPT;
         }
         if d.lost > 0 {
-            flags |= verdict::MISSING;
+            flags |= flags::MISSING;
         }
         if d.extra > 0 {
-            flags |= verdict::EXTRA;
+            flags |= flags::EXTRA;
         }
         if d.misordered_pixels > 0 {
-            flags |= verdict::MISORDERED;
+            flags |= flags::MISORDERED;
         }
         if d.overflowed > 0 {
-            flags |= verdict::OVERFLOWED;
+            flags |= flags::OVERFLOWED;
         }
         // A pixel the diff rejects for no other reason has fewer fragments missing than the
         // overflow it was allowed. Where the reference knows the count that cannot happen (the
         // allowance is `n − capacity` and at most `capacity` are held), so it is named a miscount
         // rather than left unnamed; where the reference does not know the count, the claimed
         // overflow is all there is and a reference holding no more than the candidate is no gap.
-        if d.mismatched_pixels > 0 && flags & verdict::DIFFERS == 0 && knows_n {
-            flags |= verdict::MISCOUNTED;
+        if d.mismatched_pixels > 0 && flags & flags::DIFFERS == 0 && knows_n {
+            flags |= flags::MISCOUNTED;
         }
         if !counted {
             // MDTS claims nothing: what lies beyond K is its promise.

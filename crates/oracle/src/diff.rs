@@ -1,64 +1,12 @@
-//! The per-pixel diff of a capture against the oracle, and the verdict on a scheme's guarantee
-//! drawn from it.
+//! The per-pixel diff of a capture against the oracle: lost, extra and misordered fragments,
+//! overflow predicted against overflow reported. The verdicts are drawn from it elsewhere
+//! ([`crate::verdict`]).
 
-use fragsim_capture::{Capture, Guarantee, Identity, Keeps};
+use fragsim_capture::{Capture, Identity, Keeps};
 
 use crate::{Oracle, Ties};
 
 impl Oracle {
-    /// Whether `capture` keeps `guarantee` on an executor that serialises each pixel's fragments
-    /// (`pixels_serialised`: serial, tiled) or not. Judged by the guarantee's own tie policy,
-    /// whatever policy a report uses: equal depths merged for
-    /// [`Guarantee::ExactDistinctDepths`], the canonical order otherwise.
-    ///
-    /// # Panics
-    /// If the capture covers a different number of pixels.
-    #[must_use]
-    pub fn keeps_guarantee(
-        &self,
-        capture: &Capture,
-        guarantee: Guarantee,
-        pixels_serialised: bool,
-    ) -> bool {
-        if !guarantee.owes_exactness(pixels_serialised) {
-            return true;
-        }
-        self.diff_with(capture, Self::judging_ties(guarantee))
-            .is_exact()
-    }
-
-    /// [`Oracle::keeps_guarantee`] for a capture already diffed under `ties` (`diff`): that diff is
-    /// reused when the guarantee is judged by the same tie policy, so a report pays for one diff.
-    ///
-    /// # Panics
-    /// If the capture covers a different number of pixels.
-    #[must_use]
-    pub fn keeps_guarantee_given(
-        &self,
-        capture: &Capture,
-        guarantee: Guarantee,
-        pixels_serialised: bool,
-        diff: &Diff,
-        ties: Ties,
-    ) -> bool {
-        if !guarantee.owes_exactness(pixels_serialised) {
-            return true;
-        }
-        if ties == Self::judging_ties(guarantee) {
-            return diff.is_exact();
-        }
-        self.keeps_guarantee(capture, guarantee, pixels_serialised)
-    }
-
-    /// The tie policy a guarantee is judged by.
-    fn judging_ties(guarantee: Guarantee) -> Ties {
-        if guarantee.merges_equal_depths() {
-            Ties::MergeEqualDepths
-        } else {
-            Ties::ByPrimitive
-        }
-    }
-
     /// Compares a capture with this oracle, pixel by pixel, under the capture's promise, with
     /// ties ordered by primitive id ([`Ties::ByPrimitive`]).
     ///
@@ -389,26 +337,5 @@ mod tests {
         assert!(!oracle
             .diff(&capture_of(&[&[1, 2, 3], &[4]], two_slots(vec![1, 0])))
             .is_exact());
-    }
-
-    #[test]
-    fn guarantees_are_judged_where_they_are_owed() {
-        let e = |key: u64, prim: u64| key << 32 | prim;
-        let oracle = oracle_of(&[&[e(10, 1), e(10, 2)]]);
-        let merged = capture_of(&[&[e(10, 2)]], Keeps::Nearest(2));
-        assert!(oracle.keeps_guarantee(&merged, Guarantee::ExactDistinctDepths, false));
-        assert!(!oracle.keeps_guarantee(&merged, Guarantee::Exact, false));
-        assert!(!oracle.keeps_guarantee(&merged, Guarantee::ExactWithoutHazards, true));
-        assert!(oracle.keeps_guarantee(&merged, Guarantee::ExactWithoutHazards, false));
-        assert!(oracle.keeps_guarantee(&merged, Guarantee::Approximate, true));
-        // A diff already made under the judging ties is reused, and gives the same verdict.
-        let canonical = oracle.diff(&merged);
-        for g in [Guarantee::Exact, Guarantee::ExactDistinctDepths] {
-            assert_eq!(
-                oracle.keeps_guarantee_given(&merged, g, true, &canonical, Ties::ByPrimitive),
-                oracle.keeps_guarantee(&merged, g, true),
-                "{g}"
-            );
-        }
     }
 }

@@ -1,10 +1,15 @@
 //! The serial oracle: every fragment of every pixel in canonical order, and the per-pixel diff
 //! that says where a scheme's capture departs from it.
 //!
-//! The oracle shares nothing with the schemes but the rasterizer: it counts each pixel's fragments
-//! (the depth complexity), allocates one flat array by the prefix sum of the counts, fills it in
-//! submission order and sorts each pixel's list by `(depth key, primitive id)` with the standard
-//! library's sort.
+//! The oracle's references share nothing with the schemes but the rasterizer: [`Oracle::build`]
+//! counts each pixel's fragments (the depth complexity), allocates one flat array by the prefix
+//! sum of the counts, fills it in submission order and sorts each pixel's list by `(depth key,
+//! primitive id)` with the standard library's sort; the per-sample oracle's per-pixel view is
+//! merged by this crate's own code ([`samples`]), not by the masked-node schemes' merge. From the
+//! capture crate it takes the types captures and promises are held in and, for dumps only, what
+//! decodes them: the catalog's layouts and each scheme's post pass (every word is also checked
+//! against its layout by this crate's rules, [`dump`]). [`dump::Dump::record`] runs fragsim's own scheme serially to
+//! write the dump fragsim would write as a backend: a candidate, never the oracle's reference.
 //!
 //! ```
 //! use fragsim_oracle::Oracle;

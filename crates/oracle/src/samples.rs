@@ -8,13 +8,16 @@
 //!
 //! The per-pixel view ([`SampleOracle::per_pixel`]) is what per-pixel storage with coverage masks
 //! can hold at best: each pixel's fragments merged into one node per primitive, with the mask of
-//! the samples it covers and the nearest of their depth keys
-//! ([`merge_samples`], the rule the
-//! masked-node A-buffer applies when it captures).
+//! the samples it covers and the nearest of their depth keys (the rule the masked-node schemes
+//! apply when they capture). The oracle merges with its own code, from its per-sample lists, and
+//! never calls the schemes' merge: a bug there cannot hide in the reference it is judged
+//! against.
 
-use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
+use std::collections::BTreeMap;
+
+use fragsim_capture::schemes::masked_abuffer::{MaskedLists, MaskedNode};
 use fragsim_capture::{Capture, Identity, PixelLists};
-use fragsim_raster::{Fragment, SamplePattern, View, Viewport};
+use fragsim_raster::{SamplePattern, View, Viewport};
 
 use crate::Oracle;
 
@@ -70,24 +73,31 @@ impl SampleOracle {
         depths.chunks(n).map(|pixel| pixel.iter().sum()).collect()
     }
 
-    /// The per-pixel view: every pixel's fragments merged into one node per primitive.
+    /// The per-pixel view: every pixel's fragments merged into one node per primitive, its mask
+    /// the samples of the pixel whose lists hold the primitive, its depth key the nearest of
+    /// theirs.
     #[must_use]
     pub fn per_pixel(&self) -> MaskedLists {
         let n = self.pattern.count();
         let lists = self.oracle.lists();
-        let mut fragments: Vec<Fragment> = (0..lists.pixels())
-            .flat_map(|sample| {
-                lists.pixel(sample).iter().map(move |&packed| Fragment {
-                    pixel: sample as u32,
-                    depth_key: (packed >> 32) as u32,
-                    prim: packed as u32,
-                })
-            })
-            .collect();
         let mut nodes: Vec<(u32, MaskedNode)> = Vec::new();
-        merge_samples(n, &mut fragments, &mut |pixel, node| {
-            nodes.push((pixel, node));
-        });
+        let mut by_prim: BTreeMap<u32, MaskedNode> = BTreeMap::new();
+        for pixel in 0..self.pixels.pixels() {
+            by_prim.clear();
+            for sample in 0..n {
+                for &packed in lists.pixel(pixel * n as usize + sample as usize) {
+                    let (depth_key, prim) = (depth_key(packed), primitive_id(packed));
+                    let node = by_prim.entry(prim).or_insert(MaskedNode {
+                        depth_key,
+                        prim,
+                        mask: 0,
+                    });
+                    node.mask |= 1 << sample;
+                    node.depth_key = node.depth_key.min(depth_key);
+                }
+            }
+            nodes.extend(by_prim.values().map(|&node| (pixel as u32, node)));
+        }
         MaskedLists::from_nodes(n, self.pixels.pixels(), nodes)
     }
 

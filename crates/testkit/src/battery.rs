@@ -32,7 +32,7 @@ use std::fmt;
 use std::time::{Duration, Instant};
 
 use fragsim_capture::Guarantee;
-use fragsim_oracle::compare::{verdict, Comparison};
+use fragsim_oracle::compare::{flags, Comparison};
 use fragsim_oracle::{Oracle, PixelMismatch};
 use fragsim_raster::Conventions;
 use proptest::strategy::Strategy;
@@ -613,7 +613,7 @@ fn candidates(case: &Case, found: &Found, power_of_two: bool) -> Vec<Case> {
         c.verdicts
             .iter()
             .enumerate()
-            .filter(|(_, &v)| v & verdict::DIFFERS != 0)
+            .filter(|(_, &v)| v & flags::DIFFERS != 0)
             .map(|(p, _)| (p as u32 % w, p as u32 / w))
             .collect()
     });
@@ -667,16 +667,16 @@ fn candidates(case: &Case, found: &Found, power_of_two: bool) -> Vec<Case> {
 
 /// One line on a differing verdict: pixels per verdict.
 fn describe(comparison: &Comparison, fragments: usize) -> String {
-    let mut per_verdict = [0_u64; verdict::NAMES.len()];
+    let mut per_verdict = [0_u64; flags::NAMES.len()];
     for &flags in &comparison.verdicts {
-        for (i, (flag, _)) in verdict::NAMES.iter().enumerate() {
+        for (i, (flag, _)) in flags::NAMES.iter().enumerate() {
             per_verdict[i] += u64::from(flags & flag != 0);
         }
     }
-    let named: Vec<String> = verdict::NAMES
+    let named: Vec<String> = flags::NAMES
         .iter()
         .zip(per_verdict)
-        .filter(|&((flag, _), n)| n > 0 && flag & verdict::DIFFERS != 0)
+        .filter(|&((flag, _), n)| n > 0 && flag & flags::DIFFERS != 0)
         .map(|((_, name), n)| format!("{n} {name}"))
         .collect();
     format!(

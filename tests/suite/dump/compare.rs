@@ -4,7 +4,7 @@
 
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::Identity;
-use fragsim::oracle::compare::{self, verdict, CompareOptions};
+use fragsim::oracle::compare::{self, flags, CompareOptions};
 use fragsim::oracle::dump::{Corruption, Dump, DumpScheme, Words};
 use fragsim::oracle::Oracle;
 
@@ -32,9 +32,9 @@ fn compare_names_missing_extra_and_misordered_pixels_and_agrees_with_the_diff() 
         let capture = dump.capture().unwrap();
         let comparison = compare::compare(oracle, &capture, 0, 8);
         let flags = |p: usize| comparison.verdicts[p];
-        assert_eq!(flags(swapped), verdict::MISORDERED);
-        assert_eq!(flags(renamed), verdict::MISSING | verdict::EXTRA);
-        assert_eq!(flags(holed), verdict::MISSING);
+        assert_eq!(flags(swapped), flags::MISORDERED);
+        assert_eq!(flags(renamed), flags::MISSING | flags::EXTRA);
+        assert_eq!(flags(holed), flags::MISSING);
         let lost_behind_hole = oracle.pixel(holed).len() as u64 - 1;
         assert_eq!(comparison.diff.lost, 1 + lost_behind_hole);
         assert_eq!(comparison.diff.extra, 1);
@@ -53,8 +53,8 @@ fn compare_names_missing_extra_and_misordered_pixels_and_agrees_with_the_diff() 
         );
         // Reading every word, the hole's successors are words after an empty slot.
         let whole = judged(&dump, oracle);
-        assert_eq!(whole.verdicts[holed], verdict::MISSING | verdict::CORRUPT);
-        assert_eq!(whole.verdicts[swapped], verdict::MISORDERED);
+        assert_eq!(whole.verdicts[holed], flags::MISSING | flags::CORRUPT);
+        assert_eq!(whole.verdicts[swapped], flags::MISORDERED);
         assert_eq!(
             whole.corrupt_words,
             oracle.pixel(holed).len().min(k) as u64 - 2,
@@ -109,8 +109,8 @@ fn abuffer_overflow_by_design_is_equal_but_an_overstated_counter_is_caught() {
         let comparison = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
         assert!(!comparison.is_equal());
         assert_eq!(
-            comparison.verdicts[deep] & verdict::MISCOUNTED,
-            verdict::MISCOUNTED
+            comparison.verdicts[deep] & flags::MISCOUNTED,
+            flags::MISCOUNTED
         );
         assert_eq!(comparison.counts.miscounted, 1);
     });
@@ -161,7 +161,7 @@ fn a_word_after_an_empty_mdts_slot_is_corrupt_in_every_mdts_layout() {
             );
             let whole = judged(&dump, oracle);
             assert!(!whole.is_equal(), "{scheme:?}");
-            assert_eq!(whole.verdicts[p], verdict::CORRUPT, "{scheme:?}");
+            assert_eq!(whole.verdicts[p], flags::CORRUPT, "{scheme:?}");
             assert_eq!(whole.counts.corrupt, 1);
             assert_eq!(whole.counts.equal, u64::from(WIDTH * HEIGHT) - 1);
             assert_eq!(whole.diff.mismatched_pixels, 1);
@@ -228,7 +228,7 @@ fn an_abuffer_slot_below_its_counter_holding_the_empty_marker_is_corrupt_not_ext
             let whole = judged(&dump, oracle);
             assert_eq!(
                 whole.verdicts[p],
-                verdict::CORRUPT | verdict::MISSING,
+                flags::CORRUPT | flags::MISSING,
                 "{scheme:?}"
             );
             assert_eq!((whole.diff.lost, whole.diff.extra), (1, 0), "{scheme:?}");
@@ -256,7 +256,7 @@ fn an_abuffer_word_past_its_counter_is_corrupt_when_the_header_says_slots_were_f
             .sum();
         u64_slots(&mut dump)[p * k as usize + k as usize - 1] = oracle.pixel(p)[0];
         let whole = judged(&dump, oracle);
-        assert_eq!(whole.verdicts[p], verdict::CORRUPT);
+        assert_eq!(whole.verdicts[p], flags::CORRUPT);
         assert_eq!(whole.first_corrupt[0].why, Corruption::BeyondCounter);
         assert_eq!(whole.unchecked_words, 0);
         // FreePipe leaves spare slots uninitialised: without the promise nothing is known of
@@ -290,7 +290,7 @@ fn a_stored_depth_key_above_one_is_corrupt() {
             let whole = judged(&dump, oracle);
             assert_eq!(
                 whole.verdicts[p],
-                verdict::CORRUPT | verdict::MISSING | verdict::EXTRA,
+                flags::CORRUPT | flags::MISSING | flags::EXTRA,
                 "{scheme:?}"
             );
             assert_eq!(whole.first_corrupt[0].why, Corruption::ImpossibleKey);
@@ -315,9 +315,9 @@ fn an_abuffer_counter_other_than_the_pixels_fragment_count_is_overflow_miscounte
         // the last fragment of an overflowing pixel (overflow one short of n − capacity), and
         // one larger than a pixel of two fragments could have (its extra slot is still empty).
         let cases = [
-            (deep, u32::MAX, verdict::MISCOUNTED | verdict::OVERFLOWED),
-            (deep, n - 1, verdict::MISCOUNTED | verdict::OVERFLOWED),
-            (shallow, 3, verdict::MISCOUNTED | verdict::CORRUPT),
+            (deep, u32::MAX, flags::MISCOUNTED | flags::OVERFLOWED),
+            (deep, n - 1, flags::MISCOUNTED | flags::OVERFLOWED),
+            (shallow, 3, flags::MISCOUNTED | flags::CORRUPT),
         ];
         let scheme = DumpScheme::ABufferFixed {
             capacity,
@@ -346,7 +346,7 @@ fn an_abuffer_counter_other_than_the_pixels_fragment_count_is_overflow_miscounte
             assert_eq!(whole.diff.lost, 0, "every fragment that fits is there");
             // The lists alone, counter inferred from the capture, reach the same verdict.
             let lists = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
-            assert_eq!(lists.verdicts[p] & verdict::MISCOUNTED, verdict::MISCOUNTED);
+            assert_eq!(lists.verdicts[p] & flags::MISCOUNTED, flags::MISCOUNTED);
             assert_eq!(lists.diff.overflowed, predicted);
         }
     });
@@ -402,7 +402,7 @@ fn a_sorted_abuffer_dump_is_judged_in_stored_order_an_unsorted_one_is_sorted_fir
             slots.swap(base, base + 1);
             let comparison = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
             if sorted {
-                assert_eq!(comparison.verdicts[deep], verdict::MISORDERED);
+                assert_eq!(comparison.verdicts[deep], flags::MISORDERED);
             } else {
                 assert!(
                     comparison.is_equal(),

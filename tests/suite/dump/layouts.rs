@@ -6,7 +6,7 @@
 use fragsim::capture::catalog::{Count, DumpLayout, SchemeName, SchemeRunner, Sizing, CATALOG};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::Capture;
-use fragsim::oracle::compare::{self, verdict};
+use fragsim::oracle::compare::{self, flags};
 use fragsim::oracle::dump::{
     Corruption, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, Words,
 };
@@ -104,7 +104,7 @@ fn u32s<'a>(dump: &'a mut Dump, name: &str) -> &'a mut Vec<u32> {
 fn corrupt_at(dump: &Dump, oracle: &Oracle, p: usize) -> Vec<Corruption> {
     let comparison = judged(dump, oracle);
     assert_ne!(
-        comparison.verdicts[p] & verdict::CORRUPT,
+        comparison.verdicts[p] & flags::CORRUPT,
         0,
         "pixel {p} is not flagged corrupt"
     );
@@ -152,7 +152,7 @@ fn links_out_of_the_pool_or_to_unallocated_nodes_are_corrupt() {
         u32s(&mut lost, "heads")[p] = second;
         let comparison = judged(&lost, oracle);
         assert_eq!(lost.check_words().unwrap().unreachable, 1);
-        assert_ne!(comparison.verdicts[p] & verdict::MISSING, 0);
+        assert_ne!(comparison.verdicts[p] & flags::MISSING, 0);
     });
 }
 

@@ -280,3 +280,47 @@ fn an_f32_masked_node_dump_is_judged_a_sample_at_a_time_and_a_wrong_mask_a_lost_
     assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
     assert!(record["lost"].as_u64().unwrap() >= 1, "{record}");
 }
+
+/// `render`'s line on the masked-node A-buffer and `compare oracle` on the dump of that run give
+/// one verdict, at capacities that drop nodes (overflow by design, equal) and at `auto`.
+#[test]
+fn render_and_compare_agree_on_masked_node_runs_whose_nodes_overflow() {
+    for capacity in ["1", "2", "auto"] {
+        let dir = scratch(&format!("samples-masked-agree-{capacity}"));
+        let stdout = stdout_of(
+            fragsim()
+                .args(["render", "--scene", "spheres:3", "--width", "24"])
+                .args(["--height", "18", "--samples", "4", "--no-images"])
+                .args(["--capacity", capacity, "--scheme", "abuffer-masked"])
+                .arg("--dump")
+                .arg(&dir),
+            0,
+        );
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with("abuffer-masked"))
+            .unwrap_or_else(|| panic!("no masked line:\n{stdout}"));
+        let overflowed: u64 = line
+            .split(" overflowed")
+            .next()
+            .and_then(|head| head.rsplit(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{line}"));
+        let compared = fragsim()
+            .args(["compare", "oracle"])
+            .arg(dir.join("abuffer-masked"))
+            .arg("--no-images")
+            .output()
+            .unwrap();
+        let equal = compared.status.code() == Some(0);
+        let says_equal = line.ends_with("equal to the per-pixel view of the per-sample oracle");
+        assert_eq!(
+            says_equal,
+            equal,
+            "render: {line}\ncompare: {}",
+            String::from_utf8_lossy(&compared.stdout)
+        );
+        assert!(equal, "capacity {capacity}: {line}");
+        assert_eq!(overflowed > 0, capacity != "auto", "{line}");
+    }
+}

@@ -5,7 +5,7 @@
 
 use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::mdts::Direction;
-use fragsim::oracle::compare::verdict;
+use fragsim::oracle::compare::flags;
 use fragsim::oracle::dump::{
     Corruption, DepthFormat, Dtype, Dump, DumpError, DumpScheme, LayoutSpec, Payload, SlotOrder,
     Words,
@@ -201,14 +201,8 @@ fn a_mutated_slot_major_word_is_caught_and_named_as_stored() {
         assert_eq!((corrupt.slot, corrupt.why), (2, Corruption::AfterEmpty));
         assert_eq!(corrupt.word, after_hole, "the word as the dump stores it");
         let comparison = judged(&mutated, oracle);
-        assert_eq!(
-            comparison.verdicts[holed],
-            verdict::MISSING | verdict::CORRUPT
-        );
-        assert_eq!(
-            comparison.verdicts[renamed],
-            verdict::MISSING | verdict::EXTRA
-        );
+        assert_eq!(comparison.verdicts[holed], flags::MISSING | flags::CORRUPT);
+        assert_eq!(comparison.verdicts[renamed], flags::MISSING | flags::EXTRA);
         assert_eq!(comparison.counts.equal, pixels as u64 - 2);
         // An A-buffer's counted slot holding the empty marker, slot-major.
         let abuffer = DumpScheme::ABufferFixed {

@@ -4,7 +4,7 @@
 //! or a sample depth past its interval different, and the joint snaps deciding shared edges at
 //! every sample.
 
-use fragsim::oracle::compare::{compare_with, verdict};
+use fragsim::oracle::compare::{compare_with, flags};
 use fragsim::oracle::precision::Precision;
 use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
@@ -142,7 +142,7 @@ fn per_sample_f32_captures_are_equal_at_4_and_8_samples_and_different_bit_for_bi
                 let errors = judged
                     .verdicts
                     .iter()
-                    .filter(|&&v| v & verdict::DIFFERS != 0)
+                    .filter(|&&v| v & flags::DIFFERS != 0)
                     .count();
                 println!(
                     "{samples}x {name}: {samples_judged} samples judged, {} covered, exact \
@@ -175,20 +175,16 @@ fn a_dropped_sample_and_a_sample_depth_past_its_interval_are_different_per_sampl
             deeper[p][i] = u64::from(q.key_hi + 1) << 32 | u64::from(q.prim);
             deeper[p].sort_unstable();
             for (name, bugged, expected) in [
-                ("dropped", dropped, verdict::MISSING | verdict::MISCOUNTED),
-                (
-                    "past its interval",
-                    deeper,
-                    verdict::MISSING | verdict::EXTRA,
-                ),
+                ("dropped", dropped, flags::MISSING | flags::MISCOUNTED),
+                ("past its interval", deeper, flags::MISSING | flags::EXTRA),
             ] {
                 let judged = judge(precision, oracle, &bugged);
                 let wrong: Vec<usize> = (0..bugged.len())
-                    .filter(|&s| judged.verdicts[s] & verdict::DIFFERS != 0)
+                    .filter(|&s| judged.verdicts[s] & flags::DIFFERS != 0)
                     .collect();
                 assert_eq!(wrong, [p], "{samples}x {name}: the planted sample alone");
-                assert_eq!(judged.verdicts[p] & verdict::DIFFERS, expected, "{name}");
-                assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "{name}");
+                assert_eq!(judged.verdicts[p] & flags::DIFFERS, expected, "{name}");
+                assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "{name}");
             }
         });
     }
@@ -213,15 +209,11 @@ fn per_sample_joint_snaps_decide_shared_edges_and_catch_a_dropped_or_doubled_sam
         );
         assert!(shared.len() >= 4, "{} shared-edge samples", shared.len());
         for &(p, present, absent) in shared.iter().take(8) {
-            assert_eq!(judged.verdicts[p] & verdict::AMBIGUOUS, 0, "sample {p}");
+            assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "sample {p}");
             let mut dropped = lists.clone();
             dropped[p].retain(|&w| w as u32 != present);
             let flags = judge(precision, oracle, &dropped).verdicts[p];
-            assert_ne!(
-                flags & verdict::MISSING,
-                0,
-                "sample {p} dropped: {flags:#b}"
-            );
+            assert_ne!(flags & flags::MISSING, 0, "sample {p} dropped: {flags:#b}");
             let key_lo = precision
                 .pixel(p)
                 .iter()
@@ -232,7 +224,7 @@ fn per_sample_joint_snaps_decide_shared_edges_and_catch_a_dropped_or_doubled_sam
             doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
             doubled[p].sort_unstable();
             let flags = judge(precision, oracle, &doubled).verdicts[p];
-            assert_ne!(flags & verdict::EXTRA, 0, "sample {p} doubled: {flags:#b}");
+            assert_ne!(flags & flags::EXTRA, 0, "sample {p} doubled: {flags:#b}");
         }
     });
 }

@@ -12,6 +12,7 @@ use std::time::Duration;
 use clap::Args;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
+use fragsim_oracle::verdict::{judge_run, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::{Conventions, SamplePattern};
 use serde::Serialize;
@@ -353,7 +354,13 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let counted = pool.install(|| runner.run(name, executor, &view, &sizing))?;
             progress.inc(1);
             let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
-            let diff = oracle.diff(&named.run.capture);
+            let RunVerdict { diff, kept, .. } = judge_run(
+                &oracle,
+                &named.run.capture,
+                named.guarantee,
+                executor.serialises_pixels(),
+                Ties::ByPrimitive,
+            );
             let judged = judge.judge(&named.run.capture);
             let error_pixels = judged.as_ref().map(|j| j.errors);
             let colour = ColourColumns::of(judged.as_ref().map(|j| j.colour));
@@ -388,13 +395,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             rows.push(BenchRow {
                 scheme: named.name.clone(),
                 guarantee: named.guarantee.to_string(),
-                keeps_guarantee: oracle.keeps_guarantee_given(
-                    &named.run.capture,
-                    named.guarantee,
-                    executor.serialises_pixels(),
-                    &diff,
-                    Ties::ByPrimitive,
-                ),
+                keeps_guarantee: kept,
                 executor: executor.name().into(),
                 threads: stats.threads,
                 passes: stats.passes,

@@ -31,7 +31,7 @@ use super::spec::{Encoding, LayoutSpec, SlotOrder, LARGEST_KEY};
 use super::word_check::{Corruption, Counter, WordCheck};
 use super::{err, Dtype, Dump, DumpError, Header, Words};
 use super::{FORMAT, VERSION};
-use crate::compare::{compare_with, verdict, CompareOptions, Comparison};
+use crate::compare::{compare_with, flags, CompareOptions, Comparison};
 use crate::diff::PixelMismatch;
 use crate::precision::{compare_within, Precision};
 use crate::Oracle;
@@ -261,7 +261,7 @@ impl Dump {
     /// an A-buffer's fragments with every word checked ([`compare_with`]), then each stored
     /// node's mask against the reference node of its primitive in the pixel. A wrong mask makes
     /// the reference node missing and the stored one extra: the pixel is
-    /// [`verdict::MISSING`] and [`verdict::EXTRA`], and each such node counts one lost and one
+    /// [`flags::MISSING`] and [`flags::EXTRA`], and each such node counts one lost and one
     /// extra fragment.
     ///
     /// # Errors
@@ -301,7 +301,7 @@ impl Dump {
         }
         let flagged: Vec<(usize, u8)> = wrong_masks
             .iter()
-            .map(|w| (w.pixel, verdict::MISSING | verdict::EXTRA))
+            .map(|w| (w.pixel, flags::MISSING | flags::EXTRA))
             .collect();
         let wrong = wrong_masks.len() as u64;
         nodes.diff.lost += wrong;
@@ -323,7 +323,7 @@ impl Dump {
     /// sample is undecided under the joint snaps). A node's key is the nearest of its samples'
     /// depths, so it must lie from the least `key_lo` to the least `key_hi` of its primitive's
     /// possibilities at the samples of its mask: a key outside makes the node's first sample
-    /// [`verdict::MISSING`] and [`verdict::EXTRA`] (one lost and one extra fragment). Corrupt
+    /// [`flags::MISSING`] and [`flags::EXTRA`] (one lost and one extra fragment). Corrupt
     /// words are charged to their pixel's first sample. The verdicts are per sample
     /// (`pixels × samples`, sample `s` of pixel `p` at `p · samples + s`); `wrong_masks` is empty
     /// (a wrong mask is judged per sample).
@@ -404,7 +404,7 @@ impl Dump {
                         && node.depth_key <= hi.saturating_add(widen)
                 });
                 if let (false, Some(&first)) = (inside, covered.first()) {
-                    stray_keys.push((first, verdict::MISSING | verdict::EXTRA));
+                    stray_keys.push((first, flags::MISSING | flags::EXTRA));
                 }
             }
         }

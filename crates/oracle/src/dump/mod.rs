@@ -13,7 +13,7 @@
 //! and names each pixel's verdict. Decoding stops where the layout says a list ends, so
 //! [`Dump::check_words`] reads every word against the layout's rules (nothing after an empty MDTS
 //! slot, no empty marker below an A-buffer counter, no key above 1.0) and [`Dump::compare`] adds
-//! what it finds: [`verdict::CORRUPT`](crate::compare::verdict::CORRUPT), and [`verdict::MISCOUNTED`](crate::compare::verdict::MISCOUNTED) for an A-buffer counter other
+//! what it finds: [`flags::CORRUPT`](crate::compare::flags::CORRUPT), and [`flags::MISCOUNTED`](crate::compare::flags::MISCOUNTED) for an A-buffer counter other
 //! than the pixel's fragment count, which the oracle knows.
 //!
 //! ```

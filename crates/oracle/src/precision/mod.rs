@@ -465,6 +465,6 @@ mod error_analysis;
 #[cfg(test)]
 mod tests;
 mod triangle;
-mod verdict;
+mod within;
 
-pub use verdict::{compare_within, f32_reference};
+pub use within::{compare_within, f32_reference};

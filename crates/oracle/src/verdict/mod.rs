@@ -1,5 +1,6 @@
-//! The one verdict on a capture: what `fragsim compare` prints, what `fragsim conform`, the
-//! testkit's battery and the wgpu backend's judge decide by, computed once, here.
+//! The one verdict on a capture: what `fragsim compare` prints, what `fragsim render` and
+//! `fragsim bench` say of each run, what `fragsim conform`, the testkit's battery and the wgpu
+//! backend's judge decide by, computed once, here.
 //!
 //! A [`Reference`] is what the candidate is judged against: fragsim's oracle of a view with the
 //! [`Precision`] a declared vertex stage owes (every bit under f64, the derived bounds under
@@ -9,18 +10,30 @@
 //! takes the two and returns one [`Verdict`]: the per-list verdicts and their totals (the
 //! library's [`Comparison`]), whether the sides are equal, what was compared, the precision
 //! bounds, per-sample and masked-node counts, the first differing lists with both sides
-//! ([`Example`]) and every note that qualifies the verdict. [`judge_sides`] does the same for
-//! two [`Side`]s as the command line names them (a dump directory or `oracle`): it checks the
-//! headers against each other and rebuilds the oracle from the scene a dump names.
+//! ([`Example`]) and every note that qualifies the verdict. It prepares the candidate once and
+//! compares it as its kind of reference asks, one module each: `against_oracle` (exact, within
+//! an f32 vertex stage's bounds or a unorm payload's steps, samples on an edge under the rule
+//! that explains the capture), `against_masked` (masked nodes, exact or per sample within
+//! precision), `against_dump` (what a reference dump can know). [`judge_sides`] does the same
+//! for two [`Side`]s as the command line names them (a dump directory or `oracle`): it checks
+//! the headers against each other and rebuilds the oracle from the scene a dump names.
+//! [`judge_run`] judges a run's capture by its scheme's own guarantee, on the executor that ran
+//! it. Where no verdict can be given the error says why ([`VerdictError`]).
 //!
 //! Guarantee: every caller gets the same decision for the same inputs, the policy (which
 //! comparison applies, what a reference dump cannot know, how a key-only reference reduces the
-//! candidate, how a unorm depth is owed) being written in this module alone; the comparisons
-//! themselves are [`compare_with`], [`compare_within`] and [`Dump::compare_masked`].
+//! candidate, how a unorm depth is owed, which guarantee is owed where) being written in this
+//! module alone; the comparisons themselves are [`compare_with`], [`compare_within`] and
+//! [`Dump::compare_masked`].
 
+mod against_dump;
 mod allowance;
+mod against_masked;
+mod against_oracle;
+mod error;
 mod reference;
 mod report;
+mod run;
 mod sides;
 #[cfg(test)]
 mod tests;
@@ -30,20 +43,22 @@ use std::borrow::Cow;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::{EdgeTies, VertexPrecision};
 
-use crate::compare::{verdict, with_identity, CompareOptions, Comparison};
-use crate::dump::{DepthFormat, Dump};
-use crate::edge_ties::TiePoints;
-use crate::precision::{compare_within, Bounds, Precision};
+use crate::compare::{flags, CompareOptions, Comparison};
+use crate::dump::{DepthFormat, Dump, WordCheck};
+use crate::precision::{Bounds, Precision};
 use crate::Oracle;
 use fragsim_raster::scene_spec::SceneSpec;
+use reference::Kind;
 
 #[cfg(doc)]
-use crate::compare::compare_with;
+use crate::{compare::compare_with, precision::compare_within};
 
 pub(crate) use allowance::hold_to_reference;
 pub use allowance::MiscountedCounter;
+pub use error::VerdictError;
 pub use reference::Reference;
 pub use report::{Corrupt, Entry, Example, FragmentTotals, SampleCounts, Summary, WordTotals};
+pub use run::{judge_run, RunVerdict};
 pub use sides::{judge_sides, Side, SideReport, SidesOptions};
 
 /// What a verdict is asked to judge: a candidate dump, a run's capture, or the oracle.
@@ -121,7 +136,10 @@ impl Verdict {
     }
 }
 
-/// Judges `candidate` against `reference` (see the module documentation).
+/// Judges `candidate` against `reference` (see the module documentation): the candidate
+/// prepared once, compared as the kind of reference asks (the oracle, exactly or
+/// within precision; the per-sample oracle's per-pixel view; another dump), the verdict
+/// assembled from the outcome.
 ///
 /// # Errors
 /// A candidate dump of another viewport than the reference's or one that cannot be decoded, a
@@ -131,224 +149,190 @@ pub fn judge(
     reference: &Reference<'_>,
     candidate: Candidate<'_>,
     options: &Options,
-) -> Result<Verdict, String> {
-    let oracle = reference.oracle();
-    if let Candidate::Dump(dump) = candidate {
-        let (w, h) = (dump.header.width, dump.header.height);
-        if (w, h) != (reference.width, reference.height) {
-            return Err(format!(
-                "the dump covers {w}x{h} pixels, the reference {}x{}",
-                reference.width, reference.height
+) -> Result<Verdict, VerdictError> {
+    let mut judged = Judged::of(reference, candidate)?;
+    let outcome = match &reference.kind {
+        Kind::Oracle {
+            precision,
+            edge_ties,
+            ..
+        } => against_oracle::compare(
+            &mut judged,
+            reference.oracle(),
+            precision,
+            edge_ties.as_ref(),
+            options,
+        ),
+        Kind::Masked { nodes, within } => {
+            against_masked::compare(candidate, nodes, within.as_ref(), options)?
+        }
+        Kind::Dump {
+            complete, identity, ..
+        } => against_dump::compare(&mut judged, reference, complete, *identity, options),
+    };
+    Ok(judged.verdict(reference, outcome, options))
+}
+
+/// The candidate as every kind of reference judges it: its lists (decoded, for a dump), its
+/// words' check, how it stores depth, and the notes that qualify the verdict so far.
+struct Judged {
+    capture: Capture,
+    words: Option<WordCheck>,
+    stored: DepthFormat,
+    notes: Vec<String>,
+}
+
+/// What comparing with one kind of reference found.
+struct Outcome<'p> {
+    /// The per-list verdicts.
+    comparison: Comparison,
+    /// The precision the lists were judged within (`None`: every bit owed).
+    precision: Option<Cow<'p, Precision>>,
+    /// The edge-tie rule samples exactly on an edge were judged under, where the reference
+    /// let the rule vary.
+    edge_ties: Option<EdgeTies>,
+    /// A masked-node dump judged exactly: stored nodes whose mask is not the reference's.
+    wrong_masks: Option<u64>,
+}
+
+impl Outcome<'_> {
+    /// A comparison of every bit, with nothing else to say.
+    fn exact(comparison: Comparison) -> Self {
+        Self {
+            comparison,
+            precision: None,
+            edge_ties: None,
+            wrong_masks: None,
+        }
+    }
+}
+
+impl Judged {
+    /// `candidate` decoded and checked against `reference`'s viewport and lists, with the notes
+    /// the reference and the candidate's words give.
+    fn of(reference: &Reference<'_>, candidate: Candidate<'_>) -> Result<Self, VerdictError> {
+        let oracle = reference.oracle();
+        if let Candidate::Dump(dump) = candidate {
+            let size = (dump.header.width, dump.header.height);
+            if size != (reference.width, reference.height) {
+                return Err(VerdictError::Viewport {
+                    candidate: size,
+                    reference: (reference.width, reference.height),
+                });
+            }
+        }
+        // A unorm payload cannot owe the f32 bits: the oracle's fragments are judged as the dump
+        // stores depth, each interval the steps the conversion may land on.
+        let stored = match (candidate, &reference.kind) {
+            (Candidate::Dump(dump), Kind::Oracle { .. }) => dump.depth_format(),
+            _ => DepthFormat::F32,
+        };
+        let mut notes = reference.notes.clone();
+        if stored != DepthFormat::F32 {
+            notes.push(format!(
+                "depth stored as {}: each reference depth z is owed as any step from \
+                 floor(z·s − 1/2) to ceil(z·s + 1/2), s = 2^{} − 1 (a rounding or truncating \
+                 conversion of the f32 product)",
+                stored.name(),
+                stored.bits()
             ));
         }
+        if let Kind::Dump { notes: caveats, .. } = &reference.kind {
+            notes.extend(caveats.iter().cloned());
+        }
+        let (capture, words) = match candidate {
+            Candidate::Dump(dump) => (dump.capture()?, Some(dump.check_words()?)),
+            Candidate::Capture(capture) => (capture.clone(), None),
+            Candidate::Oracle(oracle) => (oracle_capture(oracle), None),
+        };
+        if let Some(unchecked) = words.as_ref().map(|w| w.unchecked).filter(|&u| u > 0) {
+            notes.push(format!(
+                "{unchecked} A-buffer slots past their pixel's counter were not checked: the \
+                 header does not say every slot was filled with the empty marker (\"filled\": \
+                 true)"
+            ));
+        }
+        if capture.pixels() != oracle.pixels() {
+            return Err(VerdictError::Lists {
+                candidate: capture.pixels(),
+                reference: oracle.pixels(),
+            });
+        }
+        Ok(Self {
+            capture,
+            words,
+            stored,
+            notes,
+        })
     }
-    // A unorm payload cannot owe the f32 bits: the oracle's fragments are judged as the dump
-    // stores depth, each interval the steps the conversion may land on.
-    let stored = match (candidate, reference.precision()) {
-        (Candidate::Dump(dump), Some(_)) if !reference.is_masked() => dump.depth_format(),
-        _ => DepthFormat::F32,
-    };
-    let mut notes = reference.notes.clone();
-    if stored != DepthFormat::F32 {
-        notes.push(format!(
-            "depth stored as {}: each reference depth z is owed as any step from \
-             floor(z·s − 1/2) to ceil(z·s + 1/2), s = 2^{} − 1 (a rounding or truncating \
-             conversion of the f32 product)",
-            stored.name(),
-            stored.bits()
-        ));
+
+    /// The verdict of `outcome`, what comparing this candidate with `reference` found.
+    fn verdict(
+        mut self,
+        reference: &Reference<'_>,
+        outcome: Outcome<'_>,
+        options: &Options,
+    ) -> Verdict {
+        let Outcome {
+            mut comparison,
+            precision,
+            edge_ties,
+            wrong_masks,
+        } = outcome;
+        let capture = &self.capture;
+        if !matches!(capture.keeps, Keeps::All { .. }) {
+            // A K-nearest (K-farthest) list claims nothing: what lies beyond K is its promise, as
+            // the exact comparison counts it (the precision verdict leaves it at 0).
+            comparison.claimed_overflow = comparison.diff.overflowed;
+        }
+        let bounds = precision
+            .as_deref()
+            .filter(|p| !p.is_exact())
+            .map(Precision::bounds);
+        self.notes.extend(overflow_notes(&comparison, capture));
+        self.notes.extend(allowance::counter_note(&comparison));
+        let lists_per_pixel = reference.lists_per_pixel();
+        let (width, height) = (reference.width, reference.height);
+        let vertex_precision = reference.vertex_precision();
+        Verdict {
+            equal: comparison.is_equal() && reference.corrupt_words() == 0,
+            per_sample: SampleCounts::of(&comparison, lists_per_pixel),
+            examples: report::examples(&comparison, width, lists_per_pixel, capture.identity),
+            compared: report::what_is_compared(
+                capture,
+                options.depth_ulps,
+                vertex_precision == VertexPrecision::F32,
+                self.stored,
+            ),
+            comparison,
+            scene: None,
+            width,
+            height,
+            lists_per_pixel,
+            depth_ulps: options.depth_ulps,
+            vertex_precision,
+            stored_depth: self.stored,
+            bounds,
+            wrong_masks,
+            reference_fragments: reference
+                .masked_within_precision()
+                .map_or(reference.oracle(), |within| &within.samples)
+                .depth_complexity(),
+            identity: capture.identity,
+            notes: self.notes,
+            edge_ties,
+        }
     }
-    notes.extend(reference.dump_notes());
-    let (mut capture, words) = match candidate {
-        Candidate::Dump(dump) => (
-            dump.capture().map_err(|e| e.to_string())?,
-            Some(dump.check_words().map_err(|e| e.to_string())?),
-        ),
-        Candidate::Capture(capture) => (capture.clone(), None),
-        Candidate::Oracle(oracle) => (oracle_capture(oracle), None),
-    };
-    if let Some(unchecked) = words.as_ref().map(|w| w.unchecked).filter(|&u| u > 0) {
-        notes.push(format!(
-            "{unchecked} A-buffer slots past their pixel's counter were not checked: the header \
-             does not say every slot was filled with the empty marker (\"filled\": true)"
-        ));
-    }
-    if reference.identity() == Identity::KeyOnly && capture.identity != Identity::KeyOnly {
-        notes.push("the reference holds depth keys only: primitive ids are not compared".into());
-        capture = with_identity(&capture, Identity::KeyOnly);
-    }
-    if capture.pixels() != oracle.pixels() {
-        return Err(format!(
-            "the candidate covers {} pixels, the reference {}",
-            capture.pixels(),
-            oracle.pixels()
-        ));
-    }
-    notes.extend(reference.drop_unknowable(&mut capture));
-    let compare_options = CompareOptions {
+}
+
+/// How [`compare_with`] and [`compare_within`] are asked to compare under `options`, the
+/// reference knowing every fragment where `complete` says so (everywhere: `None`).
+fn compare_options<'c>(options: &Options, complete: Option<&'c [bool]>) -> CompareOptions<'c> {
+    CompareOptions {
         depth_ulps: options.depth_ulps,
         examples: options.examples,
-        complete: reference.complete(),
-    };
-    // The analysis as the candidate stores depth: a unorm payload's steps.
-    let as_stored = |precision: Cow<'_, Precision>, oracle: &Oracle| -> Precision {
-        if stored == DepthFormat::F32 {
-            precision.into_owned()
-        } else {
-            precision.into_owned().stored_as(stored, oracle)
-        }
-    };
-    let precision = reference.precision().map(|precision| {
-        if stored == DepthFormat::F32 {
-            Cow::Borrowed(precision)
-        } else {
-            Cow::Owned(as_stored(Cow::Borrowed(precision), oracle))
-        }
-    });
-    let mut wrong_masks = None;
-    let compare = |oracle: &Oracle, precision: Option<&Precision>| match precision {
-        Some(precision) => compare_within(
-            precision,
-            oracle,
-            &capture,
-            words.as_ref(),
-            &compare_options,
-        ),
-        None => crate::compare::compare_with(oracle, &capture, words.as_ref(), &compare_options),
-    };
-    let mut comparison = match (candidate, reference.per_pixel()) {
-        (Candidate::Dump(dump), Some(per_pixel)) => match reference.masked_within_precision() {
-            // Per sample: a wrong mask is a missing or an extra node at the samples it gets
-            // wrong, counted there.
-            Some(within) => {
-                dump.compare_masked_within(&within.precision, &within.samples, &compare_options)
-                    .map_err(|e| e.to_string())?
-                    .nodes
-            }
-            None => {
-                let masked = dump
-                    .compare_masked(per_pixel, &compare_options)
-                    .map_err(|e| e.to_string())?;
-                wrong_masks = Some(masked.wrong_masks.len() as u64);
-                masked.nodes
-            }
-        },
-        (_, Some(_)) => {
-            return Err(
-                "the per-pixel view of the per-sample oracle judges masked-node dumps \
-                        only"
-                    .into(),
-            )
-        }
-        (_, None) => compare(oracle, precision.as_deref()),
-    };
-    let mut precision = precision;
-    let mut edge_ties = None;
-    if let Some(source) = reference.edge_ties() {
-        let pipeline_fits = source.candidates.contains(&source.pipeline);
-        edge_ties = Some(source.pipeline);
-        if !(pipeline_fits && comparison.is_equal()) {
-            let ties = TiePoints::of(source.view);
-            let exact = precision.as_deref().is_none_or(Precision::is_exact);
-            // Where no snapped triangle the vertices may reach puts a sample on an edge, every
-            // rule gives the pipeline's lists.
-            let met = !ties.is_empty()
-                || precision
-                    .as_deref()
-                    .is_some_and(|p| p.bounds().edge_tie_pairs > 0);
-            let mut best: Option<(EdgeTies, Comparison, Option<Precision>)> = None;
-            if pipeline_fits || !met {
-                best = Some((source.pipeline, comparison.clone(), None));
-            }
-            let others = source
-                .candidates
-                .iter()
-                .copied()
-                .filter(|&rule| met && rule != source.pipeline);
-            for rule in others {
-                let under = ties.oracle_under(oracle, source.pipeline, rule);
-                let lists = under.as_ref().unwrap_or(oracle);
-                let analysis = (!exact)
-                    .then(|| Precision::derive_under(source.view, &source.conventions, rule));
-                let analysis = match (analysis, stored) {
-                    (Some(a), _) => Some(as_stored(Cow::Owned(a), lists)),
-                    (None, DepthFormat::F32) => None,
-                    (None, _) => Some(as_stored(Cow::Owned(Precision::exact()), lists)),
-                };
-                let judged = compare(lists, analysis.as_ref());
-                let better = best.as_ref().is_none_or(|(_, b, _)| {
-                    (judged.is_equal(), std::cmp::Reverse(errors(&judged)))
-                        > (b.is_equal(), std::cmp::Reverse(errors(b)))
-                });
-                if better {
-                    best = Some((rule, judged, analysis));
-                }
-            }
-            if let Some((rule, judged, analysis)) = best {
-                if rule != source.pipeline {
-                    notes.push(format!(
-                        "samples exactly on an edge judged under the {} rule (fragsim \
-                         rasterizes with {}; they disagree on {} fragments): {}",
-                        rule.name(),
-                        source.pipeline.name(),
-                        ties.differences(source.pipeline, rule),
-                        if source.candidates.len() == 1 {
-                            "the rule the dump declares"
-                        } else {
-                            "the one rule that explains the capture best"
-                        }
-                    ));
-                    comparison = judged;
-                    if let Some(analysis) = analysis {
-                        precision = Some(Cow::Owned(analysis));
-                    }
-                }
-                edge_ties = Some(rule);
-            }
-        }
+        complete,
     }
-    if !matches!(capture.keeps, Keeps::All { .. }) {
-        // A K-nearest (K-farthest) list claims nothing: what lies beyond K is its promise, as
-        // the exact comparison counts it (the precision verdict leaves it at 0).
-        comparison.claimed_overflow = comparison.diff.overflowed;
-    }
-    let bounds = precision
-        .as_deref()
-        .filter(|p| !p.is_exact())
-        .map(Precision::bounds);
-    notes.extend(overflow_notes(&comparison, &capture));
-    notes.extend(allowance::counter_note(&comparison));
-    let lists_per_pixel = reference.lists_per_pixel();
-    let (width, height) = (reference.width, reference.height);
-    let vertex_precision = reference.vertex_precision();
-    Ok(Verdict {
-        equal: comparison.is_equal() && reference.corrupt_words() == 0,
-        per_sample: SampleCounts::of(&comparison, lists_per_pixel),
-        examples: report::examples(&comparison, width, lists_per_pixel, capture.identity),
-        compared: report::what_is_compared(
-            &capture,
-            options.depth_ulps,
-            vertex_precision == VertexPrecision::F32,
-            stored,
-        ),
-        comparison,
-        scene: None,
-        width,
-        height,
-        lists_per_pixel,
-        depth_ulps: options.depth_ulps,
-        vertex_precision,
-        stored_depth: stored,
-        bounds,
-        wrong_masks,
-        reference_fragments: reference
-            .masked_within_precision()
-            .map_or(oracle, |within| &within.samples)
-            .depth_complexity(),
-        identity: capture.identity,
-        notes,
-        edge_ties,
-    })
 }
 
 /// The lists of a comparison whose verdict is an error.
@@ -356,7 +340,7 @@ fn errors(comparison: &Comparison) -> usize {
     comparison
         .verdicts
         .iter()
-        .filter(|&&v| v & verdict::DIFFERS != 0)
+        .filter(|&&v| v & flags::DIFFERS != 0)
         .count()
 }
 
@@ -377,7 +361,7 @@ fn overflow_notes(comparison: &Comparison, capture: &Capture) -> Vec<String> {
         let pixels = comparison
             .verdicts
             .iter()
-            .filter(|&&v| v & verdict::OVERFLOWED != 0)
+            .filter(|&&v| v & flags::OVERFLOWED != 0)
             .count();
         if pixels > 0 {
             notes.push(format!(

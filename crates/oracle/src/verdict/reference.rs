@@ -8,6 +8,7 @@ use fragsim_capture::schemes::masked_abuffer::MaskedLists;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use fragsim_raster::{Conventions, EdgeTies, VertexPrecision, View};
 
+use super::VerdictError;
 use crate::compare::complete_pixels;
 use crate::dump::{node_capture, Dump};
 use crate::edge_ties::{candidates, pipeline_rule};
@@ -19,7 +20,8 @@ use crate::Oracle;
 pub struct Reference<'a> {
     /// The reference's lists: the oracle's, or a dump's decoded ones.
     lists: Cow<'a, Oracle>,
-    kind: Kind<'a>,
+    /// How it knows them: what [`super::judge`] dispatches on.
+    pub(super) kind: Kind<'a>,
     /// Viewport width, pixels.
     pub(super) width: u32,
     /// Viewport height, pixels.
@@ -30,7 +32,7 @@ pub struct Reference<'a> {
 
 /// How a reference knows its lists.
 #[derive(Clone, Debug)]
-enum Kind<'a> {
+pub(super) enum Kind<'a> {
     /// The oracle, owed within `precision` by a vertex stage of `vertex_precision`, with the
     /// view to judge samples exactly on an edge under another rule than the pipeline's.
     Oracle {
@@ -195,13 +197,10 @@ impl<'a> Reference<'a> {
     ///
     /// # Errors
     /// A dump that cannot be decoded.
-    pub fn dump(dump: &Dump) -> Result<Self, String> {
-        let capture = dump.capture().map_err(|e| e.to_string())?;
+    pub fn dump(dump: &Dump) -> Result<Self, VerdictError> {
+        let capture = dump.capture()?;
         let mut notes = caveats(&capture);
-        let corrupt_words = dump
-            .check_words()
-            .map_err(|e| e.to_string())?
-            .corrupt_words();
+        let corrupt_words = dump.check_words()?.corrupt_words();
         if corrupt_words > 0 {
             notes.push(format!(
                 "the reference dump holds {corrupt_words} words its layout says cannot be there: \
@@ -229,27 +228,6 @@ impl<'a> Reference<'a> {
         &self.lists
     }
 
-    /// How samples exactly on an edge may be judged (`None`: as the reference's lists say).
-    pub(super) fn edge_ties(&self) -> Option<&EdgeTieSource<'a>> {
-        match &self.kind {
-            Kind::Oracle { edge_ties, .. } => edge_ties.as_ref(),
-            _ => None,
-        }
-    }
-
-    /// The precision the oracle is owed within (`None` for a dump or an exact masked
-    /// reference).
-    pub(super) fn precision(&self) -> Option<&Precision> {
-        match &self.kind {
-            Kind::Oracle { precision, .. } => Some(&**precision),
-            Kind::Masked {
-                within: Some(within),
-                ..
-            } => Some(&within.precision),
-            _ => None,
-        }
-    }
-
     /// The vertex stage the candidate is judged as (f64 but against the oracle under f32).
     pub(super) fn vertex_precision(&self) -> VertexPrecision {
         match &self.kind {
@@ -263,39 +241,10 @@ impl<'a> Reference<'a> {
         }
     }
 
-    /// The per-pixel view of the per-sample oracle, for a masked reference.
-    pub(super) fn per_pixel(&self) -> Option<&MaskedLists> {
-        match &self.kind {
-            Kind::Masked { nodes, .. } => Some(nodes),
-            _ => None,
-        }
-    }
-
-    /// Whether this is the per-sample oracle's per-pixel view.
-    pub(super) fn is_masked(&self) -> bool {
-        matches!(self.kind, Kind::Masked { .. })
-    }
-
     /// What a masked reference judges within precision with (`None`: every bit owed).
     pub(super) fn masked_within_precision(&self) -> Option<&MaskedWithin> {
         match &self.kind {
             Kind::Masked { within, .. } => within.as_ref(),
-            _ => None,
-        }
-    }
-
-    /// The identity of the reference's words.
-    pub(super) fn identity(&self) -> Identity {
-        match &self.kind {
-            Kind::Dump { identity, .. } => *identity,
-            _ => Identity::KeyAndPrim,
-        }
-    }
-
-    /// Per list, whether the reference knows every fragment (`None`: everywhere).
-    pub(super) fn complete(&self) -> Option<&[bool]> {
-        match &self.kind {
-            Kind::Dump { complete, .. } => Some(complete),
             _ => None,
         }
     }
@@ -305,14 +254,6 @@ impl<'a> Reference<'a> {
         match &self.kind {
             Kind::Dump { corrupt_words, .. } => *corrupt_words,
             _ => 0,
-        }
-    }
-
-    /// A reference dump's caveats.
-    pub(super) fn dump_notes(&self) -> Vec<String> {
-        match &self.kind {
-            Kind::Dump { notes, .. } => notes.clone(),
-            _ => Vec::new(),
         }
     }
 

@@ -8,7 +8,7 @@ use fragsim_raster::{depth_from_key, EdgeTies, VertexPrecision};
 use serde::Serialize;
 
 use super::{SideReport, Verdict};
-use crate::compare::{verdict, AmbiguityCounts, Comparison, SnapCounts, VerdictCounts};
+use crate::compare::{flags, AmbiguityCounts, Comparison, SnapCounts, VerdictCounts};
 use crate::dump::{CorruptWord, DepthFormat};
 use crate::precision::Bounds;
 
@@ -60,7 +60,7 @@ pub struct Example {
     /// The sample index within the pixel, for a per-sample layout.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sample: Option<u32>,
-    /// The names of its verdict's flags ([`verdict::names`]).
+    /// The names of its verdict's flags ([`flags::names`]).
     pub verdict: Vec<&'static str>,
     /// The reference's list.
     pub reference: Vec<Entry>,
@@ -88,7 +88,7 @@ pub struct SampleCounts {
 impl SampleCounts {
     /// The counts of `comparison`, whose lists are `samples` a pixel (`None` for one a pixel).
     pub(super) fn of(comparison: &Comparison, samples: u32) -> Option<Self> {
-        let differs = |v: &u8| v & verdict::DIFFERS != 0;
+        let differs = |v: &u8| v & flags::DIFFERS != 0;
         (samples > 1).then(|| Self {
             samples,
             compared: comparison.verdicts.len() as u64,
@@ -120,7 +120,7 @@ pub(super) fn examples(
             x: (m.pixel / n % row) as u32,
             y: (m.pixel / n / row) as u32,
             sample: (n > 1).then_some((m.pixel % n) as u32),
-            verdict: verdict::names(comparison.verdicts[m.pixel]),
+            verdict: flags::names(comparison.verdicts[m.pixel]),
             reference: m.expected.iter().map(|&w| Entry::of(w, identity)).collect(),
             candidate: m.got.iter().map(|&w| Entry::of(w, identity)).collect(),
             corrupt_words: corrupt_of(&comparison.first_corrupt, m.pixel),

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use fragsim_raster::{Conventions, VertexPrecision, Viewport};
 use serde::Serialize;
 
-use super::{judge, Candidate, Options, Reference, Verdict};
-use crate::dump::{Dump, DumpError, Header, MASKED_SCHEME};
+use super::{judge, Candidate, Options, Reference, Verdict, VerdictError};
+use crate::dump::{Dump, DumpError, Header};
 use crate::precision::Precision;
 use crate::samples::SampleOracle;
 use crate::Oracle;
@@ -61,7 +61,7 @@ impl Side {
     ///
     /// # Errors
     /// A dump that cannot be read.
-    pub fn open(text: &str) -> Result<Self, String> {
+    pub fn open(text: &str) -> Result<Self, VerdictError> {
         Self::open_within(text, fragsim_capture::MEMORY_CAP_DEFAULT)
     }
 
@@ -70,12 +70,12 @@ impl Side {
     ///
     /// # Errors
     /// A dump that cannot be read, or arrays over `limit`.
-    pub fn open_within(text: &str, limit: u64) -> Result<Self, String> {
+    pub fn open_within(text: &str, limit: u64) -> Result<Self, VerdictError> {
         if text == "oracle" {
             return Ok(Self::Oracle);
         }
         let path = PathBuf::from(text);
-        let dump = Dump::read_within(&path, limit).map_err(|e| e.to_string())?;
+        let dump = Dump::read_within(&path, limit)?;
         Ok(Self::Dump(Box::new(dump), path))
     }
 
@@ -142,14 +142,12 @@ pub fn judge_sides(
     reference: &Side,
     candidate: &Side,
     options: &SidesOptions<'_>,
-) -> Result<Verdict, String> {
+) -> Result<Verdict, VerdictError> {
     let (mut header, beside) = match (reference, candidate) {
         (Side::Dump(dump, path), _) | (Side::Oracle, Side::Dump(dump, path)) => {
             (dump.header.clone(), dump_dir(path))
         }
-        (Side::Oracle, Side::Oracle) => {
-            return Err("compare needs at least one dump: both sides are `oracle`".into())
-        }
+        (Side::Oracle, Side::Oracle) => return Err(VerdictError::NoDump),
     };
     if let Some(mesh) = options.mesh {
         (header.scene.mesh, header.scene.name) = (Some(mesh.display().to_string()), None);
@@ -157,36 +155,27 @@ pub fn judge_sides(
     let mut notes = Vec::new();
     if let (Some(a), Some(b)) = (reference.header(), candidate.header()) {
         if (a.width, a.height) != (b.width, b.height) {
-            return Err(format!(
-                "the dumps cover different viewports: {}x{} and {}x{}",
-                a.width, a.height, b.width, b.height
-            ));
+            return Err(VerdictError::DumpViewports {
+                a: (a.width, a.height),
+                b: (b.width, b.height),
+            });
         }
         if a.scene != b.scene {
-            let which = format!(
-                "the dumps name different scenes: {} and {}",
-                a.scene.describe(),
-                b.scene.describe()
-            );
+            let (a, b) = (a.scene.describe(), b.scene.describe());
             if !options.allow_different_scenes {
-                return Err(format!(
-                    "{which} (--allow-different-scenes compares them anyway)"
-                ));
+                return Err(VerdictError::DifferentScenes { a, b });
             }
-            notes.push(which);
+            notes.push(format!("the dumps name different scenes: {a} and {b}"));
         }
     }
     let judged_f32 = options.vertex_precision == VertexPrecision::F32;
     // The precision bounds are derived per sample; the sample count is checked here all the same.
-    header.samples().map_err(|e| e.to_string())?;
+    header.samples()?;
     // A masked-node dump is judged against the per-pixel view of the per-sample oracle, which
     // only the oracle side can give.
     let masked = candidate.is_masked();
     if reference.is_masked() || (masked && !matches!(reference, Side::Oracle)) {
-        return Err(format!(
-            "a masked-node dump ({MASKED_SCHEME}) is compared as the candidate against the \
-             oracle: `fragsim compare oracle DUMP`"
-        ));
+        return Err(VerdictError::MaskedSide);
     }
     let size = (header.width, header.height);
     // The oracle is built only when a side asks for it (the scene may be a large mesh). Without
@@ -202,38 +191,34 @@ pub fn judge_sides(
     if let (true, Some(cap), Some(name), None) =
         (needs_oracle, options.memory_cap, &spec.name, &spec.mesh)
     {
-        let lists = header.framebuffer().map_err(|e| e.to_string())?.pixels() as u64;
-        crate::memory_cap::check_named_scene(name, lists, cap)?;
+        let lists = header.framebuffer()?.pixels() as u64;
+        crate::memory_cap::check_named_scene(name, lists, cap).map_err(VerdictError::MemoryCap)?;
     }
     let loaded = if needs_oracle {
-        Some(
-            spec.load(Some(&beside))
-                .map_err(|e| DumpError::from(e).to_string())?,
-        )
+        Some(spec.load(Some(&beside)).map_err(DumpError::from)?)
     } else {
         None
     };
     let view = match &loaded {
         Some(loaded) => {
-            let viewport = Viewport::new(header.width, header.height)?;
-            Some(
-                spec.view(loaded, viewport)
-                    .map_err(|e| DumpError::from(e).to_string())?,
-            )
+            let viewport =
+                Viewport::new(header.width, header.height).map_err(VerdictError::View)?;
+            Some(spec.view(loaded, viewport).map_err(DumpError::from)?)
         }
         None => None,
     };
     if let (true, Some(view)) = (judged_f32, &view) {
         // The f32 stage judged is not the view's (f64 here): its range is checked all the same.
-        view.check_f32_range().map_err(|e| format!("scene: {e}"))?;
+        view.check_f32_range()
+            .map_err(|e| VerdictError::View(format!("scene: {e}")))?;
     }
     if let (Some(view), Some(cap)) = (&view, options.memory_cap) {
-        crate::memory_cap::check(view, cap)?;
+        crate::memory_cap::check(view, cap).map_err(VerdictError::MemoryCap)?;
     }
     let oracle = match &view {
         None => None,
         Some(view) if masked => {
-            let sampled = SampleOracle::build(view)?;
+            let sampled = SampleOracle::build(view).map_err(VerdictError::View)?;
             let reference = Reference::masked(sampled.per_pixel(), size);
             Some(if judged_f32 {
                 // The exact per-sample oracle (the view's vertex stage is f64 here) and the
@@ -267,11 +252,7 @@ pub fn judge_sides(
         }
     };
     if judged_f32 && !matches!(reference, Side::Oracle) {
-        return Err(
-            "--vertex-precision f32 needs the oracle as the reference: a dump holds no geometry \
-             to derive bounds from"
-                .into(),
-        );
+        return Err(VerdictError::F32NeedsOracle);
     }
     // The oracle is the reference, or (against a reference dump) the candidate.
     let (mut reference, oracle) = match (reference, oracle) {

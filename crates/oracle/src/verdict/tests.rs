@@ -1,11 +1,14 @@
 //! The verdict's entry points on a small scene: the oracle against itself, a dump of fragsim's
-//! own MDTS, and that dump with one fragment taken out.
+//! own MDTS, and that dump with one fragment taken out; a masked-node dump whose nodes a merge
+//! with a planted bug made.
 
+use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
 use fragsim_capture::schemes::mdts::Direction;
-use fragsim_raster::{VertexPrecision, View, Viewport};
+use fragsim_raster::{Fragment, VertexPrecision, View, Viewport};
 
 use super::*;
 use crate::dump::{DumpScheme, Words};
+use crate::samples::SampleOracle;
 
 /// Calls `test` with the view of a small scene (32 × 24), its oracle and fragsim's MDTS dump
 /// of it (K = every fragment, so that the dump holds every fragment).
@@ -84,4 +87,101 @@ fn a_dump_missing_one_fragment_is_different_at_that_pixel_alone() {
         assert_eq!(example.verdict, ["missing"]);
         assert_eq!(example.reference.len(), example.candidate.len() + 1);
     });
+}
+
+/// A masked-node dump of `spheres:3` at 4 samples whose nodes are those `merge` makes of the
+/// per-sample oracle's fragments (the capacity the most nodes a pixel has), with the per-pixel
+/// view of the per-sample oracle it is judged against.
+fn masked_dump_merged_by(
+    merge: fn(u32, &mut [Fragment], &mut dyn FnMut(u32, MaskedNode)),
+) -> (Dump, Reference<'static>) {
+    let mut spec = SceneSpec::named("spheres:3", 30.0, 15.0);
+    spec.conventions.samples = 4;
+    let scene = spec.load(None).unwrap();
+    let view = spec.view(&scene, Viewport::new(24, 18).unwrap()).unwrap();
+    let sampled = SampleOracle::build(&view).unwrap();
+    let lists = sampled.oracle().lists();
+    let mut fragments: Vec<Fragment> = (0..lists.pixels())
+        .flat_map(|sample| {
+            lists.pixel(sample).iter().map(move |&packed| Fragment {
+                pixel: sample as u32,
+                depth_key: (packed >> 32) as u32,
+                prim: packed as u32,
+            })
+        })
+        .collect();
+    let pixels = view.pixel_viewport().pixels();
+    let mut nodes = Vec::new();
+    merge(4, &mut fragments, &mut |pixel, node| {
+        nodes.push((pixel, node))
+    });
+    let merged = MaskedLists::from_nodes(4, pixels, nodes);
+    let capacity = (0..pixels).map(|p| merged.pixel(p).len()).max().unwrap();
+    let mut dump = Dump::record_masked(&view, spec, capacity as u32, "test").unwrap();
+    let counters: Vec<u32> = (0..pixels).map(|p| merged.pixel(p).len() as u32).collect();
+    let (mut words, mut masks) = (
+        vec![u64::MAX; pixels * capacity],
+        vec![0; pixels * capacity],
+    );
+    for p in 0..pixels {
+        for (i, node) in merged.pixel(p).iter().enumerate() {
+            words[p * capacity + i] = node.packed();
+            masks[p * capacity + i] = node.mask;
+        }
+    }
+    for (name, array) in [
+        ("counters", Words::U32(counters)),
+        ("masks", Words::U32(masks)),
+        ("nodes", Words::U64(words)),
+    ] {
+        *dump.arrays.get_mut(name).unwrap() = array;
+    }
+    let (w, h) = (dump.header.width, dump.header.height);
+    (dump, Reference::masked(sampled.per_pixel(), (w, h)))
+}
+
+/// The masked-node schemes' merge ([`merge_samples`]) with one bug planted: a node keeps the
+/// farthest depth key of its samples, not the nearest.
+fn merge_keeping_the_farthest(
+    samples: u32,
+    fragments: &mut [Fragment],
+    emit: &mut dyn FnMut(u32, MaskedNode),
+) {
+    fragments.sort_unstable_by_key(|f| (f.pixel / samples, f.prim, f.depth_key));
+    let mut rest = &*fragments;
+    while let Some(first) = rest.first() {
+        let (pixel, prim) = (first.pixel / samples, first.prim);
+        let same = rest
+            .iter()
+            .take_while(|f| f.pixel / samples == pixel && f.prim == prim)
+            .count();
+        let mask = rest[..same]
+            .iter()
+            .fold(0_u32, |mask, f| mask | 1 << (f.pixel % samples));
+        let depth_key = rest[same - 1].depth_key;
+        emit(
+            pixel,
+            MaskedNode {
+                depth_key,
+                prim,
+                mask,
+            },
+        );
+        rest = &rest[same..];
+    }
+}
+
+#[test]
+fn a_bug_planted_in_the_schemes_merge_is_caught_by_the_oracles_own_merge() {
+    // The control: the schemes' merge, as it is, holds the per-pixel view exactly.
+    let (dump, reference) = masked_dump_merged_by(|samples, fragments, mut emit| {
+        merge_samples(samples, fragments, &mut emit);
+    });
+    let verdict = judge(&reference, Candidate::Dump(&dump), &OPTIONS).unwrap();
+    assert!(verdict.equal, "{:?}", verdict.comparison.counts);
+    // The planted bug: the reference does not share it, so the verdict sees it.
+    let (planted, reference) = masked_dump_merged_by(merge_keeping_the_farthest);
+    let verdict = judge(&reference, Candidate::Dump(&planted), &OPTIONS).unwrap();
+    assert!(!verdict.equal);
+    assert!(verdict.comparison.counts.extra > 0 && verdict.comparison.counts.missing > 0);
 }

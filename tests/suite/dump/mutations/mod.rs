@@ -27,7 +27,7 @@ use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::masked_abuffer::MaskedLists;
 use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::Capacity;
-use fragsim::oracle::compare::{compare_with, verdict, CompareOptions, Comparison};
+use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
 use fragsim::oracle::dump::{
     node_capture, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder,
 };
@@ -154,7 +154,7 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
     for p in 0..layout.oracle.pixels() {
         let reference = layout.oracle.pixel(p);
         // Overflow past K or the capacity is the layout's promise, not a doubt.
-        let doubtless = |c: &Comparison| c.verdicts[p] & !verdict::OVERFLOWED == 0;
+        let doubtless = |c: &Comparison| c.verdicts[p] & !flags::OVERFLOWED == 0;
         if reference.len() < 2 {
             continue;
         }
@@ -172,9 +172,7 @@ fn pools(layout: &Layout<'_>, storage: &Storage, correct: &[Comparison]) -> [Vec
             spans.windows(2).all(|w| w[0].1 < w[1].0)
         });
         let decided = correct.iter().all(doubtless);
-        let equal = correct
-            .iter()
-            .all(|c| c.verdicts[p] & verdict::DIFFERS == 0);
+        let equal = correct.iter().all(|c| c.verdicts[p] & flags::DIFFERS == 0);
         if certain && disjoint && decided {
             pools[0].push(p);
         }

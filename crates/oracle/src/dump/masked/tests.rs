@@ -97,7 +97,7 @@ fn an_f32_masked_dump_is_equal_per_sample_and_a_dropped_sample_or_a_stray_key_is
                 .compare_masked_within(&precision, &oracle, &options())
                 .unwrap();
             let flags = judged.nodes.verdicts[planted];
-            assert_ne!(flags & verdict::DIFFERS, 0, "{samples}x {name}: {flags:#b}");
+            assert_ne!(flags & flags::DIFFERS, 0, "{samples}x {name}: {flags:#b}");
             let wrong = judged.nodes.diff.mismatched_pixels;
             assert!(wrong <= 2, "{samples}x {name}: {:?}", judged.nodes.diff);
         }

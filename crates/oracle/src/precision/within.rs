@@ -6,8 +6,8 @@
 //! admits (extra: another triangle, or a depth outside its interval), a list out of its own
 //! stored order (misordered: an implementation sorts its own depths), a counter outside the
 //! counts the pixel may have (overflow-miscounted), a corrupt word. Where the reference could
-//! go either way the pixel is [`verdict::AMBIGUOUS`]; equal with some depth moved inside its
-//! interval, [`verdict::WITHIN_PRECISION`]. With an exact analysis (f64 vertex precision) this is
+//! go either way the pixel is [`flags::AMBIGUOUS`]; equal with some depth moved inside its
+//! interval, [`flags::WITHIN_PRECISION`]. With an exact analysis (f64 vertex precision) this is
 //! [`compare_with`], unchanged.
 
 use std::path::Path;
@@ -18,7 +18,7 @@ use fragsim_raster::{Conventions, Viewport};
 
 use super::{Bounds, Doubt, Possible, Precision};
 use crate::compare::{
-    compare_with, inferred_counter, verdict, AmbiguityCounts, CompareOptions, Comparison,
+    compare_with, flags, inferred_counter, AmbiguityCounts, CompareOptions, Comparison,
 };
 use crate::dump::{Dump, DumpError, WordCheck};
 use crate::{Oracle, PixelMismatch};
@@ -134,7 +134,7 @@ pub fn compare_within(
         let got = pixel.got;
         let mut flags = judged.flags;
         if words.is_some_and(|w| !w.corrupt[p].is_empty()) {
-            flags |= verdict::CORRUPT;
+            flags |= flags::CORRUPT;
         }
         comparison.claimed_overflow += judged.claimed_overflow;
         comparison.ambiguity.add(&judged.ambiguity);
@@ -143,8 +143,8 @@ pub fn compare_within(
         total.overflowed += judged.overflowed;
         total.lost += judged.lost;
         total.extra += judged.extra;
-        total.misordered_pixels += u64::from(flags & verdict::MISORDERED != 0);
-        total.overflow_miscounted_pixels += u64::from(flags & verdict::MISCOUNTED != 0);
+        total.misordered_pixels += u64::from(flags & flags::MISORDERED != 0);
+        total.overflow_miscounted_pixels += u64::from(flags & flags::MISCOUNTED != 0);
         comparison.record(p, flags, options.examples, words, || {
             let mask = match candidate.identity {
                 Identity::KeyAndPrim => u64::MAX,
@@ -216,7 +216,7 @@ struct Judged {
 impl Judged {
     /// Marks the pixel ambiguous because of `doubt`.
     fn doubt(&mut self, doubt: Doubt) {
-        self.flags |= verdict::AMBIGUOUS;
+        self.flags |= flags::AMBIGUOUS;
         let cause = match doubt {
             Doubt::Coverage => &mut self.ambiguity.coverage,
             Doubt::Depth => &mut self.ambiguity.depth,
@@ -337,7 +337,7 @@ fn judge_pixel(
                 }
                 let key = (got[i] >> 32) as u32;
                 if identity != Identity::PrimOnly && q.reference != Some(key) {
-                    judged.flags |= verdict::WITHIN_PRECISION;
+                    judged.flags |= flags::WITHIN_PRECISION;
                 }
             }
         }
@@ -404,7 +404,7 @@ fn judge_pixel(
                 } else if surely >= k {
                     judged.overflowed += 1;
                 } else {
-                    judged.flags |= verdict::AMBIGUOUS;
+                    judged.flags |= flags::AMBIGUOUS;
                     judged.ambiguity.order = 1;
                 }
             }
@@ -415,7 +415,7 @@ fn judge_pixel(
             judged.lost += lost as u64;
             judged.overflowed += (owed - lost) as u64;
             if judged.overflowed > 0 {
-                judged.flags |= verdict::OVERFLOWED;
+                judged.flags |= flags::OVERFLOWED;
             }
         }
         Keeps::All { capacity, overflow } => {
@@ -436,7 +436,7 @@ fn judge_pixel(
             };
             let counted = !matches!(capacity, Capacity::PerPixelUncounted(_));
             if counted && (count < certain || count > possible.len()) {
-                judged.flags |= verdict::MISCOUNTED;
+                judged.flags |= flags::MISCOUNTED;
             }
             let held = assigned.iter().flatten().count();
             // The fragments storage could not hold: the implementation's own count past the
@@ -454,15 +454,15 @@ fn judge_pixel(
             judged.overflowed = allowed.min(absent_certain.len()) as u64;
             judged.lost = absent_certain.len().saturating_sub(allowed) as u64;
             if judged.overflowed > 0 {
-                judged.flags |= verdict::OVERFLOWED;
+                judged.flags |= flags::OVERFLOWED;
             }
         }
     }
     if judged.lost > 0 {
-        judged.flags |= verdict::MISSING;
+        judged.flags |= flags::MISSING;
     }
     if judged.extra > 0 {
-        judged.flags |= verdict::EXTRA;
+        judged.flags |= flags::EXTRA;
     }
     let misordered = match identity {
         // Bare ids: out of order only where the stored neighbours' depths are decided reversed.
@@ -474,7 +474,7 @@ fn judge_pixel(
         _ => got.windows(2).any(|w| w[0] > w[1]),
     };
     if misordered {
-        judged.flags |= verdict::MISORDERED;
+        judged.flags |= flags::MISORDERED;
     }
     judged
 }

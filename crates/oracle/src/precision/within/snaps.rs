@@ -5,7 +5,7 @@
 use fragsim_capture::Identity;
 
 use super::{Judged, Pixel};
-use crate::compare::{verdict, SnapCounts};
+use crate::compare::{flags, SnapCounts};
 use crate::precision::{Doubt, Possible, Precision};
 
 /// The most joint snaps of one pixel's vertices that are enumerated (one vertex with two points
@@ -72,7 +72,7 @@ impl Snaps {
                 .into_iter()
                 .filter(|choice| {
                     let under = snaps.under(precision, p, &vertices, choice);
-                    pixel.judge(&under.possible).flags & verdict::DIFFERS == 0
+                    pixel.judge(&under.possible).flags & flags::DIFFERS == 0
                 })
                 .collect();
             if !fitting.is_empty() {
@@ -136,11 +136,11 @@ impl Snaps {
         for choice in &joint {
             let under = self.under(precision, p, &vertices, choice);
             let judged = pixel.judge(&under.possible);
-            let fits = judged.flags & verdict::DIFFERS == 0;
+            let fits = judged.flags & flags::DIFFERS == 0;
             if fits && !fitting_sets.contains(&under.covered) {
                 fitting_sets.push(under.covered);
             }
-            let errors = |j: &Judged| (j.flags & verdict::DIFFERS != 0, j.lost + j.extra);
+            let errors = |j: &Judged| (j.flags & flags::DIFFERS != 0, j.lost + j.extra);
             if best.as_ref().is_none_or(|b| errors(&judged) < errors(b)) {
                 best = Some(judged);
             }
