@@ -348,7 +348,8 @@ mod tests {
 
     #[test]
     fn an_aligned_table_pads_names_left_and_numbers_right() {
-        let columns: [(&str, fn(&(&str, u32)) -> String); 2] =
+        type Row = (&'static str, u32);
+        let columns: [(&str, fn(&Row) -> String); 2] =
             [("scheme", |r| r.0.to_string()), ("lost", |r| r.1.to_string())];
         let text = aligned_table(&columns, &[("mdts", 0), ("kbuffer-stores", 1234)], 1);
         assert_eq!(
