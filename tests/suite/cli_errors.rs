@@ -350,3 +350,27 @@ fn a_closed_stdout_ends_the_output_quietly_keeping_the_exit_code() {
     let dump = format!("{dumps}/mdts");
     assert_quiet_on_a_closed_pipe(&["compare", "oracle", dump.as_str(), "--no-images"]);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Output paths
+
+#[test]
+fn export_scene_into_a_missing_folder_is_refused_and_creates_nothing() {
+    let dir = crate::support::scratch("cli-errors", "export-missing-folder");
+    let missing = dir.join("no-such-folder");
+    let out = missing.join("scene.tri");
+    let output = Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(["export-scene", "--width", "16", "--height", "16", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains("does not exist"),
+        "{stderr}"
+    );
+    assert!(stderr.contains(&missing.display().to_string()), "{stderr}");
+    assert!(!missing.exists(), "the missing folder was created");
+}

@@ -43,6 +43,8 @@ mod precision;
 mod precision_cli;
 mod progress;
 mod properties;
+mod readme;
+mod reports;
 mod scheduled;
 mod shards;
 mod shipping;

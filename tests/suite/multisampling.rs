@@ -500,6 +500,13 @@ fn bench_samples_rows_hold_masked_nodes_exact_with_room_and_count_their_overflow
         assert!(field(r, "error_pixels") > 0, "{r}");
         assert_eq!(field(r, "memory_bytes"), bytes_of(r, 1), "{r}");
     }
+    // Per-sample storage keeps overflow and loss apart, as the single-sample rows do: a full
+    // capacity is overflow, not loss.
+    for r in tight.iter().filter(|r| r["storage"] == "per-sample") {
+        assert!(field(r, "overflowed") > 0, "{r}");
+        assert_eq!(field(r, "missing"), field(r, "overflowed"), "{r}");
+        assert_eq!(field(r, "lost"), 0, "{r}");
+    }
     // `auto`: the masked schemes' own counting pass of nodes sizes the A-buffer to the deepest
     // pixel and the pool to every node.
     let auto = sampled_rows(&out, "auto");
@@ -510,4 +517,33 @@ fn bench_samples_rows_hold_masked_nodes_exact_with_room_and_count_their_overflow
     assert_eq!(auto[3]["slots"], auto[3]["msaa"]["max_nodes_per_pixel"]);
     assert_eq!(auto[5]["slots"], serde_json::Value::Null);
     std::fs::remove_dir_all(out).unwrap();
+}
+
+/// `bench --samples` shows its multisampled table on the terminal, under the single-sample one,
+/// and its closing line names it among what bench.md holds.
+#[test]
+fn bench_samples_prints_its_multisampled_table() {
+    let out = crate::support::scratch("multisampling", "terminal-table");
+    let output = assert_cmd::Command::cargo_bin("fragsim")
+        .unwrap()
+        .args(["bench", "--scene", "bunny", "--width", "32", "--height", "32"])
+        .args(["--scheme", "mdts", "--k", "1", "--executor", "serial", "--frames", "1"])
+        .args(["--samples", "4", "--no-images", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    let table = stdout
+        .split_once("Multisampled schemes at 4 samples")
+        .map(|(_, table)| table)
+        .unwrap_or_else(|| panic!("no multisampled table: {stdout}"));
+    let heading = table.lines().nth(2).unwrap_or_default();
+    for column in ["scheme", "storage", "overflow", "lost", "wrong samples"] {
+        assert!(heading.contains(column), "{column} not in {heading}");
+    }
+    assert!(
+        stdout.contains("the multisampled table"),
+        "the closing line does not name it: {stdout}"
+    );
 }

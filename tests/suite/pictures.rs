@@ -224,21 +224,3 @@ fn explain_prints_a_key_to_its_symbols() {
         assert!(text.contains(symbol), "{symbol:?} not in {text}");
     }
 }
-
-#[test]
-fn the_readme_names_every_command_and_the_json_schema() {
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    for command in [
-        "fragsim render",
-        "fragsim bench",
-        "fragsim sweep",
-        "fragsim compare",
-        "fragsim export-scene",
-        "fragsim explain",
-        "fragsim hazard",
-        "docs/json-schema.md",
-    ] {
-        assert!(readme.contains(command), "README lacks {command:?}");
-    }
-}

@@ -7,7 +7,7 @@
 //! adapter each test prints one line saying it was skipped; with `CI=true` or
 //! `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
-use fragsim_oracle::compare::verdict;
+use fragsim_oracle::compare::flags;
 use fragsim_oracle::dump::{Dump, Words};
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::scene_spec::{SceneSpec, ViewProjection};
@@ -97,7 +97,7 @@ fn errors(judgement: &WithinJudgement) -> usize {
     let verdicts = &judgement.comparison.verdicts;
     verdicts
         .iter()
-        .filter(|&&v| v & verdict::DIFFERS != 0)
+        .filter(|&&v| v & flags::DIFFERS != 0)
         .count()
 }
 

@@ -52,6 +52,17 @@ fn recorded_spec(spec: &SceneSpec, view: &View<'_>) -> Result<SceneSpec, String>
 /// # Errors
 /// A scene that cannot be loaded, a bad viewport, a file that cannot be written.
 pub(crate) fn export_scene(args: &ExportArgs) -> Result<(), String> {
+    // A file's missing folders are a mistyped path far more often than a wish: refuse them, as
+    // `cp` does, rather than create a tree nobody asked for.
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(format!(
+                "export-scene --out {}: the folder {} does not exist (create it first)",
+                args.out.display(),
+                dir.display()
+            ));
+        }
+    }
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;
     let view = spec

@@ -96,7 +96,12 @@ pub struct SampledRow {
     pub overflow_unit: &'static str,
     /// Sample fragments of the per-sample oracle.
     pub sample_fragments: u64,
-    /// Of those, missing from the scheme's per-sample resolve.
+    /// Of those, missing from the scheme's per-sample resolve, the overflow's included.
+    pub missing: u64,
+    /// Of the missing, those the scheme owed: per-sample storage, fragments beyond the oracle's
+    /// predicted overflow (as `bench` rows count `lost`, so that a full K is not read as a bug);
+    /// masked storage, every missing one (its overflow counts whole nodes, whose sample
+    /// fragments cannot be told from losses).
     pub lost: u64,
     /// Samples whose list differs from the per-sample oracle's in any way.
     pub wrong_samples: u64,
@@ -296,7 +301,8 @@ fn rows(
             overflowed: common.overflowed,
             overflow_unit: common.overflow_unit,
             sample_fragments: error.fragments,
-            lost: error.lost,
+            missing: error.lost,
+            lost: common.owed_lost.unwrap_or(error.lost),
             wrong_samples: error.wrong_samples,
             wrong_sample_rate: error.wrong_samples as f64 / error.samples.max(1) as f64,
             misordered_samples: error.misordered_samples,
@@ -333,6 +339,7 @@ fn rows(
             )?;
             let stats = &named.run.stats;
             let capture = &named.run.capture;
+            let diff = oracle.oracle().diff(capture);
             row(
                 Common {
                     scheme: named.name.clone(),
@@ -344,8 +351,9 @@ fn rows(
                     slots: named.slots,
                     memory_bytes: stats.memory_bytes,
                     fragments: stats.counters.fragments,
-                    overflowed: oracle.oracle().diff(capture).overflowed,
+                    overflowed: diff.overflowed,
                     overflow_unit: "fragments",
+                    owed_lost: Some(diff.lost),
                     times,
                 },
                 oracle.capture_error(capture),
@@ -393,6 +401,7 @@ fn rows(
                     fragments: masked.fragments,
                     overflowed: masked.frame.dropped,
                     overflow_unit: "nodes",
+                    owed_lost: None,
                     times,
                 },
                 oracle.sample_error(&per_sample),
@@ -417,6 +426,9 @@ struct Common {
     fragments: u64,
     overflowed: u64,
     overflow_unit: &'static str,
+    /// Fragments lost beyond the predicted overflow, where the overflow is counted in fragments
+    /// (`None`: in nodes, so every missing sample fragment counts as lost).
+    owed_lost: Option<u64>,
     times: FrameTimes,
 }
 
@@ -511,14 +523,50 @@ fn masked_frame(
     })
 }
 
+/// What `bench --samples` prints on a terminal under the single-sample table: the line of
+/// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
+/// (bench.md holds every column and their key).
+pub(crate) fn terminal_table(msaa: &MsaaReport) -> String {
+    type Cell = fn(&SampledRow) -> String;
+    let columns: [(&str, Cell); 10] = [
+        ("scheme", |r| r.scheme.clone()),
+        ("storage", |r| r.storage.to_string()),
+        ("executor", |r| r.executor.clone()),
+        ("passes", |r| r.passes.to_string()),
+        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
+        ("overflow", |r| format!("{} {}", r.overflowed, r.overflow_unit)),
+        ("lost", |r| r.lost.to_string()),
+        ("wrong samples", |r| r.wrong_samples.to_string()),
+        ("EPR %", |r| {
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".into(), |e| crate::record::percent(e, 3))
+        }),
+        ("frame ms", |r| format!("{:.2}", r.time_ms)),
+    ];
+    let mut text = markdown(msaa)
+        .lines()
+        .find(|line| !line.is_empty())
+        .unwrap_or_default()
+        .to_string();
+    text.push_str("\n\n");
+    text.push_str(&crate::record::aligned_table(&columns, &msaa.rows, 3));
+    text.push_str(
+        "Columns: overflow what found no room (sample fragments, or whole masked nodes); lost \
+         sample fragments the scheme owed and is missing (per-sample storage: beyond the \
+         overflow); wrong samples samples whose list differs from the per-sample oracle's; the \
+         rest as above.\n",
+    );
+    text
+}
+
 /// bench.md's table of the multisampled rows, with what its columns mean.
 pub(crate) fn markdown(msaa: &MsaaReport) -> String {
     let percent = |part: u64, whole: u64| 100.0 * part as f64 / whole.max(1) as f64;
     let mut text = format!(
         "\nMultisampled schemes at {n} samples a pixel, against the per-sample oracle ({} sample \
          fragments; its deepest pixel needs {} masked nodes)\n\n\
-         | scheme | storage | executor | thr | passes | slots | memory B | B/px | overflow | lost | wrong samples | misordered | EPR % | mean err | max err | PSNR dB | passes ms | post ms | frame ms |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         | scheme | storage | executor | thr | passes | slots | memory B | B/px | overflow | missing | lost | wrong samples | misordered | EPR % | mean err | max err | PSNR dB | passes ms | post ms | frame ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         msaa.sample_fragments,
         msaa.max_nodes_per_pixel,
         n = msaa.samples,
@@ -526,7 +574,7 @@ pub(crate) fn markdown(msaa: &MsaaReport) -> String {
     for r in &msaa.rows {
         let [mean_error, max_error, psnr] = r.colour.cells();
         text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} {} | {} ({:.3} %) | {} ({:.3} %) | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} {} | {} ({:.3} %) | {} | {} ({:.3} %) | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} |\n",
             r.scheme,
             r.storage,
             r.executor,
@@ -537,8 +585,9 @@ pub(crate) fn markdown(msaa: &MsaaReport) -> String {
             r.bytes_per_pixel,
             r.overflowed,
             r.overflow_unit,
+            r.missing,
+            percent(r.missing, r.sample_fragments),
             r.lost,
-            percent(r.lost, r.sample_fragments),
             r.wrong_samples,
             100.0 * r.wrong_sample_rate,
             r.misordered_samples,
@@ -564,8 +613,11 @@ had (`--k`, `--capacity`, or its counting pass's deepest pixel under `auto`; cou
 every node, storage sized per pixel); **memory B**, **B/px** \
 bytes allocated, in all and per pixel (all its samples); **overflow** what found no room: sample \
 fragments (per-sample storage, the oracle's prediction as above) or whole nodes (masked storage, \
-its counters' count: per pixel, or the pool's one counter); **lost** sample fragments of the per-sample oracle missing from the \
-scheme's per-sample resolve, with their share; **wrong samples** samples whose list differs from \
+its counters' count: per pixel, or the pool's one counter); **missing** sample fragments of the \
+per-sample oracle missing from the scheme's per-sample resolve, the overflow's included, with \
+their share; **lost** of those, the ones the scheme owed: beyond the predicted overflow for \
+per-sample storage (as the single-sample table counts them: 0 for a correct scheme whatever K), \
+every missing one for masked storage (its overflow counts nodes); **wrong samples** samples whose list differs from \
 the per-sample oracle's, with their share of all samples; **misordered** of those, samples with \
 every fragment present in another order (a masked node orders all its samples by its nearest \
 depth); **EPR %**, **mean err**, **max err**, **PSNR dB** the transparency image shaded per \

@@ -263,6 +263,20 @@ pub fn mean_of_channels(colour: &ColourColumns) -> Option<f64> {
     colour.mean_abs_error.map(|m| m.iter().sum::<f64>() / 3.0)
 }
 
+/// `fraction` as a percentage with `decimals` decimals for a table cell, where a rate that is not
+/// zero never prints as zero: one error pixel in a million is `<0.001`, not `0.000` beside a
+/// colour error of 68.
+#[must_use]
+pub fn percent(fraction: f64, decimals: usize) -> String {
+    let percent = fraction * 100.0;
+    let smallest = 10_f64.powi(-i32::try_from(decimals).unwrap_or(i32::MAX));
+    if percent > 0.0 && percent < smallest / 2.0 {
+        format!("<{smallest:.decimals$}")
+    } else {
+        format!("{percent:.decimals$}")
+    }
+}
+
 /// A table's cells of one bucket: its name, pixels, EPR % of them, and the colour error's mean,
 /// maximum and PSNR cells (as the whole image's: `inf` for a bucket equal to the oracle's).
 #[must_use]
@@ -271,12 +285,77 @@ pub fn bucket_cells(bucket: &BucketError) -> [String; 6] {
     [
         bucket.label(),
         bucket.pixels.to_string(),
-        format!(
-            "{:.3}",
-            bucket.error_pixels as f64 * 100.0 / bucket.pixels.max(1) as f64
-        ),
+        percent(bucket.error_pixels as f64 / bucket.pixels.max(1) as f64, 3),
         mean,
         max,
         psnr,
     ]
+}
+
+/// A terminal table of `rows`, one column per `(heading, cell)`: each column as wide as its
+/// widest cell, the first `left` columns (names) aligned left and the rest (numbers) right, two
+/// spaces between columns, a line a row under the line of headings.
+pub(crate) fn aligned_table<Row>(columns: &[(&str, fn(&Row) -> String)], rows: &[Row], left: usize) -> String {
+    let mut cells = vec![columns
+        .iter()
+        .map(|(heading, _)| (*heading).to_string())
+        .collect::<Vec<_>>()];
+    cells.extend(
+        rows.iter()
+            .map(|row| columns.iter().map(|(_, cell)| cell(row)).collect()),
+    );
+    let widths: Vec<usize> = (0..columns.len())
+        .map(|c| {
+            cells
+                .iter()
+                .map(|line| line[c].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let mut text = String::new();
+    for line in &cells {
+        let padded: Vec<String> = line
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (cell, &w))| {
+                if c < left {
+                    format!("{cell:<w$}")
+                } else {
+                    format!("{cell:>w$}")
+                }
+            })
+            .collect();
+        text.push_str(padded.join("  ").trim_end());
+        text.push('\n');
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{aligned_table, percent};
+
+    #[test]
+    fn a_rate_that_is_not_zero_never_prints_as_zero() {
+        assert_eq!(percent(0.0, 3), "0.000", "zero is zero");
+        assert_eq!(percent(1e-6, 3), "<0.001", "one pixel in a million");
+        assert_eq!(percent(1e-7, 4), "<0.0001", "the cell's own precision");
+        assert_eq!(percent(0.012_34, 3), "1.234", "rounded as before");
+        assert_eq!(percent(1.0, 3), "100.000", "every pixel");
+    }
+
+    #[test]
+    fn an_aligned_table_pads_names_left_and_numbers_right() {
+        type Row = (&'static str, u32);
+        let columns: [(&str, fn(&Row) -> String); 2] =
+            [("scheme", |r| r.0.to_string()), ("lost", |r| r.1.to_string())];
+        let text = aligned_table(&columns, &[("mdts", 0), ("kbuffer-stores", 1234)], 1);
+        assert_eq!(
+            text,
+            "scheme          lost\nmdts               0\nkbuffer-stores  1234\n",
+            "{text}"
+        );
+    }
 }

@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
-use crate::record::{bucket_cells, mean_of_channels, ColourByDepth, Context};
+use crate::record::{bucket_cells, mean_of_channels, percent, ColourByDepth, Context};
 use crate::schemes::{family, SchemeChoice, SchemeRunner};
 use fragsim_raster::{Conventions, SceneSpec};
 use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
@@ -312,14 +312,14 @@ fn print_summary(
             .error_pixel_rate
             .iter()
             .flatten()
-            .map(|r| r * 100.0)
+            .copied()
             .collect();
-        let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| format!("{r:.4}"));
+        let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| percent(r, 4));
         let max_rate = rates
             .iter()
             .copied()
             .reduce(f64::max)
-            .map_or("n/a".into(), |r| format!("{r:.4}"));
+            .map_or("n/a".into(), |r| percent(r, 4));
         let mean_ms = mean(s.time_ms.iter().copied()).unwrap_or(0.0);
         let [mean_error, max_error, psnr] = colour_over_angles(&s.colour);
         outln!(

@@ -7,7 +7,7 @@
 //! builds its report from), its one-word verdict, and its per-list flags, from which the Python
 //! side finds the differing pixels with numpy.
 
-use fragsim_oracle::compare::verdict;
+use fragsim_oracle::compare::flags;
 use fragsim_oracle::verdict::{SideReport, Verdict};
 use fragsim_oracle::Oracle;
 use numpy::{PyArray1, PyArrayMethods};
@@ -57,7 +57,7 @@ pub(crate) fn reference_arrays<'py>(
 
 /// `verdict` as the Python side reads it: `equal`, `word` (`EQUAL (bit-identical)`, …,
 /// `DIFFERENT`), `summary` (the report's JSON, its sides described as `reference` and
-/// `candidate`), `flags` (uint8 per list: `fragsim_oracle::compare::verdict`'s bits),
+/// `candidate`), `flags` (uint8 per list: `fragsim_oracle::compare::flags`'s bits),
 /// `reference_fragments` (uint32 per list), `width`, `height`, `lists_per_pixel`.
 pub(crate) fn verdict_dict<'py>(
     py: Python<'py>,
@@ -89,9 +89,9 @@ pub(crate) fn verdict_dict<'py>(
 /// list differ), as the per-list `flags` of a verdict hold them.
 #[pyfunction]
 pub fn verdict_flags() -> Vec<(&'static str, u8)> {
-    verdict::NAMES
+    flags::NAMES
         .iter()
         .map(|&(bit, name)| (name, bit))
-        .chain([("differs", verdict::DIFFERS)])
+        .chain([("differs", flags::DIFFERS)])
         .collect()
 }

@@ -87,17 +87,10 @@ pub fn heat_map_with_bar(
             let t = (bar_bottom - y) as f32 / (bar_bottom - bar_top) as f32;
             fill(area, [(x0, y), (x0 + 24, y + 1)], crate::ramp(t))?;
         }
-        // Ticks at 0, ¼, ½, ¾ and the top of the scale, as whole fragment counts.
-        let mut last = None;
-        for i in 0..=4_u32 {
-            let value = (top * i).div_ceil(4);
-            if last == Some(value) {
-                continue;
-            }
-            last = Some(value);
+        for value in bar_ticks(top) {
             let y = bar_bottom - ((bar_bottom - bar_top) as f32 * value as f32 / top as f32) as i32;
             fill(area, [(x0 + 24, y), (x0 + 30, y + 1)], Rgb([0, 0, 0]))?;
-            let label = if i == 4 && max_seen > top {
+            let label = if value == top && max_seen > top {
                 format!("≥ {value}")
             } else {
                 value.to_string()
@@ -116,6 +109,32 @@ pub fn heat_map_with_bar(
             12,
         )
     })
+}
+
+/// The counts the colour bar labels, for a scale whose top is `top`: every count up to 10 (a
+/// reader counts layers one by one there), above that the multiples of a round step (1, 2 or 5
+/// times a power of ten) giving at most 8 intervals, and always the top itself; a multiple closer
+/// to the top than half a step is left out so that the two labels do not overlap.
+fn bar_ticks(top: u32) -> Vec<u32> {
+    if top <= 10 {
+        return (0..=top).collect();
+    }
+    let mut step = 1;
+    'search: loop {
+        for factor in [1, 2, 5] {
+            if top <= step * factor * 8 {
+                step *= factor;
+                break 'search;
+            }
+        }
+        step *= 10;
+    }
+    let mut ticks: Vec<u32> = (0..top).step_by(step as usize).collect();
+    if ticks.last().is_some_and(|&last| 2 * (top - last) < step && last > 0) {
+        ticks.pop();
+    }
+    ticks.push(top);
+    ticks
 }
 
 /// The nearest depth of each pixel (`crate::nearest_depth`) with its key: white is near, dark
@@ -361,6 +380,21 @@ pub fn effect_difference_figure(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_colour_bar_labels_every_count_of_a_shallow_scene_and_round_steps_of_a_deep_one() {
+        assert_eq!(bar_ticks(1), [0, 1], "a scale of one");
+        assert_eq!(bar_ticks(6), [0, 1, 2, 3, 4, 5, 6], "no count skipped up to 10");
+        assert_eq!(bar_ticks(40), [0, 5, 10, 15, 20, 25, 30, 35, 40], "steps of 5");
+        assert_eq!(bar_ticks(37), [0, 5, 10, 15, 20, 25, 30, 37], "35 too close to 37");
+        assert_eq!(bar_ticks(1000), [0, 200, 400, 600, 800, 1000], "steps of 200");
+        for top in 1..3000 {
+            let ticks = bar_ticks(top);
+            assert!(ticks.len() <= 11, "{top}: {ticks:?}");
+            assert_eq!(ticks.last(), Some(&top), "{top}: the top is labelled");
+            assert!(ticks.windows(2).all(|w| w[0] < w[1]), "{top}: increasing");
+        }
+    }
 
     #[test]
     fn the_picture_is_copied_unchanged_and_the_panel_is_drawn() {

@@ -6,7 +6,7 @@ use serde::Serialize;
 use super::{BenchArgs, BenchReport, BenchRow};
 use crate::approximate::ApproximateRow;
 use crate::multisampled::SampledRow;
-use crate::record::{bucket_cells, mean_of_channels};
+use crate::record::{bucket_cells, mean_of_channels, percent};
 use crate::schemes::family;
 
 /// One line of bench's JSON Lines: a row with what the whole bench measured.
@@ -91,7 +91,15 @@ pub(super) fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<()
         eprintln!("{wrote}");
     } else {
         out!("{}", terminal_table(report));
-        outln!("{wrote} (bench.md: every column, with their key, and the per-depth tables)");
+        if let Some(msaa) = &report.msaa {
+            out!("\n{}", crate::multisampled::terminal_table(msaa));
+        }
+        let tables = if report.msaa.is_some() {
+            "every column, with their key, the per-depth tables and the multisampled table"
+        } else {
+            "every column, with their key, and the per-depth tables"
+        };
+        outln!("{wrote} (bench.md: {tables})");
     }
     Ok(())
 }
@@ -168,7 +176,7 @@ fn terminal_table(report: &BenchReport) -> String {
         ("mismatched px", |r| r.mismatched_pixels.to_string()),
         ("EPR %", |r| {
             r.error_pixel_rate
-                .map_or_else(|| "n/a".into(), |e| format!("{:.3}", e * 100.0))
+                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
         }),
         ("PSNR dB", |r| r.colour.cells()[2].clone()),
         ("frame ms", |r| format!("{:.2}", r.time_ms)),
@@ -177,46 +185,13 @@ fn terminal_table(report: &BenchReport) -> String {
                 .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
         }),
     ];
-    let mut rows = vec![columns
-        .iter()
-        .map(|(h, _)| (*h).to_string())
-        .collect::<Vec<_>>()];
-    rows.extend(
-        report
-            .rows
-            .iter()
-            .map(|r| columns.iter().map(|(_, cell)| cell(r)).collect()),
-    );
-    let widths: Vec<usize> = (0..columns.len())
-        .map(|c| {
-            rows.iter()
-                .map(|row| row[c].chars().count())
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
     let mut text = markdown(report)
         .lines()
         .next()
         .unwrap_or_default()
         .to_string();
     text.push_str("\n\n");
-    for row in &rows {
-        let cells: Vec<String> = row
-            .iter()
-            .zip(&widths)
-            .enumerate()
-            .map(|(c, (cell, &w))| {
-                if c < 2 {
-                    format!("{cell:<w$}")
-                } else {
-                    format!("{cell:>w$}")
-                }
-            })
-            .collect();
-        text.push_str(cells.join("  ").trim_end());
-        text.push('\n');
-    }
+    text.push_str(&crate::record::aligned_table(&columns, &report.rows, 2));
     text.push_str(
         "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
          should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
@@ -279,7 +254,7 @@ fn markdown(report: &BenchReport) -> String {
             r.overflowed,
             r.lost,
             r.mismatched_pixels,
-            r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
+            r.error_pixel_rate.map_or_else(|| "n/a".to_string(), |e| percent(e, 3)),
             mean_error,
             max_error,
             psnr,

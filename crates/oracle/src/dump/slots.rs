@@ -202,6 +202,11 @@ impl Dump {
             .collect();
         let mut dump = self.clone();
         dump.header.layout = None;
+        // The words are now pixel-major: a slot-major `[k, pixels]` shape would read as the
+        // transpose of fragsim's own, so the array is described flat, as it is held.
+        if let Some(spec) = dump.header.arrays.get_mut("slots") {
+            spec.shape = vec![own.len() as u64];
+        }
         dump.arrays
             .insert("slots".into(), words_of(own_dtype(scheme), own));
         Ok(Some(dump))

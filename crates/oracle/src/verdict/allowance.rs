@@ -20,7 +20,7 @@
 use fragsim_capture::{Capture, Identity};
 use serde::Serialize;
 
-use crate::compare::{verdict, CompareOptions, Comparison};
+use crate::compare::{flags, CompareOptions, Comparison};
 use crate::dump::WordCheck;
 use crate::precision::Precision;
 use crate::{Oracle, PixelMismatch};
@@ -126,7 +126,7 @@ pub(crate) fn hold_to_reference(
         if skipped > 0 {
             comparison.diff.lost += skipped;
             comparison.diff.overflowed = comparison.diff.overflowed.saturating_sub(skipped);
-            late.push((p, verdict::MISSING));
+            late.push((p, flags::MISSING));
         }
     }
     comparison.add_flags(&late, options.examples, |p| PixelMismatch {
