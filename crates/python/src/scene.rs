@@ -23,7 +23,9 @@ use fragsim_capture::catalog::CATALOG;
 use fragsim_oracle::dump::{Dump, Words};
 use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::triangles::TriangleExport;
-use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Side, SideReport};
+use fragsim_oracle::verdict::{
+    self, Candidate, Options, Reference, Side, SideReport, VerdictError,
+};
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::{mesh_hash, SceneSpec};
 use fragsim_raster::{Conventions, Fragment, Mesh, Scene, UpAxis, VertexPrecision, View, Viewport};
@@ -180,7 +182,7 @@ impl SceneCore {
             Reference::of_view(self.oracle_of(&view, f32_stage), &view, stage)
         };
         let verdict = verdict::judge(&reference, Candidate::Dump(dump), &options)
-            .map_err(|message| refusal(dump, message))?;
+            .map_err(verdict_error)?;
         let candidate = SideReport {
             source: "arrays".into(),
             scheme: dump.header.scheme.clone(),
@@ -411,13 +413,12 @@ impl SceneCore {
     }
 }
 
-/// The typed error behind the verdict's refusal `message`: the dump's own [`DumpError`] where
-/// decoding or checking its words fails (a malformed dump, not a refusal to compare), else a
-/// [`JudgeError`]. Run only on the error path, so a verdict decodes the words once.
-fn refusal(dump: &Dump, message: String) -> PyErr {
-    match dump.capture().and_then(|_| dump.check_words()) {
-        Err(e) => dump_error(e),
-        Ok(_) => JudgeError::new_err(message),
+/// The exception for a verdict the oracle could not give: the dump's own [`DumpError`] where
+/// decoding it failed (a malformed dump, not a refusal to compare), else a [`JudgeError`].
+fn verdict_error(error: VerdictError) -> PyErr {
+    match error {
+        VerdictError::Dump(e) => dump_error(e),
+        other => JudgeError::new_err(other.to_string()),
     }
 }
 
