@@ -416,3 +416,12 @@ fn length(right: usize, fault: u8, which: u8) -> usize {
         right
     }
 }
+
+/// The bits of a `payload` word outside its depth and id fields (`docs/dump-format.md`: a word
+/// read as a fragment holds 0 there), written out from the format rather than asked of the
+/// reader.
+pub(super) fn outside_fields(payload: &Payload) -> u64 {
+    let bits = |n: u32| if n >= 64 { u64::MAX } else { (1_u64 << n) - 1 };
+    bits(payload.dtype.bits())
+        & !(bits(payload.prim_bits) | bits(payload.depth.bits()) << payload.depth_shift)
+}

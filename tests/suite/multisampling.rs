@@ -526,8 +526,19 @@ fn bench_samples_prints_its_multisampled_table() {
     let out = crate::support::scratch("multisampling", "terminal-table");
     let output = assert_cmd::Command::cargo_bin("fragsim")
         .unwrap()
-        .args(["bench", "--scene", "bunny", "--width", "32", "--height", "32"])
-        .args(["--scheme", "mdts", "--k", "1", "--executor", "serial", "--frames", "1"])
+        .args([
+            "bench", "--scene", "bunny", "--width", "32", "--height", "32",
+        ])
+        .args([
+            "--scheme",
+            "mdts",
+            "--k",
+            "1",
+            "--executor",
+            "serial",
+            "--frames",
+            "1",
+        ])
         .args(["--samples", "4", "--no-images", "--out"])
         .arg(&out)
         .output()

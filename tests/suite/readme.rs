@@ -35,7 +35,11 @@ fn command_table(readme: &str) -> Vec<(String, String)> {
         .map(|line| {
             let cells: Vec<&str> = line.split(" | ").collect();
             let command = cells[0].trim_start_matches("| ").split('`').nth(1).unwrap();
-            let example = cells.last().unwrap().trim_end_matches(" |").trim_matches('`');
+            let example = cells
+                .last()
+                .unwrap()
+                .trim_end_matches(" |")
+                .trim_matches('`');
             (command.to_string(), example.to_string())
         })
         .collect()
@@ -49,9 +53,15 @@ fn the_readme_table_names_every_subcommand_and_the_json_schema() {
     assert!(subcommands.len() >= 8, "{subcommands:?}");
     for name in &subcommands {
         let command = format!("fragsim {name}");
-        assert!(table.contains(&command), "the README's table lacks {command:?}: {table:?}");
+        assert!(
+            table.contains(&command),
+            "the README's table lacks {command:?}: {table:?}"
+        );
     }
-    assert!(readme.contains("docs/json-schema.md"), "README lacks the JSON schema");
+    assert!(
+        readme.contains("docs/json-schema.md"),
+        "README lacks the JSON schema"
+    );
 }
 
 /// Each example of the README's table, run as written but smaller (64 × 64 where the command
@@ -64,12 +74,24 @@ fn the_readme_table_examples_run() {
     // `compare oracle out/dumps/mdts` reads what a render with --dump wrote there.
     let dumped = Command::cargo_bin("fragsim")
         .unwrap()
-        .args(["--scheme", "mdts", "--width", "64", "--height", "64", "--no-images"])
+        .args([
+            "--scheme",
+            "mdts",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--no-images",
+        ])
         .args(["--out", dir_text, "--dump"])
         .arg(dir.join("dumps"))
         .output()
         .unwrap();
-    assert!(dumped.status.success(), "{}", String::from_utf8_lossy(&dumped.stderr));
+    assert!(
+        dumped.status.success(),
+        "{}",
+        String::from_utf8_lossy(&dumped.stderr)
+    );
     for (command, example) in command_table(&readme()) {
         let words: Vec<String> = example
             .split_whitespace()
@@ -129,13 +151,30 @@ fn the_readme_example_output_is_what_the_main_job_prints() {
         .arg(&dir)
         .output()
         .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let printed = String::from_utf8_lossy(&output.stdout).into_owned();
     let expected: Vec<&str> = block.lines().collect();
     let got: Vec<&str> = printed.lines().collect();
-    assert_eq!(expected.len(), got.len(), "README:\n{block}\nbinary:\n{printed}");
-    let before_time = |line: &str| line.split(" (oracle").next().unwrap_or_default().to_string();
-    assert_eq!(before_time(expected[0]), before_time(got[0]), "the scene line");
+    assert_eq!(
+        expected.len(),
+        got.len(),
+        "README:\n{block}\nbinary:\n{printed}"
+    );
+    let before_time = |line: &str| {
+        line.split(" (oracle")
+            .next()
+            .unwrap_or_default()
+            .to_string()
+    };
+    assert_eq!(
+        before_time(expected[0]),
+        before_time(got[0]),
+        "the scene line"
+    );
     assert_eq!(expected[1], got[1], "the heading line");
     // Columns 3 (threads), 8 (time ms) and the last (mem ops: the parallel atomicMin walks
     // depend on the interleaving) vary from machine to machine and run to run.
@@ -150,6 +189,10 @@ fn the_readme_example_output_is_what_the_main_job_prints() {
             .collect()
     };
     for (readme_row, binary_row) in expected[2..].iter().zip(&got[2..]) {
-        assert_eq!(steady(readme_row), steady(binary_row), "{readme_row}\n{binary_row}");
+        assert_eq!(
+            steady(readme_row),
+            steady(binary_row),
+            "{readme_row}\n{binary_row}"
+        );
     }
 }

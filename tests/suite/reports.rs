@@ -18,13 +18,22 @@ fn a_linked_list_header_without_its_payload_is_refused_naming_the_field() {
         .arg(dir.join("dumps"))
         .output()
         .unwrap();
-    assert!(render.status.success(), "{}", String::from_utf8_lossy(&render.stderr));
+    assert!(
+        render.status.success(),
+        "{}",
+        String::from_utf8_lossy(&render.stderr)
+    );
     let dump = dir.join("dumps/linked-list");
     let header_path = dump.join("dump.json");
     let mut header: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&header_path).unwrap()).unwrap();
-    let layout = header["layout"].as_object_mut().expect("a linked-list layout");
-    assert!(layout.remove("payload").is_some(), "the render wrote a payload");
+    let layout = header["layout"]
+        .as_object_mut()
+        .expect("a linked-list layout");
+    assert!(
+        layout.remove("payload").is_some(),
+        "the render wrote a payload"
+    );
     std::fs::write(&header_path, header.to_string()).unwrap();
     let compare = Command::cargo_bin("fragsim")
         .unwrap()
@@ -34,5 +43,8 @@ fn a_linked_list_header_without_its_payload_is_refused_naming_the_field() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&compare.stderr);
     assert_eq!(compare.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("payload") && stderr.contains("dump.json"), "{stderr}");
+    assert!(
+        stderr.contains("payload") && stderr.contains("dump.json"),
+        "{stderr}"
+    );
 }

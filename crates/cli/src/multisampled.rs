@@ -534,7 +534,9 @@ pub(crate) fn terminal_table(msaa: &MsaaReport) -> String {
         ("executor", |r| r.executor.clone()),
         ("passes", |r| r.passes.to_string()),
         ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
-        ("overflow", |r| format!("{} {}", r.overflowed, r.overflow_unit)),
+        ("overflow", |r| {
+            format!("{} {}", r.overflowed, r.overflow_unit)
+        }),
         ("lost", |r| r.lost.to_string()),
         ("wrong samples", |r| r.wrong_samples.to_string()),
         ("EPR %", |r| {

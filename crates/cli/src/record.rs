@@ -295,7 +295,11 @@ pub fn bucket_cells(bucket: &BucketError) -> [String; 6] {
 /// A terminal table of `rows`, one column per `(heading, cell)`: each column as wide as its
 /// widest cell, the first `left` columns (names) aligned left and the rest (numbers) right, two
 /// spaces between columns, a line a row under the line of headings.
-pub(crate) fn aligned_table<Row>(columns: &[(&str, fn(&Row) -> String)], rows: &[Row], left: usize) -> String {
+pub(crate) fn aligned_table<Row>(
+    columns: &[(&str, fn(&Row) -> String)],
+    rows: &[Row],
+    left: usize,
+) -> String {
     let mut cells = vec![columns
         .iter()
         .map(|(heading, _)| (*heading).to_string())
@@ -349,12 +353,13 @@ mod tests {
     #[test]
     fn an_aligned_table_pads_names_left_and_numbers_right() {
         type Row = (&'static str, u32);
-        let columns: [(&str, fn(&Row) -> String); 2] =
-            [("scheme", |r| r.0.to_string()), ("lost", |r| r.1.to_string())];
+        let columns: [(&str, fn(&Row) -> String); 2] = [
+            ("scheme", |r| r.0.to_string()),
+            ("lost", |r| r.1.to_string()),
+        ];
         let text = aligned_table(&columns, &[("mdts", 0), ("kbuffer-stores", 1234)], 1);
         assert_eq!(
-            text,
-            "scheme          lost\nmdts               0\nkbuffer-stores  1234\n",
+            text, "scheme          lost\nmdts               0\nkbuffer-stores  1234\n",
             "{text}"
         );
     }

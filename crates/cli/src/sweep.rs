@@ -308,12 +308,7 @@ fn print_summary(
         "mean ms"
     );
     for s in series {
-        let rates: Vec<f64> = s
-            .error_pixel_rate
-            .iter()
-            .flatten()
-            .copied()
-            .collect();
+        let rates: Vec<f64> = s.error_pixel_rate.iter().flatten().copied().collect();
         let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| percent(r, 4));
         let max_rate = rates
             .iter()

@@ -181,8 +181,8 @@ impl SceneCore {
         } else {
             Reference::of_view(self.oracle_of(&view, f32_stage), &view, stage)
         };
-        let verdict = verdict::judge(&reference, Candidate::Dump(dump), &options)
-            .map_err(verdict_error)?;
+        let verdict =
+            verdict::judge(&reference, Candidate::Dump(dump), &options).map_err(verdict_error)?;
         let candidate = SideReport {
             source: "arrays".into(),
             scheme: dump.header.scheme.clone(),

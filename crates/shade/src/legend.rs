@@ -130,7 +130,10 @@ fn bar_ticks(top: u32) -> Vec<u32> {
         step *= 10;
     }
     let mut ticks: Vec<u32> = (0..top).step_by(step as usize).collect();
-    if ticks.last().is_some_and(|&last| 2 * (top - last) < step && last > 0) {
+    if ticks
+        .last()
+        .is_some_and(|&last| 2 * (top - last) < step && last > 0)
+    {
         ticks.pop();
     }
     ticks.push(top);
@@ -384,10 +387,26 @@ mod tests {
     #[test]
     fn the_colour_bar_labels_every_count_of_a_shallow_scene_and_round_steps_of_a_deep_one() {
         assert_eq!(bar_ticks(1), [0, 1], "a scale of one");
-        assert_eq!(bar_ticks(6), [0, 1, 2, 3, 4, 5, 6], "no count skipped up to 10");
-        assert_eq!(bar_ticks(40), [0, 5, 10, 15, 20, 25, 30, 35, 40], "steps of 5");
-        assert_eq!(bar_ticks(37), [0, 5, 10, 15, 20, 25, 30, 37], "35 too close to 37");
-        assert_eq!(bar_ticks(1000), [0, 200, 400, 600, 800, 1000], "steps of 200");
+        assert_eq!(
+            bar_ticks(6),
+            [0, 1, 2, 3, 4, 5, 6],
+            "no count skipped up to 10"
+        );
+        assert_eq!(
+            bar_ticks(40),
+            [0, 5, 10, 15, 20, 25, 30, 35, 40],
+            "steps of 5"
+        );
+        assert_eq!(
+            bar_ticks(37),
+            [0, 5, 10, 15, 20, 25, 30, 37],
+            "35 too close to 37"
+        );
+        assert_eq!(
+            bar_ticks(1000),
+            [0, 200, 400, 600, 800, 1000],
+            "steps of 200"
+        );
         for top in 1..3000 {
             let ticks = bar_ticks(top);
             assert!(ticks.len() <= 11, "{top}: {ticks:?}");

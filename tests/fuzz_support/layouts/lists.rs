@@ -7,7 +7,7 @@ use fragsim::oracle::dump::{Corruption, Header, LayoutSpec, Words};
 use fragsim::raster::Viewport;
 
 use super::super::input::Input;
-use super::{k, length, payload, payload_word, payload_words, Model};
+use super::{k, length, outside_fields, payload, payload_word, payload_words, Model};
 
 /// A linked-list dump (`scheme` is `linked-list` or `linked-list-nearest`) and its model.
 pub(super) fn linked_lists(
@@ -107,6 +107,8 @@ pub(super) fn linked_lists(
             let (fragment, possible) = payload.fragment(nodes[i]);
             if !possible {
                 model.corrupt[p].push((walked.len(), Corruption::ImpossibleKey));
+            } else if nodes[i] & outside_fields(&payload) != 0 {
+                model.corrupt[p].push((walked.len(), Corruption::OutsideFields));
             }
             walked.push(fragment);
             node = next[i];
@@ -181,6 +183,8 @@ pub(super) fn layer_major(
             let (fragment, possible) = payload.fragment(layers[layer * pixels + p]);
             if !possible {
                 model.corrupt[p].push((layer, Corruption::ImpossibleKey));
+            } else if layers[layer * pixels + p] & outside_fields(&payload) != 0 {
+                model.corrupt[p].push((layer, Corruption::OutsideFields));
             }
             list.push(fragment);
         }

@@ -2,11 +2,13 @@
 //! or pixel-major with any payload, and its model: the same words in fragsim's own encoding.
 
 use fragsim::capture::catalog::{DumpLayout, SchemeName, CATALOG};
-use fragsim::oracle::dump::{Dtype, Dump, Header, LayoutSpec, Payload, SlotOrder, Words};
+use fragsim::oracle::dump::{
+    Corruption, Dtype, Dump, Header, LayoutSpec, Payload, SlotOrder, Words,
+};
 use fragsim::raster::Viewport;
 
 use super::super::input::Input;
-use super::{k, length, payload, payload_word, payload_words, words_of, Model};
+use super::{k, length, outside_fields, payload, payload_word, payload_words, words_of, Model};
 
 /// The slot schemes a slot dump may name, whether the A-buffer's storage is exact, and which
 /// k-buffer's slots (under its own name: its promise and resolve).
@@ -170,6 +172,11 @@ pub(super) fn slots(
             .collect(),
     };
     fragsims.header.layout = None;
+    // Pixel-major now, so described flat: a slot-major `[k, pixels]` shape would read as the
+    // transpose of fragsim's own.
+    if let Some(spec) = fragsims.header.arrays.get_mut("slots") {
+        spec.shape = vec![total as u64];
+    }
     fragsims
         .arrays
         .insert("slots".into(), words_of(own_dtype, own));
@@ -181,25 +188,61 @@ pub(super) fn slots(
         SlotScheme::ABufferExact => offsets[p] as usize,
         _ => p * per_pixel,
     };
+    // The own encoding's corrupt words, each named as stored (exact storage's room other than
+    // its counter is named by the room itself, at slot 0).
+    let mut corrupt: Vec<Vec<(usize, Corruption)>> = words
+        .corrupt
+        .iter()
+        .map(|c| c.iter().map(|w| (w.slot, w.why)).collect())
+        .collect();
+    let mut stored_words: Vec<Vec<u64>> = words
+        .corrupt
+        .iter()
+        .map(|c| {
+            c.iter()
+                .map(|w| match w.why {
+                    Corruption::RoomNotCount => w.word,
+                    _ => stored[stored_at(first_slot(w.pixel) + w.slot)],
+                })
+                .collect()
+        })
+        .collect();
+    // The format's rule on the bits outside a payload's fields, written out: a slot read as a
+    // fragment (below an A-buffer's counter; any MDTS or k-buffer slot) that is not the empty
+    // marker holds 0 there, and a slot named for another reason is not named again.
+    let outside = payload.map_or(0, |p| outside_fields(&p));
+    let counters = arrays
+        .iter()
+        .find_map(|(name, words)| match (*name, words) {
+            ("counters", Words::U32(c)) => Some(c.clone()),
+            _ => None,
+        });
+    if outside != 0 {
+        for p in 0..pixels {
+            let room = counts[p] as usize;
+            let read = counters.as_ref().map_or(room, |c| room.min(c[p] as usize));
+            for slot in 0..read {
+                let word = stored[stored_at(first_slot(p) + slot)];
+                let fields = if scheme == SlotScheme::MdtsDesc {
+                    word.wrapping_sub(1)
+                } else {
+                    word
+                };
+                let named = corrupt[p]
+                    .iter()
+                    .any(|&(s, why)| s == slot && why != Corruption::RoomNotCount);
+                if word != empty && fields & outside != 0 && !named {
+                    corrupt[p].push((slot, Corruption::OutsideFields));
+                    stored_words[p].push(word);
+                }
+            }
+        }
+    }
     Ok(Some(Model {
-        corrupt: words
-            .corrupt
-            .iter()
-            .map(|c| c.iter().map(|w| (w.slot, w.why)).collect())
-            .collect(),
+        corrupt,
         lists: (0..pixels).map(|p| capture.pixel(p).to_vec()).collect(),
         unreachable: 0,
-        stored_words: Some(
-            words
-                .corrupt
-                .iter()
-                .map(|c| {
-                    c.iter()
-                        .map(|w| stored[stored_at(first_slot(w.pixel) + w.slot)])
-                        .collect()
-                })
-                .collect(),
-        ),
+        stored_words: Some(stored_words),
         judged_against_itself: !abuffer,
     }))
 }

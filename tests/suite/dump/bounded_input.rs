@@ -11,14 +11,15 @@ use std::time::Duration;
 use super::binary::{fragsim, stdout_of};
 use super::scratch;
 
-/// `fragsim render` of `quads:4` at 16 × 12 with `mdts`, its dump in `out/mdts`.
+/// `fragsim render` of `quads:4` at 64 × 64 with `mdts` at K = 1 (4,096 slots of 8 bytes:
+/// 32,768 bytes of arrays), its dump in `out/mdts`.
 fn quads_dump(out: &Path) {
     stdout_of(
         fragsim()
             .args([
-                "render", "--scene", "quads:4", "--width", "16", "--height", "12",
+                "render", "--scene", "quads:4", "--width", "64", "--height", "64",
             ])
-            .args(["--scheme", "mdts", "--k", "4", "--executor", "serial"])
+            .args(["--scheme", "mdts", "--k", "1", "--executor", "serial"])
             .args(["--no-images", "--quiet", "--dump"])
             .arg(out),
         0,
@@ -86,7 +87,7 @@ fn a_header_naming_a_huge_procedural_scene_is_refused_from_its_name() {
     name_scene(&dir, "quads:4");
     refused(
         &mut compare(&dir, &["--memory-cap", "50000"]),
-        &["the oracle of this view", "memory cap of 50000 bytes"],
+        &["scene quads:4", "its oracle", "memory cap of 50000 bytes"],
     );
 }
 

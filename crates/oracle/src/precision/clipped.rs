@@ -19,6 +19,11 @@ use super::error_analysis::{clip_error, window_bound, Located};
 use super::triangle::{triangle, Target, Triangle};
 use super::{gamma_both, Bounds, Doubt, Found, VertexBound};
 
+/// Pixels either side of an edge made by clipping within which a sample's coverage is in doubt
+/// (`pieces`): the gap between an exact per-sample depth clip and a clipped polygon's snapped,
+/// tie-ruled edge.
+const CLIP_EDGE_MARGIN: f64 = 1.0 / 16.0;
+
 /// The pieces of clipped triangle `prim` with their vertices' bounds: the fan
 /// `(polygon[0], polygon[i], polygon[i + 1])` of the pieces whose vertices all have `w > 0`, as
 /// the pipeline rasterizes them (`View::screen_triangles`). `None` when the reference does not
@@ -59,13 +64,25 @@ pub(super) fn pieces(
         errors.push(error);
     }
     let polygon = &trace.polygon;
+    let viewport = view.viewport();
     let mut located = Vec::with_capacity(polygon.len());
     for (k, &i) in polygon.iter().enumerate() {
         let used = clipped.polygon[k].to_array();
         let traced = trace.points[i].to_array();
         // The pipeline's clamp to the guard band moves a point only by its own rounding: what it
         // moved is added to the point's error.
-        let error: [f64; 4] = std::array::from_fn(|c| errors[i][c] + (used[c] - traced[c]).abs());
+        let mut error: [f64; 4] =
+            std::array::from_fn(|c| errors[i][c] + (used[c] - traced[c]).abs());
+        // A vertex the clipping made lies on a clip edge, which an implementation may also draw
+        // without making it: a rasterizer that clips depth per sample (lavapipe keeps a sample
+        // at depth exactly 0) has the exact plane where one that clips the polygon has a snapped
+        // edge and its fill rule. Samples within a sixteenth of a pixel of such an edge are in
+        // doubt either way.
+        if matches!(trace.origins[i], ClipOrigin::Crossing { .. }) {
+            let w = used[3].abs();
+            error[0] += CLIP_EDGE_MARGIN * 2.0 * w / f64::from(viewport.width);
+            error[1] += CLIP_EDGE_MARGIN * 2.0 * w / f64::from(viewport.height);
+        }
         let (snapped, depth) = clipped.snapped[k];
         let at = Located {
             clip: used,

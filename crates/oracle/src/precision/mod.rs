@@ -215,23 +215,43 @@ fn twins(view: &View<'_>) -> Vec<u32> {
 }
 
 /// Triangle `prim`, which the reference clips and whose pieces cannot be bounded (a vertex whose
-/// `w` or side of a clipping plane its error leaves open): its reference fragments listed as
-/// ambiguous with any depth.
+/// `w` or side of a clipping plane its error leaves open, as a corner exactly on the near plane):
+/// its reference fragments listed as ambiguous with any depth, and the pixels next to them as
+/// places a fragment of it may be (a clip edge through a sample: an implementation that clips
+/// depth per sample keeps what the reference's clipped polygon leaves to its fill rule).
 fn not_analysed(view: &View<'_>, prim: u32, found: &mut Vec<Found>, bounds: &mut Bounds) {
     bounds.unanalysed_triangles += 1;
+    let doubt = |pixel: u32, reference: Option<u32>| Found {
+        pixel,
+        possible: Possible {
+            prim,
+            key_lo: 0,
+            key_hi: KEY_ONE,
+            doubt: Some(Doubt::Clipped),
+            reference,
+        },
+        covered: reference.is_some(),
+    };
+    let mut covered = std::collections::BTreeSet::new();
     view.rasterize(prim, &mut |f| {
-        found.push(Found {
-            pixel: f.pixel,
-            possible: Possible {
-                prim,
-                key_lo: 0,
-                key_hi: KEY_ONE,
-                doubt: Some(Doubt::Clipped),
-                reference: Some(f.depth_key),
-            },
-            covered: true,
-        });
+        covered.insert(f.pixel);
+        found.push(doubt(f.pixel, Some(f.depth_key)));
     });
+    let viewport = view.viewport();
+    let (width, height) = (viewport.width, viewport.height);
+    let mut near = std::collections::BTreeSet::new();
+    for &pixel in &covered {
+        let (x, y) = (pixel % width, pixel / width);
+        for ny in y.saturating_sub(1)..=(y + 1).min(height - 1) {
+            for nx in x.saturating_sub(1)..=(x + 1).min(width - 1) {
+                let neighbour = ny * width + nx;
+                if !covered.contains(&neighbour) {
+                    near.insert(neighbour);
+                }
+            }
+        }
+    }
+    found.extend(near.into_iter().map(|pixel| doubt(pixel, None)));
 }
 
 /// A vertex's error bounds: the snapped positions it may reach, their radius (subpixels) and the

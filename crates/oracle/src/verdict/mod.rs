@@ -27,9 +27,9 @@
 //! [`Dump::compare_masked`].
 
 mod against_dump;
-mod allowance;
 mod against_masked;
 mod against_oracle;
+mod allowance;
 mod error;
 mod reference;
 mod report;

@@ -132,7 +132,9 @@ impl View<'_> {
                 format!(" times vertex {v}'s {}", ["x", "y", "z"][column])
             });
             format!(
-                "view_projection.row_major[{}] is {}: under an f32 vertex stage its product{times}                  is {product:e}, outside f32's normal range ({:e} to {:e}; a GPU may flush                  subnormals to zero)",
+                "view_projection.row_major[{}] is {:e}: under an f32 vertex stage its \
+                 product{times} is {product:e}, outside f32's normal range ({:e} to {:e}; a GPU \
+                 may flush subnormals to zero)",
                 row * 4 + column,
                 m[column][row],
                 f32::MIN_POSITIVE,

@@ -17,7 +17,6 @@
 //! lists). The test prints a kill table by kind and layout, per judge (`docs/testing.md` has it
 //! and its command).
 
-mod clipped;
 mod kinds;
 mod storage;
 
