@@ -527,8 +527,7 @@ fn masked_frame(
 /// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
 /// (bench.md holds every column and their key).
 pub(crate) fn terminal_table(msaa: &MsaaReport) -> String {
-    type Cell = fn(&SampledRow) -> String;
-    let columns: [(&str, Cell); 10] = [
+    let columns: [crate::record::Column<SampledRow>; 10] = [
         ("scheme", |r| r.scheme.clone()),
         ("storage", |r| r.storage.to_string()),
         ("executor", |r| r.executor.clone()),

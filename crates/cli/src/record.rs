@@ -292,14 +292,13 @@ pub fn bucket_cells(bucket: &BucketError) -> [String; 6] {
     ]
 }
 
+/// A column of a terminal table: its heading, and the cell it shows of a row.
+pub(crate) type Column<Row> = (&'static str, fn(&Row) -> String);
+
 /// A terminal table of `rows`, one column per `(heading, cell)`: each column as wide as its
 /// widest cell, the first `left` columns (names) aligned left and the rest (numbers) right, two
 /// spaces between columns, a line a row under the line of headings.
-pub(crate) fn aligned_table<Row>(
-    columns: &[(&str, fn(&Row) -> String)],
-    rows: &[Row],
-    left: usize,
-) -> String {
+pub(crate) fn aligned_table<Row>(columns: &[Column<Row>], rows: &[Row], left: usize) -> String {
     let mut cells = vec![columns
         .iter()
         .map(|(heading, _)| (*heading).to_string())
@@ -339,7 +338,7 @@ pub(crate) fn aligned_table<Row>(
 
 #[cfg(test)]
 mod tests {
-    use super::{aligned_table, percent};
+    use super::{aligned_table, percent, Column};
 
     #[test]
     fn a_rate_that_is_not_zero_never_prints_as_zero() {
@@ -353,7 +352,7 @@ mod tests {
     #[test]
     fn an_aligned_table_pads_names_left_and_numbers_right() {
         type Row = (&'static str, u32);
-        let columns: [(&str, fn(&Row) -> String); 2] = [
+        let columns: [Column<Row>; 2] = [
             ("scheme", |r| r.0.to_string()),
             ("lost", |r| r.1.to_string()),
         ];

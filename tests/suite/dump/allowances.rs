@@ -132,7 +132,7 @@ fn exact_storage_owes_room_for_every_fragment_whatever_its_offsets_say() {
 
 /// Each pixel's `k` slots of `slots` (pixel-major) replaced by `pick` of the pixel's full list
 /// `all` (every fragment, as the exact A-buffer holds it), sorted, empty slots after.
-fn keep(slots: &mut [u64], all: &[u64], offsets: &[u32], k: usize, pick: fn(&mut Vec<u64>)) {
+fn keep(slots: &mut [u64], all: &[u64], offsets: &[u32], k: usize, pick: Pick) {
     for (p, run) in slots.chunks_exact_mut(k).enumerate() {
         let mut list = all[offsets[p] as usize..offsets[p + 1] as usize].to_vec();
         pick(&mut list);
@@ -143,18 +143,22 @@ fn keep(slots: &mut [u64], all: &[u64], offsets: &[u32], k: usize, pick: fn(&mut
     }
 }
 
+/// A way to pick which of a pixel's fragments a K-slot list keeps: the list ordered so that the
+/// kept ones come first.
+type Pick = fn(&mut [u64]);
+
 /// Orders a pixel's fragments by primitive id, first submitted first.
-fn by_primitive(list: &mut Vec<u64>) {
+fn by_primitive(list: &mut [u64]) {
     list.sort_unstable_by_key(|&w| w as u32);
 }
 
 /// Orders a pixel's fragments by primitive id, last submitted first.
-fn by_primitive_last_first(list: &mut Vec<u64>) {
+fn by_primitive_last_first(list: &mut [u64]) {
     list.sort_unstable_by_key(|&w| std::cmp::Reverse(w as u32));
 }
 
 /// Orders a pixel's fragments nearest first.
-fn nearest_first(list: &mut Vec<u64>) {
+fn nearest_first(list: &mut [u64]) {
     list.sort_unstable();
 }
 
@@ -181,7 +185,7 @@ fn each_k_buffer_is_held_to_its_own_ordering_promise() {
     let (all, offsets) = (u64s(&every, "slots"), u32s(&every, "offsets"));
     let deep = offsets.windows(2).filter(|w| w[1] - w[0] > 2).count();
     assert!(deep > 50, "{deep} pixels deeper than K");
-    let picks: [(&str, fn(&mut Vec<u64>)); 3] = [
+    let picks: [(&str, Pick); 3] = [
         ("the nearest 2", nearest_first),
         ("the first 2 by primitive", by_primitive),
         ("the last 2 by primitive", by_primitive_last_first),

@@ -166,8 +166,7 @@ median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments p
 /// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
 /// first, aligned, in about 120 characters (bench.md holds all 26).
 fn terminal_table(report: &BenchReport) -> String {
-    type Cell = fn(&BenchRow) -> String;
-    let columns: [(&str, Cell); 10] = [
+    let columns: [crate::record::Column<BenchRow>; 10] = [
         ("scheme", |r| r.scheme.clone()),
         ("executor", |r| r.executor.clone()),
         ("passes", |r| r.passes.to_string()),

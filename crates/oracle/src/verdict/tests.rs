@@ -92,9 +92,10 @@ fn a_dump_missing_one_fragment_is_different_at_that_pixel_alone() {
 /// A masked-node dump of `spheres:3` at 4 samples whose nodes are those `merge` makes of the
 /// per-sample oracle's fragments (the capacity the most nodes a pixel has), with the per-pixel
 /// view of the per-sample oracle it is judged against.
-fn masked_dump_merged_by(
-    merge: fn(u32, &mut [Fragment], &mut dyn FnMut(u32, MaskedNode)),
-) -> (Dump, Reference<'static>) {
+/// A merge of a pixel's sample fragments into masked nodes, as `merge_samples` is.
+type Merge = fn(u32, &mut [Fragment], &mut dyn FnMut(u32, MaskedNode));
+
+fn masked_dump_merged_by(merge: Merge) -> (Dump, Reference<'static>) {
     let mut spec = SceneSpec::named("spheres:3", 30.0, 15.0);
     spec.conventions.samples = 4;
     let scene = spec.load(None).unwrap();
@@ -113,7 +114,7 @@ fn masked_dump_merged_by(
     let pixels = view.pixel_viewport().pixels();
     let mut nodes = Vec::new();
     merge(4, &mut fragments, &mut |pixel, node| {
-        nodes.push((pixel, node))
+        nodes.push((pixel, node));
     });
     let merged = MaskedLists::from_nodes(4, pixels, nodes);
     let capacity = (0..pixels).map(|p| merged.pixel(p).len()).max().unwrap();

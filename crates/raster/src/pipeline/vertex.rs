@@ -122,6 +122,10 @@ impl View<'_> {
     ///
     /// # Errors
     /// The first such entry, by its row-major index, with the vertex and the product.
+    #[expect(
+        clippy::needless_range_loop,
+        reason = "row and column index the column-major matrix and name the row-major entry"
+    )]
     pub fn check_f32_range(&self) -> Result<(), String> {
         let normal = |x: f64| {
             x == 0.0 || (f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs())

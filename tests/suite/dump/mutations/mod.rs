@@ -66,7 +66,7 @@ enum Judge<'a> {
     /// Bit for bit against the oracle.
     Exact,
     /// Against an analysis: the f32 vertex stage's, or the exact one as a unorm field stores it.
-    Within(Precision),
+    Within(Box<Precision>),
     /// A masked-node dump against the per-pixel view of the per-sample oracle.
     Masked(&'a MaskedLists),
 }
@@ -513,14 +513,14 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         let unorm = name.ends_with("unorm24");
         let (exact, within, possible) = if unorm {
             (
-                Judge::Within(unorm_exact.clone()),
-                Judge::Within(unorm_f32.clone()),
+                Judge::Within(Box::new(unorm_exact.clone())),
+                Judge::Within(Box::new(unorm_f32.clone())),
                 &unorm_f32,
             )
         } else {
             (
                 Judge::Exact,
-                Judge::Within(f32_analysis.clone()),
+                Judge::Within(Box::new(f32_analysis.clone())),
                 &f32_analysis,
             )
         };
@@ -568,7 +568,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             oracle: samples.oracle(),
             judges: vec![
                 ("exact", Judge::Exact),
-                ("f32", Judge::Within(f32_per_sample.clone())),
+                ("f32", Judge::Within(Box::new(f32_per_sample.clone()))),
             ],
             possible: Some(&f32_per_sample),
             format: DepthFormat::F32,
