@@ -117,16 +117,30 @@ fn the_clamped_counters_and_the_racy_counter_are_caught_within_100_cases() {
 /// A backend that fails on every case (exit 3, or past its timeout) fails on the smallest case
 /// too: the run stops at once, unshrunk, within 5 seconds. Control: the same run's report of a
 /// backend that fails on a case's content is shrunk (`each_planted_bug_…` above).
+///
+/// The timeout kills the backend's whole process group (a child it left running in the
+/// background included) and nothing else: a process outside the group, started before the run,
+/// is still running after it. (A `kill` that misread the group once signalled every process.)
 #[test]
 fn a_backend_that_always_fails_stops_within_five_seconds_unshrunk() {
+    let grandchild =
+        std::env::temp_dir().join(format!("fragsim-conform-grandchild-{}", std::process::id()));
+    let timeout_backend = format!(
+        "sleep 23 & echo $! > {}; wait # {{out}}",
+        grandchild.display()
+    );
     for (name, backend, timeout) in [
         ("exit", "exit 3 # {out}", "30"),
-        ("timeout", "sleep 20 # {out}", "1"),
+        ("timeout", timeout_backend.as_str(), "1"),
     ] {
         let save = std::env::temp_dir().join(format!(
             "fragsim-conform-always-{name}-{}",
             std::process::id()
         ));
+        let mut bystander = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
         let start = std::time::Instant::now();
         let output = Command::cargo_bin("fragsim")
             .unwrap()
@@ -146,7 +160,26 @@ fn a_backend_that_always_fails_stops_within_five_seconds_unshrunk() {
         assert_eq!(summary["shrink_steps"], 0, "{name}: {summary}");
         assert_eq!(summary["case_number"], 1, "{name}: {summary}");
         assert_eq!(summary["property"], "runs", "{name}: {summary}");
+        let bystander_running = bystander.try_wait().unwrap().is_none();
+        let _ = bystander.kill();
+        let _ = bystander.wait();
+        assert!(
+            bystander_running,
+            "{name}: a process outside the backend's group was killed"
+        );
     }
+    let pid = std::fs::read_to_string(&grandchild).unwrap();
+    let _ = std::fs::remove_file(&grandchild);
+    // Killed: gone, or a zombie waiting for whichever process adopted it.
+    let state = std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).unwrap_or_default();
+    let running = state
+        .rsplit(") ")
+        .next()
+        .is_some_and(|rest| !rest.starts_with('Z') && !rest.is_empty());
+    assert!(
+        !running,
+        "the backend's background child {pid} outlived its timeout: {state}"
+    );
 }
 
 #[test]

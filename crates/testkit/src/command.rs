@@ -188,9 +188,12 @@ impl CommandBackend {
                     std::thread::sleep(Duration::from_millis(2));
                 }
                 Ok(None) => {
-                    // The whole group: `sh` and whatever it started.
+                    // The whole group: `sh` and whatever it started. `-s KILL --` spells the
+                    // group as an operand: procps-ng 4.0.2 (Debian 12) reads `kill -KILL -PGID`
+                    // as `kill(-<first digit of PGID>)`, which for a group such as 12345 is
+                    // kill(-1): every process the user may signal (seen under strace).
                     let _ = Command::new("kill")
-                        .args(["-KILL", &format!("-{}", child.id())])
+                        .args(["-s", "KILL", "--", &format!("-{}", child.id())])
                         .status();
                     let _ = child.kill();
                     let _ = child.wait();
