@@ -226,11 +226,22 @@ mod tests {
         let small = RgbImage::new(1, 1);
         let wide = RgbImage::new(2, 1);
         let refused = colour_error(&small, &wide).unwrap_err();
+        assert_eq!(
+            refused,
+            CompareError::Sizes {
+                reference: (1, 1),
+                candidate: (2, 1)
+            }
+        );
+        let refused = refused.to_string();
         assert!(
             refused.contains("(2, 1)") && refused.contains("(1, 1)"),
             "{refused}"
         );
-        assert!(colour_error(&RgbImage::new(0, 0), &RgbImage::new(0, 0)).is_err());
+        assert_eq!(
+            colour_error(&RgbImage::new(0, 0), &RgbImage::new(0, 0)),
+            Err(CompareError::Empty)
+        );
     }
 
     /// Four pixels of 0, 1, 3 and 40 fragments, the one of 3 off by 6 in green: the bucket
@@ -252,7 +263,9 @@ mod tests {
         assert!(buckets[0].error.unwrap().psnr_db.is_infinite());
         assert!(buckets[5].error.unwrap().psnr_db.is_infinite());
         assert!(buckets[2].error.is_none());
-        let short = colour_error_by_depth(&reference, &candidate, &[1, 2]).unwrap_err();
+        let short = colour_error_by_depth(&reference, &candidate, &[1, 2])
+            .unwrap_err()
+            .to_string();
         assert!(
             short.contains("2 depth-complexity counts for 4 pixels"),
             "{short}"
