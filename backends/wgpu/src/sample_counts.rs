@@ -146,8 +146,14 @@ impl SampleCounts {
 /// # Errors
 /// An expanded framebuffer past fragsim's largest side.
 pub fn reference_counts(view: &View<'_>, pattern: SamplePattern) -> Result<Vec<u32>, String> {
-    let sampled = view.clone().with_samples(pattern).map_err(|e| e.to_string())?;
-    Ok(SampleOracle::build(&sampled).map_err(|e| e.to_string())?.oracle().depth_complexity())
+    let sampled = view
+        .clone()
+        .with_samples(pattern)
+        .map_err(|e| e.to_string())?;
+    Ok(SampleOracle::build(&sampled)
+        .map_err(|e| e.to_string())?
+        .oracle()
+        .depth_complexity())
 }
 
 /// The primitives whose fragments fragsim's per-sample oracle of `view` at `pattern` holds at
@@ -160,7 +166,13 @@ pub fn covering_prims(
     pattern: SamplePattern,
     samples: &[usize],
 ) -> Result<Vec<Vec<u32>>, String> {
-    let oracle = SampleOracle::build(&view.clone().with_samples(pattern).map_err(|e| e.to_string())?).map_err(|e| e.to_string())?;
+    let oracle = SampleOracle::build(
+        &view
+            .clone()
+            .with_samples(pattern)
+            .map_err(|e| e.to_string())?,
+    )
+    .map_err(|e| e.to_string())?;
     Ok(samples
         .iter()
         .map(|&i| oracle.oracle().pixel(i).iter().map(|&w| w as u32).collect())

@@ -429,7 +429,8 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         "% of covered pixels wrong",
         &by_width,
         false,
-    ).map_err(|e| e.to_string())?;
+    )
+    .map_err(|e| e.to_string())?;
     let by_dc: Vec<Series> = report
         .rows
         .iter()
@@ -467,7 +468,8 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         &by_dc,
         false,
         Some(&ticks),
-    ).map_err(|e| e.to_string())?;
+    )
+    .map_err(|e| e.to_string())?;
     say_wrote(args, &["hazard.md", "hazard.json", &vs_width, &vs_dc])
 }
 

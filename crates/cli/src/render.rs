@@ -241,7 +241,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         let mut last = None;
         for &executor in executors {
             progress.set_message(format!("{name} on the {executor} executor"));
-            let named = pool.install(|| runner.run(name, executor, &view, &sizing)).map_err(|e| e.to_string())?;
+            let named = pool
+                .install(|| runner.run(name, executor, &view, &sizing))
+                .map_err(|e| e.to_string())?;
             let run = &named.run;
             let RunVerdict { diff, owed, kept } = judge_run(
                 &oracle,
@@ -261,10 +263,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                     viewport.width,
                     viewport.height,
                     &nearest,
-                ).map_err(|e| e.to_string())?;
+                )
+                .map_err(|e| e.to_string())?;
                 let what = format!("nearest depth captured by {name} on the {executor} executor");
-                let image = fragsim_shade::legend::captioned(&image, &caption(args, &what)?).map_err(|e| e.to_string())?;
-                fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png")).map_err(|e| e.to_string())?;
+                let image = fragsim_shade::legend::captioned(&image, &caption(args, &what)?)
+                    .map_err(|e| e.to_string())?;
+                fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png"))
+                    .map_err(|e| e.to_string())?;
                 nearest_written = true;
             }
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
@@ -321,12 +326,15 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             viewport.height,
             &oracle.depth_complexity(),
             args.scale_max,
-        ).map_err(|e| e.to_string())?;
+        )
+        .map_err(|e| e.to_string())?;
         let heat = fragsim_shade::legend::captioned(
             &heat,
             &caption(args, "depth complexity (the oracle's fragments a pixel)")?,
-        ).map_err(|e| e.to_string())?;
-        fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png")).map_err(|e| e.to_string())?;
+        )
+        .map_err(|e| e.to_string())?;
+        fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))
+            .map_err(|e| e.to_string())?;
     }
     if args.json {
         let context = crate::record::Context::of_scene("render", &args.scene)?.sized(&args.schemes);

@@ -36,9 +36,11 @@ impl Images<'_> {
         what: &str,
     ) -> Result<(), String> {
         self.save(image, &format!("{stem}.png"))?;
-        let difference = fragsim_shade::legend::effect_difference_figure(reference, image).map_err(|e| e.to_string())?;
+        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)
+            .map_err(|e| e.to_string())?;
         let caption = format!("{}: {what} against the oracle's image", self.scene);
-        let figure = fragsim_shade::legend::captioned(&difference, &caption).map_err(|e| e.to_string())?;
+        let figure =
+            fragsim_shade::legend::captioned(&difference, &caption).map_err(|e| e.to_string())?;
         self.save(&figure, &format!("{stem}-diff.png"))
     }
 }

@@ -141,7 +141,9 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let sizing = args.schemes.sizing();
         let mut runner = SchemeRunner::default();
         for (i, &name) in schemes.iter().enumerate() {
-            let named = pool.install(|| runner.run(name, executor, &view, &sizing)).map_err(|e| e.to_string())?;
+            let named = pool
+                .install(|| runner.run(name, executor, &view, &sizing))
+                .map_err(|e| e.to_string())?;
             if series.len() <= i {
                 series.push(SweepSeries::named(&named.name));
             }
@@ -256,7 +258,8 @@ fn write_outputs(
         "EPR (% of covered pixels)",
         &per_angle,
         false,
-    ).map_err(|e| e.to_string())?;
+    )
+    .map_err(|e| e.to_string())?;
     let scatter: Vec<fragsim_shade::plot::Point> = series
         .iter()
         .filter_map(|s| {
@@ -274,7 +277,8 @@ fn write_outputs(
         &format!("{scene}: speed against accuracy (means over the sweep)"),
         "mean frame time (ms, log scale)",
         &scatter,
-    ).map_err(|e| e.to_string())?;
+    )
+    .map_err(|e| e.to_string())?;
     print_summary(
         args,
         series,

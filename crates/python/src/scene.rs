@@ -166,7 +166,8 @@ impl SceneCore {
         let view = self.view(f32_stage)?;
         let size = (self.viewport.width, self.viewport.height);
         let reference = if dump.is_masked() {
-            let sampled = SampleOracle::build(&view).map_err(|e| SceneError::new_err(e.to_string()))?;
+            let sampled =
+                SampleOracle::build(&view).map_err(|e| SceneError::new_err(e.to_string()))?;
             let reference = Reference::masked(sampled.per_pixel(), size);
             if f32_stage {
                 let conventions = Conventions {

@@ -17,9 +17,8 @@ use fragsim_oracle::dump::{Dump, DumpScheme, Words};
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_testkit::{
-    Backend, BackendError, Battery, Case, Exercised, Failure, GuaranteeError, Input, Limits, Output,
-    Params,
-    Property,
+    Backend, BackendError, Battery, Case, Exercised, Failure, GuaranteeError, Input, Limits,
+    Output, Params, Property,
 };
 
 /// A bug planted in [`UserABuffer`].

@@ -166,20 +166,19 @@ impl SchemeRunner {
             counts: counted.as_ref().map(|c| c.counts.as_slice()),
             order: order.as_ref(),
         };
-        let mut named = name
-            .build(
-                &build,
-                RunOn {
-                    runner: self,
-                    executor,
-                    view,
-                    sizes: Build {
-                        counts: None,
-                        order: None,
-                        ..build
-                    },
+        let mut named = name.build(
+            &build,
+            RunOn {
+                runner: self,
+                executor,
+                view,
+                sizes: Build {
+                    counts: None,
+                    order: None,
+                    ..build
                 },
-            )?;
+            },
+        )?;
         if let Some(counted) = counted {
             named.run = named.run.after_count_pass(&counted.run);
             named.counts = Some(counted.counts);

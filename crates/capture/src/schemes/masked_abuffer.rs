@@ -399,11 +399,7 @@ impl MaskedABuffer {
     ///
     /// # Errors
     /// As [`MaskedABuffer::capture`].
-    pub fn insert_all<M: Memory>(
-        &self,
-        view: &View<'_>,
-        memory: &M,
-    ) -> Result<u64, CaptureError> {
+    pub fn insert_all<M: Memory>(&self, view: &View<'_>, memory: &M) -> Result<u64, CaptureError> {
         self.check_view(view)?;
         let mut scratch = Vec::new();
         Ok((0..view.triangle_count())

@@ -345,13 +345,17 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             };
             let (named, times) =
                 time_frames(&mut view, &camera, frame_pool, frames, &progress, |view| {
-                    let named = pool.install(|| runner.run(name, executor, view, &sizing)).map_err(|e| e.to_string())?;
+                    let named = pool
+                        .install(|| runner.run(name, executor, view, &sizing))
+                        .map_err(|e| e.to_string())?;
                     let stats = &named.run.stats;
                     let (pass_time, resolve_time) = (stats.pass_time, stats.resolve_time);
                     Ok((named, pass_time, resolve_time))
                 })?;
             runner.count_locked_ops = true;
-            let counted = pool.install(|| runner.run(name, executor, &view, &sizing)).map_err(|e| e.to_string())?;
+            let counted = pool
+                .install(|| runner.run(name, executor, &view, &sizing))
+                .map_err(|e| e.to_string())?;
             progress.inc(1);
             let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
             let RunVerdict { diff, kept, .. } = judge_run(

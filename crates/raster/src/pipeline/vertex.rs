@@ -14,10 +14,10 @@ use super::{
     VERTICES_PER_TASK,
 };
 use crate::camera::Camera;
-use crate::conventions::{Conventions, F32RangeError};
 use crate::conventions::DepthRange::{self, MinusOneToOne, ZeroToOne};
 use crate::conventions::VertexPrecision::{self, F32, F64};
 use crate::conventions::WindowOrigin::{LowerLeft, UpperLeft};
+use crate::conventions::{Conventions, F32RangeError};
 
 impl View<'_> {
     /// Runs the vertex stage again for another camera, reusing this view's buffers (a frame loop
@@ -131,14 +131,13 @@ impl View<'_> {
             x == 0.0 || (f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs())
         };
         let m = self.view_projection.to_cols_array_2d();
-        let out_of_range = |row: usize, column: usize, vertex: Option<usize>, product: f64| {
-            F32RangeError {
+        let out_of_range =
+            |row: usize, column: usize, vertex: Option<usize>, product: f64| F32RangeError {
                 index: row * 4 + column,
                 entry: m[column][row],
                 vertex: vertex.map(|v| (v, ["x", "y", "z"][column])),
                 product,
-            }
-        };
+            };
         for row in 0..4 {
             if !normal(m[3][row]) {
                 return Err(out_of_range(row, 3, None, m[3][row]));
