@@ -39,7 +39,8 @@ fn main() -> Result<(), String> {
         ["cache", mesh, out] => cache(Path::new(mesh), Path::new(out)),
         ["run", cache, width, height, scheme, executor, frames] => {
             let number = |text: &str| text.parse::<u32>().map_err(|e| format!("{text}: {e}"));
-            let viewport = Viewport::new(number(width)?, number(height)?)?;
+            let viewport =
+                Viewport::new(number(width)?, number(height)?).map_err(|e| e.to_string())?;
             run(
                 Path::new(cache),
                 viewport,

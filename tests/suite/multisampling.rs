@@ -285,7 +285,8 @@ fn a_view_refuses_a_framebuffer_too_wide_and_the_masked_abuffer_a_view_of_anothe
     let wide = view_of(&scene, 2048, 0.0);
     let message = wide
         .with_samples(SamplePattern::standard(16).unwrap())
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(
         message.contains("2048") && message.contains("16"),
         "{message}"
@@ -295,6 +296,7 @@ fn a_view_refuses_a_framebuffer_too_wide_and_the_masked_abuffer_a_view_of_anothe
     assert!(scheme
         .capture(&view, false)
         .unwrap_err()
+        .to_string()
         .contains("1 samples"));
     assert!(SampleOracle::build(&view).is_err());
 }

@@ -23,7 +23,9 @@ use fragsim_capture::executors::Executor;
 use fragsim_capture::Guarantee;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::VertexPrecision;
-use fragsim_testkit::{Backend, BackendError, Case, CatalogBackend, Input, Output, Params};
+use fragsim_testkit::{
+    Backend, BackendError, Case, CatalogBackend, GuaranteeError, Input, Output, Params,
+};
 
 use crate::capture::{capture_planted, Mode};
 use crate::device::{Gpu, GpuError};
@@ -60,13 +62,14 @@ impl Backend for WgpuBackend<'_> {
     }
 
     /// The catalog scheme's own claim, once the adapter and the plant are known to run it.
-    fn guarantee(&self, params: &Params) -> Result<Guarantee, String> {
-        let scheme = Self::scheme(params)?;
+    fn guarantee(&self, params: &Params) -> Result<Guarantee, GuaranteeError> {
+        let unsupported = |e: &dyn std::fmt::Display| GuaranteeError::Unsupported(e.to_string());
+        let scheme = Self::scheme(params).map_err(|e| unsupported(&e))?;
         self.gpu
             .check(scheme.name(), scheme.needs())
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| unsupported(&e))?;
         if let Some(plant) = self.plant {
-            plant.check(&scheme).map_err(|e| e.to_string())?;
+            plant.check(&scheme).map_err(|e| unsupported(&e))?;
         }
         CatalogBackend::on(Executor::Parallel).guarantee(params)
     }

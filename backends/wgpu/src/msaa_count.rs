@@ -209,7 +209,10 @@ pub(crate) fn msaa_count(gpu: &Gpu, args: &MsaaArgs) -> Result<bool, Box<dyn std
                     format!(" ({within}/{checked} near an edge)")
                 });
                 let mirror = if args.mirrored && samples > 1 {
-                    let other = reference_counts(&reference_view, mirrored(pattern)?)?;
+                    let other = reference_counts(
+                        &reference_view,
+                        mirrored(pattern).map_err(|e| e.to_string())?,
+                    )?;
                     let against = CountDiff::of(&counted.counts, &other, args.width, samples, 0);
                     println!(
                         "  against the mirrored positions (x, 16 - y): {} of {} samples, {} pixels' sums differ",

@@ -44,7 +44,7 @@
 use fragsim_oracle::precision::Precision;
 use fragsim_oracle::samples::SampleOracle;
 use fragsim_raster::conventions::VertexPrecision;
-use fragsim_raster::{SamplePattern, View, SUBPIXEL_BITS};
+use fragsim_raster::{SampleError, SamplePattern, View, SUBPIXEL_BITS};
 
 use crate::capture::{execute, execute_replay_of, Mode};
 use crate::device::{Gpu, GpuError};
@@ -146,8 +146,14 @@ impl SampleCounts {
 /// # Errors
 /// An expanded framebuffer past fragsim's largest side.
 pub fn reference_counts(view: &View<'_>, pattern: SamplePattern) -> Result<Vec<u32>, String> {
-    let sampled = view.clone().with_samples(pattern)?;
-    Ok(SampleOracle::build(&sampled)?.oracle().depth_complexity())
+    let sampled = view
+        .clone()
+        .with_samples(pattern)
+        .map_err(|e| e.to_string())?;
+    Ok(SampleOracle::build(&sampled)
+        .map_err(|e| e.to_string())?
+        .oracle()
+        .depth_complexity())
 }
 
 /// The primitives whose fragments fragsim's per-sample oracle of `view` at `pattern` holds at
@@ -160,7 +166,13 @@ pub fn covering_prims(
     pattern: SamplePattern,
     samples: &[usize],
 ) -> Result<Vec<Vec<u32>>, String> {
-    let oracle = SampleOracle::build(&view.clone().with_samples(pattern)?)?;
+    let oracle = SampleOracle::build(
+        &view
+            .clone()
+            .with_samples(pattern)
+            .map_err(|e| e.to_string())?,
+    )
+    .map_err(|e| e.to_string())?;
     Ok(samples
         .iter()
         .map(|&i| oracle.oracle().pixel(i).iter().map(|&w| w as u32).collect())
@@ -173,7 +185,7 @@ pub fn covering_prims(
 ///
 /// # Errors
 /// A pattern with a position at `y = 0`, whose mirror would lie on the next pixel's edge.
-pub fn mirrored(pattern: SamplePattern) -> Result<SamplePattern, String> {
+pub fn mirrored(pattern: SamplePattern) -> Result<SamplePattern, SampleError> {
     let positions: Vec<[u8; 2]> = pattern
         .positions()
         .iter()

@@ -98,6 +98,25 @@ pub enum CaptureError {
         /// The cap.
         cap: u64,
     },
+    /// A view other than the one the scheme was built for: another number of pixels, or
+    /// another sample count (a per-sample scheme needs a view rasterizing per sample at its
+    /// count).
+    #[error(
+        "{scheme} was built for {pixels} pixels at {samples} samples, the view is {view_pixels} \
+         pixels at {view_samples} samples"
+    )]
+    OtherView {
+        /// The scheme.
+        scheme: String,
+        /// The pixels it was built for.
+        pixels: usize,
+        /// The samples a pixel it was built for.
+        samples: u32,
+        /// The view's pixels.
+        view_pixels: usize,
+        /// The view's samples a pixel (1 for a view that does not rasterize per sample).
+        view_samples: u32,
+    },
 }
 
 /// What a scheme is, as the rest of the simulator sees it: written once, by the scheme's

@@ -253,7 +253,7 @@ impl<'a> ColourJudge<'a> {
         image: RgbImage,
         pass: Option<AttributePass>,
     ) -> Result<JudgedImage<'_>, String> {
-        let colour = colour_error(&self.reference, &image)?;
+        let colour = colour_error(&self.reference, &image).map_err(|e| e.to_string())?;
         let errors = effects::error_pixels(&self.reference, &image) as u64;
         Ok(JudgedImage {
             image,

@@ -212,8 +212,9 @@ fn write_image(v: &Verdict, path: &Path) -> Result<(), String> {
     // Rings only where differences are sparse: dense ones show alone, and rings would hide some.
     let ring = differing.clone().count() <= fragsim_shade::legend::MARKS;
     let marks: Vec<(u32, u32)> = differing.take(fragsim_shade::legend::MARKS).collect();
-    let figure = fragsim_shade::legend::difference_figure(&image, &legend(v), &marks, ring)?;
-    fragsim_shade::save_png(&figure, path)
+    let figure = fragsim_shade::legend::difference_figure(&image, &legend(v), &marks, ring)
+        .map_err(|e| e.to_string())?;
+    fragsim_shade::save_png(&figure, path).map_err(|e| e.to_string())
 }
 
 /// The report as JSON Lines: the report's fields flattened into one `compare` record (a group's

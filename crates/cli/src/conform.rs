@@ -439,7 +439,7 @@ fn save(
         for d in [&scene, &dir.join("out")] {
             std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
         }
-        write_case(case, &view, params, &scene)?;
+        write_case(case, &view, params, &scene).map_err(|e| e.to_string())?;
         Err(found.message.clone())
     } else {
         backend.run_in(&input, dir).map_err(|e| e.to_string())

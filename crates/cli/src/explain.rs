@@ -183,7 +183,7 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<bool, String> {
 pub(crate) fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String> {
     let fragments = one_pixel(&args.depths)?;
     let k = args.k.unwrap_or(fragments.len() as u32);
-    let viewport = Viewport::new(1, 1)?;
+    let viewport = Viewport::new(1, 1).map_err(|e| e.to_string())?;
     let name = args.scheme.0;
     match Shown::of(name).ok_or_else(|| format!("explain cannot explain {name}"))? {
         Shown::Hazard(own) => {

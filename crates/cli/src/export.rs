@@ -66,7 +66,7 @@ pub(crate) fn export_scene(args: &ExportArgs) -> Result<(), String> {
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;
     let view = spec
-        .view(&scene, args.scene.viewport()?)
+        .view(&scene, args.scene.viewport().map_err(|e| e.to_string())?)
         .map_err(|e| e.to_string())?;
     let spec = recorded_spec(&spec, &view)?;
     // The records are in pixels whatever the sample count (a backend scans them at the samples

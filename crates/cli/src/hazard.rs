@@ -135,9 +135,9 @@ pub(crate) fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
     }
     let spec = args.scene.spec(Conventions::REFERENCE);
     let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport()?;
+    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
     let view = spec.view(&scene, viewport).map_err(|e| e.to_string())?;
-    crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT)?;
+    crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT).map_err(|e| e.to_string())?;
     let oracle = Oracle::build(&view);
     let in_bucket = covered_by_bucket(&oracle);
     let covered: usize = in_bucket.iter().sum();
@@ -429,7 +429,8 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         "% of covered pixels wrong",
         &by_width,
         false,
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     let by_dc: Vec<Series> = report
         .rows
         .iter()
@@ -467,7 +468,8 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         &by_dc,
         false,
         Some(&ticks),
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     say_wrote(args, &["hazard.md", "hazard.json", &vs_width, &vs_dc])
 }
 

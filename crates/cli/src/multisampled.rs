@@ -172,8 +172,12 @@ pub(crate) fn check_early(
     schemes: &[SchemeName],
     sizing: &Sizing,
 ) -> Result<(), String> {
-    check_memory_cap_early(schemes, pattern.expand(view.viewport())?, sizing)
-        .map_err(|e| format!("at {} samples a pixel: {e}", pattern.count()))?;
+    check_memory_cap_early(
+        schemes,
+        pattern.expand(view.viewport()).map_err(|e| e.to_string())?,
+        sizing,
+    )
+    .map_err(|e| format!("at {} samples a pixel: {e}", pattern.count()))?;
     if let Count::Fixed(capacity) = sizing.capacity {
         for linked in [false, true] {
             let storage = masked_storage(linked, capacity, view.viewport().pixels());
@@ -195,11 +199,16 @@ pub(crate) fn check_early(
 /// Memory beyond the cap, a scheme's refusal, or an image that cannot be written.
 pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<MsaaReport, String> {
     let samples = pattern.count();
-    let mut view = bench.view.clone().with_samples(pattern)?;
+    let mut view = bench
+        .view
+        .clone()
+        .with_samples(pattern)
+        .map_err(|e| e.to_string())?;
     // The per-sample oracle is about `samples` single-sample oracles (one per sample index,
     // each on a shifted pixel grid): the single-sample bound against that share of the cap.
-    crate::oracle_memory::check(bench.view, bench.sizing.memory_cap / u64::from(samples))?;
-    let oracle = SampleOracle::build(&view)?;
+    crate::oracle_memory::check(bench.view, bench.sizing.memory_cap / u64::from(samples))
+        .map_err(|e| e.to_string())?;
+    let oracle = SampleOracle::build(&view).map_err(|e| e.to_string())?;
     let lists = oracle.oracle();
     let judge = ColourJudge::per_sample(
         crate::colour_judge::EffectName::Transparency,
@@ -331,7 +340,8 @@ fn rows(
                 |view| {
                     let named = bench
                         .pool
-                        .install(|| runner.run(name, executor, view, &bench.sizing))?;
+                        .install(|| runner.run(name, executor, view, &bench.sizing))
+                        .map_err(|e| e.to_string())?;
                     let stats = &named.run.stats;
                     let (pass_time, resolve_time) = (stats.pass_time, stats.resolve_time);
                     Ok((named, pass_time, resolve_time))
@@ -495,7 +505,8 @@ fn masked_frame(
     let (count, storage) = match sizing.capacity {
         Count::Fixed(capacity) => (None, masked_storage(linked, capacity, pixels.pixels())),
         Count::Auto => {
-            let counted = MaskedABuffer::count_nodes(pixels, samples, view, parallel)?;
+            let counted = MaskedABuffer::count_nodes(pixels, samples, view, parallel)
+                .map_err(|e| e.to_string())?;
             let nodes = counted.lists.overflow.iter();
             let storage = if linked {
                 MaskedStorage::Pool(nodes.map(|&n| n as usize).sum::<usize>().max(1))
@@ -507,7 +518,7 @@ fn masked_frame(
     };
     let scheme = MaskedABuffer::with_storage(pixels, samples, storage, sizing.memory_cap)
         .map_err(|e| e.to_string())?;
-    let frame = scheme.frame(view, parallel)?;
+    let frame = scheme.frame(view, parallel).map_err(|e| e.to_string())?;
     let slots = match (storage, sizing.capacity) {
         (MaskedStorage::Slots(capacity), _) => Some(capacity),
         (MaskedStorage::Pool(_), Count::Fixed(capacity)) => Some(capacity),

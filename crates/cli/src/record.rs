@@ -214,7 +214,8 @@ impl ColourByDepth {
     ) -> Result<Self, String> {
         let buckets = match images {
             Some((reference, candidate)) => {
-                colour_error_by_depth(reference, candidate, depth_complexity)?
+                colour_error_by_depth(reference, candidate, depth_complexity)
+                    .map_err(|e| e.to_string())?
             }
             None => Vec::new(),
         };

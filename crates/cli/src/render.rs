@@ -198,7 +198,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;
     let view = args.schemes.submission(
-        spec.view(&scene, args.scene.viewport()?)
+        spec.view(&scene, args.scene.viewport().map_err(|e| e.to_string())?)
             .map_err(|e| e.to_string())?,
     );
     crate::args::warn_if_empty(&scene, &view);
@@ -215,9 +215,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         .collect();
     let schemes = SchemeChoice::expand(&catalog);
     let sizing = args.schemes.sizing();
-    check_memory_cap_early(&schemes, viewport, &sizing)?;
+    check_memory_cap_early(&schemes, viewport, &sizing).map_err(|e| e.to_string())?;
     let executors = args.schemes.executors();
-    crate::oracle_memory::check(&view, sizing.memory_cap)?;
+    crate::oracle_memory::check(&view, sizing.memory_cap).map_err(|e| e.to_string())?;
     let progress = crate::progress::bar((schemes.len() * executors.len() + 1) as u64, "render");
     progress.set_message("oracle (serial reference)");
     let oracle_start = Instant::now();
@@ -241,7 +241,9 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         let mut last = None;
         for &executor in executors {
             progress.set_message(format!("{name} on the {executor} executor"));
-            let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            let named = pool
+                .install(|| runner.run(name, executor, &view, &sizing))
+                .map_err(|e| e.to_string())?;
             let run = &named.run;
             let RunVerdict { diff, owed, kept } = judge_run(
                 &oracle,
@@ -261,10 +263,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                     viewport.width,
                     viewport.height,
                     &nearest,
-                )?;
+                )
+                .map_err(|e| e.to_string())?;
                 let what = format!("nearest depth captured by {name} on the {executor} executor");
-                let image = fragsim_shade::legend::captioned(&image, &caption(args, &what)?)?;
-                fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png"))?;
+                let image = fragsim_shade::legend::captioned(&image, &caption(args, &what)?)
+                    .map_err(|e| e.to_string())?;
+                fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png"))
+                    .map_err(|e| e.to_string())?;
                 nearest_written = true;
             }
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
@@ -321,12 +326,15 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             viewport.height,
             &oracle.depth_complexity(),
             args.scale_max,
-        )?;
+        )
+        .map_err(|e| e.to_string())?;
         let heat = fragsim_shade::legend::captioned(
             &heat,
             &caption(args, "depth complexity (the oracle's fragments a pixel)")?,
-        )?;
-        fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))?;
+        )
+        .map_err(|e| e.to_string())?;
+        fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))
+            .map_err(|e| e.to_string())?;
     }
     if args.json {
         let context = crate::record::Context::of_scene("render", &args.scene)?.sized(&args.schemes);
@@ -374,7 +382,7 @@ fn masked(
             "--scheme {MASKED_SCHEME} runs per sample: it needs --samples 2, 4, 8 or 16"
         ));
     };
-    let oracle = SampleOracle::build(view)?;
+    let oracle = SampleOracle::build(view).map_err(|e| e.to_string())?;
     let per_pixel = oracle.per_pixel();
     let capacity = match sizing.capacity {
         Count::Fixed(c) => c,

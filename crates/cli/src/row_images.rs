@@ -20,7 +20,7 @@ impl Images<'_> {
     /// # Errors
     /// A file that cannot be written.
     pub(crate) fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
-        fragsim_shade::save_png(image, &self.dir.join(name))
+        fragsim_shade::save_png(image, &self.dir.join(name)).map_err(|e| e.to_string())
     }
 
     /// Saves `image` as `stem.png` and its difference from `reference` (error pixels red, with
@@ -36,9 +36,11 @@ impl Images<'_> {
         what: &str,
     ) -> Result<(), String> {
         self.save(image, &format!("{stem}.png"))?;
-        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)?;
+        let difference = fragsim_shade::legend::effect_difference_figure(reference, image)
+            .map_err(|e| e.to_string())?;
         let caption = format!("{}: {what} against the oracle's image", self.scene);
-        let figure = fragsim_shade::legend::captioned(&difference, &caption)?;
+        let figure =
+            fragsim_shade::legend::captioned(&difference, &caption).map_err(|e| e.to_string())?;
         self.save(&figure, &format!("{stem}-diff.png"))
     }
 }

@@ -110,7 +110,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
     let pool = args.schemes.pool()?;
     let spec = args.scene.spec(Conventions::REFERENCE);
     let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport()?;
+    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
     let executor = args.schemes.executors()[0];
     let mut threads = 0;
     let schemes = SchemeChoice::expand(&args.scheme);
@@ -133,7 +133,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let view = args
             .schemes
             .submission(at_angle.view(&scene, viewport).map_err(|e| e.to_string())?);
-        crate::oracle_memory::check(&view, args.schemes.memory_cap)?;
+        crate::oracle_memory::check(&view, args.schemes.memory_cap).map_err(|e| e.to_string())?;
         let oracle = Oracle::build(&view);
         let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
         crate::approximate::check_effect(&judge, &args.approximate)?;
@@ -141,7 +141,9 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
         let sizing = args.schemes.sizing();
         let mut runner = SchemeRunner::default();
         for (i, &name) in schemes.iter().enumerate() {
-            let named = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            let named = pool
+                .install(|| runner.run(name, executor, &view, &sizing))
+                .map_err(|e| e.to_string())?;
             if series.len() <= i {
                 series.push(SweepSeries::named(&named.name));
             }
@@ -256,7 +258,8 @@ fn write_outputs(
         "EPR (% of covered pixels)",
         &per_angle,
         false,
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     let scatter: Vec<fragsim_shade::plot::Point> = series
         .iter()
         .filter_map(|s| {
@@ -274,7 +277,8 @@ fn write_outputs(
         &format!("{scene}: speed against accuracy (means over the sweep)"),
         "mean frame time (ms, log scale)",
         &scatter,
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     print_summary(
         args,
         series,

@@ -25,7 +25,71 @@
 //! triangles would itself be a large allocation; a smaller one is made and bounded by
 //! [`check`]. Nothing is allocated before the refusal.
 
-use fragsim_raster::{Scene, ScreenTriangle, View};
+use fragsim_raster::{Scene, SceneSize, ScreenTriangle, View};
+
+/// Why the oracle, or a named scene, is refused before it is made: the bound on the bytes it
+/// would need, how the bound is made, and the cap.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum MemoryCapError {
+    /// The oracle of a view ([`check`]).
+    #[error(
+        "the oracle of this view would need up to {bytes} bytes (up to {fragments} fragments \
+         of {BYTES_PER_FRAGMENT} bytes, bounded from the screen triangles' areas, plus \
+         {BYTES_PER_PIXEL} bytes for each of {pixels} pixels), over the memory cap of {cap} \
+         bytes (--memory-cap raises it)"
+    )]
+    Oracle {
+        /// The bound on the oracle's bytes.
+        bytes: u64,
+        /// The bound on the view's fragments.
+        fragments: u64,
+        /// The view's pixels (lists).
+        pixels: u64,
+        /// The cap.
+        cap: u64,
+    },
+    /// A named scene's mesh alone ([`check_named_scene`]).
+    #[error(
+        "scene {name}: its mesh ({} vertices, {} triangles) would need {bytes} bytes, over the \
+         memory cap of {cap} bytes (--memory-cap raises it)",
+        size.vertices,
+        size.triangles
+    )]
+    SceneMesh {
+        /// The scene's name.
+        name: String,
+        /// What its name says it holds.
+        size: SceneSize,
+        /// The mesh's bytes.
+        bytes: u64,
+        /// The cap.
+        cap: u64,
+    },
+    /// A named scene's mesh and the bound on its oracle, from its name ([`check_named_scene`]).
+    #[error(
+        "scene {name}: its mesh ({} vertices, {} triangles) and its oracle (up to {} triangles \
+         over each of {lists} lists: {fragments} fragments of {BYTES_PER_FRAGMENT} bytes, plus \
+         {BYTES_PER_PIXEL} bytes a list) would need {bytes} bytes, over the memory cap of {cap} \
+         bytes (--memory-cap raises it)",
+        size.vertices,
+        size.triangles,
+        size.layers
+    )]
+    SceneAndOracle {
+        /// The scene's name.
+        name: String,
+        /// What its name says it holds.
+        size: SceneSize,
+        /// The lists (pixels, or samples) of the view.
+        lists: u64,
+        /// The bound on the oracle's fragments.
+        fragments: u64,
+        /// The bytes of the mesh and the oracle together.
+        bytes: u64,
+        /// The cap.
+        cap: u64,
+    },
+}
 
 /// Bytes of the oracle a pixel needs beside its fragments: offset, count, cursor.
 const BYTES_PER_PIXEL: u64 = 24;
@@ -95,19 +159,19 @@ fn triangle_bound(tri: &ScreenTriangle, width: u32, height: u32, slack: i64) -> 
 ///
 /// # Errors
 /// The bound on the oracle's bytes, with how it is made, over the cap.
-pub fn check(view: &View<'_>, cap: u64) -> Result<(), String> {
+pub fn check(view: &View<'_>, cap: u64) -> Result<(), MemoryCapError> {
     let fragments = fragments_at_most(view);
     let pixels = view.viewport().pixels() as u64;
     let bytes = fragments
         .saturating_mul(BYTES_PER_FRAGMENT)
         .saturating_add(pixels.saturating_mul(BYTES_PER_PIXEL));
     if bytes > cap {
-        return Err(format!(
-            "the oracle of this view would need up to {bytes} bytes (up to {fragments} fragments \
-             of {BYTES_PER_FRAGMENT} bytes, bounded from the screen triangles' areas, plus \
-             {BYTES_PER_PIXEL} bytes for each of {pixels} pixels), over the memory cap of {cap} \
-             bytes (--memory-cap raises it)"
-        ));
+        return Err(MemoryCapError::Oracle {
+            bytes,
+            fragments,
+            pixels,
+            cap,
+        });
     }
     Ok(())
 }
@@ -120,23 +184,18 @@ pub fn check(view: &View<'_>, cap: u64) -> Result<(), String> {
 /// # Errors
 /// The scene's mesh, or the mesh and the oracle's bound, over the cap: the bytes, how they are
 /// made, and the cap.
-pub fn check_named_scene(name: &str, lists: u64, cap: u64) -> Result<(), String> {
+pub fn check_named_scene(name: &str, lists: u64, cap: u64) -> Result<(), MemoryCapError> {
     let Ok(size) = Scene::procedural_size(name) else {
         return Ok(());
     };
     let mesh = size.mesh_bytes();
-    let over = |what: String, bytes: u64| {
-        format!(
-            "scene {name}: {what} would need {bytes} bytes, over the memory cap of {cap} bytes \
-             (--memory-cap raises it)"
-        )
-    };
-    let mesh_what = format!(
-        "its mesh ({} vertices, {} triangles)",
-        size.vertices, size.triangles
-    );
     if mesh > cap {
-        return Err(over(mesh_what, mesh));
+        return Err(MemoryCapError::SceneMesh {
+            name: name.into(),
+            size,
+            bytes: mesh,
+            cap,
+        });
     }
     let fragments = size.layers.saturating_mul(lists);
     let oracle = fragments
@@ -144,15 +203,14 @@ pub fn check_named_scene(name: &str, lists: u64, cap: u64) -> Result<(), String>
         .saturating_add(lists.saturating_mul(BYTES_PER_PIXEL));
     let total = mesh.saturating_add(oracle);
     if total > cap && mesh > cap / PRECISE_SHARE {
-        return Err(over(
-            format!(
-                "{mesh_what} and its oracle (up to {} triangles over each of {lists} lists: \
-                 {fragments} fragments of {BYTES_PER_FRAGMENT} bytes, plus {BYTES_PER_PIXEL} \
-                 bytes a list)",
-                size.layers
-            ),
-            total,
-        ));
+        return Err(MemoryCapError::SceneAndOracle {
+            name: name.into(),
+            size,
+            lists,
+            fragments,
+            bytes: total,
+            cap,
+        });
     }
     Ok(())
 }
@@ -186,15 +244,24 @@ mod tests {
     #[test]
     fn huge_named_scenes_are_refused_from_their_name_and_small_ones_pass() {
         let cap = 4 << 30;
-        let quads = check_named_scene("quads:1000000", 64 * 64, cap).unwrap_err();
+        let quads = check_named_scene("quads:1000000", 64 * 64, cap)
+            .unwrap_err()
+            .to_string();
         assert!(
             quads.contains("scene quads:1000000") && quads.contains("memory cap"),
             "{quads}"
         );
         let soup = check_named_scene("soup:10000000:1", 16 * 16, cap).unwrap_err();
-        assert!(soup.contains("10000000 triangles"), "{soup}");
+        assert!(
+            matches!(soup, MemoryCapError::SceneAndOracle { .. }),
+            "{soup:?}"
+        );
+        assert!(soup.to_string().contains("10000000 triangles"), "{soup}");
         // A mesh past the cap on its own, whatever the viewport.
-        assert!(check_named_scene("soup:10000000:1", 1, 64 << 20).is_err());
+        assert!(matches!(
+            check_named_scene("soup:10000000:1", 1, 64 << 20),
+            Err(MemoryCapError::SceneMesh { .. })
+        ));
         // The controls: the default soup at 1024 x 1024, whose name bound exceeds the cap but
         // whose mesh is small, is left to the bound from its triangles; 1000 quads fit.
         check_named_scene("soup:2000", 1024 * 1024, cap).unwrap();

@@ -21,6 +21,11 @@ use fragsim_raster::{SamplePattern, View, Viewport};
 
 use crate::Oracle;
 
+/// A view that does not rasterize per sample, given to [`SampleOracle::build`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the per-sample oracle needs a view rasterizing per sample (View::with_samples)")]
+pub struct UnsampledViewError;
+
 /// The exact per-sample fragment lists of a view rasterizing per sample.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SampleOracle {
@@ -34,10 +39,8 @@ impl SampleOracle {
     ///
     /// # Errors
     /// A view that does not rasterize per sample.
-    pub fn build(view: &View<'_>) -> Result<Self, String> {
-        let pattern = view.samples().ok_or(
-            "the per-sample oracle needs a view rasterizing per sample (View::with_samples)",
-        )?;
+    pub fn build(view: &View<'_>) -> Result<Self, UnsampledViewError> {
+        let pattern = view.samples().ok_or(UnsampledViewError)?;
         Ok(Self {
             pattern,
             pixels: view.pixel_viewport(),

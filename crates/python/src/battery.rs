@@ -17,7 +17,8 @@ use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::VertexPrecision;
 use fragsim_testkit::Case;
 use fragsim_testkit::{
-    Backend, BackendError, Battery, CatalogBackend, Failure, Input, Limits, Output, Params,
+    Backend, BackendError, Battery, CatalogBackend, Failure, GuaranteeError, Input, Limits, Output,
+    Params,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
@@ -54,7 +55,7 @@ impl Backend for PythonBackend<'_> {
     }
 
     /// The catalog scheme's own guarantee at these sizes (a claim of the caller's replaces it).
-    fn guarantee(&self, params: &Params) -> Result<Guarantee, String> {
+    fn guarantee(&self, params: &Params) -> Result<Guarantee, GuaranteeError> {
         CatalogBackend::on(Executor::Parallel).guarantee(params)
     }
 

@@ -166,7 +166,8 @@ impl SceneCore {
         let view = self.view(f32_stage)?;
         let size = (self.viewport.width, self.viewport.height);
         let reference = if dump.is_masked() {
-            let sampled = SampleOracle::build(&view).map_err(SceneError::new_err)?;
+            let sampled =
+                SampleOracle::build(&view).map_err(|e| SceneError::new_err(e.to_string()))?;
             let reference = Reference::masked(sampled.per_pixel(), size);
             if f32_stage {
                 let conventions = Conventions {
@@ -213,8 +214,9 @@ impl SceneCore {
     ) -> PyResult<Self> {
         let mut spec: SceneSpec = serde_json::from_str(spec_json)
             .map_err(|e| SceneError::new_err(format!("scene: {e}")))?;
-        spec.up = UpAxis::parse(up).map_err(SceneError::new_err)?;
-        let viewport = Viewport::new(width, height).map_err(SceneError::new_err)?;
+        spec.up = UpAxis::parse(up).map_err(|e| SceneError::new_err(e.to_string()))?;
+        let viewport =
+            Viewport::new(width, height).map_err(|e| SceneError::new_err(e.to_string()))?;
         let (scene, obj) = match (vertices, indices) {
             (Some(vertices), Some(indices)) => {
                 let rows = |shape: &[usize], what: &str| match shape {

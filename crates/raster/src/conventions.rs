@@ -22,7 +22,65 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::samples::SamplePattern;
+use crate::samples::{SampleError, SamplePattern};
+
+/// Why fragsim cannot rasterize a view under some conventions.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConventionsError {
+    /// Subpixel bits outside `1..=MAX_SUBPIXEL_BITS`.
+    #[error("{bits} subpixel bits: fragsim rasterizes with 1 to {MAX_SUBPIXEL_BITS}")]
+    SubpixelBits {
+        /// The bits declared.
+        bits: u32,
+    },
+    /// A sample count without a standard pattern.
+    #[error(
+        "conventions \"samples\" {samples}: the standard sample patterns have 1, 2, 4, 8 or 16 \
+         samples a pixel"
+    )]
+    Samples {
+        /// The count declared.
+        samples: u32,
+    },
+    /// Under f32 vertex precision, the view's vertex stage would leave f32's normal range.
+    #[error(transparent)]
+    F32Range(#[from] F32RangeError),
+    /// The sample-expanded framebuffer cannot be made (too wide).
+    #[error(transparent)]
+    Sampling(#[from] SampleError),
+}
+
+/// A view whose f32 vertex stage would leave f32's normal range
+/// ([`View::check_f32_range`](crate::View::check_f32_range)): the first entry of the
+/// view-projection matrix whose product with a vertex coordinate (or which, as a translation
+/// entry, alone) is nonzero and below `f32::MIN_POSITIVE` or above `f32::MAX` in magnitude.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "view_projection.row_major[{index}] is {entry:e}: under an f32 vertex stage its \
+     product{times} is {product:e}, outside f32's normal range ({min:e} to {max:e}; a GPU \
+     may flush subnormals to zero)",
+    times = factor_words(self.vertex),
+    min = f32::MIN_POSITIVE,
+    max = f32::MAX
+)]
+pub struct F32RangeError {
+    /// The entry's index, row by row.
+    pub index: usize,
+    /// The entry.
+    pub entry: f64,
+    /// The vertex whose coordinate the entry multiplies, and that coordinate's name (`x`, `y`
+    /// or `z`); `None` for a translation entry, which multiplies no coordinate.
+    pub vertex: Option<(usize, &'static str)>,
+    /// The product out of range (the entry itself for a translation entry).
+    pub product: f64,
+}
+
+/// The words naming the vertex coordinate an entry multiplies, for [`F32RangeError`]'s message.
+fn factor_words(vertex: Option<(usize, &str)>) -> String {
+    vertex.map_or(String::new(), |(v, axis)| {
+        format!(" times vertex {v}'s {axis}")
+    })
+}
 
 /// Where window row 0 lies, which decides which edge the fill rule gives a shared pixel centre.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -183,12 +241,11 @@ impl Conventions {
     /// # Errors
     /// Subpixel bits outside `1..=MAX_SUBPIXEL_BITS`, or a sample count without a standard
     /// pattern, by value and field name.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), ConventionsError> {
         if !(1..=MAX_SUBPIXEL_BITS).contains(&self.subpixel_bits) {
-            return Err(format!(
-                "{} subpixel bits: fragsim rasterizes with 1 to {MAX_SUBPIXEL_BITS}",
-                self.subpixel_bits
-            ));
+            return Err(ConventionsError::SubpixelBits {
+                bits: self.subpixel_bits,
+            });
         }
         self.pattern().map(|_| ())
     }
@@ -198,15 +255,12 @@ impl Conventions {
     ///
     /// # Errors
     /// A count other than 1, 2, 4, 8 or 16, naming the field `samples`.
-    pub fn pattern(&self) -> Result<Option<SamplePattern>, String> {
+    pub fn pattern(&self) -> Result<Option<SamplePattern>, ConventionsError> {
         match self.samples {
             1 => Ok(None),
-            n => SamplePattern::standard(n).map(Some).map_err(|_| {
-                format!(
-                    "conventions \"samples\" {n}: the standard sample patterns have 1, 2, 4, \
-                         8 or 16 samples a pixel"
-                )
-            }),
+            samples => SamplePattern::standard(samples)
+                .map(Some)
+                .map_err(|_| ConventionsError::Samples { samples }),
         }
     }
 }

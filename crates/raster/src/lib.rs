@@ -34,15 +34,18 @@ mod scenes;
 mod viewport;
 
 pub use camera::{Camera, OrbitCamera};
-pub use conventions::{Conventions, DepthRange, EdgeTies, VertexPrecision, WindowOrigin};
+pub use conventions::{
+    Conventions, ConventionsError, DepthRange, EdgeTies, F32RangeError, VertexPrecision,
+    WindowOrigin,
+};
 pub use fragment::{depth_from_key, depth_key, Fragment, EMPTY_KEY};
-pub use mesh::{Mesh, MeshError, UpAxis, MESH_BYTES_LIMIT};
+pub use mesh::{Mesh, MeshError, UpAxis, UpAxisError, MESH_BYTES_LIMIT};
 pub use pipeline::{
     edge_function, fill_thresholds, ClipOrigin, ClipTrace, Clipped, CullMode, ScreenTriangle,
     TriangleSetup, View, GUARD_BAND_PIXELS,
 };
 pub use rng::SplitMix64;
-pub use samples::SamplePattern;
+pub use samples::{SampleError, SamplePattern};
 pub use scene_spec::{mesh_hash, SceneSpec, SceneSpecError, ViewProjection};
 pub use scenes::{Scene, SceneError, SceneSize, DEFAULT_SCENE_NAME};
-pub use viewport::{PixelRect, Viewport, SUBPIXEL_BITS};
+pub use viewport::{PixelRect, Viewport, ViewportError, SUBPIXEL_BITS};

@@ -27,6 +27,14 @@ impl From<FileError> for MeshError {
     }
 }
 
+/// A name that is no up axis ([`UpAxis::parse`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{text:?} is not an axis: x, y, z, -x, -y or -z")]
+pub struct UpAxisError {
+    /// The text given.
+    pub text: String,
+}
+
 /// Why a mesh could not be loaded or used.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
@@ -189,7 +197,7 @@ impl Mesh {
         if text.contains('\0') {
             return Err(obj(not_text(text.as_bytes())));
         }
-        check_faces(&text).map_err(obj)?;
+        check_faces(&text).map_err(|e| obj(e.to_string()))?;
         let text = text.into_bytes();
         let (models, _materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |_| {
             // Materials are irrelevant to depth; an absent .mtl must not fail the load.
@@ -307,13 +315,13 @@ impl UpAxis {
     ///
     /// # Errors
     /// Any other text, with the names accepted.
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, UpAxisError> {
         let lower = text.trim().to_ascii_lowercase();
         let name = lower.strip_prefix('+').unwrap_or(&lower);
         Self::ALL
             .into_iter()
             .find(|axis| axis.name() == name)
-            .ok_or_else(|| format!("{text:?} is not an axis: x, y, z, -x, -y or -z"))
+            .ok_or_else(|| UpAxisError { text: text.into() })
     }
 
     /// The rotation turning this axis onto +y, row by row (`p' = R · p`): a quarter or half turn
@@ -415,6 +423,50 @@ fn not_text(bytes: &[u8]) -> String {
     )
 }
 
+/// A line of OBJ text that tobj would misread, or panic on, found by [`check_faces`]; lines
+/// numbered from 1. It becomes [`MeshError::Obj`]'s reason.
+#[derive(Debug, thiserror::Error)]
+enum ObjLineError {
+    /// A face of fewer than 3 vertices.
+    #[error("line {line}: a face needs at least 3 vertices, got {corners}")]
+    TooFewCorners { line: usize, corners: usize },
+    /// A face or line element refers to an element that is not defined (before it, for a
+    /// negative index).
+    #[error(
+        "line {line}: {element} refers to {kind} {index}, but {available} {kinds} are \
+         defined{whence}"
+    )]
+    IndexOutOfRange {
+        line: usize,
+        /// `a face` or `a line`.
+        element: &'static str,
+        /// `vertex`, `texture coordinate` or `normal`.
+        kind: &'static str,
+        index: i64,
+        available: usize,
+        /// `kind` in the plural.
+        kinds: &'static str,
+        /// ` before it` for a negative (relative) index, else empty.
+        whence: &'static str,
+    },
+    /// A `v`, `vt` or `vn` line with a word that is no `f32`.
+    #[error("line {line}: {what} parse error: {word:?} is not a number")]
+    NotANumber {
+        line: usize,
+        /// `position`, `texture coordinate` or `normal`.
+        what: &'static str,
+        word: String,
+    },
+    /// A `v` or `vn` line with fewer than 3 numbers.
+    #[error("line {line}: {what} parse error: needs 3 numbers, got {count}")]
+    TooFewNumbers {
+        line: usize,
+        /// `position` or `normal`.
+        what: &'static str,
+        count: usize,
+    },
+}
+
 /// Face checks made before tobj parses: a face of fewer than 3 vertices (tobj makes it a
 /// degenerate triangle), and every vertex, texture-coordinate and normal index of a face or line
 /// element in range. tobj drops references to attributes the file has none of, and its index
@@ -422,7 +474,7 @@ fn not_text(bytes: &[u8]) -> String {
 /// overflow checks are on, as in `cargo test`), so indices are bounded here first: positive ones
 /// by the file's total, negative (relative) ones by the elements defined before the line, as tobj
 /// resolves them. Parts that are not integers are left for tobj to reject.
-fn check_faces(text: &str) -> Result<(), String> {
+fn check_faces(text: &str) -> Result<(), ObjLineError> {
     const KINDS: [(&str, &str, &str); 3] = [
         ("v", "vertex", "vertices"),
         ("vt", "texture coordinate", "texture coordinates"),
@@ -441,7 +493,7 @@ fn check_faces(text: &str) -> Result<(), String> {
         let Some(tag) = words.next() else { continue };
         if let Some(k) = kind_of(tag) {
             before[k] += 1;
-            check_numbers(k, words).map_err(|e| format!("line {}: {e}", number + 1))?;
+            check_numbers(number + 1, k, words)?;
             continue;
         }
         if tag != "f" && tag != "l" {
@@ -449,11 +501,10 @@ fn check_faces(text: &str) -> Result<(), String> {
         }
         let corners: Vec<&str> = words.collect();
         if tag == "f" && corners.len() < 3 {
-            return Err(format!(
-                "line {}: a face needs at least 3 vertices, got {}",
-                number + 1,
-                corners.len()
-            ));
+            return Err(ObjLineError::TooFewCorners {
+                line: number + 1,
+                corners: corners.len(),
+            });
         }
         for corner in corners {
             for (k, part) in corner.split('/').take(3).enumerate() {
@@ -467,12 +518,15 @@ fn check_faces(text: &str) -> Result<(), String> {
                     (totals[k], "")
                 };
                 if index == 0 || index.unsigned_abs() > available as u64 {
-                    let element = if tag == "f" { "a face" } else { "a line" };
-                    return Err(format!(
-                        "line {}: {element} refers to {kind} {index}, \
-                         but {available} {kinds} are defined{whence}",
-                        number + 1
-                    ));
+                    return Err(ObjLineError::IndexOutOfRange {
+                        line: number + 1,
+                        element: if tag == "f" { "a face" } else { "a line" },
+                        kind,
+                        index,
+                        available,
+                        kinds,
+                        whence,
+                    });
                 }
             }
         }
@@ -481,20 +535,28 @@ fn check_faces(text: &str) -> Result<(), String> {
 }
 
 /// The numbers of a `v` (`k` = 0), `vt` (1) or `vn` (2) line, checked as tobj parses them (the
-/// first three as `f32`; positions and normals need three) so that the error can give the line,
-/// which tobj's does not.
-fn check_numbers<'a>(k: usize, words: impl Iterator<Item = &'a str>) -> Result<(), String> {
+/// first three as `f32`; positions and normals need three) so that the error can give the line
+/// (`line`, from 1), which tobj's does not.
+fn check_numbers<'a>(
+    line: usize,
+    k: usize,
+    words: impl Iterator<Item = &'a str>,
+) -> Result<(), ObjLineError> {
     const WHAT: [&str; 3] = ["position", "texture coordinate", "normal"];
     let numbers: Vec<&str> = words.take(3).collect();
     if let Some(word) = numbers.iter().find(|w| w.parse::<f32>().is_err()) {
-        return Err(format!("{} parse error: {word:?} is not a number", WHAT[k]));
+        return Err(ObjLineError::NotANumber {
+            line,
+            what: WHAT[k],
+            word: (*word).into(),
+        });
     }
     if k != 1 && numbers.len() < 3 {
-        return Err(format!(
-            "{} parse error: needs 3 numbers, got {}",
-            WHAT[k],
-            numbers.len()
-        ));
+        return Err(ObjLineError::TooFewNumbers {
+            line,
+            what: WHAT[k],
+            count: numbers.len(),
+        });
     }
     Ok(())
 }

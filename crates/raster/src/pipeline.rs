@@ -33,7 +33,7 @@
 use glam::{DMat4, DVec4};
 
 use crate::camera::Camera;
-use crate::conventions::{Conventions, VertexPrecision};
+use crate::conventions::{Conventions, ConventionsError, VertexPrecision};
 use crate::fragment::Fragment;
 use crate::mesh::Mesh;
 use crate::viewport::{PixelRect, Viewport, HALF, ONE, SUBPIXEL_BITS};
@@ -156,14 +156,14 @@ impl<'mesh> View<'mesh> {
         viewport: Viewport,
         cull: CullMode,
         conventions: Conventions,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ConventionsError> {
         conventions.check()?;
         let view = Self::build(mesh, camera, viewport, cull, conventions);
         if conventions.vertex_precision == VertexPrecision::F32 {
             view.check_f32_range()?;
         }
         match conventions.pattern()? {
-            Some(pattern) => view.with_samples(pattern),
+            Some(pattern) => Ok(view.with_samples(pattern)?),
             None => Ok(view),
         }
     }

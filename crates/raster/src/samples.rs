@@ -23,7 +23,53 @@
 //! pixel `(x, y)` is column `x * n + s`. Every consumer of a view (the oracle, every scheme, every
 //! executor, tiles included) then works per sample unchanged, with `n` times the storage.
 
-use crate::viewport::Viewport;
+use crate::viewport::{Viewport, ViewportError};
+
+/// Why a sample pattern, or the framebuffer it expands, could not be made.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SampleError {
+    /// No standard pattern has this many samples.
+    #[error("{count} samples per pixel: the standard patterns have 1, 2, 4, 8 or 16")]
+    NotStandard {
+        /// The count asked for.
+        count: u32,
+    },
+    /// A custom pattern of no position, or of more than 16.
+    #[error("{count} sample positions: a pattern has 1 to 16")]
+    PositionCount {
+        /// How many positions were given.
+        count: usize,
+    },
+    /// A custom position outside the pixel's 16 × 16 grid.
+    #[error("sample position {position:?}: coordinates are 0 to 15 (1/16 pixel)")]
+    OutsidePixel {
+        /// The position, in 1/16 pixel.
+        position: [u8; 2],
+    },
+    /// A custom position given twice.
+    #[error("sample position {position:?} is repeated")]
+    Repeated {
+        /// The position, in 1/16 pixel.
+        position: [u8; 2],
+    },
+    /// The sample-expanded framebuffer would be wider than [`Viewport::MAX_SIDE`].
+    #[error(
+        "{width} pixels wide at {samples} samples is {columns} sample columns, more than {max}",
+        max = Viewport::MAX_SIDE
+    )]
+    TooWide {
+        /// The viewport's width in pixels.
+        width: u32,
+        /// Samples a pixel.
+        samples: u32,
+        /// The expanded width in sample columns.
+        columns: u64,
+    },
+    /// The sample-expanded framebuffer is no viewport (a side of the pixels' viewport out of
+    /// range).
+    #[error(transparent)]
+    Viewport(#[from] ViewportError),
+}
 
 /// A fixed set of sample positions per pixel, each in 1/16 pixel from the pixel's upper-left
 /// corner (x right, y down).
@@ -78,18 +124,14 @@ impl SamplePattern {
     ///
     /// # Errors
     /// A count other than 1, 2, 4, 8 or 16, named in the message.
-    pub fn standard(count: u32) -> Result<Self, String> {
+    pub fn standard(count: u32) -> Result<Self, SampleError> {
         let positions: &'static [[u8; 2]] = match count {
             1 => &POSITIONS_1,
             2 => &POSITIONS_2,
             4 => &POSITIONS_4,
             8 => &POSITIONS_8,
             16 => &POSITIONS_16,
-            _ => {
-                return Err(format!(
-                    "{count} samples per pixel: the standard patterns have 1, 2, 4, 8 or 16"
-                ))
-            }
+            _ => return Err(SampleError::NotStandard { count }),
         };
         Ok(Self { positions })
     }
@@ -101,22 +143,19 @@ impl SamplePattern {
     ///
     /// # Errors
     /// No position or more than 16, a coordinate past 15, or a position repeated.
-    pub fn custom(positions: &'static [[u8; 2]]) -> Result<Self, String> {
+    pub fn custom(positions: &'static [[u8; 2]]) -> Result<Self, SampleError> {
         if positions.is_empty() || positions.len() > 16 {
-            return Err(format!(
-                "{} sample positions: a pattern has 1 to 16",
-                positions.len()
-            ));
+            return Err(SampleError::PositionCount {
+                count: positions.len(),
+            });
         }
-        if let Some(p) = positions.iter().find(|p| p[0] > 15 || p[1] > 15) {
-            return Err(format!(
-                "sample position {p:?}: coordinates are 0 to 15 (1/16 pixel)"
-            ));
+        if let Some(&position) = positions.iter().find(|p| p[0] > 15 || p[1] > 15) {
+            return Err(SampleError::OutsidePixel { position });
         }
         let mut sorted = positions.to_vec();
         sorted.sort_unstable();
         if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            return Err(format!("sample position {:?} is repeated", w[0]));
+            return Err(SampleError::Repeated { position: w[0] });
         }
         Ok(Self { positions })
     }
@@ -157,21 +196,18 @@ impl SamplePattern {
     /// The sample-expanded framebuffer of `pixels`: `count` columns a pixel.
     ///
     /// # Errors
-    /// An expanded width beyond [`Viewport::MAX_SIDE`].
-    pub fn expand(self, pixels: Viewport) -> Result<Viewport, String> {
-        let width = u64::from(pixels.width) * u64::from(self.count());
-        let width = u32::try_from(width)
+    /// An expanded width beyond [`Viewport::MAX_SIDE`] ([`SampleError::TooWide`]).
+    pub fn expand(self, pixels: Viewport) -> Result<Viewport, SampleError> {
+        let columns = u64::from(pixels.width) * u64::from(self.count());
+        let width = u32::try_from(columns)
             .ok()
             .filter(|&w| w <= Viewport::MAX_SIDE)
-            .ok_or_else(|| {
-                format!(
-                    "{} pixels wide at {} samples is {width} sample columns, more than {}",
-                    pixels.width,
-                    self.count(),
-                    Viewport::MAX_SIDE
-                )
+            .ok_or(SampleError::TooWide {
+                width: pixels.width,
+                samples: self.count(),
+                columns,
             })?;
-        Viewport::new(width, pixels.height)
+        Ok(Viewport::new(width, pixels.height)?)
     }
 }
 
@@ -203,8 +239,9 @@ mod tests {
         assert_eq!(SamplePattern::standard(1).unwrap(), SamplePattern::CENTRE);
         assert_eq!(SamplePattern::CENTRE.fixed_offset(0), [128, 128]);
         for bad in [0, 3, 32] {
-            let message = SamplePattern::standard(bad).unwrap_err();
-            assert!(message.contains(&bad.to_string()), "{message}");
+            let error = SamplePattern::standard(bad).unwrap_err();
+            assert_eq!(error, SampleError::NotStandard { count: bad });
+            assert!(error.to_string().contains(&bad.to_string()), "{error}");
         }
     }
 

@@ -5,11 +5,11 @@ use std::io::Read;
 use std::path::Path;
 
 use crate::camera::{Camera, OrbitCamera};
-use crate::conventions::{Conventions, DepthRange};
+use crate::conventions::{Conventions, ConventionsError, DepthRange};
 use crate::mesh::{is_ply, read_mesh_file, Mesh, MeshError, UpAxis};
 use crate::pipeline::{CullMode, View};
 use crate::rng::SplitMix64;
-use crate::viewport::Viewport;
+use crate::viewport::{Viewport, ViewportError};
 use glam::{DMat4, DVec4};
 
 /// The name of the embedded default scene.
@@ -37,8 +37,16 @@ pub enum SceneError {
         reason: String,
     },
     /// The viewport is invalid.
-    #[error("{0}")]
-    Viewport(String),
+    #[error(transparent)]
+    Viewport(#[from] ViewportError),
+    /// fragsim cannot rasterize the scene under the conventions asked for.
+    #[error("scene {name}: {source}")]
+    Conventions {
+        /// The scene.
+        name: String,
+        /// Why the conventions are refused.
+        source: ConventionsError,
+    },
 }
 
 /// A named mesh: what the pipeline renders.
@@ -227,8 +235,12 @@ impl Scene {
         if self.mesh.triangles.is_empty() {
             return Err(bad("no triangles".into()));
         }
-        View::with_conventions(&self.mesh, camera, viewport, CullMode::None, conventions)
-            .map_err(bad)
+        View::with_conventions(&self.mesh, camera, viewport, CullMode::None, conventions).map_err(
+            |source| SceneError::Conventions {
+                name: self.name.clone(),
+                source,
+            },
+        )
     }
 
     /// A warning when `view` (of this scene) rasterizes no fragment at all: every triangle lies

@@ -10,6 +10,16 @@ pub(crate) const ONE: i64 = 1 << SUBPIXEL_BITS;
 /// Half a pixel in grid units: where a pixel's centre lies from its corner.
 pub(crate) const HALF: i64 = ONE / 2;
 
+/// Why a viewport could not be made: a side out of range.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("viewport {side_name} must be between 1 and {max}, got {side}", max = Viewport::MAX_SIDE)]
+pub struct ViewportError {
+    /// `width` or `height`.
+    pub side_name: &'static str,
+    /// The side given.
+    pub side: u32,
+}
+
 /// The size of the render target in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Viewport {
@@ -26,14 +36,11 @@ impl Viewport {
     /// A viewport of `width × height` pixels.
     ///
     /// # Errors
-    /// A zero or larger than [`Viewport::MAX_SIDE`] side, named in the message.
-    pub fn new(width: u32, height: u32) -> Result<Self, String> {
-        for (name, side) in [("width", width), ("height", height)] {
+    /// A zero or larger than [`Viewport::MAX_SIDE`] side, by name.
+    pub fn new(width: u32, height: u32) -> Result<Self, ViewportError> {
+        for (side_name, side) in [("width", width), ("height", height)] {
             if side == 0 || side > Self::MAX_SIDE {
-                return Err(format!(
-                    "viewport {name} must be between 1 and {}, got {side}",
-                    Self::MAX_SIDE
-                ));
+                return Err(ViewportError { side_name, side });
             }
         }
         Ok(Self { width, height })

@@ -14,6 +14,30 @@
 
 use image::RgbImage;
 
+/// Why two images could not be compared.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum CompareError {
+    /// The images differ in size.
+    #[error("cannot compare a {candidate:?} image with a {reference:?} one")]
+    Sizes {
+        /// The reference's width and height.
+        reference: (u32, u32),
+        /// The candidate's width and height.
+        candidate: (u32, u32),
+    },
+    /// The images have no pixel.
+    #[error("cannot compare empty images")]
+    Empty,
+    /// The depth complexity is not one count a pixel.
+    #[error("{counts} depth-complexity counts for {pixels} pixels")]
+    DepthCounts {
+        /// The counts given.
+        counts: usize,
+        /// The images' pixels.
+        pixels: usize,
+    },
+}
+
 /// How far a candidate image is from the reference.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ColourError {
@@ -29,10 +53,13 @@ pub struct ColourError {
 ///
 /// # Errors
 /// The images differ in size, or are empty.
-pub fn colour_error(reference: &RgbImage, candidate: &RgbImage) -> Result<ColourError, String> {
+pub fn colour_error(
+    reference: &RgbImage,
+    candidate: &RgbImage,
+) -> Result<ColourError, CompareError> {
     check_sizes(reference, candidate)?;
     if reference.width() == 0 || reference.height() == 0 {
-        return Err("cannot compare empty images".into());
+        return Err(CompareError::Empty);
     }
     let mut sums = Sums::default();
     for (a, b) in reference.pixels().zip(candidate.pixels()) {
@@ -84,14 +111,14 @@ pub fn colour_error_by_depth(
     reference: &RgbImage,
     candidate: &RgbImage,
     depth_complexity: &[u32],
-) -> Result<Vec<BucketError>, String> {
+) -> Result<Vec<BucketError>, CompareError> {
     check_sizes(reference, candidate)?;
     let pixels = reference.width() as usize * reference.height() as usize;
     if depth_complexity.len() != pixels {
-        return Err(format!(
-            "{} depth-complexity counts for {pixels} pixels",
-            depth_complexity.len()
-        ));
+        return Err(CompareError::DepthCounts {
+            counts: depth_complexity.len(),
+            pixels,
+        });
     }
     let mut sums = [Sums::default(); DEPTH_BUCKETS.len()];
     for ((a, b), &n) in reference
@@ -119,15 +146,14 @@ pub fn colour_error_by_depth(
         .collect())
 }
 
-fn check_sizes(reference: &RgbImage, candidate: &RgbImage) -> Result<(), String> {
+fn check_sizes(reference: &RgbImage, candidate: &RgbImage) -> Result<(), CompareError> {
     if reference.dimensions() == candidate.dimensions() {
         return Ok(());
     }
-    Err(format!(
-        "cannot compare a {:?} image with a {:?} one",
-        candidate.dimensions(),
-        reference.dimensions()
-    ))
+    Err(CompareError::Sizes {
+        reference: reference.dimensions(),
+        candidate: candidate.dimensions(),
+    })
 }
 
 /// The running sums every figure is made of, over the pixels added so far.
@@ -200,11 +226,22 @@ mod tests {
         let small = RgbImage::new(1, 1);
         let wide = RgbImage::new(2, 1);
         let refused = colour_error(&small, &wide).unwrap_err();
+        assert_eq!(
+            refused,
+            CompareError::Sizes {
+                reference: (1, 1),
+                candidate: (2, 1)
+            }
+        );
+        let refused = refused.to_string();
         assert!(
             refused.contains("(2, 1)") && refused.contains("(1, 1)"),
             "{refused}"
         );
-        assert!(colour_error(&RgbImage::new(0, 0), &RgbImage::new(0, 0)).is_err());
+        assert_eq!(
+            colour_error(&RgbImage::new(0, 0), &RgbImage::new(0, 0)),
+            Err(CompareError::Empty)
+        );
     }
 
     /// Four pixels of 0, 1, 3 and 40 fragments, the one of 3 off by 6 in green: the bucket
@@ -226,7 +263,9 @@ mod tests {
         assert!(buckets[0].error.unwrap().psnr_db.is_infinite());
         assert!(buckets[5].error.unwrap().psnr_db.is_infinite());
         assert!(buckets[2].error.is_none());
-        let short = colour_error_by_depth(&reference, &candidate, &[1, 2]).unwrap_err();
+        let short = colour_error_by_depth(&reference, &candidate, &[1, 2])
+            .unwrap_err()
+            .to_string();
         assert!(
             short.contains("2 depth-complexity counts for 4 pixels"),
             "{short}"

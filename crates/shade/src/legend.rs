@@ -12,6 +12,8 @@ use image::{Rgb, RgbImage};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::DrawError;
+
 /// Width of the panel beside the picture, in pixels.
 const PANEL: u32 = 260;
 /// The least height of a figure: a panel's text needs it beside a small picture.
@@ -22,8 +24,8 @@ const MIN_HEIGHT: u32 = 300;
 fn figure(
     picture: &RgbImage,
     below: u32,
-    panel: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<RgbImage, String> {
+    panel: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), DrawError>,
+) -> Result<RgbImage, DrawError> {
     crate::plot::register_font();
     let (w, h) = picture.dimensions();
     let size = (w + PANEL, (h + below).max(MIN_HEIGHT));
@@ -34,7 +36,7 @@ fn figure(
     {
         let root = BitMapBackend::with_buffer(&mut out, size).into_drawing_area();
         panel(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(DrawError::from)?;
     }
     Ok(out)
 }
@@ -44,23 +46,23 @@ fn text<DB: DrawingBackend>(
     s: &str,
     at: (i32, i32),
     size: i32,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     area.draw(&Text::new(
         s.to_string(),
         at,
         ("sans-serif", size).into_font(),
     ))
-    .map_err(|e| e.to_string())
+    .map_err(DrawError::from)
 }
 
 fn fill<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     corners: [(i32, i32); 2],
     colour: Rgb<u8>,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     let [r, g, b] = colour.0;
     area.draw(&Rectangle::new(corners, RGBColor(r, g, b).filled()))
-        .map_err(|e| e.to_string())
+        .map_err(DrawError::from)
 }
 
 /// The depth-complexity heat map of `counts` with a colour bar: `scale_max` fixes the count
@@ -74,7 +76,7 @@ pub fn heat_map_with_bar(
     height: u32,
     counts: &[u32],
     scale_max: Option<u32>,
-) -> Result<RgbImage, String> {
+) -> Result<RgbImage, DrawError> {
     let max_seen = counts.iter().copied().max().unwrap_or(0);
     let top = scale_max.unwrap_or(max_seen).max(1);
     let picture = crate::heat_map_scaled(width, height, counts, top);
@@ -149,7 +151,7 @@ pub fn nearest_depth_with_key(
     width: u32,
     height: u32,
     nearest: &[Option<f32>],
-) -> Result<RgbImage, String> {
+) -> Result<RgbImage, DrawError> {
     let picture = crate::nearest_depth(width, height, nearest);
     let present = nearest.iter().flatten();
     let lo = present.clone().copied().fold(f32::INFINITY, f32::min);
@@ -168,7 +170,7 @@ pub fn nearest_depth_with_key(
             [(x0, bar_top), (x0 + 24, bar_bottom)],
             BLACK.stroke_width(1),
         ))
-        .map_err(|e| e.to_string())?;
+        .map_err(DrawError::from)?;
         let (near, far) = if lo.is_finite() {
             (
                 format!("near (white): {lo:.4}"),
@@ -193,7 +195,7 @@ pub fn nearest_depth_with_key(
 ///
 /// # Errors
 /// Text cannot be drawn (a font error).
-pub fn captioned(figure: &RgbImage, caption: &str) -> Result<RgbImage, String> {
+pub fn captioned(figure: &RgbImage, caption: &str) -> Result<RgbImage, DrawError> {
     const LINE: u32 = 17;
     // The embedded font's 13-pixel glyphs average under 7 pixels.
     let per_line = (figure.width().saturating_sub(12) / 7).max(16) as usize;
@@ -219,7 +221,7 @@ pub fn captioned(figure: &RgbImage, caption: &str) -> Result<RgbImage, String> {
         for (i, line) in lines.iter().enumerate() {
             text(&root, line, (6, (h + 4 + LINE * i as u32) as i32), 13)?;
         }
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(DrawError::from)?;
     }
     Ok(out)
 }
@@ -244,7 +246,7 @@ pub fn difference_figure(
     legend: &[(Rgb<u8>, String)],
     marks: &[(u32, u32)],
     ring: bool,
-) -> Result<RgbImage, String> {
+) -> Result<RgbImage, DrawError> {
     let side = (2 * INSET_RADIUS + 1) * INSET_ZOOM;
     let insets = marks.len().min(INSETS);
     let (w, h) = picture.dimensions();
@@ -266,7 +268,7 @@ pub fn difference_figure(
                 [(x0, y), (x0 + 16, y + 16)],
                 BLACK.stroke_width(1),
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(DrawError::from)?;
             text(area, meaning, (x0 + 22, y + 1), 13)?;
         }
         let note_y = 44 + 22 * legend.len() as i32;
@@ -288,7 +290,7 @@ pub fn difference_figure(
                     radius,
                     colour.stroke_width(stroke),
                 ))
-                .map_err(|e| e.to_string())?;
+                .map_err(DrawError::from)?;
             }
         }
         for (i, &(x, y)) in marks.iter().take(INSETS).enumerate() {
@@ -304,7 +306,7 @@ pub fn difference_figure(
                 [(left - 1, top - 1), (left + side as i32, top + side as i32)],
                 BLACK.stroke_width(1),
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(DrawError::from)?;
         }
         Ok(())
     })?;
@@ -358,7 +360,7 @@ pub const MARKS: usize = 16;
 pub fn effect_difference_figure(
     reference: &RgbImage,
     candidate: &RgbImage,
-) -> Result<RgbImage, String> {
+) -> Result<RgbImage, DrawError> {
     let picture = crate::effects::difference_image(reference, candidate);
     let differing: Vec<(u32, u32)> = reference
         .enumerate_pixels()

@@ -19,8 +19,11 @@ pub mod approximate;
 pub mod colour_error;
 pub mod deferred;
 pub mod effects;
+mod error;
 pub mod legend;
 pub mod plot;
+
+pub use error::{DrawError, SaveError};
 
 use image::{Rgb, RgbImage};
 
@@ -83,14 +86,17 @@ pub fn nearest_depth(width: u32, height: u32, nearest: &[Option<f32>]) -> RgbIma
 ///
 /// # Errors
 /// The directory or file could not be written.
-pub fn save_png(image: &RgbImage, path: &Path) -> Result<(), String> {
+pub fn save_png(image: &RgbImage, path: &Path) -> Result<(), SaveError> {
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|source| SaveError::CreateDir {
+            dir: dir.to_path_buf(),
+            source,
+        })?;
     }
-    image
-        .save(path)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    image.save(path).map_err(|source| SaveError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]

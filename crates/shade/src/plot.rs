@@ -11,6 +11,8 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::{DrawError, SaveError};
+
 mod speed_accuracy;
 
 pub use speed_accuracy::speed_accuracy;
@@ -239,7 +241,7 @@ pub fn chart(
     y_label: &str,
     series: &[Series],
     scatter: bool,
-) -> Result<(), String> {
+) -> Result<(), SaveError> {
     chart_with_ticks(path, (title, x_label, y_label), series, scatter, None)
 }
 
@@ -254,7 +256,7 @@ pub fn chart_with_ticks(
     series: &[Series],
     scatter: bool,
     ticks: Option<&[String]>,
-) -> Result<(), String> {
+) -> Result<(), SaveError> {
     let lines = Lines {
         labels,
         series,
@@ -285,13 +287,18 @@ impl Paint for Lines<'_> {
 
 /// Draws `picture` into a PNG file (a path ending in `.png`) or an SVG file (any other) of
 /// `size` pixels, creating its directory.
-fn render(path: &Path, size: (u32, u32), picture: &impl Paint) -> Result<(), String> {
+fn render(path: &Path, size: (u32, u32), picture: &impl Paint) -> Result<(), SaveError> {
     register_font();
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|source| SaveError::CreateDir {
+            dir: dir.to_path_buf(),
+            source,
+        })?;
     }
-    let error = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
+    let error = |source: DrawError| SaveError::Draw {
+        path: path.to_path_buf(),
+        source,
+    };
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"))
@@ -299,15 +306,18 @@ fn render(path: &Path, size: (u32, u32), picture: &impl Paint) -> Result<(), Str
         let mut bytes = vec![0_u8; size.0 as usize * size.1 as usize * 3];
         {
             let root = BitMapBackend::with_buffer(&mut bytes, size).into_drawing_area();
-            picture.paint(&root).map_err(|e| error(&e))?;
+            picture.paint(&root).map_err(|e| error(e.into()))?;
         }
         image::RgbImage::from_raw(size.0, size.1, bytes)
             .expect("the buffer is the chart's size")
             .save(path)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))
+            .map_err(|source| SaveError::Write {
+                path: path.to_path_buf(),
+                source,
+            })
     } else {
         let root = SVGBackend::new(path, size).into_drawing_area();
-        picture.paint(&root).map_err(|e| error(&e))
+        picture.paint(&root).map_err(|e| error(e.into()))
     }
 }
 

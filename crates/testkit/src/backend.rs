@@ -9,7 +9,7 @@
 use fragsim_capture::catalog::{Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing};
 use fragsim_capture::executors::scheduled::run_scheduled;
 use fragsim_capture::executors::Executor;
-use fragsim_capture::{Capture, Guarantee, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim_capture::{Capture, CaptureError, Guarantee, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim_oracle::dump::Dump;
 use fragsim_raster::{VertexPrecision, View, Viewport};
 
@@ -65,6 +65,23 @@ impl std::fmt::Display for BackendError {
     }
 }
 
+/// Why a backend cannot run some parameters ([`Backend::guarantee`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum GuaranteeError {
+    /// The catalog scheme cannot be built at these sizes.
+    #[error("{scheme}: {source}")]
+    Build {
+        /// The scheme.
+        scheme: SchemeName,
+        /// Why it cannot be built.
+        source: CaptureError,
+    },
+    /// The backend cannot run the scheme, for a reason of its own (a GPU without a feature the
+    /// scheme needs), in its words.
+    #[error("{0}")]
+    Unsupported(String),
+}
+
 /// A backend under test.
 pub trait Backend {
     /// A short description for reports.
@@ -75,7 +92,7 @@ pub trait Backend {
     ///
     /// # Errors
     /// The backend cannot run `params` (a size the scheme rejects).
-    fn guarantee(&self, params: &Params) -> Result<Guarantee, String>;
+    fn guarantee(&self, params: &Params) -> Result<Guarantee, GuaranteeError>;
 
     /// Whether the backend runs each pixel's fragments one at a time in primitive order (then
     /// the guarantees that exclude hazards are owed). `false` for a GPU.
@@ -162,10 +179,13 @@ impl Backend for CatalogBackend {
         format!("fragsim's catalog on the {} executor", self.executor.name())
     }
 
-    fn guarantee(&self, params: &Params) -> Result<Guarantee, String> {
+    fn guarantee(&self, params: &Params) -> Result<Guarantee, GuaranteeError> {
         // The guarantee of the scheme built at these sizes on one pixel (the sizes decide it:
         // a capacity is part of `exact-within-capacity`).
-        let one = Viewport::new(1, 1).map_err(|e| e.to_string())?;
+        let one = Viewport {
+            width: 1,
+            height: 1,
+        };
         let build = Build {
             counts: Some(&[1]),
             ..Build::fixed(one, params.k, params.capacity, 1, MEMORY_CAP_DEFAULT)
@@ -173,7 +193,10 @@ impl Backend for CatalogBackend {
         params
             .scheme
             .build(&build, GuaranteeOf)
-            .map_err(|e| format!("{}: {e}", params.scheme))
+            .map_err(|source| GuaranteeError::Build {
+                scheme: params.scheme,
+                source,
+            })
     }
 
     fn serialises_pixels(&self) -> bool {
@@ -186,7 +209,7 @@ impl Backend for CatalogBackend {
         if self.executor != Executor::Scheduled {
             let run = SchemeRunner::default()
                 .run(params.scheme, self.executor, input.view, &sizing)
-                .map_err(BackendError::Setup)?;
+                .map_err(|e| BackendError::Setup(e.to_string()))?;
             return Ok(Output::Capture(run.run.capture));
         }
         let entry = params.scheme.entry();

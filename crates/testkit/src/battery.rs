@@ -334,7 +334,7 @@ impl<'b> Battery<'b> {
             None => self
                 .backend
                 .guarantee(&self.params)
-                .map_err(Failure::Refused)?,
+                .map_err(|e| Failure::Refused(e.to_string()))?,
         };
         if claim.merges_equal_depths() {
             return Err(Failure::Refused(format!(
@@ -573,7 +573,7 @@ impl<'b> Battery<'b> {
             BackendError::Failed(message) => found(Property::Runs, message, None, fragments),
         })?;
         let comparison = judge(&view, &oracle, &output, self.backend.vertex_precision())
-            .map_err(|e| found(Property::Runs, e, None, fragments))?;
+            .map_err(|e| found(Property::Runs, e.to_string(), None, fragments))?;
         // The verdict judges the counters too (a pixel whose counter claims an overflow no
         // conforming run has is overflow-miscounted): where that is its only error, the broken
         // property is the overflow. Under precision a counter may count a fragment the

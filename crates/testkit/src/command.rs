@@ -22,12 +22,12 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use fragsim_capture::Guarantee;
-use fragsim_oracle::dump::Dump;
+use fragsim_oracle::dump::{Dump, DumpError};
 use fragsim_oracle::triangles::TriangleExport;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::{VertexPrecision, View};
 
-use crate::backend::{Backend, BackendError, Input, Output, Params};
+use crate::backend::{Backend, BackendError, GuaranteeError, Input, Output, Params};
 use crate::case::Case;
 
 /// The exit status `sh` gives a command it cannot find or run.
@@ -56,27 +56,60 @@ fn quoted(path: &Path) -> String {
     format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
 }
 
+/// Why a case could not be written for a command ([`write_case`]).
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    /// A file of the case could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The case's directory could not be made absolute (it does not exist, say).
+    #[error("{}: {source}", path.display())]
+    Directory {
+        /// The directory.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The scene and camera could not be serialised.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// The triangle export could not be written.
+    #[error(transparent)]
+    Export(#[from] DumpError),
+}
+
 /// Writes `case` (its view `view`, to be run with `params`) into `dir`, which must exist:
 /// `scene.tri`, `mesh.obj`, `camera.json`, `case.json` (see the module docs). The scene object
 /// names the mesh by its absolute path, so the files can be read from anywhere.
 ///
 /// # Errors
 /// A file that cannot be written.
-pub fn write_case(case: &Case, view: &View<'_>, params: &Params, dir: &Path) -> Result<(), String> {
+pub fn write_case(
+    case: &Case,
+    view: &View<'_>,
+    params: &Params,
+    dir: &Path,
+) -> Result<(), CaseError> {
     let write = |name: &str, bytes: &[u8]| {
         let path = dir.join(name);
-        fs::write(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+        fs::write(&path, bytes).map_err(|source| CaseError::Write { path, source })
     };
     let obj = case.obj();
     write("mesh.obj", obj.as_bytes())?;
-    let dir = fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let dir = fs::canonicalize(dir).map_err(|source| CaseError::Directory {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let mesh = dir.join("mesh.obj");
     let scene = Case::scene_and_camera(&mesh.display().to_string(), mesh_hash(obj.as_bytes()));
-    let camera = serde_json::to_string_pretty(&scene).map_err(|e| e.to_string())?;
+    let camera = serde_json::to_string_pretty(&scene)?;
     write("camera.json", camera.as_bytes())?;
-    TriangleExport::from_view(view, scene)
-        .write(&dir.join("scene.tri"))
-        .map_err(|e| e.to_string())?;
+    TriangleExport::from_view(view, scene).write(&dir.join("scene.tri"))?;
     let about = serde_json::json!({
         "width": case.viewport.width,
         "height": case.viewport.height,
@@ -116,7 +149,8 @@ impl CommandBackend {
         for d in [&scene, &out] {
             fs::create_dir_all(d).map_err(|e| setup(format!("{}: {e}", d.display())))?;
         }
-        write_case(input.case, input.view, input.params, &scene).map_err(setup)?;
+        write_case(input.case, input.view, input.params, &scene)
+            .map_err(|e| setup(e.to_string()))?;
         let line = self.command_line(
             &fs::canonicalize(&scene).map_err(|e| setup(e.to_string()))?,
             &fs::canonicalize(&out).map_err(|e| setup(e.to_string()))?,
@@ -214,7 +248,7 @@ impl Backend for CommandBackend {
     }
 
     /// Exactness under the scheme's promise: what `fragsim compare` holds a dump to.
-    fn guarantee(&self, _: &Params) -> Result<Guarantee, String> {
+    fn guarantee(&self, _: &Params) -> Result<Guarantee, GuaranteeError> {
         Ok(Guarantee::Exact)
     }
 

@@ -10,7 +10,7 @@
 //! every word is checked against its layout; a capture has no words to check.
 
 use fragsim_oracle::compare::Comparison;
-use fragsim_oracle::verdict::{self, Candidate, Options, Reference};
+use fragsim_oracle::verdict::{self, Candidate, Options, Reference, VerdictError};
 use fragsim_oracle::Oracle;
 use fragsim_raster::{VertexPrecision, View};
 
@@ -24,13 +24,13 @@ pub const EXAMPLES: usize = 4;
 /// `view`).
 ///
 /// # Errors
-/// A capture or dump of another viewport, or a dump that cannot be decoded (its message).
+/// A capture or dump of another viewport, or a dump that cannot be decoded.
 pub fn judge(
     view: &View<'_>,
     oracle: &Oracle,
     output: &Output,
     vertex_precision: VertexPrecision,
-) -> Result<Comparison, String> {
+) -> Result<Comparison, VerdictError> {
     let reference = Reference::of_view(oracle, view, vertex_precision);
     let candidate = match output {
         Output::Capture(capture) => Candidate::Capture(capture),

@@ -36,7 +36,7 @@ pub mod command;
 pub mod judge;
 pub mod strategies;
 
-pub use backend::{Backend, BackendError, CatalogBackend, Input, Output, Params};
+pub use backend::{Backend, BackendError, CatalogBackend, GuaranteeError, Input, Output, Params};
 pub use battery::{Battery, Counterexample, Event, Exercised, Failure, Passed, Property};
 pub use case::{Case, CaseTriangle, Limits};
 pub use command::CommandBackend;

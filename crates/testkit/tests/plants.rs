@@ -17,8 +17,8 @@ use fragsim_oracle::dump::{Dump, DumpScheme, Words};
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_testkit::{
-    Backend, BackendError, Battery, Case, Exercised, Failure, Input, Limits, Output, Params,
-    Property,
+    Backend, BackendError, Battery, Case, Exercised, Failure, GuaranteeError, Input, Limits,
+    Output, Params, Property,
 };
 
 /// A bug planted in [`UserABuffer`].
@@ -63,7 +63,7 @@ impl Backend for UserABuffer {
         format!("a user's A-buffer, planted {:?}", self.plant)
     }
 
-    fn guarantee(&self, _: &Params) -> Result<Guarantee, String> {
+    fn guarantee(&self, _: &Params) -> Result<Guarantee, GuaranteeError> {
         Ok(Guarantee::Exact)
     }
 
@@ -222,7 +222,7 @@ impl Backend for Failing {
         "a failing backend".into()
     }
 
-    fn guarantee(&self, _: &Params) -> Result<Guarantee, String> {
+    fn guarantee(&self, _: &Params) -> Result<Guarantee, GuaranteeError> {
         Ok(Guarantee::Exact)
     }
 

@@ -73,7 +73,7 @@ fn a_16384_square_viewport_beyond_the_memory_cap_is_refused_naming_the_bytes() {
         abuffer.layout().least_bytes(),
     );
     // One more pixel per side is refused by the viewport itself.
-    let err = Viewport::new(side + 1, 1).unwrap_err();
+    let err = Viewport::new(side + 1, 1).unwrap_err().to_string();
     assert!(err.contains("16384"), "{err}");
 }
 

@@ -194,7 +194,7 @@ proptest! {
                 let mut run = |executor| {
                     runner
                         .run(entry.scheme, executor, view, sizing)
-                        .map_err(TestCaseError::fail)
+                        .map_err(|e| TestCaseError::fail(e.to_string()))
                 };
                 let (serial, tiled) = (run(Executor::Serial)?.run, run(Executor::Tiled)?.run);
                 prop_assert!(serial.capture == tiled.capture, "{}", entry.name);

@@ -9,9 +9,36 @@ use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use crate::primitive_order::PrimitiveOrder;
-use crate::{Descriptor, Guarantee, Memory, Scheme, Step, WordMemory};
+use crate::{CaptureError, Descriptor, Guarantee, Memory, Scheme, Step, WordMemory};
 use fragsim_raster::{Fragment, View, Viewport};
 use std::sync::Mutex;
+
+/// Why a catalog scheme could not be run ([`SchemeRunner::run`]) or is refused before any run
+/// ([`check_memory_cap_early`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RunError {
+    /// The scheme cannot be built at its sizes (a parameter out of range, or its tables over
+    /// the memory cap).
+    #[error(transparent)]
+    Build(#[from] CaptureError),
+    /// Sized to the scene, the scheme is over the memory cap even at one slot a pixel, before
+    /// any counting pass sizes it.
+    #[error("{0} (at least: sized to the scene, it needs one slot per pixel or more)")]
+    OverCapAtLeast(CaptureError),
+    /// The frame's writes reached more pages of storage than the memory cap allows.
+    #[error(
+        "{scheme} needed more than the memory cap of {cap} bytes of per-pixel storage: its frame \
+         allocated {allocated} bytes and its writes reached more pages (--memory-cap raises it)"
+    )]
+    FrameOverCap {
+        /// The scheme.
+        scheme: String,
+        /// The cap.
+        cap: u64,
+        /// The bytes the frame allocated.
+        allocated: u64,
+    },
+}
 
 /// A finished run of a named scheme.
 #[derive(Debug, Clone)]
@@ -95,7 +122,7 @@ impl SchemeRunner {
         executor: Executor,
         view: &View<'_>,
         sizing: &Sizing,
-    ) -> Result<NamedRun, String> {
+    ) -> Result<NamedRun, RunError> {
         let viewport = view.viewport();
         for cap in [
             &mut self.serial.memory_cap,
@@ -139,31 +166,29 @@ impl SchemeRunner {
             counts: counted.as_ref().map(|c| c.counts.as_slice()),
             order: order.as_ref(),
         };
-        let mut named = name
-            .build(
-                &build,
-                RunOn {
-                    runner: self,
-                    executor,
-                    view,
-                    sizes: Build {
-                        counts: None,
-                        order: None,
-                        ..build
-                    },
+        let mut named = name.build(
+            &build,
+            RunOn {
+                runner: self,
+                executor,
+                view,
+                sizes: Build {
+                    counts: None,
+                    order: None,
+                    ..build
                 },
-            )
-            .map_err(|e| e.to_string())?;
+            },
+        )?;
         if let Some(counted) = counted {
             named.run = named.run.after_count_pass(&counted.run);
             named.counts = Some(counted.counts);
         }
         if named.run.stats.over_cap {
-            return Err(format!(
-                "{} needed more than the memory cap of {} bytes of per-pixel storage: its frame \
-                 allocated {} bytes and its writes reached more pages (--memory-cap raises it)",
-                named.name, sizing.memory_cap, named.run.stats.allocated_bytes
-            ));
+            return Err(RunError::FrameOverCap {
+                scheme: named.name,
+                cap: sizing.memory_cap,
+                allocated: named.run.stats.allocated_bytes,
+            });
         }
         Ok(named)
     }
@@ -186,7 +211,7 @@ pub fn check_memory_cap_early(
     names: &[SchemeName],
     viewport: Viewport,
     sizing: &Sizing,
-) -> Result<(), String> {
+) -> Result<(), RunError> {
     let smallest = |count: Count| match count {
         Count::Auto => 1,
         Count::Fixed(n) => n,
@@ -208,11 +233,9 @@ pub fn check_memory_cap_early(
         let result = name.build(&least, Unused);
         if let Err(error) = result {
             return Err(if name.needs_count_pass(sizing) {
-                format!(
-                    "{error} (at least: sized to the scene, it needs one slot per pixel or more)"
-                )
+                RunError::OverCapAtLeast(error)
             } else {
-                error.to_string()
+                RunError::Build(error)
             });
         }
     }

@@ -335,7 +335,7 @@ impl MaskedABuffer {
     /// # Errors
     /// A view that does not rasterize per sample at this scheme's sample count, or on another
     /// number of pixels.
-    pub fn capture(&self, view: &View<'_>, parallel: bool) -> Result<MaskedLists, String> {
+    pub fn capture(&self, view: &View<'_>, parallel: bool) -> Result<MaskedLists, CaptureError> {
         self.frame(view, parallel).map(|frame| frame.lists)
     }
 
@@ -344,7 +344,7 @@ impl MaskedABuffer {
     ///
     /// # Errors
     /// As [`MaskedABuffer::capture`].
-    pub fn frame(&self, view: &View<'_>, parallel: bool) -> Result<MaskedFrame, String> {
+    pub fn frame(&self, view: &View<'_>, parallel: bool) -> Result<MaskedFrame, CaptureError> {
         self.check_view(view)?;
         let layout = self.layout();
         let start = Instant::now();
@@ -378,18 +378,17 @@ impl MaskedABuffer {
     }
 
     /// Refuses a view of another pixel count or sample count than this scheme's.
-    fn check_view(&self, view: &View<'_>) -> Result<(), String> {
+    fn check_view(&self, view: &View<'_>) -> Result<(), CaptureError> {
         if view.samples().map(|p| p.count()) != Some(self.samples)
             || view.pixel_viewport().pixels() != self.pixels
         {
-            return Err(format!(
-                "{} was built for {} pixels at {} samples, the view is {} pixels at {} samples",
-                self.name(),
-                self.pixels,
-                self.samples,
-                view.pixel_viewport().pixels(),
-                view.samples().map_or(1, |p| p.count())
-            ));
+            return Err(CaptureError::OtherView {
+                scheme: self.name().into(),
+                pixels: self.pixels,
+                samples: self.samples,
+                view_pixels: view.pixel_viewport().pixels(),
+                view_samples: view.samples().map_or(1, |p| p.count()),
+            });
         }
         Ok(())
     }
@@ -400,7 +399,7 @@ impl MaskedABuffer {
     ///
     /// # Errors
     /// As [`MaskedABuffer::capture`].
-    pub fn insert_all<M: Memory>(&self, view: &View<'_>, memory: &M) -> Result<u64, String> {
+    pub fn insert_all<M: Memory>(&self, view: &View<'_>, memory: &M) -> Result<u64, CaptureError> {
         self.check_view(view)?;
         let mut scratch = Vec::new();
         Ok((0..view.triangle_count())
@@ -420,8 +419,8 @@ impl MaskedABuffer {
         samples: u32,
         view: &View<'_>,
         parallel: bool,
-    ) -> Result<MaskedFrame, String> {
-        let mut counter = Self::new(pixels, samples, 1, u64::MAX).map_err(|e| e.to_string())?;
+    ) -> Result<MaskedFrame, CaptureError> {
+        let mut counter = Self::new(pixels, samples, 1, u64::MAX)?;
         // Capacity 0, which `new` refuses for a capture: every insertion only counts.
         counter.storage = MaskedStorage::Slots(0);
         counter.frame(view, parallel)

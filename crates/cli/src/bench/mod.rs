@@ -283,7 +283,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     let pool = args.schemes.pool()?;
     let spec = args.scene.spec(Conventions::REFERENCE);
     let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport()?;
+    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
     let orbit = spec.orbit();
     let frames = args.frames as usize;
     // The camera depends on the model's bounds, a per-scene constant (a GPU application computes
@@ -299,14 +299,14 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     crate::args::warn_if_empty(&scene, &view);
     let sizing = args.schemes.sizing();
     let schemes = SchemeChoice::expand(&args.scheme);
-    check_memory_cap_early(&schemes, viewport, &sizing)?;
+    check_memory_cap_early(&schemes, viewport, &sizing).map_err(|e| e.to_string())?;
     if let Some(pattern) = pattern {
         crate::multisampled::check_early(&view, pattern, &schemes, &sizing)?;
     }
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
-    crate::oracle_memory::check(&view, sizing.memory_cap)?;
+    crate::oracle_memory::check(&view, sizing.memory_cap).map_err(|e| e.to_string())?;
     let oracle = Oracle::build(&view);
     let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
     crate::approximate::check_effect(&judge, &args.approximate)?;
@@ -345,13 +345,17 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             };
             let (named, times) =
                 time_frames(&mut view, &camera, frame_pool, frames, &progress, |view| {
-                    let named = pool.install(|| runner.run(name, executor, view, &sizing))?;
+                    let named = pool
+                        .install(|| runner.run(name, executor, view, &sizing))
+                        .map_err(|e| e.to_string())?;
                     let stats = &named.run.stats;
                     let (pass_time, resolve_time) = (stats.pass_time, stats.resolve_time);
                     Ok((named, pass_time, resolve_time))
                 })?;
             runner.count_locked_ops = true;
-            let counted = pool.install(|| runner.run(name, executor, &view, &sizing))?;
+            let counted = pool
+                .install(|| runner.run(name, executor, &view, &sizing))
+                .map_err(|e| e.to_string())?;
             progress.inc(1);
             let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
             let RunVerdict { diff, kept, .. } = judge_run(

@@ -140,6 +140,7 @@ fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<
         "median frame time (ms, log scale)",
         &points,
     )
+    .map_err(|e| e.to_string())
 }
 
 /// What bench.md's columns mean, printed under the table.

@@ -110,7 +110,7 @@ impl Header {
     /// # Errors
     /// A zero or oversized side.
     pub fn pixel_viewport(&self) -> Result<Viewport, DumpError> {
-        Viewport::new(self.width, self.height).map_err(DumpError::Invalid)
+        Viewport::new(self.width, self.height).map_err(|e| DumpError::Invalid(e.to_string()))
     }
 
     /// Samples a pixel (`scene.conventions.samples`, 1 when absent).
@@ -121,7 +121,7 @@ impl Header {
         self.scene
             .conventions
             .pattern()
-            .map_err(DumpError::Invalid)?;
+            .map_err(|e| DumpError::Invalid(e.to_string()))?;
         Ok(self.scene.conventions.samples)
     }
 
@@ -140,8 +140,14 @@ impl Header {
         scene: &SceneSpec,
         pixels: Viewport,
     ) -> Result<Viewport, DumpError> {
-        match scene.conventions.pattern().map_err(DumpError::Invalid)? {
-            Some(pattern) => pattern.expand(pixels).map_err(DumpError::Invalid),
+        let pattern = scene
+            .conventions
+            .pattern()
+            .map_err(|e| DumpError::Invalid(e.to_string()))?;
+        match pattern {
+            Some(pattern) => pattern
+                .expand(pixels)
+                .map_err(|e| DumpError::Invalid(e.to_string())),
             None => Ok(pixels),
         }
     }

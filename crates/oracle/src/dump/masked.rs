@@ -466,7 +466,8 @@ impl Dump {
         let memory: SerialMemory = scheme.layout().allocate();
         scheme
             .insert_all(view, &memory)
-            .map_err(DumpError::Invalid)?;
+            // The view's sample count was checked above: a refusal here is the dump's to report.
+            .map_err(|e| DumpError::Invalid(e.to_string()))?;
         let n = pixels.pixels();
         let u32s: Vec<u32> = (0..WordMemory::<u32>::len(&memory))
             .map(|i| WordMemory::<u32>::load(&memory, i))

@@ -1,12 +1,17 @@
 //! Why a verdict could not be given: the sides do not describe the same thing, or one of them
 //! cannot be read. A verdict that is given is never an error, whatever it says.
 
+use fragsim_raster::{F32RangeError, ViewportError};
+
 use crate::dump::{DumpError, MASKED_SCHEME};
+use crate::memory_cap::MemoryCapError;
+use crate::samples::UnsampledViewError;
 
 /// Why [`super::judge`] or [`super::judge_sides`] gave no verdict. Each message names what is at
 /// fault; callers branch on the kind (a dump that cannot be decoded is the backend's or the
 /// header's, sides that do not match are the command line's).
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+// No `Eq`: an f32 range error carries the f64 entry and product it names.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum VerdictError {
     /// A dump could not be read or decoded, or its scene rebuilt.
     #[error(transparent)]
@@ -68,13 +73,19 @@ pub enum VerdictError {
          derive bounds from"
     )]
     F32NeedsOracle,
-    /// The view a dump names cannot be built (its viewport, its sample pattern).
-    #[error("{0}")]
-    View(String),
+    /// The viewport a dump names is no viewport.
+    #[error(transparent)]
+    DumpViewport(#[from] ViewportError),
+    /// The scene's f32 vertex stage, judged, would leave f32's normal range.
+    #[error("scene: {0}")]
+    F32Range(#[from] F32RangeError),
+    /// The per-sample oracle asked of a view that does not rasterize per sample.
+    #[error(transparent)]
+    Unsampled(#[from] UnsampledViewError),
     /// The reference (the scene a dump names, its oracle's lists) would need more memory than
     /// the cap allows: refused before it is built, the message naming the bound and the cap.
-    #[error("{0}")]
-    MemoryCap(String),
+    #[error(transparent)]
+    MemoryCap(#[from] MemoryCapError),
 }
 
 impl From<VerdictError> for String {

@@ -192,7 +192,7 @@ pub fn judge_sides(
         (needs_oracle, options.memory_cap, &spec.name, &spec.mesh)
     {
         let lists = header.framebuffer()?.pixels() as u64;
-        crate::memory_cap::check_named_scene(name, lists, cap).map_err(VerdictError::MemoryCap)?;
+        crate::memory_cap::check_named_scene(name, lists, cap)?;
     }
     let loaded = if needs_oracle {
         Some(spec.load(Some(&beside)).map_err(DumpError::from)?)
@@ -201,24 +201,22 @@ pub fn judge_sides(
     };
     let view = match &loaded {
         Some(loaded) => {
-            let viewport =
-                Viewport::new(header.width, header.height).map_err(VerdictError::View)?;
+            let viewport = Viewport::new(header.width, header.height)?;
             Some(spec.view(loaded, viewport).map_err(DumpError::from)?)
         }
         None => None,
     };
     if let (true, Some(view)) = (judged_f32, &view) {
         // The f32 stage judged is not the view's (f64 here): its range is checked all the same.
-        view.check_f32_range()
-            .map_err(|e| VerdictError::View(format!("scene: {e}")))?;
+        view.check_f32_range()?;
     }
     if let (Some(view), Some(cap)) = (&view, options.memory_cap) {
-        crate::memory_cap::check(view, cap).map_err(VerdictError::MemoryCap)?;
+        crate::memory_cap::check(view, cap)?;
     }
     let oracle = match &view {
         None => None,
         Some(view) if masked => {
-            let sampled = SampleOracle::build(view).map_err(VerdictError::View)?;
+            let sampled = SampleOracle::build(view)?;
             let reference = Reference::masked(sampled.per_pixel(), size);
             Some(if judged_f32 {
                 // The exact per-sample oracle (the view's vertex stage is f64 here) and the

@@ -370,6 +370,10 @@ fn subpixel_bits_outside_the_grid_are_refused() {
         let conventions = with(|c| c.subpixel_bits = bits);
         let error = View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions)
             .unwrap_err();
-        assert!(error.contains(&format!("{bits} subpixel bits")), "{error}");
+        assert_eq!(error, ConventionsError::SubpixelBits { bits });
+        assert!(
+            error.to_string().contains(&format!("{bits} subpixel bits")),
+            "{error}"
+        );
     }
 }

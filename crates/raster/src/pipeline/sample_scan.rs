@@ -14,7 +14,7 @@
 use super::edges::{bounding_box, edge, fill_thresholds, fragment_at};
 use super::{PixelRect, ScreenTriangle, View, Viewport, ONE};
 use crate::fragment::Fragment;
-use crate::samples::SamplePattern;
+use crate::samples::{SampleError, SamplePattern};
 
 /// The most samples a pattern has.
 const MAX_SAMPLES: usize = 16;
@@ -41,7 +41,7 @@ impl View<'_> {
     ///
     /// # Errors
     /// An expanded framebuffer wider than [`Viewport::MAX_SIDE`].
-    pub fn with_samples(mut self, pattern: SamplePattern) -> Result<Self, String> {
+    pub fn with_samples(mut self, pattern: SamplePattern) -> Result<Self, SampleError> {
         let framebuffer = pattern.expand(self.viewport)?;
         self.sampling = Some(Sampling {
             pattern,

@@ -14,10 +14,10 @@ use super::{
     VERTICES_PER_TASK,
 };
 use crate::camera::Camera;
-use crate::conventions::Conventions;
 use crate::conventions::DepthRange::{self, MinusOneToOne, ZeroToOne};
 use crate::conventions::VertexPrecision::{self, F32, F64};
 use crate::conventions::WindowOrigin::{LowerLeft, UpperLeft};
+use crate::conventions::{Conventions, F32RangeError};
 
 impl View<'_> {
     /// Runs the vertex stage again for another camera, reusing this view's buffers (a frame loop
@@ -126,25 +126,18 @@ impl View<'_> {
         clippy::needless_range_loop,
         reason = "row and column index the column-major matrix and name the row-major entry"
     )]
-    pub fn check_f32_range(&self) -> Result<(), String> {
+    pub fn check_f32_range(&self) -> Result<(), F32RangeError> {
         let normal = |x: f64| {
             x == 0.0 || (f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs())
         };
         let m = self.view_projection.to_cols_array_2d();
-        let out_of_range = |row: usize, column: usize, vertex: Option<usize>, product: f64| {
-            let times = vertex.map_or(String::new(), |v| {
-                format!(" times vertex {v}'s {}", ["x", "y", "z"][column])
-            });
-            format!(
-                "view_projection.row_major[{}] is {:e}: under an f32 vertex stage its \
-                 product{times} is {product:e}, outside f32's normal range ({:e} to {:e}; a GPU \
-                 may flush subnormals to zero)",
-                row * 4 + column,
-                m[column][row],
-                f32::MIN_POSITIVE,
-                f32::MAX
-            )
-        };
+        let out_of_range =
+            |row: usize, column: usize, vertex: Option<usize>, product: f64| F32RangeError {
+                index: row * 4 + column,
+                entry: m[column][row],
+                vertex: vertex.map(|v| (v, ["x", "y", "z"][column])),
+                product,
+            };
         for row in 0..4 {
             if !normal(m[3][row]) {
                 return Err(out_of_range(row, 3, None, m[3][row]));

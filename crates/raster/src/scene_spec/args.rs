@@ -7,7 +7,27 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::SceneSpec;
-use crate::{Conventions, UpAxis, Viewport, DEFAULT_SCENE_NAME};
+use crate::{Conventions, UpAxis, Viewport, ViewportError, DEFAULT_SCENE_NAME};
+
+/// Why an angle option's value is refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum AngleError {
+    /// The text is not a finite number.
+    #[error("expected a finite number of degrees, got {text:?}")]
+    NotFinite {
+        /// The text given.
+        text: String,
+    },
+    /// An elevation beyond ±89 degrees.
+    #[error(
+        "the elevation must be between -{MAX_ELEVATION} and {MAX_ELEVATION} degrees \
+         (the camera cannot look along its up axis), got {degrees}"
+    )]
+    Elevation {
+        /// The elevation given, in degrees.
+        degrees: f64,
+    },
+}
 
 /// The scene and the camera.
 #[derive(Debug, Clone, Args)]
@@ -63,7 +83,7 @@ impl SceneArgs {
     ///
     /// # Errors
     /// A side out of range.
-    pub fn viewport(&self) -> Result<Viewport, String> {
+    pub fn viewport(&self) -> Result<Viewport, ViewportError> {
         Viewport::new(self.width, self.height)
     }
 }
@@ -78,10 +98,10 @@ pub fn side() -> clap::builder::RangedI64ValueParser<u32> {
 ///
 /// # Errors
 /// Not a number, or not finite.
-pub fn degrees(text: &str) -> Result<f64, String> {
+pub fn degrees(text: &str) -> Result<f64, AngleError> {
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(format!("expected a finite number of degrees, got {text:?}")),
+        _ => Err(AngleError::NotFinite { text: text.into() }),
     }
 }
 
@@ -93,13 +113,10 @@ const MAX_ELEVATION: f64 = 89.0;
 ///
 /// # Errors
 /// Not a finite number, or beyond ±89.
-pub fn elevation(text: &str) -> Result<f64, String> {
+pub fn elevation(text: &str) -> Result<f64, AngleError> {
     let degrees = degrees(text)?;
     if degrees.abs() > MAX_ELEVATION {
-        return Err(format!(
-            "the elevation must be between -{MAX_ELEVATION} and {MAX_ELEVATION} degrees \
-             (the camera cannot look along its up axis), got {degrees}"
-        ));
+        return Err(AngleError::Elevation { degrees });
     }
     Ok(degrees)
 }

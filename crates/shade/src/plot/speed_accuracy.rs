@@ -6,6 +6,8 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::SaveError;
+
 use super::{
     log_ticks, palette, pareto_front, place_labels, render, tick_label, DrawResult, Marker, Paint,
     Point, FAMILIES,
@@ -33,7 +35,7 @@ pub fn speed_accuracy(
     title: &str,
     x_label: &str,
     points: &[Point],
-) -> Result<(), String> {
+) -> Result<(), SaveError> {
     let families = families(points).len() as i32;
     // The table's rows, the legend's (the Pareto line, a family a line) and the note under them.
     let column = 40 + LEGEND_LINE * (points.len() as i32 + 1) + LEGEND_LINE * (families + 2) + 40;
