@@ -502,10 +502,11 @@ class Verdict:
         if s["words"]["checked"]:
             w = s["words"]
             lines.append(
-                f"words: corrupt {w['corrupt']}, not defined by the layout {w['unchecked']}, "
-                f"nodes no list reaches {w['unreachable']}"
+                f"words: corrupt {w['corrupt']}, not checked {w['unchecked']}, "
+                f"spare room not read {w['spare']}, nodes no list reaches {w['unreachable']}"
             )
         lines += [f"note: {n}" for n in s["notes"]]
+        lines += [f"hint: {h}" for h in s["hints"]]
         lines += [_describe_example(e) for e in self.examples]
         return "\n".join(lines)
 
