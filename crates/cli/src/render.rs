@@ -263,7 +263,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                     &nearest,
                 )?;
                 let of_samples = if samples > 1 {
-                    " (a pixel's: the nearest of its samples')"
+                    " (the nearest of the pixel's samples)"
                 } else {
                     ""
                 };
