@@ -89,7 +89,9 @@ fn compare_with_oracle(dump: &Path, args: &[&str]) -> String {
 /// triangle) at 24 × 24 pixels with `more` options into `dir/dumps/<scheme>`.
 fn dumps(dir: &Path, schemes: &str, more: &[&str]) -> PathBuf {
     let (out, dumps) = (dir.join("out"), dir.join("dumps"));
-    let mut args = vec!["--scene", "quads:8", "--scheme", schemes, "--width", "24", "--height", "24"];
+    let mut args = vec![
+        "--scene", "quads:8", "--scheme", schemes, "--width", "24", "--height", "24",
+    ];
     args.extend_from_slice(more);
     args.extend(["--no-images", "--out", out.to_str().unwrap()]);
     args.extend(["--dump", dumps.to_str().unwrap()]);
@@ -131,7 +133,10 @@ fn lists(dump: &mut Dump) -> Vec<Vec<u32>> {
 /// Unlinks `node` from `pixel`'s list: a lost node, its fragment missing at the pixel.
 fn unlink(dump: &mut Dump, pixel: usize, node: u32) {
     let list = &lists(dump)[pixel];
-    let at = list.iter().position(|&n| n == node).expect("the node is in the list");
+    let at = list
+        .iter()
+        .position(|&n| n == node)
+        .expect("the node is in the list");
     let after = u32s(dump, "next")[node as usize - 1];
     match at {
         0 => u32s(dump, "heads")[pixel] = after,
@@ -149,7 +154,10 @@ fn every_note_on_unread_words_is_worded_for_its_layout() {
     let dumps = dumps(&dir, "linked-list,abuffer", &[]);
     let list = compare_with_oracle(&dumps.join("linked-list"), &[]);
     assert!(list.contains("verdict: EQUAL (bit-identical)"), "{list}");
-    assert!(!list.contains("A-buffer") && !list.contains("filled"), "{list}");
+    assert!(
+        !list.contains("A-buffer") && !list.contains("filled"),
+        "{list}"
+    );
     let spare = list
         .lines()
         .find(|l| l.starts_with("words:"))
@@ -189,7 +197,12 @@ fn conventions_are_printed_in_the_headers_words() {
     let dumps = dumps(
         &dir,
         "abuffer",
-        &["--window-origin", "lower-left", "--depth-range", "minus-one-to-one"],
+        &[
+            "--window-origin",
+            "lower-left",
+            "--depth-range",
+            "minus-one-to-one",
+        ],
     );
     let report = compare_with_oracle(&dumps.join("abuffer"), &[]);
     assert!(
@@ -201,8 +214,16 @@ fn conventions_are_printed_in_the_headers_words() {
     assert!(!report.contains("Conventions {"), "{report}");
     let help = fragsim_ok(&["compare", "--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
-    assert!(help.contains("the older `--no-image` still works"), "{help}");
-    fragsim_ok(&["compare", "oracle", dumps.join("abuffer").to_str().unwrap(), "--no-image"]);
+    assert!(
+        help.contains("the older `--no-image` still works"),
+        "{help}"
+    );
+    fragsim_ok(&[
+        "compare",
+        "oracle",
+        dumps.join("abuffer").to_str().unwrap(),
+        "--no-image",
+    ]);
 }
 
 /// The example lines of a report's side-by-side lists that are marked as differing.
@@ -263,8 +284,16 @@ fn one_missing_fragment_marks_one_row_and_the_legend_counts_as_the_text() {
         .find(|l| l.trim_start().starts_with("legend:"))
         .expect("the legend line");
     assert_eq!(count(pixels, ", missing "), 1, "{report}");
-    assert_eq!(count(legend, "; missing: "), count(pixels, ", missing "), "{report}");
-    assert_eq!(count(legend, "corrupt word: "), count(pixels, "corrupt "), "{report}");
+    assert_eq!(
+        count(legend, "; missing: "),
+        count(pixels, ", missing "),
+        "{report}"
+    );
+    assert_eq!(
+        count(legend, "corrupt word: "),
+        count(pixels, "corrupt "),
+        "{report}"
+    );
     assert!(legend.contains("missing: 1 (1 drawn above)"), "{report}");
 }
 
@@ -291,7 +320,10 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
     };
     // A few nodes one ulp deeper.
     let mut deeper = original.clone();
-    let heads: Vec<u32> = lists(&mut deeper).into_iter().filter_map(|l| l.first().copied()).collect();
+    let heads: Vec<u32> = lists(&mut deeper)
+        .into_iter()
+        .filter_map(|l| l.first().copied())
+        .collect();
     for &node in heads.iter().take(3) {
         nodes(&mut deeper)[node as usize - 1] += 1 << 32;
     }
@@ -310,7 +342,11 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
     let all = lists(&mut edge);
     let prims: Vec<Vec<u32>> = all
         .iter()
-        .map(|list| list.iter().map(|&n| nodes(&mut edge)[n as usize - 1] as u32).collect())
+        .map(|list| {
+            list.iter()
+                .map(|&n| nodes(&mut edge)[n as usize - 1] as u32)
+                .collect()
+        })
         .collect();
     let width = 24;
     let beside = |p: usize, prim: u32, inside: bool| {
@@ -340,7 +376,9 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
     unlink(&mut edge, p, node);
     let report = judged(&edge, &[]);
     assert!(
-        hints(&report).join("\n").contains("on the edge of its triangle's coverage"),
+        hints(&report)
+            .join("\n")
+            .contains("on the edge of its triangle's coverage"),
         "{report}"
     );
     let mut inside = original.clone();
@@ -380,7 +418,10 @@ fn multisampled_and_turned_pictures_are_drawn_per_pixel_and_named() {
     let (single, single_dir) = render("single", &[]);
     let (sampled, sampled_dir) = render("sampled", &["--samples", "4"]);
     for image in ["depth-complexity.png", "nearest-depth.png"] {
-        let (one, four) = (png_size(&single_dir.join(image)), png_size(&sampled_dir.join(image)));
+        let (one, four) = (
+            png_size(&single_dir.join(image)),
+            png_size(&sampled_dir.join(image)),
+        );
         assert_eq!(one.0, four.0, "{image}: {one:?} at 1 sample, {four:?} at 4");
     }
     let line = |output: &std::process::Output| {
@@ -390,8 +431,16 @@ fn multisampled_and_turned_pictures_are_drawn_per_pixel_and_named() {
             .map(String::from)
             .expect("a line naming the images")
     };
-    assert!(line(&single).contains("bunny, view 30°, elevation 15°, 40x30: "), "{}", line(&single));
-    assert!(line(&sampled).contains("40x30 at 4 samples"), "{}", line(&sampled));
+    assert!(
+        line(&single).contains("bunny, view 30°, elevation 15°, 40x30: "),
+        "{}",
+        line(&single)
+    );
+    assert!(
+        line(&sampled).contains("40x30 at 4 samples"),
+        "{}",
+        line(&sampled)
+    );
     let (turned, _) = render("turned", &["--up", "z"]);
     assert!(line(&turned).contains(", up z, "), "{}", line(&turned));
     let (json, json_dir) = render("json", &["--up", "z", "--json"]);
@@ -406,21 +455,51 @@ fn multisampled_and_turned_pictures_are_drawn_per_pixel_and_named() {
 }
 
 /// Issue 48, item 8: the sweep table says what its error-pixel rate and colour error count, and
-/// a scheme whose colour is off somewhere never shows a rate of 0 beside it.
+/// a row whose colour is off somewhere (MDTS and the single-pass bucket scheme at K = 2) never
+/// shows a rate of 0 beside it, in either table.
 #[test]
 fn the_sweep_table_says_what_epr_and_err_count() {
     let dir = crate::support::scratch("reports", "sweep");
     let out = fragsim_ok(&[
-        "sweep", "--scheme", "mdts,bdp", "--angles", "2", "--width", "32", "--height", "32",
-        "--no-images", "--out", dir.to_str().unwrap(),
+        "sweep",
+        "--scheme",
+        "bdp-single,mdts",
+        "--k",
+        "2",
+        "--angles",
+        "2",
+        "--width",
+        "96",
+        "--height",
+        "96",
+        "--no-images",
+        "--out",
+        dir.to_str().unwrap(),
     ]);
-    let table = String::from_utf8_lossy(&out.stdout);
-    assert!(table.contains("EPR: error-pixel rate, the % of covered pixels"), "{table}");
-    for row in table.lines().filter(|l| l.starts_with("mdts ") || l.starts_with("bdp ")) {
-        let cells: Vec<&str> = row.split_whitespace().collect();
-        let (max_rate, max_err) = (cells[2], cells[4]);
-        if max_err != "0" && max_err != "n/a" {
-            assert!(max_rate.parse::<f64>().map_or(true, |r| r > 0.0), "{table}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("EPR: error-pixel rate, the % of covered pixels"),
+        "{text}"
+    );
+    let (whole, buckets) = text
+        .split_once("colour error per depth-complexity bucket")
+        .expect("a table per bucket");
+    // (the table, the columns of the largest rate and of the largest error)
+    let mut errors = 0;
+    for (table, rate, error) in [(whole, 2, 4), (buckets, 3, 5)] {
+        for row in table
+            .lines()
+            .filter(|l| l.starts_with("mdts ") || l.starts_with("bdp-single "))
+        {
+            let cells: Vec<&str> = row.split_whitespace().collect();
+            if cells[error].parse::<u32>().is_ok_and(|e| e > 0) {
+                errors += 1;
+                assert!(
+                    cells[rate].parse::<f64>().map_or(true, |r| r > 0.0),
+                    "{text}"
+                );
+            }
         }
     }
+    assert!(errors > 0, "no row with a colour error: {text}");
 }

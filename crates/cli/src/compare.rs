@@ -212,7 +212,10 @@ fn legend(v: &Verdict) -> Vec<(image::Rgb<u8>, String)> {
             } else {
                 String::new()
             };
-            (image::Rgb(colour(f, n)), format!("{meaning}: {count}{above}"))
+            (
+                image::Rgb(colour(f, n)),
+                format!("{meaning}: {count}{above}"),
+            )
         })
         .collect()
 }

@@ -52,10 +52,10 @@ pub(super) fn hints(
         return Vec::new();
     }
     let (lost, extra) = (comparison.diff.lost, comparison.diff.extra);
-    let fragments = reference.fragments() as u64;
-    if fragments > 0 && 2 * lost >= fragments && 2 * extra >= fragments {
+    let total = reference.fragments() as u64;
+    if total > 0 && 2 * lost >= total && 2 * extra >= total {
         return vec![format!(
-            "most of the frame differs ({lost} of the reference's {fragments} fragments lost, \
+            "most of the frame differs ({lost} of the reference's {total} fragments lost, \
              {extra} extra): the candidate drew another scene or view than the header names; \
              check its scene (name or mesh, view_degrees, elevation_degrees, view_projection) \
              against what the backend drew"
@@ -77,21 +77,25 @@ pub(super) fn hints(
                 ulps.max(judging.depth_ulps)
             )
         } else {
-            format!("judge it with `--depth-ulps {}`", ulps.max(judging.depth_ulps))
+            format!(
+                "judge it with `--depth-ulps {}`",
+                ulps.max(judging.depth_ulps)
+            )
         };
         return vec![format!(
             "every difference is a depth key at most {ulps} f32 ulps from the reference's, on the \
              same primitive: the backend rounds depth as f32 arithmetic does; {options}"
         )];
     }
-    if candidate.identity != Identity::KeyOnly && on_edges(reference, candidate, &differing, judging.row)
+    if candidate.identity != Identity::KeyOnly
+        && on_edges(reference, candidate, &differing, judging.row)
     {
-        let precision = if judging.against_oracle && judging.vertex_precision == VertexPrecision::F64
-        {
-            ", or an f32 vertex stage (`--vertex-precision f32`)"
-        } else {
-            ""
-        };
+        let precision =
+            if judging.against_oracle && judging.vertex_precision == VertexPrecision::F64 {
+                ", or an f32 vertex stage (`--vertex-precision f32`)"
+            } else {
+                ""
+            };
         return vec![format!(
             "every lost or extra fragment lies on the edge of its triangle's coverage: the \
              candidate decides edge pixels otherwise; check the header's conventions \
@@ -133,7 +137,10 @@ fn depth_only(reference: &Oracle, candidate: &Capture, differing: &[usize]) -> O
     }
     let mut most = 0;
     for &p in differing {
-        let expected = fragments(owed(reference.pixel(p), &candidate.keeps), candidate.identity);
+        let expected = fragments(
+            owed(reference.pixel(p), &candidate.keeps),
+            candidate.identity,
+        );
         let got = fragments(candidate.lists.pixel(p), candidate.identity);
         if expected.len() != got.len() {
             return None;
@@ -168,16 +175,17 @@ fn on_edges(reference: &Oracle, candidate: &Capture, differing: &[usize], row: u
         .flatten()
     };
     differing.iter().all(|&p| {
-        let expected = fragments(owed(reference.pixel(p), &candidate.keeps), candidate.identity);
+        let expected = fragments(
+            owed(reference.pixel(p), &candidate.keeps),
+            candidate.identity,
+        );
         let got = fragments(candidate.lists.pixel(p), candidate.identity);
         let prims = |list: &[(u32, u32)]| list.iter().map(|&(prim, _)| prim).collect::<Vec<_>>();
         let (expected_prims, got_prims) = (prims(&expected), prims(&got));
         let lost = expected
             .iter()
             .filter(|f| !got.contains(f))
-            .all(|&(prim, _)| {
-                !got_prims.contains(&prim) && neighbours(p).any(|q| !has(q, prim))
-            });
+            .all(|&(prim, _)| !got_prims.contains(&prim) && neighbours(p).any(|q| !has(q, prim)));
         let extra = got
             .iter()
             .filter(|f| !expected.contains(f))
