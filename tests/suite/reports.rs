@@ -331,7 +331,7 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
     assert!(report.contains("verdict: DIFFERENT"), "{report}");
     let hint = hints(&report).join("\n");
     assert!(
-        hint.contains("at most 1 f32 ulps")
+        hint.contains("at most 1 f32 ulp from")
             && hint.contains("--vertex-precision f32")
             && hint.contains("--depth-ulps 1"),
         "{report}"

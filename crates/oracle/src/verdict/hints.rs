@@ -12,7 +12,6 @@
 //!   rasterizes under other conventions or edge-tie rules.
 
 use fragsim_capture::{Capture, Identity, Keeps};
-use fragsim_raster::VertexPrecision;
 
 use crate::compare::{flags, Comparison};
 use crate::Oracle;
@@ -25,22 +24,19 @@ const ROUNDING_ULPS: u32 = 4;
 pub(super) struct Judging {
     /// Lists in a row of the reference's grid (pixels, or samples of a per-sample layout).
     pub(super) row: usize,
-    /// The vertex stage the candidate was judged as.
-    pub(super) vertex_precision: VertexPrecision,
-    /// Whether the reference is the oracle (`--vertex-precision f32` applies only there).
-    pub(super) against_oracle: bool,
-    /// The ulps already allowed (`--depth-ulps`).
-    pub(super) depth_ulps: u32,
+    /// Whether `--vertex-precision f32` would judge the candidate otherwise: the reference is
+    /// the oracle and the candidate was judged as an f64 vertex stage (every bit owed).
+    pub(super) f32_stage_applies: bool,
 }
 
-/// The hints for `comparison` of `candidate` against `reference` (see the module documentation):
+/// The hint for `comparison` of `candidate` against `reference` (see the module documentation):
 /// none where every list is equal or no shape holds.
-pub(super) fn hints(
+pub(super) fn hint(
     reference: &Oracle,
     candidate: &Capture,
     comparison: &Comparison,
     judging: &Judging,
-) -> Vec<String> {
+) -> Option<String> {
     let differing: Vec<usize> = comparison
         .verdicts
         .iter()
@@ -49,61 +45,54 @@ pub(super) fn hints(
         .map(|(p, _)| p)
         .collect();
     if differing.is_empty() {
-        return Vec::new();
+        return None;
     }
     let (lost, extra) = (comparison.diff.lost, comparison.diff.extra);
     let total = reference.fragments() as u64;
     if total > 0 && 2 * lost >= total && 2 * extra >= total {
-        return vec![format!(
+        return Some(format!(
             "most of the frame differs ({lost} of the reference's {total} fragments lost, \
              {extra} extra): the candidate drew another scene or view than the header names; \
              check its scene (name or mesh, view_degrees, elevation_degrees, view_projection) \
              against what the backend drew"
-        )];
+        ));
     }
     // Only lists that differ in which fragments they hold make the two other shapes.
     let only_lists = differing.iter().all(|&p| {
         comparison.verdicts[p] & (flags::CORRUPT | flags::MISCOUNTED | flags::MISORDERED) == 0
     });
     if !only_lists {
-        return Vec::new();
+        return None;
     }
     if let Some(ulps) = depth_only(reference, candidate, &differing) {
-        let f32_stage = judging.against_oracle && judging.vertex_precision == VertexPrecision::F64;
-        let options = if f32_stage {
-            format!(
-                "judge it with `--vertex-precision f32` (the bounds an f32 vertex stage owes) or \
-                 `--depth-ulps {}`",
-                ulps.max(judging.depth_ulps)
-            )
+        let plural = if ulps == 1 { "" } else { "s" };
+        let f32_stage = if judging.f32_stage_applies {
+            "`--vertex-precision f32` (the bounds an f32 vertex stage owes) or "
         } else {
-            format!(
-                "judge it with `--depth-ulps {}`",
-                ulps.max(judging.depth_ulps)
-            )
+            ""
         };
-        return vec![format!(
-            "every difference is a depth key at most {ulps} f32 ulps from the reference's, on the \
-             same primitive: the backend rounds depth as f32 arithmetic does; {options}"
-        )];
+        return Some(format!(
+            "every difference is a depth key at most {ulps} f32 ulp{plural} from the \
+             reference's, on the same primitive: the backend rounds depth as f32 arithmetic \
+             does; judge it with {f32_stage}`--depth-ulps {ulps}`"
+        ));
     }
     if candidate.identity != Identity::KeyOnly
         && on_edges(reference, candidate, &differing, judging.row)
     {
-        let precision =
-            if judging.against_oracle && judging.vertex_precision == VertexPrecision::F64 {
-                ", or an f32 vertex stage (`--vertex-precision f32`)"
-            } else {
-                ""
-            };
-        return vec![format!(
+        let f32_stage = if judging.f32_stage_applies {
+            ", or an f32 vertex stage (`--vertex-precision f32`)"
+        } else {
+            ""
+        };
+        return Some(format!(
             "every lost or extra fragment lies on the edge of its triangle's coverage: the \
              candidate decides edge pixels otherwise; check the header's conventions \
              (window_origin, subpixel_bits, depth_range) and the edge-tie rule \
-             (conventions.edge_ties, docs/dump-format.md \"Edge ties\"){precision}"
-        )];
+             (conventions.edge_ties, docs/dump-format.md \"Edge ties\"){f32_stage}"
+        ));
     }
-    Vec::new()
+    None
 }
 
 /// The fragments of `list` as `(primitive, depth key)`, keyed as `identity` names them.

@@ -295,17 +295,16 @@ impl Judged {
         let (width, height) = (reference.width, reference.height);
         let vertex_precision = reference.vertex_precision();
         // Masked nodes are judged by coverage masks, not the lists the hints read.
-        let hints = match &reference.kind {
-            Kind::Masked { .. } => Vec::new(),
-            kind => hints::hints(
+        let hint = match &reference.kind {
+            Kind::Masked { .. } => None,
+            kind => hints::hint(
                 reference.oracle(),
                 capture,
                 &comparison,
                 &hints::Judging {
                     row: (width * lists_per_pixel) as usize,
-                    vertex_precision,
-                    against_oracle: matches!(kind, Kind::Oracle { .. }),
-                    depth_ulps: options.depth_ulps,
+                    f32_stage_applies: matches!(kind, Kind::Oracle { .. })
+                        && vertex_precision == VertexPrecision::F64,
                 },
             ),
         };
@@ -335,7 +334,7 @@ impl Judged {
                 .depth_complexity(),
             identity: capture.identity,
             notes: self.notes,
-            hints,
+            hints: hint.into_iter().collect(),
             edge_ties,
         }
     }
