@@ -395,6 +395,23 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
         hints(&report).join("\n").contains("another scene or view"),
         "{report}"
     );
+    // `--json` carries the same hint, and the linked list's spare pool apart from the words a
+    // header could have had checked.
+    let json = crate::support::json_lines(compare_with_oracle(&edited, &["--json"]).as_bytes());
+    assert_eq!(json[0]["record"], "compare");
+    assert!(
+        json[0]["hints"][0]
+            .as_str()
+            .is_some_and(|h| h.contains("another scene or view")),
+        "{}",
+        json[0]
+    );
+    assert_eq!(json[0]["unchecked_words"], 0, "{}", json[0]);
+    assert!(
+        json[0]["spare_words"].as_u64().is_some_and(|n| n > 0),
+        "{}",
+        json[0]
+    );
 }
 
 /// The width and height of the PNG at `path`.
