@@ -14,7 +14,7 @@ use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::verdict::{judge, judge_run, Candidate, Options, Reference, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::scene_spec::SceneSpec;
-use fragsim_raster::{depth_from_key, View};
+use fragsim_raster::{depth_from_key, Conventions, UpAxis, View};
 use serde::Serialize;
 
 use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
@@ -202,9 +202,11 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             .map_err(|e| e.to_string())?,
     );
     crate::args::warn_if_empty(&scene, &view);
-    // At more than one sample every scheme, the oracle and the images cover the sample-expanded
-    // framebuffer (`docs/semantics.md`, "Multisampling").
+    // At more than one sample every scheme and the oracle cover the sample-expanded framebuffer
+    // (`docs/semantics.md`, "Multisampling"); the pictures are drawn per pixel.
     let viewport = view.viewport();
+    let pixels = view.pixel_viewport();
+    let samples = view.samples().map_or(1, |pattern| pattern.count() as usize);
     let catalog: Vec<SchemeChoice> = args
         .scheme
         .iter()
@@ -253,19 +255,24 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
                 args.ties.into(),
             );
             if !args.no_images && !nearest_written {
-                let nearest: Vec<Option<f32>> = run
-                    .capture
-                    .nearest_keys()
-                    .into_iter()
-                    .map(|k| k.map(depth_from_key))
+                // A pixel's nearest depth is the nearest any of its samples captured.
+                let nearest: Vec<Option<f32>> = per_pixel(&run.capture.nearest_keys(), samples)
+                    .map(|keys| keys.iter().flatten().min().map(|&k| depth_from_key(k)))
                     .collect();
                 let image = fragsim_shade::legend::nearest_depth_with_key(
-                    viewport.width,
-                    viewport.height,
+                    pixels.width,
+                    pixels.height,
                     &nearest,
                 )
                 .map_err(|e| e.to_string())?;
-                let what = format!("nearest depth captured by {name} on the {executor} executor");
+                let of_samples = if samples > 1 {
+                    " (the nearest of the pixel's samples)"
+                } else {
+                    ""
+                };
+                let what = format!(
+                    "nearest depth{of_samples} captured by {name} on the {executor} executor"
+                );
                 let image = fragsim_shade::legend::captioned(&image, &caption(args, &what)?)
                     .map_err(|e| e.to_string())?;
                 fragsim_shade::save_png(&image, &args.out.join("nearest-depth.png"))
@@ -321,28 +328,44 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     }
     progress.finish_and_clear();
     if !args.no_images {
+        // A pixel's depth complexity is the most fragments any of its samples holds: the
+        // table's `maxdc`, and the single-sample count wherever one triangle covers the pixel.
+        let complexity: Vec<u32> = per_pixel(&oracle.depth_complexity(), samples)
+            .map(|counts| counts.iter().copied().max().unwrap_or(0))
+            .collect();
         let heat = fragsim_shade::legend::heat_map_with_bar(
-            viewport.width,
-            viewport.height,
-            &oracle.depth_complexity(),
+            pixels.width,
+            pixels.height,
+            &complexity,
             args.scale_max,
         )
         .map_err(|e| e.to_string())?;
-        let heat = fragsim_shade::legend::captioned(
-            &heat,
-            &caption(args, "depth complexity (the oracle's fragments a pixel)")?,
-        )
-        .map_err(|e| e.to_string())?;
+        let what = if samples > 1 {
+            "depth complexity (the oracle's fragments a pixel: the most any of its samples holds)"
+        } else {
+            "depth complexity (the oracle's fragments a pixel)"
+        };
+        let heat = fragsim_shade::legend::captioned(&heat, &caption(args, what)?)
+            .map_err(|e| e.to_string())?;
         fragsim_shade::save_png(&heat, &args.out.join("depth-complexity.png"))
             .map_err(|e| e.to_string())?;
     }
     if args.json {
+        // stdout stays JSON Lines: where the pictures went goes to stderr.
+        if !args.no_images {
+            eprintln!(
+                "wrote {}: {} ({})",
+                args.out.display(),
+                IMAGES.join(", "),
+                drawn_of(args)?
+            );
+        }
         let context = crate::record::Context::of_scene("render", &args.scene)?.sized(&args.schemes);
         for row in &rows {
             crate::record::emit("run", &context.on(&row.executor, row.threads), row)?;
         }
     } else {
-        print_table(&rows, &scene.name, &view, &oracle, oracle_ms, args);
+        print_table(&rows, &scene.name, &view, &oracle, oracle_ms, args)?;
         // Under the table its header describes (the scene, the pixels and samples).
         if let Some(line) = masked_line {
             outln!("{line}");
@@ -351,20 +374,54 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     Ok(rows)
 }
 
-/// An image's caption: the scene, the view, the size (and samples), then `what` it shows.
+/// The pictures `render` writes in its `--out` directory.
+const IMAGES: [&str; 2] = ["depth-complexity.png", "nearest-depth.png"];
+
+/// The values of `lists` (the sample-expanded framebuffer's, `samples` a pixel side by side)
+/// grouped by pixel, in pixel order: one list a pixel without multisampling.
+fn per_pixel<T>(lists: &[T], samples: usize) -> std::slice::ChunksExact<'_, T> {
+    lists.chunks_exact(samples)
+}
+
+/// What the pictures are drawn of: the scene, then every option that changed them (the view, the
+/// elevation, a turned up axis, the size and samples, the conventions that are not the
+/// reference's, in a dump header's words). Each caption opens with it, and the line naming
+/// where the pictures went repeats it.
 ///
 /// # Errors
 /// The mesh file cannot be read (for its name).
-fn caption(args: &RenderArgs, what: &str) -> Result<String, String> {
+fn drawn_of(args: &RenderArgs) -> Result<String, String> {
     let scene = crate::record::Context::of_scene("render", &args.scene)?.scene;
+    let up = match args.scene.up {
+        UpAxis::Y => String::new(),
+        axis => format!(", up {}", axis.name()),
+    };
     let samples = match args.conventions.samples {
         1 => String::new(),
         n => format!(" at {n} samples"),
     };
+    // The samples are named with the size; the other conventions as a header spells them.
+    let conventions = Conventions {
+        samples: 1,
+        ..args.conventions.conventions()
+    };
+    let conventions = if conventions.is_reference() {
+        String::new()
+    } else {
+        format!(", conventions {}", conventions.describe())
+    };
     Ok(format!(
-        "{scene}, view {}°, elevation {}°, {}x{}{samples}: {what}",
+        "{scene}, view {}°, elevation {}°{up}, {}x{}{samples}{conventions}",
         args.scene.view, args.scene.elevation, args.scene.width, args.scene.height
     ))
+}
+
+/// An image's caption: what it is drawn of ([`drawn_of`]), then `what` it shows.
+///
+/// # Errors
+/// The mesh file cannot be read (for its name).
+fn caption(args: &RenderArgs, what: &str) -> Result<String, String> {
+    Ok(format!("{}: {what}", drawn_of(args)?))
 }
 
 /// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample, at the
@@ -426,6 +483,11 @@ fn masked(
     Ok((capacity, line))
 }
 
+/// Prints the table of `rows` under a line naming the scene, its pixels and fragments, then what
+/// the columns add up to and where the pictures went.
+///
+/// # Errors
+/// The mesh file cannot be read (for the pictures' line).
 fn print_table(
     rows: &[RunSummary],
     scene: &str,
@@ -433,7 +495,7 @@ fn print_table(
     oracle: &Oracle,
     oracle_ms: f64,
     args: &RenderArgs,
-) {
+) -> Result<(), String> {
     let pixels = view.pixel_viewport();
     // Per sample, the lists and their fragments are the sample-expanded framebuffer's.
     let sampled = view.samples().map_or(String::new(), |pattern| {
@@ -539,10 +601,11 @@ fn print_table(
         outln!("passes marked c include the scheme's own counting pass, which sized its storage");
     }
     if !args.no_images {
-        outln!(
-            "images: {}/depth-complexity.png, {}/nearest-depth.png",
-            args.out.display(),
-            args.out.display()
-        );
+        let images: Vec<String> = IMAGES
+            .iter()
+            .map(|image| args.out.join(image).display().to_string())
+            .collect();
+        outln!("images of {}: {}", drawn_of(args)?, images.join(", "));
     }
+    Ok(())
 }

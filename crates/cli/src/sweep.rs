@@ -332,6 +332,13 @@ fn print_summary(
             mean_ms
         );
     }
+    // The two kinds of figure count different things: say which, so that a small rate beside a
+    // large error (one pixel far off) reads as it is.
+    outln!(
+        "EPR: error-pixel rate, the % of covered pixels whose 8-bit colour differs from the \
+         oracle's image (never printed as 0 when one differs); err: the absolute difference of a \
+         colour channel (0 to 255), mean over the channels and pixels, max of any pixel"
+    );
     print_depth_table(series);
     outln!("{wrote}");
     Ok(())

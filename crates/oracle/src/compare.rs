@@ -136,8 +136,10 @@ pub struct Comparison {
     pub claimed_overflow: u64,
     /// Words that the layout says cannot be there (0 when no words were checked).
     pub corrupt_words: u64,
-    /// Words the layout leaves undefined, not checked ([`WordCheck::unchecked`]).
+    /// Words a header could have defined but did not, not checked ([`WordCheck::unchecked`]).
     pub unchecked_words: u64,
+    /// Words of room no counter handed out, not read ([`WordCheck::spare`]).
+    pub spare_words: u64,
     /// Whether the candidate's words were checked at all ([`compare_with`] with a
     /// [`WordCheck`]), not only its decoded lists.
     pub words_checked: bool,
@@ -218,6 +220,7 @@ impl Comparison {
             claimed_overflow: 0,
             corrupt_words: words.map_or(0, WordCheck::corrupt_words),
             unchecked_words: words.map_or(0, |w| w.unchecked),
+            spare_words: words.map_or(0, |w| w.spare),
             words_checked: words.is_some(),
             first_corrupt: Vec::new(),
             ambiguity: AmbiguityCounts::default(),

@@ -93,6 +93,17 @@ pub enum WindowOrigin {
     LowerLeft,
 }
 
+impl WindowOrigin {
+    /// The origin as a dump header spells it (`upper-left`, `lower-left`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::UpperLeft => "upper-left",
+            Self::LowerLeft => "lower-left",
+        }
+    }
+}
+
 /// The clip-space depth range that maps to window depth `[0, 1]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -102,6 +113,17 @@ pub enum DepthRange {
     ZeroToOne,
     /// `−w ≤ z ≤ w`, window depth `(z / w + 1) / 2` (OpenGL's default `GL_NEGATIVE_ONE_TO_ONE`).
     MinusOneToOne,
+}
+
+impl DepthRange {
+    /// The range as a dump header spells it (`zero-to-one`, `minus-one-to-one`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ZeroToOne => "zero-to-one",
+            Self::MinusOneToOne => "minus-one-to-one",
+        }
+    }
 }
 
 /// The arithmetic of the vertex stage (transform, perspective divide, viewport mapping).
@@ -114,6 +136,17 @@ pub enum VertexPrecision {
     /// f32, as a vertex shader computes: the matrix and positions rounded to f32, each product and
     /// sum rounded to f32.
     F32,
+}
+
+impl VertexPrecision {
+    /// The arithmetic as a dump header spells it (`f64`, `f32`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::F64 => "f64",
+            Self::F32 => "f32",
+        }
+    }
 }
 
 /// Which edges own a sample lying exactly on them (an edge function of 0), in the API's own window
@@ -262,6 +295,36 @@ impl Conventions {
                 .map(Some)
                 .map_err(|_| ConventionsError::Samples { samples }),
         }
+    }
+}
+
+impl Conventions {
+    /// The fields that are not the reference's, as a dump header's `conventions` object spells
+    /// them (`{"window_origin": "lower-left", "samples": 4}`), so that a report names them in
+    /// the words a user writes; `{}` for the reference conventions.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let reference = Self::REFERENCE;
+        let quoted = |name: &str| format!("\"{name}\"");
+        let fields = [
+            (self.window_origin != reference.window_origin)
+                .then(|| ("window_origin", quoted(self.window_origin.name()))),
+            (self.subpixel_bits != reference.subpixel_bits)
+                .then(|| ("subpixel_bits", self.subpixel_bits.to_string())),
+            (self.depth_range != reference.depth_range)
+                .then(|| ("depth_range", quoted(self.depth_range.name()))),
+            (self.vertex_precision != reference.vertex_precision)
+                .then(|| ("vertex_precision", quoted(self.vertex_precision.name()))),
+            (self.samples != reference.samples).then(|| ("samples", self.samples.to_string())),
+            self.edge_ties
+                .map(|rule| ("edge_ties", quoted(rule.name()))),
+        ];
+        let fields: Vec<String> = fields
+            .into_iter()
+            .flatten()
+            .map(|(field, value)| format!("\"{field}\": {value}"))
+            .collect();
+        format!("{{{}}}", fields.join(", "))
     }
 }
 

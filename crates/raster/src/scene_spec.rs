@@ -353,12 +353,21 @@ impl SceneSpec {
         Ok(())
     }
 
-    /// A short description for reports.
+    /// A short description for reports: the scene, the camera (a turned orbit's up axis named),
+    /// and the conventions that are not the reference's, as a dump header spells them
+    /// ([`Conventions::describe`]).
     #[must_use]
     pub fn describe(&self) -> String {
         let scene = self.mesh.as_deref().or(self.name.as_deref()).unwrap_or("?");
         let camera = match &self.view_projection {
             Some(_) => "the engine's view-projection matrix".to_string(),
+            // A turned orbit (`--up`) is named: it changes every picture of the scene.
+            None if self.up != UpAxis::Y => format!(
+                "view {}°, elevation {}°, up {}",
+                self.view_degrees,
+                self.elevation_degrees,
+                self.up.name()
+            ),
             None => format!(
                 "view {}°, elevation {}°",
                 self.view_degrees, self.elevation_degrees
@@ -367,7 +376,10 @@ impl SceneSpec {
         if self.conventions.is_reference() {
             format!("{scene}, {camera}")
         } else {
-            format!("{scene}, {camera}, conventions {:?}", self.conventions)
+            format!(
+                "{scene}, {camera}, conventions {}",
+                self.conventions.describe()
+            )
         }
     }
 }

@@ -23,8 +23,8 @@ pub(super) struct Translated {
     pub(super) words64: Vec<u64>,
     /// Per pixel, its corrupt words.
     pub(super) corrupt: Vec<Vec<CorruptWord>>,
-    /// Words the layout leaves undefined, so unchecked.
-    pub(super) unchecked: u64,
+    /// Words of room no counter handed out, so not read ([`super::WordCheck::spare`]).
+    pub(super) spare: u64,
     /// Linked lists: nodes the counter handed out that no list reaches.
     pub(super) unreachable: u64,
 }
@@ -99,8 +99,8 @@ pub(super) fn linked_lists(lists: &ListArrays<'_>) -> Translated {
         }
     }
     out.unreachable = allocated as u64 - reached;
-    // Nodes past the counter hold whatever the pool held: undefined.
-    out.unchecked = 2 * (pool - allocated) as u64;
+    // Nodes past the counter hold whatever the pool held: no list may reach them.
+    out.spare = 2 * (pool - allocated) as u64;
     out
 }
 
@@ -157,7 +157,7 @@ pub(super) fn layer_major(
                 });
             }
         }
-        out.unchecked += u64::from(k) - stored as u64;
+        out.spare += u64::from(k) - stored as u64;
     }
     out
 }
@@ -282,6 +282,6 @@ mod tests {
         let got = layer_major(&[3, 1], &[0, 0, 0, 0], 2, Payload::FRAGMENT);
         assert_eq!(got.corrupt[0][0].why, Corruption::CounterPastStorage);
         assert!(got.corrupt[1].is_empty());
-        assert_eq!(got.unchecked, 1);
+        assert_eq!(got.spare, 1);
     }
 }

@@ -101,10 +101,18 @@ pub struct WordCheck {
     /// A-buffer dumps: each pixel's counter and capacity, for the comparison to check the
     /// counter against the pixel's fragment count.
     pub counters: Option<Vec<Counter>>,
-    /// Words the layout leaves undefined and so were not checked: A-buffer slots past the counter
-    /// when the header does not say they were filled, layers past a counter, pool nodes past the
-    /// node counter, every word of a memory dump (its scheme's memory has no rules here).
+    /// Words a header could have defined but did not, so not checked: an A-buffer's (or a
+    /// masked-node A-buffer's) slots past the counter when the header does not say they were
+    /// filled with the empty marker (`"filled": true`), every word of a memory dump (its
+    /// scheme's memory has no rules here). A dump with any is at best `EQUAL (lists
+    /// bit-identical)`.
     pub unchecked: u64,
+    /// Words of room that no counter handed out and that no header field defines, so not read: a
+    /// linked list's pool nodes past the node counter (a `next` and a payload each), a
+    /// layer-major dump's layers past a pixel's counter. No list holds them (a link to such a
+    /// node is corrupt), so leaving them unread hides no fragment and no stray link: they do not
+    /// keep a dump from being bit-identical.
+    pub spare: u64,
     /// Linked lists: nodes the counter handed out that no list reaches (a lost node; its
     /// fragment is missing from the lists, which the comparison counts).
     pub unreachable: u64,
@@ -235,7 +243,7 @@ impl Dump {
             DumpScheme::LinkedLists { .. } | DumpScheme::LayerMajor { .. } => {
                 let translated = self.translate(&scheme)?;
                 check.corrupt = translated.corrupt;
-                check.unchecked = translated.unchecked;
+                check.spare = translated.spare;
                 check.unreachable = translated.unreachable;
                 if matches!(scheme, DumpScheme::LinkedLists { .. }) {
                     check.list_counter = translated.words32.get(pixels).copied();

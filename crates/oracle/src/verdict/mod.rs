@@ -31,6 +31,7 @@ mod against_masked;
 mod against_oracle;
 mod allowance;
 mod error;
+mod hints;
 mod reference;
 mod report;
 mod run;
@@ -44,7 +45,7 @@ use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::{EdgeTies, VertexPrecision};
 
 use crate::compare::{flags, CompareOptions, Comparison};
-use crate::dump::{DepthFormat, Dump, WordCheck};
+use crate::dump::{DepthFormat, Dump, DumpScheme, WordCheck};
 use crate::precision::{Bounds, Precision};
 use crate::Oracle;
 use fragsim_raster::scene_spec::SceneSpec;
@@ -120,6 +121,9 @@ pub struct Verdict {
     pub identity: Identity,
     /// Notes that qualify the verdict, in the order they arose.
     pub notes: Vec<String>,
+    /// What to check next, where the differences have a shape that names a cause (the whole
+    /// frame, depth rounding only, edges only); never a change to the verdict.
+    pub hints: Vec<String>,
     /// The first differing lists, both sides.
     pub examples: Vec<Example>,
     /// The edge-tie rule (in fragsim's y-down rows) samples exactly on an edge were judged
@@ -245,12 +249,8 @@ impl Judged {
             Candidate::Capture(capture) => (capture.clone(), None),
             Candidate::Oracle(oracle) => (oracle_capture(oracle), None),
         };
-        if let Some(unchecked) = words.as_ref().map(|w| w.unchecked).filter(|&u| u > 0) {
-            notes.push(format!(
-                "{unchecked} A-buffer slots past their pixel's counter were not checked: the \
-                 header does not say every slot was filled with the empty marker (\"filled\": \
-                 true)"
-            ));
+        if let (Candidate::Dump(dump), Some(words)) = (candidate, &words) {
+            notes.extend(unread_notes(dump, words)?);
         }
         if capture.pixels() != oracle.pixels() {
             return Err(VerdictError::Lists {
@@ -294,6 +294,20 @@ impl Judged {
         let lists_per_pixel = reference.lists_per_pixel();
         let (width, height) = (reference.width, reference.height);
         let vertex_precision = reference.vertex_precision();
+        // Masked nodes are judged by coverage masks, not the lists the hints read.
+        let hint = match &reference.kind {
+            Kind::Masked { .. } => None,
+            kind => hints::hint(
+                reference.oracle(),
+                capture,
+                &comparison,
+                &hints::Judging {
+                    row: (width * lists_per_pixel) as usize,
+                    f32_stage_applies: matches!(kind, Kind::Oracle { .. })
+                        && vertex_precision == VertexPrecision::F64,
+                },
+            ),
+        };
         Verdict {
             equal: comparison.is_equal() && reference.corrupt_words() == 0,
             per_sample: SampleCounts::of(&comparison, lists_per_pixel),
@@ -320,6 +334,7 @@ impl Judged {
                 .depth_complexity(),
             identity: capture.identity,
             notes: self.notes,
+            hints: hint.into_iter().collect(),
             edge_ties,
         }
     }
@@ -342,6 +357,55 @@ fn errors(comparison: &Comparison) -> usize {
         .iter()
         .filter(|&&v| v & flags::DIFFERS != 0)
         .count()
+}
+
+/// The notes on the words of `dump` that its check did not read ([`WordCheck::unchecked`],
+/// [`WordCheck::spare`]), each worded for the layout they belong to: what they are, and whether
+/// a header field would have had them checked.
+///
+/// # Errors
+/// A header whose scheme is unknown (the check that counted the words has read it already).
+fn unread_notes(dump: &Dump, words: &WordCheck) -> Result<Vec<String>, VerdictError> {
+    let scheme = if dump.is_masked() {
+        None
+    } else {
+        Some(dump.scheme()?)
+    };
+    let (unchecked, spare) = (words.unchecked, words.spare);
+    let mut notes = Vec::new();
+    if unchecked > 0 {
+        notes.push(match &scheme {
+            None => format!(
+                "{unchecked} words of masked-node slots past their pixel's counter (a node and a \
+                 mask each) were not checked: the header does not say every slot was cleared \
+                 (\"filled\": true)"
+            ),
+            Some(DumpScheme::Memory { .. }) => format!(
+                "the {unchecked} words of this memory dump were not checked: a scheme's own \
+                 memory has no word rules here, only the lists its resolve decodes are judged"
+            ),
+            Some(_) => format!(
+                "{unchecked} A-buffer slots past their pixel's counter were not checked: the \
+                 header does not say every slot was filled with the empty marker (\"filled\": \
+                 true)"
+            ),
+        });
+    }
+    if spare > 0 {
+        notes.push(match &scheme {
+            Some(DumpScheme::LinkedLists { pool, .. }) => format!(
+                "{} of the pool's {pool} nodes lie past the node counter and were not read: the \
+                 counter never handed them out, so no list may reach them (a link to one is \
+                 corrupt) and what they hold is whatever the pool held",
+                spare / 2
+            ),
+            _ => format!(
+                "{spare} layers past their pixel's counter were not read: no list holds them, \
+                 and the layout does not say what they hold"
+            ),
+        });
+    }
+    Ok(notes)
 }
 
 /// The notes on overflow: storage that stops without a count, and counters that claim another

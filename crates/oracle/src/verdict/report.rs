@@ -232,6 +232,9 @@ pub struct Summary<'a> {
     pub edge_ties: Option<&'static str>,
     /// Notes that qualify the verdict.
     pub notes: &'a [String],
+    /// What to check next, where the differences have a shape that names a cause
+    /// ([`Verdict::hints`]).
+    pub hints: &'a [String],
 }
 
 /// Fragment totals of a verdict.
@@ -258,8 +261,14 @@ pub struct WordTotals {
     pub checked: bool,
     /// Words the layout says cannot be there.
     pub corrupt: u64,
-    /// Words the layout leaves undefined (unfilled A-buffer slots past the counter).
+    /// Words a header could have defined but did not, so not checked (an unfilled A-buffer's
+    /// slots past the counter, a memory dump's words): they keep the verdict from
+    /// `EQUAL (bit-identical)`.
     pub unchecked: u64,
+    /// Words of room no counter handed out, which no header field defines, so not read (a linked
+    /// list's pool nodes past the node counter, layers past a pixel's counter): no list holds
+    /// them, and they leave a dump bit-identical.
+    pub spare: u64,
     /// Linked lists: nodes the pool counter handed out that no list reaches (each a lost
     /// fragment, missing at its pixel, or a node no fragment took): never equal.
     pub unreachable: u64,
@@ -267,8 +276,9 @@ pub struct WordTotals {
 
 impl Summary<'_> {
     /// The verdict in a word or three: `EQUAL (bit-identical)` where every list is equal bit for
-    /// bit and every word was read and defined, `EQUAL (lists bit-identical)` where some words
-    /// were unseen (an unfilled A-buffer's spare slots, the oracle as the candidate), `EQUAL
+    /// bit and every word a header can define was read (a linked list's pool past its counter is
+    /// room no header defines), `EQUAL (lists bit-identical)` where some words were unseen (an
+    /// unfilled A-buffer's spare slots, a memory dump, the oracle as the candidate), `EQUAL
     /// (within tolerance)` under a tolerance or precision, else `DIFFERENT`.
     #[must_use]
     pub fn word(&self) -> &'static str {
@@ -321,11 +331,13 @@ impl Verdict {
                 checked: c.words_checked,
                 corrupt: c.corrupt_words,
                 unchecked: c.unchecked_words,
+                spare: c.spare_words,
                 unreachable: c.unreachable_nodes,
             },
             first_differences: &self.examples,
             edge_ties: self.edge_ties.map(EdgeTies::name),
             notes: &self.notes,
+            hints: &self.hints,
         }
     }
 }

@@ -389,8 +389,9 @@ class Verdict:
     ``EQUAL (within tolerance)``, ``DIFFERENT``, …). The differing lists are numpy arrays
     (:attr:`differing`, :attr:`x`, :attr:`y`, :attr:`sample`, :attr:`differing_flags`), the
     totals dicts (:attr:`counts`, :attr:`fragments`, :attr:`words`), the first differing lists
-    with both sides :attr:`examples`, the qualifications :attr:`notes`; :meth:`report` is the
-    text, :attr:`json` the summary as ``compare``'s JSON groups it.
+    with both sides :attr:`examples`, the qualifications :attr:`notes`, what to check next
+    :attr:`hints`; :meth:`report` is the text, :attr:`json` the summary as ``compare``'s JSON
+    groups it.
     """
 
     def __init__(self, raw: Mapping[str, Any]) -> None:
@@ -424,8 +425,9 @@ class Verdict:
 
     @property
     def words(self) -> dict[str, Any]:
-        """Word totals of the storage: ``checked``, ``corrupt``, ``unchecked``,
-        ``unreachable``."""
+        """Word totals of the storage: ``checked``, ``corrupt``, ``unchecked`` (words a header
+        could have defined but did not), ``spare`` (room no counter handed out: a linked list's
+        pool past its counter), ``unreachable``."""
         return self.summary["words"]
 
     @property
@@ -437,6 +439,12 @@ class Verdict:
     def notes(self) -> list[str]:
         """Notes that qualify the verdict."""
         return self.summary["notes"]
+
+    @property
+    def hints(self) -> list[str]:
+        """What to check next, where the differences have a shape that names a cause (the
+        whole frame, depth rounding only, edges only); never a change to the verdict."""
+        return self.summary["hints"]
 
     @property
     def examples(self) -> list[dict[str, Any]]:
@@ -480,7 +488,7 @@ class Verdict:
         return self.differing % self.lists_per_pixel
 
     def report(self) -> str:
-        """The verdict as text: counts, totals, notes and the first differing lists."""
+        """The verdict as text: counts, totals, notes, hints and the first differing lists."""
         s = self.summary
         v = s["verdicts"]
         f = s["fragments"]
@@ -502,10 +510,11 @@ class Verdict:
         if s["words"]["checked"]:
             w = s["words"]
             lines.append(
-                f"words: corrupt {w['corrupt']}, not defined by the layout {w['unchecked']}, "
-                f"nodes no list reaches {w['unreachable']}"
+                f"words: corrupt {w['corrupt']}, not checked {w['unchecked']}, "
+                f"spare room not read {w['spare']}, nodes no list reaches {w['unreachable']}"
             )
         lines += [f"note: {n}" for n in s["notes"]]
+        lines += [f"hint: {h}" for h in s["hints"]]
         lines += [_describe_example(e) for e in self.examples]
         return "\n".join(lines)
 
