@@ -20,7 +20,7 @@ use crate::support::strategies::{
 };
 
 proptest! {
-    #![proptest_config(config(384))]
+    #![proptest_config(config(192))]
 
     /// Property 1: concurrent MDTS (64-bit words ascending and descending, 32-bit depth-key
     /// words ascending and descending; the parallel executor with 1 to 8 triangles a task and the
