@@ -19,8 +19,8 @@
 //! exactly when a side does not read or decode, the two cover different viewports or name
 //! different scenes, or the memory cap refuses the work; otherwise it gives a verdict (exit code
 //! 0 or 1), and "equal" (0) only when neither side holds a word its layout says cannot be there.
-//! A dump that decodes to lists in canonical order, with no overflow and no corrupt word,
-//! compared with itself is equal.
+//! A dump that decodes to lists in canonical order, with no overflow, no corrupt word and (a
+//! linked list) a node counter equal to its lists' fragments, compared with itself is equal.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -220,7 +220,19 @@ fn check_pair(reference: &Path, candidate: &Path) {
     // A memory dump may hold the empty marker in a list, which the comparison takes for no
     // fragment: no promise is made of such lists.
     let no_marker = (0..capture.pixels()).all(|p| !capture.pixel(p).contains(&u64::MAX));
-    if reference == candidate && words_a.corrupt_words() == 0 && is_canonical(capture) && no_marker
+    // A list's node counter is held to the fragments its reference holds (docs/semantics.md §6):
+    // a dump whose counter disagrees with its own lists differs from itself, by that rule.
+    let stored: u64 = (0..capture.pixels())
+        .map(|p| capture.pixel(p).len() as u64)
+        .sum();
+    let counter_agrees = words_a
+        .list_counter
+        .is_none_or(|counter| u64::from(counter) == stored);
+    if reference == candidate
+        && words_a.corrupt_words() == 0
+        && is_canonical(capture)
+        && no_marker
+        && counter_agrees
     {
         assert!(equal, "a dump in canonical order differs from itself");
     }

@@ -45,7 +45,7 @@ pub(super) fn counter_note(comparison: &Comparison) -> Option<String> {
             format!("{} to {}", m.least, m.most)
         };
         format!(
-            "the node counter is {}, the scene has {owed} fragments: a counter counts every \
+            "the node counter is {}, the reference holds {owed} fragments: a counter counts every \
              allocation, past the pool's end too, so it ends at the fragment count whatever the \
              pool",
             m.counter
