@@ -15,8 +15,11 @@
 //! analysis of the per-sample view as any other layout; masked nodes exactly only (the kinds
 //! choose their sites from one list's possibilities, and a node stands for several samples'
 //! lists). The test prints a kill table by kind and layout, per judge (`docs/testing.md` has it
-//! and its command).
+//! and its command). Two families run on scenes of their own: triangles clipped by the near plane
+//! ([`clipped`]) and headers that contradict themselves ([`header`]).
 
+mod clipped;
+mod header;
 mod kinds;
 mod storage;
 
