@@ -7,29 +7,23 @@
 //! (uniform random, lockstep warps), each width `W` and each seed, the k-buffer runs the scene one
 //! fragment per thread under the scheduled executor, and `Oracle::diff` counts the covered pixels
 //! whose list differs from the oracle's `K` nearest (a fragment lost, duplicated or out of order).
-//! The measurements are `fragsim_explain::hazard`'s and `fragsim_explain::baselines`'s; this
-//! module holds the options, the progress lines and the tables and plots written.
+//! The measurement is `fragsim_measure::hazard`'s; this module holds the options and the tables,
+//! records and plots written.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_capture::schemes::kbuffer::KBuffer;
-use fragsim_capture::MEMORY_CAP_DEFAULT;
-use fragsim_explain::baselines;
-use fragsim_explain::hazard::{covered_by_bucket, machine_name, rate, BUCKETS, POLICIES};
-pub use fragsim_explain::{
-    baselines::BaselineRow,
-    hazard::{HazardReport, HazardRow},
-};
-use fragsim_oracle::Oracle;
+use fragsim_explain::hazard::{machine_name, POLICIES};
+use fragsim_measure::hazard::HazardReport;
+use fragsim_measure::hazard::{Campaign, HazardParams};
+use fragsim_raster::Conventions;
 use fragsim_shade::plot::{chart, chart_with_ticks, Series};
 use serde::Serialize;
 
 use crate::args::SceneArgs;
 use crate::explain::WriteBackArg;
 use crate::record::{Context, Slots};
-use fragsim_raster::Conventions;
 
 /// Options of `fragsim hazard`.
 #[derive(Debug, Clone, Args)]
@@ -128,78 +122,29 @@ struct BaselineRecord<'a> {
 /// # Errors
 /// Scene, parameter or output errors.
 pub(crate) fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
-    if args.threads_in_flight.contains(&0) || args.seeds == 0 || args.write_back.is_empty() {
-        return Err(
-            "hazard needs --threads-in-flight ≥ 1, at least one seed and one machine".into(),
-        );
-    }
-    let spec = args.scene.spec(Conventions::REFERENCE);
-    let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
-    let view = spec.view(&scene, viewport).map_err(|e| e.to_string())?;
-    crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT).map_err(|e| e.to_string())?;
-    let oracle = Oracle::build(&view);
-    let in_bucket = covered_by_bucket(&oracle);
-    let covered: usize = in_bucket.iter().sum();
-    let mut report = HazardReport {
-        scene: args.scene.mesh.as_ref().map_or_else(
-            || args.scene.scene.clone(),
-            |p| crate::record::file_name(&p.display().to_string()),
-        ),
-        width: args.scene.width,
-        height: args.scene.height,
-        k: args.k,
-        covered,
-        fragments: oracle.fragments(),
-        buckets: BUCKETS
-            .iter()
-            .zip(&in_bucket)
-            .map(|(&(_, label), &n)| (label.to_string(), n))
-            .collect(),
-        rows: Vec::new(),
-        baselines: Vec::new(),
+    let campaign = if args.baselines {
+        Campaign::Baselines {
+            ks: args.ks.clone(),
+        }
+    } else {
+        Campaign::Rates {
+            k: args.k,
+            threads_in_flight: args.threads_in_flight.clone(),
+            seeds: args.seeds,
+        }
     };
-    let machines: Vec<_> = args.write_back.iter().map(|w| w.machine()).collect();
+    let params = HazardParams {
+        scene: args.scene.spec(Conventions::REFERENCE),
+        viewport: args.scene.viewport().map_err(|e| e.to_string())?,
+        write_back: args.write_back.iter().map(|w| w.machine()).collect(),
+        campaign,
+    };
+    let report = fragsim_measure::hazard::hazard(&params, &crate::progress::Bars::default())?;
     if args.baselines {
-        // The output lists hold every layer (as `render` sizes them).
-        let layers = oracle.max_depth_complexity().max(1);
-        let table = baselines::table(viewport, &args.ks, &machines, layers)?;
-        let progress = crate::progress::bar(table.len() as u64, "hazard --baselines");
-        for baseline in table {
-            progress.set_message(format!("{} K = {}", baseline.scheme, baseline.k));
-            report
-                .baselines
-                .extend(baselines::rows(&baseline, &view, &oracle)?);
-            progress.inc(1);
-        }
-        progress.finish_and_clear();
         write_baselines(args, &report)?;
-        return Ok(report);
+    } else {
+        write(args, &report)?;
     }
-    let progress = crate::progress::bar(
-        (machines.len() * POLICIES.len() * args.threads_in_flight.len()) as u64,
-        "hazard",
-    );
-    for &machine in &machines {
-        let scheme = KBuffer::with_write_back(viewport, args.k, machine, MEMORY_CAP_DEFAULT)
-            .map_err(|e| e.to_string())?;
-        for policy in POLICIES {
-            for &in_flight in &args.threads_in_flight {
-                progress.set_message(format!(
-                    "{} {} W = {in_flight}",
-                    machine_name(machine),
-                    policy.1
-                ));
-                let row = rate(
-                    &view, &oracle, &scheme, machine, policy, in_flight, args.seeds,
-                );
-                report.rows.push(row);
-                progress.inc(1);
-            }
-        }
-    }
-    progress.finish_and_clear();
-    write(args, &report)?;
     Ok(report)
 }
 

@@ -10,10 +10,9 @@
 use serde::Serialize;
 
 use crate::args::{Count, SceneArgs, SchemeArgs};
-use crate::colour_judge::ColourColumns;
+use fragsim_measure::colour_judge::ColourColumns;
 use fragsim_raster::{Conventions, SceneSpec};
-use fragsim_shade::colour_error::{colour_error_by_depth, BucketError, DEPTH_BUCKETS};
-use image::RgbImage;
+use fragsim_shade::colour_error::BucketError;
 
 /// A slot count as a record writes it: a number, or `"auto"` when the scene sized it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -78,11 +77,7 @@ impl Context {
     /// The context of `command` on the scene and camera of `spec`, at `width × height`.
     #[must_use]
     pub fn new(command: &'static str, spec: &SceneSpec, width: u32, height: u32) -> Self {
-        let scene = match (&spec.name, &spec.mesh) {
-            (Some(name), _) => name.clone(),
-            (None, Some(mesh)) => file_name(mesh),
-            (None, None) => "engine".into(),
-        };
+        let scene = fragsim_measure::scene_name(spec);
         let orbit = spec.view_projection.is_none();
         Self {
             fragsim_version: env!("CARGO_PKG_VERSION"),
@@ -140,14 +135,6 @@ impl Context {
     }
 }
 
-/// The last component of a path, as records and chart titles name a mesh file.
-#[must_use]
-pub fn file_name(path: &str) -> String {
-    std::path::Path::new(path)
-        .file_name()
-        .map_or_else(|| path.to_string(), |f| f.to_string_lossy().into_owned())
-}
-
 /// One line: the record's kind, the context, then the record's own fields.
 #[derive(Serialize)]
 struct Line<'a, T: Serialize> {
@@ -186,75 +173,6 @@ pub fn emit<T: Serialize>(
 ) -> Result<(), String> {
     outln!("{}", line(record, context, fields)?);
     Ok(())
-}
-
-/// The colour error of an effect's image per depth-complexity bucket, as `bench` and `sweep`
-/// records carry it: for each bucket of [`DEPTH_BUCKETS`] (fragments per pixel, from the
-/// oracle), six flat fields named `<quantity>_dc_<bucket>` (`dc_1`, `dc_2_4`, …, `dc_33+`):
-/// `pixels` (covered pixels in the bucket), `error_pixels` (of them, those whose 8-bit colour
-/// differs), `error_pixel_rate` (the fraction; `null` for an empty bucket), `mean_abs_error`,
-/// `max_abs_error`, `psnr_db` (as the whole image's, over the bucket's pixels alone; `null` for
-/// an empty bucket). Every field is `null` where there is no image (the words cannot resolve the
-/// effect), so that every record has every field.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ColourByDepth {
-    /// One entry per bucket of [`DEPTH_BUCKETS`], in order; empty where there is no image.
-    pub buckets: Vec<BucketError>,
-}
-
-impl ColourByDepth {
-    /// The buckets of `candidate` against `reference` (`None`: no image), pixel `p` having
-    /// `depth_complexity[p]` fragments.
-    ///
-    /// # Errors
-    /// The images differ in size, or `depth_complexity` is not one count a pixel (a bug).
-    pub fn of(
-        images: Option<(&RgbImage, &RgbImage)>,
-        depth_complexity: &[u32],
-    ) -> Result<Self, String> {
-        let buckets = match images {
-            Some((reference, candidate)) => {
-                colour_error_by_depth(reference, candidate, depth_complexity)
-                    .map_err(|e| e.to_string())?
-            }
-            None => Vec::new(),
-        };
-        Ok(Self { buckets })
-    }
-
-    /// The buckets with pixels in them.
-    pub fn covered(&self) -> impl Iterator<Item = &BucketError> {
-        self.buckets.iter().filter(|b| b.pixels > 0)
-    }
-}
-
-impl Serialize for ColourByDepth {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let mut map = serializer.serialize_map(Some(DEPTH_BUCKETS.len() * 6))?;
-        for (i, &(lo, hi)) in DEPTH_BUCKETS.iter().enumerate() {
-            let suffix = match (lo, hi) {
-                (lo, hi) if lo == hi => format!("dc_{lo}"),
-                (lo, u32::MAX) => format!("dc_{lo}+"),
-                (lo, hi) => format!("dc_{lo}_{hi}"),
-            };
-            let bucket = self.buckets.get(i);
-            let colour = ColourColumns::of(bucket.and_then(|b| b.error));
-            let rate = bucket
-                .filter(|b| b.pixels > 0)
-                .map(|b| b.error_pixels as f64 / b.pixels as f64);
-            map.serialize_entry(&format!("pixels_{suffix}"), &bucket.map(|b| b.pixels))?;
-            map.serialize_entry(
-                &format!("error_pixels_{suffix}"),
-                &bucket.map(|b| b.error_pixels),
-            )?;
-            map.serialize_entry(&format!("error_pixel_rate_{suffix}"), &rate)?;
-            map.serialize_entry(&format!("mean_abs_error_{suffix}"), &colour.mean_abs_error)?;
-            map.serialize_entry(&format!("max_abs_error_{suffix}"), &colour.max_abs_error)?;
-            map.serialize_entry(&format!("psnr_db_{suffix}"), &colour.psnr_db)?;
-        }
-        map.end()
-    }
 }
 
 /// The mean absolute error of an image over its three channels, as tables and charts print it

@@ -194,10 +194,11 @@ pub struct RunSummary {
 /// A scene that cannot be loaded, bad parameters, storage beyond the memory cap, an image that
 /// cannot be written.
 pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
-    let pool = args.schemes.pool()?;
+    let setup = args.schemes.setup();
+    let pool = setup.pool()?;
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let view = args.schemes.submission(
+    let view = setup.submission(
         spec.view(&scene, args.scene.viewport().map_err(|e| e.to_string())?)
             .map_err(|e| e.to_string())?,
     );

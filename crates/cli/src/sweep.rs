@@ -1,21 +1,22 @@
 //! `fragsim sweep`: the error-pixel rate of each scheme at many view angles around the model
 //! (the bucket depth peeling paper's Figure 6), the colour error over the image and per
-//! depth-complexity bucket at each angle, and the speed-versus-accuracy scatter.
+//! depth-complexity bucket at each angle, and the speed-versus-accuracy scatter. The measurement
+//! is `fragsim_measure::sweep`'s; this module holds the options and the table, records and charts.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_capture::primitive_order::PrimitiveOrder;
-use fragsim_oracle::Oracle;
+use fragsim_measure::approximate::ApproximateName;
+use fragsim_measure::colour_by_depth::ColourByDepth;
+use fragsim_measure::colour_judge::{ColourColumns, EffectName};
+use fragsim_measure::sweep::{SweepParams, SweepReport, SweepSeries};
+use fragsim_raster::Conventions;
+use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
 use serde::Serialize;
 
-use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
-use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
-use crate::record::{bucket_cells, mean_of_channels, percent, ColourByDepth, Context};
-use crate::schemes::{family, SchemeChoice, SchemeRunner};
-use fragsim_raster::{Conventions, SceneSpec};
-use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
+use crate::record::{bucket_cells, mean_of_channels, percent, Context};
+use crate::schemes::{family, SchemeChoice};
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -75,126 +76,27 @@ struct SweepRecord<'a> {
     time_ms: f64,
 }
 
-/// One scheme's measurements over the sweep.
-#[derive(Debug, Clone, Serialize)]
-pub struct SweepSeries {
-    /// Scheme name.
-    pub scheme: String,
-    /// Error-pixel rate (over covered pixels) per angle; `None` where the effect is unresolvable.
-    pub error_pixel_rate: Vec<Option<f64>>,
-    /// The colour error against the oracle's image per angle (`None` fields: unresolvable).
-    pub colour: Vec<ColourColumns>,
-    /// The same per depth-complexity bucket, per angle (no buckets: unresolvable).
-    pub colour_by_depth: Vec<ColourByDepth>,
-    /// Frame time per angle, ms.
-    pub time_ms: Vec<f64>,
-}
-
-impl SweepSeries {
-    fn named(scheme: &str) -> Self {
-        Self {
-            scheme: scheme.into(),
-            error_pixel_rate: Vec::new(),
-            colour: Vec::new(),
-            colour_by_depth: Vec::new(),
-            time_ms: Vec::new(),
-        }
-    }
-}
-
 /// Runs `sweep`.
 ///
 /// # Errors
 /// Scene, parameter or output errors.
-pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
-    let pool = args.schemes.pool()?;
-    let spec = args.scene.spec(Conventions::REFERENCE);
-    let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
-    let executor = args.schemes.executors()[0];
-    let mut threads = 0;
-    let schemes = SchemeChoice::expand(&args.scheme);
-    let mut series: Vec<SweepSeries> = Vec::new();
-    let mut angles = Vec::new();
-    let shard = args.shard.unwrap_or(Shard::WHOLE);
-    let steps: Vec<u32> = (0..args.angles)
-        .filter(|&step| shard.takes(step as usize))
-        .collect();
-    let progress = crate::progress::bar(steps.len() as u64, "sweep");
-    for step in steps {
-        progress.set_message(format!("angle {step}"));
-        let angle = 360.0 * f64::from(step) / f64::from(args.angles);
-        angles.push(angle);
-        let at_angle = SceneSpec {
-            view_degrees: angle,
-            ..spec.clone()
-        };
-        let orbit = at_angle.orbit();
-        let view = args
-            .schemes
-            .submission(at_angle.view(&scene, viewport).map_err(|e| e.to_string())?);
-        crate::oracle_memory::check(&view, args.schemes.memory_cap).map_err(|e| e.to_string())?;
-        let oracle = Oracle::build(&view);
-        let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
-        crate::approximate::check_effect(&judge, &args.approximate)?;
-        let depth_complexity = oracle.depth_complexity();
-        let sizing = args.schemes.sizing();
-        let mut runner = SchemeRunner::default();
-        for (i, &name) in schemes.iter().enumerate() {
-            let named = pool
-                .install(|| runner.run(name, executor, &view, &sizing))
-                .map_err(|e| e.to_string())?;
-            if series.len() <= i {
-                series.push(SweepSeries::named(&named.name));
-            }
-            let judged = judge.judge(&named.run.capture);
-            let rate = judged
-                .as_ref()
-                .map(|judged| judged.errors as f64 / judge.covered.max(1) as f64);
-            series[i].error_pixel_rate.push(rate);
-            series[i]
-                .colour
-                .push(ColourColumns::of(judged.as_ref().map(|j| j.colour)));
-            series[i].colour_by_depth.push(ColourByDepth::of(
-                judged.as_ref().map(|j| (j.reference, &j.image)),
-                &depth_complexity,
-            )?);
-            series[i].time_ms.push(
-                (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,
-            );
-            threads = named.run.stats.threads;
-        }
-        if !args.approximate.is_empty() {
-            let order = PrimitiveOrder::of_view(&view);
-            let raster_ms = pool
-                .install(|| crate::frame_timing::time_raster_alone(&view))
-                .as_secs_f64()
-                * 1e3;
-            let nodes = crate::approximate::nodes(args.schemes.k, &oracle);
-            for (j, &scheme) in args.approximate.iter().enumerate() {
-                let (row, _) = pool.install(|| {
-                    crate::approximate::measure(
-                        scheme, nodes, &judge, &oracle, &order, 1, raster_ms,
-                    )
-                })?;
-                let i = schemes.len() + j;
-                if series.len() <= i {
-                    series.push(SweepSeries::named(&row.scheme));
-                }
-                series[i].error_pixel_rate.push(Some(row.error_pixel_rate));
-                series[i].colour.push(row.colour);
-                series[i].colour_by_depth.push(row.colour_by_depth);
-                series[i].time_ms.push(row.time_ms);
-            }
-        }
-        progress.inc(1);
-    }
-    progress.finish_and_clear();
+pub(crate) fn sweep(args: &SweepArgs) -> Result<SweepReport, String> {
+    let params = SweepParams {
+        scene: args.scene.spec(Conventions::REFERENCE),
+        viewport: args.scene.viewport().map_err(|e| e.to_string())?,
+        schemes: SchemeChoice::expand(&args.scheme),
+        setup: args.schemes.setup(),
+        angles: args.angles,
+        effect: args.effect,
+        shard: args.shard.unwrap_or(Shard::WHOLE),
+        approximate: args.approximate.clone(),
+    };
+    let report = fragsim_measure::sweep::sweep(&params, &crate::progress::Bars::default())?;
     let context = Context::of_scene("sweep", &args.scene)?
         .sized(&args.schemes)
-        .on(executor.name(), threads);
-    write_outputs(args, &context, &angles, &series)?;
-    Ok(series)
+        .on(&report.executor, report.threads);
+    write_outputs(args, &context, &report.angles, &report.series)?;
+    Ok(report)
 }
 
 fn write_outputs(

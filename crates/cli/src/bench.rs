@@ -1,13 +1,112 @@
-//! What `bench` writes: its JSON Lines records, the terminal table, the Markdown report and the
-//! speed/accuracy chart.
+//! `fragsim bench`: the speed/accuracy trade of every scheme on one scene (the measurement is
+//! `fragsim_measure::bench`'s), and what it writes: its JSON Lines records, the terminal table,
+//! the Markdown report and the speed/accuracy chart.
 
+use std::path::PathBuf;
+
+use clap::Args;
+use fragsim_measure::approximate::{ApproximateName, ApproximateRow};
+use fragsim_measure::bench::{BenchParams, BenchReport, BenchRow};
+use fragsim_measure::colour_judge::EffectName;
+use fragsim_measure::images::Images;
+use fragsim_measure::multisampled::{MsaaReport, SampledRow};
+use fragsim_raster::Conventions;
 use serde::Serialize;
 
-use super::{BenchArgs, BenchReport, BenchRow};
-use crate::approximate::ApproximateRow;
-use crate::multisampled::SampledRow;
-use crate::record::{bucket_cells, mean_of_channels, percent};
-use crate::schemes::family;
+use crate::args::{SceneArgs, SchemeArgs, Shard};
+use crate::record::{bucket_cells, mean_of_channels, percent, Context};
+use crate::schemes::{family, SchemeChoice};
+
+/// Options of `fragsim bench`.
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// The scene.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Scheme sizing and executors.
+    #[command(flatten)]
+    pub schemes: SchemeArgs,
+    /// Schemes to run, comma-separated, or `all`.
+    #[arg(long, value_delimiter = ',', default_value = "all")]
+    pub scheme: Vec<SchemeChoice>,
+    /// Frames timed per scheme and executor (the median, min and max are reported).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: u32,
+    /// The effect whose image is compared with the oracle's.
+    #[arg(long, default_value = "transparency")]
+    pub effect: EffectName,
+    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart (its own,
+    /// so that the sweep's files do not mix with the bench's).
+    #[arg(long, default_value = "out/bench")]
+    pub out: PathBuf,
+    /// Print JSON Lines instead of the table: one record per scheme and executor
+    /// (`docs/json-schema.md`; bench.jsonl holds the same).
+    #[arg(long)]
+    pub json: bool,
+    /// Write no images (effect images, difference images, the chart); bench.jsonl and bench.md
+    /// are still written.
+    #[arg(long)]
+    pub no_images: bool,
+    /// Also measure multisampling at this many samples a pixel (1, 2, 4, 8 or 16: the standard
+    /// patterns, `docs/semantics.md` §11): the oracle's transparency image resolved from them
+    /// against the single-sample image (`bench-oracle-transparency-msaa<N>.png`, its difference
+    /// image and the `msaa` fields), and after the single-sample rows, one `bench-msaa` row per
+    /// multisampled scheme against the per-sample oracle: every `--scheme` run per sample
+    /// (storage × N), the masked-node A-buffer (`--capacity` nodes a pixel, each carrying a
+    /// coverage mask) and the masked-node linked list (a pool of `--capacity` nodes a pixel),
+    /// these two on the serial and parallel executors.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u32>,
+    /// Approximate OIT schemes to measure beside the catalog's, by their transparency image
+    /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub approximate: Vec<ApproximateName>,
+    /// Measure only shard I of N of the rows (cargo-nextest's `count:I/N`): of the (scheme,
+    /// executor) rows in `--scheme` × `--executor` order, then the `--approximate` rows, row `k`
+    /// (from 0) when `k mod N = I − 1`. The shards' bench.jsonl files together hold the
+    /// unsharded bench's rows (times apart; `vs DP` where depth peeling ran in the same shard).
+    /// Not with `--samples`.
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse, conflicts_with = "samples")]
+    pub shard: Option<Shard>,
+}
+
+/// Runs `bench`: measures, then writes and prints the report.
+///
+/// # Errors
+/// Scene, parameter or output errors.
+pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
+    let images = if args.no_images {
+        None
+    } else {
+        let context = Context::of_scene("bench", &args.scene)?;
+        Some(Images {
+            dir: args.out.clone(),
+            scene: format!(
+                "{}, view {}°, elevation {}°, {}x{}",
+                context.scene,
+                args.scene.view,
+                args.scene.elevation,
+                args.scene.width,
+                args.scene.height
+            ),
+        })
+    };
+    let params = BenchParams {
+        scene: args.scene.spec(Conventions::REFERENCE),
+        viewport: args.scene.viewport().map_err(|e| e.to_string())?,
+        schemes: SchemeChoice::expand(&args.scheme),
+        setup: args.schemes.setup(),
+        frames: args.frames,
+        effect: args.effect,
+        samples: args.samples,
+        approximate: args.approximate.clone(),
+        shard: args.shard.unwrap_or(Shard::WHOLE),
+        images,
+    };
+    let report = fragsim_measure::bench::bench(&params, &crate::progress::Bars::default())?;
+    write_outputs(&report, args)?;
+    Ok(report)
+}
 
 /// One line of bench's JSON Lines: a row with what the whole bench measured.
 #[derive(Serialize)]
@@ -42,18 +141,19 @@ struct SampledRecord<'a> {
 ///
 /// # Errors
 /// A file that cannot be written.
-pub(super) fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
+fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
+    let bench_context = Context::of_scene("bench", &args.scene)?.sized(&args.schemes);
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let mut lines = String::new();
     for row in &report.rows {
-        let context = report.context.on(&row.executor, row.threads);
+        let context = bench_context.on(&row.executor, row.threads);
         let record = BenchRecord { row, bench: report };
         lines.push_str(&crate::record::line("bench", &context, &record)?);
         lines.push('\n');
     }
     for row in &report.approximate {
-        let context = report.context.on("primitive-order", row.threads);
+        let context = bench_context.on("primitive-order", row.threads);
         let record = ApproximateRecord { row, bench: report };
         lines.push_str(&crate::record::line(
             "bench-approximate",
@@ -63,7 +163,7 @@ pub(super) fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<()
         lines.push('\n');
     }
     for row in report.msaa.iter().flat_map(|m| &m.rows) {
-        let context = report.context.on(&row.executor, row.threads);
+        let context = bench_context.on(&row.executor, row.threads);
         let record = SampledRecord { row, bench: report };
         lines.push_str(&crate::record::line("bench-msaa", &context, &record)?);
         lines.push('\n');
@@ -92,7 +192,7 @@ pub(super) fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<()
     } else {
         out!("{}", terminal_table(report));
         if let Some(msaa) = &report.msaa {
-            out!("\n{}", crate::multisampled::terminal_table(msaa));
+            out!("\n{}", msaa_terminal_table(msaa));
         }
         let tables = if report.msaa.is_some() {
             "every column, with their key, the per-depth tables and the multisampled table"
@@ -274,11 +374,11 @@ fn markdown(report: &BenchReport) -> String {
     }
     text.push_str(COLUMNS);
     if !report.approximate.is_empty() {
-        text.push_str(&crate::approximate::markdown(&report.approximate));
+        text.push_str(&approximate_markdown(&report.approximate));
     }
     text.push_str(&depth_markdown(report));
     if let Some(msaa) = &report.msaa {
-        text.push_str(&crate::multisampled::markdown(msaa));
+        text.push_str(&msaa_markdown(msaa));
     }
     text
 }
@@ -319,4 +419,143 @@ fn depth_markdown(report: &BenchReport) -> String {
          alone. JSON: `pixels_dc_5_8`, `error_pixels_dc_5_8`, `error_pixel_rate_dc_5_8`, \
          `mean_abs_error_dc_5_8`, … for every bucket, on every record.\n"
     )
+}
+
+/// bench.md's table of the approximate schemes, with what its columns mean.
+fn approximate_markdown(rows: &[ApproximateRow]) -> String {
+    let mut text = String::from(
+        "\nApproximate OIT (judged by the image: their storage holds colour, not lists)\n\n\
+         | scheme | nodes | memory B | B/px | px beyond nodes | EPR % | mean err | max err | PSNR dB | blend ms | frame ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let [mean, max, psnr] = r.colour.cells();
+        text.push_str(&format!(
+            "| {} | {} | {} | {:.1} | {} | {:.3} | {mean} | {max} | {psnr} | {:.2} | {:.2} |\n",
+            r.scheme,
+            r.nodes.map_or("-".into(), |k| k.to_string()),
+            r.memory_bytes,
+            r.bytes_per_pixel,
+            r.pixels_beyond_nodes,
+            r.error_pixel_rate * 100.0,
+            r.blend_ms,
+            r.time_ms,
+        ));
+    }
+    text.push_str(
+        "\nColumns: **nodes** per pixel (`--k`; WBOIT none); **memory B**, **B/px** the storage a \
+         GPU needs as the paper lays it out; **px beyond nodes** pixels with more fragments than \
+         nodes (WBOIT: more than one), the only pixels where the scheme may differ from the \
+         exact image; **EPR %**, **mean err**, **max err**, **PSNR dB** as above, of its \
+         transparency image; **blend ms** the median time of the blend over every pixel's \
+         fragments in primitive order; **frame ms** the rasterization alone plus the blend.\n",
+    );
+    text
+}
+
+/// What `bench --samples` prints on a terminal under the single-sample table: the line of
+/// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
+/// (bench.md holds every column and their key).
+fn msaa_terminal_table(msaa: &MsaaReport) -> String {
+    let columns: [crate::record::Column<SampledRow>; 10] = [
+        ("scheme", |r| r.scheme.clone()),
+        ("storage", |r| r.storage.to_string()),
+        ("executor", |r| r.executor.clone()),
+        ("passes", |r| r.passes.to_string()),
+        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
+        ("overflow", |r| {
+            format!("{} {}", r.overflowed, r.overflow_unit)
+        }),
+        ("lost", |r| r.lost.to_string()),
+        ("wrong samples", |r| r.wrong_samples.to_string()),
+        ("EPR %", |r| {
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
+        }),
+        ("frame ms", |r| format!("{:.2}", r.time_ms)),
+    ];
+    let mut text = msaa_markdown(msaa)
+        .lines()
+        .find(|line| !line.is_empty())
+        .unwrap_or_default()
+        .to_string();
+    text.push_str("\n\n");
+    text.push_str(&crate::record::aligned_table(&columns, &msaa.rows, 3));
+    text.push_str(
+        "Columns: overflow what found no room (sample fragments, or whole masked nodes); lost \
+         sample fragments the scheme owed and is missing (per-sample storage: beyond the \
+         overflow); wrong samples samples whose list differs from the per-sample oracle's; the \
+         rest as above.\n",
+    );
+    text
+}
+
+/// bench.md's table of the multisampled rows, with what its columns mean.
+fn msaa_markdown(msaa: &MsaaReport) -> String {
+    let percent = |part: u64, whole: u64| 100.0 * part as f64 / whole.max(1) as f64;
+    let mut text = format!(
+        "\nMultisampled schemes at {n} samples a pixel, against the per-sample oracle ({} sample \
+         fragments; its deepest pixel needs {} masked nodes)\n\n\
+         | scheme | storage | executor | thr | passes | slots | memory B | B/px | overflow | missing | lost | wrong samples | misordered | EPR % | mean err | max err | PSNR dB | passes ms | post ms | frame ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        msaa.sample_fragments,
+        msaa.max_nodes_per_pixel,
+        n = msaa.samples,
+    );
+    for r in &msaa.rows {
+        let [mean_error, max_error, psnr] = r.colour.cells();
+        text.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} {} | {} ({:.3} %) | {} | {} ({:.3} %) | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} |\n",
+            r.scheme,
+            r.storage,
+            r.executor,
+            r.threads,
+            r.passes,
+            r.slots.map_or_else(|| "counted".to_string(), |s| s.to_string()),
+            r.memory_bytes,
+            r.bytes_per_pixel,
+            r.overflowed,
+            r.overflow_unit,
+            r.missing,
+            percent(r.missing, r.sample_fragments),
+            r.lost,
+            r.wrong_samples,
+            100.0 * r.wrong_sample_rate,
+            r.misordered_samples,
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
+            mean_error,
+            max_error,
+            psnr,
+            r.passes_ms,
+            r.resolve_ms,
+            r.time_ms,
+        ));
+    }
+    text.push_str(
+        "
+Columns: **storage** `per-sample`: the scheme run on the sample-expanded framebuffer (its storage \
+× samples); `masked`: per-pixel nodes, one per primitive and pixel, each carrying the mask of the \
+samples it covers and the nearest of their depths, in `--capacity` slots a pixel \
+(`abuffer-masked`) or a pool of `--capacity` nodes a pixel shared by all (`linked-list-masked`); \
+**passes** geometry passes, its own counting pass included; **slots** slots a sample \
+(per-sample), nodes a pixel (masked A-buffer) or pool nodes a pixel (linked lists) the storage \
+had (`--k`, `--capacity`, or its counting pass's deepest pixel under `auto`; counted: a pool of \
+every node, storage sized per pixel); **memory B**, **B/px** \
+bytes allocated, in all and per pixel (all its samples); **overflow** what found no room: sample \
+fragments (per-sample storage, the oracle's prediction as above) or whole nodes (masked storage, \
+its counters' count: per pixel, or the pool's one counter); **missing** sample fragments of the \
+per-sample oracle missing from the scheme's per-sample resolve, the overflow's included, with \
+their share; **lost** of those, the ones the scheme owed: beyond the predicted overflow for \
+per-sample storage (as the single-sample table counts them: 0 for a correct scheme whatever K), \
+every missing one for masked storage (its overflow counts nodes); **wrong samples** samples whose list differs from \
+the per-sample oracle's, with their share of all samples; **misordered** of those, samples with \
+every fragment present in another order (a masked node orders all its samples by its nearest \
+depth); **EPR %**, **mean err**, **max err**, **PSNR dB** the transparency image shaded per \
+sample and box-resolved per pixel against the oracle's resolved the same way; **passes ms**, \
+**post ms**, **frame ms** medians of the geometry passes, the post pass and the frame (vertex \
+stage included).
+",
+    );
+    text
 }
