@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::args::{Count, SceneArgs, SchemeArgs};
 use fragsim_measure::colour_judge::ColourColumns;
 use fragsim_raster::{Conventions, SceneSpec};
-use fragsim_shade::colour_error::BucketError;
+use fragsim_shade::colour_error::BucketDeviation;
 
 /// A slot count as a record writes it: a number, or `"auto"` when the scene sized it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -199,7 +199,7 @@ pub fn percent(fraction: f64, decimals: usize) -> String {
 /// A table's cells of one bucket: its name, pixels, EPR % of them, and the colour error's mean,
 /// maximum and PSNR cells (as the whole image's: `inf` for a bucket equal to the oracle's).
 #[must_use]
-pub fn bucket_cells(bucket: &BucketError) -> [String; 6] {
+pub fn bucket_cells(bucket: &BucketDeviation) -> [String; 6] {
     let [mean, max, psnr] = ColourColumns::of(bucket.error).cells();
     [
         bucket.label(),

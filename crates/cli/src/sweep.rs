@@ -11,7 +11,7 @@ use fragsim_measure::colour_by_depth::ColourByDepth;
 use fragsim_measure::colour_judge::{ColourColumns, EffectName};
 use fragsim_measure::sweep::{SweepParams, SweepReport, SweepSeries};
 use fragsim_raster::Conventions;
-use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
+use fragsim_shade::colour_error::{BucketDeviation, ColourDeviation, DEPTH_BUCKETS};
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs, Shard};
@@ -314,12 +314,12 @@ fn print_depth_table(series: &[SweepSeries]) {
 /// error weighted by each angle's pixels (so it is the mean over every pixel of every angle in
 /// the bucket), the largest error, and the lowest PSNR of any angle; buckets without a pixel at
 /// any angle are left out.
-fn pooled_over_angles(angles: &[ColourByDepth]) -> Vec<BucketError> {
+fn pooled_over_angles(angles: &[ColourByDepth]) -> Vec<BucketDeviation> {
     DEPTH_BUCKETS
         .iter()
         .enumerate()
         .filter_map(|(i, &(lo, hi))| {
-            let at_angles: Vec<(u64, u64, ColourError)> = angles
+            let at_angles: Vec<(u64, u64, ColourDeviation)> = angles
                 .iter()
                 .filter_map(|a| a.buckets.get(i))
                 .filter_map(|b| Some((b.pixels, b.error_pixels, b.error?)))
@@ -334,12 +334,12 @@ fn pooled_over_angles(angles: &[ColourByDepth]) -> Vec<BucketError> {
                         / pixels as f64
                 };
                 let largest = |c: usize| at_angles.iter().map(|(_, _, e)| e.max_abs[c]).max();
-                BucketError {
+                BucketDeviation {
                     lo,
                     hi,
                     pixels,
                     error_pixels: at_angles.iter().map(|a| a.1).sum(),
-                    error: Some(ColourError {
+                    error: Some(ColourDeviation {
                         mean_abs: [0, 1, 2].map(weighted),
                         max_abs: [0, 1, 2].map(|c| largest(c).unwrap_or(0)),
                         psnr_db: at_angles

@@ -2,7 +2,7 @@
 //! `bench` and `sweep` rows and records carry it: where an approximate or lossy scheme's error
 //! lives is in the deep pixels, which the whole image's mean hides.
 
-use fragsim_shade::colour_error::{colour_error_by_depth, BucketError, DEPTH_BUCKETS};
+use fragsim_shade::colour_error::{colour_error_by_depth, BucketDeviation, DEPTH_BUCKETS};
 use image::RgbImage;
 use serde::Serialize;
 
@@ -19,7 +19,7 @@ use crate::colour_judge::ColourColumns;
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ColourByDepth {
     /// One entry per bucket of [`DEPTH_BUCKETS`], in order; empty where there is no image.
-    pub buckets: Vec<BucketError>,
+    pub buckets: Vec<BucketDeviation>,
 }
 
 impl ColourByDepth {
@@ -43,7 +43,7 @@ impl ColourByDepth {
     }
 
     /// The buckets with pixels in them.
-    pub fn covered(&self) -> impl Iterator<Item = &BucketError> {
+    pub fn covered(&self) -> impl Iterator<Item = &BucketDeviation> {
         self.buckets.iter().filter(|b| b.pixels > 0)
     }
 }

@@ -24,7 +24,7 @@ use fragsim_capture::{Capture, PixelLists};
 use fragsim_oracle::Oracle;
 use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
-use fragsim_shade::colour_error::{colour_error, ColourError};
+use fragsim_shade::colour_error::{colour_error, ColourDeviation};
 use fragsim_shade::deferred::{self, PerEntry};
 use fragsim_shade::effects::{self, Effect, Entries, Geometry, Material};
 use image::RgbImage;
@@ -95,7 +95,7 @@ pub struct ColourColumns {
 
 impl ColourColumns {
     /// The columns of `error`, where there is an image.
-    pub fn of(error: Option<ColourError>) -> Self {
+    pub fn of(error: Option<ColourDeviation>) -> Self {
         error.map_or_else(Self::default, |e| Self {
             mean_abs_error: Some(e.mean_abs),
             max_abs_error: Some(e.max_abs),
@@ -127,7 +127,7 @@ pub struct JudgedImage<'j> {
     /// Pixels whose 8-bit colour differs.
     pub errors: u64,
     /// How far its colours are from the oracle's.
-    pub colour: ColourError,
+    pub colour: ColourDeviation,
     /// What was completed or recomputed, if anything.
     pub pass: Option<AttributePass>,
 }

@@ -16,7 +16,7 @@
 //!
 //! **The error** of every row is against the per-sample oracle, whatever the storage: the sample
 //! fragments missing from the scheme's per-sample resolve, the samples whose list differs, and of
-//! those the misordered ones ([`SampleError`]); and the colour error of its transparency image,
+//! those the misordered ones ([`SampleDeviation`]); and the colour error of its transparency image,
 //! shaded per sample and box-resolved per pixel, against the oracle's image resolved the same
 //! way ([`ColourJudge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
@@ -24,7 +24,7 @@
 use fragsim_capture::catalog::{check_memory_cap_early, Count, SchemeName, SchemeRunner, Sizing};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
-use fragsim_oracle::samples::{SampleError, SampleOracle};
+use fragsim_oracle::samples::{SampleDeviation, SampleOracle};
 use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
 use serde::Serialize;
@@ -285,7 +285,7 @@ fn rows(
     let samples = oracle.pattern().count();
     let mut rows = Vec::new();
     // The row of a first frame's per-sample lists and its times; the image unless --no-images.
-    let mut row = |common: Common, error: SampleError, judged: Option<JudgedImage<'_>>| {
+    let mut row = |common: Common, error: SampleDeviation, judged: Option<JudgedImage<'_>>| {
         let times = &common.times;
         if let (Some(images), Some(j)) = (bench.images, &judged) {
             images.save_with_difference(
