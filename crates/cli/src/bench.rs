@@ -16,6 +16,7 @@ use serde::Serialize;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::record::{bucket_cells, mean_of_channels, percent, Context};
 use crate::schemes::{family, SchemeChoice};
+use crate::table::{Column, Table};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -267,7 +268,7 @@ median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments p
 /// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
 /// first, aligned, in about 120 characters (bench.md holds all 26).
 fn terminal_table(report: &BenchReport) -> String {
-    let columns: [crate::record::Column<BenchRow>; 10] = [
+    let columns: [Column<BenchRow>; 10] = [
         ("scheme", |r| r.scheme.clone()),
         ("executor", |r| r.executor.clone()),
         ("passes", |r| r.passes.to_string()),
@@ -291,7 +292,7 @@ fn terminal_table(report: &BenchReport) -> String {
         .unwrap_or_default()
         .to_string();
     text.push_str("\n\n");
-    text.push_str(&crate::record::aligned_table(&columns, &report.rows, 2));
+    text.push_str(&Table::of(&columns, &report.rows, 2).text(2));
     text.push_str(
         "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
          should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
@@ -457,7 +458,7 @@ fn approximate_markdown(rows: &[ApproximateRow]) -> String {
 /// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
 /// (bench.md holds every column and their key).
 fn msaa_terminal_table(msaa: &MsaaReport) -> String {
-    let columns: [crate::record::Column<SampledRow>; 10] = [
+    let columns: [Column<SampledRow>; 10] = [
         ("scheme", |r| r.scheme.clone()),
         ("storage", |r| r.storage.to_string()),
         ("executor", |r| r.executor.clone()),
@@ -480,7 +481,7 @@ fn msaa_terminal_table(msaa: &MsaaReport) -> String {
         .unwrap_or_default()
         .to_string();
     text.push_str("\n\n");
-    text.push_str(&crate::record::aligned_table(&columns, &msaa.rows, 3));
+    text.push_str(&Table::of(&columns, &msaa.rows, 3).text(2));
     text.push_str(
         "Columns: overflow what found no room (sample fragments, or whole masked nodes); lost \
          sample fragments the scheme owed and is missing (per-sample storage: beyond the \

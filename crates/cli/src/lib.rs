@@ -54,6 +54,7 @@ pub mod record;
 mod render;
 mod schemes;
 mod sweep;
+mod table;
 
 use std::process::ExitCode;
 

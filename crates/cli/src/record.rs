@@ -211,53 +211,9 @@ pub fn bucket_cells(bucket: &BucketDeviation) -> [String; 6] {
     ]
 }
 
-/// A column of a terminal table: its heading, and the cell it shows of a row.
-pub(crate) type Column<Row> = (&'static str, fn(&Row) -> String);
-
-/// A terminal table of `rows`, one column per `(heading, cell)`: each column as wide as its
-/// widest cell, the first `left` columns (names) aligned left and the rest (numbers) right, two
-/// spaces between columns, a line a row under the line of headings.
-pub(crate) fn aligned_table<Row>(columns: &[Column<Row>], rows: &[Row], left: usize) -> String {
-    let mut cells = vec![columns
-        .iter()
-        .map(|(heading, _)| (*heading).to_string())
-        .collect::<Vec<_>>()];
-    cells.extend(
-        rows.iter()
-            .map(|row| columns.iter().map(|(_, cell)| cell(row)).collect()),
-    );
-    let widths: Vec<usize> = (0..columns.len())
-        .map(|c| {
-            cells
-                .iter()
-                .map(|line| line[c].chars().count())
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
-    let mut text = String::new();
-    for line in &cells {
-        let padded: Vec<String> = line
-            .iter()
-            .zip(&widths)
-            .enumerate()
-            .map(|(c, (cell, &w))| {
-                if c < left {
-                    format!("{cell:<w$}")
-                } else {
-                    format!("{cell:>w$}")
-                }
-            })
-            .collect();
-        text.push_str(padded.join("  ").trim_end());
-        text.push('\n');
-    }
-    text
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{aligned_table, percent, Column};
+    use super::percent;
 
     #[test]
     fn a_rate_that_is_not_zero_never_prints_as_zero() {
@@ -266,19 +222,5 @@ mod tests {
         assert_eq!(percent(1e-7, 4), "<0.0001", "the cell's own precision");
         assert_eq!(percent(0.012_34, 3), "1.234", "rounded as before");
         assert_eq!(percent(1.0, 3), "100.000", "every pixel");
-    }
-
-    #[test]
-    fn an_aligned_table_pads_names_left_and_numbers_right() {
-        type Row = (&'static str, u32);
-        let columns: [Column<Row>; 2] = [
-            ("scheme", |r| r.0.to_string()),
-            ("lost", |r| r.1.to_string()),
-        ];
-        let text = aligned_table(&columns, &[("mdts", 0), ("kbuffer-stores", 1234)], 1);
-        assert_eq!(
-            text, "scheme          lost\nmdts               0\nkbuffer-stores  1234\n",
-            "{text}"
-        );
     }
 }
