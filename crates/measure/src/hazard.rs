@@ -62,21 +62,43 @@ pub enum Campaign {
 /// # Errors
 /// No machine, no seed or zero threads in flight; scene, memory or scheme errors.
 pub fn hazard(params: &HazardParams, progress: &dyn Progress) -> Result<HazardReport, String> {
-    if params.write_back.is_empty() {
-        return Err("hazard needs at least one machine (write-back)".into());
-    }
     let spec = &params.scene;
     let scene = spec.load(None).map_err(|e| e.to_string())?;
     let view = spec
         .view(&scene, params.viewport)
         .map_err(|e| e.to_string())?;
-    fragsim_oracle::memory_cap::check(&view, MEMORY_CAP_DEFAULT).map_err(|e| e.to_string())?;
-    let oracle = Oracle::build(&view);
+    hazard_in_view(
+        &view,
+        crate::scene_name(spec),
+        &params.write_back,
+        &params.campaign,
+        progress,
+    )
+}
+
+/// [`hazard`] in a view already made (a scene given as arrays, which no spec loads), the scene
+/// named `scene` in the report.
+///
+/// # Errors
+/// No machine, no seed or zero threads in flight; memory or scheme errors.
+pub fn hazard_in_view(
+    view: &View<'_>,
+    scene: String,
+    write_back: &[WriteBack],
+    campaign: &Campaign,
+    progress: &dyn Progress,
+) -> Result<HazardReport, String> {
+    if write_back.is_empty() {
+        return Err("hazard needs at least one machine (write-back)".into());
+    }
+    fragsim_oracle::memory_cap::check(view, MEMORY_CAP_DEFAULT).map_err(|e| e.to_string())?;
+    let oracle = Oracle::build(view);
     let in_bucket = covered_by_bucket(&oracle);
+    let viewport = view.viewport();
     let mut report = HazardReport {
-        scene: crate::scene_name(spec),
-        width: params.viewport.width,
-        height: params.viewport.height,
+        scene,
+        width: viewport.width,
+        height: viewport.height,
         k: 0,
         covered: in_bucket.iter().sum(),
         fragments: oracle.fragments(),
@@ -88,7 +110,7 @@ pub fn hazard(params: &HazardParams, progress: &dyn Progress) -> Result<HazardRe
         rows: Vec::new(),
         baselines: Vec::new(),
     };
-    match &params.campaign {
+    match campaign {
         Campaign::Rates {
             k,
             threads_in_flight,
@@ -99,8 +121,8 @@ pub fn hazard(params: &HazardParams, progress: &dyn Progress) -> Result<HazardRe
             }
             report.k = *k;
             report.rows = rates(
-                params,
-                (&view, &oracle),
+                write_back,
+                (view, &oracle),
                 (*k, threads_in_flight, *seeds),
                 progress,
             )?;
@@ -108,13 +130,13 @@ pub fn hazard(params: &HazardParams, progress: &dyn Progress) -> Result<HazardRe
         Campaign::Baselines { ks } => {
             // The output lists hold every layer (as `render` sizes them).
             let layers = oracle.max_depth_complexity().max(1);
-            let table = baselines::table(params.viewport, ks, &params.write_back, layers)?;
+            let table = baselines::table(viewport, ks, write_back, layers)?;
             progress.begin(table.len() as u64, "hazard --baselines");
             for baseline in table {
                 progress.message(&format!("{} K = {}", baseline.scheme, baseline.k));
                 report
                     .baselines
-                    .extend(baselines::rows(&baseline, &view, &oracle)?);
+                    .extend(baselines::rows(&baseline, view, &oracle)?);
                 progress.step();
             }
             progress.end();
@@ -124,20 +146,20 @@ pub fn hazard(params: &HazardParams, progress: &dyn Progress) -> Result<HazardRe
 }
 
 /// The rows of a `Rates` campaign of `k` slots, `threads_in_flight` and `seeds` on `view`
-/// and its oracle: every machine, policy and number of threads in flight.
+/// and its oracle: every machine of `write_back`, policy and number of threads in flight.
 fn rates(
-    params: &HazardParams,
+    write_back: &[WriteBack],
     (view, oracle): (&View<'_>, &Oracle),
     (k, threads_in_flight, seeds): (u32, &[usize], u64),
     progress: &dyn Progress,
 ) -> Result<Vec<HazardRow>, String> {
     progress.begin(
-        (params.write_back.len() * POLICIES.len() * threads_in_flight.len()) as u64,
+        (write_back.len() * POLICIES.len() * threads_in_flight.len()) as u64,
         "hazard",
     );
     let mut rows = Vec::new();
-    for &machine in &params.write_back {
-        let scheme = KBuffer::with_write_back(params.viewport, k, machine, MEMORY_CAP_DEFAULT)
+    for &machine in write_back {
+        let scheme = KBuffer::with_write_back(view.viewport(), k, machine, MEMORY_CAP_DEFAULT)
             .map_err(|e| e.to_string())?;
         for policy in POLICIES {
             for &in_flight in threads_in_flight {
@@ -155,4 +177,12 @@ fn rates(
     }
     progress.end();
     Ok(rows)
+}
+
+/// The machine that rows and reports name `name` (`render-target`, `separate-stores`), if any.
+#[must_use]
+pub fn machine_named(name: &str) -> Option<WriteBack> {
+    [WriteBack::RenderTarget, WriteBack::SeparateStores]
+        .into_iter()
+        .find(|&machine| machine_name(machine) == name)
 }
