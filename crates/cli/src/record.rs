@@ -10,9 +10,7 @@
 use serde::Serialize;
 
 use crate::args::{Count, SceneArgs, SchemeArgs};
-use fragsim_measure::colour_judge::ColourColumns;
 use fragsim_raster::{Conventions, SceneSpec};
-use fragsim_shade::colour_error::BucketDeviation;
 
 /// A slot count as a record writes it: a number, or `"auto"` when the scene sized it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -173,54 +171,4 @@ pub fn emit<T: Serialize>(
 ) -> Result<(), String> {
     outln!("{}", line(record, context, fields)?);
     Ok(())
-}
-
-/// The mean absolute error of an image over its three channels, as tables and charts print it
-/// (`None`: no image).
-#[must_use]
-pub fn mean_of_channels(colour: &ColourColumns) -> Option<f64> {
-    colour.mean_abs_error.map(|m| m.iter().sum::<f64>() / 3.0)
-}
-
-/// `fraction` as a percentage with `decimals` decimals for a table cell, where a rate that is not
-/// zero never prints as zero: one error pixel in a million is `<0.001`, not `0.000` beside a
-/// colour error of 68.
-#[must_use]
-pub fn percent(fraction: f64, decimals: usize) -> String {
-    let percent = fraction * 100.0;
-    let smallest = 10_f64.powi(-i32::try_from(decimals).unwrap_or(i32::MAX));
-    if percent > 0.0 && percent < smallest / 2.0 {
-        format!("<{smallest:.decimals$}")
-    } else {
-        format!("{percent:.decimals$}")
-    }
-}
-
-/// A table's cells of one bucket: its name, pixels, EPR % of them, and the colour error's mean,
-/// maximum and PSNR cells (as the whole image's: `inf` for a bucket equal to the oracle's).
-#[must_use]
-pub fn bucket_cells(bucket: &BucketDeviation) -> [String; 6] {
-    let [mean, max, psnr] = ColourColumns::of(bucket.error).cells();
-    [
-        bucket.label(),
-        bucket.pixels.to_string(),
-        percent(bucket.error_pixels as f64 / bucket.pixels.max(1) as f64, 3),
-        mean,
-        max,
-        psnr,
-    ]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::percent;
-
-    #[test]
-    fn a_rate_that_is_not_zero_never_prints_as_zero() {
-        assert_eq!(percent(0.0, 3), "0.000", "zero is zero");
-        assert_eq!(percent(1e-6, 3), "<0.001", "one pixel in a million");
-        assert_eq!(percent(1e-7, 4), "<0.0001", "the cell's own precision");
-        assert_eq!(percent(0.012_34, 3), "1.234", "rounded as before");
-        assert_eq!(percent(1.0, 3), "100.000", "every pixel");
-    }
 }

@@ -7,16 +7,17 @@ use std::path::PathBuf;
 
 use clap::Args;
 use fragsim_measure::approximate::ApproximateName;
+use fragsim_measure::cells::{bucket_cells, family, mean_of_channels, percent};
 use fragsim_measure::colour_by_depth::ColourByDepth;
 use fragsim_measure::colour_judge::{ColourColumns, EffectName};
 use fragsim_measure::sweep::{SweepParams, SweepReport, SweepSeries};
 use fragsim_raster::Conventions;
-use fragsim_shade::colour_error::{BucketDeviation, ColourDeviation, DEPTH_BUCKETS};
 use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs, Shard};
-use crate::record::{bucket_cells, mean_of_channels, percent, Context};
-use crate::schemes::{family, SchemeChoice};
+use crate::record::Context;
+use crate::schemes::SchemeChoice;
+use crate::table::Table;
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -203,16 +204,21 @@ fn print_summary(
         eprintln!("{wrote}");
         return Ok(());
     }
-    outln!(
-        "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12}",
-        "scheme",
-        "mean EPR %",
-        "max EPR %",
-        "mean err",
-        "max err",
-        "min PSNR dB",
-        "mean ms"
-    );
+    let mut table = Table::new(
+        [
+            "scheme",
+            "mean EPR %",
+            "max EPR %",
+            "mean err",
+            "max err",
+            "min PSNR dB",
+            "mean ms",
+        ]
+        .map(String::from)
+        .into(),
+        1,
+    )
+    .at_least(vec![20, 12, 12, 10, 8, 12, 12]);
     for s in series {
         let rates: Vec<f64> = s.error_pixel_rate.iter().flatten().copied().collect();
         let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| percent(r, 4));
@@ -223,17 +229,17 @@ fn print_summary(
             .map_or("n/a".into(), |r| percent(r, 4));
         let mean_ms = mean(s.time_ms.iter().copied()).unwrap_or(0.0);
         let [mean_error, max_error, psnr] = colour_over_angles(&s.colour);
-        outln!(
-            "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12.2}",
-            s.scheme,
+        table.push(vec![
+            s.scheme.clone(),
             mean_rate,
             max_rate,
             mean_error,
             max_error,
             psnr,
-            mean_ms
-        );
+            format!("{mean_ms:.2}"),
+        ]);
     }
+    out!("{}", table.text(1));
     // The two kinds of figure count different things: say which, so that a small rate beside a
     // large error (one pixel far off) reads as it is.
     outln!(
@@ -274,8 +280,8 @@ fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
 }
 
 /// The sweep's second table: each scheme's colour error per depth-complexity bucket, pooled
-/// over the angles ([`pooled_over_angles`]); schemes whose images all resolve and all equal the
-/// oracle's are left out, as are empty buckets.
+/// over the angles ([`SweepSeries::colour_by_depth_over_angles`]); schemes whose images all
+/// resolve and all equal the oracle's are left out, as are empty buckets.
 fn print_depth_table(series: &[SweepSeries]) {
     let differing = |s: &&SweepSeries| {
         s.colour_by_depth
@@ -283,72 +289,32 @@ fn print_depth_table(series: &[SweepSeries]) {
             .flat_map(ColourByDepth::covered)
             .any(|b| b.error_pixels > 0)
     };
-    let mut header = true;
+    let mut table = Table::new(
+        [
+            "scheme",
+            "fragments/px",
+            "pixels",
+            "EPR %",
+            "mean err",
+            "max err",
+            "min PSNR dB",
+        ]
+        .map(String::from)
+        .into(),
+        1,
+    )
+    .at_least(vec![20, 12, 10, 10, 10, 8, 12]);
     for s in series.iter().filter(differing) {
-        if std::mem::take(&mut header) {
-            outln!(
-                "\ncolour error per depth-complexity bucket (fragments per pixel), over every angle"
-            );
-            outln!(
-                "{:<20} {:>12} {:>10} {:>10} {:>10} {:>8} {:>12}",
-                "scheme",
-                "fragments/px",
-                "pixels",
-                "EPR %",
-                "mean err",
-                "max err",
-                "min PSNR dB"
-            );
-        }
-        for bucket in pooled_over_angles(&s.colour_by_depth) {
-            let [label, pixels, rate, mean, max, psnr] = bucket_cells(&bucket);
-            outln!(
-                "{:<20} {label:>12} {pixels:>10} {rate:>10} {mean:>10} {max:>8} {psnr:>12}",
-                s.scheme
-            );
+        for bucket in s.colour_by_depth_over_angles() {
+            let mut row = vec![s.scheme.clone()];
+            row.extend(bucket_cells(&bucket));
+            table.push(row);
         }
     }
-}
-
-/// One scheme's buckets over every angle: pixels and error pixels summed, the mean absolute
-/// error weighted by each angle's pixels (so it is the mean over every pixel of every angle in
-/// the bucket), the largest error, and the lowest PSNR of any angle; buckets without a pixel at
-/// any angle are left out.
-fn pooled_over_angles(angles: &[ColourByDepth]) -> Vec<BucketDeviation> {
-    DEPTH_BUCKETS
-        .iter()
-        .enumerate()
-        .filter_map(|(i, &(lo, hi))| {
-            let at_angles: Vec<(u64, u64, ColourDeviation)> = angles
-                .iter()
-                .filter_map(|a| a.buckets.get(i))
-                .filter_map(|b| Some((b.pixels, b.error_pixels, b.error?)))
-                .collect();
-            let pixels: u64 = at_angles.iter().map(|a| a.0).sum();
-            (pixels > 0).then(|| {
-                let weighted = |c: usize| {
-                    at_angles
-                        .iter()
-                        .map(|(n, _, e)| e.mean_abs[c] * *n as f64)
-                        .sum::<f64>()
-                        / pixels as f64
-                };
-                let largest = |c: usize| at_angles.iter().map(|(_, _, e)| e.max_abs[c]).max();
-                BucketDeviation {
-                    lo,
-                    hi,
-                    pixels,
-                    error_pixels: at_angles.iter().map(|a| a.1).sum(),
-                    error: Some(ColourDeviation {
-                        mean_abs: [0, 1, 2].map(weighted),
-                        max_abs: [0, 1, 2].map(|c| largest(c).unwrap_or(0)),
-                        psnr_db: at_angles
-                            .iter()
-                            .map(|(_, _, e)| e.psnr_db)
-                            .fold(f64::INFINITY, f64::min),
-                    }),
-                }
-            })
-        })
-        .collect()
+    if !table.is_empty() {
+        outln!(
+            "\ncolour error per depth-complexity bucket (fragments per pixel), over every angle"
+        );
+        out!("{}", table.text(1));
+    }
 }

@@ -1,7 +1,7 @@
 //! The one table printer of the command line's terminal output: `render`'s summary, `bench`'s
-//! tables and `explain`'s step-by-step table are each a [`Table`] (headings, rows of cells, each
-//! column as wide as its widest cell), laid out as aligned text or as a Markdown table, so that
-//! no command lays out columns by hand.
+//! and `sweep`'s tables and `explain`'s step-by-step table are each a [`Table`] (headings, rows
+//! of cells, each column as wide as its widest cell), laid out as aligned text or as a Markdown
+//! table, so that no command lays out columns by hand.
 
 /// A column of a table of `Row`s: its heading, and the cell it shows of a row.
 pub(crate) type Column<Row> = (&'static str, fn(&Row) -> String);
@@ -55,6 +55,11 @@ impl Table {
     pub(crate) fn push(&mut self, cells: Vec<String>) {
         debug_assert_eq!(cells.len(), self.headings.len(), "one cell a column");
         self.rows.push(cells);
+    }
+
+    /// Whether the table has no row.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.rows.is_empty()
     }
 
     /// Each column's width: its widest cell or heading, at least its least width.
@@ -132,7 +137,7 @@ mod tests {
         );
         let wide = table.at_least(vec![0, 6]).text(1);
         assert_eq!(
-            wide, "scheme           lost\nmdts                0\nkbuffer-stores    1234\n",
+            wide, "scheme           lost\nmdts                0\nkbuffer-stores   1234\n",
             "{wide}"
         );
     }

@@ -22,6 +22,8 @@ use crate::images::Images;
 use crate::multisampled::MsaaReport;
 use crate::{Progress, SchemeSetup, Shard};
 
+pub mod report;
+
 /// What `bench` measures, and how.
 #[derive(Debug, Clone)]
 pub struct BenchParams {

@@ -22,6 +22,8 @@ use fragsim_raster::{SceneSpec, View, Viewport};
 
 use crate::Progress;
 
+pub mod report;
+
 /// What `hazard` measures.
 #[derive(Debug, Clone)]
 pub struct HazardParams {

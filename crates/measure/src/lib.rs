@@ -5,12 +5,14 @@
 //!
 //! Why a crate of its own: the command line (`fragsim-cli`) is clap glue and printing, and the
 //! Python package and a backend's own bench call the same measurements. Each measurement takes a
-//! plain parameter struct and returns plain result structs; it never prints. What it has to say
-//! while it runs (steps done, a warning) goes to the caller's [`Progress`]; the only files it
-//! writes are the effect images a caller asks for ([`images::Images`]).
+//! plain parameter struct and returns plain result structs; its reports (Markdown, charts) are
+//! functions of those. It never prints: what it has to say while it runs (steps done, a warning)
+//! goes to the caller's [`Progress`], and the only files it writes are the images and charts a
+//! caller asks for ([`images::Images`], the reports' charts).
 
 pub mod approximate;
 pub mod bench;
+pub mod cells;
 pub mod colour_by_depth;
 pub mod colour_judge;
 pub mod frame_timing;

@@ -6,6 +6,7 @@ use fragsim_capture::catalog::{SchemeName, SchemeRunner};
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::Oracle;
 use fragsim_raster::{SceneSpec, Viewport};
+use fragsim_shade::colour_error::{BucketDeviation, ColourDeviation, DEPTH_BUCKETS};
 use serde::Serialize;
 
 use crate::approximate::ApproximateName;
@@ -71,6 +72,51 @@ impl SweepSeries {
             colour_by_depth: Vec::new(),
             time_ms: Vec::new(),
         }
+    }
+
+    /// Its buckets over every angle: pixels and error pixels summed, the mean absolute
+    /// error weighted by each angle's pixels (so it is the mean over every pixel of every angle in
+    /// the bucket), the largest error, and the lowest PSNR of any angle; buckets without a pixel at
+    /// any angle are left out.
+    #[must_use]
+    pub fn colour_by_depth_over_angles(&self) -> Vec<BucketDeviation> {
+        let angles = &self.colour_by_depth;
+        DEPTH_BUCKETS
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &(lo, hi))| {
+                let at_angles: Vec<(u64, u64, ColourDeviation)> = angles
+                    .iter()
+                    .filter_map(|a| a.buckets.get(i))
+                    .filter_map(|b| Some((b.pixels, b.error_pixels, b.error?)))
+                    .collect();
+                let pixels: u64 = at_angles.iter().map(|a| a.0).sum();
+                (pixels > 0).then(|| {
+                    let weighted = |c: usize| {
+                        at_angles
+                            .iter()
+                            .map(|(n, _, e)| e.mean_abs[c] * *n as f64)
+                            .sum::<f64>()
+                            / pixels as f64
+                    };
+                    let largest = |c: usize| at_angles.iter().map(|(_, _, e)| e.max_abs[c]).max();
+                    BucketDeviation {
+                        lo,
+                        hi,
+                        pixels,
+                        error_pixels: at_angles.iter().map(|a| a.1).sum(),
+                        error: Some(ColourDeviation {
+                            mean_abs: [0, 1, 2].map(weighted),
+                            max_abs: [0, 1, 2].map(|c| largest(c).unwrap_or(0)),
+                            psnr_db: at_angles
+                                .iter()
+                                .map(|(_, _, e)| e.psnr_db)
+                                .fold(f64::INFINITY, f64::min),
+                        }),
+                    }
+                })
+            })
+            .collect()
     }
 }
 
