@@ -90,8 +90,16 @@ pub fn hazard_in_view(
     campaign: &Campaign,
     progress: &dyn Progress,
 ) -> Result<HazardReport, String> {
-    if write_back.is_empty() {
-        return Err("hazard needs at least one machine (write-back)".into());
+    let nothing_to_run = match campaign {
+        Campaign::Rates {
+            threads_in_flight,
+            seeds,
+            ..
+        } => threads_in_flight.contains(&0) || *seeds == 0,
+        Campaign::Baselines { .. } => false,
+    };
+    if write_back.is_empty() || nothing_to_run {
+        return Err("hazard needs threads in flight ≥ 1, at least one seed and one machine".into());
     }
     fragsim_oracle::memory_cap::check(view, MEMORY_CAP_DEFAULT).map_err(|e| e.to_string())?;
     let oracle = Oracle::build(view);
@@ -118,9 +126,6 @@ pub fn hazard_in_view(
             threads_in_flight,
             seeds,
         } => {
-            if threads_in_flight.contains(&0) || *seeds == 0 {
-                return Err("hazard needs threads in flight ≥ 1 and at least one seed".into());
-            }
             report.k = *k;
             report.rows = rates(
                 write_back,
