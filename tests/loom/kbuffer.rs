@@ -139,9 +139,10 @@ fn negative_control_rmw_kbuffer_separate_stores_2_threads_k3_loses_a_fragment() 
 /// Render-target write-backs (2 threads, K = 3, exhaustive): the pixel lock really makes a read
 /// and a write-back one step each under loom's memory model, so no interleaving tears a
 /// write-back (every list sorted, distinct, made of inserted values), yet stale reads lose a
-/// fragment in some interleavings and none in others. (Three threads: `tests/suite/kbuffer.rs` drives
-/// all 90 step interleavings; under loom a preemption bound stops a waiting thread from yielding
-/// to the lock's holder, and the unbounded model is too large for the suite.)
+/// fragment in some interleavings and none in others. (Three threads:
+/// `tests/suite/kbuffer/single.rs` drives all 90 step interleavings; under loom a preemption
+/// bound stops a waiting thread from yielding to the lock's holder, and the unbounded model is
+/// too large for the suite.)
 #[test]
 fn kbuffer_render_target_2_threads_k3_only_loses() {
     let list = fragments(&DISTINCT[..2]);

@@ -10,6 +10,8 @@ use fragsim_raster::{Conventions, DepthRange, Scene, VertexPrecision, View, Wind
 
 pub use fragsim_capture::catalog::Count;
 use fragsim_capture::catalog::Sizing;
+use fragsim_measure::SchemeSetup;
+pub use fragsim_measure::Shard;
 use fragsim_oracle::dump::{Encoding, ListNumbering, Payload, SlotOrder};
 pub use fragsim_raster::scene_spec::args::SceneArgs;
 
@@ -169,27 +171,15 @@ pub struct SchemeArgs {
 }
 
 impl SchemeArgs {
-    /// `view` with its triangles submitted in `--shuffle`'s order, where one is given.
+    /// The setup of the measurements' scheme runs.
     #[must_use]
-    pub fn submission<'m>(&self, view: View<'m>) -> View<'m> {
-        match self.shuffle {
-            Some(seed) => view.shuffled(seed),
-            None => view,
+    pub fn setup(&self) -> SchemeSetup {
+        SchemeSetup {
+            sizing: self.sizing(),
+            executors: self.executors().to_vec(),
+            threads: self.threads.map(|t| t as usize),
+            shuffle: self.shuffle,
         }
-    }
-
-    /// The rayon pool of `--threads`.
-    ///
-    /// # Errors
-    /// The pool cannot be built.
-    pub fn pool(&self) -> Result<rayon::ThreadPool, String> {
-        let threads = self
-            .threads
-            .map_or_else(rayon::current_num_threads, |t| t as usize);
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| e.to_string())
     }
 
     /// The executors chosen.
@@ -248,51 +238,4 @@ pub enum ExecutorChoice {
     Scheduled,
     /// Serial, parallel and tiled.
     All,
-}
-
-/// `--shard I/N`: shard `I` of `N` (from 1) of a campaign split over machines, in
-/// cargo-nextest's `--partition count:I/N` convention (`count:I/N` is accepted too): item `k`
-/// (from 0) of the campaign's fixed order belongs to shard `k mod N + 1`, so the `N` shards are
-/// disjoint, deterministic, and together exactly the unsharded run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Shard {
-    /// This shard, from 1.
-    pub index: u32,
-    /// Shards in all.
-    pub count: u32,
-}
-
-impl Shard {
-    /// The whole campaign, unsharded.
-    pub const WHOLE: Self = Self { index: 1, count: 1 };
-
-    /// Parses `I/N` or `count:I/N`.
-    ///
-    /// # Errors
-    /// Any other form, `N` = 0, or `I` outside `1..=N`.
-    pub fn parse(text: &str) -> Result<Self, String> {
-        let form = || format!("{text:?} is not I/N (shard I of N, from 1; nextest's count:I/N)");
-        let bare = text.strip_prefix("count:").unwrap_or(text);
-        let (index, count) = bare.split_once('/').ok_or_else(form)?;
-        let number = |field: &str| field.trim().parse::<u32>().map_err(|_| form());
-        let (index, count) = (number(index)?, number(count)?);
-        if count == 0 || !(1..=count).contains(&index) {
-            return Err(format!(
-                "--shard {text}: the shard must be between 1 and the count, which must be at least 1"
-            ));
-        }
-        Ok(Self { index, count })
-    }
-
-    /// Whether item `k` (from 0, in the campaign's order) is this shard's.
-    #[must_use]
-    pub fn takes(self, k: usize) -> bool {
-        k % self.count as usize == (self.index - 1) as usize
-    }
-}
-
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
 }

@@ -34,6 +34,8 @@ use fragsim_explain::interleaving::{
 use fragsim_explain::{kbuffer, mdts, Shown};
 use fragsim_raster::{Fragment, Viewport};
 
+use crate::table::Table;
+
 /// A catalog scheme `explain` can explain ([`Shown::of`]), on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ExplainedScheme(pub SchemeName);
@@ -446,7 +448,7 @@ fn table(
     );
     header.push("memory after".into());
     header.extend(extra.iter().map(|(title, _)| (*title).to_string()));
-    let mut rows = vec![header];
+    let mut table = Table::new(header, usize::MAX);
     for (i, (events, m)) in trace.steps().zip(memory).enumerate() {
         let mut row = vec![i.to_string()];
         row.extend((0..threads).map(|t| {
@@ -461,24 +463,7 @@ fn table(
             m.iter().map(|&v| value(v)).collect::<Vec<_>>().join(", ")
         ));
         row.extend(extra.iter().map(|(_, cells)| cells[i].clone()));
-        rows.push(row);
+        table.push(row);
     }
-    let columns = rows[0].len();
-    let widths: Vec<usize> = (0..columns)
-        .map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
-        .collect();
-    let mut out = String::new();
-    for (r, row) in rows.iter().enumerate() {
-        let line: Vec<String> = row
-            .iter()
-            .zip(&widths)
-            .map(|(s, &w)| format!("{s}{}", " ".repeat(w - s.chars().count())))
-            .collect();
-        let _ = writeln!(out, "| {} |", line.join(" | "));
-        if r == 0 {
-            let rule: Vec<String> = widths.iter().map(|&w| "-".repeat(w)).collect();
-            let _ = writeln!(out, "|-{}-|", rule.join("-|-"));
-        }
-    }
-    out
+    table.markdown()
 }

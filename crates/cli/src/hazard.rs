@@ -7,29 +7,21 @@
 //! (uniform random, lockstep warps), each width `W` and each seed, the k-buffer runs the scene one
 //! fragment per thread under the scheduled executor, and `Oracle::diff` counts the covered pixels
 //! whose list differs from the oracle's `K` nearest (a fragment lost, duplicated or out of order).
-//! The measurements are `fragsim_explain::hazard`'s and `fragsim_explain::baselines`'s; this
-//! module holds the options, the progress lines and the tables and plots written.
+//! The measurement and its reports (hazard.md, baselines.md, the charts) are
+//! `fragsim_measure::hazard`'s; this module holds the options, the JSON Lines records and what is
+//! printed and written where.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_capture::schemes::kbuffer::KBuffer;
-use fragsim_capture::MEMORY_CAP_DEFAULT;
-use fragsim_explain::baselines;
-use fragsim_explain::hazard::{covered_by_bucket, machine_name, rate, BUCKETS, POLICIES};
-pub use fragsim_explain::{
-    baselines::BaselineRow,
-    hazard::{HazardReport, HazardRow},
-};
-use fragsim_oracle::Oracle;
-use fragsim_shade::plot::{chart, chart_with_ticks, Series};
+use fragsim_measure::hazard::{report, HazardReport};
+use fragsim_measure::hazard::{Campaign, HazardParams};
+use fragsim_raster::Conventions;
 use serde::Serialize;
 
 use crate::args::SceneArgs;
 use crate::explain::WriteBackArg;
 use crate::record::{Context, Slots};
-use fragsim_raster::Conventions;
 
 /// Options of `fragsim hazard`.
 #[derive(Debug, Clone, Args)]
@@ -128,113 +120,36 @@ struct BaselineRecord<'a> {
 /// # Errors
 /// Scene, parameter or output errors.
 pub(crate) fn hazard(args: &HazardArgs) -> Result<HazardReport, String> {
-    if args.threads_in_flight.contains(&0) || args.seeds == 0 || args.write_back.is_empty() {
-        return Err(
-            "hazard needs --threads-in-flight ≥ 1, at least one seed and one machine".into(),
-        );
-    }
-    let spec = args.scene.spec(Conventions::REFERENCE);
-    let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
-    let view = spec.view(&scene, viewport).map_err(|e| e.to_string())?;
-    crate::oracle_memory::check(&view, MEMORY_CAP_DEFAULT).map_err(|e| e.to_string())?;
-    let oracle = Oracle::build(&view);
-    let in_bucket = covered_by_bucket(&oracle);
-    let covered: usize = in_bucket.iter().sum();
-    let mut report = HazardReport {
-        scene: args.scene.mesh.as_ref().map_or_else(
-            || args.scene.scene.clone(),
-            |p| crate::record::file_name(&p.display().to_string()),
-        ),
-        width: args.scene.width,
-        height: args.scene.height,
-        k: args.k,
-        covered,
-        fragments: oracle.fragments(),
-        buckets: BUCKETS
-            .iter()
-            .zip(&in_bucket)
-            .map(|(&(_, label), &n)| (label.to_string(), n))
-            .collect(),
-        rows: Vec::new(),
-        baselines: Vec::new(),
+    let campaign = if args.baselines {
+        Campaign::Baselines {
+            ks: args.ks.clone(),
+        }
+    } else {
+        Campaign::Rates {
+            k: args.k,
+            threads_in_flight: args.threads_in_flight.clone(),
+            seeds: args.seeds,
+        }
     };
-    let machines: Vec<_> = args.write_back.iter().map(|w| w.machine()).collect();
+    let params = HazardParams {
+        scene: args.scene.spec(Conventions::REFERENCE),
+        viewport: args.scene.viewport().map_err(|e| e.to_string())?,
+        write_back: args.write_back.iter().map(|w| w.machine()).collect(),
+        campaign,
+    };
+    let report = fragsim_measure::hazard::hazard(&params, &crate::progress::Bars::default())?;
     if args.baselines {
-        // The output lists hold every layer (as `render` sizes them).
-        let layers = oracle.max_depth_complexity().max(1);
-        let table = baselines::table(viewport, &args.ks, &machines, layers)?;
-        let progress = crate::progress::bar(table.len() as u64, "hazard --baselines");
-        for baseline in table {
-            progress.set_message(format!("{} K = {}", baseline.scheme, baseline.k));
-            report
-                .baselines
-                .extend(baselines::rows(&baseline, &view, &oracle)?);
-            progress.inc(1);
-        }
-        progress.finish_and_clear();
         write_baselines(args, &report)?;
-        return Ok(report);
+    } else {
+        write(args, &report)?;
     }
-    let progress = crate::progress::bar(
-        (machines.len() * POLICIES.len() * args.threads_in_flight.len()) as u64,
-        "hazard",
-    );
-    for &machine in &machines {
-        let scheme = KBuffer::with_write_back(viewport, args.k, machine, MEMORY_CAP_DEFAULT)
-            .map_err(|e| e.to_string())?;
-        for policy in POLICIES {
-            for &in_flight in &args.threads_in_flight {
-                progress.set_message(format!(
-                    "{} {} W = {in_flight}",
-                    machine_name(machine),
-                    policy.1
-                ));
-                let row = rate(
-                    &view, &oracle, &scheme, machine, policy, in_flight, args.seeds,
-                );
-                report.rows.push(row);
-                progress.inc(1);
-            }
-        }
-    }
-    progress.finish_and_clear();
-    write(args, &report)?;
     Ok(report)
 }
 
 fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
     let out = &args.out;
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "`{}` at {}×{}: {} fragments, {} covered pixels; output lists sized to the maximum depth complexity.\n",
-        report.scene, report.width, report.height, report.fragments, report.covered
-    );
-    let _ = writeln!(
-        md,
-        "| scheme | K | executor | passes | overflowed | lost | extra | duplicates | misordered px | error px (of covered) | memory MiB |"
-    );
-    let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for r in &report.baselines {
-        let _ = writeln!(
-            md,
-            "| `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} ({:.2} %) | {:.1} |",
-            r.scheme,
-            r.k,
-            r.executor,
-            r.passes,
-            r.overflowed,
-            r.lost,
-            r.extra,
-            r.duplicates,
-            r.misordered_pixels,
-            r.error_pixels,
-            100.0 * r.error_pixels as f64 / report.covered.max(1) as f64,
-            r.memory_bytes as f64 / f64::from(1 << 20),
-        );
-    }
+    let md = report::baselines_markdown(report);
     write_file(out, "baselines.md", &md)?;
     let json = serde_json::to_string_pretty(&report.baselines).map_err(|e| e.to_string())?;
     write_file(out, "baselines.json", &json)?;
@@ -300,27 +215,6 @@ fn print_json(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
     Ok(())
 }
 
-/// What hazard.md's tables mean, under them.
-const KEY: &str = "
-Key: **W** threads in flight: how many fragments the scheduled executor keeps walking at once, one \
-thread each (W = 1 runs each walk alone: no hazard); **write-back** the k-buffer's machine \
-(`render-target`: the K slots read in one step and written back in one, write-backs committed in \
-order, so only a stale read loses; `separate-stores`: K loads and K stores, one step each, as CUDA \
-code does, so write-backs also tear); **policy** how the scheduled executor picks the next step \
-(`random`: any thread in flight, uniformly; `warps`: warps of 32 threads in round-robin, one step \
-per lane in lane order); **pixels wrong %** covered pixels whose slots differ from the oracle's K \
-nearest, in percent, mean over the seeds (JSON: the fraction, `mismatched_pixel_rate`); **per \
-seed** the same for each seed, 0, 1, … (`mismatched_pixel_rate_per_seed`); **lost**, **extra**, \
-**duplicates** fragments summed over the seeds; **misordered px** pixels whose slots are out of \
-order; **dc** a pixel's depth complexity (its fragments), bucketed, with the covered pixels in \
-each bucket.
-";
-
-/// `rate` (a fraction) as the tables print rates: a percentage.
-fn percent(rate: f64) -> String {
-    format!("{:.2}", 100.0 * rate)
-}
-
 /// Writes `text` to `name` in `out`, naming the file in an error.
 fn write_file(out: &std::path::Path, name: &str, text: &str) -> Result<(), String> {
     let path = out.join(name);
@@ -330,67 +224,7 @@ fn write_file(out: &std::path::Path, name: &str, text: &str) -> Result<(), Strin
 fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
     let out = &args.out;
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "k-buffer (K = {}) on `{}` at {}×{}: {} fragments, {} covered pixels; {} seeds per row.\n",
-        report.k,
-        report.scene,
-        report.width,
-        report.height,
-        report.fragments,
-        report.covered,
-        args.seeds
-    );
-    let _ = writeln!(
-        md,
-        "| write-back | policy | W | pixels wrong % (mean) | per seed % | lost | extra | duplicates | misordered px |"
-    );
-    let _ = writeln!(md, "|---|---|---:|---:|---|---:|---:|---:|---:|");
-    for r in &report.rows {
-        let per_seed: Vec<String> = r.rate_per_seed.iter().map(|&x| percent(x)).collect();
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            r.write_back,
-            r.policy,
-            r.threads_in_flight,
-            percent(r.rate),
-            per_seed.join(" "),
-            r.lost,
-            r.extra,
-            r.duplicates,
-            r.misordered_pixels
-        );
-    }
-    let _ = writeln!(
-        md,
-        "\nPixels wrong by depth complexity, % of the bucket's pixels:\n"
-    );
-    let labels: Vec<String> = report
-        .buckets
-        .iter()
-        .map(|(l, n)| format!("dc {l} ({n} px)"))
-        .collect();
-    let _ = writeln!(md, "| write-back | policy | W | {} |", labels.join(" | "));
-    let _ = writeln!(md, "|---|---|---:|{}", "---:|".repeat(labels.len()));
-    for r in &report.rows {
-        let cells: Vec<String> = r
-            .rate_by_depth_complexity
-            .iter()
-            .zip(&report.buckets)
-            .map(|(&x, (_, n))| if *n == 0 { "–".into() } else { percent(x) })
-            .collect();
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} |",
-            r.write_back,
-            r.policy,
-            r.threads_in_flight,
-            cells.join(" | ")
-        );
-    }
-    md.push_str(KEY);
+    let md = report::markdown(report);
     write_file(out, "hazard.md", &md)?;
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
     write_file(out, "hazard.json", &json)?;
@@ -403,73 +237,7 @@ fn write(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
         return say_wrote(args, &["hazard.md", "hazard.json"]);
     }
     let ext = if args.svg { "svg" } else { "png" };
-    let mut by_width: Vec<Series> = Vec::new();
-    for &write_back in &args.write_back {
-        for (_, p) in POLICIES {
-            let points = report
-                .rows
-                .iter()
-                .filter(|r| r.policy == p && r.write_back == machine_name(write_back.machine()))
-                .map(|r| ((r.threads_in_flight as f64).log2(), 100.0 * r.rate))
-                .collect();
-            by_width.push((
-                format!("{} {p}", machine_name(write_back.machine())),
-                points,
-            ));
-        }
-    }
-    let vs_width = format!("hazard-vs-width.{ext}");
-    chart(
-        &out.join(&vs_width),
-        &format!(
-            "k-buffer (K = {}): pixels wrong vs threads in flight",
-            report.k
-        ),
-        "log2 W (threads in flight)",
-        "% of covered pixels wrong",
-        &by_width,
-        false,
-    )
-    .map_err(|e| e.to_string())?;
-    let by_dc: Vec<Series> = report
-        .rows
-        .iter()
-        .filter(|r| r.threads_in_flight > 1)
-        .map(|r| {
-            let points = r
-                .rate_by_depth_complexity
-                .iter()
-                .enumerate()
-                .filter(|&(i, _)| report.buckets[i].1 > 0)
-                .map(|(i, &x)| (i as f64, 100.0 * x))
-                .collect();
-            (
-                format!("{} {} W={}", r.write_back, r.policy, r.threads_in_flight),
-                points,
-            )
-        })
-        .collect();
-    let ticks: Vec<String> = report
-        .buckets
-        .iter()
-        .map(|(label, n)| format!("{label} ({n} px)"))
-        .collect();
-    let vs_dc = format!("hazard-vs-depth-complexity.{ext}");
-    chart_with_ticks(
-        &out.join(&vs_dc),
-        (
-            &format!(
-                "k-buffer (K = {}): pixels wrong vs depth complexity",
-                report.k
-            ),
-            "depth complexity of the pixel (bucket, pixels in it)",
-            "% of the bucket's pixels wrong",
-        ),
-        &by_dc,
-        false,
-        Some(&ticks),
-    )
-    .map_err(|e| e.to_string())?;
+    let [vs_width, vs_dc] = report::charts(report, out, ext)?;
     say_wrote(args, &["hazard.md", "hazard.json", &vs_width, &vs_dc])
 }
 

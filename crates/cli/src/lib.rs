@@ -1,5 +1,7 @@
 //! The `fragsim` command line: `render` (the default) runs schemes on a scene, checks them
-//! against the serial oracle and writes a table, JSON and PNGs.
+//! against the serial oracle and writes a table, JSON and PNGs. The measurements (`bench`,
+//! `sweep`, `hazard`) are `fragsim_measure`'s; their commands here turn the options into the
+//! library's parameters and print and write what it returns.
 
 use std::ffi::OsString;
 use std::io::Write;
@@ -39,44 +41,37 @@ fn write_stdout(text: std::fmt::Arguments<'_>) {
     }
 }
 
-mod approximate;
 mod args;
 mod bench;
-mod colour_judge;
 mod compare;
 mod conform;
 mod explain;
 mod export;
-mod frame_timing;
 mod hazard;
-mod multisampled;
 use fragsim_oracle::memory_cap as oracle_memory;
 mod progress;
 pub mod record;
 mod render;
-mod row_images;
 mod schemes;
 mod sweep;
+mod table;
 
 use std::process::ExitCode;
 
 use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
-pub use approximate::{ApproximateName, ApproximateRow};
 pub use args::{ConventionsArgs, Count, DumpArgs, ExecutorChoice, SceneArgs, SchemeArgs, Shard};
-pub use bench::{BenchArgs, BenchReport, BenchRow, StageShares};
-pub use colour_judge::{AttributePass, ColourColumns, EffectName};
+pub use bench::BenchArgs;
 pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
 pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
 pub use fragsim_capture::catalog::{SchemeName, Sizing};
-pub use hazard::{BaselineRow, HazardArgs, HazardReport, HazardRow};
-pub use multisampled::{MsaaReport, SampledRow};
+pub use hazard::HazardArgs;
 pub use render::{RenderArgs, RenderScheme, RunSummary, TieChoice};
 pub use schemes::{Fault, SchemeChoice};
-pub use sweep::{SweepArgs, SweepSeries};
+pub use sweep::SweepArgs;
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
 #[derive(Debug, Parser)]

@@ -1,14 +1,17 @@
 //! Progress bars (indicatif) on stderr for the work that can take more than a second: render's
-//! schemes, bench's frames, sweep's angles, hazard's rows.
+//! schemes, bench's frames, sweep's angles, hazard's rows (the measurements' [`Progress`] drawn
+//! as bars: [`Bars`]).
 //!
 //! Guarantee: a bar is drawn only when stderr is a terminal and `--quiet` was not given, so
 //! that piped or captured output (and `--json` on stdout) carries no bar; stdout is never
 //! touched.
 
+use std::cell::RefCell;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use fragsim_measure::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// Set by `--quiet`.
@@ -39,4 +42,41 @@ pub(crate) fn bar(len: u64, what: &str) -> ProgressBar {
         bar.enable_steady_tick(Duration::from_millis(100));
     }
     bar
+}
+
+/// The command line's [`Progress`]: each stage a measurement begins is a bar ([`bar`]), its
+/// warnings lines on stderr.
+#[derive(Debug, Default)]
+pub(crate) struct Bars {
+    /// The bar of the current stage.
+    current: RefCell<Option<ProgressBar>>,
+}
+
+impl Progress for Bars {
+    fn begin(&self, steps: u64, what: &str) {
+        self.end();
+        *self.current.borrow_mut() = Some(bar(steps, what));
+    }
+
+    fn message(&self, text: &str) {
+        if let Some(bar) = &*self.current.borrow() {
+            bar.set_message(text.to_string());
+        }
+    }
+
+    fn step(&self) {
+        if let Some(bar) = &*self.current.borrow() {
+            bar.inc(1);
+        }
+    }
+
+    fn end(&self) {
+        if let Some(bar) = self.current.borrow_mut().take() {
+            bar.finish_and_clear();
+        }
+    }
+
+    fn warn(&self, warning: &str) {
+        eprintln!("warning: {warning}");
+    }
 }

@@ -19,6 +19,7 @@ use serde::Serialize;
 
 use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
 use crate::schemes::{check_memory_cap_early, Fault, SchemeChoice, SchemeRunner};
+use crate::table::Table;
 
 /// Options of `fragsim render`.
 #[derive(Debug, Clone, Args)]
@@ -194,10 +195,11 @@ pub struct RunSummary {
 /// A scene that cannot be loaded, bad parameters, storage beyond the memory cap, an image that
 /// cannot be written.
 pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
-    let pool = args.schemes.pool()?;
+    let setup = args.schemes.setup();
+    let pool = setup.pool()?;
     let spec = args.scene.spec(args.conventions.conventions());
     let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let view = args.schemes.submission(
+    let view = setup.submission(
         spec.view(&scene, args.scene.viewport().map_err(|e| e.to_string())?)
             .map_err(|e| e.to_string())?,
     );
@@ -552,43 +554,17 @@ fn print_table(
         }),
         ("mem ops", 9, |r| r.memory_ops.to_string()),
     ];
-    let header: Vec<String> = columns.iter().map(|(h, _, _)| (*h).to_string()).collect();
-    let cells: Vec<Vec<String>> = rows
-        .iter()
-        .map(|r| columns.iter().map(|(_, _, cell)| cell(r)).collect())
-        .collect();
     // Each column as wide as its widest cell (a long scheme name widens its column, never
     // pushes the rest out of line), at least its usual width.
-    let widths: Vec<usize> = columns
-        .iter()
-        .enumerate()
-        .map(|(i, (_, least, _))| {
-            cells
-                .iter()
-                .chain([&header])
-                .map(|row| row[i].chars().count())
-                .fold(*least, usize::max)
-        })
-        .collect();
-    let line = |cells: &[String]| {
-        let padded: Vec<String> = cells
-            .iter()
-            .zip(&widths)
-            .enumerate()
-            .map(|(i, (cell, &width))| {
-                if i < 3 {
-                    format!("{cell:<width$}")
-                } else {
-                    format!("{cell:>width$}")
-                }
-            })
-            .collect();
-        outln!("{}", padded.join(" "));
-    };
-    line(&header);
-    for row in &cells {
-        line(row);
+    let mut table = Table::new(
+        columns.iter().map(|(h, _, _)| (*h).to_string()).collect(),
+        3,
+    )
+    .at_least(columns.iter().map(|&(_, least, _)| least).collect());
+    for r in rows {
+        table.push(columns.iter().map(|(_, _, cell)| cell(r)).collect());
     }
+    out!("{}", table.text(1));
     outln!("captured + overflow + lost − extra = fragments, on every row");
     if rows.iter().any(|r| !r.guarantee_owed) {
         outln!(

@@ -57,36 +57,6 @@ impl ValueEnum for SchemeChoice {
     }
 }
 
-/// The family a scheme belongs to, as charts mark it (one marker shape a family): `mdts`,
-/// `a-buffer` (A-buffers, linked lists, the layer counter, the stencil-routed A-buffer),
-/// `peeling` (depth peeling and the z-buffer), `k-buffer` (k-buffers and loop32), `bucket`
-/// (bucket and adaptive depth peeling), `approximate` (WBOIT, MLAB, tail blending:
-/// `--approximate`).
-#[must_use]
-pub(crate) fn family(scheme: &str) -> &'static str {
-    const FAMILIES: [(&str, &str); 15] = [
-        ("mdts", "mdts"),
-        ("abuffer", "a-buffer"),
-        ("linked-list", "a-buffer"),
-        ("layer-counter", "a-buffer"),
-        ("srab", "a-buffer"),
-        ("peeling", "peeling"),
-        ("dual-peeling", "peeling"),
-        ("zbuffer", "peeling"),
-        ("kbuffer", "k-buffer"),
-        ("loop32", "k-buffer"),
-        ("bdp", "bucket"),
-        ("adp", "bucket"),
-        ("wboit", "approximate"),
-        ("mlab", "approximate"),
-        ("tail-blend", "approximate"),
-    ];
-    FAMILIES
-        .iter()
-        .find(|(prefix, _)| scheme.starts_with(prefix))
-        .map_or("other", |&(_, family)| family)
-}
-
 /// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Fault {
@@ -98,23 +68,6 @@ impl From<Fault> for fragsim_capture::catalog::Fault {
     fn from(fault: Fault) -> Self {
         match fault {
             Fault::MiscountOverflow => Self::MiscountOverflow,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    /// Every scheme's family has its own marker on the charts (`fragsim_shade::plot::FAMILIES`),
-    /// so a family looks the same on bench's chart and sweep's.
-    #[test]
-    fn every_catalog_family_has_a_chart_marker() {
-        for entry in fragsim_capture::catalog::CATALOG {
-            let family = super::family(entry.name);
-            assert!(
-                fragsim_shade::plot::FAMILIES.contains(&family),
-                "{}: {family}",
-                entry.name
-            );
         }
     }
 }

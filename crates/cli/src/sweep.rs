@@ -1,21 +1,23 @@
 //! `fragsim sweep`: the error-pixel rate of each scheme at many view angles around the model
 //! (the bucket depth peeling paper's Figure 6), the colour error over the image and per
-//! depth-complexity bucket at each angle, and the speed-versus-accuracy scatter.
+//! depth-complexity bucket at each angle, and the speed-versus-accuracy scatter. The measurement
+//! is `fragsim_measure::sweep`'s; this module holds the options and the table, records and charts.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_capture::primitive_order::PrimitiveOrder;
-use fragsim_oracle::Oracle;
+use fragsim_measure::approximate::ApproximateName;
+use fragsim_measure::cells::{bucket_cells, family, mean_of_channels, percent};
+use fragsim_measure::colour_by_depth::ColourByDepth;
+use fragsim_measure::colour_judge::{ColourColumns, EffectName};
+use fragsim_measure::sweep::{SweepParams, SweepReport, SweepSeries};
+use fragsim_raster::Conventions;
 use serde::Serialize;
 
-use crate::approximate::ApproximateName;
 use crate::args::{SceneArgs, SchemeArgs, Shard};
-use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
-use crate::record::{bucket_cells, mean_of_channels, percent, ColourByDepth, Context};
-use crate::schemes::{family, SchemeChoice, SchemeRunner};
-use fragsim_raster::{Conventions, SceneSpec};
-use fragsim_shade::colour_error::{BucketError, ColourError, DEPTH_BUCKETS};
+use crate::record::Context;
+use crate::schemes::SchemeChoice;
+use crate::table::Table;
 
 /// Options of `fragsim sweep`.
 #[derive(Debug, Clone, Args)]
@@ -75,126 +77,27 @@ struct SweepRecord<'a> {
     time_ms: f64,
 }
 
-/// One scheme's measurements over the sweep.
-#[derive(Debug, Clone, Serialize)]
-pub struct SweepSeries {
-    /// Scheme name.
-    pub scheme: String,
-    /// Error-pixel rate (over covered pixels) per angle; `None` where the effect is unresolvable.
-    pub error_pixel_rate: Vec<Option<f64>>,
-    /// The colour error against the oracle's image per angle (`None` fields: unresolvable).
-    pub colour: Vec<ColourColumns>,
-    /// The same per depth-complexity bucket, per angle (no buckets: unresolvable).
-    pub colour_by_depth: Vec<ColourByDepth>,
-    /// Frame time per angle, ms.
-    pub time_ms: Vec<f64>,
-}
-
-impl SweepSeries {
-    fn named(scheme: &str) -> Self {
-        Self {
-            scheme: scheme.into(),
-            error_pixel_rate: Vec::new(),
-            colour: Vec::new(),
-            colour_by_depth: Vec::new(),
-            time_ms: Vec::new(),
-        }
-    }
-}
-
 /// Runs `sweep`.
 ///
 /// # Errors
 /// Scene, parameter or output errors.
-pub(crate) fn sweep(args: &SweepArgs) -> Result<Vec<SweepSeries>, String> {
-    let pool = args.schemes.pool()?;
-    let spec = args.scene.spec(Conventions::REFERENCE);
-    let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
-    let executor = args.schemes.executors()[0];
-    let mut threads = 0;
-    let schemes = SchemeChoice::expand(&args.scheme);
-    let mut series: Vec<SweepSeries> = Vec::new();
-    let mut angles = Vec::new();
-    let shard = args.shard.unwrap_or(Shard::WHOLE);
-    let steps: Vec<u32> = (0..args.angles)
-        .filter(|&step| shard.takes(step as usize))
-        .collect();
-    let progress = crate::progress::bar(steps.len() as u64, "sweep");
-    for step in steps {
-        progress.set_message(format!("angle {step}"));
-        let angle = 360.0 * f64::from(step) / f64::from(args.angles);
-        angles.push(angle);
-        let at_angle = SceneSpec {
-            view_degrees: angle,
-            ..spec.clone()
-        };
-        let orbit = at_angle.orbit();
-        let view = args
-            .schemes
-            .submission(at_angle.view(&scene, viewport).map_err(|e| e.to_string())?);
-        crate::oracle_memory::check(&view, args.schemes.memory_cap).map_err(|e| e.to_string())?;
-        let oracle = Oracle::build(&view);
-        let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
-        crate::approximate::check_effect(&judge, &args.approximate)?;
-        let depth_complexity = oracle.depth_complexity();
-        let sizing = args.schemes.sizing();
-        let mut runner = SchemeRunner::default();
-        for (i, &name) in schemes.iter().enumerate() {
-            let named = pool
-                .install(|| runner.run(name, executor, &view, &sizing))
-                .map_err(|e| e.to_string())?;
-            if series.len() <= i {
-                series.push(SweepSeries::named(&named.name));
-            }
-            let judged = judge.judge(&named.run.capture);
-            let rate = judged
-                .as_ref()
-                .map(|judged| judged.errors as f64 / judge.covered.max(1) as f64);
-            series[i].error_pixel_rate.push(rate);
-            series[i]
-                .colour
-                .push(ColourColumns::of(judged.as_ref().map(|j| j.colour)));
-            series[i].colour_by_depth.push(ColourByDepth::of(
-                judged.as_ref().map(|j| (j.reference, &j.image)),
-                &depth_complexity,
-            )?);
-            series[i].time_ms.push(
-                (named.run.stats.pass_time + named.run.stats.resolve_time).as_secs_f64() * 1e3,
-            );
-            threads = named.run.stats.threads;
-        }
-        if !args.approximate.is_empty() {
-            let order = PrimitiveOrder::of_view(&view);
-            let raster_ms = pool
-                .install(|| crate::frame_timing::time_raster_alone(&view))
-                .as_secs_f64()
-                * 1e3;
-            let nodes = crate::approximate::nodes(args.schemes.k, &oracle);
-            for (j, &scheme) in args.approximate.iter().enumerate() {
-                let (row, _) = pool.install(|| {
-                    crate::approximate::measure(
-                        scheme, nodes, &judge, &oracle, &order, 1, raster_ms,
-                    )
-                })?;
-                let i = schemes.len() + j;
-                if series.len() <= i {
-                    series.push(SweepSeries::named(&row.scheme));
-                }
-                series[i].error_pixel_rate.push(Some(row.error_pixel_rate));
-                series[i].colour.push(row.colour);
-                series[i].colour_by_depth.push(row.colour_by_depth);
-                series[i].time_ms.push(row.time_ms);
-            }
-        }
-        progress.inc(1);
-    }
-    progress.finish_and_clear();
+pub(crate) fn sweep(args: &SweepArgs) -> Result<SweepReport, String> {
+    let params = SweepParams {
+        scene: args.scene.spec(Conventions::REFERENCE),
+        viewport: args.scene.viewport().map_err(|e| e.to_string())?,
+        schemes: SchemeChoice::expand(&args.scheme),
+        setup: args.schemes.setup(),
+        angles: args.angles,
+        effect: args.effect,
+        shard: args.shard.unwrap_or(Shard::WHOLE),
+        approximate: args.approximate.clone(),
+    };
+    let report = fragsim_measure::sweep::sweep(&params, &crate::progress::Bars::default())?;
     let context = Context::of_scene("sweep", &args.scene)?
         .sized(&args.schemes)
-        .on(executor.name(), threads);
-    write_outputs(args, &context, &angles, &series)?;
-    Ok(series)
+        .on(&report.executor, report.threads);
+    write_outputs(args, &context, &report.angles, &report.series)?;
+    Ok(report)
 }
 
 fn write_outputs(
@@ -301,16 +204,21 @@ fn print_summary(
         eprintln!("{wrote}");
         return Ok(());
     }
-    outln!(
-        "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12}",
-        "scheme",
-        "mean EPR %",
-        "max EPR %",
-        "mean err",
-        "max err",
-        "min PSNR dB",
-        "mean ms"
-    );
+    let mut table = Table::new(
+        [
+            "scheme",
+            "mean EPR %",
+            "max EPR %",
+            "mean err",
+            "max err",
+            "min PSNR dB",
+            "mean ms",
+        ]
+        .map(String::from)
+        .into(),
+        1,
+    )
+    .at_least(vec![20, 12, 12, 10, 8, 12, 12]);
     for s in series {
         let rates: Vec<f64> = s.error_pixel_rate.iter().flatten().copied().collect();
         let mean_rate = mean(rates.iter().copied()).map_or("n/a".into(), |r| percent(r, 4));
@@ -321,17 +229,17 @@ fn print_summary(
             .map_or("n/a".into(), |r| percent(r, 4));
         let mean_ms = mean(s.time_ms.iter().copied()).unwrap_or(0.0);
         let [mean_error, max_error, psnr] = colour_over_angles(&s.colour);
-        outln!(
-            "{:<20} {:>12} {:>12} {:>10} {:>8} {:>12} {:>12.2}",
-            s.scheme,
+        table.push(vec![
+            s.scheme.clone(),
             mean_rate,
             max_rate,
             mean_error,
             max_error,
             psnr,
-            mean_ms
-        );
+            format!("{mean_ms:.2}"),
+        ]);
     }
+    out!("{}", table.text(1));
     // The two kinds of figure count different things: say which, so that a small rate beside a
     // large error (one pixel far off) reads as it is.
     outln!(
@@ -372,8 +280,8 @@ fn colour_over_angles(colour: &[ColourColumns]) -> [String; 3] {
 }
 
 /// The sweep's second table: each scheme's colour error per depth-complexity bucket, pooled
-/// over the angles ([`pooled_over_angles`]); schemes whose images all resolve and all equal the
-/// oracle's are left out, as are empty buckets.
+/// over the angles ([`SweepSeries::colour_by_depth_over_angles`]); schemes whose images all
+/// resolve and all equal the oracle's are left out, as are empty buckets.
 fn print_depth_table(series: &[SweepSeries]) {
     let differing = |s: &&SweepSeries| {
         s.colour_by_depth
@@ -381,72 +289,32 @@ fn print_depth_table(series: &[SweepSeries]) {
             .flat_map(ColourByDepth::covered)
             .any(|b| b.error_pixels > 0)
     };
-    let mut header = true;
+    let mut table = Table::new(
+        [
+            "scheme",
+            "fragments/px",
+            "pixels",
+            "EPR %",
+            "mean err",
+            "max err",
+            "min PSNR dB",
+        ]
+        .map(String::from)
+        .into(),
+        1,
+    )
+    .at_least(vec![20, 12, 10, 10, 10, 8, 12]);
     for s in series.iter().filter(differing) {
-        if std::mem::take(&mut header) {
-            outln!(
-                "\ncolour error per depth-complexity bucket (fragments per pixel), over every angle"
-            );
-            outln!(
-                "{:<20} {:>12} {:>10} {:>10} {:>10} {:>8} {:>12}",
-                "scheme",
-                "fragments/px",
-                "pixels",
-                "EPR %",
-                "mean err",
-                "max err",
-                "min PSNR dB"
-            );
-        }
-        for bucket in pooled_over_angles(&s.colour_by_depth) {
-            let [label, pixels, rate, mean, max, psnr] = bucket_cells(&bucket);
-            outln!(
-                "{:<20} {label:>12} {pixels:>10} {rate:>10} {mean:>10} {max:>8} {psnr:>12}",
-                s.scheme
-            );
+        for bucket in s.colour_by_depth_over_angles() {
+            let mut row = vec![s.scheme.clone()];
+            row.extend(bucket_cells(&bucket));
+            table.push(row);
         }
     }
-}
-
-/// One scheme's buckets over every angle: pixels and error pixels summed, the mean absolute
-/// error weighted by each angle's pixels (so it is the mean over every pixel of every angle in
-/// the bucket), the largest error, and the lowest PSNR of any angle; buckets without a pixel at
-/// any angle are left out.
-fn pooled_over_angles(angles: &[ColourByDepth]) -> Vec<BucketError> {
-    DEPTH_BUCKETS
-        .iter()
-        .enumerate()
-        .filter_map(|(i, &(lo, hi))| {
-            let at_angles: Vec<(u64, u64, ColourError)> = angles
-                .iter()
-                .filter_map(|a| a.buckets.get(i))
-                .filter_map(|b| Some((b.pixels, b.error_pixels, b.error?)))
-                .collect();
-            let pixels: u64 = at_angles.iter().map(|a| a.0).sum();
-            (pixels > 0).then(|| {
-                let weighted = |c: usize| {
-                    at_angles
-                        .iter()
-                        .map(|(n, _, e)| e.mean_abs[c] * *n as f64)
-                        .sum::<f64>()
-                        / pixels as f64
-                };
-                let largest = |c: usize| at_angles.iter().map(|(_, _, e)| e.max_abs[c]).max();
-                BucketError {
-                    lo,
-                    hi,
-                    pixels,
-                    error_pixels: at_angles.iter().map(|a| a.1).sum(),
-                    error: Some(ColourError {
-                        mean_abs: [0, 1, 2].map(weighted),
-                        max_abs: [0, 1, 2].map(|c| largest(c).unwrap_or(0)),
-                        psnr_db: at_angles
-                            .iter()
-                            .map(|(_, _, e)| e.psnr_db)
-                            .fold(f64::INFINITY, f64::min),
-                    }),
-                }
-            })
-        })
-        .collect()
+    if !table.is_empty() {
+        outln!(
+            "\ncolour error per depth-complexity bucket (fragments per pixel), over every angle"
+        );
+        out!("{}", table.text(1));
+    }
 }

@@ -111,7 +111,7 @@ impl SampleOracle {
     /// # Panics
     /// If `candidate` covers another number of samples.
     #[must_use]
-    pub fn sample_error(&self, candidate: &PixelLists) -> SampleError {
+    pub fn sample_error(&self, candidate: &PixelLists) -> SampleDeviation {
         self.error_by(candidate, primitive_id)
     }
 
@@ -123,7 +123,7 @@ impl SampleOracle {
     /// # Panics
     /// If `capture` covers another number of samples.
     #[must_use]
-    pub fn capture_error(&self, capture: &Capture) -> SampleError {
+    pub fn capture_error(&self, capture: &Capture) -> SampleDeviation {
         let identify = match capture.identity {
             Identity::KeyOnly => depth_key,
             Identity::KeyAndPrim | Identity::PrimOnly => primitive_id,
@@ -132,13 +132,13 @@ impl SampleOracle {
     }
 
     /// The error of `candidate`, each entry reduced to what `identify` compares.
-    fn error_by(&self, candidate: &PixelLists, identify: fn(u64) -> u32) -> SampleError {
+    fn error_by(&self, candidate: &PixelLists, identify: fn(u64) -> u32) -> SampleDeviation {
         assert_eq!(
             candidate.pixels(),
             self.oracle.pixels(),
             "sample counts differ"
         );
-        let mut error = SampleError::default();
+        let mut error = SampleDeviation::default();
         for sample in 0..candidate.pixels() {
             let (want, got) = (self.oracle.pixel(sample), candidate.pixel(sample));
             error.fragments += want.len() as u64;
@@ -168,7 +168,7 @@ fn depth_key(entry: u64) -> u32 {
 
 /// What a per-sample resolve lost or misordered, against the per-sample oracle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SampleError {
+pub struct SampleDeviation {
     /// Samples compared.
     pub samples: u64,
     /// Sample fragments in the oracle.

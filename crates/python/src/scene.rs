@@ -20,6 +20,8 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use fragsim_capture::catalog::CATALOG;
+use fragsim_measure::hazard::{hazard_in_view, machine_named, Campaign};
+use fragsim_measure::Silent;
 use fragsim_oracle::dump::{Dump, Words};
 use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::triangles::TriangleExport;
@@ -34,7 +36,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
 use crate::errors::{dump_error, mesh_error, scene_error, scene_spec_error, JudgeError};
-use crate::errors::{DumpError, SceneError};
+use crate::errors::{DumpError, FragsimError, SceneError};
 
 /// The file name an array scene's mesh is written under, beside each of its dumps.
 pub const ARRAY_MESH_FILE: &str = "mesh.obj";
@@ -389,6 +391,43 @@ impl SceneCore {
             examples,
         };
         self.verdict(py, &dump, vertex_precision, options)
+    }
+
+    /// The k-buffer's hazard rate on this scene (`fragsim_measure::hazard`, as `fragsim hazard`
+    /// measures it): K slots a pixel, each number of threads in flight of `threads_in_flight`
+    /// under both scheduling policies, `seeds` seeds a row, on each machine of `write_back`
+    /// (`render-target`, `separate-stores`). Returns the report as JSON.
+    ///
+    /// # Errors
+    /// An unknown machine, no machine or seed, zero threads in flight, or a view beyond the
+    /// memory cap: a [`FragsimError`].
+    #[pyo3(signature = (k, threads_in_flight, seeds, write_back))]
+    fn hazard(
+        &self,
+        k: u32,
+        threads_in_flight: Vec<usize>,
+        seeds: u64,
+        write_back: Vec<String>,
+    ) -> PyResult<String> {
+        let machines = write_back
+            .iter()
+            .map(|name| {
+                machine_named(name).ok_or_else(|| {
+                    FragsimError::new_err(format!(
+                        "no k-buffer machine {name:?} (render-target, separate-stores)"
+                    ))
+                })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let campaign = Campaign::Rates {
+            k,
+            threads_in_flight,
+            seeds,
+        };
+        let scene = fragsim_measure::scene_name(&self.spec);
+        let report = hazard_in_view(&self.view(false)?, scene, &machines, &campaign, &Silent)
+            .map_err(FragsimError::new_err)?;
+        serde_json::to_string(&report).map_err(|e| FragsimError::new_err(e.to_string()))
     }
 
     /// Writes a dump (its header's JSON and arrays' bytes, as for [`SceneCore::judge`]) into

@@ -96,18 +96,6 @@ impl Scene {
         })
     }
 
-    /// A mesh from an OBJ file.
-    ///
-    /// # Errors
-    /// See [`Mesh::load_obj`].
-    pub fn from_obj(path: &Path) -> Result<Self, SceneError> {
-        let mesh = Mesh::load_obj(path)?;
-        Ok(Self {
-            name: path.display().to_string(),
-            mesh,
-        })
-    }
-
     /// A scene by name: `bunny` (embedded), `bunny-spheres[:N[:SEED]]` (the bunny with N random
     /// spheres, default 500), `spheres[:N]` (N nested closed spheres: depth
     /// complexity 2N at the centre), `soup[:COUNT[:SEED]]` (random triangles in a cube) or

@@ -40,7 +40,7 @@ pub enum CompareError {
 
 /// How far a candidate image is from the reference.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ColourError {
+pub struct ColourDeviation {
     /// Mean absolute error per channel (R, G, B), in 8-bit units.
     pub mean_abs: [f64; 3],
     /// Largest absolute error per channel, in 8-bit units.
@@ -56,7 +56,7 @@ pub struct ColourError {
 pub fn colour_error(
     reference: &RgbImage,
     candidate: &RgbImage,
-) -> Result<ColourError, CompareError> {
+) -> Result<ColourDeviation, CompareError> {
     check_sizes(reference, candidate)?;
     if reference.width() == 0 || reference.height() == 0 {
         return Err(CompareError::Empty);
@@ -75,7 +75,7 @@ pub const DEPTH_BUCKETS: [(u32, u32); 6] =
 
 /// The colour error over the covered pixels of one depth-complexity bucket.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BucketError {
+pub struct BucketDeviation {
     /// Fewest fragments per pixel of the bucket.
     pub lo: u32,
     /// Most fragments per pixel of the bucket (`u32::MAX`: no upper end).
@@ -85,10 +85,10 @@ pub struct BucketError {
     /// Of them, those whose 8-bit colour differs.
     pub error_pixels: u64,
     /// The colour error over them (`None`: no pixel in the bucket).
-    pub error: Option<ColourError>,
+    pub error: Option<ColourDeviation>,
 }
 
-impl BucketError {
+impl BucketDeviation {
     /// The bucket's name in tables: `1`, `2–4`, `33+`.
     #[must_use]
     pub fn label(&self) -> String {
@@ -111,7 +111,7 @@ pub fn colour_error_by_depth(
     reference: &RgbImage,
     candidate: &RgbImage,
     depth_complexity: &[u32],
-) -> Result<Vec<BucketError>, CompareError> {
+) -> Result<Vec<BucketDeviation>, CompareError> {
     check_sizes(reference, candidate)?;
     let pixels = reference.width() as usize * reference.height() as usize;
     if depth_complexity.len() != pixels {
@@ -136,7 +136,7 @@ pub fn colour_error_by_depth(
     Ok(DEPTH_BUCKETS
         .iter()
         .zip(sums)
-        .map(|(&(lo, hi), sums)| BucketError {
+        .map(|(&(lo, hi), sums)| BucketDeviation {
             lo,
             hi,
             pixels: sums.pixels,
@@ -179,10 +179,10 @@ impl Sums {
     }
 
     /// The figures over at least one pixel.
-    fn error(&self) -> ColourError {
+    fn error(&self) -> ColourDeviation {
         let pixels = self.pixels as f64;
         let mse = self.squares as f64 / (3.0 * pixels);
-        ColourError {
+        ColourDeviation {
             mean_abs: self.abs.map(|s| s as f64 / pixels),
             max_abs: self.max,
             psnr_db: 10.0 * (255.0_f64 * 255.0 / mse).log10(),
@@ -253,7 +253,7 @@ mod tests {
         let mut candidate = reference.clone();
         candidate.put_pixel(0, 1, Rgb([50, 56, 50]));
         let buckets = colour_error_by_depth(&reference, &candidate, &[0, 1, 3, 40]).unwrap();
-        let labels: Vec<String> = buckets.iter().map(BucketError::label).collect();
+        let labels: Vec<String> = buckets.iter().map(BucketDeviation::label).collect();
         assert_eq!(labels, ["1", "2–4", "5–8", "9–16", "17–32", "33+"]);
         let pixels: Vec<u64> = buckets.iter().map(|b| b.pixels).collect();
         assert_eq!(pixels, [1, 1, 0, 0, 0, 1]);

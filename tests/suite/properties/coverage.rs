@@ -13,8 +13,8 @@ use proptest::test_runner::TestCaseError;
 
 use super::{check_tiling, config, coverage, odd_pixels, with_view};
 use crate::support::strategies::{
-    closed_mesh, depth_plane, hinge, identity_camera, is_closed, k_choice, orbit_camera,
-    orbit_camera_outside, scene_spec, unit_depth_pair, viewport, viewport_and_tiling, KChoice,
+    closed_mesh, depth_plane, generated_scene, hinge, identity_camera, is_closed, k_choice,
+    orbit_camera, orbit_camera_outside, unit_depth_pair, viewport, viewport_and_tiling, KChoice,
 };
 
 proptest! {
@@ -26,7 +26,7 @@ proptest! {
     /// depth complexity is the length of its oracle list.
     #[test]
     fn fragment_counts_agree(
-        spec in scene_spec(),
+        spec in generated_scene(),
         camera in orbit_camera(),
         viewport in viewport(),
         k in k_choice(),

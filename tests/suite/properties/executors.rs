@@ -16,7 +16,7 @@ use proptest::test_runner::TestCaseError;
 
 use super::{check_mdts_concurrent, config, counted, total_overflow, with_view};
 use crate::support::strategies::{
-    concurrency, k_choice, orbit_camera, scene_spec, small_capacity, viewport,
+    concurrency, generated_scene, k_choice, orbit_camera, small_capacity, viewport,
 };
 
 proptest! {
@@ -30,7 +30,7 @@ proptest! {
     /// counts, are the executor's dropped walks.
     #[test]
     fn mdts_concurrent_equals_the_oracle(
-        spec in scene_spec(),
+        spec in generated_scene(),
         camera in orbit_camera(),
         viewport in viewport(),
         k in k_choice(),
@@ -54,7 +54,7 @@ proptest! {
     /// the capacity computed here from the oracle's per-pixel counts.
     #[test]
     fn abuffer_concurrent_equals_the_oracle(
-        spec in scene_spec(),
+        spec in generated_scene(),
         camera in orbit_camera(),
         viewport in viewport(),
         capacity in small_capacity(),
@@ -170,7 +170,7 @@ proptest! {
     /// hazard needs two writers on one pixel), plus the counting pass that sizes the others.
     #[test]
     fn the_tiled_executor_equals_the_serial_one_for_every_scheme(
-        spec in scene_spec(),
+        spec in generated_scene(),
         camera in orbit_camera(),
         viewport in viewport(),
         k in k_choice(),
@@ -215,7 +215,7 @@ proptest! {
     /// counts and list lengths agree, and the whole capture does when nothing overflows.
     #[test]
     fn serial_and_concurrent_executors_agree(
-        spec in scene_spec(),
+        spec in generated_scene(),
         camera in orbit_camera(),
         viewport in viewport(),
         k in k_choice(),

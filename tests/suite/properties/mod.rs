@@ -15,7 +15,7 @@ use fragsim::raster::{CullMode, OrbitCamera, Scene, View, Viewport};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 
-use crate::support::strategies::{identity_camera, Concurrency, PlanarTiling, SceneSpec};
+use crate::support::strategies::{identity_camera, Concurrency, GeneratedScene, PlanarTiling};
 
 mod coverage;
 mod executors;
@@ -90,7 +90,7 @@ fn counted(view: &View<'_>, concurrency: &Concurrency) -> Vec<u32> {
 
 /// Builds the scene of `spec` and its oracle, and calls `check` with the view.
 fn with_view(
-    spec: &SceneSpec,
+    spec: &GeneratedScene,
     viewport: Viewport,
     camera: &OrbitCamera,
     check: impl FnOnce(&View<'_>, &Oracle) -> Result<(), TestCaseError>,

@@ -27,7 +27,7 @@
 //! fragments in the *same* order, which the GPU guarantees (fragments of one pixel reach the ROP
 //! in API order) and the serial executor reproduces. Under the parallel or scheduled executors the
 //! order may change from pass to pass: a fragment may then be captured twice and another never;
-//! the diff reports both (`tests/suite/kbuffer.rs`).
+//! the diff reports both (`tests/suite/kbuffer/srab.rs`).
 //!
 //! **Memory per pixel:** `8 P` samples of 8 bytes and a 4-byte counter: 68 bytes for one pass,
 //! 132 for two. FreePipe's Table 3 counts 16 MB at 512×512, i.e. 64 bytes a pixel: 8 samples of

@@ -30,7 +30,7 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass
-from typing import Any, Mapping, Optional
+from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
@@ -375,6 +375,29 @@ class Scene:
     def reference(self, k: Optional[int] = None) -> Reference:
         """The exact per-list fragments; with ``k``, also the K nearest of each list."""
         return Reference(**self._core.reference(k))
+
+    def hazard(
+        self,
+        k: int = 8,
+        threads_in_flight: Sequence[int] = (1, 32, 1024),
+        seeds: int = 3,
+        write_back: Sequence[str] = ("render-target", "separate-stores"),
+    ) -> dict[str, Any]:
+        """The k-buffer's read-modify-write hazard on this scene, as ``fragsim hazard`` measures
+        it: for each machine of ``write_back`` (``"render-target"``: write-backs committed in
+        order, only a stale read loses; ``"separate-stores"``: K loads and K stores, as CUDA code
+        does), each scheduling policy (``"random"``, ``"warps"``) and each number of threads in
+        flight ``W``, the k-buffer with ``k`` slots runs under the scheduled executor for
+        ``seeds`` seeds. Returns the report: ``covered``, ``fragments``, ``buckets`` and one
+        dict per row in ``rows`` (``write_back``, ``policy``, ``threads_in_flight``,
+        ``mismatched_pixel_rate`` and its ``_per_seed`` list, ``lost``, ``extra``,
+        ``duplicates``, ``misordered_pixels``, ``mismatched_pixel_rate_by_depth_complexity``).
+        ``W = 1`` runs each walk alone: its rate is 0.
+
+        Raises :class:`FragsimError` for an unknown machine, no seed or ``W = 0``.
+        """
+        report = self._core.hazard(int(k), [int(w) for w in threads_in_flight], int(seeds), list(write_back))
+        return json.loads(report)
 
     def __repr__(self) -> str:
         spec = self.spec

@@ -10,7 +10,7 @@
 //! | [`orbit_camera`], [`orbit_camera_outside`], [`orbit_camera_with_distance`] | an [`OrbitCamera`](fragsim_raster::OrbitCamera) |
 //! | [`procedural_scene_name`] | a name for [`Scene::procedural`](fragsim_raster::Scene::procedural) |
 //! | [`random_mesh`], [`random_mesh_in_box`] | a triangle soup with near-degenerate and coincident triangles |
-//! | [`scene_spec`] | a [`SceneSpec`]: a procedural name or a random mesh |
+//! | [`generated_scene`] | a [`GeneratedScene`]: a procedural name or a random mesh |
 //! | [`closed_mesh`] | a watertight mesh (perturbed icosphere or subdivided cube) |
 //! | [`planar_tiling`], [`viewport_and_tiling`] | a [`PlanarTiling`]: triangles tiling a rectangle |
 //! | [`depth_plane`] | a [`DepthPlane`] to put a tiling on, crossing the near plane |
@@ -19,7 +19,7 @@
 //! | [`unit_depth`], [`unit_depth_pair`] | depths in `[0, 1]` for the depth-key order |
 //! | [`concurrency`] | a [`Concurrency`]: how a run interleaves (task size, schedule) |
 //!
-//! Scenes are generated as a [`SceneSpec`] rather than as a [`Scene`](fragsim_raster::Scene) so that a failing case
+//! Scenes are generated as a [`GeneratedScene`] rather than as a [`Scene`](fragsim_raster::Scene) so that a failing case
 //! prints a short procedural name rather than thousands of vertices.
 
 mod views;

@@ -27,14 +27,14 @@ pub fn procedural_scene_name() -> impl Strategy<Value = String> {
 
 /// A scene to build inside a test: a procedural name, or a random mesh.
 #[derive(Clone, Debug)]
-pub enum SceneSpec {
+pub enum GeneratedScene {
     /// A name for [`Scene::procedural`].
     Procedural(String),
     /// A mesh, e.g. from [`random_mesh_in_box`].
     Mesh(Mesh),
 }
 
-impl SceneSpec {
+impl GeneratedScene {
     /// The scene.
     ///
     /// # Panics
@@ -52,10 +52,10 @@ impl SceneSpec {
 
 /// A procedural scene (weight 2) or a random soup of up to 40 triangles in a random box
 /// (weight 1).
-pub fn scene_spec() -> impl Strategy<Value = SceneSpec> {
+pub fn generated_scene() -> impl Strategy<Value = GeneratedScene> {
     prop_oneof![
-        2 => procedural_scene_name().prop_map(SceneSpec::Procedural),
-        1 => random_mesh_in_box(40).prop_map(SceneSpec::Mesh),
+        2 => procedural_scene_name().prop_map(GeneratedScene::Procedural),
+        1 => random_mesh_in_box(40).prop_map(GeneratedScene::Mesh),
     ]
 }
 

@@ -68,7 +68,8 @@ fn run() -> Result<(), String> {
 
     let scene = Scene::from_file(mesh_path).map_err(|e| e.to_string())?;
     let viewport = Viewport::new(width, height)?;
-    // Exactly what `fragsim bench/render --view V --elevation E` builds (cli/src/args.rs `orbit`).
+    // Exactly what `fragsim bench/render --view V --elevation E` builds (`SceneSpec::orbit`,
+    // crates/raster/src/scene_spec.rs).
     let orbit = OrbitCamera {
         angle_degrees: view_degrees,
         elevation_degrees: elevation,

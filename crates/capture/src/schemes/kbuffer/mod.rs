@@ -26,7 +26,7 @@
 //! `K` nearest fragments in canonical order: [`Promise::Nearest`](crate::Promise::Nearest)`(K)`, exact up to `K`, on both
 //! machines. Under any other interleaving it is **not** safe: this is the read–modify–write hazard
 //! the papers name. Nothing here hides it: the post pass reports the slots as they are, and
-//! `Oracle::diff` counts the lost, extra and misordered fragments (`tests/suite/kbuffer.rs` drives each
+//! `Oracle::diff` counts the lost, extra and misordered fragments (`tests/suite/kbuffer/` drives each
 //! case by hand; `docs/baselines/kbuffer.md` and `docs/rmw-hazard.md` write them out).
 //!
 //! **How the render-target step is made indivisible.** On the serial and scheduled executors a

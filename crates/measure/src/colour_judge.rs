@@ -20,19 +20,19 @@
 
 use std::time::Instant;
 
-use clap::ValueEnum;
 use fragsim_capture::{Capture, PixelLists};
 use fragsim_oracle::Oracle;
 use fragsim_raster::attributes::Attributes;
 use fragsim_raster::{OrbitCamera, Scene, View};
-use fragsim_shade::colour_error::{colour_error, ColourError};
+use fragsim_shade::colour_error::{colour_error, ColourDeviation};
 use fragsim_shade::deferred::{self, PerEntry};
 use fragsim_shade::effects::{self, Effect, Entries, Geometry, Material};
 use image::RgbImage;
 use serde::Serialize;
 
 /// Effects whose images are compared.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "args", derive(clap::ValueEnum))]
 pub enum EffectName {
     /// Front-to-back transparency.
     Transparency,
@@ -95,7 +95,7 @@ pub struct ColourColumns {
 
 impl ColourColumns {
     /// The columns of `error`, where there is an image.
-    pub fn of(error: Option<ColourError>) -> Self {
+    pub fn of(error: Option<ColourDeviation>) -> Self {
         error.map_or_else(Self::default, |e| Self {
             mean_abs_error: Some(e.mean_abs),
             max_abs_error: Some(e.max_abs),
@@ -118,7 +118,8 @@ impl ColourColumns {
 }
 
 /// A capture's image against the oracle's.
-pub(crate) struct JudgedImage<'j> {
+#[derive(Debug)]
+pub struct JudgedImage<'j> {
     /// The capture's image.
     pub image: RgbImage,
     /// The oracle's image.
@@ -126,7 +127,7 @@ pub(crate) struct JudgedImage<'j> {
     /// Pixels whose 8-bit colour differs.
     pub errors: u64,
     /// How far its colours are from the oracle's.
-    pub colour: ColourError,
+    pub colour: ColourDeviation,
     /// What was completed or recomputed, if anything.
     pub pass: Option<AttributePass>,
 }
@@ -137,7 +138,7 @@ pub(crate) struct JudgedImage<'j> {
 /// sample-expanded lists and resolves each pixel from its samples
 /// ([`effects::render_resolved`], `docs/semantics.md` §11): its images are the render target's
 /// size, its reference the per-sample oracle's resolved image.
-pub(crate) struct ColourJudge<'a> {
+pub struct ColourJudge<'a> {
     effect: Effect,
     material: Material,
     size: (u32, u32),
@@ -152,10 +153,21 @@ pub(crate) struct ColourJudge<'a> {
     pub covered: usize,
 }
 
+impl std::fmt::Debug for ColourJudge<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ColourJudge")
+            .field("effect", &self.effect)
+            .field("size", &self.size)
+            .field("samples", &self.samples)
+            .field("covered", &self.covered)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<'a> ColourJudge<'a> {
     /// The judge of `effect` for `view` of `scene` through `orbit` (a view rasterizing per
     /// sample through [`ColourJudge::per_sample`], which refuses what is not resolved per sample).
-    pub(crate) fn new(
+    pub fn new(
         effect: EffectName,
         scene: &Scene,
         view: &View<'a>,
@@ -204,7 +216,7 @@ impl<'a> ColourJudge<'a> {
     /// # Errors
     /// A view at one sample, or Fresnel: its normals are recomputed per pixel centre, not per
     /// sample.
-    pub(crate) fn per_sample(
+    pub fn per_sample(
         effect: EffectName,
         scene: &Scene,
         view: &View<'a>,
@@ -224,22 +236,22 @@ impl<'a> ColourJudge<'a> {
     }
 
     /// The oracle's image.
-    pub(crate) fn reference(&self) -> Option<&RgbImage> {
+    pub fn reference(&self) -> Option<&RgbImage> {
         Some(&self.reference)
     }
 
     /// The effect judged.
-    pub(crate) fn effect(&self) -> Effect {
+    pub fn effect(&self) -> Effect {
         self.effect
     }
 
     /// The material every image is shaded with.
-    pub(crate) fn material(&self) -> &Material {
+    pub fn material(&self) -> &Material {
         &self.material
     }
 
     /// The images' width and height.
-    pub(crate) fn size(&self) -> (u32, u32) {
+    pub fn size(&self) -> (u32, u32) {
         self.size
     }
 
@@ -248,7 +260,7 @@ impl<'a> ColourJudge<'a> {
     ///
     /// # Errors
     /// The image is not the judge's size.
-    pub(crate) fn judge_image(
+    pub fn judge_image(
         &self,
         image: RgbImage,
         pass: Option<AttributePass>,
@@ -300,7 +312,7 @@ impl<'a> ColourJudge<'a> {
     }
 
     /// The capture's image, compared with the oracle's.
-    pub(crate) fn judge(&self, capture: &Capture) -> Option<JudgedImage<'_>> {
+    pub fn judge(&self, capture: &Capture) -> Option<JudgedImage<'_>> {
         let start = Instant::now();
         let (full, completed) = deferred::complete(capture, self.oracle);
         self.judge_full(&full.lists, completed, start)
@@ -308,7 +320,7 @@ impl<'a> ColourJudge<'a> {
 
     /// The image of `lists` of full identities (depth key and primitive id, indexed like the
     /// oracle's), compared with the oracle's: the masked nodes' per-sample resolve.
-    pub(crate) fn judge_lists(&self, lists: &PixelLists) -> Option<JudgedImage<'_>> {
+    pub fn judge_lists(&self, lists: &PixelLists) -> Option<JudgedImage<'_>> {
         self.judge_full(lists, None, Instant::now())
     }
 

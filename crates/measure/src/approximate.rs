@@ -19,7 +19,6 @@
 
 use std::time::{Duration, Instant};
 
-use clap::ValueEnum;
 use fragsim_capture::catalog::Count;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::Oracle;
@@ -28,11 +27,12 @@ use fragsim_shade::effects::Effect;
 use image::RgbImage;
 use serde::Serialize;
 
+use crate::colour_by_depth::ColourByDepth;
 use crate::colour_judge::{ColourColumns, ColourJudge};
-use crate::record::ColourByDepth;
 
 /// An approximate OIT scheme, as `--approximate` spells it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "args", derive(clap::ValueEnum))]
 pub enum ApproximateName {
     /// Weighted blended OIT (McGuire & Bavoil 2013, the weight of their eq. 10).
     Wboit,
@@ -101,7 +101,7 @@ impl ApproximateRow {
 }
 
 /// `--k` resolved for the approximate schemes: `auto` is the scene's maximum depth complexity.
-pub(crate) fn nodes(k: Count, oracle: &Oracle) -> u32 {
+pub fn nodes(k: Count, oracle: &Oracle) -> u32 {
     match k {
         Count::Fixed(n) => n,
         Count::Auto => oracle.max_depth_complexity().max(1),
@@ -112,17 +112,14 @@ pub(crate) fn nodes(k: Count, oracle: &Oracle) -> u32 {
 ///
 /// # Errors
 /// The judge's effect is not transparency.
-pub(crate) fn check_effect(
+pub fn check_effect(
     judge: &ColourJudge<'_>,
     approximate: &[ApproximateName],
 ) -> Result<(), String> {
     if approximate.is_empty() || judge.effect() == Effect::Transparency {
         return Ok(());
     }
-    let name = approximate[0]
-        .to_possible_value()
-        .map(|v| v.get_name().to_string())
-        .unwrap_or_default();
+    let name = approximate[0].with_k(1).name();
     Err(format!(
         "--approximate {name} blends transparency only: run it with --effect transparency"
     ))
@@ -135,7 +132,7 @@ pub(crate) fn check_effect(
 ///
 /// # Errors
 /// The image is not the judge's size (a bug).
-pub(crate) fn measure(
+pub fn measure(
     scheme: ApproximateName,
     k: u32,
     judge: &ColourJudge<'_>,
@@ -182,36 +179,4 @@ pub(crate) fn measure(
         colour_by_depth,
     };
     Ok((row, judged.image))
-}
-
-/// bench.md's table of the approximate schemes, with what its columns mean.
-pub(crate) fn markdown(rows: &[ApproximateRow]) -> String {
-    let mut text = String::from(
-        "\nApproximate OIT (judged by the image: their storage holds colour, not lists)\n\n\
-         | scheme | nodes | memory B | B/px | px beyond nodes | EPR % | mean err | max err | PSNR dB | blend ms | frame ms |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|\n",
-    );
-    for r in rows {
-        let [mean, max, psnr] = r.colour.cells();
-        text.push_str(&format!(
-            "| {} | {} | {} | {:.1} | {} | {:.3} | {mean} | {max} | {psnr} | {:.2} | {:.2} |\n",
-            r.scheme,
-            r.nodes.map_or("-".into(), |k| k.to_string()),
-            r.memory_bytes,
-            r.bytes_per_pixel,
-            r.pixels_beyond_nodes,
-            r.error_pixel_rate * 100.0,
-            r.blend_ms,
-            r.time_ms,
-        ));
-    }
-    text.push_str(
-        "\nColumns: **nodes** per pixel (`--k`; WBOIT none); **memory B**, **B/px** the storage a \
-         GPU needs as the paper lays it out; **px beyond nodes** pixels with more fragments than \
-         nodes (WBOIT: more than one), the only pixels where the scheme may differ from the \
-         exact image; **EPR %**, **mean err**, **max err**, **PSNR dB** as above, of its \
-         transparency image; **blend ms** the median time of the blend over every pixel's \
-         fragments in primitive order; **frame ms** the rasterization alone plus the blend.\n",
-    );
-    text
 }

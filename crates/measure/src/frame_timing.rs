@@ -5,21 +5,26 @@
 use std::time::{Duration, Instant};
 
 use fragsim_raster::{Camera, View};
-use indicatif::ProgressBar;
 use rayon::prelude::*;
 
+use crate::Progress;
+
 /// The median of `times` (sorted in place).
-pub(crate) fn median(times: &mut [Duration]) -> Duration {
+#[must_use]
+pub fn median(times: &mut [Duration]) -> Duration {
     times.sort_unstable();
     times[times.len() / 2]
 }
 
-pub(crate) fn ms(d: Duration) -> f64 {
+/// `d` in milliseconds.
+#[must_use]
+pub fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
 /// The times of one scheme's frames on one executor ([`time_frames`]).
-pub(crate) struct FrameTimes {
+#[derive(Debug, Clone)]
+pub struct FrameTimes {
     /// Every frame: vertex stage, geometry passes and post pass, fastest first.
     pub frames: Vec<Duration>,
     /// The vertex stage's median.
@@ -32,7 +37,8 @@ pub(crate) struct FrameTimes {
 
 impl FrameTimes {
     /// The median frame.
-    pub(crate) fn median(&self) -> Duration {
+    #[must_use]
+    pub fn median(&self) -> Duration {
         self.frames[self.frames.len() / 2]
     }
 }
@@ -44,12 +50,12 @@ impl FrameTimes {
 ///
 /// # Errors
 /// The first error of `frame`.
-pub(crate) fn time_frames<T>(
+pub fn time_frames<T>(
     view: &mut View<'_>,
     camera: &Camera,
     vertex_pool: &rayon::ThreadPool,
     frames: usize,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
     mut frame: impl FnMut(&View<'_>) -> Result<(T, Duration, Duration), String>,
 ) -> Result<(T, FrameTimes), String> {
     let mut totals = Vec::with_capacity(frames);
@@ -65,7 +71,7 @@ pub(crate) fn time_frames<T>(
         passes.push(pass_time);
         resolve.push(resolve_time);
         first.get_or_insert(made);
-        progress.inc(1);
+        progress.step();
     }
     totals.sort_unstable();
     let times = FrameTimes {
@@ -77,8 +83,9 @@ pub(crate) fn time_frames<T>(
     Ok((first.expect("at least one frame"), times))
 }
 
-/// Rasterizes every triangle on the current pool and discards the fragments.
-pub(crate) fn time_raster_alone(view: &View<'_>) -> Duration {
+/// Rasterizes every triangle on the current pool and discards the fragments; returns the time.
+#[must_use]
+pub fn time_raster_alone(view: &View<'_>) -> Duration {
     let start = Instant::now();
     let fragments: u64 = (0..view.triangle_count())
         .into_par_iter()

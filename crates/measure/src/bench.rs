@@ -4,79 +4,50 @@
 //! frame (median, min, max over `--frames`), with the split between vertex stage, rasterization
 //! and capture.
 
-mod output;
-
-use std::path::PathBuf;
 use std::time::Duration;
 
-use clap::Args;
+use fragsim_capture::catalog::{check_memory_cap_early, SchemeName, SchemeRunner};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
 use fragsim_oracle::verdict::{judge_run, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::{Conventions, SamplePattern};
+use fragsim_raster::{SamplePattern, SceneSpec, Viewport};
 use serde::Serialize;
 
 use crate::approximate::{ApproximateName, ApproximateRow};
-use crate::args::{SceneArgs, SchemeArgs, Shard};
+use crate::colour_by_depth::ColourByDepth;
 use crate::colour_judge::{AttributePass, ColourColumns, ColourJudge, EffectName, JudgedImage};
 use crate::frame_timing::{median, ms, time_frames, time_raster_alone};
+use crate::images::Images;
 use crate::multisampled::MsaaReport;
-use crate::record::{ColourByDepth, Context};
-use crate::row_images::Images;
-use crate::schemes::{check_memory_cap_early, SchemeChoice, SchemeName, SchemeRunner};
+use crate::{Progress, SchemeSetup, Shard};
 
-/// Options of `fragsim bench`.
-#[derive(Debug, Clone, Args)]
-pub struct BenchArgs {
-    /// The scene.
-    #[command(flatten)]
-    pub scene: SceneArgs,
-    /// Scheme sizing and executors.
-    #[command(flatten)]
-    pub schemes: SchemeArgs,
-    /// Schemes to run, comma-separated, or `all`.
-    #[arg(long, value_delimiter = ',', default_value = "all")]
-    pub scheme: Vec<SchemeChoice>,
+pub mod report;
+
+/// What `bench` measures, and how.
+#[derive(Debug, Clone)]
+pub struct BenchParams {
+    /// The scene and its camera.
+    pub scene: SceneSpec,
+    /// The viewport.
+    pub viewport: Viewport,
+    /// The catalog schemes measured, in order.
+    pub schemes: Vec<SchemeName>,
+    /// Their sizes, executors, threads and submission order.
+    pub setup: SchemeSetup,
     /// Frames timed per scheme and executor (the median, min and max are reported).
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
     /// The effect whose image is compared with the oracle's.
-    #[arg(long, default_value = "transparency")]
     pub effect: EffectName,
-    /// Directory for bench.jsonl, bench.md, the images and the speed/accuracy chart (its own,
-    /// so that the sweep's files do not mix with the bench's).
-    #[arg(long, default_value = "out/bench")]
-    pub out: PathBuf,
-    /// Print JSON Lines instead of the table: one record per scheme and executor
-    /// (`docs/json-schema.md`; bench.jsonl holds the same).
-    #[arg(long)]
-    pub json: bool,
-    /// Write no images (effect images, difference images, the chart); bench.jsonl and bench.md
-    /// are still written.
-    #[arg(long)]
-    pub no_images: bool,
-    /// Also measure multisampling at this many samples a pixel (1, 2, 4, 8 or 16: the standard
-    /// patterns, `docs/semantics.md` §11): the oracle's transparency image resolved from them
-    /// against the single-sample image (`bench-oracle-transparency-msaa<N>.png`, its difference
-    /// image and the `msaa` fields), and after the single-sample rows, one `bench-msaa` row per
-    /// multisampled scheme against the per-sample oracle: every `--scheme` run per sample
-    /// (storage × N), the masked-node A-buffer (`--capacity` nodes a pixel, each carrying a
-    /// coverage mask) and the masked-node linked list (a pool of `--capacity` nodes a pixel),
-    /// these two on the serial and parallel executors.
-    #[arg(long, value_name = "N")]
+    /// Also measure multisampling at this many samples a pixel (the standard patterns).
     pub samples: Option<u32>,
-    /// Approximate OIT schemes to measure beside the catalog's, by their transparency image
-    /// (`wboit`, `mlab`, `tail-blend`; MLAB and tail blending with `--k` nodes), comma-separated.
-    #[arg(long, value_delimiter = ',')]
+    /// Approximate OIT schemes measured beside the catalog's.
     pub approximate: Vec<ApproximateName>,
-    /// Measure only shard I of N of the rows (cargo-nextest's `count:I/N`): of the (scheme,
-    /// executor) rows in `--scheme` × `--executor` order, then the `--approximate` rows, row `k`
-    /// (from 0) when `k mod N = I − 1`. The shards' bench.jsonl files together hold the
-    /// unsharded bench's rows (times apart; `vs DP` where depth peeling ran in the same shard).
-    /// Not with `--samples`.
-    #[arg(long, value_name = "I/N", value_parser = Shard::parse, conflicts_with = "samples")]
-    pub shard: Option<Shard>,
+    /// The rows measured: of the (scheme, executor) rows, then the approximate ones, row `k`
+    /// when the shard takes `k`.
+    pub shard: Shard,
+    /// Where the effect images and their differences go (`None`: no images).
+    pub images: Option<Images>,
 }
 
 /// One row of the bench.
@@ -203,9 +174,6 @@ fn ns_per(time: Duration, items: u64) -> f64 {
 /// What the whole bench measured.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchReport {
-    /// The context of every record (scene, viewport, camera, sizes).
-    #[serde(skip)]
-    pub context: Context,
     /// Scene name, as tables and titles print it (a mesh by its file name).
     #[serde(skip)]
     pub scene: String,
@@ -241,51 +209,29 @@ pub struct BenchReport {
     pub approximate: Vec<ApproximateRow>,
 }
 
-/// The images of `args` (`None` under `--no-images`).
-///
-/// # Errors
-/// The mesh file cannot be read (for its name in the caption).
-fn images(args: &BenchArgs) -> Result<Option<Images<'_>>, String> {
-    if args.no_images {
-        return Ok(None);
-    }
-    let context = Context::of_scene("bench", &args.scene)?;
-    Ok(Some(Images {
-        dir: &args.out,
-        scene: format!(
-            "{}, view {}°, elevation {}°, {}x{}",
-            context.scene,
-            args.scene.view,
-            args.scene.elevation,
-            args.scene.width,
-            args.scene.height
-        ),
-    }))
-}
-
 /// Runs `bench`.
 ///
 /// # Errors
 /// Scene, parameter or output errors.
-pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
-    let pattern = args
+pub fn bench(params: &BenchParams, progress: &dyn Progress) -> Result<BenchReport, String> {
+    let pattern = params
         .samples
         .map(|count| {
-            if args.effect != EffectName::Transparency {
+            if params.effect != EffectName::Transparency {
                 return Err(format!(
                     "--samples resolves the transparency image only, not {}",
-                    args.effect.label()
+                    params.effect.label()
                 ));
             }
             SamplePattern::standard(count).map_err(|e| format!("--samples {count}: {e}"))
         })
         .transpose()?;
-    let pool = args.schemes.pool()?;
-    let spec = args.scene.spec(Conventions::REFERENCE);
+    let pool = params.setup.pool()?;
+    let spec = &params.scene;
     let scene = spec.load(None).map_err(|e| e.to_string())?;
-    let viewport = args.scene.viewport().map_err(|e| e.to_string())?;
+    let viewport = params.viewport;
     let orbit = spec.orbit();
-    let frames = args.frames as usize;
+    let frames = params.frames as usize;
     // The camera depends on the model's bounds, a per-scene constant (a GPU application computes
     // it at load); the vertex stage proper is timed per frame, on the pool.
     let camera = spec.camera(&scene, viewport).map_err(|e| e.to_string())?;
@@ -293,48 +239,53 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let mut view = args
-        .schemes
+    let mut view = params
+        .setup
         .submission(spec.view(&scene, viewport).map_err(|e| e.to_string())?);
-    crate::args::warn_if_empty(&scene, &view);
-    let sizing = args.schemes.sizing();
-    let schemes = SchemeChoice::expand(&args.scheme);
-    check_memory_cap_early(&schemes, viewport, &sizing).map_err(|e| e.to_string())?;
+    if let Some(warning) = scene.empty_view_warning(&view) {
+        progress.warn(&warning);
+    }
+    let sizing = params.setup.sizing;
+    let schemes = &params.schemes;
+    check_memory_cap_early(schemes, viewport, &sizing).map_err(|e| e.to_string())?;
     if let Some(pattern) = pattern {
-        crate::multisampled::check_early(&view, pattern, &schemes, &sizing)?;
+        crate::multisampled::check_early(&view, pattern, schemes, &sizing)?;
     }
     let raster_times: Vec<Duration> = (0..frames)
         .map(|_| pool.install(|| time_raster_alone(&view)))
         .collect();
-    crate::oracle_memory::check(&view, sizing.memory_cap).map_err(|e| e.to_string())?;
+    fragsim_oracle::memory_cap::check(&view, sizing.memory_cap).map_err(|e| e.to_string())?;
     let oracle = Oracle::build(&view);
-    let judge = ColourJudge::new(args.effect, &scene, &view, orbit, &oracle);
-    crate::approximate::check_effect(&judge, &args.approximate)?;
+    let judge = ColourJudge::new(params.effect, &scene, &view, orbit, &oracle);
+    crate::approximate::check_effect(&judge, &params.approximate)?;
     let covered = judge.covered;
     let depth_complexity = oracle.depth_complexity();
-    let executors = args.schemes.executors();
+    let executors = &params.setup.executors;
     // One step a frame, plus the untimed frame that counts locked operations.
-    let progress = crate::progress::bar(
+    let shard = params.shard;
+    progress.begin(
         ((0..schemes.len() * executors.len())
-            .filter(|&k| args.shard.unwrap_or(Shard::WHOLE).takes(k))
+            .filter(|&k| shard.takes(k))
             .count()
             * (frames + 1)) as u64,
         "bench",
     );
-    let images = images(args)?;
+    let images = &params.images;
     if let (Some(image), Some(images)) = (judge.reference(), &images) {
-        images.save(image, &format!("bench-oracle-{}.png", args.effect.label()))?;
+        images.save(
+            image,
+            &format!("bench-oracle-{}.png", params.effect.label()),
+        )?;
     }
-    let shard = args.shard.unwrap_or(Shard::WHOLE);
     // Row `k` of the campaign: the (scheme, executor) rows in order, then the approximate ones.
     let mut row_number = 0..;
     let mut rows = Vec::new();
-    for &name in &schemes {
+    for &name in schemes {
         for &executor in executors {
             if !row_number.next().is_some_and(|k| shard.takes(k)) {
                 continue;
             }
-            progress.set_message(format!("{name} on the {executor} executor"));
+            progress.message(&format!("{name} on the {executor} executor"));
             let mut runner = SchemeRunner::default();
             // A frame is the vertex stage, the geometry passes and the post pass; the serial
             // executor's vertex stage runs on one thread too.
@@ -344,7 +295,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 &pool
             };
             let (named, times) =
-                time_frames(&mut view, &camera, frame_pool, frames, &progress, |view| {
+                time_frames(&mut view, &camera, frame_pool, frames, progress, |view| {
                     let named = pool
                         .install(|| runner.run(name, executor, view, &sizing))
                         .map_err(|e| e.to_string())?;
@@ -356,7 +307,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             let counted = pool
                 .install(|| runner.run(name, executor, &view, &sizing))
                 .map_err(|e| e.to_string())?;
-            progress.inc(1);
+            progress.step();
             let locked_ops = counted.run.stats.locked_ops.unwrap_or(0);
             let RunVerdict { diff, kept, .. } = judge_run(
                 &oracle,
@@ -385,7 +336,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                     &format!("bench-{}-{executor}", named.name),
                     &format!(
                         "{} of {} on the {executor} executor",
-                        args.effect.label(),
+                        params.effect.label(),
                         named.name
                     ),
                 )?;
@@ -438,7 +389,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
             });
         }
     }
-    progress.finish_and_clear();
+    progress.end();
     set_speedups(&mut rows);
     let msaa = pattern
         .map(|pattern| {
@@ -448,23 +399,24 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                 orbit,
                 camera: &camera,
                 judge: &judge,
-                schemes: &schemes,
+                schemes,
                 executors,
                 sizing,
                 frames,
                 pool: &pool,
                 serial_pool: &serial_pool,
                 images: images.as_ref(),
+                progress,
             };
             crate::multisampled::measure(&bench, pattern)
         })
         .transpose()?;
     let raster_ms = ms(median(&mut raster_times.clone()));
-    let order = (!args.approximate.is_empty()).then(|| PrimitiveOrder::of_view(&view));
+    let order = (!params.approximate.is_empty()).then(|| PrimitiveOrder::of_view(&view));
     let mut approximate = Vec::new();
     if let Some(order) = &order {
         let nodes = crate::approximate::nodes(sizing.k, &oracle);
-        for &scheme in &args.approximate {
+        for &scheme in &params.approximate {
             if !row_number.next().is_some_and(|k| shard.takes(k)) {
                 continue;
             }
@@ -478,16 +430,14 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
                     &image,
                     reference,
                     &format!("bench-{}", row.scheme),
-                    &format!("{} of {}", args.effect.label(), row.label()),
+                    &format!("{} of {}", params.effect.label(), row.label()),
                 )?;
             }
             approximate.push(row);
         }
     }
-    let context = Context::of_scene("bench", &args.scene)?.sized(&args.schemes);
     let report = BenchReport {
-        scene: context.scene.clone(),
-        context,
+        scene: crate::scene_name(spec),
         triangles: view.triangle_count(),
         width: viewport.width,
         height: viewport.height,
@@ -495,13 +445,12 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
         max_depth_complexity: oracle.max_depth_complexity(),
         covered_pixels: covered,
         raster_ms,
-        effect: args.effect.label().into(),
-        frames: args.frames,
+        effect: params.effect.label().into(),
+        frames: params.frames,
         msaa,
         rows,
         approximate,
     };
-    output::write_outputs(&report, args)?;
     Ok(report)
 }
 

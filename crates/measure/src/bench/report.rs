@@ -1,111 +1,19 @@
-//! What `bench` writes: its JSON Lines records, the terminal table, the Markdown report and the
-//! speed/accuracy chart.
+//! What `bench` reports beside its rows: bench.md (every column of every row with their key,
+//! the approximate rows, the colour error per depth-complexity bucket, the multisampled rows) and
+//! the speed/accuracy chart. Text and files, never stdout: the command line prints them.
 
-use serde::Serialize;
+use std::path::Path;
 
-use super::{BenchArgs, BenchReport, BenchRow};
+use super::BenchReport;
 use crate::approximate::ApproximateRow;
-use crate::multisampled::SampledRow;
-use crate::record::{bucket_cells, mean_of_channels, percent};
-use crate::schemes::family;
-
-/// One line of bench's JSON Lines: a row with what the whole bench measured.
-#[derive(Serialize)]
-struct BenchRecord<'a> {
-    #[serde(flatten)]
-    row: &'a BenchRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// One line of bench's JSON Lines for an approximate scheme: its row with what the whole bench
-/// measured.
-#[derive(Serialize)]
-struct ApproximateRecord<'a> {
-    #[serde(flatten)]
-    row: &'a ApproximateRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// One line of bench's JSON Lines for a multisampled scheme (`--samples`): its row with what the
-/// whole bench measured.
-#[derive(Serialize)]
-struct SampledRecord<'a> {
-    #[serde(flatten)]
-    row: &'a SampledRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// Writes the report's records, Markdown and chart into `--out` and prints its table.
-///
-/// # Errors
-/// A file that cannot be written.
-pub(super) fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let mut lines = String::new();
-    for row in &report.rows {
-        let context = report.context.on(&row.executor, row.threads);
-        let record = BenchRecord { row, bench: report };
-        lines.push_str(&crate::record::line("bench", &context, &record)?);
-        lines.push('\n');
-    }
-    for row in &report.approximate {
-        let context = report.context.on("primitive-order", row.threads);
-        let record = ApproximateRecord { row, bench: report };
-        lines.push_str(&crate::record::line(
-            "bench-approximate",
-            &context,
-            &record,
-        )?);
-        lines.push('\n');
-    }
-    for row in report.msaa.iter().flat_map(|m| &m.rows) {
-        let context = report.context.on(&row.executor, row.threads);
-        let record = SampledRecord { row, bench: report };
-        lines.push_str(&crate::record::line("bench-msaa", &context, &record)?);
-        lines.push('\n');
-    }
-    let json_path = args.out.join("bench.jsonl");
-    std::fs::write(&json_path, &lines)
-        .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
-    let markdown = markdown(report);
-    let md_path = args.out.join("bench.md");
-    std::fs::write(&md_path, &markdown)
-        .map_err(|e| format!("cannot write {}: {e}", md_path.display()))?;
-    let wrote = if args.no_images {
-        format!("wrote {}: bench.jsonl, bench.md", args.out.display())
-    } else {
-        speed_accuracy_chart(report, &args.out.join("bench-speed-accuracy.png"))?;
-        format!(
-            "wrote {}: bench.jsonl, bench.md, bench-speed-accuracy.png and the effect and \
-             difference images",
-            args.out.display()
-        )
-    };
-    // Under `--json` stdout stays JSON Lines: where the files went goes to stderr.
-    if args.json {
-        out!("{lines}");
-        eprintln!("{wrote}");
-    } else {
-        out!("{}", terminal_table(report));
-        if let Some(msaa) = &report.msaa {
-            out!("\n{}", crate::multisampled::terminal_table(msaa));
-        }
-        let tables = if report.msaa.is_some() {
-            "every column, with their key, the per-depth tables and the multisampled table"
-        } else {
-            "every column, with their key, and the per-depth tables"
-        };
-        outln!("{wrote} (bench.md: {tables})");
-    }
-    Ok(())
-}
+use crate::cells::{bucket_cells, family, mean_of_channels, percent};
+use crate::multisampled::MsaaReport;
 
 /// The bench's own speed/accuracy chart: one point per scheme and executor.
-fn speed_accuracy_chart(report: &BenchReport, path: &std::path::Path) -> Result<(), String> {
+///
+/// # Errors
+/// The chart cannot be drawn or written.
+pub fn speed_accuracy_chart(report: &BenchReport, path: &Path) -> Result<(), String> {
     let points: Vec<fragsim_shade::plot::Point> = report
         .rows
         .iter()
@@ -164,44 +72,10 @@ median; **Mtri/s**, **Mfrag/s** millions of triangles (per pass) and fragments p
 **vs DP** depth peeling's median time over this row's (above 1: faster than depth peeling).
 ";
 
-/// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
-/// first, aligned, in about 120 characters (bench.md holds all 26).
-fn terminal_table(report: &BenchReport) -> String {
-    let columns: [crate::record::Column<BenchRow>; 10] = [
-        ("scheme", |r| r.scheme.clone()),
-        ("executor", |r| r.executor.clone()),
-        ("passes", |r| r.passes.to_string()),
-        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
-        ("lost", |r| r.lost.to_string()),
-        ("mismatched px", |r| r.mismatched_pixels.to_string()),
-        ("EPR %", |r| {
-            r.error_pixel_rate
-                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
-        }),
-        ("PSNR dB", |r| r.colour.cells()[2].clone()),
-        ("frame ms", |r| format!("{:.2}", r.time_ms)),
-        ("vs DP", |r| {
-            r.speedup_vs_depth_peeling
-                .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
-        }),
-    ];
-    let mut text = markdown(report)
-        .lines()
-        .next()
-        .unwrap_or_default()
-        .to_string();
-    text.push_str("\n\n");
-    text.push_str(&crate::record::aligned_table(&columns, &report.rows, 2));
-    text.push_str(
-        "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
-         should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
-         pixels whose 8-bit colour of the effect differs, in % of the covered pixels; PSNR dB of \
-         that image; frame ms the median frame; vs DP speed-up over depth peeling.\n",
-    );
-    text
-}
-
-fn markdown(report: &BenchReport) -> String {
+/// bench.md: the scene, the rows' table with its key, the approximate rows, the colour error
+/// per depth-complexity bucket and the multisampled rows.
+#[must_use]
+pub fn markdown(report: &BenchReport) -> String {
     let mut text = format!(
         "scene {}: {} triangles, {}x{}, {} fragments, max depth complexity {}, {} covered pixels; \
          rasterization alone {:.2} ms (median of {} frames); effect {}\n\n",
@@ -274,11 +148,11 @@ fn markdown(report: &BenchReport) -> String {
     }
     text.push_str(COLUMNS);
     if !report.approximate.is_empty() {
-        text.push_str(&crate::approximate::markdown(&report.approximate));
+        text.push_str(&approximate_markdown(&report.approximate));
     }
     text.push_str(&depth_markdown(report));
     if let Some(msaa) = &report.msaa {
-        text.push_str(&crate::multisampled::markdown(msaa));
+        text.push_str(&msaa_markdown(msaa));
     }
     text
 }
@@ -319,4 +193,107 @@ fn depth_markdown(report: &BenchReport) -> String {
          alone. JSON: `pixels_dc_5_8`, `error_pixels_dc_5_8`, `error_pixel_rate_dc_5_8`, \
          `mean_abs_error_dc_5_8`, … for every bucket, on every record.\n"
     )
+}
+
+/// bench.md's table of the approximate schemes, with what its columns mean.
+fn approximate_markdown(rows: &[ApproximateRow]) -> String {
+    let mut text = String::from(
+        "\nApproximate OIT (judged by the image: their storage holds colour, not lists)\n\n\
+         | scheme | nodes | memory B | B/px | px beyond nodes | EPR % | mean err | max err | PSNR dB | blend ms | frame ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let [mean, max, psnr] = r.colour.cells();
+        text.push_str(&format!(
+            "| {} | {} | {} | {:.1} | {} | {:.3} | {mean} | {max} | {psnr} | {:.2} | {:.2} |\n",
+            r.scheme,
+            r.nodes.map_or("-".into(), |k| k.to_string()),
+            r.memory_bytes,
+            r.bytes_per_pixel,
+            r.pixels_beyond_nodes,
+            r.error_pixel_rate * 100.0,
+            r.blend_ms,
+            r.time_ms,
+        ));
+    }
+    text.push_str(
+        "\nColumns: **nodes** per pixel (`--k`; WBOIT none); **memory B**, **B/px** the storage a \
+         GPU needs as the paper lays it out; **px beyond nodes** pixels with more fragments than \
+         nodes (WBOIT: more than one), the only pixels where the scheme may differ from the \
+         exact image; **EPR %**, **mean err**, **max err**, **PSNR dB** as above, of its \
+         transparency image; **blend ms** the median time of the blend over every pixel's \
+         fragments in primitive order; **frame ms** the rasterization alone plus the blend.\n",
+    );
+    text
+}
+
+/// bench.md's table of the multisampled rows, with what its columns mean.
+#[must_use]
+pub fn msaa_markdown(msaa: &MsaaReport) -> String {
+    let percent = |part: u64, whole: u64| 100.0 * part as f64 / whole.max(1) as f64;
+    let mut text = format!(
+        "\nMultisampled schemes at {n} samples a pixel, against the per-sample oracle ({} sample \
+         fragments; its deepest pixel needs {} masked nodes)\n\n\
+         | scheme | storage | executor | thr | passes | slots | memory B | B/px | overflow | missing | lost | wrong samples | misordered | EPR % | mean err | max err | PSNR dB | passes ms | post ms | frame ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        msaa.sample_fragments,
+        msaa.max_nodes_per_pixel,
+        n = msaa.samples,
+    );
+    for r in &msaa.rows {
+        let [mean_error, max_error, psnr] = r.colour.cells();
+        text.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} {} | {} ({:.3} %) | {} | {} ({:.3} %) | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} |\n",
+            r.scheme,
+            r.storage,
+            r.executor,
+            r.threads,
+            r.passes,
+            r.slots.map_or_else(|| "counted".to_string(), |s| s.to_string()),
+            r.memory_bytes,
+            r.bytes_per_pixel,
+            r.overflowed,
+            r.overflow_unit,
+            r.missing,
+            percent(r.missing, r.sample_fragments),
+            r.lost,
+            r.wrong_samples,
+            100.0 * r.wrong_sample_rate,
+            r.misordered_samples,
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
+            mean_error,
+            max_error,
+            psnr,
+            r.passes_ms,
+            r.resolve_ms,
+            r.time_ms,
+        ));
+    }
+    text.push_str(
+        "
+Columns: **storage** `per-sample`: the scheme run on the sample-expanded framebuffer (its storage \
+× samples); `masked`: per-pixel nodes, one per primitive and pixel, each carrying the mask of the \
+samples it covers and the nearest of their depths, in `--capacity` slots a pixel \
+(`abuffer-masked`) or a pool of `--capacity` nodes a pixel shared by all (`linked-list-masked`); \
+**passes** geometry passes, its own counting pass included; **slots** slots a sample \
+(per-sample), nodes a pixel (masked A-buffer) or pool nodes a pixel (linked lists) the storage \
+had (`--k`, `--capacity`, or its counting pass's deepest pixel under `auto`; counted: a pool of \
+every node, storage sized per pixel); **memory B**, **B/px** \
+bytes allocated, in all and per pixel (all its samples); **overflow** what found no room: sample \
+fragments (per-sample storage, the oracle's prediction as above) or whole nodes (masked storage, \
+its counters' count: per pixel, or the pool's one counter); **missing** sample fragments of the \
+per-sample oracle missing from the scheme's per-sample resolve, the overflow's included, with \
+their share; **lost** of those, the ones the scheme owed: beyond the predicted overflow for \
+per-sample storage (as the single-sample table counts them: 0 for a correct scheme whatever K), \
+every missing one for masked storage (its overflow counts nodes); **wrong samples** samples whose list differs from \
+the per-sample oracle's, with their share of all samples; **misordered** of those, samples with \
+every fragment present in another order (a masked node orders all its samples by its nearest \
+depth); **EPR %**, **mean err**, **max err**, **PSNR dB** the transparency image shaded per \
+sample and box-resolved per pixel against the oracle's resolved the same way; **passes ms**, \
+**post ms**, **frame ms** medians of the geometry passes, the post pass and the frame (vertex \
+stage included).
+",
+    );
+    text
 }

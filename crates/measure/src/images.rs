@@ -1,25 +1,26 @@
 //! Where `bench` saves its rows' images (its own and its multisampled rows'): each effect image
 //! as it is, and its difference from the oracle's, captioned with the scene.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use image::RgbImage;
 
 /// Where bench's images go, and the scene and view their captions name.
-pub(crate) struct Images<'a> {
+#[derive(Debug, Clone)]
+pub struct Images {
     /// The directory (`--out`).
-    pub(crate) dir: &'a Path,
+    pub dir: PathBuf,
     /// The scene, view and size, as every caption opens.
-    pub(crate) scene: String,
+    pub scene: String,
 }
 
-impl Images<'_> {
+impl Images {
     /// Saves the effect image `image` as `name`, as it is: pixel data that readers compare
     /// (its file name says what it is; its figure, the difference, carries the caption).
     ///
     /// # Errors
     /// A file that cannot be written.
-    pub(crate) fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
+    pub fn save(&self, image: &RgbImage, name: &str) -> Result<(), String> {
         fragsim_shade::save_png(image, &self.dir.join(name)).map_err(|e| e.to_string())
     }
 
@@ -28,7 +29,7 @@ impl Images<'_> {
     ///
     /// # Errors
     /// Images of different sizes, a font error, or a file that cannot be written.
-    pub(crate) fn save_with_difference(
+    pub fn save_with_difference(
         &self,
         image: &RgbImage,
         reference: &RgbImage,

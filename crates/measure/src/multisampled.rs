@@ -16,7 +16,7 @@
 //!
 //! **The error** of every row is against the per-sample oracle, whatever the storage: the sample
 //! fragments missing from the scheme's per-sample resolve, the samples whose list differs, and of
-//! those the misordered ones ([`SampleError`]); and the colour error of its transparency image,
+//! those the misordered ones ([`SampleDeviation`]); and the colour error of its transparency image,
 //! shaded per sample and box-resolved per pixel, against the oracle's image resolved the same
 //! way ([`ColourJudge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
@@ -24,14 +24,15 @@
 use fragsim_capture::catalog::{check_memory_cap_early, Count, SchemeName, SchemeRunner, Sizing};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
-use fragsim_oracle::samples::{SampleError, SampleOracle};
+use fragsim_oracle::samples::{SampleDeviation, SampleOracle};
 use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
 use serde::Serialize;
 
 use crate::colour_judge::{ColourColumns, ColourJudge, JudgedImage};
 use crate::frame_timing::{ms, time_frames, FrameTimes};
-use crate::row_images::Images;
+use crate::images::Images;
+use crate::Progress;
 
 /// The oracle's transparency image resolved from several samples a pixel, against the
 /// single-sample image, and the multisampled schemes' rows (`--samples`).
@@ -157,7 +158,9 @@ pub(crate) struct Bench<'b, 'v> {
     /// One thread: a serial row's vertex stage.
     pub serial_pool: &'b rayon::ThreadPool,
     /// Where images go (`None`: `--no-images`).
-    pub images: Option<&'b Images<'b>>,
+    pub images: Option<&'b Images>,
+    /// Where the rows' progress goes.
+    pub progress: &'b dyn Progress,
 }
 
 /// Refuses, before any pass, storage of the multisampled rows beyond the memory cap: every scheme
@@ -206,7 +209,7 @@ pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<M
         .map_err(|e| e.to_string())?;
     // The per-sample oracle is about `samples` single-sample oracles (one per sample index,
     // each on a shifted pixel grid): the single-sample bound against that share of the cap.
-    crate::oracle_memory::check(bench.view, bench.sizing.memory_cap / u64::from(samples))
+    fragsim_oracle::memory_cap::check(bench.view, bench.sizing.memory_cap / u64::from(samples))
         .map_err(|e| e.to_string())?;
     let oracle = SampleOracle::build(&view).map_err(|e| e.to_string())?;
     let lists = oracle.oracle();
@@ -272,7 +275,8 @@ fn rows(
         .copied()
         .filter(|&e| matches!(e, Executor::Serial | Executor::Parallel))
         .collect();
-    let progress = crate::progress::bar(
+    let progress = bench.progress;
+    progress.begin(
         ((bench.schemes.len() * bench.executors.len() + 2 * masked_executors.len()) * bench.frames)
             as u64,
         "bench --samples",
@@ -281,7 +285,7 @@ fn rows(
     let samples = oracle.pattern().count();
     let mut rows = Vec::new();
     // The row of a first frame's per-sample lists and its times; the image unless --no-images.
-    let mut row = |common: Common, error: SampleError, judged: Option<JudgedImage<'_>>| {
+    let mut row = |common: Common, error: SampleDeviation, judged: Option<JudgedImage<'_>>| {
         let times = &common.times;
         if let (Some(images), Some(j)) = (bench.images, &judged) {
             images.save_with_difference(
@@ -327,20 +331,22 @@ fn rows(
         });
         Ok::<(), String>(())
     };
+    // Copied out of `bench`, whose progress the pool's threads must not see.
+    let sizing = bench.sizing;
     for &name in bench.schemes {
         for &executor in bench.executors {
-            progress.set_message(format!("{name} per sample on the {executor} executor"));
+            progress.message(&format!("{name} per sample on the {executor} executor"));
             let mut runner = SchemeRunner::default();
             let (named, times) = time_frames(
                 view,
                 bench.camera,
                 bench.vertex_pool(executor),
                 bench.frames,
-                &progress,
+                progress,
                 |view| {
                     let named = bench
                         .pool
-                        .install(|| runner.run(name, executor, view, &bench.sizing))
+                        .install(|| runner.run(name, executor, view, &sizing))
                         .map_err(|e| e.to_string())?;
                     let stats = &named.run.stats;
                     let (pass_time, resolve_time) = (stats.pass_time, stats.resolve_time);
@@ -375,17 +381,17 @@ fn rows(
         for &executor in &masked_executors {
             let parallel = executor == Executor::Parallel;
             let kind = if linked { "linked list" } else { "A-buffer" };
-            progress.set_message(format!("masked {kind} on the {executor} executor"));
+            progress.message(&format!("masked {kind} on the {executor} executor"));
             let (masked, times) = time_frames(
                 view,
                 bench.camera,
                 bench.vertex_pool(executor),
                 bench.frames,
-                &progress,
+                progress,
                 |view| {
                     let masked = bench
                         .pool
-                        .install(|| masked_frame(view, bench.sizing, linked, parallel))?;
+                        .install(|| masked_frame(view, sizing, linked, parallel))?;
                     let (pass_time, resolve_time) = (masked.pass_time(), masked.frame.resolve_time);
                     Ok((masked, pass_time, resolve_time))
                 },
@@ -419,7 +425,7 @@ fn rows(
             )?;
         }
     }
-    progress.finish_and_clear();
+    progress.end();
     Ok(rows)
 }
 
@@ -532,111 +538,4 @@ fn masked_frame(
         count,
         frame,
     })
-}
-
-/// What `bench --samples` prints on a terminal under the single-sample table: the line of
-/// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
-/// (bench.md holds every column and their key).
-pub(crate) fn terminal_table(msaa: &MsaaReport) -> String {
-    let columns: [crate::record::Column<SampledRow>; 10] = [
-        ("scheme", |r| r.scheme.clone()),
-        ("storage", |r| r.storage.to_string()),
-        ("executor", |r| r.executor.clone()),
-        ("passes", |r| r.passes.to_string()),
-        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
-        ("overflow", |r| {
-            format!("{} {}", r.overflowed, r.overflow_unit)
-        }),
-        ("lost", |r| r.lost.to_string()),
-        ("wrong samples", |r| r.wrong_samples.to_string()),
-        ("EPR %", |r| {
-            r.error_pixel_rate
-                .map_or_else(|| "n/a".into(), |e| crate::record::percent(e, 3))
-        }),
-        ("frame ms", |r| format!("{:.2}", r.time_ms)),
-    ];
-    let mut text = markdown(msaa)
-        .lines()
-        .find(|line| !line.is_empty())
-        .unwrap_or_default()
-        .to_string();
-    text.push_str("\n\n");
-    text.push_str(&crate::record::aligned_table(&columns, &msaa.rows, 3));
-    text.push_str(
-        "Columns: overflow what found no room (sample fragments, or whole masked nodes); lost \
-         sample fragments the scheme owed and is missing (per-sample storage: beyond the \
-         overflow); wrong samples samples whose list differs from the per-sample oracle's; the \
-         rest as above.\n",
-    );
-    text
-}
-
-/// bench.md's table of the multisampled rows, with what its columns mean.
-pub(crate) fn markdown(msaa: &MsaaReport) -> String {
-    let percent = |part: u64, whole: u64| 100.0 * part as f64 / whole.max(1) as f64;
-    let mut text = format!(
-        "\nMultisampled schemes at {n} samples a pixel, against the per-sample oracle ({} sample \
-         fragments; its deepest pixel needs {} masked nodes)\n\n\
-         | scheme | storage | executor | thr | passes | slots | memory B | B/px | overflow | missing | lost | wrong samples | misordered | EPR % | mean err | max err | PSNR dB | passes ms | post ms | frame ms |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-        msaa.sample_fragments,
-        msaa.max_nodes_per_pixel,
-        n = msaa.samples,
-    );
-    for r in &msaa.rows {
-        let [mean_error, max_error, psnr] = r.colour.cells();
-        text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} {} | {} ({:.3} %) | {} | {} ({:.3} %) | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} |\n",
-            r.scheme,
-            r.storage,
-            r.executor,
-            r.threads,
-            r.passes,
-            r.slots.map_or_else(|| "counted".to_string(), |s| s.to_string()),
-            r.memory_bytes,
-            r.bytes_per_pixel,
-            r.overflowed,
-            r.overflow_unit,
-            r.missing,
-            percent(r.missing, r.sample_fragments),
-            r.lost,
-            r.wrong_samples,
-            100.0 * r.wrong_sample_rate,
-            r.misordered_samples,
-            r.error_pixel_rate
-                .map_or_else(|| "n/a".to_string(), |e| format!("{:.3}", e * 100.0)),
-            mean_error,
-            max_error,
-            psnr,
-            r.passes_ms,
-            r.resolve_ms,
-            r.time_ms,
-        ));
-    }
-    text.push_str(
-        "
-Columns: **storage** `per-sample`: the scheme run on the sample-expanded framebuffer (its storage \
-× samples); `masked`: per-pixel nodes, one per primitive and pixel, each carrying the mask of the \
-samples it covers and the nearest of their depths, in `--capacity` slots a pixel \
-(`abuffer-masked`) or a pool of `--capacity` nodes a pixel shared by all (`linked-list-masked`); \
-**passes** geometry passes, its own counting pass included; **slots** slots a sample \
-(per-sample), nodes a pixel (masked A-buffer) or pool nodes a pixel (linked lists) the storage \
-had (`--k`, `--capacity`, or its counting pass's deepest pixel under `auto`; counted: a pool of \
-every node, storage sized per pixel); **memory B**, **B/px** \
-bytes allocated, in all and per pixel (all its samples); **overflow** what found no room: sample \
-fragments (per-sample storage, the oracle's prediction as above) or whole nodes (masked storage, \
-its counters' count: per pixel, or the pool's one counter); **missing** sample fragments of the \
-per-sample oracle missing from the scheme's per-sample resolve, the overflow's included, with \
-their share; **lost** of those, the ones the scheme owed: beyond the predicted overflow for \
-per-sample storage (as the single-sample table counts them: 0 for a correct scheme whatever K), \
-every missing one for masked storage (its overflow counts nodes); **wrong samples** samples whose list differs from \
-the per-sample oracle's, with their share of all samples; **misordered** of those, samples with \
-every fragment present in another order (a masked node orders all its samples by its nearest \
-depth); **EPR %**, **mean err**, **max err**, **PSNR dB** the transparency image shaded per \
-sample and box-resolved per pixel against the oracle's resolved the same way; **passes ms**, \
-**post ms**, **frame ms** medians of the geometry passes, the post pass and the frame (vertex \
-stage included).
-",
-    );
-    text
 }
