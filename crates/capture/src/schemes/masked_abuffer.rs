@@ -41,11 +41,11 @@
 
 use std::time::{Duration, Instant};
 
+use fragsim_memory::{AtomicMemory, Layout, Memory, SerialMemory, WordMemory};
 use fragsim_raster::{Fragment, View, Viewport};
 use rayon::prelude::*;
 
 use crate::capture::PixelLists;
-use crate::memory::{AtomicMemory, Layout, Memory, SerialMemory, WordMemory};
 use crate::scheme::CaptureError;
 
 /// One primitive's coverage of one pixel: its nearest depth key over the samples it covers, and

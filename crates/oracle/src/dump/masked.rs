@@ -23,7 +23,8 @@
 //! take: from the least of its samples' lowest keys to the least of their highest.
 
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists, MaskedNode};
-use fragsim_capture::{Capacity, Capture, Identity, Keeps, SerialMemory, WordMemory};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::View;
 
 use super::slots::{words_of, Placement, SlotCodec};

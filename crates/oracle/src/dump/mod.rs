@@ -78,9 +78,11 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+#[cfg(doc)]
+use fragsim_capture::Capture;
 use fragsim_capture::CaptureError;
 #[cfg(doc)]
-use fragsim_capture::{Capture, SerialMemory};
+use fragsim_memory::SerialMemory;
 use fragsim_raster::SceneSpecError;
 
 #[cfg(doc)]

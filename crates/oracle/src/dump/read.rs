@@ -4,7 +4,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use fragsim_capture::{Capture, Scheme, SerialMemory, WordMemory};
+use fragsim_capture::{Capture, Scheme};
+
+use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::Viewport;
 
 use super::arrays::stored_lists;
@@ -30,7 +32,7 @@ fn file_error(e: FileError) -> DumpError {
     }
 }
 
-fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W]) {
+fn write_all<W: fragsim_memory::Word>(memory: &impl WordMemory<W>, words: &[W]) {
     for (i, &w) in words.iter().enumerate() {
         memory.store(i, w);
     }

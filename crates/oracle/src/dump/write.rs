@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use fragsim_capture::catalog::DumpLayout;
-use fragsim_capture::{Scheme, SerialMemory, WordMemory};
+use fragsim_capture::Scheme;
+use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::View;
 
 use super::arrays::sort_abuffer_in_place;
@@ -43,7 +44,7 @@ fn array_spec(name: &str, dtype: Dtype, shape: Vec<u64>) -> ArraySpec {
     }
 }
 
-fn read_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>) -> Vec<W> {
+fn read_all<W: fragsim_memory::Word>(memory: &impl WordMemory<W>) -> Vec<W> {
     (0..memory.len()).map(|i| memory.load(i)).collect()
 }
 
