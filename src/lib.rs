@@ -5,7 +5,8 @@
 //! - [`raster`]: scenes, camera and the exact rasterizer that produces fragments;
 //! - [`memory`]: the simulated GPU's memory, the `Memory` seam the schemes step on;
 //! - [`capture`]: the schemes (MDTS, A-buffer) and the executors;
-//! - [`oracle`]: the serial reference lists and the per-pixel diff;
+//! - [`dump`]: the dump format GPU backends write, and the triangle export;
+//! - [`oracle`]: the serial reference lists, the per-pixel diff and the verdict;
 //! - [`shade`]: images of the results.
 //!
 //! ```
@@ -22,6 +23,7 @@
 //! ```
 
 pub use fragsim_capture as capture;
+pub use fragsim_dump as dump;
 pub use fragsim_memory as memory;
 pub use fragsim_oracle as oracle;
 pub use fragsim_raster as raster;

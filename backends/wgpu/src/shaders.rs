@@ -8,7 +8,7 @@
 //! scheme's memory starts at, so the dump's untouched words are the layout's empty markers.
 
 use fragsim_capture::schemes::linked_list::Resolve;
-use fragsim_oracle::dump::{Dtype, LayoutSpec};
+use fragsim_dump::{Dtype, LayoutSpec};
 
 use crate::device::GpuError;
 

@@ -9,7 +9,7 @@
 //! nor a battery that checked nothing ([`BatteryRefused`]). All derive from [`FragsimError`];
 //! the message is the library's own, which names the field, array or file at fault.
 
-use fragsim_oracle::dump::DumpError as OracleDumpError;
+use fragsim_dump::DumpError as OracleDumpError;
 use fragsim_raster::{MeshError, SceneError as RasterSceneError, SceneSpecError};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;

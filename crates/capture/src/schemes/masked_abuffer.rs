@@ -394,7 +394,7 @@ impl MaskedABuffer {
     }
 
     /// The pass alone, serially in submission order, into `memory` (of [`MaskedABuffer::layout`]):
-    /// the words a dump records (`fragsim_oracle::dump`), before the post pass; returns the
+    /// the words a dump records (`fragsim_dump`), before the post pass; returns the
     /// sample fragments rasterized.
     ///
     /// # Errors
