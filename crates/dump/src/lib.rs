@@ -3,8 +3,8 @@
 //! scene after fragsim's vertex stage, so that a backend can test its scan and atomics alone.
 //! This crate is the format only: headers, layouts, arrays, reading and writing, and the bounds
 //! every input is checked against. Judging a dump against a reference is the oracle's
-//! (`fragsim-oracle`, built on this crate: raster ← capture ← dump ← oracle), so that a backend
-//! or a test kit that writes dumps needs no judge to do so.
+//! (`fragsim-oracle`, built on this crate: raster ← capture ← dump ← oracle), so that a
+//! backend or a test kit that writes dumps needs no judge to do so.
 //!
 //! A dump is a directory: `dump.json` (format, version, the scene and camera that produced it,
 //! viewport, scheme, K or capacity, the names, dtypes and shapes of the arrays) and one file of
