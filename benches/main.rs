@@ -28,7 +28,8 @@ use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy,
 use fragsim::capture::executors::{ParallelExecutor, SerialExecutor};
 use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
 use fragsim::capture::schemes::mdts::Mdts;
-use fragsim::capture::{AtomicMemory, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::AtomicMemory;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
 use rayon::prelude::*;
 

@@ -3,8 +3,10 @@
 //! This facade re-exports the workspace's crates so that the integration tests in `tests/` and
 //! users see one library:
 //! - [`raster`]: scenes, camera and the exact rasterizer that produces fragments;
-//! - [`capture`]: the `Memory` seam, the schemes (MDTS, A-buffer) and the executors;
-//! - [`oracle`]: the serial reference lists and the per-pixel diff;
+//! - [`memory`]: the simulated GPU's memory, the `Memory` seam the schemes step on;
+//! - [`capture`]: the schemes (MDTS, A-buffer) and the executors;
+//! - [`dump`]: the dump format GPU backends write, and the triangle export;
+//! - [`oracle`]: the serial reference lists, the per-pixel diff and the verdict;
 //! - [`shade`]: images of the results.
 //!
 //! ```
@@ -21,6 +23,8 @@
 //! ```
 
 pub use fragsim_capture as capture;
+pub use fragsim_dump as dump;
+pub use fragsim_memory as memory;
 pub use fragsim_oracle as oracle;
 pub use fragsim_raster as raster;
 pub use fragsim_shade as shade;

@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use clap::{Args, Command, FromArgMatches};
 use fragsim::capture::Capture;
-use fragsim::oracle::dump::{Dump, WordCheck, HEADER_FILE};
+use fragsim::dump::{Dump, WordCheck, HEADER_FILE};
 use fragsim_cli::CompareArgs;
 
 use super::dump::{is_canonical, Blob};

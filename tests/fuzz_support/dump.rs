@@ -10,8 +10,8 @@
 //! per pixel of the viewport, or fails with an error.
 
 use fragsim::capture::{Capture, Keeps};
+use fragsim::dump::{Dump, DumpError};
 use fragsim::oracle::compare::compare;
-use fragsim::oracle::dump::{Dump, DumpError};
 use fragsim::oracle::Oracle;
 
 use super::input::Input;

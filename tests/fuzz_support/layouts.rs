@@ -30,10 +30,10 @@
 
 use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::Capture;
-use fragsim::oracle::compare::{compare_with, flags, CompareOptions};
-use fragsim::oracle::dump::{
+use fragsim::dump::{
     ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, Payload, Words,
 };
+use fragsim::oracle::compare::{compare_with, flags, CompareOptions};
 use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::{mesh_hash, ViewProjection};
 use fragsim::raster::{DepthRange, VertexPrecision, Viewport, WindowOrigin};

@@ -10,9 +10,8 @@
 use fragsim::capture::catalog::{Build, Passes, SchemeVisitor, CATALOG};
 use fragsim::capture::executors::frame::{self, Counters, Run};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
-use fragsim::capture::{
-    Capture, Guarantee, Identity, Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT,
-};
+use fragsim::capture::{Capture, Guarantee, Identity, Keeps, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::SerialMemory;
 use fragsim::raster::{depth_key, Fragment, Viewport};
 
 use super::input::Input;

@@ -5,7 +5,7 @@
 //! read gives the same records (less the pad word, written 0) and reads back the same, or the
 //! writer refuses a scene number it cannot encode.
 
-use fragsim::oracle::triangles::{TriangleExport, TRIANGLE_RECORD_BYTES};
+use fragsim::dump::triangles::{TriangleExport, TRIANGLE_RECORD_BYTES};
 
 /// Bytes of the fixed header before the scene's JSON.
 const HEADER_BYTES: usize = 40;

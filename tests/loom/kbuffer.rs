@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
 use fragsim::capture::schemes::mdts::Direction;
-use fragsim::capture::{Scheme, SerialMemory, Step, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
+use fragsim::memory::SerialMemory;
 use fragsim::raster::Fragment;
 
 use super::{

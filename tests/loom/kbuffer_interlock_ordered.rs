@@ -32,7 +32,8 @@ use std::sync::Arc;
 use fragsim::capture::primitive_order::PrimitiveOrder;
 use fragsim::capture::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
 use fragsim::capture::schemes::mdts::Direction;
-use fragsim::capture::{Scheme, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::WordMemory;
 use fragsim::raster::Fragment;
 
 use super::{explore, fragments, k_best_error, one_pixel, run_spinning, DISTINCT};

@@ -27,7 +27,8 @@ use std::time::Instant;
 
 use fragsim::capture::schemes::abuffer::ABuffer;
 use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
-use fragsim::capture::{Keeps, Memory, Promise, Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Keeps, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
+use fragsim::memory::{Memory, WordMemory};
 use fragsim::raster::{depth_key, Fragment, Viewport};
 use loom::sync::atomic::{
     AtomicU32, AtomicU64,

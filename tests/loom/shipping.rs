@@ -3,7 +3,8 @@
 use fragsim::capture::schemes::layer_counter::LayerCounter;
 use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};
 use fragsim::capture::schemes::loop32::Loop32;
-use fragsim::capture::{Scheme, Step, WordMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
+use fragsim::memory::WordMemory;
 
 use super::{explore, fragments, keyed, one_pixel, run_threads, LoomMemory, Walks, DISTINCT, TIES};
 

@@ -6,9 +6,10 @@
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
-use fragsim::capture::schemes::mdts::Direction;
+use fragsim::dump::Direction;
+use fragsim::dump::{Dump, DumpScheme};
 use fragsim::oracle::compare::CompareOptions;
-use fragsim::oracle::dump::{Dump, DumpScheme};
+use fragsim::oracle::verdict::JudgeDump;
 use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::{mesh_hash, SceneSpec, ViewProjection};
 use fragsim::raster::{

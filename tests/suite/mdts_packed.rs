@@ -7,7 +7,8 @@ use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::schemes::mdts_packed::{
     depth20, held_depth, remapped_depth, Colours, MdtsPacked, COLOURS,
 };
-use fragsim::capture::{Capture, CaptureError, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Capture, CaptureError, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
 use rayon::prelude::*;

@@ -13,9 +13,9 @@ use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy,
 use fragsim::capture::executors::tiled::run_tiled;
 use fragsim::capture::executors::{run_parallel, run_serial};
 use fragsim::capture::{
-    Descriptor, Guarantee, Identity, Layout, Memory, Promise, Scheme, Step, WordMemory,
-    MEMORY_CAP_DEFAULT,
+    Descriptor, Guarantee, Identity, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
 };
+use fragsim::memory::{Layout, Memory, WordMemory};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
 

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
-use fragsim_oracle::dump::{Dump, Words};
+use fragsim_dump::{Dump, Words};
 
 /// A linked list's layout names its node word: a header without `payload` is refused naming the
 /// field and the file (docs/dump-format.md says all three of `null`, `node_base` and `payload`

@@ -2,11 +2,12 @@
 //! seed; runs are pure functions of the schedule; traces record every memory operation.
 
 use fragsim::capture::executors::scheduled::{
-    run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
+    run_fragments, run_scheduled, Granularity, Policy, Schedule,
 };
 use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
 use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{Capture, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::Op;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
 use proptest::prelude::*;

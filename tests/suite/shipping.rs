@@ -17,7 +17,7 @@
 //! (submission order), the rest are seeded GPU-like interleavings.
 
 use fragsim::capture::executors::scheduled::{
-    run_fragments, run_scheduled, Granularity, Op, Policy, Schedule,
+    run_fragments, run_scheduled, Granularity, Policy, Schedule,
 };
 use fragsim::capture::executors::tiled::run_tiled;
 use fragsim::capture::executors::{run_parallel, run_serial, Executor};
@@ -26,6 +26,7 @@ use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};
 use fragsim::capture::schemes::loop32::Loop32;
 use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::{Capture, Keeps, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::Op;
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
 use proptest::prelude::*;

@@ -1,4 +1,4 @@
-// Mirrors crates/capture/src/memory/mod.rs: the memory seam, the only place that knows which
+// Mirrors crates/memory/src/lib.rs: the memory seam, the only place that knows which
 // atomic type is underneath. On CUDA the schemes' words live in global memory (cudaMalloc) and
 // the atomics are the hardware's; in the serial emulation they are host arrays and the atomics
 // plain read-modify-writes, as the Rust side's SerialMemory is to its AtomicMemory.

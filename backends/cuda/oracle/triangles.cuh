@@ -1,4 +1,4 @@
-// Mirrors crates/oracle/src/triangles.rs: reads the FRAGTRI1 triangle export that
+// Mirrors crates/dump/src/triangles.rs: reads the FRAGTRI1 triangle export that
 // `fragsim export-scene` writes (docs/dump-format.md): the screen triangles after fragsim's vertex
 // stage, and the scene's JSON, which every dump copies so that `fragsim compare` can rebuild the
 // oracle from it.

@@ -30,7 +30,7 @@
 
 use std::collections::BTreeMap;
 
-use fragsim_oracle::dump::{ArraySpec, Dtype, Dump, Header, Words, FORMAT, VERSION};
+use fragsim_dump::{ArraySpec, Dtype, Dump, Header, Words, FORMAT, VERSION};
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::scene_spec::{SceneSpec, ViewProjection};
 use fragsim_raster::{Conventions, View};

@@ -18,8 +18,8 @@
 use std::borrow::Cow;
 
 use fragsim_capture::{Capacity, Identity, Keeps};
+use fragsim_dump::{Dump, DumpError, Words};
 use fragsim_oracle::compare::Comparison;
-use fragsim_oracle::dump::{Dump, DumpError, Words};
 use fragsim_oracle::precision::{f32_reference, Bounds, Precision};
 use fragsim_oracle::verdict::{self, Candidate, Options, Reference, Verdict};
 use fragsim_oracle::Oracle;

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use fragsim_oracle::dump::DumpError;
+use fragsim_dump::DumpError;
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::args::SceneArgs;
 use fragsim_raster::scene_spec::SceneSpec;

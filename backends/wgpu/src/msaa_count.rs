@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_oracle::dump::DumpError;
+use fragsim_dump::DumpError;
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::scene_spec::args::{degrees, elevation, side};
 use fragsim_raster::scene_spec::SceneSpec;

@@ -8,7 +8,7 @@
 //! scheme's memory starts at, so the dump's untouched words are the layout's empty markers.
 
 use fragsim_capture::schemes::linked_list::Resolve;
-use fragsim_oracle::dump::{Dtype, LayoutSpec};
+use fragsim_dump::{Dtype, LayoutSpec};
 
 use crate::device::GpuError;
 
@@ -544,7 +544,7 @@ mod tests {
         };
         // The catalog scheme's lock words (zeros, left out of the dump) and its slots (u64 words
         // are two u32 on the GPU; their initial word all ones is u64::MAX).
-        let catalog = |l: fragsim_capture::Layout| {
+        let catalog = |l: fragsim_memory::Layout| {
             assert_eq!((l.init32, l.init64, l.table_bytes), (0, u64::MAX, 0));
             vec![
                 ("locks", l.words32 as u64, 0, false),

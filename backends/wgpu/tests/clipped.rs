@@ -7,8 +7,8 @@
 //! adapter each test prints one line saying it was skipped; with `CI=true` or
 //! `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
+use fragsim_dump::{Dump, Words};
 use fragsim_oracle::compare::flags;
-use fragsim_oracle::dump::{Dump, Words};
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::scene_spec::{SceneSpec, ViewProjection};
 use fragsim_raster::Viewport;

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_capture::schemes::linked_list::Resolve;
-use fragsim_oracle::dump::{Dump, Words};
+use fragsim_dump::{Dump, Words};
 
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::SceneSpec;

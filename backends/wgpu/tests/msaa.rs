@@ -16,7 +16,7 @@
 //! at 1 and 4); without an adapter the tests are skipped with a line, or fail where a GPU is
 //! required (`adapter_or_skip`).
 
-use fragsim_oracle::dump::Dump;
+use fragsim_dump::Dump;
 use fragsim_oracle::verdict::{judge_sides, Side, SidesOptions, Verdict};
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{SamplePattern, VertexPrecision, Viewport};

@@ -8,8 +8,8 @@
 //! is an error (ambiguous only where MDTS's own pixel is), elsewhere its verdict is MDTS's. Without an adapter each test prints one line
 //! saying it was skipped; with `CI=true` or `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
+use fragsim_dump::Dump;
 use fragsim_oracle::compare::{flags, Comparison};
-use fragsim_oracle::dump::Dump;
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::Viewport;
 use fragsim_wgpu::judge::Within;

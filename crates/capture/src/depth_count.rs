@@ -23,12 +23,12 @@
 //! assert_eq!(counts.max(), 6);
 //! ```
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::executors::Run;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{Descriptor, Promise, Scheme, Step};
 
 /// The counting pass as a scheme: its capture holds one entry per pixel, the pixel's count.

@@ -1,10 +1,11 @@
 //! Capture schemes as state machines over per-pixel memory, and the executors that run them.
 //!
 //! The one idea (see `docs/architecture.md`): every scheme is a per-fragment state machine that
-//! performs **exactly one memory operation per step** on a [`Memory`]. The same scheme code then
-//! runs on plain memory (the serial executor), on std atomics (the parallel executor) and on loom's
-//! atomics (the model-checking suite in `tests/loom/`), and whether a scheme is safe under
-//! concurrency is a question of where its steps are cut.
+//! performs **exactly one memory operation per step** on a [`Memory`], the seam of the crate
+//! below this one (`fragsim-memory`: words, operations, the serial and atomic memories). The
+//! same scheme code then runs on plain memory (the serial executor), on std atomics (the
+//! parallel executor) and on loom's atomics (the model-checking suite in `tests/loom/`), and
+//! whether a scheme is safe under concurrency is a question of where its steps are cut.
 //!
 //! Schemes, one module each, every one stating its algorithm, guarantee, passes and memory:
 //! - FreePipe (Liu et al., I3D 2010): [`mdts`](schemes::mdts) (the multi-depth test scheme, §4.1.1),
@@ -32,7 +33,7 @@
 //! # The tree
 //!
 //! ```text
-//! lib.rs          this map, and the re-exports of the core types (Scheme, Memory, Capture, ...)
+//! lib.rs          this map, and the re-exports of the core types (Scheme, Capture, ...)
 //! scheme.rs       the Scheme trait: begin, step, end pass, resolve; the Descriptor each scheme
 //!                 builds once; Step, Promise, Simt, CaptureError
 //! guarantee.rs    what a scheme guarantees against the oracle
@@ -42,8 +43,6 @@
 //! primitive_order.rs  each pixel's primitives in submission order (the ordered interlock's)
 //! catalog/        every scheme by name: passes, sizing, dump layout, its constructor (mod.rs),
 //!                 building it for a visitor (build.rs), running it (run.rs), dump layouts
-//! memory/         the memory seam: Word, WordMemory, Memory, SerialMemory, AtomicMemory,
-//!                 Layout (the words a scheme asks for), CountingMemory (counts locked ops)
 //! schemes/        one file per scheme, named after it; bucket/ holds bucket peeling's three,
 //!                 kbuffer/ the k-buffer (mod.rs), its shared slots (slots.rs) and its four siblings
 //!   common/       what several schemes share: the fragment words (MdtsWord), the post passes'
@@ -52,12 +51,14 @@
 //!                 parallel.rs, tiled.rs, scheduled.rs, counting.rs (the counted frame)
 //! ```
 //!
-//! Imports go one way: `memory` needs nothing else of the crate; `scheme` needs `memory`,
+//! Imports go one way: the memory is a crate of its own (`fragsim-memory`); `scheme` needs it,
 //! `capture` and `guarantee` (and `post_pass`, whose serial form its default `resolve` runs: the
 //! one circle left, explained in `post_pass.rs`); `schemes` need those and `schemes::common`, never
 //! another scheme's module (a scheme built on another, as the packed MDTS on MDTS's walks, names
 //! it; a family's members share their folder's common part, as `kbuffer/slots.rs`); the executors
-//! need `scheme` and `memory`; the catalog needs everything.
+//! need `scheme` and the memory; the catalog needs everything.
+//!
+//! [`Memory`]: fragsim_memory::Memory
 //!
 //! ```
 //! use fragsim_capture::{executors, schemes::mdts::Mdts};
@@ -75,7 +76,6 @@ pub mod catalog;
 pub mod depth_count;
 pub mod executors;
 mod guarantee;
-mod memory;
 mod post_pass;
 pub mod primitive_order;
 mod scheme;
@@ -83,9 +83,6 @@ pub mod schemes;
 
 pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 pub use guarantee::Guarantee;
-pub use memory::{
-    AtomicMemory, CountingMemory, Layout, Memory, SerialMemory, SpanVisitor, Word, WordMemory,
-};
 pub use scheme::{
     CaptureError, Descriptor, PixelRun, Promise, Scheme, Simt, Step, MEMORY_CAP_DEFAULT,
 };

@@ -21,8 +21,9 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use fragsim_memory::Memory;
+
 use crate::capture::{Capture, PixelLists};
-use crate::memory::Memory;
 use crate::scheme::{PixelRun, Promise, Scheme};
 
 /// Pixels per rayon work item: a few pages of slots, enough to amortise a task, small enough to

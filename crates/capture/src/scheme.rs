@@ -2,11 +2,11 @@
 
 use std::fmt::Debug;
 
+use fragsim_memory::{Layout, Memory};
 use fragsim_raster::Fragment;
 
 use crate::capture::{Capacity, Capture, Identity, Keeps};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory};
 
 /// Default cap on the per-pixel storage a scheme may allocate: 4 GiB.
 pub const MEMORY_CAP_DEFAULT: u64 = 4 << 30;
@@ -51,7 +51,7 @@ impl PixelRun {
     /// The run of `words_per_pixel` words a pixel from `pixel`'s first word on, before `end`:
     /// empty where the pixels' first words lie in a run of untouched words, else to resolve
     /// while their first words lie in the run of written blocks (at least `pixel` itself).
-    pub(crate) fn of_first_words<W: crate::memory::Word, A: crate::memory::WordMemory<W>>(
+    pub(crate) fn of_first_words<W: fragsim_memory::Word, A: fragsim_memory::WordMemory<W>>(
         words: &A,
         pixel: usize,
         end: usize,
@@ -243,7 +243,7 @@ pub trait Scheme: Sync {
     fn step<M: Memory>(&self, state: &mut Self::State, memory: &M) -> Step;
 
     /// Loads the words that the fragment's walk of the first geometry pass begins with, ahead
-    /// of the walk ([`crate::WordMemory::prefetch`]): an executor that rasterizes a run of fragments
+    /// of the walk ([`fragsim_memory::WordMemory::prefetch`]): an executor that rasterizes a run of fragments
     /// before walking them calls it as each is rasterized, so that their cache misses overlap.
     /// No step and no memory operation of the GPU; schemes that do not override it load
     /// nothing ahead.
@@ -277,8 +277,8 @@ pub trait Scheme: Sync {
     /// asking again. [`PixelRun::Resolve`] of every pixel up to `end`, the default, is always
     /// correct.
     ///
-    /// [`WordMemory::untouched_run`]: crate::memory::WordMemory::untouched_run
-    /// [`WordMemory::written_run`]: crate::memory::WordMemory::written_run
+    /// [`WordMemory::untouched_run`]: fragsim_memory::WordMemory::untouched_run
+    /// [`WordMemory::written_run`]: fragsim_memory::WordMemory::written_run
     fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> PixelRun {
         let _ = memory;
         PixelRun::Resolve(end - pixel)

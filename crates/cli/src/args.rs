@@ -10,9 +10,9 @@ use fragsim_raster::{Conventions, DepthRange, Scene, VertexPrecision, View, Wind
 
 pub use fragsim_capture::catalog::Count;
 use fragsim_capture::catalog::Sizing;
+use fragsim_dump::{Encoding, ListNumbering, Payload, SlotOrder};
 use fragsim_measure::SchemeSetup;
 pub use fragsim_measure::Shard;
-use fragsim_oracle::dump::{Encoding, ListNumbering, Payload, SlotOrder};
 pub use fragsim_raster::scene_spec::args::SceneArgs;
 
 /// The rasterization conventions of the view (`docs/semantics.md` §9); the defaults are

@@ -25,13 +25,14 @@ use std::fmt::Write as _;
 use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
 use fragsim_capture::catalog::SchemeName;
-use fragsim_capture::executors::scheduled::{Op, Trace, TraceEvent};
+use fragsim_capture::executors::scheduled::Trace;
 use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack, EMPTY};
 use fragsim_capture::schemes::mdts::Mdts;
 use fragsim_explain::interleaving::{
     memory_after, nearest, one_pixel, schedule, step_count, switches,
 };
 use fragsim_explain::{kbuffer, mdts, Shown};
+use fragsim_memory::{Op, TraceEvent};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::table::Table;

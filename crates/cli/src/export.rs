@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use fragsim_capture::catalog::DumpLayout;
-use fragsim_oracle::dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
-use fragsim_oracle::triangles::TriangleExport;
+use fragsim_dump::triangles::TriangleExport;
+use fragsim_dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
 use fragsim_raster::{SceneSpec, View};
 
 use crate::args::{ConventionsArgs, SceneArgs};

@@ -9,7 +9,7 @@ use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
 use fragsim_capture::catalog::Count;
 use fragsim_capture::schemes::masked_abuffer::MaskedABuffer;
-use fragsim_oracle::dump::{Dump, MASKED_SCHEME};
+use fragsim_dump::{Dump, MASKED_SCHEME};
 use fragsim_oracle::samples::SampleOracle;
 use fragsim_oracle::verdict::{judge, judge_run, Candidate, Options, Reference, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};

@@ -7,9 +7,10 @@
 //! lock); [`Trace::steps`] groups them.
 
 use fragsim_capture::executors::scheduled::{
-    run_fragments_in_order, Granularity, Op, Policy, Schedule, Trace,
+    run_fragments_in_order, Granularity, Policy, Schedule, Trace,
 };
 use fragsim_capture::Scheme;
+use fragsim_memory::Op;
 use fragsim_raster::{depth_key, Fragment};
 
 /// The most fragments an explanation takes: one thread each, and `Trace::order` numbers threads

@@ -15,10 +15,11 @@
 use std::fmt;
 
 use fragsim_capture::executors::scheduled::{
-    run_fragments, Deadlock, Granularity, Op, Policy, Schedule, TraceEvent, WARP_LANES,
+    run_fragments, Deadlock, Granularity, Policy, Schedule, WARP_LANES,
 };
 use fragsim_capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
 use fragsim_capture::{CaptureError, MEMORY_CAP_DEFAULT};
+use fragsim_memory::{Op, TraceEvent};
 use fragsim_raster::{Fragment, Viewport};
 
 /// What `explain --scheme kbuffer-spinlock` reports.

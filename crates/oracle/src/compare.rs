@@ -4,8 +4,8 @@
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use serde::Serialize;
 
-use crate::dump::{CorruptWord, Counter, Dump, DumpError, WordCheck};
 use crate::{Diff, Oracle, PixelMismatch};
+use fragsim_dump::{CorruptWord, Counter, WordCheck};
 
 /// A capture reduced to a coarser identity (e.g. to compare a u64 dump with a u32 reference).
 #[must_use]
@@ -38,7 +38,7 @@ pub mod flags {
     /// An A-buffer counter that is not the pixel's fragment count: larger than the pixel could
     /// have, or an overflow `counter − capacity` other than `max(0, n − capacity)`.
     pub const MISCOUNTED: u8 = 16;
-    /// A stored word that the layout says cannot be there ([`crate::dump::Corruption`]).
+    /// A stored word that the layout says cannot be there ([`fragsim_dump::Corruption`]).
     pub const CORRUPT: u8 = 32;
     /// Every fragment matches one the reference allows, some with a depth other than the
     /// reference's but inside the precision bound ([`crate::precision`]): not an error.
@@ -341,26 +341,6 @@ pub fn compare(
         complete: None,
     };
     compare_with(reference, candidate, None, &options)
-}
-
-impl Dump {
-    /// Compares this dump with `reference`: its decoded lists ([`Dump::capture`]) and every one
-    /// of its words ([`Dump::check_words`]), with [`compare_with`].
-    ///
-    /// # Errors
-    /// As [`Dump::capture`].
-    ///
-    /// # Panics
-    /// If the dump and the reference cover different numbers of pixels.
-    pub fn compare(
-        &self,
-        reference: &Oracle,
-        options: &CompareOptions<'_>,
-    ) -> Result<Comparison, DumpError> {
-        let capture = self.capture()?;
-        let words = self.check_words()?;
-        Ok(compare_with(reference, &capture, Some(&words), options))
-    }
 }
 
 /// An A-buffer pixel's counter as a capture alone shows it: `stored + overflow`, and a capacity

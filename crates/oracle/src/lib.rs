@@ -6,10 +6,11 @@
 //! sum of the counts, fills it in submission order and sorts each pixel's list by `(depth key,
 //! primitive id)` with the standard library's sort; the per-sample oracle's per-pixel view is
 //! merged by this crate's own code ([`samples`]), not by the masked-node schemes' merge. From the
-//! capture crate it takes the types captures and promises are held in and, for dumps only, what
-//! decodes them: the catalog's layouts and each scheme's post pass (every word is also checked
-//! against its layout by this crate's rules, [`dump`]). [`dump::Dump::record`] runs fragsim's own scheme serially to
-//! write the dump fragsim would write as a backend: a candidate, never the oracle's reference.
+//! capture crate it takes the types captures and promises are held in; dumps it takes decoded
+//! and their words checked from the format's crate (`fragsim_dump`, which decodes them with the
+//! catalog's layouts and each scheme's post pass) and judges them ([`verdict::JudgeDump`]).
+//! `fragsim_dump::Dump::record` runs fragsim's own scheme serially to write the dump fragsim
+//! would write as a backend: a candidate, never the oracle's reference.
 //!
 //! ```
 //! use fragsim_oracle::Oracle;
@@ -22,12 +23,10 @@
 
 pub mod compare;
 mod diff;
-pub mod dump;
 pub mod edge_ties;
 pub mod memory_cap;
 pub mod precision;
 pub mod samples;
-pub mod triangles;
 pub mod verdict;
 
 pub use diff::{Diff, PixelMismatch};

@@ -12,7 +12,7 @@
 use fragsim_capture::catalog::SchemeName;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::Guarantee;
-use fragsim_oracle::dump::Dump;
+use fragsim_dump::Dump;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::VertexPrecision;
 use fragsim_testkit::Case;
@@ -80,7 +80,7 @@ impl Backend for PythonBackend<'_> {
                 .get(file)
                 .map(|b| b.as_bytes().to_vec())
                 .ok_or_else(|| {
-                    fragsim_oracle::dump::DumpError::Invalid(format!(
+                    fragsim_dump::DumpError::Invalid(format!(
                         "the header names file {file:?}, and no array was given for it"
                     ))
                 })

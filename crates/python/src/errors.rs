@@ -9,7 +9,7 @@
 //! nor a battery that checked nothing ([`BatteryRefused`]). All derive from [`FragsimError`];
 //! the message is the library's own, which names the field, array or file at fault.
 
-use fragsim_oracle::dump::DumpError as OracleDumpError;
+use fragsim_dump::DumpError as FormatDumpError;
 use fragsim_raster::{MeshError, SceneError as RasterSceneError, SceneSpecError};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
@@ -70,10 +70,10 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// A dump error as its Python class: [`DumpIoError`] for a file, [`DumpError`] otherwise.
-pub(crate) fn dump_error(e: OracleDumpError) -> PyErr {
+pub(crate) fn dump_error(e: FormatDumpError) -> PyErr {
     match e {
-        OracleDumpError::Io { .. } => DumpIoError::new_err(e.to_string()),
-        OracleDumpError::Invalid(_) | OracleDumpError::Capture(_) => {
+        FormatDumpError::Io { .. } => DumpIoError::new_err(e.to_string()),
+        FormatDumpError::Invalid(_) | FormatDumpError::Capture(_) => {
             DumpError::new_err(e.to_string())
         }
     }

@@ -12,7 +12,7 @@
 //! The pure-Python half (`python/fragsim/`) holds the public API: it names the keyword
 //! arguments, builds the dump header from them (the same JSON as `dump.json`) and turns the
 //! verdict into a result object. The split keeps every decision in the library crates: a header
-//! is parsed by `fragsim_oracle::dump::Dump::parse`, judged by `fragsim_oracle::verdict::judge`,
+//! is parsed by `fragsim_dump::Dump::parse`, judged by `fragsim_oracle::verdict::judge`,
 //! and a battery is `fragsim_testkit::Battery`.
 //!
 //! The crate is a workspace member like any other: without the `extension-module` feature (which

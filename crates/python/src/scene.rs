@@ -20,11 +20,11 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use fragsim_capture::catalog::CATALOG;
+use fragsim_dump::triangles::TriangleExport;
+use fragsim_dump::{Dump, Words};
 use fragsim_measure::hazard::{hazard_in_view, machine_named, Campaign};
 use fragsim_measure::Silent;
-use fragsim_oracle::dump::{Dump, Words};
 use fragsim_oracle::samples::SampleOracle;
-use fragsim_oracle::triangles::TriangleExport;
 use fragsim_oracle::verdict::{
     self, Candidate, Options, Reference, Side, SideReport, VerdictError,
 };
@@ -127,7 +127,7 @@ impl SceneCore {
                 .get(file)
                 .map(|bytes| bytes.as_bytes().to_vec())
                 .ok_or_else(|| {
-                    fragsim_oracle::dump::DumpError::Invalid(format!(
+                    fragsim_dump::DumpError::Invalid(format!(
                         "the header names file {file:?}, and no array was given for it"
                     ))
                 })
@@ -443,7 +443,7 @@ impl SceneCore {
         if let Some(obj) = &self.obj {
             let path = dir.join(ARRAY_MESH_FILE);
             std::fs::write(&path, obj).map_err(|e| {
-                dump_error(fragsim_oracle::dump::DumpError::Io {
+                dump_error(fragsim_dump::DumpError::Io {
                     action: "write".into(),
                     path,
                     reason: e.to_string(),

@@ -10,7 +10,7 @@ use fragsim_capture::catalog::{Build, Count, SchemeName, SchemeRunner, SchemeVis
 use fragsim_capture::executors::scheduled::run_scheduled;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::{Capture, CaptureError, Guarantee, Scheme, MEMORY_CAP_DEFAULT};
-use fragsim_oracle::dump::Dump;
+use fragsim_dump::Dump;
 use fragsim_raster::{VertexPrecision, View, Viewport};
 
 use crate::case::Case;

@@ -13,8 +13,8 @@
 //!
 //! Guarantee: a command that exits non-zero, runs past its timeout (it is killed, with its whole
 //! process group) or leaves no readable dump fails the case; its stderr's last lines are in the
-//! message. Source: the dump format and the triangle export (`fragsim_oracle::dump`,
-//! `fragsim_oracle::triangles`).
+//! message. Source: the dump format and the triangle export (`fragsim_dump`,
+//! `fragsim_dump::triangles`).
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -22,8 +22,8 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use fragsim_capture::Guarantee;
-use fragsim_oracle::dump::{Dump, DumpError};
-use fragsim_oracle::triangles::TriangleExport;
+use fragsim_dump::triangles::TriangleExport;
+use fragsim_dump::{Dump, DumpError};
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::{VertexPrecision, View};
 

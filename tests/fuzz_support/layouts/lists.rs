@@ -3,7 +3,7 @@
 //! (counters past their layers), each with the model of what decoding must give.
 
 use fragsim::capture::catalog::SchemeName;
-use fragsim::oracle::dump::{Corruption, Header, LayoutSpec, Words};
+use fragsim::dump::{Corruption, Header, LayoutSpec, Words};
 use fragsim::raster::Viewport;
 
 use super::super::input::Input;

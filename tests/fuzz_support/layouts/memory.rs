@@ -3,7 +3,7 @@
 
 use fragsim::capture::catalog::{Build, DumpLayout, SchemeName, SchemeVisitor, CATALOG};
 use fragsim::capture::Scheme;
-use fragsim::oracle::dump::{Header, LayoutSpec, Words};
+use fragsim::dump::{Header, LayoutSpec, Words};
 use fragsim::raster::Viewport;
 
 use super::super::input::Input;

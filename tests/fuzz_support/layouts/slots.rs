@@ -2,9 +2,7 @@
 //! or pixel-major with any payload, and its model: the same words in fragsim's own encoding.
 
 use fragsim::capture::catalog::{DumpLayout, SchemeName, CATALOG};
-use fragsim::oracle::dump::{
-    Corruption, Dtype, Dump, Header, LayoutSpec, Payload, SlotOrder, Words,
-};
+use fragsim::dump::{Corruption, Dtype, Dump, Header, LayoutSpec, Payload, SlotOrder, Words};
 use fragsim::raster::Viewport;
 
 use super::super::input::Input;

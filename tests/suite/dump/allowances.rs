@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use fragsim::oracle::dump::{Dump, Words};
+use fragsim::dump::{Dump, Words};
 
 use super::binary::{fragsim, stdout_of};
 use super::soundness::compared;

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use assert_cmd::Command;
-use fragsim::oracle::triangles::TriangleExport;
+use fragsim::dump::triangles::TriangleExport;
 
 use super::{scratch, spec, with_view, SCENE, WIDTH};
 

@@ -2,10 +2,10 @@
 //! design against an overstated counter, corrupt words and miscounted overflow, the depth tolerance
 //! and key-only references.
 
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::Identity;
+use fragsim::dump::Direction;
+use fragsim::dump::{Corruption, Dump, DumpScheme, Words};
 use fragsim::oracle::compare::{self, flags, CompareOptions};
-use fragsim::oracle::dump::{Corruption, Dump, DumpScheme, Words};
 use fragsim::oracle::Oracle;
 
 use super::{counters, judged, pixel_with, spec, u64_slots, with_view, HEIGHT, WIDTH};

@@ -9,7 +9,7 @@
 
 use std::path::PathBuf;
 
-use fragsim::oracle::dump::{Dump, DumpScheme, Words};
+use fragsim::dump::{Dump, DumpScheme, Words};
 use fragsim::oracle::edge_ties::{pipeline_rule, TiePoints};
 use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::{SceneSpec, ViewProjection};

@@ -4,11 +4,11 @@
 
 use std::path::Path;
 
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Capacity, Keeps};
+use fragsim::dump::triangles::TriangleExport;
+use fragsim::dump::Direction;
+use fragsim::dump::{Dtype, Dump, DumpScheme};
 use fragsim::oracle::compare;
-use fragsim::oracle::dump::{Dtype, Dump, DumpScheme};
-use fragsim::oracle::triangles::TriangleExport;
 use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};

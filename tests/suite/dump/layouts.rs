@@ -6,10 +6,8 @@
 use fragsim::capture::catalog::{Count, DumpLayout, SchemeName, SchemeRunner, Sizing, CATALOG};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::Capture;
+use fragsim::dump::{Corruption, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, Words};
 use fragsim::oracle::compare::{self, flags};
-use fragsim::oracle::dump::{
-    Corruption, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, Words,
-};
 use fragsim::oracle::Oracle;
 use fragsim::raster::View;
 

@@ -6,9 +6,10 @@
 use std::path::PathBuf;
 
 use fragsim::capture::catalog::SchemeName;
-use fragsim::capture::schemes::mdts::Direction;
+use fragsim::dump::Direction;
+use fragsim::dump::{Dump, DumpScheme, Words};
 use fragsim::oracle::compare::{CompareOptions, Comparison};
-use fragsim::oracle::dump::{Dump, DumpScheme, Words};
+use fragsim::oracle::verdict::JudgeDump;
 use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::{Scene, Viewport};

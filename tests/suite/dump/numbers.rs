@@ -1,8 +1,8 @@
 //! Scene numbers in headers: every finite `f64` and `f32` round-trips to the same bits, any
 //! decimal parses to the nearest `f64`, and numbers JSON cannot hold are refused by name.
 
-use fragsim::oracle::dump::Dump;
-use fragsim::oracle::triangles::TriangleExport;
+use fragsim::dump::triangles::TriangleExport;
+use fragsim::dump::Dump;
 use fragsim::raster::scene_spec::SceneSpec;
 use proptest::prelude::*;
 

@@ -1,7 +1,7 @@
 //! `dump_parse` reads a dump from memory as `read` does from files, and the regressions the
 //! `dump_parse` fuzz target found.
 
-use fragsim::oracle::dump::Dump;
+use fragsim::dump::Dump;
 
 use super::{mdts_header, parse_recording, scratch};
 

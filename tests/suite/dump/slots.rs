@@ -4,12 +4,12 @@
 //! fragsim's own dumps are; a mutated word is named as stored; a bad field is a clear error.
 
 use fragsim::capture::catalog::SchemeName;
-use fragsim::capture::schemes::mdts::Direction;
-use fragsim::oracle::compare::flags;
-use fragsim::oracle::dump::{
+use fragsim::dump::Direction;
+use fragsim::dump::{
     Corruption, DepthFormat, Dtype, Dump, DumpError, DumpScheme, LayoutSpec, Payload, SlotOrder,
     Words,
 };
+use fragsim::oracle::compare::flags;
 use serde_json::json;
 
 use super::binary::{fragsim, render_dump};

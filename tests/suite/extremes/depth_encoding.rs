@@ -1,7 +1,7 @@
 //! Depth encoding: the keys of the ends of the depth range, subnormals, values just outside it,
 //! infinities and NaN, and fragments interpolated or clipped at depths 0 and 1.
 
-use fragsim::capture::SerialMemory;
+use fragsim::memory::SerialMemory;
 use fragsim::raster::{depth_from_key, depth_key, CullMode, Mesh, MeshError, View};
 use proptest::prelude::*;
 

@@ -4,9 +4,9 @@
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
-    Descriptor, Guarantee, Identity, Layout, Memory, Promise, Scheme, SerialMemory, Step,
-    WordMemory, MEMORY_CAP_DEFAULT,
+    Descriptor, Guarantee, Identity, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
 };
+use fragsim::memory::{Layout, Memory, SerialMemory, WordMemory};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, EMPTY_KEY};
 use proptest::prelude::*;

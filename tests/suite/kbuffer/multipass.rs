@@ -5,7 +5,8 @@ use fragsim::capture::executors::run_serial;
 use fragsim::capture::executors::scheduled::run_scheduled;
 use fragsim::capture::schemes::kbuffer::multipass::KBufferMultipass;
 use fragsim::capture::schemes::kbuffer::WriteBack;
-use fragsim::capture::{Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, SplitMix64, View};
 

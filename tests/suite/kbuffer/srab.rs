@@ -3,7 +3,8 @@
 
 use fragsim::capture::executors::{run_parallel, run_serial};
 use fragsim::capture::schemes::stencil_routed::StencilRouted;
-use fragsim::capture::{Keeps, Scheme, SerialMemory, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{Keeps, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene};
 

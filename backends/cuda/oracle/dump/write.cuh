@@ -1,4 +1,4 @@
-// Mirrors crates/oracle/src/dump/write.rs: writes a scheme's memory as a dump directory
+// Mirrors crates/dump/src/write.rs: writes a scheme's memory as a dump directory
 // (docs/dump-format.md): `dump.json`, the header naming the scene, the scheme, its parameters, the
 // word encoding and the array files, plus the raw little-endian arrays themselves.
 #pragma once

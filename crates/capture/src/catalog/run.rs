@@ -9,7 +9,8 @@ use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use crate::primitive_order::PrimitiveOrder;
-use crate::{CaptureError, Descriptor, Guarantee, Memory, Scheme, Step, WordMemory};
+use crate::{CaptureError, Descriptor, Guarantee, Scheme, Step};
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, View, Viewport};
 use std::sync::Mutex;
 
@@ -62,7 +63,7 @@ pub struct NamedRun {
     pub memory: Option<MemoryWords>,
 }
 
-/// Every word of a scheme's memory, in the order of its [`Layout`](crate::Layout).
+/// Every word of a scheme's memory, in the order of its [`Layout`](fragsim_memory::Layout).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct MemoryWords {
     /// The u32 words.
@@ -115,7 +116,7 @@ impl SchemeRunner {
     ///
     /// # Errors
     /// A parameter the scheme rejects, or storage beyond the memory cap: its tables when it is
-    /// built, or the pages its frame's writes reach (`memory/pages.rs`).
+    /// built, or the pages its frame's writes reach (`fragsim_memory`'s `pages.rs`).
     pub fn run(
         &mut self,
         name: SchemeName,
@@ -202,7 +203,7 @@ impl SchemeRunner {
 /// refusal must not wait for them. Every catalog entry is built at its smallest (one slot or
 /// layer, the least pool, no fragments) and refused if even that exceeds the cap; what a build
 /// checks is what is allocated before any fragment (tables and page tables,
-/// [`Layout::least_bytes`](crate::Layout::least_bytes): the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
+/// [`Layout::least_bytes`](fragsim_memory::Layout::least_bytes): the exact A-buffer's offsets, 4 bytes a pixel), the pages of words
 /// being checked as a frame writes them.
 ///
 /// # Errors

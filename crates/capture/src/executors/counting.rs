@@ -5,12 +5,12 @@
 
 use std::time::Instant;
 
+use fragsim_memory::{AtomicMemory, CountingMemory, SerialMemory};
 use fragsim_raster::View;
 
 use super::frame::{Run, RunStats};
 use super::parallel::{parallel_frame, TRIANGLES_PER_TASK};
 use super::serial::serial_frame;
-use crate::memory::{AtomicMemory, CountingMemory, SerialMemory};
 use crate::scheme::Scheme;
 
 /// Runs one frame of `scheme` over `view` on fresh storage that counts its read-modify-write

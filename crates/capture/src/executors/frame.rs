@@ -15,10 +15,10 @@
 
 use std::time::{Duration, Instant};
 
+use fragsim_memory::{AtomicMemory, Layout, Memory, SerialMemory};
 use fragsim_raster::{Fragment, PixelRect, View};
 
 use crate::capture::Capture;
-use crate::memory::{AtomicMemory, Layout, Memory, SerialMemory};
 use crate::scheme::{Scheme, Step};
 
 /// Counts of what a pass did.
@@ -79,7 +79,7 @@ pub struct RunStats {
     /// Bytes of per-pixel storage the scheme addresses (its [`Layout`], words and tables).
     pub memory_bytes: u64,
     /// Bytes of per-pixel storage allocated: the tables and the pages of words that writes
-    /// reached (`memory/pages.rs`), at most [`RunStats::memory_bytes`] and the page tables.
+    /// reached (`fragsim_memory`'s `pages.rs`), at most [`RunStats::memory_bytes`] and the page tables.
     pub allocated_bytes: u64,
     /// Whether a write found no storage within the memory cap: the capture is not to be used
     /// (`SchemeRunner::run` reports the run as over the cap).
@@ -358,7 +358,8 @@ mod tests {
     use crate::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
     use crate::schemes::mdts::Mdts;
     use crate::schemes::peeling::DepthPeeling;
-    use crate::{WordMemory, MEMORY_CAP_DEFAULT};
+    use crate::MEMORY_CAP_DEFAULT;
+    use fragsim_memory::WordMemory;
 
     /// The view's fragments in submission order.
     fn fragments(view: &View<'_>) -> Vec<Fragment> {

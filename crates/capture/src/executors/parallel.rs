@@ -5,11 +5,11 @@
 
 use std::time::Instant;
 
+use fragsim_memory::{AtomicMemory, Memory};
 use fragsim_raster::View;
 use rayon::prelude::*;
 
 use super::frame::{self, rasterize_into, reuse_storage, Counters, Run};
-use crate::memory::{AtomicMemory, Memory};
 use crate::post_pass::resolve_parallel;
 use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
 

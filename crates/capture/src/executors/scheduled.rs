@@ -27,7 +27,7 @@
 //!   bound with probability below (1 − 1/`W`)^(64 `W`) < e^−64.
 //! - Everything is a pure function of (scene, scheme, policy, `W`, seed): the same [`Schedule`]
 //!   replays the same interleaving, step for step.
-//! - Every memory operation can be recorded as a [`TraceEvent`]; a trace can be filtered to one
+//! - Every memory operation can be recorded as a [`TraceEvent`](fragsim_memory::TraceEvent); a trace can be filtered to one
 //!   pixel ([`Trace::pixel`]); an explicit interleaving of a fragment list can be replayed
 //!   ([`run_fragments_in_order`]: `fragsim explain` shrinks interleavings with it).
 //!
@@ -36,21 +36,19 @@
 //! by its lane order.
 //!
 //! This file holds the run loop; the policies and their chooser are in `scheduled/policy.rs`, the
-//! trace in `scheduled/trace.rs`, the memory that records it in `memory/recording.rs`.
+//! trace in `scheduled/trace.rs`, the memory that records it in `fragsim_memory`'s `recording.rs`.
 
-use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::time::Instant;
 
+use fragsim_memory::{RecordingMemory, SerialMemory};
 use fragsim_raster::{Fragment, View};
 
 use super::frame::{self, Counters, Run};
-use crate::memory::recording::RecordingMemory;
-use crate::memory::SerialMemory;
 use crate::scheme::{Scheme, Simt, Step};
 use policy::Chooser;
 pub use policy::{Granularity, Policy, Schedule, WARP_LANES};
-pub use trace::{Op, Trace, TraceEvent};
+pub use trace::Trace;
 
 mod policy;
 mod trace;
@@ -243,7 +241,7 @@ fn run_stream<S: Scheme>(
     let start = Instant::now();
     let mut memory: RecordingMemory = scheme.layout().allocate();
     if record {
-        memory.log = Some(RefCell::new(Vec::new()));
+        memory.record();
     }
     let mut chooser = Chooser::new(schedule, 4 * u64::from(triangles).max(1));
     chooser.order = order.map(|order| (order.to_vec(), 0));
@@ -270,14 +268,13 @@ fn run_stream<S: Scheme>(
         counters
     };
     let run = frame::run(scheme, &memory, start, 1, geometry_pass, |memory| {
-        scheme.resolve(&memory.inner)
+        scheme.resolve(memory.serial())
     });
+    let (memory, events) = memory.into_parts();
     ScheduledRun {
         run,
-        trace: memory.log.map(|log| Trace {
-            events: log.into_inner(),
-        }),
-        memory: memory.inner,
+        trace: events.map(|events| Trace { events }),
+        memory,
         deadlock,
     }
 }
@@ -350,9 +347,7 @@ fn run_pass<S: Scheme>(
         let t = chooser.choose(&mut threads, &active, step, |s| scheme.simt(s).reconverging);
         let thread = &mut threads[t];
         let (state, fragment, index) = thread.walk.as_mut().expect("chosen threads are active");
-        memory
-            .context
-            .set((step, t as u32, *index, fragment.pixel, pass));
+        memory.set_context(step, t as u32, *index, fragment.pixel, pass);
         step += 1;
         counters.steps += 1;
         let outcome = scheme.step(state, memory);

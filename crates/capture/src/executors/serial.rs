@@ -4,10 +4,10 @@
 
 use std::time::Instant;
 
+use fragsim_memory::{Memory, SerialMemory};
 use fragsim_raster::View;
 
 use super::frame::{self, rasterize_into, reuse_storage, Counters, Run};
-use crate::memory::{Memory, SerialMemory};
 use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
 
 /// Runs `scheme` over `view` serially, in submission order, on fresh storage.

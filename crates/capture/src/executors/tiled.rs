@@ -32,12 +32,12 @@ use std::cell::RefCell;
 use std::ops::Range;
 use std::time::Instant;
 
+use fragsim_memory::AtomicMemory;
 use fragsim_raster::{Fragment, PixelRect, TriangleSetup, View, Viewport};
 use rayon::prelude::*;
 
 use super::frame::{self, reuse_storage, walk, Counters, Run};
 use super::parallel::rayon_frame;
-use crate::memory::AtomicMemory;
 use crate::post_pass::{resolve_range, Resolved};
 use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
 

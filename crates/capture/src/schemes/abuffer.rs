@@ -24,11 +24,11 @@
 //! slot 0, the counter here never wraps: a pixel receives at most one fragment per triangle and a
 //! view has fewer than 2^32 triangles.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{
     CaptureError, Descriptor, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
 };

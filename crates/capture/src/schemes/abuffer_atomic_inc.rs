@@ -24,9 +24,9 @@
 //! [`Memory`]); every reader reduces it modulo `bound + 1`, which is what `atomicInc` would have
 //! left in the word.
 
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Scheme, Step};
 use crate::schemes::abuffer::{ABuffer, Claim, PostSort};
 use crate::schemes::common::sort::insertion_sort;
@@ -139,9 +139,9 @@ impl Scheme for ABufferAtomicInc {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::memory::SerialMemory;
     use crate::schemes::abuffer::{ABuffer, PostSort};
     use crate::{Keeps, MEMORY_CAP_DEFAULT};
+    use fragsim_memory::SerialMemory;
 
     /// `n` fragments on one pixel, depths ascending, inserted in order; the kept list, the
     /// reported overflow and the walks that ended in a drop.

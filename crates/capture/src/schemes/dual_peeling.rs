@@ -54,9 +54,9 @@
 //! shader, which reads both bounds in one RG32F texture fetch, the two bounds are two words read by
 //! two loads.
 
+use fragsim_memory::{Memory, Word, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::memory::{Memory, Word, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::LayerStorage;
 use crate::schemes::common::MdtsWord;

@@ -25,11 +25,11 @@
 //! `depth_key << 32 | prim` (the colour is a function of the primitive); unlike the GPU, the
 //! resolve does not reset the counters (every frame starts from fresh storage).
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::common::sort::insertion_sort;
 

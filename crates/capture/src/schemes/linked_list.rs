@@ -31,11 +31,11 @@
 //! unlike Vulkan-Samples (terminator `0xFFFFFFFF`), the terminator is node 0, so that every 32-bit
 //! word starts at 0.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 
 /// Which of a long list the resolve keeps.

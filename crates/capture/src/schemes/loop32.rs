@@ -31,11 +31,11 @@
 //! (the effects colour by primitive); unlike the GPU, the tail blend of fragments past `K` is not
 //! modelled: they are outside the promise ([`Promise::Nearest`]).
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 
 /// The empty depth slot.

@@ -29,11 +29,11 @@
 //! primitive); the tail blend of what does not fit is not modelled (those fragments are outside
 //! the promise, and counted as drops); no MSAA (the sample has none for loop64 either).
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 
 /// An empty slot.
@@ -207,7 +207,7 @@ mod tests {
     #[test]
     fn a_fragment_beyond_the_last_slot_gives_up_after_one_load() {
         let scheme = Loop64::new(Viewport::new(1, 1).unwrap(), 1, u64::MAX).unwrap();
-        let memory: crate::SerialMemory = scheme.layout().allocate();
+        let memory: fragsim_memory::SerialMemory = scheme.layout().allocate();
         let mut steps = 0;
         assert_eq!(
             scheme.insert(fragment(3, 0), &memory, &mut steps),

@@ -41,11 +41,11 @@
 
 use std::time::{Duration, Instant};
 
+use fragsim_memory::{AtomicMemory, Layout, Memory, SerialMemory, WordMemory};
 use fragsim_raster::{Fragment, View, Viewport};
 use rayon::prelude::*;
 
 use crate::capture::PixelLists;
-use crate::memory::{AtomicMemory, Layout, Memory, SerialMemory, WordMemory};
 use crate::scheme::CaptureError;
 
 /// One primitive's coverage of one pixel: its nearest depth key over the samples it covers, and
@@ -394,7 +394,7 @@ impl MaskedABuffer {
     }
 
     /// The pass alone, serially in submission order, into `memory` (of [`MaskedABuffer::layout`]):
-    /// the words a dump records (`fragsim_oracle::dump`), before the post pass; returns the
+    /// the words a dump records (`fragsim_dump`), before the post pass; returns the
     /// sample fragments rasterized.
     ///
     /// # Errors

@@ -24,7 +24,7 @@
 //! linearised at the load. The lists are therefore those of the plain walk under some
 //! interleaving (proof in `docs/proof.md`; loom checks it in `tests/loom/`), with fewer
 //! read-modify-writes counted: `fragsim bench` reports both. The memories themselves answer an
-//! `atomicMin` that cannot change its word with a load (`memory/serial_atomic.rs`), so on the CPU
+//! `atomicMin` that cannot change its word with a load (`fragsim_memory`'s `serial_atomic.rs`), so on the CPU
 //! the plain walk runs no more locked instructions than this one; the probing walk is the GPU
 //! algorithm that does the same in its steps.
 //!
@@ -33,11 +33,11 @@
 //! largest is `0x3F80_0000` (depth 1.0). Unlike the paper's descending variant, whose empty value 0
 //! is also the key of depth 0.0, values are stored plus one so that no fragment equals empty.
 
+use fragsim_memory::{Layout, Memory, SpanVisitor, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, SpanVisitor, WordMemory};
 use crate::scheme::{
     walk_to_end, CaptureError, Descriptor, PixelRun, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
 };
@@ -350,8 +350,7 @@ impl<W: MdtsWord> Scheme for Mdts<W> {
 mod tests {
     use super::*;
     use crate::executors::frame::{interleaved, walks};
-    use crate::memory::pages::PAGE_WORDS;
-    use crate::SerialMemory;
+    use fragsim_memory::{SerialMemory, PAGE_WORDS};
 
     /// Every word of the `u64` array.
     fn words(memory: &SerialMemory) -> Vec<u64> {

@@ -35,11 +35,11 @@
 //! loop has the fixed shape of `kbuffer::spinlock` (the section inside the loop body), so lockstep
 //! warps do not deadlock on it.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::Simt;
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 
@@ -311,8 +311,8 @@ impl Scheme for MdtsEmulated64 {
 mod tests {
     use super::*;
     use crate::executors::scheduled::run_fragments_in_order;
-    use crate::memory::SerialMemory;
     use crate::schemes::common::one_pixel::{fragment, one_pixel};
+    use fragsim_memory::SerialMemory;
 
     #[test]
     fn serially_both_keep_the_k_nearest_in_order() {

@@ -56,11 +56,11 @@
 //! walk of array B: each array drops `n − K` words at a pixel of `n` fragments, so the walks ending
 //! [`Step::Dropped`] count the fragments the promise does not keep.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{depth_from_key, Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::mdts::{Direction, Mdts, MdtsWord, Walk};
 

@@ -49,11 +49,11 @@
 //! and `bench --approximate` blends in primitive order, as an ordered interlock would. Nodes
 //! hold a fragment count instead of colour and transmittance (see above).
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::EMPTY;
 
@@ -180,8 +180,8 @@ impl Scheme for Mlab {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::memory::SerialMemory;
     use crate::schemes::common::one_pixel::{fragment, one_pixel};
+    use fragsim_memory::SerialMemory;
 
     /// Every arrival order of five fragments of one pixel: the nodes are the `K` nearest, their
     /// counts add up to five, and exactly the fragments beyond `K` end a walk dropped.

@@ -42,9 +42,9 @@
 //! compares the words themselves, so with `u64` words fragments of equal depth are peeled one by
 //! one in primitive order.
 
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
-use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::{depth_test, LayerStorage, MdtsWord};
 

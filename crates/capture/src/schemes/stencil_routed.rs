@@ -37,11 +37,11 @@
 //! that never wraps, so the overflow is exact. Unlike the GPU's samples, which hold a colour and a
 //! depth, a sample is one `u64` `depth_key << 32 | prim`.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::sort::bitonic_sort;
 

@@ -16,11 +16,11 @@
 //! (§4.1.2): that heuristic can pair one fragment's depth with another's colour when two depths
 //! agree in those bits. 64-bit `atomicMin` exists since compute capability 3.5.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::depth_test;
 

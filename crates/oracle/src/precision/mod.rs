@@ -25,10 +25,10 @@ use fragsim_raster::samples::SamplePattern;
 use fragsim_raster::{Conventions, EdgeTies, View};
 use serde::Serialize;
 
-use crate::dump::DepthFormat;
 use crate::edge_ties::pipeline_rule;
 use crate::Oracle;
 use error_analysis::vertex_bound;
+use fragsim_dump::DepthFormat;
 use triangle::{reachable_points, triangle, Target, Triangle};
 
 /// f32's unit roundoff, `2^-24`.

@@ -16,12 +16,12 @@ use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::conventions::VertexPrecision;
 use fragsim_raster::{Conventions, Viewport};
 
-use super::{Bounds, Doubt, Possible, Precision};
+use super::{Doubt, Possible, Precision};
 use crate::compare::{
     compare_with, flags, inferred_counter, AmbiguityCounts, CompareOptions, Comparison,
 };
-use crate::dump::{Dump, DumpError, WordCheck};
 use crate::{Oracle, PixelMismatch};
+use fragsim_dump::{DumpError, WordCheck};
 use fragsim_raster::scene_spec::SceneSpec;
 use snaps::Snaps;
 
@@ -53,31 +53,6 @@ pub fn f32_reference(
         ..exact.conventions
     };
     Ok((Oracle::build(&view), Precision::derive(&view, &f32_stage)))
-}
-
-impl Dump {
-    /// The dump judged within the precision of an f32 vertex stage ([`f32_reference`] as the
-    /// dump stores depth, [`Precision::stored_as`]; every word read with [`Dump::check_words`],
-    /// [`compare_within`]), with the bounds derived and the
-    /// reference's covered pixels (what the ambiguous pixels are a share of).
-    ///
-    /// # Errors
-    /// As [`f32_reference`] and [`Dump::capture`].
-    pub fn compare_within(
-        &self,
-        beside: Option<&Path>,
-        options: &CompareOptions<'_>,
-    ) -> Result<(Comparison, Bounds, u64), DumpError> {
-        let (oracle, precision) = f32_reference(&self.header.scene, self.viewport()?, beside)?;
-        let precision = precision.stored_as(self.depth_format(), &oracle);
-        let capture = self.capture()?;
-        let words = self.check_words()?;
-        let covered = (0..oracle.pixels())
-            .filter(|&p| !oracle.pixel(p).is_empty())
-            .count() as u64;
-        let comparison = compare_within(&precision, &oracle, &capture, Some(&words), options);
-        Ok((comparison, precision.bounds(), covered))
-    }
 }
 
 /// Compares `candidate` with what `precision` allows, pixel by pixel under the candidate's

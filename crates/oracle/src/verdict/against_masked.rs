@@ -7,7 +7,7 @@ use std::borrow::Cow;
 use fragsim_capture::schemes::masked_abuffer::MaskedLists;
 
 use super::reference::MaskedWithin;
-use super::{compare_options, Candidate, Options, Outcome, VerdictError};
+use super::{compare_options, Candidate, JudgeDump, Options, Outcome, VerdictError};
 
 /// Compares `candidate` with `nodes`, the per-pixel view of the per-sample oracle, within
 /// `within` where given.

@@ -10,10 +10,10 @@ use fragsim_raster::EdgeTies;
 use super::reference::EdgeTieSource;
 use super::{compare_options, errors, Judged, Options, Outcome};
 use crate::compare::{compare_with, CompareOptions, Comparison};
-use crate::dump::DepthFormat;
 use crate::edge_ties::TiePoints;
 use crate::precision::{compare_within, Precision};
 use crate::Oracle;
+use fragsim_dump::DepthFormat;
 
 /// Compares `judged` with `oracle`, owed within `precision` (as the candidate stores depth), and
 /// where `edge_ties` gives the view, under the edge-tie rule that explains the capture.

@@ -21,9 +21,9 @@ use fragsim_capture::{Capture, Identity};
 use serde::Serialize;
 
 use crate::compare::{flags, CompareOptions, Comparison};
-use crate::dump::WordCheck;
 use crate::precision::Precision;
 use crate::{Oracle, PixelMismatch};
+use fragsim_dump::WordCheck;
 
 /// A linked list's node counter outside the counts the reference allows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

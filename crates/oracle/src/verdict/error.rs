@@ -3,9 +3,9 @@
 
 use fragsim_raster::{F32RangeError, ViewportError};
 
-use crate::dump::{DumpError, MASKED_SCHEME};
 use crate::memory_cap::MemoryCapError;
 use crate::samples::UnsampledViewError;
+use fragsim_dump::{DumpError, MASKED_SCHEME};
 
 /// Why [`super::judge`] or [`super::judge_sides`] gave no verdict. Each message names what is at
 /// fault; callers branch on the kind (a dump that cannot be decoded is the backend's or the

@@ -24,7 +24,7 @@
 //! comparison applies, what a reference dump cannot know, how a key-only reference reduces the
 //! candidate, how a unorm depth is owed, which guarantee is owed where) being written in this
 //! module alone; the comparisons themselves are [`compare_with`], [`compare_within`] and
-//! [`Dump::compare_masked`].
+//! [`JudgeDump::compare_masked`].
 
 mod against_dump;
 mod against_masked;
@@ -32,6 +32,7 @@ mod against_oracle;
 mod allowance;
 mod error;
 mod hints;
+mod judge_dump;
 mod reference;
 mod report;
 mod run;
@@ -45,9 +46,9 @@ use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_raster::{EdgeTies, VertexPrecision};
 
 use crate::compare::{flags, CompareOptions, Comparison};
-use crate::dump::{DepthFormat, Dump, DumpScheme, WordCheck};
 use crate::precision::{Bounds, Precision};
 use crate::Oracle;
+use fragsim_dump::{DepthFormat, Dump, DumpScheme, WordCheck};
 use fragsim_raster::scene_spec::SceneSpec;
 use reference::Kind;
 
@@ -57,6 +58,7 @@ use crate::{compare::compare_with, precision::compare_within};
 pub(crate) use allowance::hold_to_reference;
 pub use allowance::MiscountedCounter;
 pub use error::VerdictError;
+pub use judge_dump::{JudgeDump, MaskedComparison, WrongMask};
 pub use reference::Reference;
 pub use report::{Corrupt, Entry, Example, FragmentTotals, SampleCounts, Summary, WordTotals};
 pub use run::{judge_run, RunVerdict};

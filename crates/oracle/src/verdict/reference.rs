@@ -10,10 +10,10 @@ use fragsim_raster::{Conventions, EdgeTies, VertexPrecision, View};
 
 use super::VerdictError;
 use crate::compare::complete_pixels;
-use crate::dump::{node_capture, Dump};
 use crate::edge_ties::{candidates, pipeline_rule};
 use crate::precision::Precision;
 use crate::Oracle;
+use fragsim_dump::{node_capture, Dump};
 
 /// The reference side of a verdict ([`super::judge`]).
 #[derive(Clone, Debug)]
@@ -61,7 +61,7 @@ pub(super) enum Kind<'a> {
 }
 
 /// What judging masked nodes within precision needs: the per-sample oracle and the bounds of an
-/// f32 vertex stage at every sample ([`crate::dump::Dump::compare_masked_within`]).
+/// f32 vertex stage at every sample ([`JudgeDump::compare_masked_within`](super::JudgeDump::compare_masked_within)).
 #[derive(Clone, Debug)]
 pub(super) struct MaskedWithin {
     /// The exact oracle, a list per (pixel, sample).

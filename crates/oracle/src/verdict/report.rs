@@ -9,8 +9,8 @@ use serde::Serialize;
 
 use super::{SideReport, Verdict};
 use crate::compare::{flags, AmbiguityCounts, Comparison, SnapCounts, VerdictCounts};
-use crate::dump::{CorruptWord, DepthFormat};
 use crate::precision::Bounds;
+use fragsim_dump::{CorruptWord, DepthFormat};
 
 /// A fragment as a report shows it.
 #[derive(Clone, Debug, Serialize)]

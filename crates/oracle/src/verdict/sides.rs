@@ -9,10 +9,10 @@ use fragsim_raster::{Conventions, VertexPrecision, Viewport};
 use serde::Serialize;
 
 use super::{judge, Candidate, Options, Reference, Verdict, VerdictError};
-use crate::dump::{Dump, DumpError, Header};
 use crate::precision::Precision;
 use crate::samples::SampleOracle;
 use crate::Oracle;
+use fragsim_dump::{Dump, DumpError, Header};
 
 /// One side of a comparison.
 #[derive(Debug)]

@@ -3,12 +3,12 @@
 //! with a planted bug made.
 
 use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
-use fragsim_capture::schemes::mdts::Direction;
+use fragsim_dump::Direction;
 use fragsim_raster::{Fragment, VertexPrecision, View, Viewport};
 
 use super::*;
-use crate::dump::{DumpScheme, Words};
 use crate::samples::SampleOracle;
+use fragsim_dump::{DumpScheme, Words};
 
 /// Calls `test` with the view of a small scene (32 × 24), its oracle and fragsim's MDTS dump
 /// of it (K = every fragment, so that the dump holds every fragment).

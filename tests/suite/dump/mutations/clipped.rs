@@ -12,8 +12,8 @@
 //! of doubt enough to mutate; that scene is judged from a real lavapipe capture instead.
 
 use fragsim::capture::catalog::SchemeName;
-use fragsim::capture::schemes::mdts::Direction;
-use fragsim::oracle::dump::{DepthFormat, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
+use fragsim::dump::Direction;
+use fragsim::dump::{DepthFormat, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
 use fragsim::oracle::precision::{f32_reference, Precision};
 use fragsim::raster::conventions::VertexPrecision;
 use fragsim::raster::scene_spec::{SceneSpec, ViewProjection};

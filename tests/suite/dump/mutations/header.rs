@@ -10,8 +10,8 @@
 use std::path::Path;
 
 use fragsim::capture::catalog::SchemeName;
-use fragsim::capture::schemes::mdts::Direction;
-use fragsim::oracle::dump::{Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
+use fragsim::dump::Direction;
+use fragsim::dump::{Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
 use fragsim::oracle::Oracle;
 use fragsim::raster::scene_spec::SceneSpec;
 use fragsim::raster::Viewport;

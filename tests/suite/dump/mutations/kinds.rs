@@ -1,7 +1,7 @@
 //! The mutation kinds: each a change to one pixel's stored list (or to a list's pool) that no
 //! conforming implementation could make, or, for the conforming kinds, one that some could.
 
-use fragsim::oracle::dump::{Dump, LayoutSpec, SlotOrder, Words};
+use fragsim::dump::{Dump, LayoutSpec, SlotOrder, Words};
 use fragsim::oracle::precision::Possible;
 
 use super::storage::{links, set, words, Item, Storage};

@@ -27,14 +27,15 @@ use std::path::Path;
 
 use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::masked_abuffer::MaskedLists;
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::Capacity;
-use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
-use fragsim::oracle::dump::{
+use fragsim::dump::Direction;
+use fragsim::dump::{
     node_capture, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder,
 };
+use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
 use fragsim::oracle::precision::{compare_within, f32_reference, Precision};
 use fragsim::oracle::samples::SampleOracle;
+use fragsim::oracle::verdict::JudgeDump;
 use fragsim::oracle::Oracle;
 use fragsim::raster::conventions::VertexPrecision;
 use fragsim::raster::scene_spec::SceneSpec;

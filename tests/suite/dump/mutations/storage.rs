@@ -2,7 +2,7 @@
 //! what the battery mutates before the dump is re-encoded in the layout under test
 //! ([`Dump::in_layout`]).
 
-use fragsim::oracle::dump::{Dump, DumpScheme, LayoutSpec, Words};
+use fragsim::dump::{Dump, DumpScheme, LayoutSpec, Words};
 
 /// One stored entry: fragsim's fragment word (`key << 32 | prim`; a bare key's `key << 32`), and
 /// a masked node's coverage mask (0 elsewhere).
@@ -100,8 +100,8 @@ impl Storage {
             DumpScheme::Mdts { k, direction } => Self::Slots {
                 k: k as usize,
                 word: match direction {
-                    fragsim::capture::schemes::mdts::Direction::Ascending => SlotWord::Fragment,
-                    fragsim::capture::schemes::mdts::Direction::Descending => SlotWord::PlusOne,
+                    fragsim::dump::Direction::Ascending => SlotWord::Fragment,
+                    fragsim::dump::Direction::Descending => SlotWord::PlusOne,
                 },
             },
             DumpScheme::KBuffer { k, .. } => Self::Slots {

@@ -1,10 +1,11 @@
 //! The scheduled executor's traces: every memory operation of a run as a [`TraceEvent`] (recorded
-//! by `memory/recording.rs`), in execution order ([`Trace`]), grouped by step or filtered to one
-//! pixel.
+//! by `fragsim_memory`'s [`RecordingMemory`](fragsim_memory::RecordingMemory)), in execution
+//! order ([`Trace`]), grouped by step or filtered to one pixel.
+
+use fragsim_memory::TraceEvent;
 
 #[cfg(doc)]
 use super::run_fragments_in_order;
-pub use crate::memory::recording::{Op, TraceEvent};
 
 /// The recorded memory operations of a run, in execution order.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

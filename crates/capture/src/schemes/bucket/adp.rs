@@ -55,11 +55,11 @@
 
 use std::marker::PhantomData;
 
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use super::{positive, read_single, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS};
 use crate::capture::Capacity;
-use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::MdtsWord;
 

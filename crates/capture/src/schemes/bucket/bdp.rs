@@ -31,6 +31,7 @@
 
 use std::marker::PhantomData;
 
+use fragsim_memory::Memory;
 use fragsim_raster::{Fragment, Viewport};
 
 use super::{
@@ -38,7 +39,6 @@ use super::{
     RANGE_WORDS,
 };
 use crate::capture::Capacity;
-use crate::memory::Memory;
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::MdtsWord;
 

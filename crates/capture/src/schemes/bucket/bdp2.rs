@@ -28,13 +28,13 @@
 
 use std::marker::PhantomData;
 
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use super::{
     positive, push_distinct, read_pair, word_suffix, Blend, Plan, Stage, Walk, RANGE_WORDS,
 };
 use crate::capture::Capacity;
-use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::common::MdtsWord;
 

@@ -64,11 +64,11 @@ pub use adp::{Adp, AdpStage, ADP_BATCH, ADP_SUBINTERVALS};
 pub use bdp::{Bdp, Buckets};
 pub use bdp2::{Bdp2, Bdp2Stage};
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Step};
 use crate::schemes::common::MdtsWord;
 

@@ -4,12 +4,12 @@
 
 use std::marker::PhantomData;
 
+use fragsim_memory::{Layout, Memory, Word, WordMemory};
 use fragsim_raster::Viewport;
 
 use super::MdtsWord;
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, Word, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Step};
 
 /// The storage of a peeling scheme: per pixel, `working` words of type `W` that the geometry

@@ -2,10 +2,10 @@
 //! key) or one `u64` (depth key and primitive id), with the array of that width in a memory.
 //! MDTS defined it first; peeling, dual peeling and bucket peeling store the same words.
 
+use fragsim_memory::{Memory, Word, WordMemory};
 use fragsim_raster::Fragment;
 
 use crate::capture::Identity;
-use crate::memory::{Memory, Word, WordMemory};
 
 /// A word type MDTS can sort: `u32` (depth key) or `u64` (depth key and primitive id).
 pub trait MdtsWord: Word {

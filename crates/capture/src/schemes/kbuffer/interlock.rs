@@ -51,10 +51,10 @@
 //! As in the k-buffer, a slot is one `u64` `depth_key << 32 | prim` rather than the samples'
 //! packed depth and colour, so the capture is compared fragment for fragment with the oracle.
 
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
 
@@ -169,9 +169,9 @@ impl Scheme for KBufferInterlock {
 mod tests {
     use super::*;
     use crate::executors::scheduled::run_fragments_in_order;
-    use crate::memory::{AtomicMemory, SerialMemory};
     use crate::schemes::common::one_pixel::{fragment, one_pixel};
     use crate::schemes::kbuffer::KBuffer;
+    use fragsim_memory::{AtomicMemory, SerialMemory};
 
     #[test]
     fn a_walk_is_one_step_that_keeps_the_k_nearest_and_drops_what_falls_off() {

@@ -56,11 +56,11 @@
 //! order unless the view is shuffled. As in the k-buffer, a slot is one `u64`
 //! `depth_key << 32 | prim`.
 
+use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::Capacity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Memory, WordMemory};
 use crate::primitive_order::PrimitiveOrder;
 use crate::scheme::Simt;
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
@@ -198,8 +198,8 @@ impl Scheme for KBufferInterlockOrdered<'_> {
 mod tests {
     use super::*;
     use crate::executors::scheduled::run_fragments_in_order;
-    use crate::memory::SerialMemory;
     use crate::schemes::common::one_pixel::{fragment, one_pixel};
+    use fragsim_memory::SerialMemory;
 
     /// A later fragment that arrives first waits (one step each attempt, nothing written) until
     /// the earlier one has left; then it enters.

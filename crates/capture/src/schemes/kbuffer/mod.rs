@@ -87,10 +87,10 @@ pub mod spinlock;
 pub use slots::{Insert, Phase, WriteBack, EMPTY};
 pub(crate) use slots::{Outcome, Slots};
 
+use fragsim_memory::Memory;
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::guarantee::Guarantee;
-use crate::memory::Memory;
 use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 
 /// The single-pass k-buffer over `u64` slots.
@@ -186,8 +186,8 @@ impl Scheme for KBuffer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::memory::SerialMemory;
     use crate::schemes::common::one_pixel::fragment;
+    use fragsim_memory::SerialMemory;
 
     #[test]
     fn a_walk_is_k_loads_then_k_stores_or_one_read_and_one_write_back() {

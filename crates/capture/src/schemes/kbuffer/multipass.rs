@@ -53,11 +53,11 @@
 //! the technical report's own rule for its robustness against "the unreliable parallel
 //! read-after-write behavior" is not described by the citing papers, so this check is ours.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::capture::{Capacity, Identity};
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack, EMPTY};
 
@@ -375,7 +375,7 @@ impl Scheme for KBufferMultipass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::memory::SerialMemory;
+    use fragsim_memory::SerialMemory;
 
     /// One pass over `fragments` with the walks interleaved as `order` says (`order[i]` is the walk
     /// that takes step `i`; unfinished walks then run in order), then the kernel.

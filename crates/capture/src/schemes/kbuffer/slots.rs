@@ -4,11 +4,11 @@
 //! k-buffers run its insertion inside their critical sections. The module docs of the schemes say
 //! what each step is on which machine.
 
+use fragsim_memory::{Layout, Memory, WordMemory};
 use fragsim_raster::Fragment;
 
 use crate::capture::Identity;
 use crate::guarantee::Guarantee;
-use crate::memory::{Layout, Memory, WordMemory};
 use crate::scheme::{CaptureError, Descriptor, Promise};
 
 /// The value of an empty slot: larger than every packed fragment.

@@ -61,10 +61,10 @@
 //! `depth_key << 32 | prim` rather than the samples' packed depth and colour, so the capture is
 //! compared fragment for fragment with the oracle.
 
+use fragsim_memory::Memory;
 use fragsim_raster::{Fragment, Viewport};
 
 use crate::guarantee::Guarantee;
-use crate::memory::Memory;
 use crate::scheme::Simt;
 use crate::scheme::{CaptureError, Descriptor, Scheme, Step, MEMORY_CAP_DEFAULT};
 use crate::schemes::kbuffer::{Insert, Outcome, Slots, WriteBack};
@@ -253,9 +253,9 @@ impl Scheme for KBufferSpinlock {
 mod tests {
     use super::*;
     use crate::executors::scheduled::{
-        run_fragments, run_fragments_in_order, Granularity, Op, Policy, Schedule,
+        run_fragments, run_fragments_in_order, Granularity, Policy, Schedule,
     };
-    use crate::memory::{SerialMemory, WordMemory};
+    use fragsim_memory::{Op, SerialMemory, WordMemory};
 
     fn fragment(pixel: u32, depth_key: u32, prim: u32) -> Fragment {
         Fragment {

@@ -4,14 +4,16 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use fragsim_capture::{Capture, Scheme, SerialMemory, WordMemory};
+use fragsim_capture::{Capture, Scheme};
+
+use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::Viewport;
 
-use super::arrays::stored_lists;
-use super::header::{array_bytes, check_array, check_distinct_files, check_file_name};
-use super::shapes::check_shapes;
-use super::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
-use super::{FORMAT, HEADER_FILE, VERSION};
+use crate::arrays::stored_lists;
+use crate::header::{array_bytes, check_array, check_distinct_files, check_file_name};
+use crate::shapes::check_shapes;
+use crate::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
+use crate::{FORMAT, HEADER_FILE, VERSION};
 use fragsim_capture::catalog::{SchemeName, SchemeVisitor};
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::files::{read_regular, FileError};
@@ -30,7 +32,7 @@ fn file_error(e: FileError) -> DumpError {
     }
 }
 
-fn write_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>, words: &[W]) {
+fn write_all<W: fragsim_memory::Word>(memory: &impl WordMemory<W>, words: &[W]) {
     for (i, &w) in words.iter().enumerate() {
         memory.store(i, w);
     }

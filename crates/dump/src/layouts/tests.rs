@@ -2,7 +2,7 @@
 //! with a layout dumps in it.
 
 use super::*;
-use crate::dump::{Dtype, FORMAT, VERSION};
+use crate::{Dtype, FORMAT, VERSION};
 use fragsim_raster::scene_spec::SceneSpec;
 
 fn header(scheme: &str) -> Header {
@@ -25,7 +25,7 @@ fn header(scheme: &str) -> Header {
         // Memory dumps' sizes are bounded by their words.
         arrays: [(
             "words32".to_string(),
-            crate::dump::ArraySpec {
+            crate::ArraySpec {
                 file: "words32.u32".into(),
                 dtype: Dtype::U32,
                 shape: vec![8],

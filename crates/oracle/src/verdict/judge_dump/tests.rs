@@ -1,7 +1,9 @@
 //! Tests of the masked-node dump under an f32 vertex stage: equal per sample at 4 and 8 samples,
 //! and a dropped sample or a stray key different.
 
+use fragsim_dump::Words;
 use fragsim_raster::conventions::VertexPrecision;
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{Conventions, Viewport};
 
 use super::*;
@@ -34,12 +36,28 @@ fn f32_masked(samples: u32) -> (Dump, Precision, Oracle) {
     (dump, precision, oracle)
 }
 
+/// The words of array `name`, which the dump holds as u32.
+fn u32s<'d>(dump: &'d Dump, name: &str) -> &'d [u32] {
+    match &dump.arrays[name] {
+        Words::U32(words) => words,
+        Words::U64(_) => panic!("array {name} is u64"),
+    }
+}
+
+/// The words of array `name`, which the dump holds as u64.
+fn u64s<'d>(dump: &'d Dump, name: &str) -> &'d [u64] {
+    match &dump.arrays[name] {
+        Words::U64(words) => words,
+        Words::U32(_) => panic!("array {name} is u32"),
+    }
+}
+
 /// The first stored node covering at least two samples, each certain for its primitive:
 /// its slot, word and mask, and the least highest key of those samples.
 fn certain_node(dump: &Dump, precision: &Precision, n: usize) -> (usize, u64, u32, u32) {
-    let counters = dump.u32s("counters").unwrap().unwrap();
-    let nodes = dump.u64s("nodes").unwrap().unwrap();
-    let masks = dump.u32s("masks").unwrap().unwrap();
+    let counters = u32s(dump, "counters");
+    let nodes = u64s(dump, "nodes");
+    let masks = u32s(dump, "masks");
     (0..counters.len())
         .flat_map(|p| (0..counters[p] as usize).map(move |i| (p, p * CAPACITY as usize + i)))
         .find_map(|(p, slot)| {
@@ -76,13 +94,13 @@ fn an_f32_masked_dump_is_equal_per_sample_and_a_dropped_sample_or_a_stray_key_is
         );
         let n = samples as usize;
         let (slot, word, mask, key_hi) = certain_node(&dump, &precision, n);
-        let shape = dump.shape_of("masks");
+        let shape = dump.header.arrays["masks"].shape.clone();
         let mut dropped = dump.clone();
-        let mut masks = dump.u32s("masks").unwrap().unwrap().to_vec();
+        let mut masks = u32s(&dump, "masks").to_vec();
         masks[slot] = mask & (mask - 1);
         dropped.set_array("masks", Words::U32(masks), shape.clone());
         let mut stray = dump.clone();
-        let mut nodes = dump.u64s("nodes").unwrap().unwrap().to_vec();
+        let mut nodes = u64s(&dump, "nodes").to_vec();
         nodes[slot] = u64::from(key_hi + 1) << 32 | (word & u64::from(u32::MAX));
         stray.set_array("nodes", Words::U64(nodes), shape);
         // The pixel's first covered sample: the one dropped, or the one a stray key is

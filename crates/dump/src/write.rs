@@ -5,14 +5,15 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use fragsim_capture::catalog::DumpLayout;
-use fragsim_capture::{Scheme, SerialMemory, WordMemory};
+use fragsim_capture::Scheme;
+use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::View;
 
-use super::arrays::sort_abuffer_in_place;
-use super::header::{check_array, check_distinct_files, check_file_name};
-use super::{err, io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
-use super::{LayoutSpec, ListNumbering};
-use super::{FORMAT, HEADER_FILE, VERSION};
+use crate::arrays::sort_abuffer_in_place;
+use crate::header::{check_array, check_distinct_files, check_file_name};
+use crate::{err, io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
+use crate::{LayoutSpec, ListNumbering};
+use crate::{FORMAT, HEADER_FILE, VERSION};
 use fragsim_capture::catalog::SchemeVisitor;
 use fragsim_raster::scene_spec::SceneSpec;
 
@@ -43,7 +44,7 @@ fn array_spec(name: &str, dtype: Dtype, shape: Vec<u64>) -> ArraySpec {
     }
 }
 
-fn read_all<W: fragsim_capture::Word>(memory: &impl WordMemory<W>) -> Vec<W> {
+fn read_all<W: fragsim_memory::Word>(memory: &impl WordMemory<W>) -> Vec<W> {
     (0..memory.len()).map(|i| memory.load(i)).collect()
 }
 

@@ -1,30 +1,48 @@
-//! The memory seam: the only place that knows which atomic type is underneath.
+//! The simulated GPU's memory: the per-pixel words the capture schemes work on, the only place
+//! that knows which atomic type is underneath.
 //!
-//! Schemes see per-pixel storage as two flat arrays of words, one of `u32` and one of `u64`,
-//! through [`WordMemory`]'s seven operations: the atomics CUDA offers on global memory (`atomicMin`,
-//! `atomicMax`, `atomicAdd`, `atomicOr`, `atomicExch`) plus plain loads and stores. Every
-//! operation is one step.
+//! - **Words.** Schemes see per-pixel storage as two flat arrays of words, one of `u32` and one of
+//!   `u64` ([`Word`]), sized and initialised by a [`Layout`] (how many words of each width, and
+//!   their initial values).
+//! - **Operations.** [`WordMemory`] has seven: the atomics CUDA offers on global memory
+//!   (`atomicMin`, `atomicMax`, `atomicAdd`, `atomicOr`, `atomicExch`) plus plain loads and
+//!   stores. Every operation is one step of a scheme's state machine. [`Memory`] is both arrays,
+//!   with a spin lock on a `u32` word for the steps a GPU performs as one (a render target's
+//!   read or write of a pixel's slots).
+//! - **Orderings.** Unlike the GPU, the atomic implementation uses `Relaxed` ordering: the
+//!   schemes' guarantees need only per-location atomicity (a total order of the
+//!   read-modify-writes on each word), and the end of a pass, a thread join, publishes everything
+//!   (the proof is in `docs/proof.md`, loom checks it). The lock alone fences: acquire after
+//!   taking it, release before freeing it.
+//! - **The memories.** [`SerialMemory`] (plain cells, one thread: the serial executor's),
+//!   [`AtomicMemory`] (std atomics, shared by threads: the parallel and tiled executors'),
+//!   [`CountingMemory`] (any memory, its read-modify-writes counted: the locked instructions
+//!   `fragsim bench` reports) and [`RecordingMemory`] (the serial memory with a log of every
+//!   operation as a [`TraceEvent`]: the scheduled executor's traces). The loom suite
+//!   (`tests/loom/`) puts loom's atomics behind the same traits.
+//! - **Pages and budget.** The serial and atomic memories allocate their words a page of
+//!   [`PAGE_WORDS`] at a time, on the first write that reaches a page (`pages.rs`), within a
+//!   byte cap set by the executor ([`SerialMemory::reset`]): storage, its reset and the post
+//!   pass then follow the pixels the fragments reach, not viewport × K. A write the cap refuses
+//!   goes to a scratch page and the frame is reported over the cap ([`Memory::over_cap`]). That
+//!   bookkeeping is no memory operation of the simulated GPU: it costs a load of the page's entry
+//!   and of its written flag beside each operation, and the first write to a page its allocation.
 //!
-//! Unlike the GPU, the atomic implementation uses `Relaxed` ordering: the schemes' guarantees need
-//! only per-location atomicity (a total order of the read-modify-writes on each word), and the end
-//! of a pass, a thread join, publishes everything (the proof is in `docs/proof.md`, loom checks it).
-//!
-//! Both memories allocate their words a page at a time, on the first write that reaches a page
-//! (`memory/pages.rs`), within a byte cap set by the executor ([`SerialMemory::reset`]): storage, its
-//! reset and the post pass then follow the pixels the fragments reach, not viewport × K. That
-//! bookkeeping is no memory operation of the simulated GPU: it costs a load of the page's entry
-//! and of its written flag beside each operation, and the first write to a page its allocation.
+//! The crate needs nothing of the schemes or the executors (`fragsim-capture`), which are built
+//! on it: it sits below them as `crossbeam-utils` below `crossbeam`.
 
 use std::fmt::Debug;
 
 mod counting;
 mod layout;
-pub(crate) mod pages;
-pub(crate) mod recording;
+mod pages;
+mod recording;
 mod serial_atomic;
 
 pub use counting::CountingMemory;
 pub use layout::Layout;
+pub use pages::PAGE_WORDS;
+pub use recording::{Op, RecordingMemory, TraceEvent};
 pub use serial_atomic::{AtomicMemory, SerialMemory};
 
 /// A memory word: `u32` or `u64`.
@@ -171,7 +189,7 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
         Self: Sized;
 
     /// Bytes of storage actually allocated, where the memory allocates as it is written
-    /// (`memory/pages.rs`); `None` for a memory that holds every word of its layout.
+    /// (`pages.rs`); `None` for a memory that holds every word of its layout.
     fn allocated_bytes(&self) -> Option<u64> {
         None
     }
@@ -188,11 +206,12 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
     ///
     /// A scheme uses it to make one step of several words indivisible: a render target's read or
     /// write of a pixel's `K` slots, which the GPU's ROP performs as one operation
-    /// (`crate::schemes::kbuffer::WriteBack::RenderTarget`). The words themselves stay `Relaxed`: the
-    /// ordering comes from the fences around the lock word's `swap` and `store` (C++ fence–fence
-    /// synchronisation: a release fence before the store that frees the lock synchronises with the
-    /// acquire fence after the `swap` that reads it free). Memories whose threads are not OS
-    /// threads (loom's) must override both methods with their own fences and a yielding spin.
+    /// (`fragsim_capture::schemes::kbuffer::WriteBack::RenderTarget`). The words themselves
+    /// stay `Relaxed`: the ordering comes from the fences around the lock word's `swap` and
+    /// `store` (C++ fence–fence synchronisation: a release fence before the store that frees the
+    /// lock synchronises with the acquire fence after the `swap` that reads it free). Memories
+    /// whose threads are not OS threads (loom's) must override both methods with their own
+    /// fences and a yielding spin.
     fn lock(&self, index: usize) {
         while WordMemory::<u32>::swap(self, index, 1) != 0 {
             // Wait with plain loads, so that waiting threads do not bounce the line.

@@ -9,11 +9,21 @@
 use fragsim_capture::catalog::{
     Build, DumpLayout, SchemeName, SchemeVisitor, SlotWord, Storage, CATALOG,
 };
-use fragsim_capture::schemes::mdts::Direction;
 use fragsim_raster::Viewport;
 
-use super::spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
-use super::{err, Dump, DumpError, Header};
+use crate::spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
+use crate::{err, Dump, DumpError, Header};
+
+/// Which way an MDTS slot array of fragment words is sorted, as its header's scheme names it:
+/// the format's own word for what the scheme's `atomicMin` or `atomicMax` left, so that the
+/// format names no scheme's internals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// `mdts`: ascending words `key << 32 | prim`, empty = all ones (the `K` nearest).
+    Ascending,
+    /// `mdts-desc`: descending words `(key << 32 | prim) + 1`, empty = 0 (the `K` farthest).
+    Descending,
+}
 
 /// Which scheme's memory a dump holds, with its parameters.
 #[derive(Clone, Debug, PartialEq, Eq)]

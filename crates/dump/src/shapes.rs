@@ -4,9 +4,9 @@
 //! of words. A two-dimensional shape must be the one the fields make; its transpose is named as
 //! such, since it is what a slot array in the other order looks like.
 
-use super::masked::MASKED_SCHEME;
-use super::spec::{LayoutSpec, SlotOrder};
-use super::{err, Dump, DumpError, DumpScheme, Header};
+use crate::masked::MASKED_SCHEME;
+use crate::spec::{LayoutSpec, SlotOrder};
+use crate::{err, Dump, DumpError, DumpScheme, Header};
 
 /// Checks the shapes the header alone fixes (every layout's but the masked nodes' and an
 /// A-buffer's with `offsets`, whose sizes come from an array), before any array is read. A

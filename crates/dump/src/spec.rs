@@ -14,7 +14,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{err, Dtype, DumpError};
+use crate::{err, Dtype, DumpError};
 
 /// How a payload word stores the depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -2,13 +2,13 @@
 //! what the decoded lists cannot show, each corrupt word named with its reason ([`Corruption`]),
 //! an A-buffer's counters beside their capacities.
 
+use crate::layouts::Direction;
 use fragsim_capture::catalog::SchemeName;
-use fragsim_capture::schemes::mdts::Direction;
 use serde::Serialize;
 
-use super::layouts::DumpScheme;
-use super::spec::{Payload, LARGEST_KEY};
-use super::{Dump, DumpError};
+use crate::layouts::DumpScheme;
+use crate::spec::{Payload, LARGEST_KEY};
+use crate::{Dump, DumpError};
 
 /// Why a stored word is one that its layout says cannot be there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

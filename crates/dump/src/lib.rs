@@ -1,6 +1,10 @@
 //! The interchange with GPU backends (`docs/dump-format.md`): the **dump**, what a backend's
-//! per-pixel memory held after its passes, and the **triangle export**, the scene after fragsim's
-//! vertex stage, so that a backend can test its scan and atomics alone.
+//! per-pixel memory held after its passes, and the **triangle export** ([`triangles`]), the
+//! scene after fragsim's vertex stage, so that a backend can test its scan and atomics alone.
+//! This crate is the format only: headers, layouts, arrays, reading and writing, and the bounds
+//! every input is checked against. Judging a dump against a reference is the oracle's
+//! (`fragsim-oracle`, built on this crate: raster ← capture ← dump ← oracle), so that a
+//! backend or a test kit that writes dumps needs no judge to do so.
 //!
 //! A dump is a directory: `dump.json` (format, version, the scene and camera that produced it,
 //! viewport, scheme, K or capacity, the names, dtypes and shapes of the arrays) and one file of
@@ -8,32 +12,26 @@
 //! [`Capture`] through the named scheme's own post pass (`Scheme::resolve`): fragsim's MDTS reads
 //! each pixel's slots until the first empty one, the A-buffer reads `min(counter, capacity)` slots
 //! and sorts them. A dump whose A-buffer lists were already sorted on the GPU (`"sorted": true`)
-//! is taken in stored order, so a broken sort kernel shows up as misordered pixels.
-//! [`compare`](crate::compare::compare) then diffs a capture against an [`Oracle`] pixel by pixel with [`Oracle::diff`]
-//! and names each pixel's verdict. Decoding stops where the layout says a list ends, so
-//! [`Dump::check_words`] reads every word against the layout's rules (nothing after an empty MDTS
-//! slot, no empty marker below an A-buffer counter, no key above 1.0) and [`Dump::compare`] adds
-//! what it finds: [`flags::CORRUPT`](crate::compare::flags::CORRUPT), and [`flags::MISCOUNTED`](crate::compare::flags::MISCOUNTED) for an A-buffer counter other
-//! than the pixel's fragment count, which the oracle knows.
+//! is taken in stored order, so a broken sort kernel shows up as misordered pixels. Decoding
+//! stops where the layout says a list ends, so [`Dump::check_words`] reads every word against
+//! the layout's rules (nothing after an empty MDTS slot, no empty marker below an A-buffer
+//! counter, no key above 1.0) and the oracle's comparison adds what it finds to its verdict: a
+//! corrupt word, and an A-buffer counter other than the pixel's fragment count, which the
+//! reference knows.
 //!
 //! ```
-//! use fragsim_capture::schemes::mdts::Direction;
-//! use fragsim_oracle::compare::CompareOptions;
-//! use fragsim_oracle::dump::{Dump, DumpScheme};
+//! use fragsim_dump::{Direction, Dump, DumpScheme};
 //! use fragsim_raster::scene_spec::SceneSpec;
-//! use fragsim_oracle::Oracle;
 //! use fragsim_raster::Viewport;
 //!
 //! let spec = SceneSpec::named("spheres:2", 30.0, 15.0);
 //! let scene = spec.load(None).unwrap();
 //! let view = scene.view(Viewport::new(32, 24).unwrap(), &spec.orbit()).unwrap();
-//! let oracle = Oracle::build(&view);
-//! let k = oracle.max_depth_complexity();
-//! let scheme = DumpScheme::Mdts { k, direction: Direction::Ascending };
+//! let scheme = DumpScheme::Mdts { k: 8, direction: Direction::Ascending };
 //! let dump = Dump::record(&view, spec, &scheme, "doc").unwrap();
-//! let options = CompareOptions { examples: 4, ..Default::default() };
-//! let comparison = dump.compare(&oracle, &options).unwrap();
-//! assert!(comparison.is_equal() && comparison.words_checked);
+//! let capture = dump.capture().unwrap();
+//! assert_eq!(capture.pixels(), 32 * 24);
+//! assert_eq!(dump.check_words().unwrap().corrupt_words(), 0);
 //! ```
 //!
 //! Every catalog scheme has a layout: MDTS slots, the A-buffer's counters and slots, a k-buffer's
@@ -47,11 +45,12 @@
 //!
 //! The parts: the header and its words (`header.rs`), the layout description (`spec.rs`), the
 //! layouts and their word rules (`layouts.rs`, from the catalog's
-//! [`DumpLayout`](fragsim_capture::catalog::DumpLayout)), linked lists and layers turned into
-//! fragsim's memory with their links checked (`lists.rs`), slot arrays in an engine's order and
-//! payload turned into fragsim's (`slots.rs`), parsing and decoding (`read.rs`),
-//! recording and writing (`write.rs`); the scene a dump names is
-//! [`fragsim_raster::scene_spec`], the comparison [`crate::compare`], the triangle export [`crate::triangles`].
+//! [`DumpLayout`](fragsim_capture::catalog::DumpLayout), which names each scheme's layout
+//! without knowing the format; `word_check.rs`), linked lists and layers turned into fragsim's
+//! memory with their links checked (`lists.rs`), slot arrays in an engine's order and payload
+//! turned into fragsim's (`slots.rs`), the array shapes a header states (`shapes.rs`), the
+//! masked-node A-buffer's arrays (`masked.rs`), parsing and decoding (`read.rs`, `arrays.rs`),
+//! recording and writing (`write.rs`); the scene a dump names is [`fragsim_raster::scene_spec`].
 //!
 //! Unlike the GPU, which leaves its words in device memory, [`Dump::record`] runs fragsim's scheme
 //! serially on [`SerialMemory`] and copies every word out; for MDTS the words are the same under
@@ -71,6 +70,7 @@ mod read;
 mod shapes;
 mod slots;
 mod spec;
+pub mod triangles;
 mod word_check;
 mod write;
 
@@ -78,17 +78,16 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+#[cfg(doc)]
+use fragsim_capture::Capture;
 use fragsim_capture::CaptureError;
 #[cfg(doc)]
-use fragsim_capture::{Capture, SerialMemory};
+use fragsim_memory::SerialMemory;
 use fragsim_raster::SceneSpecError;
 
-#[cfg(doc)]
-use crate::Oracle;
-
 pub use header::{ArraySpec, Dtype, Header, Words};
-pub use layouts::DumpScheme;
-pub use masked::{masked_spec, node_capture, MaskedComparison, WrongMask, MASKED_SCHEME};
+pub use layouts::{Direction, DumpScheme};
+pub use masked::{masked_spec, node_capture, MASKED_SCHEME};
 pub use read::HEADER_BYTES_LIMIT;
 pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
 pub use word_check::{CorruptWord, Corruption, Counter, WordCheck};

@@ -1,7 +1,7 @@
 //! [`Layout`]: how many words of each width a scheme's storage has, and their initial values.
 //!
 //! It lives beside the memories rather than beside the `Scheme` trait because the memories are
-//! re-initialised from it ([`crate::SerialMemory::reset`]): the memory module then needs nothing
+//! re-initialised from it ([`crate::SerialMemory::reset`]): the memory crate then needs nothing
 //! of the schemes, and the schemes import the memory, one way.
 
 use super::Memory;
@@ -42,7 +42,7 @@ impl Layout {
     }
 
     /// The bytes a frame allocates before any fragment: the tables and the page tables of the
-    /// words, whose pages are allocated as writes reach them (`memory/pages.rs`). What the memory
+    /// words, whose pages are allocated as writes reach them (`pages.rs`). What the memory
     /// cap is checked against when a scheme is built; the pages are checked as they are
     /// allocated.
     #[must_use]

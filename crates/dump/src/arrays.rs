@@ -6,10 +6,10 @@ use std::collections::BTreeMap;
 
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 
-use super::layouts::DumpScheme;
-use super::lists::{layer_major, linked_lists, ListArrays, Translated};
-use super::spec::LayoutSpec;
-use super::{err, Dtype, Dump, DumpError, Words};
+use crate::layouts::DumpScheme;
+use crate::lists::{layer_major, linked_lists, ListArrays, Translated};
+use crate::spec::LayoutSpec;
+use crate::{err, Dtype, Dump, DumpError, Words};
 
 /// A-buffer lists as the GPU's sort kernel left them: `min(counter, capacity)` slots, unsorted.
 pub(super) fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture {

@@ -25,7 +25,7 @@ use super::Word;
 /// Words per page: 32 KiB of `u64` words, a few hundred pixels of K slots, large enough that the
 /// page table (one entry a page) is a fraction of a percent of the storage, small enough that a
 /// sparse frame leaves most pages unallocated.
-pub(crate) const PAGE_WORDS: usize = 4096;
+pub const PAGE_WORDS: usize = 4096;
 
 /// Words per block of a page's written flags: 64 words, four or eight cache lines, a few pixels
 /// of K slots.

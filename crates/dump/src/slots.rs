@@ -10,10 +10,10 @@
 //! index is taken, so a header cannot make the reader index past it or allocate more than it
 //! holds.
 
-use super::spec::{LayoutSpec, Payload, SlotOrder};
-use super::word_check::{outside_fields, Corruption, WordCheck};
-use super::{err, Dtype, Dump, DumpError, DumpScheme, Words};
-use fragsim_capture::schemes::mdts::Direction;
+use crate::layouts::Direction;
+use crate::spec::{LayoutSpec, Payload, SlotOrder};
+use crate::word_check::{outside_fields, Corruption, WordCheck};
+use crate::{err, Dtype, Dump, DumpError, DumpScheme, Words};
 
 /// How one slot word of a layout maps to fragsim's.
 #[derive(Clone, Copy, Debug)]

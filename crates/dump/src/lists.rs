@@ -9,10 +9,10 @@
 //! at a node the counter never handed out, or reaches a node already visited (a cycle, or two
 //! lists sharing a node) is cut there and named a [`CorruptWord`] of its pixel.
 
-use super::slots::words_of;
-use super::spec::{LayoutSpec, ListNumbering, Payload};
-use super::word_check::{outside_fields, CorruptWord, Corruption};
-use super::{err, Dump, DumpError, Words};
+use crate::slots::words_of;
+use crate::spec::{LayoutSpec, ListNumbering, Payload};
+use crate::word_check::{outside_fields, CorruptWord, Corruption};
+use crate::{err, Dump, DumpError, Words};
 
 /// Fragsim's memory of a scheme built from a dump's arrays, and what the translation found.
 #[derive(Debug, Default)]

@@ -2,7 +2,7 @@
 //! (`lock cmpxchg`, `lock xadd`) a frame costs on x86, reported per fragment by `fragsim bench`.
 //!
 //! Counting costs an atomic increment per operation, so the executors use it only for a separate,
-//! untimed frame ([`crate::executors::count_locked_ops`]); timed frames run on the bare memory.
+//! untimed frame (`fragsim_capture::executors::count_locked_ops`); timed frames run on the bare memory.
 
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 

@@ -1,6 +1,7 @@
 //! The masked-node A-buffer's dump (`abuffer-masked`, `docs/dump-format.md`): per-pixel storage
-//! whose nodes carry a coverage mask ([`MaskedABuffer`]), judged against the per-pixel view of
-//! the per-sample oracle ([`SampleOracle::per_pixel`](crate::samples::SampleOracle::per_pixel)).
+//! whose nodes carry a coverage mask ([`MaskedABuffer`]), read, checked and recorded here, judged
+//! by the oracle's verdict (`fragsim_oracle::verdict::JudgeDump`) against the per-pixel view of
+//! the per-sample oracle.
 //!
 //! Arrays: `counters` u32 `[pixels]` (the `fetch_add` counts, never wrapped), `nodes`
 //! `[pixels, capacity]` node words (fragsim's `key << 32 | prim`, or the header's payload) and
@@ -10,32 +11,18 @@
 //! description (`"layout": {"kind": "slots", …}`) whose order and payload the reader turns into
 //! fragsim's words before the scheme's own post pass ([`MaskedABuffer::resolve`]) runs, so that a
 //! dump is decoded exactly as fragsim decodes its own runs.
-//!
-//! The nodes are compared as an A-buffer's fragments are ([`compare_with`]: missing, extra,
-//! overflow allowed past `capacity` and counted, counters checked), and each stored node's mask
-//! against the reference node of its primitive: a mask that differs makes the reference's node
-//! missing and the stored one extra ([`Dump::compare_masked`]).
-//!
-//! Under the precision of an f32 vertex stage ([`Dump::compare_masked_within`]) the nodes are
-//! spread over the samples their masks hold and judged per sample by the precision verdict
-//! ([`compare_within`]: coverage at each sample, the joint snaps per vertex), by primitive id; a
-//! node's key, the nearest of its samples' depths, must lie in the interval that nearest may
-//! take: from the least of its samples' lowest keys to the least of their highest.
 
-use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists, MaskedNode};
-use fragsim_capture::{Capacity, Capture, Identity, Keeps, SerialMemory, WordMemory};
+use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists};
+use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_memory::{SerialMemory, WordMemory};
+use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::View;
 
-use super::slots::{words_of, Placement, SlotCodec};
-use super::spec::{Encoding, LayoutSpec, SlotOrder, LARGEST_KEY};
-use super::word_check::{Corruption, Counter, WordCheck};
-use super::{err, Dtype, Dump, DumpError, Header, Words};
-use super::{FORMAT, VERSION};
-use crate::compare::{compare_with, flags, CompareOptions, Comparison};
-use crate::diff::PixelMismatch;
-use crate::precision::{compare_within, Precision};
-use crate::Oracle;
-use fragsim_raster::scene_spec::SceneSpec;
+use crate::slots::{words_of, Placement, SlotCodec};
+use crate::spec::{Encoding, LayoutSpec, SlotOrder, LARGEST_KEY};
+use crate::word_check::{Corruption, Counter, WordCheck};
+use crate::{err, Dtype, Dump, DumpError, Header, Words};
+use crate::{FORMAT, VERSION};
 
 /// The header `scheme` of a masked-node dump.
 pub const MASKED_SCHEME: &str = "abuffer-masked";
@@ -54,29 +41,6 @@ struct Masked {
 /// A masked-node dump's words in fragsim's pixel-major order: the counters, the nodes
 /// (fragsim's words) and the masks.
 type OwnWords = (Vec<u32>, Vec<u64>, Vec<u32>);
-
-/// One stored node whose coverage mask differs from the reference node of its primitive.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct WrongMask {
-    /// Row-major pixel index.
-    pub pixel: usize,
-    /// The node's primitive id.
-    pub prim: u32,
-    /// The reference node's mask.
-    pub expected: u32,
-    /// The stored node's mask.
-    pub got: u32,
-}
-
-/// A masked-node dump against the per-pixel view of the per-sample oracle.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct MaskedComparison {
-    /// The nodes compared as fragments (`key << 32 | prim`), each wrong mask folded in as a
-    /// missing and an extra node of its pixel.
-    pub nodes: Comparison,
-    /// Every stored node whose mask differs from the reference's, in pixel order.
-    pub wrong_masks: Vec<WrongMask>,
-}
 
 /// The capture of masked lists' nodes as words `key << 32 | prim`, with `capacity` nodes a pixel
 /// and each pixel's overflow: what an A-buffer of the nodes would hold.
@@ -256,192 +220,6 @@ impl Dump {
         Ok(check)
     }
 
-    /// Compares this masked-node dump with `reference` (the per-pixel view of the per-sample
-    /// oracle, [`SampleOracle::per_pixel`](crate::samples::SampleOracle::per_pixel)): the nodes as
-    /// an A-buffer's fragments with every word checked ([`compare_with`]), then each stored
-    /// node's mask against the reference node of its primitive in the pixel. A wrong mask makes
-    /// the reference node missing and the stored one extra: the pixel is
-    /// [`flags::MISSING`] and [`flags::EXTRA`], and each such node counts one lost and one
-    /// extra fragment.
-    ///
-    /// # Errors
-    /// As [`Dump::masked_lists`], or a reference of another number of pixels or samples.
-    pub fn compare_masked(
-        &self,
-        reference: &MaskedLists,
-        options: &CompareOptions<'_>,
-    ) -> Result<MaskedComparison, DumpError> {
-        let lists = self.masked_lists()?;
-        if (reference.pixels(), reference.samples) != (lists.pixels(), lists.samples) {
-            return err(format!(
-                "the reference has {} pixels at {} samples, the dump {} at {}",
-                reference.pixels(),
-                reference.samples,
-                lists.pixels(),
-                lists.samples
-            ));
-        }
-        let capture = self.masked_capture()?;
-        let words = self.check_words()?;
-        let oracle = Oracle::from_capture(&node_capture(reference, Capacity::Unbounded));
-        let mut nodes = compare_with(&oracle, &capture, Some(&words), options);
-        let mut wrong_masks = Vec::new();
-        for p in 0..lists.pixels() {
-            for node in lists.pixel(p) {
-                let expected = reference.pixel(p).iter().find(|r| r.prim == node.prim);
-                if let Some(&MaskedNode { mask, .. }) = expected.filter(|r| r.mask != node.mask) {
-                    wrong_masks.push(WrongMask {
-                        pixel: p,
-                        prim: node.prim,
-                        expected: mask,
-                        got: node.mask,
-                    });
-                }
-            }
-        }
-        let flagged: Vec<(usize, u8)> = wrong_masks
-            .iter()
-            .map(|w| (w.pixel, flags::MISSING | flags::EXTRA))
-            .collect();
-        let wrong = wrong_masks.len() as u64;
-        nodes.diff.lost += wrong;
-        nodes.diff.extra += wrong;
-        nodes.add_flags(&flagged, options.examples, |p| PixelMismatch {
-            pixel: p,
-            expected: oracle.pixel(p).to_vec(),
-            got: capture.pixel(p).to_vec(),
-        });
-        Ok(MaskedComparison { nodes, wrong_masks })
-    }
-
-    /// Judges this masked-node dump within the precision of an f32 vertex stage: `precision` and
-    /// `reference` are the per-sample analysis and oracle of the dump's view
-    /// ([`f32_reference`](crate::precision::f32_reference) of a scene declaring the dump's
-    /// sample count). Each node stands for its primitive at every sample its mask holds; those
-    /// per-sample lists, by primitive id, go through [`compare_within`] (a sample a node wrongly
-    /// covers or leaves out is extra or missing there, ambiguous only where coverage at that
-    /// sample is undecided under the joint snaps). A node's key is the nearest of its samples'
-    /// depths, so it must lie from the least `key_lo` to the least `key_hi` of its primitive's
-    /// possibilities at the samples of its mask: a key outside makes the node's first sample
-    /// [`flags::MISSING`] and [`flags::EXTRA`] (one lost and one extra fragment). Corrupt
-    /// words are charged to their pixel's first sample. The verdicts are per sample
-    /// (`pixels × samples`, sample `s` of pixel `p` at `p · samples + s`); `wrong_masks` is empty
-    /// (a wrong mask is judged per sample).
-    ///
-    /// # Errors
-    /// As [`Dump::masked_lists`]; an analysis or oracle of another number of samples; a pixel
-    /// whose nodes overflowed its capacity (which samples a dropped node covered is unknowable,
-    /// so the dump is judged exactly only, [`Dump::compare_masked`]).
-    pub fn compare_masked_within(
-        &self,
-        precision: &Precision,
-        reference: &Oracle,
-        options: &CompareOptions<'_>,
-    ) -> Result<MaskedComparison, DumpError> {
-        let lists = self.masked_lists()?;
-        let n = lists.samples as usize;
-        let samples = lists.pixels() * n;
-        if precision.pixels() != samples || reference.pixels() != samples {
-            return err(format!(
-                "the analysis covers {} samples and the reference {}, the dump {} pixels at {n} \
-                 samples ({samples})",
-                precision.pixels(),
-                reference.pixels(),
-                lists.pixels()
-            ));
-        }
-        if let Some(p) = (0..lists.pixels()).find(|&p| lists.overflow[p] > 0) {
-            return err(format!(
-                "pixel {p} dropped {} nodes past the capacity: which samples they covered is \
-                 unknown, so a masked-node dump that overflowed is judged exactly only",
-                lists.overflow[p]
-            ));
-        }
-        let words = self.check_words()?;
-        let per_sample_words = WordCheck {
-            corrupt: (0..samples)
-                .map(|i| {
-                    if i % n == 0 {
-                        words.corrupt[i / n].clone()
-                    } else {
-                        Vec::new()
-                    }
-                })
-                .collect(),
-            counters: None,
-            unchecked: words.unchecked,
-            ..WordCheck::default()
-        };
-        let mut capture = Capture::with_pixels(
-            samples,
-            Identity::PrimOnly,
-            Keeps::All {
-                capacity: Capacity::Unbounded,
-                overflow: vec![0; samples],
-            },
-        );
-        let mut stray_keys: Vec<(usize, u8)> = Vec::new();
-        let mut per_sample: Vec<Vec<u64>> = vec![Vec::new(); samples];
-        for p in 0..lists.pixels() {
-            for node in lists.pixel(p) {
-                let covered: Vec<usize> = (0..n)
-                    .filter(|&s| node.mask >> s & 1 == 1)
-                    .map(|s| p * n + s)
-                    .collect();
-                let mut interval: Option<(u32, u32)> = None;
-                for &sample in &covered {
-                    per_sample[sample].push(node.packed());
-                    let possible = precision.pixel(sample).iter().find(|q| q.prim == node.prim);
-                    if let Some(q) = possible {
-                        interval = Some(interval.map_or((q.key_lo, q.key_hi), |(lo, hi)| {
-                            (lo.min(q.key_lo), hi.min(q.key_hi))
-                        }));
-                    }
-                }
-                let widen = options.depth_ulps;
-                let inside = interval.is_none_or(|(lo, hi)| {
-                    node.depth_key >= lo.saturating_sub(widen)
-                        && node.depth_key <= hi.saturating_add(widen)
-                });
-                if let (false, Some(&first)) = (inside, covered.first()) {
-                    stray_keys.push((first, flags::MISSING | flags::EXTRA));
-                }
-            }
-        }
-        for (sample, mut list) in per_sample.into_iter().enumerate() {
-            // A node's place in its pixel is its nearest sample's: at another sample the order
-            // owes nothing, so each sample lists its nodes as the analysis orders them there.
-            let possible = precision.pixel(sample);
-            let lowest = |w: &u64| {
-                possible
-                    .iter()
-                    .find(|q| q.prim == *w as u32)
-                    .map_or(u32::MAX, |q| q.key_lo)
-            };
-            list.sort_by_key(|w| (lowest(w), *w));
-            capture.push_pixel(list);
-        }
-        let mut nodes = compare_within(
-            precision,
-            reference,
-            &capture,
-            Some(&per_sample_words),
-            options,
-        );
-        let stray = stray_keys.len() as u64;
-        nodes.diff.lost += stray;
-        nodes.diff.extra += stray;
-        nodes.add_flags(&stray_keys, options.examples, |sample| PixelMismatch {
-            pixel: sample,
-            expected: reference.pixel(sample).to_vec(),
-            got: capture.pixel(sample).to_vec(),
-        });
-        Ok(MaskedComparison {
-            nodes,
-            wrong_masks: Vec::new(),
-        })
-    }
-
     /// Runs the masked-node A-buffer of `capacity` nodes a pixel serially over `view` (which
     /// rasterizes per sample, at the sample count `scene`'s conventions declare) and records its
     /// memory as a dump, `filled` (fragsim's storage starts empty).
@@ -568,6 +346,3 @@ pub fn masked_spec(encoding: &Encoding) -> (Option<LayoutSpec>, Vec<&'static str
     );
     (spec, ignored)
 }
-
-#[cfg(test)]
-mod tests;

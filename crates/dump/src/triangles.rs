@@ -5,7 +5,7 @@ use std::path::Path;
 
 use fragsim_raster::{ScreenTriangle, View, SUBPIXEL_BITS};
 
-use crate::dump::{err, io_err, DumpError};
+use crate::{err, io_err, DumpError};
 use fragsim_raster::scene_spec::SceneSpec;
 
 /// The magic bytes that open a triangle export.

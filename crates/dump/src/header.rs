@@ -6,8 +6,8 @@ use std::collections::BTreeMap;
 use fragsim_raster::Viewport;
 use serde::{Deserialize, Serialize};
 
-use super::masked::MASKED_SCHEME;
-use super::{err, DumpError, LayoutSpec};
+use crate::masked::MASKED_SCHEME;
+use crate::{err, DumpError, LayoutSpec};
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_raster::scene_spec::SceneSpec;
 

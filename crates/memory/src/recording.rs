@@ -1,8 +1,8 @@
 //! Memory that records every operation ([`RecordingMemory`]): the serial memory plus a log of
 //! [`TraceEvent`]s, each stamped with the step, thread, fragment, pixel and pass the scheduled
 //! executor sets before the step runs. The events are defined here, beside what records them, so
-//! that `memory` needs nothing else of the crate; the scheduled executor's `Trace` is made of
-//! them and re-exports them.
+//! that the memory needs nothing of the executors; the scheduled executor's `Trace` is made of
+//! them.
 
 use std::cell::{Cell, RefCell};
 
@@ -53,15 +53,42 @@ pub struct TraceEvent {
     pub returned: u64,
 }
 
-/// Storage that can record every operation: plain memory plus a log.
-pub(crate) struct RecordingMemory {
-    pub(crate) inner: SerialMemory,
-    pub(crate) log: Option<RefCell<Vec<TraceEvent>>>,
+/// Storage that can record every operation: plain memory plus a log, kept once
+/// [`RecordingMemory::record`] starts it.
+#[derive(Debug)]
+pub struct RecordingMemory {
+    inner: SerialMemory,
+    log: Option<RefCell<Vec<TraceEvent>>>,
     /// (step, thread, fragment, pixel, pass) of the step being run.
-    pub(crate) context: Cell<(u64, u32, u64, u32, u32)>,
+    context: Cell<(u64, u32, u64, u32, u32)>,
 }
 
 impl RecordingMemory {
+    /// Starts the log: every operation from here on is recorded as a [`TraceEvent`].
+    pub fn record(&mut self) {
+        self.log = Some(RefCell::new(Vec::new()));
+    }
+
+    /// Stamps the operations that follow with the step about to run: its index in the run, the
+    /// logical thread that runs it, its fragment's index in the pass's stream, that fragment's
+    /// pixel and the geometry pass.
+    pub fn set_context(&self, step: u64, thread: u32, fragment: u64, pixel: u32, pass: u32) {
+        self.context.set((step, thread, fragment, pixel, pass));
+    }
+
+    /// The memory underneath, read without recording (the post pass's).
+    #[must_use]
+    pub fn serial(&self) -> &SerialMemory {
+        &self.inner
+    }
+
+    /// The memory underneath, and the recorded events in execution order where
+    /// [`RecordingMemory::record`] started a log.
+    #[must_use]
+    pub fn into_parts(self) -> (SerialMemory, Option<Vec<TraceEvent>>) {
+        (self.inner, self.log.map(RefCell::into_inner))
+    }
+
     fn note(&self, width: u8, word: usize, op: Op, operand: u64, returned: u64) {
         if let Some(log) = &self.log {
             let (step, thread, fragment, pixel, pass) = self.context.get();
