@@ -19,6 +19,8 @@
 //! measured: the vertex stage, the geometry passes and the post pass, as `fragsim bench` times a
 //! frame. It prints the fragments and wall-clock times; callgrind's total is the instructions.
 
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::path::Path;
 use std::time::Instant;
 
@@ -64,6 +66,10 @@ fn cache(mesh: &Path, out: &Path) -> Result<(), String> {
     let scene = Scene::from_file(mesh).map_err(|e| e.to_string())?;
     let mut bytes = Vec::new();
     for count in [scene.mesh.positions.len(), scene.mesh.triangles.len()] {
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a mesh's indices are u32, so its vertex and triangle counts fit"
+        )]
         bytes.extend_from_slice(&(count as u32).to_le_bytes());
     }
     for value in scene.mesh.positions.iter().flatten() {
@@ -121,6 +127,10 @@ fn run(
     let error = |e: fragsim::capture::CaptureError| e.to_string();
     let mut parallel = ParallelExecutor::default();
     let mut tiled = TiledExecutor::default();
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "the closure's view is the one each call passes"
+    )]
     let mut frame = |view: &View<'_>| -> Result<Run, String> {
         Ok(match (scheme, executor) {
             ("mdts", "parallel") => parallel.run(

@@ -22,6 +22,17 @@
 //! assert!(oracle.diff(&run.capture).is_exact());
 //! ```
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
+// The command (`src/main.rs`) is fragsim-cli's; the facade does not re-export it.
+use fragsim_cli as _;
+
 pub use fragsim_capture as capture;
 pub use fragsim_dump as dump;
 pub use fragsim_memory as memory;

@@ -63,6 +63,7 @@ fn kbuffer_model(
     let (wrong_in, torn_in) = (Arc::clone(&wrong), Arc::clone(&torn));
     let list_in = list.to_vec();
     let explored = explore(name, preemption_bound, move || {
+        #[expect(clippy::shadow_unrelated, reason = "each explored run's own outcomes")]
         let (memory, Walks { outcomes, .. }) = run_threads(scheme, &list_in);
         let capture = scheme.resolve(memory);
         let kept = capture.pixel(0);

@@ -44,6 +44,10 @@ fn model<S: Scheme + 'static>(
         {
             wrong_in.fetch_add(1, StdOrdering::Relaxed);
         }
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a loom model's step counts are small"
+        )]
         let most = steps.iter().copied().max().unwrap_or(0) as usize;
         longest_in.fetch_max(most, StdOrdering::Relaxed);
     });

@@ -61,12 +61,20 @@ enum Order {
 /// (interleavings, wrong ones). Wrong: keeping the nearest, not exactly the `k` nearest with the
 /// drops counted; keeping the first, not the first `k` submitted (sorted), or, with an order,
 /// fewer sections run than fragments.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a loom model's list has a few fragments"
+)]
 fn model(name: &str, keep: Keep, order: Order, k: u32, list: &[Fragment]) -> (usize, usize) {
     let ordered = order != Order::None;
     let submitted: Vec<Fragment> = match order {
         Order::Reversed => list.iter().rev().copied().collect(),
         Order::Submission | Order::None => list.to_vec(),
     };
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "the order as the model's threads share it"
+    )]
     let order: &'static PrimitiveOrder =
         Box::leak(Box::new(PrimitiveOrder::of_fragments(1, &submitted)));
     let scheme: &'static KBufferInterlockOrdered<'static> = Box::leak(Box::new(
@@ -152,6 +160,7 @@ fn kbuffer_interlock_ordered_model_catches_sections_entered_out_of_order() {
          model is vacuous",
         explored - missed
     );
+    #[expect(clippy::shadow_unrelated, reason = "the next model's counts")]
     let (explored, missed) = model(
         "kbuffer_interlock_reversed_first_2_threads_k1",
         Keep::First,

@@ -21,6 +21,8 @@
 //! sentinels) must stay correct while never exiting early. The proofs these tests check are in `docs/proof.md`, with the
 //! interleaving counts and the suite's wall time.
 
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 use std::time::Instant;
@@ -379,6 +381,11 @@ fn mdts_scheme_model<W: MdtsWord>(
 /// rest dropped; the post pass gives distinct fragments, sorted, all of them when they fit and a
 /// subset otherwise, with the overflow `n − capacity` reported; unused slots are untouched.
 /// Returns the number of interleavings explored.
+#[expect(
+    clippy::cast_possible_truncation,
+    clippy::shadow_unrelated,
+    reason = "a loom model's list has a few fragments; the promise's capacity is the one the field holds"
+)]
 fn abuffer_model(
     name: &str,
     scheme: ABuffer,
@@ -411,6 +418,10 @@ fn abuffer_model(
         let dropped = outcomes.iter().filter(|&&o| o == Step::Dropped).count();
         let stored = outcomes.iter().filter(|&&o| o == Step::Stored).count();
         assert_eq!((stored, dropped), (fit, n - fit), "walks: {outcomes:?}");
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "each walk's own step count, of the walks' `steps`"
+        )]
         for (outcome, steps) in outcomes.iter().zip(&steps) {
             let expected = if *outcome == Step::Stored { 2 } else { 1 };
             assert_eq!(*steps, expected, "{outcome:?} after {steps} steps");

@@ -66,6 +66,7 @@ fn mdts_emulated64_2_threads_is_exact_where_the_unlocked_halves_tear() {
             (0, 0),
             "K = {k}: the locked emulation lost or tore"
         );
+        #[expect(clippy::shadow_unrelated, reason = "the next model's counts")]
         let (_, wrong, torn) = model(
             &format!("mdts_emulated64_torn_2_threads_k{k}"),
             Emulation::Torn,

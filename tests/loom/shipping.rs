@@ -33,6 +33,10 @@ fn linked_list_model(name: &str, n: usize, pool: usize, preemption_bound: Option
             "the counter"
         );
         let mut stored: Vec<u64> = Vec::new();
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "each walk's own step count, of the walks' `steps`"
+        )]
         for ((outcome, steps), value) in outcomes.iter().zip(&steps).zip(&values) {
             match outcome {
                 Step::Stored => {

@@ -167,6 +167,7 @@ fn tie_merging_variant_loses_a_duplicate_4_threads_k4_preemption_bound_3() {
         None,
     );
     assert_eq!(wrong, explored, "a 10 is lost in every interleaving");
+    #[expect(clippy::shadow_unrelated, reason = "the next model's counts")]
     let (explored, wrong, _) = table1_model(
         "tie_merging_4_threads_k4_preemption_bound_3",
         merging(4),

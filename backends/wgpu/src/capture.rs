@@ -115,8 +115,20 @@ fn replay_geometry_of(
     for prim in prims {
         view.screen_triangles(prim, &mut |t| {
             for (xy, z) in t.xy.iter().zip(t.z) {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "vertex positions are f32, as the GPU's vertex buffer holds them"
+                )]
                 let x = (xy[0] as f64 / sx - 1.0) as f32;
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "vertex positions are f32, as the GPU's vertex buffer holds them"
+                )]
                 let y = (1.0 - xy[1] as f64 / sy) as f32;
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "vertex positions are f32, as the GPU's vertex buffer holds them"
+                )]
                 for v in [x, y, z as f32, 1.0] {
                     vertices.extend_from_slice(&v.to_le_bytes());
                 }
@@ -303,6 +315,10 @@ fn to_dump(
     let viewport = view.viewport();
     let mut arrays = BTreeMap::new();
     let mut specs = BTreeMap::new();
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each dumped storage's own words, of the read-back `words`"
+    )]
     for (storage, words) in storages.iter().zip(words).filter(|(s, _)| s.dumped) {
         let (data, ext) = match storage.dtype {
             Dtype::U32 => (Words::U32(words), "u32"),

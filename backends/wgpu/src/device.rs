@@ -216,6 +216,10 @@ pub fn say_skipped(why: &str) {
 /// With no usable adapter where a GPU is required: `CI=true` (set by CI) or
 /// `FRAGSIM_REQUIRE_GPU=1`, so that CI fails rather than skips.
 #[must_use]
+#[expect(
+    clippy::print_stdout,
+    reason = "a test helper: the test log names the adapter (see the doc comment)"
+)]
 pub fn adapter_or_skip() -> Option<Gpu> {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());

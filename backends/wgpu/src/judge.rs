@@ -105,6 +105,10 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
     let key_only = capture.identity == Identity::KeyOnly;
     let (mut checked, mut differs) = (0_u64, 0_u64);
     for p in 0..pixels {
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "this pixel's list of the whole reference above"
+        )]
         let reference = oracle.pixel(p);
         if reference.len() > keeps {
             continue;
@@ -114,6 +118,10 @@ pub fn judge(dump: &Dump, oracle: &Oracle, depth_ulps: u32) -> Result<Judgement,
         let same = if key_only {
             got.len() == reference.len()
         } else {
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "a word's low half is its primitive id"
+            )]
             let prims = |list: &[u64]| {
                 let mut ids: Vec<u32> = list.iter().map(|&w| w as u32).collect();
                 ids.sort_unstable();

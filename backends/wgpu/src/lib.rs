@@ -11,6 +11,17 @@
 //! ([`capture_samples`]), and the per-sample counting pass of a
 //! multisampled target against fragsim's per-sample oracle ([`sample_counts`]). The command is `fragsim-wgpu` (`src/main.rs`).
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
+// The command (`src/main.rs`) parses its arguments with clap; the library itself does not.
+use clap as _;
+
 pub mod capture;
 pub mod conform;
 pub mod device;

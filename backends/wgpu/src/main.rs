@@ -19,6 +19,8 @@
 //! identical), 1 when `msaa-count` found differing counts, 2 on an error (no adapter, bad input,
 //! a sample count the adapter lacks).
 
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -212,6 +214,10 @@ fn capture_command(gpu: &Gpu, args: CaptureArgs) -> Result<(), Box<dyn std::erro
     let mut within: Option<Within> = None;
     let mut failed = 0;
     let mut runs = 0;
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each run's scheme and plant, of the lists named for them"
+    )]
     for scheme in &schemes {
         for &plant in &plants {
             if every && plant.is_some_and(|p| !p.applies_at(scheme, samples)) {

@@ -156,6 +156,7 @@ mod tests {
     }
 
     #[test]
+    #[expect(clippy::shadow_unrelated, reason = "each `e` is its own case's error")]
     fn a_plant_the_scheme_cannot_show_is_refused_naming_those_it_fits() {
         let mdts = GpuScheme::Mdts { k: 4 };
         let e = Plant::LostNode.check(&mdts).unwrap_err();
@@ -173,6 +174,7 @@ mod tests {
     }
 
     #[test]
+    #[expect(clippy::shadow_unrelated, reason = "each `e` is its own case's error")]
     fn the_centre_depth_plant_needs_samples_and_a_per_sample_variant() {
         let mdts = GpuScheme::Mdts { k: 4 };
         let e = Plant::CentreDepth.check(&mdts).unwrap_err();

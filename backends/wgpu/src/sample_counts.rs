@@ -102,6 +102,10 @@ pub fn count_samples(
 ///
 /// # Errors
 /// As [`count_samples`].
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a replay's triangles are below View::triangle_count, a u32"
+)]
 pub fn count_samples_of(
     gpu: &Gpu,
     view: &View<'_>,
@@ -161,6 +165,10 @@ pub fn reference_counts(view: &View<'_>, pattern: SamplePattern) -> Result<Vec<u
 ///
 /// # Errors
 /// As [`reference_counts`].
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word's low half is its primitive id"
+)]
 pub fn covering_prims(
     view: &View<'_>,
     pattern: SamplePattern,
@@ -350,6 +358,10 @@ impl CountDiff {
     /// # Panics
     /// If the two cover different numbers of samples, or not whole pixels.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new); sample indices are below 16"
+    )]
     pub fn of(gpu: &[u32], reference: &[u32], width: u32, samples: u32, examples: usize) -> Self {
         assert_eq!(gpu.len(), reference.len(), "sample counts differ");
         let n = samples as usize;

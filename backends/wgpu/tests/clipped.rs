@@ -7,6 +7,8 @@
 //! adapter each test prints one line saying it was skipped; with `CI=true` or
 //! `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use fragsim_dump::{Dump, Words};
 use fragsim_oracle::compare::flags;
 use fragsim_raster::conventions::VertexPrecision;
@@ -67,6 +69,10 @@ fn judged(dump: &Dump) -> WithinJudgement {
 
 /// The dump with every ground word rewritten by `change` (`None`: taken out), each pixel's
 /// slots sorted again with the empty ones last, as MDTS stores them.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word's low half is its primitive id"
+)]
 fn with_ground(dump: &Dump, change: impl Fn(u64) -> Option<u64>) -> Dump {
     let mut changed = dump.clone();
     let k = changed.header.k.unwrap() as usize;
@@ -102,6 +108,10 @@ fn errors(judgement: &WithinJudgement) -> usize {
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word's low half is its primitive id; counts of a small test frame"
+)]
 fn a_real_capture_of_a_ground_plane_through_the_near_plane_is_judged_within_precision() {
     let Some(gpu) = adapter_or_skip() else { return };
     let dump = ground_capture(&gpu);

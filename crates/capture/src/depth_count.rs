@@ -90,6 +90,10 @@ pub struct DepthCounts {
 impl DepthCounts {
     /// The counts of a finished run of [`DepthCount`].
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "each entry counts one pixel's fragments, at most one per triangle, and triangle ids are u32"
+    )]
     pub fn from_run(mut run: Run) -> Self {
         let counts = run.capture.entries.iter().map(|&c| c as u32).collect();
         run.capture.entries = Vec::new();

@@ -61,6 +61,10 @@ pub(crate) fn resolve_range<S: Scheme + ?Sized, M: Memory>(
             PixelRun::Resolve(pixels) => pixel..(pixel + pixels.max(1)).min(range.end),
         };
         pixel = run.end;
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "the loop's pixel walks the run that the cursor `pixel` just passed"
+        )]
         for pixel in run {
             let before = resolved.entries.len();
             let over = scheme.resolve_pixel(memory, pixel, &mut resolved.entries);

@@ -42,6 +42,10 @@ impl PrimitiveOrder {
     /// The order of `stream` (its submission order) on `pixels` pixels; fragments of pixels
     /// past `pixels` are left out.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a pixel's rank is below its fragment count, at most one per triangle, and triangle ids are u32"
+    )]
     pub fn of_fragments(pixels: usize, stream: &[Fragment]) -> Self {
         let on_screen = |f: &&Fragment| (f.pixel as usize) < pixels;
         let mut offsets = vec![0; pixels + 1];

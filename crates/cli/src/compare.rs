@@ -222,6 +222,10 @@ fn legend(v: &Verdict) -> Vec<(image::Rgb<u8>, String)> {
 
 /// The difference image of `v`, one column per list (a per-sample layout's samples side by
 /// side), with its `legend`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+)]
 fn write_image(
     v: &Verdict,
     legend: &[(image::Rgb<u8>, String)],
@@ -429,6 +433,7 @@ fn print_report(report: &Report<'_>) {
             e.verdict.join(", ")
         );
         outln!("  {:<36} {:<36}", "reference", "candidate");
+        #[expect(clippy::shadow_unrelated, reason = "each row's entry, not an error")]
         let show = |e: Option<&Entry>| {
             e.map_or(String::new(), |e| match e.prim {
                 Some(prim) => format!("{:.9} [{}] prim {prim}", e.depth, e.key),

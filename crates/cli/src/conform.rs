@@ -124,6 +124,10 @@ struct Entry {
     prim: u32,
 }
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn entries(words: &[u64]) -> Vec<Entry> {
     words
         .iter()
@@ -323,6 +327,7 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             if args.json {
                 record::emit("conform", &context, &summary)?;
             } else {
+                #[expect(clippy::shadow_unrelated, reason = "the shard the arguments name")]
                 let cases = match args.shard {
                     Some(shard) => format!("{shard_cases} cases (shard {shard} of {})", args.cases),
                     None => format!("{} cases", args.cases),
@@ -400,6 +405,10 @@ fn sized(mut context: Context, params: &Params) -> Context {
     context
 }
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+)]
 fn pixel_record(m: &PixelMismatch, width: u32) -> PixelRecord {
     PixelRecord {
         pixel: m.pixel,
@@ -432,6 +441,10 @@ fn save(
     // the scene files are saved all the same. A backend that fails whatever the case is not run
     // again (a timeout would cost its whole length once more).
     let rerun = if found.case_independent {
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "the scene file's path in the counterexample's directory"
+        )]
         let scene = dir.join("scene");
         if dir.exists() {
             std::fs::remove_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;

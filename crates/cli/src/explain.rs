@@ -150,6 +150,10 @@ fn machine_label(machine: WriteBack) -> &'static str {
 ///
 /// # Errors
 /// Bad depths or parameters.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "at most fragsim_explain::interleaving::MAX_FRAGMENTS (64) depths"
+)]
 pub(crate) fn explain(args: &ExplainArgs) -> Result<bool, String> {
     let (text, shown) = explain_text(args)?;
     if args.json {
@@ -185,6 +189,10 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<bool, String> {
 /// Bad depths or parameters, or a `--write-back` other than the `-stores` scheme's machine.
 pub(crate) fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String> {
     let fragments = one_pixel(&args.depths)?;
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "at most fragsim_explain::interleaving::MAX_FRAGMENTS (64) depths"
+    )]
     let k = args.k.unwrap_or(fragments.len() as u32);
     let viewport = Viewport::new(1, 1).map_err(|e| e.to_string())?;
     let name = args.scheme.0;
@@ -221,6 +229,10 @@ pub(crate) fn explain_text(args: &ExplainArgs) -> Result<(String, bool), String>
     }
 }
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word's low half is its primitive id"
+)]
 fn explain_kbuffer(
     scheme: &KBuffer,
     machine: WriteBack,
@@ -252,6 +264,10 @@ fn explain_kbuffer(
     } else {
         kbuffer::shrink(scheme, k, fragments.to_vec(), trace.order())
     };
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "the shrunk trace replaces the one it was shrunk from"
+    )]
     let (trace, damage) =
         kbuffer::hazard(scheme, k, &fragments, &order).expect("the shrunk order shows the hazard");
     let _ = writeln!(
@@ -364,6 +380,10 @@ fn values(words: &[u64]) -> String {
 }
 
 /// A slot value: `∅` for empty, else `depth#prim`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn value(v: u64) -> String {
     if v == EMPTY {
         "∅".into()

@@ -3,6 +3,14 @@
 //! `sweep`, `hazard`) are `fragsim_measure`'s; their commands here turn the options into the
 //! library's parameters and print and write what it returns.
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use. Not `print_stdout` and
+// `print_stderr`: this crate is the command line, whose job is printing.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::ffi::OsString;
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -431,6 +431,10 @@ fn caption(args: &RenderArgs, what: &str) -> Result<String, String> {
 /// its dump ([`fragsim_oracle::verdict::judge`] against the per-pixel view of the per-sample
 /// oracle: nodes beyond the capacity overflow by design). Returns its capacity (`--capacity`, or
 /// under `auto` the most nodes a pixel of that view has) and the line saying the verdict.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a pixel holds at most one fragment per triangle, and triangle ids are u32"
+)]
 fn masked(
     view: &View<'_>,
     spec: &SceneSpec,

@@ -12,6 +12,10 @@ use crate::spec::LayoutSpec;
 use crate::{err, Dtype, Dump, DumpError, Words};
 
 /// A-buffer lists as the GPU's sort kernel left them: `min(counter, capacity)` slots, unsorted.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a pixel's stored slots are at most its counter, a u32"
+)]
 pub(super) fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64]) -> Capture {
     let at = scheme.pixel_slots();
     let capacity = match scheme {
@@ -28,8 +32,8 @@ pub(super) fn stored_lists(scheme: &DumpScheme, counters: &[u32], slots: &[u64])
         },
     );
     for (p, &count) in counters.iter().enumerate() {
-        let (first, capacity) = at(p);
-        let stored = (count as usize).min(capacity);
+        let (first, slot_count) = at(p);
+        let stored = (count as usize).min(slot_count);
         capture.push_pixel(slots[first..first + stored].iter().copied());
         overflow.push(count - stored as u32);
     }

@@ -428,6 +428,10 @@ impl DumpScheme {
                 if let LayoutSpec::LinkedList { payload, .. } = spec {
                     payload.check()?;
                 }
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "the guard holds the pool to 1..=u32::MAX"
+                )]
                 let pool = match header.pool {
                     Some(pool) if (1..=u64::from(u32::MAX)).contains(&pool) => pool as u32,
                     _ => return err(format!("{name} needs \"pool\" of 1 to 2^32 − 1 nodes")),
@@ -447,12 +451,15 @@ impl DumpScheme {
                 // Each size defaults to 1, as a scheme that does not use it is built. A scheme
                 // holds at least one word per slot or layer, so a size past the dump's words is
                 // refused before the scheme is built (its storage would not fit a u64 count).
-                let words = header.arrays.iter().try_fold(0_u64, |sum, (name, spec)| {
-                    sum.checked_add(super::header::elements(name, &spec.shape)?)
-                        .ok_or_else(|| {
-                            DumpError::Invalid("the arrays' elements overflow 64 bits".into())
-                        })
-                })?;
+                let words = header
+                    .arrays
+                    .iter()
+                    .try_fold(0_u64, |sum, (array, array_spec)| {
+                        sum.checked_add(super::header::elements(array, &array_spec.shape)?)
+                            .ok_or_else(|| {
+                                DumpError::Invalid("the arrays' elements overflow 64 bits".into())
+                            })
+                    })?;
                 let size = |field: &str, value: Option<u32>| match value {
                     Some(0) => err(format!("{name} \"{field}\" must be at least 1")),
                     Some(v) if u64::from(v) > words.max(1) => err(format!(

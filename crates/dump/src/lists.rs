@@ -82,14 +82,19 @@ pub(super) fn linked_lists(lists: &ListArrays<'_>) -> Translated {
             let i = index.unwrap_or_default();
             visited[i] = true;
             reached += 1;
-            out.words32[link] = i as u32 + 1;
-            let (fragment, why) = read_payload(lists.payload, lists.nodes[i]);
-            if let Some(why) = why {
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "node indices are below the pool, at most 2^32 − 1 (the header's \"pool\")"
+            )]
+            let number = i as u32 + 1;
+            out.words32[link] = number;
+            let (fragment, payload_why) = read_payload(lists.payload, lists.nodes[i]);
+            if let Some(payload_why) = payload_why {
                 out.corrupt[p].push(CorruptWord {
                     pixel: p,
                     slot,
                     word: lists.nodes[i],
-                    why,
+                    why: payload_why,
                 });
             }
             out.words64[i] = fragment;
@@ -199,6 +204,10 @@ impl Dump {
         };
         let pixels = self.viewport()?.pixels();
         let heads = renumber(self.u32s_of("heads", pixels)?);
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "the pool fits u32: node numbers past 2^32 are refused above"
+        )]
         let next = renumber(self.u32s_of("next", pool as usize)?);
         let nodes = self
             .widened("nodes", Payload::FRAGMENT.dtype)?

@@ -162,11 +162,12 @@ impl Dump {
             slots,
         };
         self.check_slot_count(total)?;
-        Ok(Some((
-            placement,
-            SlotCodec::new(scheme, payload),
-            total as usize,
-        )))
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "the total is the length of the \"slots\" array (check_slot_count), a usize"
+        )]
+        let total = total as usize;
+        Ok(Some((placement, SlotCodec::new(scheme, payload), total)))
     }
 
     /// Refuses a `slots` array of other than `total` words.
@@ -335,6 +336,10 @@ impl Dump {
 }
 
 /// Words of `dtype` (u32 words narrowed: they came from u32 words or a u32 payload).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "u32 words narrowed: they came from u32 words or a u32 payload"
+)]
 pub(super) fn words_of(dtype: Dtype, words: Vec<u64>) -> Words {
     match dtype {
         Dtype::U32 => Words::U32(words.into_iter().map(|w| w as u32).collect()),

@@ -52,6 +52,10 @@ impl DepthFormat {
     /// The depth key a stored field reads back as: the f32 bits themselves, or the nearest f32
     /// to a unorm field's value `field / (2^bits − 1)` (what the GPU's depth was rounded from).
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an F32 field is the f32's 32 bits; a unorm field's value narrows to the nearest f32, as the GPU's depth was rounded to"
+    )]
     pub fn key_of_field(self, field: u64) -> u32 {
         match self {
             Self::F32 => field as u32,
@@ -64,6 +68,10 @@ impl DepthFormat {
     /// The field that stores depth key `key` as fragsim writes it: the bits, or the nearest
     /// unorm step `round(depth · (2^bits − 1))` (a D24 or D16 conversion).
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a depth in [0, 1] scales to a field in [0, 2^bits − 1]; `as` saturates anything else"
+    )]
     pub fn field_of_key(self, key: u32) -> u64 {
         match self {
             Self::F32 => u64::from(key),
@@ -81,6 +89,10 @@ impl DepthFormat {
     /// half a step below `2^24`, then rounds (a depth buffer's conversion) or truncates
     /// (`uint(z * s)`): either lands in that range, and no other step can.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "first and last are clamped to [0, 2^bits − 1], integers below 2^24"
+    )]
     pub fn stored_keys(self, lo: u32, hi: u32) -> (u32, u32) {
         match self {
             Self::F32 => (lo, hi),
@@ -329,6 +341,10 @@ mod tests {
     use super::*;
 
     #[test]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the expected key is the nearest f32 to the unorm24 depth"
+    )]
     fn unorm_depths_decode_to_the_nearest_f32_of_their_value() {
         let unorm24 = Payload {
             dtype: Dtype::U32,

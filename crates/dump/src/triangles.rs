@@ -62,10 +62,16 @@ impl TriangleExport {
         let padded = json.len().next_multiple_of(8);
         let count = u32::try_from(self.triangles.len())
             .map_err(|_| DumpError::Invalid("more than 2^32 screen triangles".into()))?;
+        let json_len = u32::try_from(json.len())
+            .map_err(|_| DumpError::Invalid("a scene of more than 2^32 bytes of JSON".into()))?;
         let mut bytes = Vec::with_capacity(
             TRIANGLES_HEADER_BYTES + padded + self.triangles.len() * TRIANGLE_RECORD_BYTES,
         );
         bytes.extend_from_slice(&TRIANGLES_MAGIC);
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "the record size is 56 bytes"
+        )]
         for field in [
             TRIANGLES_VERSION,
             self.width,
@@ -73,7 +79,7 @@ impl TriangleExport {
             SUBPIXEL_BITS,
             self.mesh_triangles,
             count,
-            json.len() as u32,
+            json_len,
             TRIANGLE_RECORD_BYTES as u32,
         ] {
             bytes.extend_from_slice(&field.to_le_bytes());

@@ -191,15 +191,19 @@ impl Dump {
                 check_mdts(&mut check, slots, *k as usize, empty, key);
                 if let DumpScheme::KBuffer {
                     scheme: SchemeName::KbufferInterlockOrderedFirst,
-                    k,
+                    k: first_k,
                 } = &scheme
                 {
-                    check.first_in_primitive_order = Some(*k);
+                    check.first_in_primitive_order = Some(*first_k);
                 }
             }
             DumpScheme::Mdts32 { k } => {
                 let slots = self.u32s("slots")?.ok_or_else(|| missing("slots"))?;
                 let wide: Vec<u64> = slots.iter().map(|&w| u64::from(w)).collect();
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "the wide words came from u32 slots"
+                )]
                 check_mdts(&mut check, &wide, *k as usize, u64::from(u32::MAX), |w| {
                     w as u32
                 });
@@ -233,6 +237,10 @@ impl Dump {
                         };
                         check.flag(p, slot, word, why);
                     }
+                    #[expect(
+                        clippy::cast_possible_truncation,
+                        reason = "a fixed A-buffer's capacity is a u32 (DumpScheme::ABufferFixed); exact storage's is its counter, a u32"
+                    )]
                     all.push(Counter {
                         count,
                         capacity: if exact { u32::MAX } else { capacity as u32 },

@@ -125,6 +125,10 @@ impl Dump {
             DumpScheme::LinkedLists { k: n, pool: p, .. } => {
                 (k, pool) = (Some(*n), Some(u64::from(*p)));
                 // fragsim's u32 words: the heads, the node counter, the `next` of each node.
+                #[expect(
+                    clippy::shadow_unrelated,
+                    reason = "the same pixel count as `pixels` above, as a usize to split the words by"
+                )]
                 let pixels = viewport.pixels();
                 let (heads, rest) = words32.split_at(pixels);
                 let (counter, next) = rest.split_at(1);

@@ -21,6 +21,10 @@ pub const MAX_FRAGMENTS: usize = 64;
 ///
 /// # Errors
 /// No depth, more than [`MAX_FRAGMENTS`], or a depth outside `[0, 1]`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "primitive ids are positions in at most MAX_FRAGMENTS depths"
+)]
 pub fn one_pixel(depths: &[f32]) -> Result<Vec<Fragment>, String> {
     if depths.is_empty() || depths.len() > MAX_FRAGMENTS {
         return Err(format!("explain needs 1 to {MAX_FRAGMENTS} depths"));
@@ -129,6 +133,10 @@ pub fn interleavings(order: &[u32], limit: u64) -> Option<Vec<Vec<u32>>> {
             }
         }
     }
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "thread indices are below the fragment count, at most MAX_FRAGMENTS"
+    )]
     fn extend(left: &mut [usize], prefix: &mut Vec<u32>, len: usize, out: &mut Vec<Vec<u32>>) {
         if prefix.len() == len {
             out.push(prefix.clone());

@@ -122,6 +122,10 @@ pub fn shrink(
             // The fragments keep their primitive ids (the user's numbering, which the report
             // prints); only the threads, which are positions in the list, close up.
             fewer.remove(drop);
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "drop is a position in at most MAX_FRAGMENTS fragments (crate::interleaving)"
+            )]
             let drop = drop as u32;
             let remapped: Vec<u32> = order
                 .iter()
@@ -150,6 +154,10 @@ pub fn shrink(
         return (fragments, order);
     }
     let mut best = record(scheme, &fragments, &order);
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "the second phase's own flag, as the first phase's `changed` above"
+    )]
     let mut changed = true;
     while changed {
         changed = false;
@@ -188,6 +196,7 @@ mod tests {
     }
 
     #[test]
+    #[expect(clippy::shadow_unrelated, reason = "each `d` is its own case's damage")]
     fn damage_names_the_missing_and_the_doubled() {
         let fragments = one_pixel(&[0.3, 0.5, 0.1]).unwrap();
         let [a, b, c] = [0, 1, 2].map(|i| fragments[i].packed());

@@ -378,6 +378,10 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each `judged` and `pass` is its own case's"
+    )]
     fn a_prim_only_capture_is_shaded_at_the_depths_it_holds_not_the_oracles() {
         let (scene, orbit) = two_layers();
         let view = scene
@@ -410,6 +414,10 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each `judged` and `pass` is its own case's"
+    )]
     fn a_key_only_capture_is_completed_from_the_oracle_and_its_row_says_so() {
         let (scene, orbit) = two_layers();
         let view = scene

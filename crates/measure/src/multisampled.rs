@@ -228,6 +228,10 @@ pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<M
         .reference()
         .expect("the judge shades the oracle's image");
     let n = samples as usize;
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "list entries hold primitive ids, u32s"
+    )]
     let prims = |sample: usize| lists.pixel(sample).iter().map(|&e| e as u32);
     let (mut mixed_pixels, mut layer_edge_pixels) = (0, 0);
     for first in (0..lists.pixels()).step_by(n) {
@@ -245,6 +249,10 @@ pub(crate) fn measure(bench: &Bench<'_, '_>, pattern: SamplePattern) -> Result<M
         )?;
     }
     let per_pixel = oracle.per_pixel();
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a pixel holds at most one node per triangle, and triangle ids are u32"
+    )]
     let max_nodes_per_pixel = (0..per_pixel.pixels())
         .map(|p| per_pixel.pixel(p).len() as u32)
         .max()

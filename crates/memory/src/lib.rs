@@ -31,6 +31,14 @@
 //! The crate needs nothing of the schemes or the executors (`fragsim-capture`), which are built
 //! on it: it sits below them as `crossbeam-utils` below `crossbeam`.
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::fmt::Debug;
 
 mod counting;

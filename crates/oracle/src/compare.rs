@@ -345,6 +345,10 @@ pub fn compare(
 
 /// An A-buffer pixel's counter as a capture alone shows it: `stored + overflow`, and a capacity
 /// of `stored` when it overflowed (storage ran out), unknown (at least `stored`) when not.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "stored slots are at most the pixel's capacity, a u32"
+)]
 pub(crate) fn inferred_counter(stored: usize, overflow: u32) -> Counter {
     Counter {
         // Saturating: a memory dump's words can claim any overflow (found by `dump_layouts`).
@@ -378,6 +382,10 @@ pub(crate) fn inferred_counter(stored: usize, overflow: u32) -> Counter {
 /// If the capture, the reference, `words` or `options.complete` cover different numbers of
 /// pixels.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "n is a pixel's reference count: a pixel holds at most one fragment per triangle, and triangle ids are u32"
+)]
 pub fn compare_with(
     reference: &Oracle,
     candidate: &Capture,
@@ -543,7 +551,15 @@ fn snap_to_reference(got: &mut [u64], reference: &[u64], identity: Identity, ulp
         }
     }
     for i in unmatched {
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+        )]
         let (key, prim) = ((got[i] >> 32) as u32, got[i] as u32);
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+        )]
         let nearest = (0..reference.len())
             .filter(|&j| !used[j])
             .filter(|&j| identity == Identity::KeyOnly || reference[j] as u32 == prim)

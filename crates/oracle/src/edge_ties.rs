@@ -97,6 +97,11 @@ impl TiePoints {
     /// of every sample position on it (the perimeter, not the area), each judged under the four
     /// rules, its depth the pipeline's (`docs/semantics.md` §5).
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::shadow_unrelated,
+        reason = "sample indices are below the pattern's count, at most 16; depths are f32, as a GPU's; list indices are below the sample-expanded viewport's pixels, at most Viewport::MAX_SIDE² (SampleError::TooWide); `p` and `q` are each edge's ends, as edge() names them"
+    )]
     pub fn of(view: &View<'_>) -> Self {
         let pixels = view.pixel_viewport();
         let pattern = view.samples().unwrap_or(SamplePattern::CENTRE);
@@ -208,6 +213,10 @@ impl TiePoints {
 const ONE: i64 = 1 << fragsim_raster::SUBPIXEL_BITS;
 
 /// The position of `rule` in [`EdgeTies::ALL`].
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "EdgeTies::ALL has a few rules"
+)]
 fn index(rule: EdgeTies) -> u32 {
     EdgeTies::ALL.iter().position(|&r| r == rule).unwrap_or(0) as u32
 }
@@ -216,6 +225,10 @@ fn index(rule: EdgeTies) -> u32 {
 /// `width × height` pixel grid lying exactly on the segment from `p` to `q` (ends included): a
 /// horizontal segment's samples on its row, otherwise at most one per row, where the segment's
 /// x there is an integer on the sample's column.
+#[expect(
+    clippy::shadow_unrelated,
+    reason = "each axis's span takes its own sample offset"
+)]
 fn lattice_on_segment(
     p: [i64; 2],
     q: [i64; 2],

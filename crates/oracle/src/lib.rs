@@ -21,6 +21,14 @@
 //! assert_eq!(oracle.max_depth_complexity(), 6);
 //! ```
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 pub mod compare;
 mod diff;
 pub mod edge_ties;
@@ -158,12 +166,20 @@ impl Oracle {
 
     /// Per-pixel depth complexity (fragment count).
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a pixel holds at most one fragment per triangle, and triangle ids are u32"
+    )]
     pub fn depth_complexity(&self) -> Vec<u32> {
         self.lists.lengths().map(|n| n as u32).collect()
     }
 
     /// The largest depth complexity of any pixel.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a pixel holds at most one fragment per triangle, and triangle ids are u32"
+    )]
     pub fn max_depth_complexity(&self) -> u32 {
         self.lists.lengths().max().unwrap_or(0) as u32
     }

@@ -147,6 +147,10 @@ fn triangle_bound(tri: &ScreenTriangle, width: u32, height: u32, slack: i64) -> 
     let perimeter = side(p[0], p[1]) + side(p[1], p[2]) + side(p[2], p[0]);
     let lattice = (area + perimeter / 2.0 + 1.0).floor();
     // Past u64 the box bound is the smaller anyway.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the cast is taken only below 1.8e19, under u64::MAX"
+    )]
     let lattice = if lattice < 1.8e19 {
         lattice as u64
     } else {

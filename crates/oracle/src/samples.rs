@@ -99,6 +99,10 @@ impl SampleOracle {
                     node.depth_key = node.depth_key.min(depth_key);
                 }
             }
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+            )]
             nodes.extend(by_prim.values().map(|&node| (pixel as u32, node)));
         }
         MaskedLists::from_nodes(n, self.pixels.pixels(), nodes)
@@ -157,6 +161,10 @@ impl SampleOracle {
 }
 
 /// The primitive id of a packed entry (its low half).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry's low half is its primitive id"
+)]
 fn primitive_id(entry: u64) -> u32 {
     entry as u32
 }

@@ -32,6 +32,10 @@ pub(crate) fn reference_arrays<'py>(
     offsets.push(0_u64);
     for p in 0..lists {
         let list = oracle.pixel(p);
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a pixel's list holds at most one fragment per triangle, and triangle ids are u32"
+        )]
         counts.push(list.len() as u32);
         words.extend_from_slice(list);
         offsets.push(words.len() as u64);

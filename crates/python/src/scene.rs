@@ -92,9 +92,12 @@ impl SceneCore {
             oracles: [OnceLock::new(), OnceLock::new()],
         };
         let view = core.view(false)?;
-        let spec = core.spec.recorded(&view);
+        let recorded = core.spec.recorded(&view);
         drop(view);
-        Ok(Self { spec, ..core })
+        Ok(Self {
+            spec: recorded,
+            ..core
+        })
     }
 
     /// The view; with `f64_stage`, under an f64 vertex stage whatever the spec declares.

@@ -99,6 +99,10 @@ impl<'a> Attributes<'a> {
     #[must_use]
     pub fn barycentrics(&self, prim: u32, pixel: u32) -> Option<[f64; 3]> {
         let tri = self.mesh.triangles.get(prim as usize)?;
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "the width is a viewport's (Viewport::new), at most Viewport::MAX_SIDE, held as f64 from a u32"
+        )]
         let width = self.width as u32;
         let (x, y) = (pixel % width, pixel / width);
         // Window to normalised device coordinates: the inverse of the pipeline's rule 4.
@@ -143,8 +147,8 @@ impl<'a> Attributes<'a> {
             tri.map(|i| DVec3::from(self.normals[i as usize].map(f64::from))),
         );
         n.try_normalize().unwrap_or_else(|| {
-            let [a, b, c] = tri.map(|i| position(self.mesh, i));
-            (b - a).cross(c - a).normalize_or_zero()
+            let [p0, p1, p2] = tri.map(|i| position(self.mesh, i));
+            (p1 - p0).cross(p2 - p0).normalize_or_zero()
         })
     }
 

@@ -182,6 +182,10 @@ mod tests {
         let camera = orbit.camera(bounds, 1.5);
         for p in [[0.0, 0.0, 0.0], [0.9, 1.9, 0.4], [-1.0, -2.0, -0.5]] {
             let clip = camera.view_projection * DVec4::new(p[0], p[1], p[2], 1.0);
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "an f32 depth, as a GPU's pipeline hands it to eye_distance"
+            )]
             let z = (clip.z / clip.w) as f32;
             // w is the distance along the view axis: what the inverse mapping must give back.
             let d = orbit.eye_distance(bounds, 1.5, z);

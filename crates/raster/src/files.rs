@@ -127,9 +127,9 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), FileError> {
 /// As [`open_regular`]; a file of more than `limit` bytes, refused before it is read.
 pub fn read_regular(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, FileError> {
     let (file, bytes) = open_regular(path)?;
-    let too_large = |bytes| FileError::TooLarge {
+    let too_large = |size| FileError::TooLarge {
         path: path.to_path_buf(),
-        bytes,
+        bytes: size,
         limit,
         what: what.to_string(),
     };

@@ -593,6 +593,10 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each `err` is the message of the case just parsed"
+    )]
     fn a_face_referring_to_a_normal_in_a_file_without_normals_is_an_error() {
         let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1//5 2//5 3//5\n")
             .unwrap_err()
@@ -605,6 +609,10 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each `err` is the message of the case just parsed"
+    )]
     fn a_relative_index_before_the_first_element_is_an_error_not_an_overflow() {
         // Found by the obj_load fuzz target: tobj computed `vt * 2 + 1` on the wrapped index.
         let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nf 1/-11 2/-1 3/-1\n")

@@ -248,6 +248,10 @@ impl<'mesh> View<'mesh> {
     /// [`View::submitted`] order).
     #[must_use]
     #[inline]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "primitive ids are u32, as a GPU's: mesh files are at most MESH_BYTES_LIMIT (4 GiB), at least 8 bytes a face, and the built-in scenes have at most 10 million triangles"
+    )]
     pub fn triangle_count(&self) -> u32 {
         self.mesh.triangles.len() as u32
     }

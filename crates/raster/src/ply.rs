@@ -18,6 +18,10 @@ use crate::mesh::{Mesh, MeshError};
 struct PlyVertex([f32; 3]);
 
 impl PlyVertex {
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "narrowing a double coordinate to f32 is what the rasterizer's input is made of"
+    )]
     fn set(&mut self, name: &str, value: f64) -> PropertyAccessResult {
         let axis = match name {
             "x" => 0,

@@ -162,6 +162,10 @@ impl SamplePattern {
 
     /// Samples per pixel.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a pattern has at most 16 positions (SamplePattern::custom)"
+    )]
     pub fn count(self) -> u32 {
         self.positions.len() as u32
     }

@@ -347,8 +347,8 @@ impl SceneSpec {
                 return Err(SceneSpecError::NotFinite { field, value });
             }
         }
-        if let Some(matrix) = &self.view_projection {
-            engine_matrix(matrix)?;
+        if let Some(view_projection) = &self.view_projection {
+            engine_matrix(view_projection)?;
         }
         Ok(())
     }
@@ -424,6 +424,10 @@ fn engine_matrix(matrix: &ViewProjection) -> Result<[f64; 16], SceneSpecError> {
     let mut entries = matrix.row_major;
     if matrix.precision == VertexPrecision::F32 {
         for (index, value) in entries.iter_mut().enumerate() {
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "the f32 value of an f32-precision entry is the one checked against f32's normal range"
+            )]
             let single = *value as f32;
             // Infinite, or a nonzero value that f32 holds as zero or a subnormal (which a GPU
             // may flush to zero).

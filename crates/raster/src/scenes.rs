@@ -307,6 +307,10 @@ enum Procedural {
 }
 
 impl Procedural {
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "each count is at most its parameter's bound (the third argument of `param`), at most 10 million"
+    )]
     fn parse(spec: &str) -> Result<Self, SceneError> {
         let mut parts = spec.split(':');
         let kind = parts.next().unwrap_or_default();
@@ -356,6 +360,10 @@ impl Procedural {
 
 /// `count` closed UV spheres centred at the origin with radii `1/count, 2/count, …, 1`.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "at most 256 spheres (Scene::Spheres) of (stacks - 1) × slices + 2 vertices each fit u32; positions are f32, as the mesh stores them"
+)]
 pub(crate) fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
     let mut mesh = Mesh::default();
     for s in 1..=count {
@@ -399,6 +407,10 @@ pub(crate) fn nested_spheres(count: u32, slices: u32, stacks: u32) -> Mesh {
 /// The paper gives neither the spheres' sizes nor their placement; these make a scene of high
 /// depth complexity around and through the bunny.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "at most 100,000 spheres (Scene::BunnySpheres) of a few hundred vertices each beside the bunny's fit u32; positions are f32, as the mesh stores them"
+)]
 pub(crate) fn bunny_with_spheres(bunny: &Mesh, count: u32, seed: u64) -> Mesh {
     let (lo, hi) = bunny.bounds();
     let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
@@ -422,6 +434,10 @@ pub(crate) fn bunny_with_spheres(bunny: &Mesh, count: u32, seed: u64) -> Mesh {
 
 /// `count` triangles with vertices uniform in the unit cube, from `seed`.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "positions are f32, as the mesh stores them"
+)]
 pub(crate) fn triangle_soup(count: u32, seed: u64) -> Mesh {
     let mut rng = SplitMix64::new(seed);
     let mut mesh = Mesh::default();

@@ -95,6 +95,10 @@ impl PixelRect {
 /// The first and last pixel whose centre lies in `[lo, hi]` (1/256 pixel) and in the pixel range
 /// `[first, last]`; `None` when there is none.
 #[inline]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "both lie in [first, last], u32s, when they are ordered"
+)]
 fn pixel_span(lo: i64, hi: i64, (first, last): (u32, u32)) -> Option<(u32, u32)> {
     // An arithmetic shift is the floor division by `ONE` (a power of two), in fewer instructions
     // than `div_euclid`: this runs for every triangle of the mesh.

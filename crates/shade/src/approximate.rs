@@ -126,6 +126,10 @@ impl Approximation {
 /// GPU's blending and ordered interlock see them in. An entry the order does not hold (it
 /// cannot come from the recorded view) goes last, in its given order.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new); an entry packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 pub fn in_submission_order(order: &PrimitiveOrder, pixel: usize, sorted: &[u64]) -> Vec<u64> {
     let mut arrivals = sorted.to_vec();
     arrivals.sort_by_key(|&entry| {
@@ -156,6 +160,10 @@ pub fn wboit_weight(alpha: f32, d: f32) -> f32 {
 /// WBOIT: accumulate `Σ c α w` and `Σ α w` (the accumulation target, additive blending) and
 /// `Π (1 − α)` (the revealage target, multiplicative), then composite
 /// `C = (Σ c α w / Σ α w) (1 − Π) + background · Π` (the paper's Listing 2 resolve).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn wboit(material: &Material, arrivals: &[u64]) -> [f32; 3] {
     let alpha = material.opacity;
     let (mut accum, mut weight, mut revealage) = ([0.0_f32; 3], 0.0_f32, 1.0_f32);
@@ -189,6 +197,10 @@ struct Node {
 /// merge the two farthest into one ("under": the nearer over the farther, at the nearer's
 /// depth), so that a later fragment that belongs between them is blended in the wrong place.
 /// Then composite the nodes front to back.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn mlab(material: &Material, k: usize, arrivals: &[u64]) -> [f32; 3] {
     let mut nodes: Vec<Node> = Vec::with_capacity(k + 1);
     for &entry in arrivals {
@@ -219,6 +231,10 @@ fn mlab(material: &Material, k: usize, arrivals: &[u64]) -> [f32; 3] {
 /// that falls out of it (the newcomer, or the farthest it displaces) is blended at once into the
 /// tail, over what the tail holds, unsorted ("over", in eviction order, starting from the
 /// background); the `k` nearest are then composited front to back over the tail.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn tail_blend(material: &Material, k: usize, arrivals: &[u64]) -> [f32; 3] {
     let alpha = material.opacity;
     let mut kept: Vec<u64> = Vec::with_capacity(k + 1);

@@ -81,6 +81,10 @@ impl PerEntry {
 /// The normals' pass over `lists` (entries with a primitive id in the low half): `|cos θ|` of
 /// every entry, from its pixel and primitive id, 1 where the primitive does not cover the pixel
 /// (an entry no fragment has).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new); an entry packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 pub fn cosines<'l>(
     attributes: &Attributes<'_>,
     pixels: usize,
@@ -122,6 +126,10 @@ pub fn complete<'c>(
 
 /// Key-only entries to full ones: the i-th occurrence of a key takes the primitive of the i-th
 /// fragment with that key in canonical order (`fragments`: the pixel's, sorted).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn prims_of_keys(list: &[u64], fragments: &[u64]) -> Vec<u64> {
     let mut order: Vec<usize> = (0..list.len()).collect();
     order.sort_by_key(|&i| list[i] >> 32);

@@ -106,6 +106,10 @@ pub enum Entries {
 /// primitive ids, so that neighbouring triangles (which scanned meshes number close together)
 /// get close colours and a misordered or lost fragment still changes the pixel.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a channel in [0.1, 0.9], f32 as colours are"
+)]
 pub fn primitive_colour(prim: u32, primitives: u32) -> [f32; 3] {
     let hue = f64::from(prim) / f64::from(primitives.max(1));
     let channel = |offset: f64| {
@@ -118,6 +122,10 @@ pub fn primitive_colour(prim: u32, primitives: u32) -> [f32; 3] {
 
 /// Linear to 8-bit sRGB (IEC 61966-2-1), the one place where encoding happens.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "s is in [0, 1], so the scaled value is a byte (and `as` saturates)"
+)]
 pub fn encode_srgb(linear: f32) -> u8 {
     let c = linear.clamp(0.0, 1.0);
     let s = if c <= 0.003_130_8 {
@@ -131,6 +139,10 @@ pub fn encode_srgb(linear: f32) -> u8 {
 /// Resolves pixel `pixel`'s list (nearest first) to a linear colour; `None` when the effect
 /// needs what the entries lack ([`Effect::resolvable_from`]).
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry packs the depth key (high 32 bits) and the primitive id (low 32); colours are f32; the f64 arithmetic narrows back to them"
+)]
 pub fn shade_pixel(
     effect: Effect,
     material: &Material,
@@ -221,6 +233,10 @@ pub fn render<'a>(
 /// # Panics
 /// If `samples` is 0.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "colours are f32; the f64 arithmetic narrows back to them"
+)]
 pub fn render_resolved<'a>(
     effect: Effect,
     material: &Material,
@@ -294,6 +310,10 @@ pub fn difference_image(reference: &RgbImage, candidate: &RgbImage) -> RgbImage 
     RgbImage::from_fn(reference.width(), reference.height(), |x, y| {
         let (a, b) = (reference.get_pixel(x, y), candidate.get_pixel(x, y));
         if a == b {
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "three bytes summed and divided by 6 are below 128"
+            )]
             let grey = ((u16::from(b[0]) + u16::from(b[1]) + u16::from(b[2])) / 6) as u8;
             Rgb([grey, grey, grey])
         } else {
@@ -345,6 +365,10 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "colours are f32; the f64 arithmetic narrows back to them"
+    )]
     fn a_half_covered_pixel_resolves_to_the_mean_of_its_two_samples_in_linear_light() {
         let m = Material {
             opacity: 0.9,
@@ -379,6 +403,10 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an entry packs the depth key (high 32 bits) and the primitive id (low 32); a small test viewport's coordinates"
+    )]
     fn one_sample_resolves_to_the_single_sample_image_and_four_change_only_mixed_pixels() {
         use fragsim_oracle::samples::SampleOracle;
         use fragsim_oracle::Oracle;

@@ -71,6 +71,10 @@ fn fill<DB: DrawingBackend>(
 ///
 /// # Errors
 /// Text cannot be drawn (a font error).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "tick rows lie between the bar's top and bottom, within the picture"
+)]
 pub fn heat_map_with_bar(
     width: u32,
     height: u32,
@@ -163,6 +167,10 @@ pub fn nearest_depth_with_key(
         let (bar_top, bar_bottom) = (56, 216);
         for y in bar_top..=bar_bottom {
             let t = (y - bar_top) as f32 / (bar_bottom - bar_top) as f32;
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "t is in [0, 1]: the grey is in [40, 255]"
+            )]
             let v = (255.0 - 215.0 * t).round() as u8;
             fill(area, [(x0, y), (x0 + 24, y + 1)], Rgb([v, v, v]))?;
         }
@@ -195,6 +203,10 @@ pub fn nearest_depth_with_key(
 ///
 /// # Errors
 /// Text cannot be drawn (a font error).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a legend has a few lines, a picture a side of at most 16384 pixels"
+)]
 pub fn captioned(figure: &RgbImage, caption: &str) -> Result<RgbImage, DrawError> {
     const LINE: u32 = 17;
     // The embedded font's 13-pixel glyphs average under 7 pixels.
@@ -241,6 +253,10 @@ const INSET_ZOOM: u32 = 8;
 ///
 /// # Errors
 /// Text cannot be drawn (a font error).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a legend has a few lines, a picture a side of at most 16384 pixels; a legend has a few lines, a picture a side of at most 16384 pixels; at most INSETS insets; a legend has a few lines, a picture a side of at most 16384 pixels; at most INSETS insets; sx and sy are checked to lie in the picture"
+)]
 pub fn difference_figure(
     picture: &RgbImage,
     legend: &[(Rgb<u8>, String)],

@@ -13,6 +13,14 @@
 //! assert_eq!(image.dimensions(), (2, 2));
 //! ```
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::path::Path;
 
 pub mod approximate;
@@ -55,6 +63,10 @@ pub fn heat_map_scaled(width: u32, height: u32, counts: &[u32], max: u32) -> Rgb
 }
 
 /// The heat map's colour at `t` in [0, 1] of its scale.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "t is clamped to [0, 1]: the index is within RAMP and each channel, in [0, 1], scales to a byte"
+)]
 pub(crate) fn ramp(t: f32) -> Rgb<u8> {
     let scaled = t.clamp(0.0, 1.0) * (RAMP.len() - 1) as f32;
     let i = (scaled.floor() as usize).min(RAMP.len() - 2);
@@ -66,6 +78,10 @@ pub(crate) fn ramp(t: f32) -> Rgb<u8> {
 /// Nearest depth per pixel as grey, stretched over the depths present (near is white, far is
 /// dark); pixels with no fragment are black.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the depth is within [lo, lo + span]: the grey is in [40, 255]"
+)]
 pub fn nearest_depth(width: u32, height: u32, nearest: &[Option<f32>]) -> RgbImage {
     let present = nearest.iter().flatten();
     let lo = present.clone().copied().fold(f32::INFINITY, f32::min);

@@ -169,6 +169,10 @@ impl Marker {
 /// Tick values for a log axis over `lo..hi` (both positive): the 1-2-5 values of each decade
 /// inside the range, or every unit of the leading digit (1, 2, 3, … 9) where fewer than four
 /// of those fall inside: a narrow range still gets several labelled ticks.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "decades of plotted values, far within i32"
+)]
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let within = |mantissas: &[f64]| -> Vec<f64> {
         let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
@@ -185,6 +189,10 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
 }
 
 /// A tick value as a person writes it: `20`, `1.5`, `0.02`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the decade of a tick, far within i32"
+)]
 fn tick_label(v: &f64) -> String {
     let digits = (2 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
     let text = format!("{v:.digits$}");
@@ -324,6 +332,10 @@ fn render(path: &Path, size: (u32, u32), picture: &impl Paint) -> Result<(), Sav
 pub(crate) type DrawResult<DB> =
     Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "i is a whole, non-negative tick index (checked by the guard)"
+)]
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     (title, x_label, y_label): (&str, &str, &str),
@@ -402,6 +414,10 @@ fn series_marker(i: usize) -> Marker {
 }
 
 /// Pixels the legend column takes: room for the longest name at the legend's font size.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a legend has a few short names"
+)]
 fn legend_width(names: &[&str]) -> u32 {
     let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
     // About 7 pixels a character at 13 px, plus the marker and margins.
@@ -409,6 +425,10 @@ fn legend_width(names: &[&str]) -> u32 {
 }
 
 /// The series' colours and names, one a row, from the top of `area`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a legend has a few short names"
+)]
 fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     names: &[&str],

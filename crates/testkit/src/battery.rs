@@ -549,6 +549,10 @@ impl<'b> Battery<'b> {
     /// Returns what the case exercised.
     fn check_submitted(&self, submitted: &Case, property: Property) -> Result<Exercised, Stop> {
         let scene = submitted.scene();
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "each call names the property its failure is found under"
+        )]
         let found = |property, message: String, comparison, fragments| {
             Stop::Found(Box::new(Found {
                 submitted: submitted.clone(),
@@ -606,6 +610,10 @@ impl<'b> Battery<'b> {
 /// (crops around the differing pixels, under the case's schedule and seeds 0 to 3; with
 /// `power_of_two` each crop's sides rounded up to powers of two, and moved back inside the
 /// viewport), then fewer triangles.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+)]
 fn candidates(case: &Case, found: &Found, power_of_two: bool) -> Vec<Case> {
     let viewport = case.viewport;
     let (w, h) = (viewport.width, viewport.height);

@@ -104,6 +104,10 @@ impl Default for Limits {
 impl Case {
     /// The case's mesh: three vertices of its own per triangle, in submission order.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "positions are f32, as the mesh stores them; a case has a few triangles"
+    )]
     pub fn mesh(&self) -> Mesh {
         let (w, h) = (
             f64::from(self.viewport.width),

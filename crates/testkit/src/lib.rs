@@ -29,6 +29,14 @@
 //! assert_eq!(passed.cases, 8);
 //! ```
 
+// The Linebender lint set's crate-level lints (https://linebender.org/wiki/canonical-lints/), as
+// vello's lib.rs has them: `unused_crate_dependencies` not under `cfg(test)`, whose target also
+// links the dev-dependencies that only the integration tests use.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 pub mod backend;
 pub mod battery;
 pub mod case;

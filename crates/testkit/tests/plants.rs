@@ -9,6 +9,8 @@
 //! The plants are those of `crates/testkit/python/backend.py` (which `tests/suite/conform.rs`
 //! runs through the binary), here as a [`Backend`] so that CI runs all twenty in seconds.
 
+#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
+
 use std::cell::Cell;
 
 use fragsim_capture::catalog::SchemeName;
@@ -67,6 +69,10 @@ impl Backend for UserABuffer {
         Ok(Guarantee::Exact)
     }
 
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a word's low half is its primitive id; cap is a small test capacity"
+    )]
     fn capture(&self, input: &Input<'_>) -> Result<Output, BackendError> {
         let (view, plant) = (input.view, self.plant);
         let cap = input.params.capacity as usize;
@@ -257,6 +263,10 @@ fn a_backend_failing_on_every_case_stops_at_once_and_one_failing_on_deep_cases_i
         from: 2,
         runs: Cell::new(0),
     };
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "the deep battery's own counterexample"
+    )]
     let Err(Failure::Counterexample(found)) = Battery::new(&deep, params()).cases(100).run() else {
         panic!("the backend failing on deep cases passed");
     };

@@ -105,6 +105,10 @@ impl<'a> Run<'a> {
         }
         let replay = u32::from(mode == Mode::Replay);
         // `pool` fits: `capture_planted` refused larger pools.
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "capture_planted refused larger pools"
+        )]
         let pool = scheme.pool(lists).unwrap_or(0) as u32;
         for v in [
             viewport.width,
@@ -398,6 +402,10 @@ impl<'a> Run<'a> {
             let view = buffer
                 .get_mapped_range(..)
                 .map_err(|e| GpuError::Device(format!("{name}: read-back: {e}")))?;
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "a buffer's size is that of a mapped buffer, which fits the address space"
+            )]
             words.push(
                 view[..size as usize]
                     .chunks_exact(4)
@@ -526,6 +534,10 @@ fn bytes_of(words: &[u32]) -> Vec<u8> {
 
 /// Workgroups (x, y) of a per-pixel compute pass: `x` at most the adapter's limit per
 /// dimension, `y` rows of them (the shader's pixel is `id.y · x · 64 + id.x`).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "x is at most max_per_dimension, a u32, and groups / x at most the groups of at most 16384² pixels"
+)]
 fn per_pixel_groups(pixels: u64, max_per_dimension: u32) -> (u32, u32) {
     let groups = pixels.div_ceil(u64::from(PIXEL_WORKGROUP)).max(1);
     let x = groups.min(u64::from(max_per_dimension.max(1)));

@@ -419,6 +419,10 @@ mod tests {
         // The last unfinished walk first: another order of steps, the same sorted slots (MDTS's
         // words do not depend on the interleaving), every fragment's walk ended.
         let last: SerialMemory = mdts.layout().allocate();
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "the counters of this walk, as `counters` above are of the first"
+        )]
         let counters = interleaved(&mdts, &last, 0, &fragments, |unfinished| {
             unfinished.len() - 1
         });

@@ -85,6 +85,10 @@ pub(crate) fn parallel_frame<S: Scheme, M: Memory + Sync>(
             .map(|task| {
                 let mut counters = Counters::default();
                 let first = task * triangles_per_task;
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "triangle indices are below View::triangle_count, a u32"
+                )]
                 let prims = (first..(first + triangles_per_task).min(triangles))
                     .map(|index| view.submitted(index as u32));
                 rasterize_into(view, scheme, memory, pass, prims, rect, &mut counters);

@@ -181,6 +181,10 @@ pub fn run_scheduled<S: Scheme>(
 }
 
 /// Runs `scheme` on a hand-written fragment list (one "triangle" per fragment) under `schedule`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "fragment indices are u32 in traces (TraceEvent); a scheduled run walks a small frame's stream, far below 2^32 fragments"
+)]
 pub fn run_fragments<S: Scheme>(
     scheme: &S,
     fragments: &[Fragment],
@@ -204,6 +208,10 @@ pub fn run_fragments<S: Scheme>(
 /// `order` = the thread of each step of a recorded trace replays that trace exactly (a step that
 /// does several memory operations, as a render-target k-buffer's read, records several events with
 /// one `step` index: [`Trace::order`]).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "fragment indices are u32 in traces (TraceEvent); a scheduled run walks a small frame's stream, far below 2^32 fragments"
+)]
 pub fn run_fragments_in_order<S: Scheme>(
     scheme: &S,
     fragments: &[Fragment],
@@ -347,6 +355,10 @@ fn run_pass<S: Scheme>(
         let t = chooser.choose(&mut threads, &active, step, |s| scheme.simt(s).reconverging);
         let thread = &mut threads[t];
         let (state, fragment, index) = thread.walk.as_mut().expect("chosen threads are active");
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "thread indices are u32 in traces; a schedule has a warp's few threads"
+        )]
         memory.set_context(step, t as u32, *index, fragment.pixel, pass);
         step += 1;
         counters.steps += 1;
@@ -355,6 +367,11 @@ fn run_pass<S: Scheme>(
             spins += 1;
             chooser.spun(thread);
             if spins >= bound {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    clippy::shadow_unrelated,
+                    reason = "the stuck lanes name every thread as the chosen one is named above; thread indices are u32 in traces, and a schedule has a warp's few threads"
+                )]
                 let lanes = threads
                     .iter()
                     .enumerate()

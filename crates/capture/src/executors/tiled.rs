@@ -93,6 +93,10 @@ impl Tiles {
     }
 
     /// The pixels of tile `tile`.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "tiles are fewer than the viewport's pixels, at most 16384² (Viewport::new)"
+    )]
     fn rect(self, tile: usize) -> PixelRect {
         let (column, row) = (tile as u32 % self.columns, tile as u32 / self.columns);
         let last = |index: u32, side: u32| (index * TILE_SIDE + TILE_SIDE - 1).min(side - 1);
@@ -171,6 +175,10 @@ impl TiledExecutor {
             .par_iter_mut()
             .enumerate()
             .for_each(|(index, chunk)| {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "chunks start at triangle ids, u32s"
+                )]
                 let first = index as u32 * TRIANGLES_PER_CHUNK;
                 chunk.bin(
                     view,

@@ -119,6 +119,10 @@ impl ABuffer {
 
     /// The A-buffer on `storage` for `pixels` pixels, sorted by `sort`, within `memory_cap`
     /// bytes.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a fixed capacity is given as a u32 (ABuffer::fixed)"
+    )]
     fn on(
         storage: Storage,
         pixels: usize,
@@ -237,6 +241,10 @@ impl Scheme for ABuffer {
         PixelRun::of_first_words::<u32, _>(memory, pixel, end, 1)
     }
 
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "count is the pixel's u32 counter word"
+    )]
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let count = WordMemory::<u32>::load(memory, pixel) as usize;
         if count == 0 {

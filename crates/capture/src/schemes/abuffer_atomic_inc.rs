@@ -42,6 +42,10 @@ pub struct ABufferAtomicInc {
 /// CUDA's `atomicInc` as seen through `fetch_add`: the value `atomicInc(addr, bound)` returns
 /// (and leaves) when `fetch_add` on the same word returns (or leaves) `count`.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the remainder is at most bound, a u32"
+)]
 pub fn wrap(count: u32, bound: u32) -> u32 {
     (u64::from(count) % (u64::from(bound) + 1)) as u32
 }
@@ -124,6 +128,10 @@ impl Scheme for ABufferAtomicInc {
         }
     }
 
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "count is the pixel's u32 counter word"
+    )]
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         // What the GPU's post pass reads: the wrapped counter.
         let count = wrap(WordMemory::<u32>::load(memory, pixel), self.bound) as usize;
@@ -187,6 +195,11 @@ mod tests {
     }
 
     #[test]
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::shadow_unrelated,
+        reason = "the test reads back the low word, a primitive id, of each kept slot; each `one_pixel` call's results are its own case's"
+    )]
     fn past_capacity_atomic_inc_overwrites_silently_and_fetch_add_counts_the_drop() {
         let viewport = Viewport::new(1, 1).unwrap();
         let inc = ABufferAtomicInc::wrapping(viewport, 8, MEMORY_CAP_DEFAULT).unwrap();

@@ -125,6 +125,10 @@ impl<W: MdtsWord> DualDepthPeeling<W> {
 
     /// Output slots per pixel.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the layers are the u32 max_layers the storage was built with"
+    )]
     pub fn max_layers(&self) -> u32 {
         self.storage.layers() as u32
     }

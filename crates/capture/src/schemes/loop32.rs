@@ -273,6 +273,10 @@ impl Scheme for Loop32 {
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let words = memory;
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+        )]
         let pixel = pixel as u32;
         for slot in 0..self.k {
             let z = self.load(words, pixel, slot);

@@ -167,6 +167,10 @@ impl Scheme for Loop64 {
     }
 
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+        )]
         let pixel = pixel as u32;
         out.extend(
             (0..self.k)

@@ -135,6 +135,10 @@ impl MaskedLists {
         let mut offsets = Vec::with_capacity(pixels + 1);
         offsets.push(0);
         let mut at = 0;
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+        )]
         for pixel in 0..pixels as u32 {
             while at < nodes.len() && nodes[at].0 == pixel {
                 at += 1;
@@ -446,6 +450,10 @@ impl MaskedABuffer {
     /// The post pass: each pixel's stored nodes (its slots, or its list walked from the head)
     /// sorted, and the A-buffer's per-pixel overflow read from its counter.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a node's word packs the depth key (high 32 bits) and the primitive id (low 32)"
+    )]
     pub fn resolve<M: Memory>(&self, memory: &M) -> MaskedLists {
         let mut lists = MaskedLists {
             samples: self.samples,

@@ -363,6 +363,10 @@ mod tests {
     /// allocated and the lists that step after step on the whole array leaves, for pixels inside a
     /// page, across a page's edge and on pages not yet allocated, in both directions and probing.
     #[test]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a random u64 taken modulo 6 as an index"
+    )]
     fn walks_on_a_span_are_walks_on_the_array_across_page_edges() {
         let k = 20;
         // 420 pixels of 20 slots: pixel 204's slots cross the first page's edge (word 4096).

@@ -273,6 +273,10 @@ impl Scheme for MdtsEmulated64 {
                 Step::Continue
             }
             Op64::StoreLo { old } => {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "the low word of the 64-bit value, by design"
+                )]
                 WordMemory::<u32>::store(memory, lo_word, !(walk.value as u32));
                 self.finish(walk, old)
             }
@@ -350,6 +354,7 @@ mod tests {
         assert_ne!(slot0, b.packed());
 
         let locked = MdtsEmulated64::with_k(one_pixel(), 2, Emulation::Locked).unwrap();
+        #[expect(clippy::shadow_unrelated, reason = "the next run of the same test")]
         let run = run_fragments_in_order(&locked, &[a, b], &order, false);
         assert_eq!(
             run.run.capture.pixel(0),

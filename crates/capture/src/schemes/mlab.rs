@@ -222,7 +222,7 @@ mod tests {
                     "K {k}, {perm:?}"
                 );
                 let nodes = scheme.nodes(&memory, 0);
-                assert_eq!(nodes.iter().map(|n| n.1).sum::<u32>(), 5, "{nodes:?}");
+                assert_eq!(nodes.iter().map(|node| node.1).sum::<u32>(), 5, "{nodes:?}");
                 assert_eq!(dropped, stream.len() - kept, "K {k}, {perm:?}");
             }
         }

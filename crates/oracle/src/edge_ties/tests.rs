@@ -19,6 +19,11 @@ const IDENTITY: [f64; 16] = [
 /// fan of four triangles around the first sample of pixel (2, 2), its arms to the corners of a
 /// square of 4 pixels: its diagonals, shared by two triangles each, and its square's sides pass
 /// through that sample's positions in other pixels.
+#[expect(
+    clippy::cast_possible_truncation,
+    clippy::shadow_unrelated,
+    reason = "test positions are f32, as the mesh stores them; the triangles of a few hundred vertices; `triangles` becomes the mesh's index list"
+)]
 fn soup(side: u32, triangles: usize, first_sample: [i64; 2], seed: u64) -> Mesh {
     let mut rng = SplitMix64::new(seed);
     // Window position in 1/16 pixel to normalised device coordinates.
@@ -52,6 +57,10 @@ fn soup(side: u32, triangles: usize, first_sample: [i64; 2], seed: u64) -> Mesh 
 
 /// Every fragment of `view` under `rule`, found by testing every sample of every screen
 /// triangle's box with the rule's thresholds: the definition [`TiePoints`] shortcuts.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "sample indices are below 16; depths are f32, as a GPU's; fragments index a small test viewport's samples"
+)]
 fn rasterized_under(view: &View<'_>, rule: EdgeTies) -> Oracle {
     let pixels = view.pixel_viewport();
     let pattern = view

@@ -94,6 +94,10 @@ pub(super) fn pieces(
     }
     let mut out = Vec::new();
     for i in 1..polygon.len().saturating_sub(1) {
+        #[expect(
+            clippy::shadow_unrelated,
+            reason = "this fan triangle's corners, indices into the clipped polygon"
+        )]
         let corners = [0, i, i + 1];
         // A piece with a vertex not in front of the eye is dropped, as the pipeline drops it.
         let Some(at) = corners
@@ -108,6 +112,10 @@ pub(super) fn pieces(
             verts.push(window_bound(view, conventions, a, bounds)?);
         }
         let verts: [VertexBound; 3] = verts.try_into().ok()?;
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a clipped polygon has at most nine corners"
+        )]
         out.push((corners.map(|k| k as u32), verts));
     }
     Some(out)

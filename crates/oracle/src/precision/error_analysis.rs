@@ -36,6 +36,10 @@ pub(super) fn clip_error(view: &View<'_>, index: u32) -> [f64; 4] {
     // errors of the actual products and partial sums, in any order ([`dot_error`]). A matrix
     // rounded to f32 first: |fl(Σ M_rj v_j) − Σ M_rj v_j| ≤ γ_5 Σ |M_rj||v_j| (the standard
     // bound of four products and three sums in any order, one more u for the entries).
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "whether each entry is exactly an f32"
+    )]
     let rounded = m.iter().any(|&e| f64::from(e as f32) != e);
     let transform_error = |row: usize| {
         let products = [0, 1, 2, 3].map(|c| m[c * 4 + row] * v[c]);
@@ -180,6 +184,10 @@ pub(super) fn dot_error(p: [f64; 4]) -> f64 {
 /// value in `[x − e, x + e]` (pixels) may give on a grid of `bits` subpixel bits:
 /// `[⌈(x − e)·2^b − ½⌉, ⌊(x + e)·2^b + ½⌋]` grid steps (`docs/semantics.md` §10, step 4). A value
 /// that may reach a half step gives both neighbours, one whose interval holds none gives one.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "bounds of window positions inside the guard band, far within i64"
+)]
 pub(super) fn snap_reach(x: f64, error: f64, bits: u32) -> [i64; 2] {
     let bits = bits.min(SUBPIXEL_BITS);
     let (scale, grid) = (f64::from(1_u32 << bits), 1_i64 << (SUBPIXEL_BITS - bits));
@@ -218,6 +226,10 @@ pub(super) fn real(p: [i64; 2]) -> [f64; 2] {
 }
 
 /// The largest f32 not above `x`, and the smallest not below.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the nearest f32, then stepped to the side asked for"
+)]
 fn round_down(x: f64) -> f32 {
     let f = x as f32;
     if f64::from(f) > x {
@@ -227,6 +239,10 @@ fn round_down(x: f64) -> f32 {
     }
 }
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the nearest f32, then stepped to the side asked for"
+)]
 fn round_up(x: f64) -> f32 {
     let f = x as f32;
     if f64::from(f) < x {

@@ -204,6 +204,10 @@ impl Found {
 }
 
 /// Per primitive of `view`, the first primitive with the same vertex indices in the same order.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "primitive ids are below View::triangle_count, a u32"
+)]
 fn twins(view: &View<'_>) -> Vec<u32> {
     let mut first = std::collections::HashMap::new();
     view.mesh()
@@ -299,6 +303,10 @@ impl Precision {
             pixels: view.pixel_viewport(),
             pattern: view.samples().unwrap_or(SamplePattern::CENTRE),
         };
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "vertex indices are u32, as the mesh's triangles hold them"
+        )]
         let vertices: Vec<Option<VertexBound>> = (0..view.mesh().positions.len() as u32)
             .map(|i| vertex_bound(view, conventions, i, &mut bounds))
             .collect();
@@ -401,6 +409,10 @@ impl Precision {
     }
 
     /// `reference`'s fragments as an analysis in which each is certain at its own key.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+    )]
     fn certain(reference: &Oracle) -> Self {
         let mut offsets = vec![0];
         let mut entries = Vec::with_capacity(reference.fragments());

@@ -10,6 +10,10 @@ use fragsim_raster::{edge_function as edge, fill_thresholds, Viewport, WindowOri
 
 /// The pipeline's coverage and depth of one snapped triangle at every pixel centre, as
 /// `docs/semantics.md` rules 4 and 5 state them.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "test pixels index a small viewport"
+)]
 fn rasterize(viewport: Viewport, xy: [[i64; 2]; 3], z: [f64; 3]) -> Vec<(u32, f64)> {
     let (a, mut b, mut c) = (xy[0], xy[1], xy[2]);
     let (mut zb, mut zc) = (z[1], z[2]);
@@ -106,6 +110,11 @@ fn origin_form(xy: [[f32; 2]; 3], z: [f32; 3], x: f32, y: f32) -> f32 {
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    clippy::shadow_unrelated,
+    reason = "test primitive ids number a few cases; depths are f32, as a GPU's; `r` is each stage's radius"
+)]
 fn every_reachable_fragment_is_listed_and_certain_pairs_are_always_covered() {
     let viewport = Viewport::new(6, 6).unwrap();
     // Edges that pass within a subpixel or two of pixel centres (128 + 256 i), a sliver whose
@@ -239,6 +248,10 @@ fn a_centre_inside_the_edge_margin_is_ambiguous_and_outside_it_decided() {
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the bound of small test edges, far within i64"
+)]
 fn the_edge_bound_holds_every_perturbation() {
     let (p0, q, p) = ([3, -7], [40, 25], [-11, 9]);
     let (r0, rq, rp) = (2, 1, 3);
@@ -269,6 +282,10 @@ fn the_edge_bound_holds_every_perturbation() {
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "small test counters; positions and depths are f32, as the mesh stores them"
+)]
 fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interval() {
     // A steep triangle (depth 0.2 to 0.9 over three pixels) far from the window origin, its
     // vertices' f32 positions 0.49 subpixel from their snapped ones (plus up to the vertex error)
@@ -344,6 +361,10 @@ fn a_plane_on_unsnapped_positions_evaluated_from_the_origin_stays_in_its_interva
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "depth keys are of f32 depths, as a GPU's"
+)]
 fn a_triangle_a_few_subpixels_across_gets_the_depth_of_its_reachable_planes() {
     // A triangle 6 subpixels across around the centre (128, 128) of pixel 0, steep in depth, its
     // vertices each with a second reachable grid point. The bilinear bound over a plane radius of
@@ -436,6 +457,10 @@ fn reaching(x: i64, y: i64, depth: f64, dx: i64, dy: i64) -> VertexBound {
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "test primitive ids and pixels number a few cases in a 6-pixel-wide viewport"
+)]
 fn enumerated_coverage_is_exactly_that_of_the_reachable_snapped_triangles() {
     let viewport = Viewport::new(6, 6).unwrap();
     let cases = [

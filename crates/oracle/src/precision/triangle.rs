@@ -98,6 +98,7 @@ pub(super) fn triangle(
         area = -area;
     }
     let v = [a, b, c];
+    #[expect(clippy::shadow_unrelated, reason = "the vertex ids of `v`, in order")]
     let ids = [ia, ib, ic];
     let reachable = combinations(&v);
     // Each vertex's reachable points (at most 64 while enumerating), for `Dependence`.
@@ -147,12 +148,17 @@ pub(super) fn triangle(
     let area_stable = area as f64 > area_bound;
     // Per edge, whether an end lies outside the viewport: the edge leaves the clip volume.
     let window = [pixels.width, pixels.height].map(|side| i64::from(side) * one);
-    let outside = |x: &VertexBound| (0..2).any(|a| !(0..=window[a]).contains(&x.snapped[a]));
+    let outside =
+        |x: &VertexBound| (0..2).any(|axis| !(0..=window[axis]).contains(&x.snapped[axis]));
     let leaves = edges.map(|(i, j)| outside(&v[i]) || outside(&v[j]));
     let mut planes = Vec::new();
     let positions =
         (y0..=y1).flat_map(|y| (x0..=x1).flat_map(move |x| (0..samples).map(move |s| (x, y, s))));
     for (x, y, s) in positions {
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "s is a sample index, below the pattern's count, at most 16"
+        )]
         let [ox, oy] = pattern.fixed_offset(s as usize);
         let p = [x * one + ox, y * one + oy];
         let e = edges.map(|(i, j)| edge(v[i].snapped, v[j].snapped, p));
@@ -161,7 +167,7 @@ pub(super) fn triangle(
         planes.clear();
         planes.push(unsnapped);
         let mut covering = 0_u64;
-        let mut on_edge = e.contains(&0) && e.iter().all(|&v| v >= 0);
+        let mut on_edge = e.contains(&0) && e.iter().all(|&value| value >= 0);
         let (certain, possible) = match &reachable {
             // The reference's own triangle is one of them: `certain` implies `covered`.
             Some(all) => {
@@ -211,7 +217,8 @@ pub(super) fn triangle(
         // the triangle there (Vulkan clips to `−w ≤ x, y ≤ w`; a guard band only where the result
         // is the same), and the clipped edge's new end is computed and snapped in its own
         // arithmetic, so the sample may fall on either side whatever the fill rule.
-        let clipped_tie = (0..3).any(|k| e[k] == 0 && leaves[k]) && e.iter().all(|&v| v >= 0);
+        let clipped_tie =
+            (0..3).any(|k| e[k] == 0 && leaves[k]) && e.iter().all(|&value| value >= 0);
         let (certain, possible) = if clipped_tie {
             (false, true)
         } else {
@@ -223,6 +230,10 @@ pub(super) fn triangle(
         let area_f = area as f64;
         let z = (e[0] as f64 * v[0].depth + e[1] as f64 * v[1].depth + e[2] as f64 * v[2].depth)
             / area_f;
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "depths are f32, as a GPU's"
+        )]
         let reference = if covered { depth_key(z as f32) } else { None };
         let (key_lo, key_hi, inside) = depth_interval(pixels, &v, &planes, p, z);
         if shared && !certain && !clipped_tie && reachable.is_some() {
@@ -243,6 +254,10 @@ pub(super) fn triangle(
         } else {
             None
         };
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "list indices are below the sample-expanded viewport's pixels, at most Viewport::MAX_SIDE² (SampleError::TooWide)"
+        )]
         found.push(Found {
             pixel: ((y * i64::from(pixels.width) + x) * samples + s) as u32,
             possible: Possible {

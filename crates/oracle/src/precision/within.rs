@@ -225,6 +225,10 @@ fn assign(
     keeps: &Keeps,
 ) -> Vec<Option<usize>> {
     let admits = |q: &Possible, word: u64| {
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+        )]
         let (key, prim) = ((word >> 32) as u32, word as u32);
         let inside =
             || key >= q.key_lo.saturating_sub(widen) && key <= q.key_hi.saturating_add(widen);

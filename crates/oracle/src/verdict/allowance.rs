@@ -57,6 +57,10 @@ pub(super) fn counter_note(comparison: &Comparison) -> Option<String> {
 /// documentation): its verdicts and totals amended in `comparison`. `precision` is the f32
 /// analysis where the comparison was within it (`None`: every fragment of `reference` is
 /// certain); `options.complete` says where a reference dump knows every fragment.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry's low half is its primitive id"
+)]
 pub(crate) fn hold_to_reference(
     comparison: &mut Comparison,
     candidate: &Capture,

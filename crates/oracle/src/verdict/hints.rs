@@ -96,6 +96,10 @@ pub(super) fn hint(
 }
 
 /// The fragments of `list` as `(primitive, depth key)`, keyed as `identity` names them.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
+)]
 fn fragments(list: &[u64], identity: Identity) -> Vec<(u32, u32)> {
     let mut out: Vec<(u32, u32)> = list
         .iter()
@@ -151,6 +155,10 @@ fn depth_only(reference: &Oracle, candidate: &Capture, differing: &[usize]) -> O
 /// A primitive in both lists at different depths is no edge's.
 fn on_edges(reference: &Oracle, candidate: &Capture, differing: &[usize], row: usize) -> bool {
     let lists = reference.pixels();
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an entry's low half is its primitive id"
+    )]
     let has = |p: usize, prim: u32| reference.pixel(p).iter().any(|&w| w as u32 == prim);
     let neighbours = |p: usize| {
         let (x, y) = (p % row, p / row);

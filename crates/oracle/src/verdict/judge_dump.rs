@@ -197,6 +197,10 @@ impl JudgeDump for Dump {
         Ok(MaskedComparison { nodes, wrong_masks })
     }
 
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an entry's low half is its primitive id"
+    )]
     fn compare_masked_within(
         &self,
         precision: &Precision,

@@ -249,7 +249,7 @@ impl Judged {
         let (capture, words) = match candidate {
             Candidate::Dump(dump) => (dump.capture()?, Some(dump.check_words()?)),
             Candidate::Capture(capture) => (capture.clone(), None),
-            Candidate::Oracle(oracle) => (oracle_capture(oracle), None),
+            Candidate::Oracle(other) => (oracle_capture(other), None),
         };
         if let (Candidate::Dump(dump), Some(words)) = (candidate, &words) {
             notes.extend(unread_notes(dump, words)?);

@@ -258,6 +258,10 @@ impl<'a> Reference<'a> {
     }
 
     /// Lists per pixel: the samples of a per-sample layout, else 1.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "samples per pixel, at most 16"
+    )]
     pub(super) fn lists_per_pixel(&self) -> u32 {
         let pixels = (self.width as usize * self.height as usize).max(1);
         // Masked nodes judged within precision are judged a sample at a time.
@@ -297,6 +301,10 @@ impl<'a> Reference<'a> {
                 reference.first()
             };
             let got = candidate.pixel(p);
+            #[expect(
+                clippy::shadow_unrelated,
+                reason = "the bound each caller passes, not the one above"
+            )]
             let beyond = |e: u64, bound: u64| {
                 if nearest {
                     e & mask > bound & mask

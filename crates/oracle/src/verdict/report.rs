@@ -27,6 +27,10 @@ pub struct Entry {
 impl Entry {
     /// The fragment word `word` (`depth key << 32 | primitive id`) of a capture of `identity`.
     #[must_use]
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an entry's low half is its primitive id"
+    )]
     pub fn of(word: u64, identity: Identity) -> Self {
         let key = (word >> 32) as u32;
         Self {
@@ -103,6 +107,10 @@ impl SampleCounts {
 }
 
 /// The examples of `comparison`, whose lists are `samples` a pixel of a `width`-pixel row.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "pixel coordinates and sample indices fit u32: viewports are at most 16384² pixels (Viewport::new) of at most 16 samples"
+)]
 pub(super) fn examples(
     comparison: &Comparison,
     width: u32,

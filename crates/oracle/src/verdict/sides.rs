@@ -217,6 +217,10 @@ pub fn judge_sides(
         None => None,
         Some(view) if masked => {
             let sampled = SampleOracle::build(view)?;
+            #[expect(
+                clippy::shadow_unrelated,
+                reason = "the masked reference, the one this arm builds"
+            )]
             let reference = Reference::masked(sampled.per_pixel(), size);
             Some(if judged_f32 {
                 // The exact per-sample oracle (the view's vertex stage is f64 here) and the

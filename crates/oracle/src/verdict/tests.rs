@@ -95,6 +95,10 @@ fn a_dump_missing_one_fragment_is_different_at_that_pixel_alone() {
 /// A merge of a pixel's sample fragments into masked nodes, as `merge_samples` is.
 type Merge = fn(u32, &mut [Fragment], &mut dyn FnMut(u32, MaskedNode));
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32); the test's sample indices index a small viewport; a pixel holds at most one fragment per triangle, and triangle ids are u32"
+)]
 fn masked_dump_merged_by(merge: Merge) -> (Dump, Reference<'static>) {
     let mut spec = SceneSpec::named("spheres:3", 30.0, 15.0);
     spec.conventions.samples = 4;
@@ -173,6 +177,10 @@ fn merge_keeping_the_farthest(
 }
 
 #[test]
+#[expect(
+    clippy::shadow_unrelated,
+    reason = "each planted bug's reference and verdict are its own case's"
+)]
 fn a_bug_planted_in_the_schemes_merge_is_caught_by_the_oracles_own_merge() {
     // The control: the schemes' merge, as it is, holds the per-pixel view exactly.
     let (dump, reference) = masked_dump_merged_by(|samples, fragments, mut emit| {

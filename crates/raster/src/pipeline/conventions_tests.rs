@@ -224,6 +224,10 @@ fn snapped_xs(mesh: &Mesh, side: u32, conventions: Conventions) -> Vec<i64> {
 fn four_subpixel_bits_snap_to_sixteenths_rounding_half_away() {
     // Window x on a 4-pixel viewport: 1.53 (8 bits: 392/256; 4 bits: 24.48/16 → 24/16 = 384/256)
     // and 1.53125 = 24.5/16 exactly (a tie on the coarse grid: half away from zero, 25/16).
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an f32 vertex coordinate, as the mesh stores it"
+    )]
     let ndc = |window_x: f64| (window_x / 2.0 - 1.0) as f32;
     let mesh = Mesh {
         positions: vec![
@@ -244,6 +248,10 @@ fn four_subpixel_bits_snap_to_sixteenths_rounding_half_away() {
 fn four_subpixel_bits_move_a_centre_onto_an_edge() {
     // A vertical left edge at window x 1.53: right of the centres of column 1 (x 1.5) at 8
     // bits, on them at 4 bits, where the left edge owns them.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an f32 vertex coordinate, as the mesh stores it"
+    )]
     let x = (1.53_f64 / 2.0 - 1.0) as f32;
     let mesh = Mesh {
         positions: vec![[x, -1.0, 0.5], [3.0, -1.0, 0.5], [x, 3.0, 0.5]],
@@ -325,6 +333,10 @@ fn the_f32_vertex_stage_rounds_as_a_vertex_shader() {
         let view = View::with_conventions(&mesh, &camera, viewport, CullMode::None, conventions);
         view.unwrap().snapped(0).1
     };
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the f32 stage's arithmetic, which the expected depth repeats"
+    )]
     let expected = f64::from(((third as f32) * p[2] + 0.1_f32) / 1.0_f32);
     assert_eq!(depth_of_vertex_0(f32_stage).to_bits(), expected.to_bits());
     let reference = third * f64::from(p[2]) + 0.1;

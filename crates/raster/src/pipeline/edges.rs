@@ -35,6 +35,10 @@ pub(super) fn per_edge<T>(
 /// interpolated in f64 from the edge values and rounded once to f32; `None` where the depth has
 /// no key (outside `[0, 1]`).
 #[inline]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "depths are f32, as a GPU's; the pixel index is below the viewport's width × height, at most Viewport::MAX_SIDE² = 2^28"
+)]
 pub(super) fn fragment_at(
     prim: u32,
     z: [f64; 3],

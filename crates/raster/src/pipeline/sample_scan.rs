@@ -133,12 +133,13 @@ impl View<'_> {
         let corner = [i64::from(x0) * ONE, i64::from(y0) * ONE];
         let mut row = edges.map(|(p, q)| edge(p, q, corner));
         let area_f = area as f64;
+        let samples = n as usize;
         let (n, width) = (i64::from(n), i64::from(sampling.framebuffer.width));
         let columns = i64::from(rect.x.0)..=i64::from(rect.x.1);
         for y in i64::from(y0)..=i64::from(y1) {
             let mut at_corner = row;
             for x in i64::from(x0)..=i64::from(x1) {
-                for (s, offset) in offsets.iter().enumerate().take(n as usize) {
+                for (s, offset) in offsets.iter().enumerate().take(samples) {
                     let column = x * n + s as i64;
                     let e: [i64; 3] = std::array::from_fn(|k| at_corner[k] + offset[k]);
                     if !columns.contains(&column) || !(0..3).all(|k| e[k] >= threshold[k]) {
@@ -178,6 +179,10 @@ fn sample_pixels(
 /// The first and last pixel in `[first, last]` with a sample offset in `[min_offset,
 /// max_offset]` (1/256 pixel from its corner) that can lie in `[lo, hi]`; with one sample at the
 /// centre, exactly the pixels whose centres lie there.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "both lie in [first, last], u32s, when they are ordered"
+)]
 fn sample_span(
     lo: i64,
     hi: i64,

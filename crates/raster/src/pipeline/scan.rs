@@ -100,8 +100,8 @@ impl View<'_> {
 /// Adds `by` to each edge value of `values`: one step along a row or down a column.
 #[inline]
 fn advance(values: &mut [i64; 3], by: [i64; 3]) {
-    for (value, by) in values.iter_mut().zip(by) {
-        *value += by;
+    for (value, step) in values.iter_mut().zip(by) {
+        *value += step;
     }
 }
 

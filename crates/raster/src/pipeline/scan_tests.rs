@@ -47,6 +47,10 @@ fn scan_every_centre(view: &View<'_>, tri: &ScreenTriangle, rect: PixelRect) -> 
 }
 
 #[test]
+#[expect(
+    clippy::shadow_unrelated,
+    reason = "the loop checks the view and its flipped twin alike"
+)]
 fn the_scan_of_covered_runs_emits_what_testing_every_centre_emits() {
     // Tiny, large and clipped triangles of a soup under both fill rules, on the whole viewport
     // and on tiles misaligned with it, so that runs are cut by every side of a rectangle.
@@ -161,6 +165,10 @@ fn a_box_of_one_centre_on_an_edge_is_decided_by_the_fill_rule() {
 /// largest values the vector lanes hold) and just over it (scanned row by row), in both
 /// orientations, under both fill rules, on the viewport and on rectangles that cut the box.
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the corners are inside the 16384-pixel guard band: their pixels fit u32"
+)]
 fn small_triangles_scanned_as_one_block_emit_what_testing_every_centre_emits() {
     use super::setup::ScanSetup;
     use super::setup::BLOCK_SIDE;

@@ -24,6 +24,10 @@ impl View<'_> {
         let mut rng = SplitMix64::new(seed);
         for i in (1..order.len()).rev() {
             // Multiply-shift rather than `%`: no modulo bias, and the same on every platform.
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "the high word of a u64 times i + 1 is at most i, a usize"
+            )]
             let j = ((u128::from(rng.next_u64()) * (i as u128 + 1)) >> 64) as usize;
             order.swap(i, j);
         }

@@ -86,6 +86,10 @@ fn a_clipped_vertex_lost_to_cancellation_is_clamped_into_the_guard_band() {
 }
 
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the f32 vertex stage's matrix: a GPU's single-precision entries"
+)]
 fn the_written_out_outcode_equals_the_plane_dot_products() {
     let mesh = Mesh {
         positions: vec![],
@@ -188,6 +192,10 @@ fn rounding_without_libm_equals_f64_round() {
     }
     for v in values {
         // NaN goes to the lower bound (`f64::max` takes the number).
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "the bound keeps the value within i32 (ROUNDING_BOUND = 2^30)"
+        )]
         let expected = v.max(-ROUNDING_BOUND).min(ROUNDING_BOUND).round() as i32;
         assert_eq!(round_half_away(v), expected, "{v:e}");
     }
@@ -306,6 +314,10 @@ fn a_triangle_crossing_the_near_plane_is_clipped_not_lost() {
 /// batched, branch-free vertex stage must leave for every vertex inside the guard band, under
 /// every vertex precision, window origin, depth range and a few grids.
 #[test]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "vertex indices of the test scenes fit u32 (the mesh's own indices are u32)"
+)]
 fn the_batched_vertex_stage_equals_rules_1_and_3_vertex_by_vertex() {
     use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
     let scene = crate::Scene::procedural("soup:300:7").unwrap();
@@ -357,6 +369,10 @@ fn the_batched_vertex_stage_equals_rules_1_and_3_vertex_by_vertex() {
 /// The snapped window position and depth of model position `p` under `view`'s conventions,
 /// computed one vertex at a time from `docs/semantics.md` (rules 1 and 3, §9); `None` when the
 /// vertex lies outside the near plane or the guard band, or not in front of the eye.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the f32 stage narrows to f32 as a GPU does, which the expected window repeats; the snapped grid value is within the guard band"
+)]
 fn expected_window(view: &View<'_>, matrix: DMat4, p: [f32; 3]) -> Option<([i64; 2], f64)> {
     use crate::conventions::{DepthRange, VertexPrecision, WindowOrigin};
     let c = view.conventions();
@@ -418,6 +434,7 @@ fn expected_window(view: &View<'_>, matrix: DMat4, p: [f32; 3]) -> Option<([i64;
 /// what rasterizing the same triangles restricted to that tile gives, in the same order: under
 /// both fill rules, per sample, and with tiny, large and clipped triangles.
 #[test]
+#[expect(clippy::shadow_unrelated, reason = "the loop checks each view alike")]
 fn set_up_triangles_scanned_by_tiles_equal_rasterizing_each_tile() {
     let mesh = crate::scenes::triangle_soup(600, 11);
     let lower_left = Conventions {

@@ -160,6 +160,10 @@ impl View<'_> {
     }
 
     /// The vertex stage of this view's camera, viewport and conventions.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the f32 vertex stage's matrix: a GPU's single-precision entries"
+    )]
     pub(super) fn stage(&self) -> VertexStage {
         VertexStage {
             view_projection: self.view_projection,
@@ -202,6 +206,10 @@ const NO_CELLS: CentreCells = [1, 1];
 /// The [`CentreCells`] of a snapped position inside the guard band (|c| < 2^24); any other
 /// position gives some value without overflowing, which no triangle reads.
 #[inline]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "HALF and ONE are 128 and 256 (1/256 pixel), well within i32"
+)]
 fn centre_cells(xy: [i32; 2]) -> CentreCells {
     let cell = |c: i32| {
         let from_centre = c.wrapping_sub(HALF as i32);
@@ -322,6 +330,10 @@ impl VertexStage {
             let results = block_xy.iter().zip(block_outcode);
             for (vertex, (&xy, outcode)) in window[start..end].iter_mut().zip(results) {
                 // Seven bits: lossless.
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "outcodes have seven bits (one per clip plane)"
+                )]
                 let outcode = outcode as u8;
                 *vertex = WindowVertex { xy, outcode };
             }
@@ -418,6 +430,10 @@ pub(super) fn snap(viewport: Viewport, conventions: Conventions, v: DVec4) -> Sn
 /// of `bits` subpixel bits, in `i32`: exact for a vertex inside the guard band (|x|, |y| < 2^24
 /// in 1/256 pixel), some value without overflow for any other, which no triangle reads.
 #[inline]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "the f32 stage narrows the position and the viewport's size to f32 as a GPU does"
+)]
 fn snap_fixed<const F32_STAGE: bool, const LOWER_LEFT: bool, const MINUS_ONE_TO_ONE: bool>(
     viewport: Viewport,
     bits: u32,
@@ -522,6 +538,10 @@ pub(super) fn round_half_away(value: f64) -> i32 {
     let to_even = shifted - SHIFT;
     let tie = value - to_even;
     // The integer's low 32 bits, all it has (|value| ≤ 2^30).
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the integer's low 32 bits, all it has (|value| ≤ 2^30)"
+    )]
     let rounded = shifted.to_bits() as i32;
     // At a tie, to even went toward zero where the value's sign and the tie's agree.
     rounded + i32::from(tie == 0.5 && value > 0.0) - i32::from(tie == -0.5 && value < 0.0)

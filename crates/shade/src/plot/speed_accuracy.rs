@@ -30,6 +30,10 @@ const LEGEND_LINE: i32 = 20;
 ///
 /// # Errors
 /// The file cannot be written.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a plot has a few dozen points and families"
+)]
 pub fn speed_accuracy(
     path: &Path,
     title: &str,
@@ -70,6 +74,10 @@ fn families(points: &[Point]) -> Vec<&'static str> {
 }
 
 impl Paint for SpeedAccuracy<'_> {
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a plot has a few dozen points and families"
+    )]
     fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         root.fill(&WHITE)?;
         let (width, height) = root.dim_in_pixel();

@@ -22,6 +22,10 @@ pub enum KChoice {
 impl KChoice {
     /// The `K` for a scene whose largest per-pixel depth complexity is `max_depth_complexity`;
     /// always at least 1.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a fraction in [0, 1] of max, a u32"
+    )]
     pub fn resolve(self, max_depth_complexity: u32) -> u32 {
         let max = max_depth_complexity;
         match self {

@@ -136,6 +136,10 @@ pub fn random_mesh(max_triangles: usize) -> impl Strategy<Value = Mesh> {
     let max_triangles = max_triangles.max(1);
     ([point(), point(), point()], vec(piece(), 0..max_triangles)).prop_map(|(first, pieces)| {
         let mut mesh = Mesh::default();
+        #[expect(
+            clippy::cast_possible_truncation, clippy::shadow_unrelated,
+            reason = "the closure is handed the mesh it extends; a generated mesh has at most a few thousand vertices"
+        )]
         let push = |mesh: &mut Mesh, points: [[f32; 3]; 3]| {
             let base = mesh.positions.len() as u32;
             mesh.positions.extend(points);
@@ -169,6 +173,10 @@ pub fn random_mesh(max_triangles: usize) -> impl Strategy<Value = Mesh> {
                 Piece::SharedEdge { of, edge, apex } => {
                     let tri = mesh.triangles[of % mesh.triangles.len()];
                     let (i, j) = (tri[edge % 3], tri[(edge + 1) % 3]);
+                    #[expect(
+                        clippy::cast_possible_truncation,
+                        reason = "a generated mesh has at most a few thousand vertices"
+                    )]
                     let k = mesh.positions.len() as u32;
                     mesh.positions.push(apex);
                     // The opposite winding along the shared edge, as in a consistent mesh.
@@ -204,6 +212,10 @@ pub fn random_mesh_in_box(max_triangles: usize) -> impl Strategy<Value = Mesh> {
 
 /// An icosphere of radius 1: the icosahedron subdivided `level` times (20 · 4^level triangles),
 /// vertices shared, closed.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a generated mesh has at most a few thousand vertices; positions are f32, as the mesh stores them"
+)]
 pub fn icosphere(level: u32) -> Mesh {
     let t = (1.0 + 5.0_f64.sqrt()) / 2.0;
     let mut points: Vec<[f64; 3]> = vec![
@@ -277,6 +289,11 @@ pub fn lattice_cube(n: u32, diagonals: &[bool]) -> Mesh {
     let n = n.max(1);
     let mut index: HashMap<[u32; 3], u32> = HashMap::new();
     let mut mesh = Mesh::default();
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::shadow_unrelated,
+        reason = "the closure is handed the mesh it extends; a generated mesh has at most a few thousand vertices"
+    )]
     let mut vertex = |mesh: &mut Mesh, lattice: [u32; 3]| -> u32 {
         *index.entry(lattice).or_insert_with(|| {
             mesh.positions

@@ -51,23 +51,39 @@ pub fn quantize() -> impl Strategy<Value = Quantize> {
 
 /// The snapped fixed-point window x (1/256 pixel) of NDC `x` through the identity camera: the
 /// pipeline's rule 4 (`docs/semantics.md`), restated.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a snapped window x of NDC in [-1, 1] over at most 16384 pixels, far within i64"
+)]
 pub fn snap_ndc_x(x: f32, width: u32) -> i64 {
     let one = f64::from(1_u32 << SUBPIXEL_BITS);
     ((f64::from(x) / 1.0 * 0.5 + 0.5) * f64::from(width) * one).round() as i64
 }
 
 /// The snapped fixed-point window y (1/256 pixel, down) of NDC `y` through the identity camera.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a snapped window y of NDC in [-1, 1] over at most 16384 pixels, far within i64"
+)]
 pub fn snap_ndc_y(y: f32, height: u32) -> i64 {
     let one = f64::from(1_u32 << SUBPIXEL_BITS);
     ((0.5 - f64::from(y) / 1.0 * 0.5) * f64::from(height) * one).round() as i64
 }
 
 /// NDC x of window x (pixels).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "positions are f32, as the mesh stores them"
+)]
 fn ndc_x(x: f64, width: u32) -> f32 {
     (2.0 * x / f64::from(width) - 1.0) as f32
 }
 
 /// NDC y of window y (pixels, down).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "positions are f32, as the mesh stores them"
+)]
 fn ndc_y(y: f64, height: u32) -> f32 {
     (1.0 - 2.0 * y / f64::from(height)) as f32
 }
@@ -113,6 +129,10 @@ impl PlanarTiling {
 
 impl PlanarTiling {
     /// This tiling with every vertex's z moved onto `plane` (rounded to f32).
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "positions are f32, as the mesh stores them"
+    )]
     pub fn on_plane(mut self, plane: DepthPlane) -> Self {
         for p in &mut self.mesh.positions {
             p[2] = plane.at(f64::from(p[0]), f64::from(p[1])) as f32;
@@ -240,6 +260,10 @@ pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
                 let (cell_x, cell_y) = ((x_hi - x_lo) / nx as f64, (y_hi - y_lo) / ny as f64);
                 // One axis of a grid vertex: fixed on the boundary, jittered (and maybe quantized)
                 // inside.
+                #[expect(
+                    clippy::shadow_unrelated,
+                    reason = "each call passes its own axis's jitter"
+                )]
                 let axis = |i: usize, lo: f64, cell: f64, jitter: f64, q: Quantize, side: u32| {
                     let base = lo + i as f64 * cell;
                     let moved = base + jitter * cell;
@@ -267,6 +291,10 @@ pub fn jittered_grid(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> 
                         mesh.positions.push([x, y, z[j * (nx + 1) + i]]);
                     }
                 }
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "a generated mesh has at most a few thousand vertices"
+                )]
                 let at = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
                 for j in 0..ny {
                     for i in 0..nx {
@@ -311,6 +339,7 @@ pub fn fan(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
             ];
             // Points along [lo, hi], quantized but kept inside and in order.
             let along = |lo: f64, hi: f64, points: &[(f64, Quantize)], side: u32| -> Vec<f64> {
+                #[expect(clippy::shadow_unrelated, reason = "each point's own quantization")]
                 let mut out: Vec<f64> = points
                     .iter()
                     .map(|&(t, q)| q.apply(lo + t * (hi - lo), side).clamp(lo, hi))
@@ -365,6 +394,10 @@ pub fn fan(viewport: Viewport) -> impl Strategy<Value = PlanarTiling> {
             for (i, p) in boundary.iter().enumerate() {
                 mesh.positions.push([p[0], p[1], z[(i + 1) % z.len()]]);
             }
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "a generated mesh has at most a few thousand vertices"
+            )]
             let n = boundary.len() as u32;
             for i in 0..n {
                 mesh.triangles.push([0, 1 + i, 1 + (i + 1) % n]);

@@ -112,6 +112,10 @@ impl Chooser {
 
     /// The next thread to step among `threads`, of which those with `walk.is_some()` are active;
     /// `reconverging` says whether a walk stands at a reconvergence point.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "the remainder is below active.len(), a usize"
+    )]
     pub(super) fn choose<S>(
         &mut self,
         threads: &mut [Thread<S>],

@@ -99,8 +99,8 @@ pub(super) fn assemble<S: Scheme>(scheme: &S, tiles: Tiles, resolved: &[Resolved
         let band_entries = band.iter().map(|tile| tile.entries.len()).sum::<usize>();
         let (out_offsets, tail) = rest_offsets.split_at_mut(height * width);
         rest_offsets = tail;
-        let (out_entries, tail) = rest_entries.split_at_mut(band_entries);
-        rest_entries = tail;
+        let (out_entries, entries_tail) = rest_entries.split_at_mut(band_entries);
+        rest_entries = entries_tail;
         work.push((*band, first, height, out_offsets, out_entries));
     }
     work.into_par_iter()
@@ -110,6 +110,7 @@ pub(super) fn assemble<S: Scheme>(scheme: &S, tiles: Tiles, resolved: &[Resolved
     // Overflow counts only where the promise reads them (as the screen-ordered post pass).
     let overflow = if matches!(scheme.promise(), Promise::All(_)) {
         let mut overflow = vec![0; pixels];
+        #[expect(clippy::shadow_unrelated, reason = "each tile's part of `resolved`")]
         for (tile, resolved) in resolved.iter().enumerate() {
             let rect = tiles.rect(tile);
             let tile_width = (rect.x.1 - rect.x.0 + 1) as usize;

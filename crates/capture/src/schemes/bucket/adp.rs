@@ -181,6 +181,10 @@ impl<W: MdtsWord> Adp<W> {
                 while bits != 0 {
                     let j = bits.leading_zeros();
                     bits &= !(0x8000_0000 >> j);
+                    #[expect(
+                        clippy::cast_possible_truncation,
+                        reason = "i is below HISTOGRAM_WORDS, a few words of a u32 subinterval count"
+                    )]
                     let upper = i as u32 * 32 + j + 1;
                     if rank + 1 == first {
                         lower = upper;

@@ -82,6 +82,10 @@ const RANGE_WORDS: usize = 2;
 /// # Panics
 /// If `count` is 0.
 #[must_use]
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "k is floored, at least 0 and at most count - 1 after min; `as` saturates past u32"
+)]
 pub fn subinterval(key: u32, near: u32, far: u32, count: u32) -> u32 {
     assert!(count > 0, "a depth range needs at least one subinterval");
     let depth = |k: u32| f64::from(f32::from_bits(k));
@@ -364,6 +368,10 @@ mod tests {
     use super::*;
 
     #[test]
+    #[expect(
+        clippy::shadow_unrelated,
+        reason = "each loop's `d` is its own case's depth"
+    )]
     fn one_minus_d_does_not_round_trip_but_the_complement_does() {
         let d = 0.1_f32;
         assert_ne!(1.0 - (1.0 - d), d, "1 − d rounds below 0.5");

@@ -247,6 +247,7 @@ mod tests {
                 "{arrival:?}"
             );
             assert_eq!(run.run.stats.counters.dropped, 1, "{arrival:?}");
+            #[expect(clippy::shadow_unrelated, reason = "the next run of the same test")]
             let run = run_fragments_in_order(&unordered, &stream, &arrival, false);
             differ += usize::from(run.run.capture.pixel(0) != first_two.as_slice());
         }

@@ -203,6 +203,10 @@ impl KBufferMultipass {
             }
             count += 1;
         }
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "count is of one pixel's fragments, at most one per triangle, and triangle ids are u32"
+        )]
         WordMemory::<u32>::store(memory, count_word, count as u32);
     }
 
@@ -362,6 +366,10 @@ impl Scheme for KBufferMultipass {
         more
     }
 
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "count is the pixel's u32 counter word"
+    )]
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let count = WordMemory::<u32>::load(memory, self.counter(pixel, 0)) as usize;
         let stored = count.min(self.capacity as usize);

@@ -402,6 +402,7 @@ mod tests {
                 policy,
                 ..lockstep(2)
             };
+            #[expect(clippy::shadow_unrelated, reason = "the next run of the same test")]
             let run = run_fragments(&naive, &same, &schedule, false)
                 .checked()
                 .unwrap();

@@ -206,6 +206,10 @@ impl Snaps {
     /// to the one grid point its domain leaves: an enumerated fragment whose triangle then
     /// covers the centre is certain (unless its depth may leave `[0, 1]`), one whose triangle
     /// does not is no possibility.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a trailing-zero count of a u32 is at most 32"
+    )]
     fn under(&self, precision: &Precision, p: usize, vertices: &[u32], choice: &[u8]) -> Under {
         let point = |v: u32| match vertices.binary_search(&v) {
             Ok(i) => choice[i],

@@ -54,6 +54,10 @@ fn u64s<'d>(dump: &'d Dump, name: &str) -> &'d [u64] {
 
 /// The first stored node covering at least two samples, each certain for its primitive:
 /// its slot, word and mask, and the least highest key of those samples.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry's low half is its primitive id"
+)]
 fn certain_node(dump: &Dump, precision: &Precision, n: usize) -> (usize, u64, u32, u32) {
     let counters = u32s(dump, "counters");
     let nodes = u64s(dump, "nodes");
@@ -111,6 +115,7 @@ fn an_f32_masked_dump_is_equal_per_sample_and_a_dropped_sample_or_a_stray_key_is
             ("a sample dropped", dropped),
             ("a key past its interval", stray),
         ] {
+            #[expect(clippy::shadow_unrelated, reason = "each case's verdict")]
             let judged = bugged
                 .compare_masked_within(&precision, &oracle, &options())
                 .unwrap();
