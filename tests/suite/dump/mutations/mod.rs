@@ -592,24 +592,33 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         format: DepthFormat::F32,
         triangles,
     });
+    let bounds = f32_analysis.bounds();
+    run_battery(
+        &layouts,
+        1000,
+        &format!(
+            "scene: {} fragments, depth complexity up to {}; f32 analysis: vertex error up to \
+             {:.2} subpixels, {} (pixel, triangle) pairs in doubt\n\
+             cells: right/tried exactly, then under f32 precision; =: a conforming change, kept \
+             EQUAL; -: no such mutant in the layout; n/a: not judged so",
+            oracle.fragments(),
+            oracle.max_depth_complexity(),
+            bounds.max_vertex_error_subpixels,
+            bounds.ambiguous_pairs,
+        ),
+    );
+}
+
+/// Runs every kind on every layout (seeded by the layout's index), prints `scene` and the kill
+/// table, and checks that more than `least` mutants were judged, every one as expected.
+fn run_battery(layouts: &[Layout<'_>], least: usize, scene: &str) {
     let (mut tallies, mut wrong) = (Vec::new(), Vec::new());
     for (seed, layout) in layouts.iter().enumerate() {
         run(layout, seed as u64, &mut tallies, &mut wrong);
     }
     let names: Vec<&str> = layouts.iter().map(|l| l.name).collect();
-    let bounds = f32_analysis.bounds();
-    println!(
-        "scene: {} fragments, depth complexity up to {}; f32 analysis: vertex error up to {:.2} \
-         subpixels, {} (pixel, triangle) pairs in doubt\n\
-         cells: right/tried exactly, then under f32 precision; =: a conforming change, kept \
-         EQUAL; -: no such mutant in the layout; n/a: not judged so\n{}",
-        oracle.fragments(),
-        oracle.max_depth_complexity(),
-        bounds.max_vertex_error_subpixels,
-        bounds.ambiguous_pairs,
-        table(&names, &tallies)
-    );
+    println!("{scene}\n{}", table(&names, &tallies));
     let total: usize = tallies.iter().map(|t| t.tried).sum();
-    assert!(total > 1000, "{total} judgements");
+    assert!(total > least, "{total} judgements");
     assert!(wrong.is_empty(), "misjudged mutants: {wrong:#?}");
 }
