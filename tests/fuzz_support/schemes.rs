@@ -10,7 +10,9 @@
 use fragsim::capture::catalog::{Build, Passes, SchemeVisitor, CATALOG};
 use fragsim::capture::executors::frame::{self, Counters, Run};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
-use fragsim::capture::{Capture, Guarantee, Identity, Keeps, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{
+    inputs_of, Capture, Guarantee, Identity, Keeps, Scheme, MEMORY_CAP_DEFAULT,
+};
 use fragsim::memory::SerialMemory;
 use fragsim::raster::{depth_key, Fragment, Viewport};
 
@@ -194,15 +196,16 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
         return;
     }
     let name = scheme.name();
+    // The fragments as the scheme's walks take them (themselves, for a scheme of fragments).
+    let inputs = inputs_of(scheme, case.fragments.iter().copied());
     let memory: SerialMemory = scheme.layout().allocate();
     let (counters, _) = frame::passes(scheme, &memory, |pass| {
-        frame::walks(scheme, &memory, pass, &case.fragments)
+        frame::walks(scheme, &memory, pass, &inputs)
     });
     // A scheme whose second pass would take no fragment is a one-pass scheme; multi-pass schemes
     // count overflow per pass.
     let one_pass = scheme.counts_every_drop()
-        && case
-            .fragments
+        && inputs
             .first()
             .is_none_or(|&f| scheme.begin_pass(1, f).is_none());
     let capture = scheme.resolve(&memory);
@@ -211,7 +214,7 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
     if runs == Runs::SerialOnly {
         return;
     }
-    let Run { capture, stats } = run_fragments(scheme, &case.fragments, &case.schedule, false).run;
+    let Run { capture, stats } = run_fragments(scheme, &inputs, &case.schedule, false).run;
     if one_pass {
         assert_eq!(
             stats.counters.fragments,

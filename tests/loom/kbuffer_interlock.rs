@@ -18,7 +18,7 @@ use super::{explore, fragments, k_best_error, one_pixel, run_threads, Walks, DIS
 /// of `list`, checked by the checker that passes MDTS (`k_best_error`: exactly the `k` nearest
 /// kept, one `Dropped` walk per fragment beyond them). Returns (interleavings, wrong ones, the
 /// most steps a walk took).
-fn model<S: Scheme + 'static>(
+fn model<S: Scheme<Input = Fragment> + 'static>(
     name: &str,
     scheme: S,
     k: u32,

@@ -184,7 +184,7 @@ struct Walks {
 /// `'static`) and the walks' outcomes and step counts.
 fn run_threads<S>(scheme: &'static S, fragments: &[Fragment]) -> (&'static LoomMemory, Walks)
 where
-    S: Scheme + 'static,
+    S: Scheme<Input = Fragment> + 'static,
 {
     let memory: &'static LoomMemory = Box::leak(Box::new(scheme.layout().allocate()));
     let handles: Vec<_> = fragments
@@ -217,7 +217,7 @@ fn run_spinning<S, B, A>(
     after: A,
 ) -> (&'static LoomMemory, Vec<Step>)
 where
-    S: Scheme + 'static,
+    S: Scheme<Input = Fragment> + 'static,
     B: Fn(&S::State) + Copy + Send + 'static,
     A: Fn(&S::State, &S::State) + Copy + Send + 'static,
 {

@@ -55,6 +55,7 @@ impl Table1 {
 
 impl Scheme for Table1 {
     type State = (u32, u32);
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -9,8 +9,10 @@
 use std::path::PathBuf;
 
 use fragsim::capture::catalog::{Count, SchemeRunner, Sizing, CATALOG};
+use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
-use fragsim::capture::schemes::masked_abuffer::MaskedABuffer;
+use fragsim::capture::executors::{run_serial, run_tiled, ParallelExecutor};
+use fragsim::capture::schemes::masked_abuffer::{MaskedABuffer, MaskedStorage};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::samples::SampleOracle;
 use fragsim::oracle::Oracle;
@@ -276,6 +278,75 @@ fn the_masked_node_abuffer_holds_the_per_pixel_view_within_capacity_and_drops_wh
             }
             assert!(oracle.sample_error(&bounded.per_sample()).lost > 0);
         }
+    }
+}
+
+/// The masked-node A-buffer and linked list as schemes on the one frame loop: on the serial,
+/// parallel (small tasks, so that triangles' nodes really interleave on the pool's threads),
+/// tiled and scheduled (random interleaving of 64 walks in flight) executors, the nodes read
+/// back from the per-sample capture equal the per-pixel view of the per-sample oracle, masks
+/// and nearest keys included. The control: a pool one node short of the frame's loses a node,
+/// and the same comparison says so.
+#[test]
+fn the_masked_node_storage_runs_on_every_executor_equal_to_the_per_pixel_view() {
+    let scene = Scene::procedural("bunny-spheres:80:4").unwrap();
+    let view = view_of(&scene, 48, 40.0);
+    let count = 4;
+    let sampled = view
+        .clone()
+        .with_samples(SamplePattern::standard(count).unwrap())
+        .unwrap();
+    let per_pixel = SampleOracle::build(&sampled).unwrap().per_pixel();
+    let deepest = (0..per_pixel.pixels())
+        .map(|p| per_pixel.pixel(p).len())
+        .max()
+        .unwrap();
+    let deepest = u32::try_from(deepest).unwrap();
+    let schedule = Schedule {
+        policy: Policy::Random,
+        in_flight: 64,
+        granularity: Granularity::Fragment,
+        seed: 7,
+    };
+    let runs = |scheme: &MaskedABuffer| {
+        [
+            ("serial", run_serial(&sampled, scheme)),
+            (
+                "parallel",
+                ParallelExecutor::with_task_size(4).run(&sampled, scheme),
+            ),
+            ("tiled", run_tiled(&sampled, scheme)),
+            (
+                "scheduled",
+                run_scheduled(&sampled, scheme, &schedule, false).run,
+            ),
+        ]
+    };
+    let pool = MaskedStorage::Pool(per_pixel.nodes.len());
+    for storage in [MaskedStorage::Slots(deepest), pool] {
+        let scheme =
+            MaskedABuffer::with_storage(view.viewport(), count, storage, MEMORY_CAP_DEFAULT)
+                .unwrap();
+        for (executor, run) in runs(&scheme) {
+            let frame = scheme.masked_frame(&run);
+            assert_eq!(
+                frame.lists.nodes, per_pixel.nodes,
+                "{storage:?} on {executor}"
+            );
+            assert_eq!(frame.lists.offsets, per_pixel.offsets);
+            assert_eq!(
+                (frame.dropped, frame.nodes),
+                (0, per_pixel.nodes.len() as u64)
+            );
+        }
+    }
+    let short = MaskedStorage::Pool(per_pixel.nodes.len() - 1);
+    let scheme =
+        MaskedABuffer::with_storage(view.viewport(), count, short, MEMORY_CAP_DEFAULT).unwrap();
+    for (executor, run) in runs(&scheme) {
+        let frame = scheme.masked_frame(&run);
+        assert_eq!(frame.dropped, 1, "{executor}");
+        assert_ne!(frame.lists.nodes, per_pixel.nodes, "{executor}");
     }
 }
 

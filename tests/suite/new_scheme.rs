@@ -73,6 +73,7 @@ impl FarBuffer {
 
 impl Scheme for FarBuffer {
     type State = FarWalk;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

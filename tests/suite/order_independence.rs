@@ -18,7 +18,7 @@ use fragsim::capture::catalog::{
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::primitive_order::PrimitiveOrder;
-use fragsim::capture::{Capture, Guarantee, Keeps, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::capture::{inputs_of, Capture, Guarantee, Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
 use proptest::prelude::*;
@@ -152,7 +152,8 @@ struct Serially<'a>(&'a [Fragment]);
 impl SchemeVisitor for Serially<'_> {
     type Output = Capture;
     fn visit<S: Scheme>(self, scheme: &S, _: Option<u32>) -> Capture {
-        run_fragments(scheme, self.0, &serial(), false).run.capture
+        let inputs = inputs_of(scheme, self.0.iter().copied());
+        run_fragments(scheme, &inputs, &serial(), false).run.capture
     }
 }
 

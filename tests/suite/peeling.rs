@@ -222,7 +222,7 @@ fn key(depth: f32) -> u64 {
 
 /// Runs `scheme` on a hand-made fragment list under several interleavings; every one must give
 /// the same single-pixel list and pass count, which are returned.
-fn run_by_hand<S: Scheme>(scheme: &S, fragments: &[Fragment]) -> (Vec<u64>, u32) {
+fn run_by_hand<S: Scheme<Input = Fragment>>(scheme: &S, fragments: &[Fragment]) -> (Vec<u64>, u32) {
     let mut result = None;
     for seed in 0..8 {
         let schedule = Schedule {

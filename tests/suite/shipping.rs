@@ -88,7 +88,11 @@ fn viewport(pixels: usize) -> Viewport {
     Viewport::new(pixels as u32, 1).expect("1 to 3 pixels")
 }
 
-fn capture<S: Scheme>(scheme: &S, stream: &Stream, schedule: &Schedule) -> Capture {
+fn capture<S: Scheme<Input = Fragment>>(
+    scheme: &S,
+    stream: &Stream,
+    schedule: &Schedule,
+) -> Capture {
     run_fragments(scheme, &stream.fragments, schedule, false)
         .run
         .capture

@@ -58,6 +58,7 @@ impl DepthCount {
 impl Scheme for DepthCount {
     /// The pixel whose counter the fragment increments.
     type State = u32;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -39,6 +39,8 @@
 //! guarantee.rs    what a scheme guarantees against the oracle
 //! capture.rs      the per-pixel lists a run returns, and what they keep
 //! depth_count.rs  the counting pass that sizes exact storage
+//! walk_input.rs   what a walk starts from: a fragment, or what a scheme gathers from a triangle's
+//!                 fragments (a masked node)
 //! post_pass.rs    the post pass of every executor: empty pixels skipped in bulk, in parallel
 //! primitive_order.rs  each pixel's primitives in submission order (the ordered interlock's)
 //! catalog/        every scheme by name: passes, sizing, dump layout, its constructor (mod.rs),
@@ -88,9 +90,11 @@ mod post_pass;
 pub mod primitive_order;
 mod scheme;
 pub mod schemes;
+mod walk_input;
 
 pub use capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 pub use guarantee::Guarantee;
 pub use scheme::{
     CaptureError, Descriptor, PixelRun, Promise, Scheme, Simt, Step, MEMORY_CAP_DEFAULT,
 };
+pub use walk_input::{inputs_of, WalkInput};

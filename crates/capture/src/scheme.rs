@@ -3,10 +3,10 @@
 use std::fmt::Debug;
 
 use fragsim_memory::{Layout, Memory};
-use fragsim_raster::Fragment;
 
 use crate::capture::{Capacity, Capture, Identity, Keeps};
 use crate::guarantee::Guarantee;
+use crate::walk_input::WalkInput;
 
 /// Default cap on the per-pixel storage a scheme may allocate: 4 GiB.
 pub const MEMORY_CAP_DEFAULT: u64 = 4 << 30;
@@ -174,6 +174,11 @@ pub trait Scheme: Sync {
     /// A fragment's progress between steps.
     type State: Send + Clone + Debug;
 
+    /// What a walk starts from: the rasterizer's [`Fragment`](fragsim_raster::Fragment), or for a scheme whose walks start
+    /// from something gathered from a triangle's fragments (a masked node), that
+    /// ([`WalkInput`]).
+    type Input: WalkInput;
+
     /// What the scheme is: its name, storage, identity, guarantee, promise and pixels, built
     /// once by its constructor. The accessors below read it.
     fn descriptor(&self) -> &Descriptor;
@@ -230,12 +235,18 @@ pub trait Scheme: Sync {
         false
     }
 
+    /// A fresh gathering of the rasterizer's fragments into this scheme's walk inputs, one per
+    /// thread that rasterizes ([`WalkInput::gather`]); the default holds nothing.
+    fn gathering(&self) -> <Self::Input as WalkInput>::Gathering {
+        Default::default()
+    }
+
     /// The state of a fragment before its first step in the first geometry pass.
-    fn begin(&self, fragment: Fragment) -> Self::State;
+    fn begin(&self, fragment: Self::Input) -> Self::State;
 
     /// The state of a fragment before its first step in geometry pass `pass` (from 0), or `None`
     /// when the pass ignores fragments. One-pass schemes need not override it.
-    fn begin_pass(&self, pass: u32, fragment: Fragment) -> Option<Self::State> {
+    fn begin_pass(&self, pass: u32, fragment: Self::Input) -> Option<Self::State> {
         (pass == 0).then(|| self.begin(fragment))
     }
 
@@ -247,7 +258,7 @@ pub trait Scheme: Sync {
     /// before walking them calls it as each is rasterized, so that their cache misses overlap.
     /// No step and no memory operation of the GPU; schemes that do not override it load
     /// nothing ahead.
-    fn prefetch<M: Memory>(&self, fragment: Fragment, memory: &M) {
+    fn prefetch<M: Memory>(&self, fragment: Self::Input, memory: &M) {
         let _ = (fragment, memory);
     }
 
@@ -300,7 +311,7 @@ pub trait Scheme: Sync {
     }
 
     /// Runs one fragment's walk to the end on `memory`, counting the steps into `steps`.
-    fn insert<M: Memory>(&self, fragment: Fragment, memory: &M, steps: &mut u64) -> Step {
+    fn insert<M: Memory>(&self, fragment: Self::Input, memory: &M, steps: &mut u64) -> Step {
         self.insert_state(self.begin(fragment), memory, steps)
     }
 

@@ -9,10 +9,11 @@
 //! `p · capacity + i` (or `i · pixels + p` slot-major, both arrays alike). The header gives
 //! `capacity`, the sample count in `scene.conventions.samples`, and optionally a slot layout
 //! description (`"layout": {"kind": "slots", …}`) whose order and payload the reader turns into
-//! fragsim's words before the scheme's own post pass ([`MaskedABuffer::resolve`]) runs, so that a
+//! fragsim's words before the scheme's own post pass ([`MaskedABuffer::node_lists`]) runs, so that a
 //! dump is decoded exactly as fragsim decodes its own runs.
 
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists};
+use fragsim_capture::Scheme as _;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
 use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::scene_spec::SceneSpec;
@@ -144,7 +145,7 @@ impl Dump {
         for (i, &w) in nodes.iter().enumerate() {
             WordMemory::<u64>::store(&memory, i, w);
         }
-        Ok(scheme.resolve(&memory))
+        Ok(scheme.node_lists(&memory))
     }
 
     fn masked_checked(&self) -> Result<Masked, DumpError> {

@@ -62,7 +62,7 @@ pub fn schedule(seed: u64, threads: usize) -> Schedule {
 
 /// The trace of `fragments` run in `order` (thread `order[i]` takes step `i`).
 #[must_use]
-pub fn record<S: Scheme>(scheme: &S, fragments: &[Fragment], order: &[u32]) -> Trace {
+pub fn record<S: Scheme>(scheme: &S, fragments: &[S::Input], order: &[u32]) -> Trace {
     run_fragments_in_order(scheme, fragments, order, true)
         .trace
         .expect("a recorded run has a trace")
@@ -195,7 +195,7 @@ mod tests {
     }
 
     /// The order seed 1 (PCT) runs.
-    fn schedule_order<S: Scheme>(scheme: &S, fragments: &[Fragment]) -> Vec<u32> {
+    fn schedule_order<S: Scheme<Input = Fragment>>(scheme: &S, fragments: &[Fragment]) -> Vec<u32> {
         let run = fragsim_capture::executors::scheduled::run_fragments(
             scheme,
             fragments,

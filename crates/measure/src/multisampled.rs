@@ -24,6 +24,7 @@
 use fragsim_capture::catalog::{check_memory_cap_early, Count, SchemeName, SchemeRunner, Sizing};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
+use fragsim_capture::Scheme as _;
 use fragsim_oracle::samples::{SampleDeviation, SampleOracle};
 use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
 use fragsim_shade::effects::error_pixels;
@@ -87,7 +88,8 @@ pub struct SampledRow {
     pub memory_bytes: u64,
     /// Bytes per pixel of the render target (all its samples).
     pub bytes_per_pixel: f64,
-    /// Sample fragments rasterized per frame, over all passes.
+    /// Walks per frame, over all passes: sample fragments for per-sample storage, nodes (one
+    /// per pixel a primitive covers: the fragment-shader invocations) for masked storage.
     pub fragments: u64,
     /// What found no room: sample fragments for per-sample storage (beyond K or the capacity,
     /// the oracle's prediction, as `bench` rows count it), whole nodes for masked storage (as its
@@ -407,7 +409,7 @@ fn rows(
             let per_sample = masked.frame.lists.per_sample();
             row(
                 Common {
-                    scheme: masked.name.into(),
+                    scheme: masked.name.clone(),
                     storage: "masked",
                     executor,
                     threads: if parallel {
@@ -422,7 +424,7 @@ fn rows(
                         .map(|c| ms(c.pass_time + c.resolve_time)),
                     slots: masked.slots,
                     memory_bytes: masked.memory_bytes,
-                    fragments: masked.fragments,
+                    fragments: masked.nodes,
                     overflowed: masked.frame.dropped,
                     overflow_unit: "nodes",
                     owed_lost: None,
@@ -470,7 +472,7 @@ impl Bench<'_, '_> {
 /// One frame of masked-node storage, with its counting pass where `--capacity auto`.
 struct MaskedRun {
     /// `abuffer-masked` or `linked-list-masked`.
-    name: &'static str,
+    name: String,
     /// The counting pass of nodes, where one sized the storage.
     count: Option<MaskedFrame>,
     /// The capture.
@@ -480,8 +482,9 @@ struct MaskedRun {
     /// Bytes of the capture's storage (the counting pass needs one counter a pixel, which a GPU
     /// clears and reuses as the capture's).
     memory_bytes: u64,
-    /// Sample fragments rasterized, over both passes.
-    fragments: u64,
+    /// Nodes walked (fragment-shader invocations, one per pixel a primitive covers), over both
+    /// passes.
+    nodes: u64,
 }
 
 impl MaskedRun {
@@ -542,7 +545,7 @@ fn masked_frame(
         name: scheme.name(),
         slots,
         memory_bytes: scheme.layout().bytes(),
-        fragments: frame.fragments + count.as_ref().map_or(0, |c| c.fragments),
+        nodes: frame.nodes + count.as_ref().map_or(0, |c| c.nodes),
         count,
         frame,
     })

@@ -109,7 +109,11 @@ fn one_pixel(depths: &[f32]) -> Vec<Fragment> {
 }
 
 /// The capture's depths at pixel 0 after a run on `fragments` under a random schedule.
-fn captured_depths<S: Scheme>(scheme: &S, fragments: &[Fragment], seed: u64) -> (Vec<f32>, u32) {
+fn captured_depths<S: Scheme<Input = Fragment>>(
+    scheme: &S,
+    fragments: &[Fragment],
+    seed: u64,
+) -> (Vec<f32>, u32) {
     let schedule = Schedule {
         policy: Policy::Random,
         in_flight: fragments.len(),

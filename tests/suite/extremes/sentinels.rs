@@ -219,6 +219,7 @@ struct Table1Walk {
 
 impl Scheme for Table1Mdts {
     type State = Table1Walk;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

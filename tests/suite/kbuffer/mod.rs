@@ -53,7 +53,7 @@ pub(super) fn one_pixel_quads(scene: &Scene) -> (View<'_>, Vec<Fragment>) {
 
 /// Runs a hand-written interleaving: `script[i]` names the fragment whose walk takes the i-th
 /// step. Every walk must be over when the script ends.
-pub(super) fn drive<S: Scheme>(
+pub(super) fn drive<S: Scheme<Input = Fragment>>(
     scheme: &S,
     memory: &SerialMemory,
     walks: &[Fragment],
@@ -72,7 +72,7 @@ pub(super) fn drive<S: Scheme>(
 
 /// Runs one pass of a multi-pass scheme over `all`, interleaving the walks as `pick` chooses among
 /// the unfinished ones, then the between-pass kernel; returns whether another pass is needed.
-pub(super) fn drive_pass<S: Scheme>(
+pub(super) fn drive_pass<S: Scheme<Input = Fragment>>(
     scheme: &S,
     memory: &SerialMemory,
     pass: u32,

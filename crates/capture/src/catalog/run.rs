@@ -9,9 +9,9 @@ use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use crate::primitive_order::PrimitiveOrder;
-use crate::{CaptureError, Descriptor, Guarantee, Scheme, Step};
+use crate::{CaptureError, Descriptor, Guarantee, Scheme, Step, WalkInput};
 use fragsim_memory::{Memory, WordMemory};
-use fragsim_raster::{Fragment, View, Viewport};
+use fragsim_raster::{View, Viewport};
 use std::sync::Mutex;
 
 /// Why a catalog scheme could not be run ([`SchemeRunner::run`]) or is refused before any run
@@ -335,6 +335,7 @@ struct Instrumented<'a, S> {
 
 impl<S: Scheme> Scheme for Instrumented<'_, S> {
     type State = S::State;
+    type Input = S::Input;
 
     fn descriptor(&self) -> &Descriptor {
         self.scheme.descriptor()
@@ -343,14 +344,23 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
         // The memory kept for a dump is read in the layout it declares, screen-ordered.
         self.keep.is_none() && self.scheme.tile_local()
     }
-    fn begin(&self, fragment: Fragment) -> S::State {
-        self.scheme.begin(fragment)
+    fn gathering(&self) -> <S::Input as WalkInput>::Gathering {
+        self.scheme.gathering()
     }
-    fn begin_pass(&self, pass: u32, fragment: Fragment) -> Option<S::State> {
-        self.scheme.begin_pass(pass, fragment)
+    fn begin(&self, input: S::Input) -> S::State {
+        self.scheme.begin(input)
+    }
+    fn begin_pass(&self, pass: u32, input: S::Input) -> Option<S::State> {
+        self.scheme.begin_pass(pass, input)
     }
     fn step<M: Memory>(&self, state: &mut S::State, memory: &M) -> Step {
         self.scheme.step(state, memory)
+    }
+    fn prefetch<M: Memory>(&self, input: S::Input, memory: &M) {
+        self.scheme.prefetch(input, memory);
+    }
+    fn insert_state<M: Memory>(&self, state: S::State, memory: &M, steps: &mut u64) -> Step {
+        self.scheme.insert_state(state, memory, steps)
     }
     fn simt(&self, state: &S::State) -> crate::Simt {
         self.scheme.simt(state)
@@ -363,6 +373,13 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
             }
         }
         more
+    }
+    fn pixel_run<M: Memory>(&self, memory: &M, pixel: usize, end: usize) -> crate::PixelRun {
+        // The miscounted pixel is resolved on its own, so that its count is the one altered.
+        match self.scheme.pixel_run(memory, pixel, end) {
+            crate::PixelRun::Empty(_) if self.miscount && pixel == 0 => crate::PixelRun::Resolve(1),
+            run => run,
+        }
     }
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
         let overflow = self.scheme.resolve_pixel(memory, pixel, out);

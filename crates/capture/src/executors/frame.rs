@@ -16,10 +16,11 @@
 use std::time::{Duration, Instant};
 
 use fragsim_memory::{AtomicMemory, Layout, Memory, SerialMemory};
-use fragsim_raster::{Fragment, PixelRect, View};
+use fragsim_raster::{PixelRect, View};
 
 use crate::capture::Capture;
 use crate::scheme::{Scheme, Step};
+use crate::walk_input::WalkInput;
 
 /// Counts of what a pass did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -209,7 +210,7 @@ pub fn walk<S: Scheme, M: Memory>(
     scheme: &S,
     memory: &M,
     pass: u32,
-    fragment: Fragment,
+    fragment: S::Input,
     counters: &mut Counters,
 ) {
     if let Some(state) = scheme.begin_pass(pass, fragment) {
@@ -224,7 +225,7 @@ pub fn walks<S: Scheme, M: Memory>(
     scheme: &S,
     memory: &M,
     pass: u32,
-    fragments: &[Fragment],
+    fragments: &[S::Input],
 ) -> Counters {
     let mut counters = Counters::default();
     for &fragment in fragments {
@@ -244,7 +245,7 @@ pub fn interleaved<S: Scheme, M: Memory>(
     scheme: &S,
     memory: &M,
     pass: u32,
-    fragments: &[Fragment],
+    fragments: &[S::Input],
     mut pick: impl FnMut(&[usize]) -> usize,
 ) -> Counters {
     let mut counters = Counters::default();
@@ -276,9 +277,10 @@ pub fn interleaved<S: Scheme, M: Memory>(
 const FRAGMENTS_AHEAD: usize = 32;
 
 /// Rasterizes the pixels of `rect` that the triangles `prims` cover, triangle after triangle in
-/// the order given ([`View::rasterize_each_in`]), and runs each fragment's walk of geometry pass
-/// `pass` to its end, in the order rasterized, [`FRAGMENTS_AHEAD`] fragments after it is
-/// rasterized (the first pass's fragments loaded ahead).
+/// the order given ([`View::rasterize_each_in`]), gathers the fragments into the scheme's walk
+/// inputs ([`WalkInput::gather`]: the fragments themselves, for every scheme that walks
+/// fragments), and runs each input's walk of geometry pass `pass` to its end, in that order,
+/// [`FRAGMENTS_AHEAD`] inputs after it is gathered (the first pass's inputs loaded ahead).
 pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
     view: &View<'_>,
     scheme: &S,
@@ -288,19 +290,58 @@ pub(crate) fn rasterize_into<S: Scheme, M: Memory>(
     rect: PixelRect,
     counters: &mut Counters,
 ) {
-    let mut ahead = [None; FRAGMENTS_AHEAD];
-    let mut next = 0;
+    let mut ahead = Ahead::new(scheme, memory, pass);
+    let mut gathering = scheme.gathering();
     view.rasterize_each_in(prims, rect, &mut |fragment| {
-        if pass == 0 {
-            scheme.prefetch(fragment, memory);
-        }
-        if let Some(earlier) = ahead[next].replace(fragment) {
-            walk(scheme, memory, pass, earlier, counters);
-        }
-        next = (next + 1) % FRAGMENTS_AHEAD;
+        S::Input::gather(&mut gathering, fragment, &mut |input| {
+            ahead.push(input, counters);
+        });
     });
-    for fragment in ahead[next..].iter().chain(&ahead[..next]).flatten() {
-        walk(scheme, memory, pass, *fragment, counters);
+    S::Input::flush(&mut gathering, &mut |input| ahead.push(input, counters));
+    ahead.finish(counters);
+}
+
+/// The walks of one thread's stream of inputs, each run [`FRAGMENTS_AHEAD`] inputs after it
+/// came, its first words loaded as it came (in the first pass).
+pub(crate) struct Ahead<'a, S: Scheme, M> {
+    scheme: &'a S,
+    memory: &'a M,
+    pass: u32,
+    ring: [Option<S::Input>; FRAGMENTS_AHEAD],
+    next: usize,
+}
+
+impl<'a, S: Scheme, M: Memory> Ahead<'a, S, M> {
+    /// No input yet, for geometry pass `pass` of `scheme` on `memory`.
+    pub(crate) fn new(scheme: &'a S, memory: &'a M, pass: u32) -> Self {
+        Self {
+            scheme,
+            memory,
+            pass,
+            ring: [None; FRAGMENTS_AHEAD],
+            next: 0,
+        }
+    }
+
+    /// Takes `input`, loading its first words ahead, and runs the walk of the input that came
+    /// [`FRAGMENTS_AHEAD`] before it, counting it into `counters`.
+    #[inline]
+    pub(crate) fn push(&mut self, input: S::Input, counters: &mut Counters) {
+        if self.pass == 0 {
+            self.scheme.prefetch(input, self.memory);
+        }
+        if let Some(earlier) = self.ring[self.next].replace(input) {
+            walk(self.scheme, self.memory, self.pass, earlier, counters);
+        }
+        self.next = (self.next + 1) % FRAGMENTS_AHEAD;
+    }
+
+    /// Runs the walks still waiting, in the order they came.
+    pub(crate) fn finish(self, counters: &mut Counters) {
+        let (later, earlier) = self.ring.split_at(self.next);
+        for input in earlier.iter().chain(later).flatten() {
+            walk(self.scheme, self.memory, self.pass, *input, counters);
+        }
     }
 }
 
@@ -360,6 +401,7 @@ mod tests {
     use crate::schemes::peeling::DepthPeeling;
     use crate::MEMORY_CAP_DEFAULT;
     use fragsim_memory::WordMemory;
+    use fragsim_raster::Fragment;
 
     /// The view's fragments in submission order.
     fn fragments(view: &View<'_>) -> Vec<Fragment> {

@@ -42,10 +42,11 @@ use std::collections::VecDeque;
 use std::time::Instant;
 
 use fragsim_memory::{RecordingMemory, SerialMemory};
-use fragsim_raster::{Fragment, View};
+use fragsim_raster::View;
 
 use super::frame::{self, Counters, Run};
 use crate::scheme::{Scheme, Simt, Step};
+use crate::walk_input::{inputs_of, WalkInput};
 use policy::Chooser;
 pub use policy::{Granularity, Policy, Schedule, WARP_LANES};
 pub use trace::Trace;
@@ -149,9 +150,9 @@ impl ScheduledRun {
 }
 
 /// One logical thread: its current walk and the fragments still queued for it.
-struct Thread<S> {
-    walk: Option<(S, Fragment, u64)>,
-    queue: VecDeque<(Fragment, u64)>,
+struct Thread<S, I> {
+    walk: Option<(S, I, u64)>,
+    queue: VecDeque<(I, u64)>,
     priority: u64,
 }
 
@@ -168,7 +169,7 @@ pub fn run_scheduled<S: Scheme>(
     let fragments_of = |index: u32| {
         let mut list = Vec::new();
         view.rasterize(view.submitted(index), &mut |f| list.push(f));
-        list
+        inputs_of(scheme, list)
     };
     run_stream(
         scheme,
@@ -187,7 +188,7 @@ pub fn run_scheduled<S: Scheme>(
 )]
 pub fn run_fragments<S: Scheme>(
     scheme: &S,
-    fragments: &[Fragment],
+    fragments: &[S::Input],
     schedule: &Schedule,
     record: bool,
 ) -> ScheduledRun {
@@ -214,7 +215,7 @@ pub fn run_fragments<S: Scheme>(
 )]
 pub fn run_fragments_in_order<S: Scheme>(
     scheme: &S,
-    fragments: &[Fragment],
+    fragments: &[S::Input],
     order: &[u32],
     record: bool,
 ) -> ScheduledRun {
@@ -237,7 +238,7 @@ pub fn run_fragments_in_order<S: Scheme>(
 fn run_stream<S: Scheme>(
     scheme: &S,
     triangles: u32,
-    fragments_of: impl Fn(u32) -> Vec<Fragment>,
+    fragments_of: impl Fn(u32) -> Vec<S::Input>,
     schedule: &Schedule,
     order: Option<&[u32]>,
     record: bool,
@@ -296,7 +297,7 @@ fn run_pass<S: Scheme>(
     memory: &RecordingMemory,
     pass: u32,
     triangles: u32,
-    fragments_of: &impl Fn(u32) -> Vec<Fragment>,
+    fragments_of: &impl Fn(u32) -> Vec<S::Input>,
     schedule: &Schedule,
     chooser: &mut Chooser,
     first_step: u64,
@@ -304,9 +305,9 @@ fn run_pass<S: Scheme>(
     let mut counters = Counters::default();
     let mut next_triangle = 0_u32;
     let mut next_fragment_index = 0_u64;
-    let mut pending: VecDeque<(Fragment, u64)> = VecDeque::new();
+    let mut pending: VecDeque<(S::Input, u64)> = VecDeque::new();
     // Hands a thread its next unit of work: a fragment, or a whole triangle's fragments.
-    let mut refill = |queue: &mut VecDeque<(Fragment, u64)>| -> bool {
+    let mut refill = |queue: &mut VecDeque<(S::Input, u64)>| -> bool {
         loop {
             match schedule.granularity {
                 Granularity::Fragment => {
@@ -335,7 +336,7 @@ fn run_pass<S: Scheme>(
             }
         }
     };
-    let mut threads: Vec<Thread<S::State>> = Vec::with_capacity(schedule.in_flight);
+    let mut threads: Vec<Thread<S::State, S::Input>> = Vec::with_capacity(schedule.in_flight);
     let mut active: Vec<usize> = Vec::with_capacity(schedule.in_flight);
     for t in 0..schedule.in_flight {
         let priority = chooser.fresh_priority();
@@ -359,7 +360,7 @@ fn run_pass<S: Scheme>(
             clippy::cast_possible_truncation,
             reason = "thread indices are u32 in traces; a schedule has a warp's few threads"
         )]
-        memory.set_context(step, t as u32, *index, fragment.pixel, pass);
+        memory.set_context(step, t as u32, *index, fragment.pixel(), pass);
         step += 1;
         counters.steps += 1;
         let outcome = scheme.step(state, memory);
@@ -382,7 +383,7 @@ fn run_pass<S: Scheme>(
                             .map(|(state, fragment, index)| StuckLane {
                                 thread: t as u32,
                                 fragment: *index,
-                                pixel: fragment.pixel,
+                                pixel: fragment.pixel(),
                                 simt: scheme.simt(state),
                             })
                     })
@@ -422,8 +423,8 @@ fn run_pass<S: Scheme>(
 fn start_next_walk<S: Scheme>(
     scheme: &S,
     pass: u32,
-    thread: &mut Thread<S::State>,
-    refill: &mut impl FnMut(&mut VecDeque<(Fragment, u64)>) -> bool,
+    thread: &mut Thread<S::State, S::Input>,
+    refill: &mut impl FnMut(&mut VecDeque<(S::Input, u64)>) -> bool,
 ) -> bool {
     loop {
         if thread.queue.is_empty() && !refill(&mut thread.queue) {

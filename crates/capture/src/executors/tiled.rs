@@ -40,6 +40,7 @@ use super::frame::{self, reuse_storage, walk, Counters, Run};
 use super::parallel::rayon_frame;
 use crate::post_pass::{resolve_range, Resolved};
 use crate::scheme::{Scheme, MEMORY_CAP_DEFAULT};
+use crate::walk_input::WalkInput;
 
 mod storage;
 
@@ -219,9 +220,9 @@ struct TileFragments<'a, 'v> {
 }
 
 impl TileFragments<'_, '_> {
-    /// Scans tile `tile`'s records, chunk after chunk, and runs each fragment's walk of pass
-    /// `pass` to its end, the fragment's pixel given to the scheme as `index(pixel)` (its
-    /// storage index), counting into `counters`.
+    /// Scans tile `tile`'s records, chunk after chunk, and runs the walk of pass `pass` of each
+    /// input gathered from its fragments to its end, each fragment's pixel given to the scheme
+    /// as `index(pixel)` (its storage index), counting into `counters`.
     fn walk<S: Scheme>(
         self,
         tile: usize,
@@ -232,15 +233,18 @@ impl TileFragments<'_, '_> {
         counters: &mut Counters,
     ) {
         let rect = self.tiles.rect(tile);
+        let mut gathering = scheme.gathering();
+        let mut run = |input| walk(scheme, memory, pass, input, counters);
         for setup in self.chunks.iter().flat_map(|chunk| chunk.list(tile)) {
             self.view.scan_within(setup, rect, &mut |fragment| {
                 let stored = Fragment {
                     pixel: index(fragment.pixel),
                     ..fragment
                 };
-                walk(scheme, memory, pass, stored, counters);
+                S::Input::gather(&mut gathering, stored, &mut run);
             });
         }
+        S::Input::flush(&mut gathering, &mut run);
     }
 }
 

@@ -190,6 +190,7 @@ impl ABuffer {
 
 impl Scheme for ABuffer {
     type State = Claim;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

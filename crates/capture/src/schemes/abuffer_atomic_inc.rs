@@ -93,6 +93,7 @@ impl ABufferAtomicInc {
 
 impl Scheme for ABufferAtomicInc {
     type State = Claim;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor
@@ -153,7 +154,7 @@ mod tests {
 
     /// `n` fragments on one pixel, depths ascending, inserted in order; the kept list, the
     /// reported overflow and the walks that ended in a drop.
-    fn one_pixel<S: Scheme>(scheme: &S, n: u32) -> (Vec<u64>, u32, u32) {
+    fn one_pixel<S: Scheme<Input = Fragment>>(scheme: &S, n: u32) -> (Vec<u64>, u32, u32) {
         let memory: SerialMemory = scheme.layout().allocate();
         let (mut steps, mut dropped) = (0, 0);
         for prim in 0..n {

@@ -153,6 +153,7 @@ fn complement<W: Word>(value: W) -> W {
 
 impl<W: MdtsWord> Scheme for DualDepthPeeling<W> {
     type State = DualPeel<W>;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         self.storage.descriptor()

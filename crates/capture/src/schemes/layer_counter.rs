@@ -104,6 +104,7 @@ impl LayerCounter {
 
 impl Scheme for LayerCounter {
     type State = LayerStep;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -163,6 +163,7 @@ impl LinkedList {
 
 impl Scheme for LinkedList {
     type State = Node;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

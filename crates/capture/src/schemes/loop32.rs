@@ -179,6 +179,7 @@ impl Loop32 {
 
 impl Scheme for Loop32 {
     type State = Loop32Step;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

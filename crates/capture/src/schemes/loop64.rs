@@ -119,6 +119,7 @@ impl Loop64 {
 
 impl Scheme for Loop64 {
     type State = Loop64Step;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -34,153 +34,44 @@
 //! counter, and per pool node a `u64` word, a `u32` mask and a `u32` next: `4 + 16 × nodes` bytes
 //! a pixel for a pool of `nodes` a pixel.
 //!
-//! **Departures.** It is not a [`Scheme`](crate::Scheme): its walks start from merged nodes, not
-//! from the rasterizer's fragments, so it runs its own serial and parallel loops over the view's
-//! triangles ([`MaskedABuffer::capture`]), on the same [`Memory`] seam, three operations a node
-//! (the linked list: five).
+//! **As a [`Scheme`].** Its walks start from merged nodes, not from the rasterizer's fragments:
+//! its [`Scheme::Input`] is a [`PixelNode`], which every executor gathers from a triangle's
+//! per-sample fragments ([`Merging`], the one frame loop's [`WalkInput`] hook), so it runs on
+//! the serial, parallel, tiled and scheduled executors like any scheme, one memory operation a
+//! step: three a node (claim the slot, store the word, store the mask), five in the linked list
+//! (claim the node, exchange the head, store the word, the `next` and the mask). Its capture
+//! covers the sample-expanded framebuffer, as every scheme's does at more than one sample: the
+//! per-sample resolve, each sample's list the nodes whose mask holds it, keyed by the node's
+//! depth. [`MaskedLists::from_per_sample`] reads the node lists back from it, masks included.
+//! The A-buffer reports a pixel's dropped nodes on its first sample.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use fragsim_memory::{AtomicMemory, Layout, Memory, SerialMemory, WordMemory};
-use fragsim_raster::{Fragment, View, Viewport};
-use rayon::prelude::*;
+use fragsim_memory::{Layout, Memory, WordMemory};
+use fragsim_raster::{View, Viewport};
 
-use crate::capture::PixelLists;
-use crate::scheme::CaptureError;
+use crate::capture::{Capacity, Identity};
+use crate::executors::{run_parallel, run_serial, serial_passes, Run};
+use crate::guarantee::Guarantee;
+use crate::scheme::{CaptureError, Descriptor, Promise, Scheme, Step};
+use crate::walk_input::WalkInput;
 
-/// One primitive's coverage of one pixel: its nearest depth key over the samples it covers, and
-/// the mask of those samples (bit `s`: sample `s`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct MaskedNode {
-    /// The smallest depth key of the primitive's samples in the pixel.
-    pub depth_key: u32,
-    /// Primitive id.
-    pub prim: u32,
-    /// Covered samples.
-    pub mask: u32,
-}
+mod nodes;
 
-impl MaskedNode {
-    /// The node's identity in the canonical packing: depth key high, primitive id low.
-    #[must_use]
-    pub fn packed(self) -> u64 {
-        (u64::from(self.depth_key) << 32) | u64::from(self.prim)
-    }
-}
-
-/// Merges per-sample fragments (their `pixel` a sample index of `samples` samples a pixel) into
-/// one node per pixel and primitive; calls `emit(pixel, node)` in `(pixel, primitive)` order.
-/// Sorts `fragments` in place.
-pub fn merge_samples(
-    samples: u32,
-    fragments: &mut [Fragment],
-    emit: &mut impl FnMut(u32, MaskedNode),
-) {
-    fragments.sort_unstable_by_key(|f| (f.pixel / samples, f.prim, f.depth_key));
-    let mut rest = &*fragments;
-    while let Some(first) = rest.first() {
-        let (pixel, prim) = (first.pixel / samples, first.prim);
-        let same = rest
-            .iter()
-            .take_while(|f| f.pixel / samples == pixel && f.prim == prim)
-            .count();
-        let mask = rest[..same]
-            .iter()
-            .fold(0_u32, |mask, f| mask | 1 << (f.pixel % samples));
-        // Sorted by depth key within the group: the first is the nearest.
-        emit(
-            pixel,
-            MaskedNode {
-                depth_key: first.depth_key,
-                prim,
-                mask,
-            },
-        );
-        rest = &rest[same..];
-    }
-}
-
-/// Every pixel's nodes in `(depth key, primitive id)` order, with the nodes each pixel dropped.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct MaskedLists {
-    /// Samples a pixel.
-    pub samples: u32,
-    /// `offsets[p]..offsets[p + 1]` are pixel `p`'s nodes.
-    pub offsets: Vec<usize>,
-    /// The nodes of every pixel.
-    pub nodes: Vec<MaskedNode>,
-    /// Nodes each pixel dropped for lack of storage, where the storage counts them per pixel
-    /// (the A-buffer's counters); all 0 for an oracle's view and for a pool's lists, whose one
-    /// counter counts them in all ([`MaskedFrame::dropped`]).
-    pub overflow: Vec<u32>,
-}
-
-impl MaskedLists {
-    /// Pixel `p`'s nodes.
-    #[must_use]
-    pub fn pixel(&self, p: usize) -> &[MaskedNode] {
-        &self.nodes[self.offsets[p]..self.offsets[p + 1]]
-    }
-
-    /// Number of pixels.
-    #[must_use]
-    pub fn pixels(&self) -> usize {
-        self.offsets.len() - 1
-    }
-
-    /// The lists of `nodes` (pixel, node) in any order over `pixels` pixels, sorted.
-    #[must_use]
-    pub fn from_nodes(samples: u32, pixels: usize, mut nodes: Vec<(u32, MaskedNode)>) -> Self {
-        nodes.sort_unstable_by_key(|&(pixel, node)| (pixel, node.packed()));
-        let mut offsets = Vec::with_capacity(pixels + 1);
-        offsets.push(0);
-        let mut at = 0;
-        #[expect(
-            clippy::cast_possible_truncation,
-            reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
-        )]
-        for pixel in 0..pixels as u32 {
-            while at < nodes.len() && nodes[at].0 == pixel {
-                at += 1;
-            }
-            offsets.push(at);
-        }
-        Self {
-            samples,
-            offsets,
-            nodes: nodes.into_iter().map(|(_, node)| node).collect(),
-            overflow: vec![0; pixels],
-        }
-    }
-
-    /// The resolve per sample: each sample's list (indexed by sample index, as a per-sample
-    /// oracle's) holds the nodes whose mask covers it, in node order, each packed with the node's
-    /// depth key. What a per-sample blend reads, and what is compared with the per-sample oracle.
-    #[must_use]
-    pub fn per_sample(&self) -> PixelLists {
-        let mut lists = PixelLists::with_pixels(self.pixels() * self.samples as usize);
-        for p in 0..self.pixels() {
-            for s in 0..self.samples {
-                let covering = self.pixel(p).iter().filter(|n| n.mask >> s & 1 == 1);
-                lists.push_pixel(covering.map(|n| n.packed()));
-            }
-        }
-        lists
-    }
-}
+pub use nodes::{merge_samples, MaskedLists, MaskedNode, Merging, PixelNode};
 
 /// One timed frame of a [`MaskedABuffer`].
 #[derive(Clone, Debug)]
 pub struct MaskedFrame {
     /// The sorted node lists, with each pixel's dropped nodes.
     pub lists: MaskedLists,
-    /// Sample fragments rasterized (before merging).
-    pub fragments: u64,
-    /// Nodes dropped for lack of storage, as the counters counted them.
+    /// Nodes walked: the fragment-shader invocations, one per pixel a primitive covers.
+    pub nodes: u64,
+    /// Nodes dropped for lack of storage, as the walks ended.
     pub dropped: u64,
-    /// The geometry pass: storage allocation, rasterization per sample, merging, insertion.
+    /// The geometry pass: storage initialisation, rasterization per sample, merging, insertion.
     pub pass_time: Duration,
-    /// The post pass: every pixel's stored nodes read back and sorted.
+    /// The post pass: every sample's list read back from its pixel's nodes and sorted.
     pub resolve_time: Duration,
 }
 
@@ -201,6 +92,22 @@ pub struct MaskedABuffer {
     pixels: usize,
     samples: u32,
     storage: MaskedStorage,
+    descriptor: Descriptor,
+}
+
+/// Where a node's walk stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeWalk {
+    /// Claims a slot from the pixel's counter, or a pool node from the global counter.
+    Claim(PixelNode),
+    /// Exchanges the pixel's head for pool node `index` (numbered from 1 in the heads).
+    Link(PixelNode, usize),
+    /// Stores the node's word at `index`; then its `next` (`Some`: the linked list's old head).
+    Word(PixelNode, usize, Option<u32>),
+    /// Stores the linked list's `next` of node `index`.
+    Next(PixelNode, usize, u32),
+    /// Stores the mask of the node at `index`: the last step.
+    Mask(PixelNode, usize),
 }
 
 impl MaskedABuffer {
@@ -243,20 +150,13 @@ impl MaskedABuffer {
             }
             _ => {}
         }
-        if !(1..=32).contains(&samples) {
-            return Err(CaptureError::BadParameter(format!(
-                "{samples} samples per pixel: a coverage mask holds 1 to 32"
-            )));
-        }
-        let scheme = Self {
-            pixels: pixels.pixels(),
-            samples,
-            storage,
-        };
+        let scheme = Self::built(pixels.pixels(), samples, storage)?;
+        // Every word is checked, not only the tables (`Descriptor::within`): the nodes are
+        // few beside a per-sample scheme's, and the run and the dump both write them all.
         let needed = scheme.layout().bytes();
         if needed > memory_cap {
             return Err(CaptureError::TooMuchMemory {
-                scheme: scheme.name().into(),
+                scheme: scheme.name(),
                 needed,
                 cap: memory_cap,
             });
@@ -264,13 +164,44 @@ impl MaskedABuffer {
         Ok(scheme)
     }
 
-    /// `abuffer-masked` or `linked-list-masked`, as `bench --samples` names the rows.
-    #[must_use]
-    pub fn name(&self) -> &'static str {
-        match self.storage {
-            MaskedStorage::Slots(_) => "abuffer-masked",
-            MaskedStorage::Pool(_) => "linked-list-masked",
+    /// The scheme, its storage unchecked but for the sample count.
+    fn built(pixels: usize, samples: u32, storage: MaskedStorage) -> Result<Self, CaptureError> {
+        if !(1..=32).contains(&samples) {
+            return Err(CaptureError::BadParameter(format!(
+                "{samples} samples per pixel: a coverage mask holds 1 to 32"
+            )));
         }
+        let (name, layout, guarantee) = match storage {
+            MaskedStorage::Slots(capacity) => {
+                let slots = pixels * capacity as usize;
+                (
+                    "abuffer-masked",
+                    Layout::counters_and_slots(pixels + slots, slots),
+                    Guarantee::ExactWithinCapacity(capacity),
+                )
+            }
+            MaskedStorage::Pool(nodes) => (
+                "linked-list-masked",
+                Layout::counters_and_slots(pixels + 1 + 2 * nodes, nodes),
+                Guarantee::Exact,
+            ),
+        };
+        Ok(Self {
+            pixels,
+            samples,
+            storage,
+            descriptor: Descriptor {
+                name: name.into(),
+                layout,
+                identity: Identity::KeyAndPrim,
+                guarantee,
+                // Judged against the per-sample oracle with each primitive's samples in a pixel
+                // merged (`fragsim_oracle::SampleOracle::per_pixel`), while the nodes fit.
+                promise: Promise::All(Capacity::Unbounded),
+                pixels: pixels * samples as usize,
+                counts_every_drop: true,
+            },
+        })
     }
 
     /// Where the nodes are kept.
@@ -279,19 +210,10 @@ impl MaskedABuffer {
         self.storage
     }
 
-    /// The words. The A-buffer: `u32` counters then masks, `u64` node words. The linked list:
-    /// `u32` heads, the counter, the nodes' `next` then their masks, `u64` node words.
+    /// Samples a pixel.
     #[must_use]
-    pub fn layout(&self) -> Layout {
-        match self.storage {
-            MaskedStorage::Slots(capacity) => {
-                let slots = self.pixels * capacity as usize;
-                Layout::counters_and_slots(self.pixels + slots, slots)
-            }
-            MaskedStorage::Pool(nodes) => {
-                Layout::counters_and_slots(self.pixels + 1 + 2 * nodes, nodes)
-            }
-        }
+    pub fn samples(&self) -> u32 {
+        self.samples
     }
 
     /// The linked list's global counter (the `u32` word after the heads); node `i` (0-based)'s
@@ -300,41 +222,17 @@ impl MaskedABuffer {
         self.pixels
     }
 
-    /// Inserts `node` into pixel `pixel`. The A-buffer: `fetch_add` on the pixel's counter, then
-    /// the word and the mask into the slot it handed out. The linked list: `fetch_add` on the
-    /// global counter, the exchange of the pixel's head for the node (numbered from 1: 0 ends a
-    /// list), then the word, the mask and the old head as `next`. Returns whether the node was
-    /// stored (else it was dropped, and the counter, which keeps counting, says so).
-    pub fn insert<M: Memory>(&self, pixel: u32, node: MaskedNode, memory: &M) -> bool {
-        let pixel = pixel as usize;
+    /// The `u32` word of the mask of the node at `index` (a slot, or a pool node).
+    fn mask_word(&self, index: usize) -> usize {
         match self.storage {
-            MaskedStorage::Slots(capacity) => {
-                let slot = WordMemory::<u32>::fetch_add(memory, pixel, 1);
-                if slot >= capacity {
-                    return false;
-                }
-                let index = pixel * capacity as usize + slot as usize;
-                WordMemory::<u64>::store(memory, index, node.packed());
-                WordMemory::<u32>::store(memory, self.pixels + index, node.mask);
-            }
-            MaskedStorage::Pool(nodes) => {
-                let taken = WordMemory::<u32>::fetch_add(memory, self.counter(), 1);
-                if taken as usize >= nodes {
-                    return false;
-                }
-                let next = WordMemory::<u32>::swap(memory, pixel, taken + 1);
-                let index = taken as usize;
-                WordMemory::<u64>::store(memory, index, node.packed());
-                WordMemory::<u32>::store(memory, self.counter() + 1 + index, next);
-                WordMemory::<u32>::store(memory, self.counter() + 1 + nodes + index, node.mask);
-            }
+            MaskedStorage::Slots(_) => self.pixels + index,
+            MaskedStorage::Pool(nodes) => self.counter() + 1 + nodes + index,
         }
-        true
     }
 
     /// One frame: every triangle of `view` (rasterizing per sample with this scheme's sample
-    /// count) merged into nodes and inserted, serially in submission order or on the current
-    /// rayon pool with std atomics; then the post pass.
+    /// count) merged into nodes and inserted, on the serial executor or on the parallel one
+    /// (the current rayon pool, std atomics); then the post pass.
     ///
     /// # Errors
     /// A view that does not rasterize per sample at this scheme's sample count, or on another
@@ -343,72 +241,63 @@ impl MaskedABuffer {
         self.frame(view, parallel).map(|frame| frame.lists)
     }
 
-    /// [`MaskedABuffer::capture`], timed: the geometry pass (storage allocation, rasterization,
-    /// merging, insertion) and the post pass apart, as `bench --samples` reports them.
+    /// [`MaskedABuffer::capture`], timed: the geometry pass and the post pass apart, as
+    /// `bench --samples` reports them.
     ///
     /// # Errors
     /// As [`MaskedABuffer::capture`].
     pub fn frame(&self, view: &View<'_>, parallel: bool) -> Result<MaskedFrame, CaptureError> {
         self.check_view(view)?;
-        let layout = self.layout();
-        let start = Instant::now();
-        // The two memories are two types (std atomics, plain cells): one timed body each.
-        let (lists, fragments, pass_time, resolve_time) = if parallel {
-            let memory: AtomicMemory = layout.allocate();
-            let fragments = (0..view.triangle_count())
-                .into_par_iter()
-                .map_init(Vec::new, |scratch, index| {
-                    self.insert_triangle(view, view.submitted(index), scratch, &memory)
-                })
-                .sum();
-            let pass_time = start.elapsed();
-            let lists = (self.resolve(&memory), self.dropped(&memory));
-            (lists, fragments, pass_time, start.elapsed() - pass_time)
+        let run = if parallel {
+            run_parallel(view, self)
         } else {
-            let memory: SerialMemory = layout.allocate();
-            let fragments = self.insert_all(view, &memory)?;
-            let pass_time = start.elapsed();
-            let lists = (self.resolve(&memory), self.dropped(&memory));
-            (lists, fragments, pass_time, start.elapsed() - pass_time)
+            run_serial(view, self)
         };
-        let (lists, dropped) = lists;
-        Ok(MaskedFrame {
-            lists,
-            fragments,
-            dropped,
-            pass_time,
-            resolve_time,
-        })
+        Ok(self.masked_frame(&run))
+    }
+
+    /// The node lists and counts of a frame-loop run of this scheme.
+    ///
+    /// # Panics
+    /// If `run` is not a capture of this scheme (another promise, another number of pixels).
+    #[must_use]
+    pub fn masked_frame(&self, run: &Run) -> MaskedFrame {
+        let crate::Keeps::All { overflow, .. } = &run.capture.keeps else {
+            panic!("a masked-node capture keeps all its nodes");
+        };
+        MaskedFrame {
+            lists: MaskedLists::from_per_sample(self.samples, &run.capture, overflow),
+            nodes: run.stats.counters.fragments,
+            dropped: run.stats.counters.dropped,
+            pass_time: run.stats.pass_time,
+            resolve_time: run.stats.resolve_time,
+        }
     }
 
     /// Refuses a view of another pixel count or sample count than this scheme's.
     fn check_view(&self, view: &View<'_>) -> Result<(), CaptureError> {
-        if view.samples().map(|p| p.count()) != Some(self.samples)
-            || view.pixel_viewport().pixels() != self.pixels
-        {
+        let view_samples = view.samples().map_or(1, |p| p.count());
+        if view_samples != self.samples || view.pixel_viewport().pixels() != self.pixels {
             return Err(CaptureError::OtherView {
-                scheme: self.name().into(),
+                scheme: self.name(),
                 pixels: self.pixels,
                 samples: self.samples,
                 view_pixels: view.pixel_viewport().pixels(),
-                view_samples: view.samples().map_or(1, |p| p.count()),
+                view_samples,
             });
         }
         Ok(())
     }
 
-    /// The pass alone, serially in submission order, into `memory` (of [`MaskedABuffer::layout`]):
-    /// the words a dump records (`fragsim_dump`), before the post pass; returns the
-    /// sample fragments rasterized.
+    /// The pass alone, on the serial executor's loop in submission order, into `memory` (of
+    /// the scheme's layout): the words a dump records (`fragsim_dump`), before the post pass;
+    /// returns the nodes walked.
     ///
     /// # Errors
     /// As [`MaskedABuffer::capture`].
     pub fn insert_all<M: Memory>(&self, view: &View<'_>, memory: &M) -> Result<u64, CaptureError> {
         self.check_view(view)?;
-        let mut scratch = Vec::new();
-        Ok((0..view.triangle_count())
-            .map(|index| self.insert_triangle(view, view.submitted(index), &mut scratch, memory))
-            .sum())
+        Ok(serial_passes(view, self, memory).0.fragments)
     }
 
     /// The counting pass that sizes a masked-node A-buffer to the scene (`--capacity auto`): one
@@ -424,79 +313,63 @@ impl MaskedABuffer {
         view: &View<'_>,
         parallel: bool,
     ) -> Result<MaskedFrame, CaptureError> {
-        let mut counter = Self::new(pixels, samples, 1, u64::MAX)?;
         // Capacity 0, which `new` refuses for a capture: every insertion only counts.
-        counter.storage = MaskedStorage::Slots(0);
-        counter.frame(view, parallel)
+        Self::built(pixels.pixels(), samples, MaskedStorage::Slots(0))?.frame(view, parallel)
     }
 
-    /// Rasterizes triangle `prim` per sample into `scratch`, merges and inserts its nodes;
-    /// returns the sample fragments rasterized.
-    fn insert_triangle<M: Memory>(
-        &self,
-        view: &View<'_>,
-        prim: u32,
-        scratch: &mut Vec<Fragment>,
-        memory: &M,
-    ) -> u64 {
-        scratch.clear();
-        view.rasterize(prim, &mut |f| scratch.push(f));
-        merge_samples(self.samples, scratch, &mut |pixel, node| {
-            self.insert(pixel, node, memory);
-        });
-        scratch.len() as u64
-    }
-
-    /// The post pass: each pixel's stored nodes (its slots, or its list walked from the head)
-    /// sorted, and the A-buffer's per-pixel overflow read from its counter.
+    /// The post pass in nodes: each pixel's stored nodes (its slots, or its list walked from the
+    /// head) sorted, and the A-buffer's per-pixel overflow read from its counter. What a dump's
+    /// words hold, read without the per-sample resolve.
     #[must_use]
-    #[expect(
-        clippy::cast_possible_truncation,
-        reason = "a node's word packs the depth key (high 32 bits) and the primitive id (low 32)"
-    )]
-    pub fn resolve<M: Memory>(&self, memory: &M) -> MaskedLists {
+    pub fn node_lists<M: Memory>(&self, memory: &M) -> MaskedLists {
         let mut lists = MaskedLists {
             samples: self.samples,
             offsets: vec![0],
             nodes: Vec::new(),
             overflow: Vec::with_capacity(self.pixels),
         };
-        let node_at = |index: usize, mask: usize| {
-            let packed = WordMemory::<u64>::load(memory, index);
-            MaskedNode {
-                depth_key: (packed >> 32) as u32,
-                prim: packed as u32,
-                mask: WordMemory::<u32>::load(memory, mask),
-            }
-        };
         for pixel in 0..self.pixels {
             let start = lists.nodes.len();
-            let mut overflow = 0;
-            match self.storage {
-                MaskedStorage::Slots(capacity) => {
-                    let count = WordMemory::<u32>::load(memory, pixel);
-                    let stored = count.min(capacity);
-                    for slot in 0..stored as usize {
-                        let index = pixel * capacity as usize + slot;
-                        lists.nodes.push(node_at(index, self.pixels + index));
-                    }
-                    overflow = count - stored;
-                }
-                MaskedStorage::Pool(nodes) => {
-                    let mut node = WordMemory::<u32>::load(memory, pixel) as usize;
-                    while node != 0 {
-                        let index = node - 1;
-                        let mask = self.counter() + 1 + nodes + index;
-                        lists.nodes.push(node_at(index, mask));
-                        node = WordMemory::<u32>::load(memory, self.counter() + 1 + index) as usize;
-                    }
-                }
-            }
+            let overflow = self.stored_nodes(memory, pixel, |node| lists.nodes.push(node));
             lists.nodes[start..].sort_unstable_by_key(|n| n.packed());
             lists.offsets.push(lists.nodes.len());
             lists.overflow.push(overflow);
         }
         lists
+    }
+
+    /// Hands `pixel`'s stored nodes to `each`, in storage order; returns the nodes the pixel's
+    /// counter counted past its slots (0 for the pool, whose one counter counts for all).
+    fn stored_nodes<M: Memory>(
+        &self,
+        memory: &M,
+        pixel: usize,
+        mut each: impl FnMut(MaskedNode),
+    ) -> u32 {
+        let node_at = |index: usize| {
+            MaskedNode::unpacked(
+                WordMemory::<u64>::load(memory, index),
+                WordMemory::<u32>::load(memory, self.mask_word(index)),
+            )
+        };
+        match self.storage {
+            MaskedStorage::Slots(capacity) => {
+                let count = WordMemory::<u32>::load(memory, pixel);
+                let stored = count.min(capacity);
+                for slot in 0..stored as usize {
+                    each(node_at(pixel * capacity as usize + slot));
+                }
+                count - stored
+            }
+            MaskedStorage::Pool(_) => {
+                let mut node = WordMemory::<u32>::load(memory, pixel) as usize;
+                while node != 0 {
+                    each(node_at(node - 1));
+                    node = WordMemory::<u32>::load(memory, self.counter() + node) as usize;
+                }
+                0
+            }
+        }
     }
 
     /// Nodes dropped for lack of storage, from the counters: each pixel's count past its slots,
@@ -513,6 +386,87 @@ impl MaskedABuffer {
                 let taken = WordMemory::<u32>::load(memory, self.counter());
                 (taken as usize).saturating_sub(nodes) as u64
             }
+        }
+    }
+}
+
+impl Scheme for MaskedABuffer {
+    type State = NodeWalk;
+    type Input = PixelNode;
+
+    fn descriptor(&self) -> &Descriptor {
+        &self.descriptor
+    }
+
+    fn gathering(&self) -> <PixelNode as WalkInput>::Gathering {
+        Merging::new(self.samples)
+    }
+
+    fn begin(&self, node: PixelNode) -> NodeWalk {
+        NodeWalk::Claim(node)
+    }
+
+    fn step<M: Memory>(&self, walk: &mut NodeWalk, memory: &M) -> Step {
+        match (*walk, self.storage) {
+            (NodeWalk::Claim(node), MaskedStorage::Slots(capacity)) => {
+                let slot = WordMemory::<u32>::fetch_add(memory, node.pixel as usize, 1);
+                if slot >= capacity {
+                    return Step::Dropped;
+                }
+                let index = node.pixel as usize * capacity as usize + slot as usize;
+                *walk = NodeWalk::Word(node, index, None);
+            }
+            (NodeWalk::Claim(node), MaskedStorage::Pool(nodes)) => {
+                let taken = WordMemory::<u32>::fetch_add(memory, self.counter(), 1);
+                if taken as usize >= nodes {
+                    return Step::Dropped;
+                }
+                *walk = NodeWalk::Link(node, taken as usize);
+            }
+            (NodeWalk::Link(node, index), _) => {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "pool indices are below the pool, which `with_storage` keeps under u32::MAX"
+                )]
+                let numbered = index as u32 + 1;
+                let next = WordMemory::<u32>::swap(memory, node.pixel as usize, numbered);
+                *walk = NodeWalk::Word(node, index, Some(next));
+            }
+            (NodeWalk::Word(node, index, next), _) => {
+                WordMemory::<u64>::store(memory, index, node.node.packed());
+                *walk = match next {
+                    Some(next) => NodeWalk::Next(node, index, next),
+                    None => NodeWalk::Mask(node, index),
+                };
+            }
+            (NodeWalk::Next(node, index, next), _) => {
+                WordMemory::<u32>::store(memory, self.counter() + 1 + index, next);
+                *walk = NodeWalk::Mask(node, index);
+            }
+            (NodeWalk::Mask(node, index), _) => {
+                WordMemory::<u32>::store(memory, self.mask_word(index), node.node.mask);
+                return Step::Stored;
+            }
+        }
+        Step::Continue
+    }
+
+    /// Sample `sample_index % samples` of pixel `sample_index / samples`: the pixel's nodes
+    /// whose mask holds it, sorted; the pixel's dropped nodes on its first sample.
+    fn resolve_pixel<M: Memory>(&self, memory: &M, sample_index: usize, out: &mut Vec<u64>) -> u32 {
+        let samples = self.samples as usize;
+        let (pixel, sample) = (sample_index / samples, sample_index % samples);
+        let start = out.len();
+        let overflow = self.stored_nodes(memory, pixel, |node| {
+            if node.mask >> sample & 1 == 1 {
+                out.push(node.packed());
+            }
+        });
+        out[start..].sort_unstable();
+        if sample == 0 {
+            overflow
+        } else {
+            0
         }
     }
 }

@@ -290,6 +290,7 @@ impl<W: MdtsWord> SpanVisitor<W> for ReadList<'_, W> {
 
 impl<W: MdtsWord> Scheme for Mdts<W> {
     type State = Walk<W>;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

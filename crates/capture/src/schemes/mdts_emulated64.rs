@@ -225,6 +225,7 @@ impl MdtsEmulated64 {
 
 impl Scheme for MdtsEmulated64 {
     type State = Walk64;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

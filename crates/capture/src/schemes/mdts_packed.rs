@@ -252,6 +252,7 @@ impl MdtsPacked {
 
 impl Scheme for MdtsPacked {
     type State = PackedWalk;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

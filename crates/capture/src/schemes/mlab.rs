@@ -129,6 +129,7 @@ impl Mlab {
 
 impl Scheme for Mlab {
     type State = Fragment;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -113,6 +113,7 @@ impl<W: MdtsWord> DepthPeeling<W> {
 
 impl<W: MdtsWord> Scheme for DepthPeeling<W> {
     type State = Peel<W>;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         self.storage.descriptor()

@@ -124,6 +124,7 @@ impl StencilRouted {
 
 impl Scheme for StencilRouted {
     type State = Route;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -70,6 +70,7 @@ impl ZBuffer {
 
 impl Scheme for ZBuffer {
     type State = DepthTest;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

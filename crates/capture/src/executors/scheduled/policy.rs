@@ -103,7 +103,7 @@ impl Chooser {
 
     /// Lowers a thread's priority below every other's (PCT only): what a thread that spun does,
     /// so that the lock's holder runs.
-    pub(super) fn spun<S>(&mut self, thread: &mut Thread<S>) {
+    pub(super) fn spun<S, I>(&mut self, thread: &mut Thread<S, I>) {
         if let Policy::Pct { .. } = self.policy {
             thread.priority = self.next_low;
             self.next_low = self.next_low.saturating_sub(1);
@@ -116,9 +116,9 @@ impl Chooser {
         clippy::cast_possible_truncation,
         reason = "the remainder is below active.len(), a usize"
     )]
-    pub(super) fn choose<S>(
+    pub(super) fn choose<S, I>(
         &mut self,
-        threads: &mut [Thread<S>],
+        threads: &mut [Thread<S, I>],
         active: &[usize],
         step: u64,
         reconverging: impl Fn(&S) -> bool,

@@ -233,6 +233,7 @@ impl<W: MdtsWord> Adp<W> {
 
 impl<W: MdtsWord> Scheme for Adp<W> {
     type State = Walk<W, AdpStage>;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.plan.descriptor

@@ -146,6 +146,7 @@ impl<W: MdtsWord> Bdp<W> {
 
 impl<W: MdtsWord> Scheme for Bdp<W> {
     type State = Walk<W, Blend>;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.plan.descriptor

@@ -118,6 +118,7 @@ impl<W: MdtsWord> Bdp2<W> {
 
 impl<W: MdtsWord> Scheme for Bdp2<W> {
     type State = Walk<W, Bdp2Stage<W>>;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.plan.descriptor

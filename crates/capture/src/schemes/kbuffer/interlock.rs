@@ -140,6 +140,7 @@ impl KBufferInterlock {
 
 impl Scheme for KBufferInterlock {
     type State = Insert;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

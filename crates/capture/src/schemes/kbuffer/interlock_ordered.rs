@@ -149,6 +149,7 @@ impl<'o> KBufferInterlockOrdered<'o> {
 
 impl Scheme for KBufferInterlockOrdered<'_> {
     type State = Ordered;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -158,6 +158,7 @@ impl KBuffer {
 
 impl Scheme for KBuffer {
     type State = Insert;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

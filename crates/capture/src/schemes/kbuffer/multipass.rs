@@ -288,6 +288,7 @@ impl KBufferMultipass {
 
 impl Scheme for KBufferMultipass {
     type State = Peel;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -179,6 +179,7 @@ impl KBufferSpinlock {
 
 impl Scheme for KBufferSpinlock {
     type State = SpinInsert;
+    type Input = Fragment;
 
     fn descriptor(&self) -> &Descriptor {
         &self.descriptor

@@ -3,6 +3,14 @@
 //! pool, and bad parameters are refused by name.
 
 use super::*;
+use fragsim_memory::SerialMemory;
+use fragsim_raster::Fragment;
+
+/// Runs `node`'s walk into `pixel` to its end; whether it was stored.
+fn insert(scheme: &MaskedABuffer, pixel: u32, node: MaskedNode, memory: &SerialMemory) -> bool {
+    let mut steps = 0;
+    scheme.insert(PixelNode { pixel, node }, memory, &mut steps) == Step::Stored
+}
 
 fn sample(pixel: u32, depth_key: u32, prim: u32) -> Fragment {
     Fragment {
@@ -48,9 +56,9 @@ fn past_its_capacity_a_pixel_drops_whole_nodes_and_counts_them() {
             prim,
             mask: 1 << prim,
         };
-        assert_eq!(scheme.insert(0, node, &memory), prim != 2);
+        assert_eq!(insert(&scheme, 0, node, &memory), prim != 2);
     }
-    let lists = scheme.resolve(&memory);
+    let lists = scheme.node_lists(&memory);
     assert_eq!(lists.overflow, [1]);
     let prims: Vec<u32> = lists.pixel(0).iter().map(|n| n.prim).collect();
     assert_eq!(prims, [1, 3]);
@@ -73,9 +81,9 @@ fn past_its_pool_the_linked_list_drops_whole_nodes_and_counts_them_in_all() {
             prim,
             mask: 1 << (prim % 4),
         };
-        assert_eq!(scheme.insert(pixel, node, &memory), prim != 2);
+        assert_eq!(insert(&scheme, pixel, node, &memory), prim != 2);
     }
-    let lists = scheme.resolve(&memory);
+    let lists = scheme.node_lists(&memory);
     assert_eq!(scheme.dropped(&memory), 1);
     assert_eq!(lists.overflow, [0, 0]);
     let prims = |p| lists.pixel(p).iter().map(|n| n.prim).collect::<Vec<_>>();
