@@ -19,8 +19,6 @@
 //! measured: the vertex stage, the geometry passes and the post pass, as `fragsim bench` times a
 //! frame. It prints the fragments and wall-clock times; callgrind's total is the instructions.
 
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
-
 use std::path::Path;
 use std::time::Instant;
 

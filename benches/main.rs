@@ -15,7 +15,6 @@
 //!
 //! Run: `cargo bench --bench main`; ratios are recorded in `docs/results.md`.
 
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
 #![allow(
     missing_docs,
     reason = "criterion_group! and criterion_main! generate undocumented items"

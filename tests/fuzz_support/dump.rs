@@ -111,16 +111,15 @@ pub(crate) fn check(data: &[u8]) {
     let Ok(capture) = dump.capture() else {
         return;
     };
-    let pixels = dump.viewport().expect("parse checked it").pixels();
-    assert_eq!(capture.pixels(), pixels, "one list per pixel");
+    assert_eq!(capture.pixels(), lists, "one list per pixel and sample");
     // Every word rule runs on what decodes, linked lists whose links leave the pool or close a
     // cycle included (the walk is bounded by the pool: a hang is a fuzz timeout).
     let words = dump
         .check_words()
         .expect("a dump that decodes has its words checked");
-    assert_eq!(words.corrupt.len(), pixels, "one word check per pixel");
+    assert_eq!(words.corrupt.len(), lists, "one word check per list");
     if let Keeps::All { overflow, .. } = &capture.keeps {
-        assert_eq!(overflow.len(), pixels, "one overflow count per pixel");
+        assert_eq!(overflow.len(), lists, "one overflow count per list");
     }
     let comparison = compare(&Oracle::from_capture(&capture), &capture, 0, 4);
     assert!(

@@ -392,6 +392,11 @@ fn payload_words(words: Vec<u64>, payload: &Payload, wrong_dtype: bool) -> Words
 }
 
 /// Words of `dtype` (u32 words narrowed).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "narrowing is the point: a u32 payload's words fit, and a u64 payload written as u32 \
+              (the wrong-dtype fault) loses its high half"
+)]
 fn words_of(dtype: Dtype, words: Vec<u64>) -> Words {
     match dtype {
         Dtype::U32 => Words::U32(words.into_iter().map(|w| w as u32).collect()),

@@ -65,6 +65,7 @@ pub(crate) fn check(data: &[u8]) {
         camera_from_columns(columns)
     };
     let vertices = 3 + usize::from(input.u8() % 14);
+    let vertex_count = u32::try_from(vertices).expect("3 to 16 vertices");
     let triangles = 1 + usize::from(input.u8() % 8);
     let positions: Vec<[f32; 3]> = (0..vertices)
         .map(|_| {
@@ -78,7 +79,7 @@ pub(crate) fn check(data: &[u8]) {
         })
         .collect();
     let triangles: Vec<[u32; 3]> = (0..triangles)
-        .map(|_| [(); 3].map(|()| u32::from(input.u8()) % vertices as u32))
+        .map(|_| [(); 3].map(|()| u32::from(input.u8()) % vertex_count))
         .collect();
     let mesh = Mesh {
         positions,
@@ -144,6 +145,11 @@ pub(crate) fn reference_coverage(
     }
     let one = f64::from(1_u32 << SUBPIXEL_BITS);
     // With w = 1, x / w = x exactly; rounding is half away from zero, as `f64::round`.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "an unclipped corner lies within the guard band (16384 pixels past the \
+                  viewport), so its subpixel coordinates are far inside i64"
+    )]
     let snap = |[x, y, _]: [f32; 3]| -> [i128; 2] {
         let wx = (f64::from(x) * 0.5 + 0.5) * width;
         let wy = (0.5 - f64::from(y) * 0.5) * height;

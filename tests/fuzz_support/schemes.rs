@@ -58,7 +58,7 @@ fn decode(data: &[u8]) -> Case {
             depth_key(f32::from_bits(bits)).unwrap_or(bits % (0x3F80_0000 + 1))
         };
         let prim = if header & 0x20 == 0 {
-            fragments.len() as u32
+            u32::try_from(fragments.len()).expect("at most MAX_FRAGMENTS fragments")
         } else {
             input.u32()
         };
@@ -214,7 +214,10 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
     if runs == Runs::SerialOnly {
         return;
     }
-    let Run { capture, stats } = run_fragments(scheme, &inputs, &case.schedule, false).run;
+    let Run {
+        capture: scheduled,
+        stats,
+    } = run_fragments(scheme, &inputs, &case.schedule, false).run;
     if one_pass {
         assert_eq!(
             stats.counters.fragments,
@@ -222,9 +225,9 @@ fn check_scheme<S: Scheme>(scheme: &S, case: &Case, lists: &[Vec<u64>], runs: Ru
             "{name}: every fragment begins one walk"
         );
     }
-    let dropped = counted_drops(one_pass, &stats.counters);
+    let scheduled_drops = counted_drops(one_pass, &stats.counters);
     let name = format!("{name} under {:?}", case.schedule);
-    check_capture(&name, lists, &capture, dropped);
+    check_capture(&name, lists, &scheduled, scheduled_drops);
 }
 
 /// The drops that must equal the fragments missing: those of a one-pass scheme that counts every
@@ -264,7 +267,10 @@ fn distinct_depths(lists: &[Vec<u64>]) -> bool {
 pub(crate) fn check(data: &[u8]) {
     let case = decode(data);
     let lists = sorted_lists(case.pixels, &case.fragments);
-    let counts: Vec<u32> = lists.iter().map(|l| l.len() as u32).collect();
+    let counts: Vec<u32> = lists
+        .iter()
+        .map(|l| u32::try_from(l.len()).expect("at most MAX_FRAGMENTS fragments a pixel"))
+        .collect();
     let full = counts.iter().copied().max().unwrap_or(0).max(1);
     let viewport = Viewport::new(case.pixels, 1).expect("1..=15 pixels");
     let distinct_depths = distinct_depths(&lists);

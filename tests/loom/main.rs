@@ -21,8 +21,6 @@
 //! sentinels) must stay correct while never exiting early. The proofs these tests check are in `docs/proof.md`, with the
 //! interleaving counts and the suite's wall time.
 
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
-
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 use std::time::Instant;

@@ -40,6 +40,10 @@ fn engine_spec(scene: &Scene) -> SceneSpec {
     let viewport = Viewport::new(VIEWPORT.0, VIEWPORT.1).unwrap();
     let orbit = OrbitCamera::default().at_angle(30.0);
     let camera = scene.orbit_camera(viewport, &orbit, DepthRange::MinusOneToOne);
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "narrowing is the point: the engine's matrix is the camera's rounded to f32"
+    )]
     let row_major = camera.row_major().map(|v| f64::from(v as f32));
     SceneSpec {
         view_projection: Some(ViewProjection {
@@ -275,8 +279,8 @@ fn a_dump_that_travelled_finds_its_mesh_with_compare_mesh() {
     // Another file under --mesh is refused by its hash.
     let other = dir.join("other.obj");
     std::fs::write(&other, format!("{TETRAHEDRON}v 2 2 2\n")).unwrap();
-    let text = run(&mut compare(Some(&other)), 2);
-    assert!(text.contains("hash"), "{text}");
+    let other_text = run(&mut compare(Some(&other)), 2);
+    assert!(other_text.contains("hash"), "{other_text}");
 }
 
 #[test]

@@ -30,13 +30,16 @@ fn bunny_both_schemes_both_executors_equal_the_oracle() {
     for run in [run_serial(&view, &mdts), run_parallel(&view, &mdts)] {
         let diff = oracle.diff(&run.capture);
         assert!(diff.is_exact(), "{diff:?}");
-        assert_eq!(run.stats.counters.fragments as usize, oracle.fragments());
-        assert_eq!(diff.captured as usize, oracle.fragments());
+        assert_eq!(
+            usize::try_from(run.stats.counters.fragments),
+            Ok(oracle.fragments())
+        );
+        assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
     }
     for run in [run_serial(&view, &abuffer), run_parallel(&view, &abuffer)] {
         let diff = oracle.diff(&run.capture);
         assert!(diff.is_exact(), "{diff:?}");
-        assert_eq!(diff.captured as usize, oracle.fragments());
+        assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
     }
     // With fewer slots than layers MDTS keeps exactly the nearest K, and says how many it dropped.
     let shallow =
@@ -53,8 +56,8 @@ fn bunny_both_schemes_both_executors_equal_the_oracle() {
         MEMORY_CAP_DEFAULT,
     )
     .unwrap();
-    let diff = oracle.diff(&run_parallel(&view, &descending).capture);
-    assert!(diff.is_exact(), "{diff:?}");
+    let descending_diff = oracle.diff(&run_parallel(&view, &descending).capture);
+    assert!(descending_diff.is_exact(), "{descending_diff:?}");
 }
 
 /// `fragsim render ARGS --json --no-images`: the exit status and the rows.
@@ -94,7 +97,7 @@ fn abuffer_is_one_pass_over_fixed_arrays_and_abuffer_exact_reports_its_count_pas
         )
         .unwrap();
     let oracle = Oracle::build(&view);
-    assert_eq!(fragments as usize, oracle.fragments());
+    assert_eq!(usize::try_from(fragments), Ok(oracle.fragments()));
 
     let fixed = row(&rows, "abuffer");
     assert_eq!(fixed["passes"], 1);
@@ -205,12 +208,12 @@ fn a_scheme_misreporting_its_overflow_by_one_fails_render() {
         assert_eq!(rows[0]["keeps_guarantee"], true);
         let mut faulty = args.to_vec();
         faulty.extend(["--inject-fault", "miscount-overflow"]);
-        let (code, rows, stderr) = render_json(&faulty);
-        assert_eq!(code, 1, "{stderr}");
-        assert_eq!(rows[0]["keeps_guarantee"], false);
-        assert_eq!(rows[0]["overflow_miscounted_pixels"], 1);
+        let (faulty_code, faulty_rows, stderr) = render_json(&faulty);
+        assert_eq!(faulty_code, 1, "{stderr}");
+        assert_eq!(faulty_rows[0]["keeps_guarantee"], false);
+        assert_eq!(faulty_rows[0]["overflow_miscounted_pixels"], 1);
         assert_eq!(
-            rows[0]["lost"], 0,
+            faulty_rows[0]["lost"], 0,
             "the fragments are right; only the count is wrong"
         );
         assert!(stderr.contains("breaks its guarantee"), "{stderr}");

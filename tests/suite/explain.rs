@@ -92,7 +92,7 @@ fn the_shortest_losing_interleaving_is_4_steps_on_render_targets_and_4k_with_sep
         assert!(text.contains("LOST: "), "{text}");
         assert!(!text.contains("DUPLICATED"), "{text}");
 
-        let (ok, text) = explain(&[
+        let (second_ok, second_text) = explain(&[
             "--depths",
             depths,
             "--k",
@@ -100,9 +100,9 @@ fn the_shortest_losing_interleaving_is_4_steps_on_render_targets_and_4k_with_sep
             "--write-back",
             "separate-stores",
         ]);
-        assert!(ok, "{text}");
-        assert_eq!(steps(&text, "shrunk"), 4 * k, "{text}");
-        assert!(text.contains("store w"), "{text}");
+        assert!(second_ok, "{second_text}");
+        assert_eq!(steps(&second_text, "shrunk"), 4 * k, "{second_text}");
+        assert!(second_text.contains("store w"), "{second_text}");
     }
 }
 
@@ -162,16 +162,16 @@ fn explain_offers_the_catalogs_kbuffer_stores_as_the_kbuffer_on_separate_stores(
         "{stderr}"
     );
     // A catalog scheme explain cannot build on one pixel is refused, naming those it can.
-    let output = Command::cargo_bin("fragsim")
+    let abuffer_output = Command::cargo_bin("fragsim")
         .unwrap()
         .args(["explain", "--scheme", "abuffer"])
         .output()
         .unwrap();
-    let stderr = String::from_utf8(output.stderr).unwrap();
-    assert!(!output.status.success());
+    let abuffer_stderr = String::from_utf8(abuffer_output.stderr).unwrap();
+    assert!(!abuffer_output.status.success());
     assert!(
-        stderr.contains("mdts") && stderr.contains("kbuffer-stores"),
-        "{stderr}"
+        abuffer_stderr.contains("mdts") && abuffer_stderr.contains("kbuffer-stores"),
+        "{abuffer_stderr}"
     );
 }
 

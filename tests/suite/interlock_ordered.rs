@@ -77,9 +77,12 @@ fn on_every_executor_nearest_is_exact_and_keep_first_keeps_the_first_submitted()
                 oracle.diff(&run.run.capture).is_exact(),
                 "K = {k}, {executor}"
             );
-            let run = runner.run(first, executor, &view, &sizing(k)).unwrap();
-            assert_eq!(run.guarantee, Guarantee::ExactWithinCapacity(k));
-            assert!(lists(&run.run.capture) == expected, "K = {k}, {executor}");
+            let first_run = runner.run(first, executor, &view, &sizing(k)).unwrap();
+            assert_eq!(first_run.guarantee, Guarantee::ExactWithinCapacity(k));
+            assert!(
+                lists(&first_run.run.capture) == expected,
+                "K = {k}, {executor}"
+            );
         }
         // Then and only then: keep-first differs from the nearest where the first K submitted
         // are not the K nearest.

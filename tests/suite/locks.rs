@@ -21,6 +21,10 @@ use proptest::prelude::*;
 
 /// Fragments on `pixels` pixels, primitive ids in submission order, depth keys from six values;
 /// at most one warp's worth.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "1 to 3 pixels and at most one warp's fragments"
+)]
 fn stream() -> impl Strategy<Value = (usize, Vec<Fragment>)> {
     (1_usize..=3).prop_flat_map(|pixels| {
         proptest::collection::vec((0..pixels as u32, 0_u32..6), 0..=WARP_LANES).prop_map(
@@ -75,7 +79,7 @@ proptest! {
         seed in any::<u64>(),
     ) {
         let oracle = Oracle::from_fragments(pixels, &fragments);
-        let viewport = Viewport::new(pixels as u32, 1).unwrap();
+        let viewport = Viewport::new(u32::try_from(pixels).expect("1 to 3 pixels"), 1).unwrap();
         for shape in [Loop::Naive, Loop::Fixed] {
             let scheme = KBufferSpinlock::new(viewport, k, shape, MEMORY_CAP_DEFAULT).unwrap();
             let run = run_fragments(&scheme, &fragments, &all_in_flight(policy, &fragments, seed), false);
@@ -95,7 +99,7 @@ proptest! {
         seed in any::<u64>(),
     ) {
         let oracle = Oracle::from_fragments(pixels, &fragments);
-        let viewport = Viewport::new(pixels as u32, 1).unwrap();
+        let viewport = Viewport::new(u32::try_from(pixels).expect("1 to 3 pixels"), 1).unwrap();
         let concurrent = all_in_flight(policy, &fragments, seed);
         let locked = MdtsEmulated64::new(viewport, k, Emulation::Locked, MEMORY_CAP_DEFAULT).unwrap();
         let run = run_fragments(&locked, &fragments, &concurrent, false);
@@ -103,11 +107,11 @@ proptest! {
         prop_assert!(oracle.diff(&run.run.capture).is_exact());
         let torn = MdtsEmulated64::new(viewport, k, Emulation::Torn, MEMORY_CAP_DEFAULT).unwrap();
         let one_at_a_time = Schedule { in_flight: 1, ..concurrent };
-        let run = run_fragments(&torn, &fragments, &one_at_a_time, false);
-        prop_assert!(oracle.diff(&run.run.capture).is_exact());
+        let torn_alone = run_fragments(&torn, &fragments, &one_at_a_time, false);
+        prop_assert!(oracle.diff(&torn_alone.run.capture).is_exact());
         if oracle.depth_complexity().iter().all(|&n| n <= 1) {
-            let run = run_fragments(&torn, &fragments, &concurrent, false);
-            prop_assert!(oracle.diff(&run.run.capture).is_exact());
+            let torn_together = run_fragments(&torn, &fragments, &concurrent, false);
+            prop_assert!(oracle.diff(&torn_together.run.capture).is_exact());
         }
     }
 
@@ -120,7 +124,7 @@ proptest! {
         k in 1_u32..=5,
     ) {
         let oracle = Oracle::from_fragments(pixels, &fragments);
-        let viewport = Viewport::new(pixels as u32, 1).unwrap();
+        let viewport = Viewport::new(u32::try_from(pixels).expect("1 to 3 pixels"), 1).unwrap();
         let schedule = all_in_flight(Policy::Lockstep, &fragments, 0);
         let contended = oracle.depth_complexity().iter().any(|&n| n >= 2);
         let naive = KBufferSpinlock::new(viewport, k, Loop::Naive, MEMORY_CAP_DEFAULT).unwrap();
@@ -139,9 +143,9 @@ proptest! {
             prop_assert!(oracle.diff(&run.run.capture).is_exact());
         }
         let fixed = KBufferSpinlock::new(viewport, k, Loop::Fixed, MEMORY_CAP_DEFAULT).unwrap();
-        let run = run_fragments(&fixed, &fragments, &schedule, false);
-        prop_assert!(run.deadlock.is_none());
-        prop_assert!(oracle.diff(&run.run.capture).is_exact());
+        let fixed_run = run_fragments(&fixed, &fragments, &schedule, false);
+        prop_assert!(fixed_run.deadlock.is_none());
+        prop_assert!(oracle.diff(&fixed_run.run.capture).is_exact());
     }
 }
 
@@ -217,7 +221,7 @@ fn explain_prints_the_shortest_deadlocking_schedule() {
         "{text}"
     );
     assert!(text.contains("every fragment kept in order"), "{text}");
-    let (shown, text) = run("0.3");
-    assert!(!shown, "{text}");
-    assert!(text.contains("cannot deadlock"), "{text}");
+    let (one_shown, one_text) = run("0.3");
+    assert!(!one_shown, "{one_text}");
+    assert!(one_text.contains("cannot deadlock"), "{one_text}");
 }

@@ -1,6 +1,7 @@
 //! FreePipe §4.1.2's depth-and-colour MDTS (`mdts_packed`): where it is exact, each way it is
 //! not, and how often it is not on real scenes; and the exact 64-bit alternative (MDTS-64).
 
+use crate::support::prim_of;
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::{run_parallel, run_serial};
 use fragsim::capture::schemes::mdts::Mdts;
@@ -74,7 +75,7 @@ fn pixel_is_safe(list: &[u64], k: u32) -> bool {
     let distinct = nearest
         .windows(2)
         .all(|w| depth20((w[0] >> 32) as u32) < depth20((w[1] >> 32) as u32));
-    let prims = list.iter().all(|&e| (e as u32) < COLOURS);
+    let prims = list.iter().all(|&e| prim_of(e) < COLOURS);
     keys_below_top && distinct && prims
 }
 
@@ -112,12 +113,21 @@ fn depth20_is_monotone_below_one_wraps_the_two_largest_depths_and_rounds_once() 
         let d = f32::from_bits(k);
         // One rounding (to nearest even) of the exact 0.5 + 0.5·d, which f64 holds exactly
         // wherever the rounding can matter.
-        assert_eq!(remapped_depth(k), (0.5 + 0.5 * f64::from(d)) as f32, "{d}");
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "narrowing is the point: the scheme rounds the remapped depth to f32 once"
+        )]
+        let rounded_once = (0.5 + 0.5 * f64::from(d)) as f32;
+        assert_eq!(remapped_depth(k), rounded_once, "{d}");
         let q = depth20(k);
         assert!(q < 1 << 20);
         if k <= KEY_LAST_UNWRAPPED {
             // A 20-bit fixed-point depth: ⌊d · 2^20⌋, or one more where d' rounded up onto a
             // multiple of 2^-21.
+            #[expect(
+                clippy::cast_possible_truncation,
+                reason = "d ≤ 1 below the wrap, so ⌊d · 2^20⌋ fits 21 bits"
+            )]
             let floor = (f64::from(d) * f64::from(1_u32 << 20)).floor() as u32;
             assert!(q == floor || q == floor + 1, "{d}: {q} vs {floor}");
             assert_eq!(q == 0xF_FFFF, k >= KEY_FIRST_ALL_ONES, "{d}");
@@ -167,8 +177,8 @@ fn memory_is_two_arrays_of_k_words_and_bad_parameters_are_errors() {
     assert!(MdtsPacked::new(viewport, 5, Colours::Prim, least).is_ok());
     assert!(matches!(
         MdtsPacked::new(viewport, 5, Colours::Prim, least - 1),
-        Err(CaptureError::TooMuchMemory { scheme, needed, .. })
-            if scheme == "mdts-packed" && needed == least
+        Err(CaptureError::TooMuchMemory { scheme: name, needed, .. })
+            if name == "mdts-packed" && needed == least
     ));
     assert!(matches!(
         MdtsPacked::new(viewport, 0, Colours::Scrambled, MEMORY_CAP_DEFAULT),
@@ -219,6 +229,11 @@ fn distinct_20_bit_depths_equal_the_oracle_on_both_executors() {
 /// here in f64), and 0 for the depths that wrap; never the fragment's exact depth.
 #[test]
 fn each_entry_carries_the_depth_its_20_bits_hold() {
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "narrowing is the point: the scheme remaps the depth in f32, as the judge shades \
+                  it"
+    )]
     let held = |k: u32| -> u32 {
         let remapped = (0.5 + 0.5 * f64::from(f32::from_bits(k))) as f32;
         if remapped >= 1.0 {
@@ -239,13 +254,16 @@ fn each_entry_carries_the_depth_its_20_bits_hold() {
     let fragments: Vec<Fragment> = keys
         .iter()
         .enumerate()
-        .map(|(i, &k)| fragment(0, k, i as u32))
+        .map(|(i, &k)| fragment(0, k, u32::try_from(i).expect("six keys")))
         .collect();
-    let capture = capture_of(&packed(keys.len() as u32), &fragments);
+    let capture = capture_of(
+        &packed(u32::try_from(keys.len()).expect("six keys")),
+        &fragments,
+    );
     // Nearest first by the 20 bits: the wrapped depth 1.0 (prim 5) leads, at depth 0.0.
     assert_eq!(prims(&capture, 0), [5, 2, 1, 3, 0, 4]);
     for &entry in capture.pixel(0) {
-        let k = keys[entry as u32 as usize];
+        let k = keys[prim_of(entry) as usize];
         assert_eq!((entry >> 32) as u32, held(k), "key {k:#x}");
         assert_ne!(
             (entry >> 32) as u32,
@@ -297,7 +315,7 @@ fn an_exact_depth_tie_on_the_bunny_rejoins_two_triangles_colour_halves() {
         .windows(2)
         .find(|w| w[0] >> 32 == w[1] >> 32)
         .expect("an exact tie");
-    let (a, b) = (pair[0] as u32, pair[1] as u32);
+    let (a, b) = (prim_of(pair[0]), prim_of(pair[1]));
     let scrambled =
         MdtsPacked::new(view.viewport(), k, Colours::Scrambled, MEMORY_CAP_DEFAULT).unwrap();
     let capture = run_parallel(&view, &scrambled).capture;
@@ -360,18 +378,18 @@ fn depth_one_and_the_depth_below_it_sort_as_nearest() {
     // With K = 1 the farthest fragment is kept instead of the nearest.
     assert_eq!(prims(&capture_of(&packed(1), &fragments), 0), [7]);
     // The largest depth that does not wrap sorts last, as it should.
-    let fragments = [
+    let last_unwrapped = [
         fragment(0, KEY_LAST_UNWRAPPED, 7),
         fragment(0, key(0.25), 9),
     ];
-    assert_eq!(prims(&capture_of(&packed(2), &fragments), 0), [9, 7]);
+    assert_eq!(prims(&capture_of(&packed(2), &last_unwrapped), 0), [9, 7]);
     // At depth 1.0 and depth 0.0 the words tie and the halves are rejoined across the two.
-    let fragments = [
+    let halves = [
         fragment(0, key(0.0), 0x001_002),
         fragment(0, KEY_ONE, 0x002_001),
     ];
     assert_eq!(
-        prims(&capture_of(&packed(2), &fragments), 0),
+        prims(&capture_of(&packed(2), &halves), 0),
         [0x001_001, 0x002_002]
     );
 }

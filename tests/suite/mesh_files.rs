@@ -82,7 +82,11 @@ fn binary_strips() -> Vec<u8> {
     for v in POSITIONS.iter().flatten() {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
-    bytes.extend_from_slice(&(STRIPS.len() as i32).to_le_bytes());
+    bytes.extend_from_slice(
+        &i32::try_from(STRIPS.len())
+            .expect("a few strips")
+            .to_le_bytes(),
+    );
     for i in STRIPS {
         bytes.extend_from_slice(&i.to_le_bytes());
     }
@@ -257,8 +261,8 @@ fn up_z_stands_a_z_up_model_as_its_y_up_twin() {
     let text = String::from_utf8_lossy(&compare.stdout);
     assert!(compare.status.success() && text.contains("EQUAL"), "{text}");
     // A bad axis is refused, naming the ones accepted.
-    let output = fragsim(&["--up", "w"], &z_up);
-    let stderr = String::from_utf8(output.stderr).unwrap();
-    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    let w_up = fragsim(&["--up", "w"], &z_up);
+    let stderr = String::from_utf8(w_up.stderr).unwrap();
+    assert_eq!(w_up.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("x, y, z, -x, -y or -z"), "{stderr}");
 }

@@ -39,6 +39,11 @@ fn fragments(view: &View<'_>) -> Vec<Fragment> {
 /// The rules evaluated directly at every sample of every pixel, for every piece of every
 /// triangle: the edge functions in i128 from the vertices, the top-left rule, the depth from
 /// the barycentrics. Sorted.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "narrowing is the point: the reference interpolates depth in f64 and keys its f32 \
+              rounding, as the pipeline does"
+)]
 fn direct_samples(view: &View<'_>, pattern: SamplePattern) -> Vec<Fragment> {
     let pixels = view.pixel_viewport();
     let n = pattern.count();
@@ -179,7 +184,11 @@ fn every_scheme_run_at_one_sample_captures_bit_for_bit_what_it_captures_today() 
                     memory_cap: MEMORY_CAP_DEFAULT,
                 };
                 for &executor in executors_used {
-                    let mut run = |view| runner.run(entry.scheme, executor, view, &sizing).unwrap();
+                    let mut run = |scene_view| {
+                        runner
+                            .run(entry.scheme, executor, scene_view, &sizing)
+                            .unwrap()
+                    };
                     let (today, sampled) = (run(&view), run(&centre));
                     assert_eq!(
                         today.run.capture, sampled.run.capture,
@@ -242,6 +251,7 @@ fn the_masked_node_abuffer_holds_the_per_pixel_view_within_capacity_and_drops_wh
             .max()
             .unwrap();
         assert!(deepest >= 4, "{deepest} nodes at most");
+        let deepest_nodes = u32::try_from(deepest).expect("a test view's deepest pixel");
         // Each node's mask and nearest key come from the per-sample oracle's samples.
         let covered: u64 = per_pixel
             .nodes
@@ -251,7 +261,7 @@ fn the_masked_node_abuffer_holds_the_per_pixel_view_within_capacity_and_drops_wh
         assert_eq!(covered, oracle.oracle().fragments() as u64);
         for parallel in [false, true] {
             let full =
-                MaskedABuffer::new(view.viewport(), count, deepest as u32, MEMORY_CAP_DEFAULT)
+                MaskedABuffer::new(view.viewport(), count, deepest_nodes, MEMORY_CAP_DEFAULT)
                     .unwrap();
             let captured = full.capture(&sampled, parallel).unwrap();
             assert_eq!(captured, per_pixel, "{count} samples, parallel {parallel}");
@@ -264,13 +274,13 @@ fn the_masked_node_abuffer_holds_the_per_pixel_view_within_capacity_and_drops_wh
                 .capture(&sampled, parallel)
                 .unwrap();
             for p in 0..per_pixel.pixels() {
-                let nodes = per_pixel.pixel(p).len() as u32;
+                let nodes = u32::try_from(per_pixel.pixel(p).len()).expect("a test view's nodes");
                 assert_eq!(
                     bounded.overflow[p],
                     nodes.saturating_sub(capacity),
                     "pixel {p}"
                 );
-                assert_eq!(bounded.pixel(p).len() as u32, nodes.min(capacity));
+                assert_eq!(bounded.pixel(p).len(), nodes.min(capacity) as usize);
                 assert!(bounded
                     .pixel(p)
                     .iter()
@@ -413,7 +423,7 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
 {
     let out = std::env::temp_dir().join(format!("fragsim-msaa-bench-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let today = |out: &std::path::Path| png(&out.join("bench-oracle-transparency.png"));
+    let today = |folder: &std::path::Path| png(&folder.join("bench-oracle-transparency.png"));
 
     let (code, record, stderr) = bench_with(&out, &["--samples", "1"]);
     assert_eq!(code, Some(0), "{stderr}");
@@ -430,8 +440,8 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
         today(&out)
     );
 
-    let (code, record, stderr) = bench_with(&out, &["--samples", "4"]);
-    assert_eq!(code, Some(0), "{stderr}");
+    let (code4, record4, stderr4) = bench_with(&out, &["--samples", "4"]);
+    assert_eq!(code4, Some(0), "{stderr4}");
     let resolved = png(&out.join("bench-oracle-transparency-msaa4.png"));
     let single = today(&out);
     let differing = resolved
@@ -440,12 +450,12 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
         .filter(|(a, b)| a != b)
         .count();
     assert!(differing > 100, "{differing} pixels changed");
-    assert_eq!(record["msaa"]["differing_pixels"], differing, "{record}");
-    let mixed = record["msaa"]["mixed_pixels"].as_u64().unwrap();
-    let layer_edges = record["msaa"]["layer_edge_pixels"].as_u64().unwrap();
-    assert!(0 < layer_edges && layer_edges < mixed, "{record}");
-    let fragments = record["msaa"]["sample_fragments"].as_u64().unwrap();
-    let single_fragments = record["oracle_fragments"].as_u64().unwrap();
+    assert_eq!(record4["msaa"]["differing_pixels"], differing, "{record4}");
+    let mixed = record4["msaa"]["mixed_pixels"].as_u64().unwrap();
+    let layer_edges = record4["msaa"]["layer_edge_pixels"].as_u64().unwrap();
+    assert!(0 < layer_edges && layer_edges < mixed, "{record4}");
+    let fragments = record4["msaa"]["sample_fragments"].as_u64().unwrap();
+    let single_fragments = record4["oracle_fragments"].as_u64().unwrap();
     assert!(fragments > 3 * single_fragments && fragments < 5 * single_fragments);
     // The difference figure's picture (its top-left 64 × 64) paints each differing pixel red.
     let figure = png(&out.join("bench-oracle-transparency-msaa4-diff.png"));
@@ -468,9 +478,9 @@ fn bench_samples_writes_the_resolved_image_equal_to_todays_at_one_sample_and_ref
             "transparency",
         ),
     ] {
-        let (code, _, stderr) = bench_with(&out, extra);
-        assert_eq!(code, Some(2), "{extra:?}: {stderr}");
-        assert!(stderr.contains(says), "{extra:?}: {stderr}");
+        let (refused_code, _, refused_stderr) = bench_with(&out, extra);
+        assert_eq!(refused_code, Some(2), "{extra:?}: {refused_stderr}");
+        assert!(refused_stderr.contains(says), "{extra:?}: {refused_stderr}");
     }
     std::fs::remove_dir_all(out).unwrap();
 }

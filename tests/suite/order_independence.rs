@@ -79,7 +79,7 @@ proptest! {
                 let sizing = Sizing { k: count, capacity, memory_cap: MEMORY_CAP_DEFAULT };
                 for executor in [Executor::Serial, Executor::Scheduled] {
                     let mut run =
-                        |view| runner.run(entry.scheme, executor, view, &sizing).unwrap();
+                        |scene_view| runner.run(entry.scheme, executor, scene_view, &sizing).unwrap();
                     let a = run(&view);
                     let owed = promises_order_independence(
                         a.guarantee, &a.run.capture.keeps, deepest, ties,
@@ -121,9 +121,9 @@ fn the_order_dependent_schemes_capture_a_shuffled_view_differently() {
         "kbuffer-interlock-ordered-first",
     ] {
         let scheme = SchemeName::from_name(name).unwrap();
-        let mut run = |view| {
+        let mut run = |scene_view| {
             runner
-                .run(scheme, Executor::Serial, view, &sizing)
+                .run(scheme, Executor::Serial, scene_view, &sizing)
                 .unwrap()
                 .run
                 .capture
@@ -160,6 +160,10 @@ impl SchemeVisitor for Serially<'_> {
 /// Scheme `name` with `K` = 1 and a capacity of 2, run serially on `stream` (one pixel), its
 /// primitive order the stream's; a linked list's pool holds the stream (an exhausted pool loses
 /// whichever fragment comes last, an order dependence of its own).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a stream has at most three fragments"
+)]
 fn captured(name: &str, stream: &[Fragment]) -> Vec<u64> {
     let order = PrimitiveOrder::of_fragments(1, stream);
     let counts = [stream.len() as u32];
@@ -222,7 +226,7 @@ fn smallest_disagreement(name: &str, distinct: bool) -> Option<Disagreement> {
                 .map(|i| Fragment {
                     pixel: 0,
                     depth_key: depth_key(depths[pick(i)]).unwrap(),
-                    prim: i as u32,
+                    prim: u32::try_from(i).expect("at most three fragments"),
                 })
                 .collect();
             let kept_first = captured(name, &stream);

@@ -20,7 +20,8 @@ use proptest::prelude::*;
 /// canonical order: what merging equal depths loses there.
 fn equal_depth_duplicates_at(oracle: &Oracle, p: usize) -> u32 {
     let list = oracle.pixel(p);
-    list.windows(2).filter(|w| w[0] >> 32 == w[1] >> 32).count() as u32
+    let duplicates = list.windows(2).filter(|w| w[0] >> 32 == w[1] >> 32).count();
+    u32::try_from(duplicates).expect("a test view's depth complexity")
 }
 
 /// What merging equal depths loses over the whole view.
@@ -33,7 +34,11 @@ fn equal_depth_duplicates(oracle: &Oracle) -> u64 {
 /// The largest number of distinct depth keys at any pixel: the layers of depth-key peeling.
 fn max_distinct_depths(oracle: &Oracle) -> u32 {
     (0..oracle.pixels())
-        .map(|p| oracle.pixel(p).len() as u32 - equal_depth_duplicates_at(oracle, p))
+        .map(|p| {
+            let fragments =
+                u32::try_from(oracle.pixel(p).len()).expect("a test view's depth complexity");
+            fragments - equal_depth_duplicates_at(oracle, p)
+        })
         .max()
         .unwrap_or(0)
 }
@@ -227,7 +232,7 @@ fn run_by_hand<S: Scheme<Input = Fragment>>(scheme: &S, fragments: &[Fragment]) 
     for seed in 0..8 {
         let schedule = Schedule {
             policy: Policy::Random,
-            in_flight: 1 + seed as usize % 3,
+            in_flight: 1 + usize::try_from(seed % 3).expect("below 3"),
             granularity: Granularity::Fragment,
             seed,
         };

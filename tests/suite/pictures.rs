@@ -66,8 +66,8 @@ fn the_heat_map_has_a_colour_bar_and_a_fixed_scale_and_the_depth_a_key() {
     // On a fixed scale of 6 fragments, 3 is halfway: no white pixel in the picture.
     let fixed = scratch("heat-fixed");
     run(&[&scene[..], &["--scale-max", "6"]].concat(), &fixed);
-    let heat = png(&fixed.join("depth-complexity.png"));
-    assert_eq!(picture_white(&heat), 0);
+    let fixed_heat = png(&fixed.join("depth-complexity.png"));
+    assert_eq!(picture_white(&fixed_heat), 0);
     // The nearest depth has its key beside it.
     let nearest = png(&own.join("nearest-depth.png"));
     assert!(nearest.width() > 32 + 100 && dark_beyond(&nearest, 40) > 100);
@@ -117,7 +117,7 @@ fn compare_draws_a_legend_and_zoomed_insets_of_the_first_differing_pixels() {
     let pixel = bytes.chunks_exact(8).position(|w| w != [0xff; 8]).unwrap();
     bytes[pixel * 8..pixel * 8 + 8].copy_from_slice(&[0xff; 8]);
     std::fs::write(&slots, &bytes).unwrap();
-    let output = Command::cargo_bin("fragsim")
+    let second_output = Command::cargo_bin("fragsim")
         .unwrap()
         .args(["compare", "oracle"])
         .arg(dumps.join("mdts"))
@@ -125,12 +125,12 @@ fn compare_draws_a_legend_and_zoomed_insets_of_the_first_differing_pixels() {
         .arg(&image)
         .output()
         .unwrap();
-    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(second_output.status.code(), Some(1));
     let different = png(&image);
     // The inset, 8× zoomed below the picture and the legend (whose nine entries end above
     // y = 280), shows the missing pixel's red over a block of 8 × 8 inside its outline.
-    let insets = |image: &RgbImage| {
-        image
+    let insets = |picture: &RgbImage| {
+        picture
             .enumerate_pixels()
             .filter(|&(_, y, p)| y > 280 && p.0 == [230, 40, 40])
             .count()

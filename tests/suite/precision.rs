@@ -5,6 +5,7 @@
 //! ambiguity excuses; with f64 vertex precision the verdict is today's exact one. Per sample the
 //! same holds at every sample of the standard 4× and 8× patterns (`per_sample`).
 
+use crate::support::prim_of;
 use fragsim::capture::{Capacity, Capture, Identity, Keeps};
 use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
 use fragsim::oracle::precision::{compare_within, Doubt, Precision};
@@ -49,6 +50,11 @@ fn with_f32_bunny_512(test: impl FnOnce(&Oracle, &Precision, &[Vec<u64>])) {
 
 /// Vertex `index` through an f32 vertex shader: the matrix rounded to f32, `M·v`, the divide
 /// and the viewport map in f32, snapped by rounding to the nearest subpixel.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an f32 vertex shader rounds the matrix to f32, and a test view's subpixel \
+              coordinates fit i64"
+)]
 fn f32_vertex(view: &View<'_>, index: u32) -> ([i64; 2], f64) {
     let m = view.view_projection().to_cols_array().map(|x| x as f32);
     let p = view.mesh().positions[index as usize];
@@ -245,7 +251,7 @@ fn a_depth_at_its_bound_passes_and_one_ulp_past_fails() {
             (q.key_lo - 1, false),
         ] {
             let mut moved = lists.clone();
-            let i = moved[p].iter().position(|&e| e as u32 == q.prim).unwrap();
+            let i = moved[p].iter().position(|&e| prim_of(e) == q.prim).unwrap();
             moved[p][i] = u64::from(key) << 32 | u64::from(q.prim);
             moved[p].sort_unstable();
             let judged = judge(&precision, oracle, &moved);
@@ -313,13 +319,13 @@ fn a_keep_first_list_may_keep_any_arrivals_but_not_lose_more() {
             .iter()
             .map(|list| list[list.len().saturating_sub(c)..].to_vec())
             .collect();
-        let keep_first = |lists: &[Vec<u64>]| {
+        let keep_first = |chosen: &[Vec<u64>]| {
             let keeps = Keeps::All {
-                capacity: Capacity::PerPixelUncounted(c as u32),
-                overflow: vec![0; lists.len()],
+                capacity: Capacity::PerPixelUncounted(u32::try_from(c).expect("a small capacity")),
+                overflow: vec![0; chosen.len()],
             };
-            let mut capture = Capture::with_pixels(lists.len(), Identity::KeyAndPrim, keeps);
-            for list in lists {
+            let mut capture = Capture::with_pixels(chosen.len(), Identity::KeyAndPrim, keeps);
+            for list in chosen {
                 capture.push_pixel(list.iter().copied());
             }
             compare_within(&precision, oracle, &capture, None, &options())
@@ -344,7 +350,7 @@ fn shared_edge_pixels(precision: &Precision, lists: &[Vec<u64>]) -> Vec<(usize, 
     let undecided = |p: usize, present: bool| {
         precision.pixel(p).iter().find(|q| {
             q.doubt == Some(Doubt::Coverage)
-                && lists[p].iter().any(|&w| w as u32 == q.prim) == present
+                && lists[p].iter().any(|&w| prim_of(w) == q.prim) == present
         })
     };
     (0..lists.len())
@@ -376,7 +382,7 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
         for &(p, present, absent) in shared.iter().take(8) {
             assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "pixel {p}");
             let mut dropped = lists.to_vec();
-            dropped[p].retain(|&w| w as u32 != present);
+            dropped[p].retain(|&w| prim_of(w) != present);
             let flags = judge(precision, oracle, &dropped).verdicts[p];
             assert_ne!(flags & flags::MISSING, 0, "pixel {p} dropped: {flags:#b}");
             let key_lo = precision
@@ -388,8 +394,12 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
             let mut doubled = lists.to_vec();
             doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
             doubled[p].sort_unstable();
-            let flags = judge(precision, oracle, &doubled).verdicts[p];
-            assert_ne!(flags & flags::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+            let doubled_flags = judge(precision, oracle, &doubled).verdicts[p];
+            assert_ne!(
+                doubled_flags & flags::EXTRA,
+                0,
+                "pixel {p} doubled: {doubled_flags:#b}"
+            );
         }
     });
 }
@@ -401,8 +411,8 @@ fn one_snap_per_vertex_decides_shared_edges_and_lets_no_dropped_or_doubled_fragm
 #[test]
 fn key_only_words_leave_the_triangle_unnamed_and_still_catch_a_dropped_or_doubled_fragment() {
     with_f32_bunny_512(|oracle, precision, lists| {
-        let key_only = |lists: &[Vec<u64>]| {
-            let capture = capture_as(lists, Identity::KeyOnly);
+        let key_only = |chosen: &[Vec<u64>]| {
+            let capture = capture_as(chosen, Identity::KeyOnly);
             compare_within(precision, oracle, &capture, None, &options())
         };
         let judged = key_only(lists);
@@ -417,15 +427,19 @@ fn key_only_words_leave_the_triangle_unnamed_and_still_catch_a_dropped_or_double
         for &(p, present, _) in shared.iter().take(8) {
             assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "pixel {p}");
             let mut dropped = lists.to_vec();
-            dropped[p].retain(|&w| w as u32 != present);
+            dropped[p].retain(|&w| prim_of(w) != present);
             let flags = key_only(&dropped).verdicts[p];
             assert_ne!(flags & flags::MISSING, 0, "pixel {p} dropped: {flags:#b}");
             let mut doubled = lists.to_vec();
-            let kept = *doubled[p].iter().find(|&&w| w as u32 == present).unwrap();
+            let kept = *doubled[p].iter().find(|&&w| prim_of(w) == present).unwrap();
             doubled[p].push(kept);
             doubled[p].sort_unstable();
-            let flags = key_only(&doubled).verdicts[p];
-            assert_ne!(flags & flags::EXTRA, 0, "pixel {p} doubled: {flags:#b}");
+            let doubled_flags = key_only(&doubled).verdicts[p];
+            assert_ne!(
+                doubled_flags & flags::EXTRA,
+                0,
+                "pixel {p} doubled: {doubled_flags:#b}"
+            );
         }
     });
 }

@@ -216,7 +216,7 @@ fn a_per_sample_f32_capture_is_judged_at_each_sample() {
         let header: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(abuffer.join("dump.json")).unwrap())
                 .unwrap();
-        let capacity = header["capacity"].as_u64().unwrap() as usize;
+        let capacity = usize::try_from(header["capacity"].as_u64().unwrap()).unwrap();
         let counters_file = abuffer.join("counters.u32");
         let mut counters: Vec<u32> = std::fs::read(&counters_file)
             .unwrap()

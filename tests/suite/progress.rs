@@ -51,9 +51,9 @@ fn sweep_draws_a_bar_on_a_terminal_and_none_when_piped_or_quiet() {
 
     let mut quiet = args.clone();
     quiet.push("--quiet".into());
-    let terminal = on_a_terminal(&quiet);
-    assert!(!terminal.contains("/24"), "{terminal}");
-    assert!(terminal.contains("mean EPR %"), "{terminal}");
+    let quiet_terminal = on_a_terminal(&quiet);
+    assert!(!quiet_terminal.contains("/24"), "{quiet_terminal}");
+    assert!(quiet_terminal.contains("mean EPR %"), "{quiet_terminal}");
 
     let piped = Command::cargo_bin("fragsim")
         .unwrap()

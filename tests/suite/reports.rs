@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::support::prim_of;
 use assert_cmd::Command;
 use fragsim_dump::{Dump, Words};
 
@@ -267,7 +268,7 @@ fn one_missing_fragment_marks_one_row_and_the_legend_counts_as_the_text() {
     let head = lists(&mut dump)[p][0];
     nodes(&mut dump)[head as usize - 1] = u64::from(2.0_f32.to_bits()) << 32;
     dump.write(&edited).unwrap();
-    let report = compare_with_oracle(&edited, &["--image", image.to_str().unwrap()]);
+    let second_report = compare_with_oracle(&edited, &["--image", image.to_str().unwrap()]);
     let count = |line: &str, name: &str| -> u64 {
         line.split(name)
             .nth(1)
@@ -275,26 +276,29 @@ fn one_missing_fragment_marks_one_row_and_the_legend_counts_as_the_text() {
             .and_then(|n| n.parse().ok())
             .unwrap_or_else(|| panic!("no {name} in {line}"))
     };
-    let pixels = report
+    let pixels = second_report
         .lines()
         .find(|l| l.starts_with("pixels "))
         .expect("the verdicts line");
-    let legend = report
+    let legend = second_report
         .lines()
         .find(|l| l.trim_start().starts_with("legend:"))
         .expect("the legend line");
-    assert_eq!(count(pixels, ", missing "), 1, "{report}");
+    assert_eq!(count(pixels, ", missing "), 1, "{second_report}");
     assert_eq!(
         count(legend, "; missing: "),
         count(pixels, ", missing "),
-        "{report}"
+        "{second_report}"
     );
     assert_eq!(
         count(legend, "corrupt word: "),
         count(pixels, "corrupt "),
-        "{report}"
+        "{second_report}"
     );
-    assert!(legend.contains("missing: 1 (1 drawn above)"), "{report}");
+    assert!(
+        legend.contains("missing: 1 (1 drawn above)"),
+        "{second_report}"
+    );
 }
 
 /// Issue 48, item 7: a hint when the differences have a shape that names a cause, and none
@@ -344,7 +348,7 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
         .iter()
         .map(|list| {
             list.iter()
-                .map(|&n| nodes(&mut edge)[n as usize - 1] as u32)
+                .map(|&n| prim_of(nodes(&mut edge)[n as usize - 1]))
                 .collect()
         })
         .collect();
@@ -374,26 +378,31 @@ fn a_mismatch_of_an_actionable_shape_gets_a_hint() {
     };
     let (p, node) = lost_at(false);
     unlink(&mut edge, p, node);
-    let report = judged(&edge, &[]);
+    let edge_report = judged(&edge, &[]);
     assert!(
-        hints(&report)
+        hints(&edge_report)
             .join("\n")
             .contains("on the edge of its triangle's coverage"),
-        "{report}"
+        "{edge_report}"
     );
     let mut inside = original.clone();
-    let (p, node) = lost_at(true);
-    unlink(&mut inside, p, node);
-    let report = judged(&inside, &[]);
-    assert!(report.contains("verdict: DIFFERENT"), "{report}");
-    assert!(hints(&report).is_empty(), "{report}");
+    let (inside_pixel, inside_node) = lost_at(true);
+    unlink(&mut inside, inside_pixel, inside_node);
+    let inside_report = judged(&inside, &[]);
+    assert!(
+        inside_report.contains("verdict: DIFFERENT"),
+        "{inside_report}"
+    );
+    assert!(hints(&inside_report).is_empty(), "{inside_report}");
     // The header names another view than the one drawn.
     let mut turned = original;
     turned.header.scene.view_degrees += 180.0;
-    let report = judged(&turned, &[]);
+    let turned_report = judged(&turned, &[]);
     assert!(
-        hints(&report).join("\n").contains("another scene or view"),
-        "{report}"
+        hints(&turned_report)
+            .join("\n")
+            .contains("another scene or view"),
+        "{turned_report}"
     );
     // `--json` carries the same hint, and the linked list's spare pool apart from the words a
     // header could have had checked.

@@ -176,12 +176,12 @@ fn sweep_and_bench_shards_are_the_unsharded_run() {
         );
         records(&dir.join(out).join("bench.jsonl"))
     };
-    let whole = bench("bench-whole", &[]);
-    assert_eq!(whole.len(), 10, "9 rows and the approximate one");
-    let shards = (1..=4)
+    let bench_whole = bench("bench-whole", &[]);
+    assert_eq!(bench_whole.len(), 10, "9 rows and the approximate one");
+    let bench_shards = (1..=4)
         .map(|i| bench(&format!("bench-{i}"), &["--shard", &format!("{i}/4")]))
         .collect();
-    assert_union(whole, shards, "bench");
+    assert_union(bench_whole, bench_shards, "bench");
 }
 
 #[test]

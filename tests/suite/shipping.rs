@@ -39,6 +39,10 @@ struct Stream {
     fragments: Vec<Fragment>,
 }
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "1 to 3 pixels and at most 20 fragments"
+)]
 fn stream() -> impl Strategy<Value = Stream> {
     (1_usize..=3).prop_flat_map(|pixels| {
         proptest::collection::vec((0..pixels as u32, 0_u32..6), 0..=20).prop_map(move |list| {
@@ -85,7 +89,7 @@ fn serial() -> Schedule {
 }
 
 fn viewport(pixels: usize) -> Viewport {
-    Viewport::new(pixels as u32, 1).expect("1 to 3 pixels")
+    Viewport::new(u32::try_from(pixels).expect("1 to 3 pixels"), 1).expect("1 to 3 pixels")
 }
 
 fn capture<S: Scheme<Input = Fragment>>(
@@ -176,7 +180,7 @@ proptest! {
         for (p, &n) in oracle.depth_complexity().iter().enumerate() {
             excess += u64::from(n.saturating_sub(layers));
             over += u64::from(n > layers);
-            prop_assert_eq!(got.pixel(p).len() as u32, n.min(layers));
+            prop_assert_eq!(got.pixel(p).len(), n.min(layers) as usize);
             if schedule.in_flight == 1 {
                 let mut first: Vec<u64> = stream
                     .fragments
@@ -218,7 +222,7 @@ proptest! {
                 .events
                 .iter()
                 .filter(|e| e.op == Op::Swap && e.pixel as usize == p)
-                .map(|e| stream.fragments[e.fragment as usize].packed())
+                .map(|e| stream.fragments[usize::try_from(e.fragment).expect("one of 20 fragments")].packed())
                 .collect();
             recent.reverse();
             recent.truncate(n as usize);
@@ -282,7 +286,7 @@ fn one_pixel(depths: &[u32]) -> Stream {
             .map(|(prim, &d)| Fragment {
                 pixel: 0,
                 depth_key: key(d),
-                prim: prim as u32,
+                prim: u32::try_from(prim).expect("a one-pixel list of a few depths"),
             })
             .collect(),
     }

@@ -19,8 +19,6 @@
 //! identical), 1 when `msaa-count` found differing counts, 2 on an error (no adapter, bad input,
 //! a sample count the adapter lacks).
 
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
-
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -7,8 +7,6 @@
 //! adapter each test prints one line saying it was skipped; with `CI=true` or
 //! `FRAGSIM_REQUIRE_GPU=1` it fails instead.
 
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
-
 use fragsim_dump::{Dump, Words};
 use fragsim_oracle::compare::flags;
 use fragsim_raster::conventions::VertexPrecision;

@@ -8,8 +8,6 @@
 // links the dev-dependencies that only the integration tests use. Not `print_stdout` and
 // `print_stderr`: this crate is the command line, whose job is printing.
 #![cfg_attr(not(test), warn(unused_crate_dependencies))]
-// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
 
 use std::ffi::OsString;
 use std::io::Write;

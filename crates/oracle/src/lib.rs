@@ -26,8 +26,6 @@
 // links the dev-dependencies that only the integration tests use.
 #![cfg_attr(not(test), warn(unused_crate_dependencies))]
 #![warn(clippy::print_stdout, clippy::print_stderr)]
-// Allowed in `[workspace.lints]` until every crate is through them (see the root Cargo.toml).
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
 
 pub mod compare;
 mod diff;

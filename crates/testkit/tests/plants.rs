@@ -9,8 +9,6 @@
 //! The plants are those of `crates/testkit/python/backend.py` (which `tests/suite/conform.rs`
 //! runs through the binary), here as a [`Backend`] so that CI runs all twenty in seconds.
 
-#![warn(clippy::cast_possible_truncation, clippy::shadow_unrelated)]
-
 use std::cell::Cell;
 
 use fragsim_capture::catalog::SchemeName;

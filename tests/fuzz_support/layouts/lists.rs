@@ -20,6 +20,7 @@ pub(super) fn linked_lists(
     let pixels = viewport.pixels();
     let k = k(input);
     let pool = 1 + usize::from(input.u8() % 8);
+    let pool_nodes = u32::try_from(pool).expect("a pool of 1 to 8 nodes");
     let (null, node_base) = match input.u8() % 3 {
         0 => (0, 1),
         1 => (u32::MAX, 0),
@@ -29,10 +30,10 @@ pub(super) fn linked_lists(
     // Faults 0 to 4: an array one word off, 5: the nodes in the other dtype, 6: the counter in
     // two words; any other value: none.
     let fault = input.u8() % 12;
-    let link = |input: &mut Input<'_>| match input.u8() {
+    let link = |bytes: &mut Input<'_>| match bytes.u8() {
         255 => u32::MAX,
         b if b & 3 == 0 => null,
-        b => node_base.wrapping_add(u32::from(b >> 2) % (pool as u32 + 2)),
+        b => node_base.wrapping_add(u32::from(b >> 2) % (pool_nodes + 2)),
     };
     let heads: Vec<u32> = (0..length(pixels, fault, 0)).map(|_| link(input)).collect();
     let next: Vec<u32> = (0..length(pool, fault, 1)).map(|_| link(input)).collect();
@@ -41,7 +42,7 @@ pub(super) fn linked_lists(
         .collect();
     let counter = match input.u8() {
         255 => u32::MAX,
-        b => u32::from(b) % (pool as u32 + 3),
+        b => u32::from(b) % (pool_nodes + 3),
     };
     let counters = if fault == 6 { 2 } else { 1 };
     arrays.push(("heads", Words::U32(heads.clone())));

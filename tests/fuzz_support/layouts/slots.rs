@@ -211,7 +211,7 @@ pub(super) fn slots(
     let outside = payload.map_or(0, |p| outside_fields(&p));
     let counters = arrays
         .iter()
-        .find_map(|(name, words)| match (*name, words) {
+        .find_map(|(name, array)| match (*name, array) {
             ("counters", Words::U32(c)) => Some(c.clone()),
             _ => None,
         });

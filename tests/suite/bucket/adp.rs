@@ -12,7 +12,7 @@ use super::{both, honest, predicted_loss, view_of};
 fn close_pair_scene(gap: f32) -> Scene {
     let mut mesh = Mesh::default();
     for (q, z) in [1.0, 0.5 + gap, 0.5, 0.0].into_iter().enumerate() {
-        let base = 4 * q as u32;
+        let base = 4 * u32::try_from(q).expect("four quads");
         mesh.positions.extend([
             [-1.0, -1.0, z],
             [1.0, -1.0, z],
@@ -114,8 +114,8 @@ fn adp_storage_below_the_depth_complexity_is_counted_as_overflow_not_hidden() {
         assert_eq!(run.stats.passes, 3, "10 buckets: one batch");
     }
     // 33 buckets: the second batch holds one layer, the rest overflows.
-    let adp = Adp::<u32>::for_depth(view.viewport(), 33).unwrap();
-    let run = run_parallel(&view, &adp);
+    let adp33 = Adp::<u32>::for_depth(view.viewport(), 33).unwrap();
+    let run = run_parallel(&view, &adp33);
     let diff = oracle.diff(&run.capture);
     assert!(diff.is_exact(), "{diff:?}");
     assert_eq!(run.stats.passes, 4);

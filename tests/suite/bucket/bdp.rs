@@ -28,7 +28,7 @@ fn bdp_pairs_are_exact_with_at_most_two_fragments_per_bucket_and_singles_with_on
     {
         let diff = oracle.diff(&run.capture);
         assert!(diff.is_exact(), "{diff:?}");
-        assert_eq!(diff.captured as usize, oracle.fragments());
+        assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
         assert_eq!(run.stats.passes, 2, "range pass + capture pass");
         assert_eq!(run.stats.counters.dropped, 0);
     }
@@ -54,8 +54,8 @@ fn bdp_collisions_lose_exactly_everything_but_each_buckets_min_and_max() {
             let diff = honest(&oracle, &run, "bdp");
             assert_eq!(diff.lost, predicted, "{count} buckets keeping {keeps}");
             assert_eq!(
-                diff.captured as usize,
-                oracle.fragments() - predicted as usize
+                diff.captured + predicted,
+                u64::try_from(oracle.fragments()).expect("a 32 × 32 view's fragments"),
             );
             // A walk that lost both of its own MAX tests knows it; later displacements it cannot.
             assert!(run.stats.counters.dropped <= predicted);
@@ -81,17 +81,20 @@ fn bdp2_is_exact_with_at_most_four_fragments_per_bucket_and_loses_only_the_middl
     }
     // Deeper: 5 or more in a bucket, and BDP2 keeps exactly the two smallest and two largest.
     let deep = Scene::procedural("quads:96").unwrap();
-    let view = view_of(&deep, 32);
-    let oracle = Oracle::build(&view);
-    let (predicted, most) = predicted_loss(&oracle, 16, 4, true);
-    assert!(most > 4 && predicted > 0);
-    let predicted64 = predicted_loss(&oracle, 16, 4, false).0;
-    let bdp2_64 = Bdp2::<u64>::paper(view.viewport()).unwrap();
-    for run in both(&view, &Bdp2::<u32>::paper(view.viewport()).unwrap()) {
-        assert_eq!(honest(&oracle, &run, "bdp2").lost, predicted);
+    let deep_view = view_of(&deep, 32);
+    let deep_oracle = Oracle::build(&deep_view);
+    let (predicted, deep_most) = predicted_loss(&deep_oracle, 16, 4, true);
+    assert!(deep_most > 4 && predicted > 0);
+    let predicted64 = predicted_loss(&deep_oracle, 16, 4, false).0;
+    let bdp2_64 = Bdp2::<u64>::paper(deep_view.viewport()).unwrap();
+    for run in both(
+        &deep_view,
+        &Bdp2::<u32>::paper(deep_view.viewport()).unwrap(),
+    ) {
+        assert_eq!(honest(&deep_oracle, &run, "bdp2").lost, predicted);
     }
-    for run in both(&view, &bdp2_64) {
-        assert_eq!(honest(&oracle, &run, "bdp2-64").lost, predicted64);
+    for run in both(&deep_view, &bdp2_64) {
+        assert_eq!(honest(&deep_oracle, &run, "bdp2-64").lost, predicted64);
     }
 }
 
@@ -103,7 +106,7 @@ fn one_pixel(depths: &[f32]) -> Vec<Fragment> {
         .map(|(prim, &d)| Fragment {
             pixel: 0,
             depth_key: depth_key(d).unwrap(),
-            prim: prim as u32,
+            prim: u32::try_from(prim).expect("a one-pixel list of a few depths"),
         })
         .collect()
 }
@@ -143,16 +146,17 @@ fn hand_built_bucket_of_five_loses_what_each_scheme_cannot_hold() {
         let (single, _) = captured_depths(&Bdp::<u32>::singles(vp).unwrap(), &fragments, seed);
         // 32 buckets of 0.025: 0.5 … 0.504 still share one; its largest survives.
         assert_eq!(single, vec![0.1, 0.504, 0.9]);
-        let (bdp2, passes) = captured_depths(&Bdp2::<u32>::paper(vp).unwrap(), &fragments, seed);
+        let (bdp2, bdp2_passes) =
+            captured_depths(&Bdp2::<u32>::paper(vp).unwrap(), &fragments, seed);
         assert_eq!(
-            (bdp2, passes),
+            (bdp2, bdp2_passes),
             (vec![0.1, 0.5, 0.5001, 0.503, 0.504, 0.9], 3)
         );
-        let (adp, passes) =
+        let (adp, adp_passes) =
             captured_depths(&Adp::<u32>::for_depth(vp, 8).unwrap(), &fragments, seed);
         // Subintervals 0, 512 (0.5 and 0.5001: the farther wins), 513, 514, 515, 517, 1023.
         assert_eq!(
-            (adp, passes),
+            (adp, adp_passes),
             (vec![0.1, 0.5001, 0.501, 0.502, 0.503, 0.504, 0.9], 3)
         );
     }

@@ -38,9 +38,9 @@ proptest! {
             (run_serial(&view, &Adp::<u64>::for_depth(vp, depth).unwrap()), ADP_SUBINTERVALS, 1, false),
             (run_serial(&view, &Adp::<u32>::for_depth(vp, depth).unwrap()), ADP_SUBINTERVALS, 1, true),
         ];
-        for (run, count, keeps, key_only) in cases {
+        for (run, buckets, keeps, key_only) in cases {
             let diff = honest(&oracle, &run, "soup");
-            prop_assert_eq!(diff.lost, predicted_loss(&oracle, count, keeps, key_only).0);
+            prop_assert_eq!(diff.lost, predicted_loss(&oracle, buckets, keeps, key_only).0);
             prop_assert_eq!(diff.overflowed, 0);
         }
     }

@@ -93,7 +93,9 @@ fn exact_subinterval(key: u32, near: u32, far: u32, count: u32) -> u32 {
     assert!(d >= lo && d <= hi, "the depth lies in its pixel's range");
     let k = u128::from(count) * (d - lo) / (hi - lo);
     // The exact range puts its farthest fragment at `count`: the last subinterval is closed.
-    (k as u32).min(count - 1)
+    u32::try_from(k)
+        .expect("k = count · (d − lo) / (hi − lo) with lo ≤ d ≤ hi is at most count, a u32")
+        .min(count - 1)
 }
 
 /// Routes a depth key to a subinterval: `(key, near, far, count) -> index`.

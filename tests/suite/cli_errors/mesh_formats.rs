@@ -16,7 +16,11 @@ fn gzip_stored(data: &[u8]) -> Vec<u8> {
     out.extend((!len).to_le_bytes());
     out.extend(data);
     out.extend(crc.to_le_bytes());
-    out.extend((data.len() as u32).to_le_bytes());
+    out.extend(
+        u32::try_from(data.len())
+            .expect("a test file of a few bytes")
+            .to_le_bytes(),
+    );
     out
 }
 
@@ -68,11 +72,11 @@ fn ply_errors_name_ply_not_obj() {
     let faceless = QUAD_PLY
         .replace("element face 1", "element face 0")
         .replace("4 0 1 2 3\n", "");
-    let path = obj_file("faceless.ply", faceless.as_bytes());
-    let path = path.to_str().unwrap();
+    let faceless_path = obj_file("faceless.ply", faceless.as_bytes());
+    let faceless_path = faceless_path.to_str().unwrap();
     assert_refused(
-        &["--mesh", path],
-        &[&format!("PLY {path} has no triangles")],
+        &["--mesh", faceless_path],
+        &[&format!("PLY {faceless_path} has no triangles")],
     );
 }
 
@@ -85,14 +89,17 @@ fn utf16_and_binary_files_are_refused_saying_what_they_are_not() {
     let path = path.to_str().unwrap();
     assert_refused(&["--mesh", path], &[path, "not OBJ text", "UTF-16"]);
     let no_bom: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
-    let path = obj_file("utf16-no-bom.obj", &no_bom);
-    let path = path.to_str().unwrap();
-    assert_refused(&["--mesh", path], &[path, "not OBJ text", "UTF-16"]);
-    let path = obj_file("binary.obj", &[b'v', b' ', 0x00, 0x01, 0x9F, 0x80, b'\n']);
-    let path = path.to_str().unwrap();
+    let no_bom_path = obj_file("utf16-no-bom.obj", &no_bom);
+    let no_bom_path = no_bom_path.to_str().unwrap();
     assert_refused(
-        &["--mesh", path],
-        &[path, "not OBJ text", "binary data", "offset 2"],
+        &["--mesh", no_bom_path],
+        &[no_bom_path, "not OBJ text", "UTF-16"],
+    );
+    let binary_path = obj_file("binary.obj", &[b'v', b' ', 0x00, 0x01, 0x9F, 0x80, b'\n']);
+    let binary_path = binary_path.to_str().unwrap();
+    assert_refused(
+        &["--mesh", binary_path],
+        &[binary_path, "not OBJ text", "binary data", "offset 2"],
     );
 }
 
@@ -122,6 +129,6 @@ fn a_scene_entirely_outside_the_view_warns_and_exits_0() {
     assert!(stderr.contains("warning: "), "{stderr}");
     assert!(stderr.contains("covers a pixel"), "{stderr}");
     // A visible scene gets no such warning.
-    let output = fragsim(&["--scene", "quads:2"]);
-    assert!(!String::from_utf8_lossy(&output.stderr).contains("warning"));
+    let quads_output = fragsim(&["--scene", "quads:2"]);
+    assert!(!String::from_utf8_lossy(&quads_output.stderr).contains("warning"));
 }

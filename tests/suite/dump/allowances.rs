@@ -12,6 +12,7 @@ use fragsim::dump::{Dump, Words};
 use super::binary::{fragsim, stdout_of};
 use super::soundness::compared;
 use super::{scratch, SCENE};
+use crate::support::prim_of;
 
 /// The viewport's side: the test scene at 48 × 48 has pixels deeper than K = 2 at every layout.
 const SIDE: &str = "48";
@@ -99,35 +100,35 @@ fn exact_storage_owes_room_for_every_fragment_whatever_its_offsets_say() {
     assert_eq!(offsets[p + 1] - offsets[p], counters[p]);
 
     let cut = copy_of(&path, "cut-by-one");
-    rewrite(&cut, |dump| {
+    rewrite(&cut, |copy| {
         let mut offsets = offsets.clone();
         for offset in &mut offsets[p + 1..] {
             *offset -= 1;
         }
-        let mut slots = u64s(dump, "slots");
+        let mut slots = u64s(copy, "slots");
         slots.remove(offsets[p + 1] as usize);
         let total = slots.len() as u64;
-        dump.set_array(
+        copy.set_array(
             "offsets",
             Words::U32(offsets.clone()),
             vec![offsets.len() as u64],
         );
-        dump.set_array("slots", Words::U64(slots), vec![total]);
+        copy.set_array("slots", Words::U64(slots), vec![total]);
     });
     let report = different(&cut, "room cut by one");
     assert_eq!(report["lost"], 1, "{report}");
     assert_eq!(report["corrupt_words"], 1, "the room is named: {report}");
 
     let none = copy_of(&path, "no-room");
-    rewrite(&none, |dump| {
+    rewrite(&none, |copy| {
         let zeros = vec![0; offsets.len()];
-        dump.set_array("offsets", Words::U32(zeros), vec![offsets.len() as u64]);
-        dump.set_array("slots", Words::U64(Vec::new()), vec![0]);
+        copy.set_array("offsets", Words::U32(zeros), vec![offsets.len() as u64]);
+        copy.set_array("slots", Words::U64(Vec::new()), vec![0]);
     });
-    let report = different(&none, "offsets all zero");
+    let zeroed_report = different(&none, "offsets all zero");
     let fragments: u64 = counters.iter().map(|&c| u64::from(c)).sum();
-    assert_eq!(report["lost"], fragments, "{report}");
-    assert_eq!(report["captured"], 0, "{report}");
+    assert_eq!(zeroed_report["lost"], fragments, "{zeroed_report}");
+    assert_eq!(zeroed_report["captured"], 0, "{zeroed_report}");
 }
 
 /// Each pixel's `k` slots of `slots` (pixel-major) replaced by `pick` of the pixel's full list
@@ -149,12 +150,12 @@ type Pick = fn(&mut [u64]);
 
 /// Orders a pixel's fragments by primitive id, first submitted first.
 fn by_primitive(list: &mut [u64]) {
-    list.sort_unstable_by_key(|&w| w as u32);
+    list.sort_unstable_by_key(|&w| prim_of(w));
 }
 
 /// Orders a pixel's fragments by primitive id, last submitted first.
 fn by_primitive_last_first(list: &mut [u64]) {
-    list.sort_unstable_by_key(|&w| std::cmp::Reverse(w as u32));
+    list.sort_unstable_by_key(|&w| std::cmp::Reverse(prim_of(w)));
 }
 
 /// Orders a pixel's fragments nearest first.
@@ -241,8 +242,8 @@ fn a_linked_list_counter_is_the_scenes_fragment_count_whatever_the_pool() {
         assert_eq!(Some(u64::from(n)), dump.header.pool, "{scheme}: pool of N");
         for counter in [n + 1, 2 * n, u32::MAX, n - 1, 0] {
             let mutant = copy_of(&path, &format!("{scheme}-counter-{counter}"));
-            rewrite(&mutant, |dump| {
-                dump.set_array("counter", Words::U32(vec![counter]), vec![1]);
+            rewrite(&mutant, |copy| {
+                copy.set_array("counter", Words::U32(vec![counter]), vec![1]);
             });
             different(&mutant, &format!("{scheme} counter {counter} of {n}"));
         }

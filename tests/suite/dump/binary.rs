@@ -83,7 +83,7 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
     bytes[first * 8] ^= 1;
     std::fs::write(&slots, bytes).unwrap();
     let image = dir.join("diff.png");
-    let text = stdout_of(
+    let corrupted_text = stdout_of(
         fragsim()
             .args(["compare", "oracle"])
             .arg(dumps.join("mdts"))
@@ -91,8 +91,14 @@ fn the_binary_dumps_compares_and_exits_0_only_when_equal() {
             .arg(&image),
         1,
     );
-    assert!(text.contains("missing 1, extra 1"), "{text}");
-    assert!(text.contains("verdict: DIFFERENT"), "{text}");
+    assert!(
+        corrupted_text.contains("missing 1, extra 1"),
+        "{corrupted_text}"
+    );
+    assert!(
+        corrupted_text.contains("verdict: DIFFERENT"),
+        "{corrupted_text}"
+    );
     assert!(image.exists());
     let json = stdout_of(
         fragsim()
@@ -148,12 +154,12 @@ fn the_binary_calls_a_word_written_after_an_empty_slot_corrupt_never_equal() {
     ];
     for (scheme, file, width, empty, verdicts) in layouts {
         let path = dumps.join(scheme);
-        let k = json_report(&path, 0)[0]["candidate_k"].as_u64().unwrap() as usize;
+        let k = usize::try_from(json_report(&path, 0)[0]["candidate_k"].as_u64().unwrap()).unwrap();
         let slots = path.join(file);
         let mut bytes = std::fs::read(&slots).unwrap();
-        let word = |bytes: &[u8], i: usize| {
+        let word = |raw: &[u8], i: usize| {
             let mut le = [0_u8; 8];
-            le[..width].copy_from_slice(&bytes[i * width..(i + 1) * width]);
+            le[..width].copy_from_slice(&raw[i * width..(i + 1) * width]);
             u64::from_le_bytes(le)
         };
         // A pixel whose first slot is full and whose last two are empty; its last slot gets a
@@ -318,12 +324,12 @@ fn the_export_takes_renders_conventions() {
 fn render_dumps_every_scheme_or_nothing() {
     let dir = scratch("binary-all");
     let dumps = dir.join("dumps");
-    let render = |dumps: &Path| {
+    let render = |into: &Path| {
         fragsim()
             .args(["render", "--scene", SCENE, "--scheme", "all"])
             .args(SIZE)
             .args(["--no-images", "--dump"])
-            .arg(dumps)
+            .arg(into)
             .output()
             .unwrap()
     };

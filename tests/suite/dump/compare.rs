@@ -60,13 +60,13 @@ fn compare_names_missing_extra_and_misordered_pixels_and_agrees_with_the_diff() 
             oracle.pixel(holed).len().min(k) as u64 - 2,
             "every word behind the hole"
         );
-        let whole = oracle.diff(&capture);
+        let diff = oracle.diff(&capture);
         assert_eq!(
             (
-                whole.lost,
-                whole.extra,
-                whole.misordered_pixels,
-                whole.mismatched_pixels
+                diff.lost,
+                diff.extra,
+                diff.misordered_pixels,
+                diff.mismatched_pixels
             ),
             (
                 comparison.diff.lost,
@@ -106,13 +106,13 @@ fn abuffer_overflow_by_design_is_equal_but_an_overstated_counter_is_caught() {
             Some(Words::U32(c)) => c[deep] += 1,
             _ => panic!("no counters"),
         }
-        let comparison = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
-        assert!(!comparison.is_equal());
+        let miscounted = compare::compare(oracle, &dump.capture().unwrap(), 0, 8);
+        assert!(!miscounted.is_equal());
         assert_eq!(
-            comparison.verdicts[deep] & flags::MISCOUNTED,
+            miscounted.verdicts[deep] & flags::MISCOUNTED,
             flags::MISCOUNTED
         );
-        assert_eq!(comparison.counts.miscounted, 1);
+        assert_eq!(miscounted.counts.miscounted, 1);
     });
 }
 
@@ -262,9 +262,12 @@ fn an_abuffer_word_past_its_counter_is_corrupt_when_the_header_says_slots_were_f
         // FreePipe leaves spare slots uninitialised: without the promise nothing is known of
         // them, and the report says how many words went unread instead of judging them.
         dump.header.filled = false;
-        let whole = judged(&dump, oracle);
-        assert!(whole.is_equal());
-        assert_eq!((whole.corrupt_words, whole.unchecked_words), (0, unused));
+        let unfilled = judged(&dump, oracle);
+        assert!(unfilled.is_equal());
+        assert_eq!(
+            (unfilled.corrupt_words, unfilled.unchecked_words),
+            (0, unused)
+        );
     });
 }
 

@@ -113,7 +113,10 @@ impl Grid {
             assert!(list.len() <= c, "pixel {p} holds more than {c} fragments");
             slots[p * c..p * c + list.len()].copy_from_slice(list);
         }
-        let counters = lists.iter().map(|l| l.len() as u32).collect();
+        let counters = lists
+            .iter()
+            .map(|l| u32::try_from(l.len()).expect("at most CAPACITY fragments a pixel"))
+            .collect();
         dump.arrays.insert("slots".into(), Words::U64(slots));
         dump.arrays.insert("counters".into(), Words::U32(counters));
         let dir = self.dir.join(name);
@@ -234,8 +237,8 @@ fn a_declared_edge_tie_rule_is_owed() {
         let record = compared(&declared, options, 0);
         assert_eq!(record["equal"], true, "{options:?}: {record}");
         assert_eq!(record["edge_ties"], "bottom-right", "{options:?}: {record}");
-        let record = compared(&other, options, 1);
-        assert_eq!(record["equal"], false, "{options:?}: {record}");
+        let other_record = compared(&other, options, 1);
+        assert_eq!(other_record["equal"], false, "{options:?}: {other_record}");
     }
 }
 
@@ -266,7 +269,7 @@ fn a_tie_on_an_edge_leaving_the_viewport_may_fall_either_way_under_f32_precision
     let record = compared(&dir, &[], 1);
     assert_eq!(record["equal"], false, "{record}");
     assert_eq!(record["mismatched_pixels"], 1, "{record}");
-    let record = compared(&dir, &["--vertex-precision", "f32"], 0);
-    assert_eq!(record["equal"], true, "{record}");
-    assert_eq!(record["ambiguous_pixels"], 1, "{record}");
+    let f32_record = compared(&dir, &["--vertex-precision", "f32"], 0);
+    assert_eq!(f32_record["equal"], true, "{f32_record}");
+    assert_eq!(f32_record["ambiguous_pixels"], 1, "{f32_record}");
 }

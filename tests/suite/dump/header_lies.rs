@@ -116,8 +116,8 @@ fn mesh_on_a_named_scene_dump_is_refused_unless_it_replaces_the_scene() {
 #[test]
 fn a_shape_that_fits_only_transposed_is_named_so() {
     let dir = dumped("lies-transposed", "mdts", &["--dump-order", "slot-major"]);
-    let shape = |dir: &Path| -> serde_json::Value {
-        let text = std::fs::read_to_string(dir.join("dump.json")).unwrap();
+    let shape = |at: &Path| -> serde_json::Value {
+        let text = std::fs::read_to_string(at.join("dump.json")).unwrap();
         serde_json::from_str::<serde_json::Value>(&text).unwrap()["arrays"]["slots"]["shape"]
             .clone()
     };

@@ -129,7 +129,7 @@ fn a_linked_list_cycle_is_a_corrupt_pixel_found_in_one_walk() {
 fn links_out_of_the_pool_or_to_unallocated_nodes_are_corrupt() {
     with_view(|view, oracle| {
         let (mut dump, p) = lists(view, oracle);
-        let pool = u32s(&mut dump, "next").len() as u32;
+        let pool = u32::try_from(u32s(&mut dump, "next").len()).expect("a test scene's pool");
         let mut out = dump.clone();
         u32s(&mut out, "heads")[p] = pool + 1;
         assert_eq!(corrupt_at(&out, oracle, p), vec![Corruption::OutOfPool]);
@@ -188,6 +188,11 @@ fn a_vulkan_samples_linked_list_reads_as_fragsims() {
         let Some(Words::U64(nodes)) = dump.arrays.get("nodes") else {
             panic!("no nodes")
         };
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "a depth in [0, 1] scaled to 2^24 - 1 fits u32, and the 8-bit id is the \
+                      entry's low byte"
+        )]
         let unorm = |w: u64| {
             let depth = f64::from(f32::from_bits((w >> 32) as u32));
             let q = (depth * 16_777_215.0).round() as u32;
@@ -219,7 +224,7 @@ fn a_vulkan_samples_linked_list_reads_as_fragsims() {
             // original of its id within half a quantum (and a little for the f32 rounding).
             for &got in a {
                 assert!(
-                    b.iter().any(|&want| got as u8 == want as u8
+                    b.iter().any(|&want| got & 0xFF == want & 0xFF
                         && (depth(got) - depth(want)).abs() <= 0.6 / 16_777_215.0),
                     "pixel {p}: {got:#x} is no fragment's"
                 );

@@ -135,10 +135,10 @@ proptest! {
             }
         }
         // Read as an f32 (report fields), the same decimal rounds once, to the nearest f32.
-        let nearest: f32 = decimal.parse().unwrap();
+        let nearest_f32: f32 = decimal.parse().unwrap();
         match serde_json::from_str::<f32>(&decimal) {
-            Ok(got) => prop_assert_eq!(got.to_bits(), nearest.to_bits(), "{} read as f32 {}, nearest is {}", decimal, got, nearest),
-            Err(e) => prop_assert!(nearest.is_infinite(), "{}: {}", decimal, e),
+            Ok(got) => prop_assert_eq!(got.to_bits(), nearest_f32.to_bits(), "{} read as f32 {}, nearest is {}", decimal, got, nearest_f32),
+            Err(e) => prop_assert!(nearest_f32.is_infinite(), "{}: {}", decimal, e),
         }
     }
 }
@@ -191,8 +191,11 @@ fn a_nan_or_infinite_scene_number_is_refused_by_name_when_writing() {
                 mesh_triangles: 0,
                 triangles: Vec::new(),
             };
-            let error = export.to_bytes().unwrap_err().to_string();
-            assert!(error.contains(name), "{name} = {bad}: {error}");
+            let export_error = export.to_bytes().unwrap_err().to_string();
+            assert!(
+                export_error.contains(name),
+                "{name} = {bad}: {export_error}"
+            );
         }
     }
     assert!(dump_with_scene([30.0, 15.0, 45.0, 1.5]).encode().is_ok());

@@ -50,10 +50,10 @@ fn regression_dump_parse_refuses_array_file_names_that_leave_the_dump_directory(
         );
         let dir = scratch("bad-file-name");
         std::fs::write(dir.join("dump.json"), header).unwrap();
-        let error = Dump::read(&dir).unwrap_err().to_string();
+        let read_error = Dump::read(&dir).unwrap_err().to_string();
         assert!(
-            error.contains("must be a plain file name"),
-            "{file:?}: {error}"
+            read_error.contains("must be a plain file name"),
+            "{file:?}: {read_error}"
         );
     }
 }

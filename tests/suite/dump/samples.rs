@@ -122,9 +122,9 @@ fn a_dropped_sample_fragment_a_wrong_mask_bit_and_a_dropped_node_are_different()
     assert_eq!(records[0]["corrupt_words"], 0, "{:?}", records[0]);
     assert_eq!(records[1]["pixel"], arrays.pixel, "{:?}", records[1]);
     arrays.write_lost_node();
-    let report = &json_report(&masked, 1)[0];
-    assert_eq!(report["lost"], 1, "{report}");
-    assert_eq!(report["missing_pixels"], 1, "{report}");
+    let lost_report = &json_report(&masked, 1)[0];
+    assert_eq!(lost_report["lost"], 1, "{lost_report}");
+    assert_eq!(lost_report["missing_pixels"], 1, "{lost_report}");
 }
 
 /// A masked-node dump's arrays as written, and the first pixel that stored a node: the plants
@@ -270,15 +270,15 @@ fn an_f32_masked_node_dump_is_judged_a_sample_at_a_time_and_a_wrong_mask_a_lost_
 
     let arrays = MaskedArrays::read(&masked);
     arrays.write_wrong_mask();
-    let record = compared(&masked, &f32, 1);
-    assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
+    let wrong_mask = compared(&masked, &f32, 1);
+    assert_eq!(wrong_mask["per_sample_differing_pixels"], 1, "{wrong_mask}");
     arrays.write_stray_key();
-    let record = compared(&masked, &f32, 1);
-    assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
+    let stray_key = compared(&masked, &f32, 1);
+    assert_eq!(stray_key["per_sample_differing_pixels"], 1, "{stray_key}");
     arrays.write_lost_node();
-    let record = compared(&masked, &f32, 1);
-    assert_eq!(record["per_sample_differing_pixels"], 1, "{record}");
-    assert!(record["lost"].as_u64().unwrap() >= 1, "{record}");
+    let lost_node = compared(&masked, &f32, 1);
+    assert_eq!(lost_node["per_sample_differing_pixels"], 1, "{lost_node}");
+    assert!(lost_node["lost"].as_u64().unwrap() >= 1, "{lost_node}");
 }
 
 /// `render`'s line on the masked-node A-buffer and `compare oracle` on the dump of that run give

@@ -114,6 +114,10 @@ fn every_slot_layout_in_either_order_and_payload_round_trips_and_compares_equal(
 fn quantised(word: u64, bits: u32) -> u64 {
     let steps = f64::from((1_u32 << bits) - 1);
     let depth = f64::from(f32::from_bits((word >> 32) as u32));
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "narrowing is the point: the format reads a unorm depth back as the nearest f32"
+    )]
     let back = ((depth * steps).round() / steps) as f32;
     u64::from(back.to_bits()) << 32 | (word & 0xFFFF_FFFF)
 }
@@ -209,17 +213,20 @@ fn a_mutated_slot_major_word_is_caught_and_named_as_stored() {
             capacity: k,
             sorted: false,
         };
-        let mut dump = Dump::record(view, spec(), &abuffer, "test")
+        let mut abuffer_dump = Dump::record(view, spec(), &abuffer, "test")
             .unwrap()
             .in_layout(Some(layout))
             .unwrap();
-        let Some(Words::U64(slots)) = dump.arrays.get_mut("slots") else {
+        let Some(Words::U64(abuffer_slots)) = abuffer_dump.arrays.get_mut("slots") else {
             panic!("u64 slots")
         };
-        slots[pixels + holed] = u64::MAX;
-        let check = dump.check_words().unwrap();
-        assert_eq!(check.corrupt[holed][0].why, Corruption::EmptyCounted);
-        assert_eq!(check.corrupt_words(), 1);
+        abuffer_slots[pixels + holed] = u64::MAX;
+        let abuffer_check = abuffer_dump.check_words().unwrap();
+        assert_eq!(
+            abuffer_check.corrupt[holed][0].why,
+            Corruption::EmptyCounted
+        );
+        assert_eq!(abuffer_check.corrupt_words(), 1);
     });
 }
 
@@ -234,7 +241,7 @@ fn refused(dump: &Dump, edit: impl FnOnce(&mut serde_json::Value)) -> String {
             .cloned()
             .ok_or_else(|| DumpError::Invalid(format!("no {file}")))
     });
-    match parsed.and_then(|dump| dump.capture().map(|_| dump)) {
+    match parsed.and_then(|read| read.capture().map(|_| read)) {
         Ok(_) => panic!("accepted: {header}"),
         Err(error) => error.to_string(),
     }
@@ -311,17 +318,23 @@ fn a_bad_slot_layout_field_is_an_error_naming_it() {
             counts: oracle.depth_complexity(),
             sorted: false,
         });
-        let error = refused(&exact, |h| h["layout"] = slot_major.clone());
-        assert!(error.contains("\"order\" must be pixel-major"), "{error}");
+        let exact_error = refused(&exact, |h| h["layout"] = slot_major.clone());
+        assert!(
+            exact_error.contains("\"order\" must be pixel-major"),
+            "{exact_error}"
+        );
         // A slot-major array one slot short of the scheme's.
-        let error = refused(&mdts, |h| {
+        let mdts_error = refused(&mdts, |h| {
             h["layout"] = slot_major.clone();
             h["k"] = json!(k + 1);
         });
         let named = format!("array \"slots\": shape [1728, {k}] disagrees with the header's \"k\" {}, which makes it [{}, 1728]", k + 1, k + 1);
-        assert!(error.contains(&named), "{error}");
-        let error = refused(&kbuffer, |h| h["k"] = json!(0));
-        assert!(error.contains("scheme kbuffer needs \"k\" ≥ 1"), "{error}");
+        assert!(mdts_error.contains(&named), "{mdts_error}");
+        let kbuffer_error = refused(&kbuffer, |h| h["k"] = json!(0));
+        assert!(
+            kbuffer_error.contains("scheme kbuffer needs \"k\" ≥ 1"),
+            "{kbuffer_error}"
+        );
     });
 }
 
@@ -394,8 +407,8 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     let mut schemes = 0;
     for entry in std::fs::read_dir(&own).unwrap() {
         let name = entry.unwrap().file_name();
-        let (theirs, code) = compare_record(&engine.join(&name));
-        let (ours, own_code) = compare_record(&own.join(&name));
+        let (engine_record, code) = compare_record(&engine.join(&name));
+        let (own_record, own_code) = compare_record(&own.join(&name));
         assert_eq!(code, own_code, "{name:?}");
         for field in [
             "equal",
@@ -405,7 +418,7 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
             "extra",
             "corrupt_words",
         ] {
-            assert_eq!(theirs[field], ours[field], "{name:?}: {field}");
+            assert_eq!(engine_record[field], own_record[field], "{name:?}: {field}");
         }
         schemes += 1;
     }
@@ -432,14 +445,16 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     // written) is DIFFERENT under either promise, never excused as overflow.
     for scheme in ["kbuffer", "kbuffer-interlock-ordered-first"] {
         let path = own.join(scheme);
-        let k = json_header(&path)["k"].as_u64().unwrap() as usize;
+        let dump_k = usize::try_from(json_header(&path)["k"].as_u64().unwrap()).unwrap();
         let slots = path.join("slots.u64");
         let mut bytes = std::fs::read(&slots).unwrap();
-        let word = |bytes: &[u8], i: usize| bytes[i * 8..i * 8 + 8] == [0xff; 8];
-        let p = (0..bytes.len() / 8 / k)
-            .find(|&p| !word(&bytes, p * k))
+        let is_empty = |file: &[u8], i: usize| file[i * 8..i * 8 + 8] == [0xff; 8];
+        let first_written = (0..bytes.len() / 8 / dump_k)
+            .find(|&candidate| !is_empty(&bytes, candidate * dump_k))
             .unwrap();
-        let last = (p * k..(p + 1) * k).rfind(|&i| !word(&bytes, i)).unwrap();
+        let last = (first_written * dump_k..(first_written + 1) * dump_k)
+            .rfind(|&i| !is_empty(&bytes, i))
+            .unwrap();
         bytes[last * 8..last * 8 + 8].copy_from_slice(&[0xff; 8]);
         std::fs::write(&slots, bytes).unwrap();
         let (record, code) = compare_record(&path);
@@ -478,25 +493,29 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     let unorm16 = dir.join("u64-unorm16-32-32").join("mdts");
     let slots = unorm16.join("slots.u64");
     let written = std::fs::read(&slots).unwrap();
-    let word = |i: usize| u64::from_le_bytes(written[i * 8..i * 8 + 8].try_into().unwrap());
+    let unorm16_word = |i: usize| u64::from_le_bytes(written[i * 8..i * 8 + 8].try_into().unwrap());
     let pixels = 48 * 36;
     let farthest = (0..pixels)
-        .map(|p| pixels + p)
-        .find(|&i| word(i) != u64::MAX && word(i + pixels) == u64::MAX && word(i) >> 32 < 0xFFF0)
+        .map(|pixel| pixels + pixel)
+        .find(|&i| {
+            unorm16_word(i) != u64::MAX
+                && unorm16_word(i + pixels) == u64::MAX
+                && unorm16_word(i) >> 32 < 0xFFF0
+        })
         .expect("a pixel holding two fragments");
     for (steps, code) in [(1, 0), (2, 1)] {
         let mut bytes = written.clone();
-        let moved = word(farthest) + (steps << 32);
+        let moved = unorm16_word(farthest) + (steps << 32);
         bytes[farthest * 8..farthest * 8 + 8].copy_from_slice(&moved.to_le_bytes());
         std::fs::write(&slots, bytes).unwrap();
         assert_eq!(compare_record(&unorm16).1, code, "{steps} steps deeper");
     }
     // One flipped bit of a slot-major word: exit 1.
-    let slots = engine.join("mdts").join("slots.u64");
-    let mut bytes = std::fs::read(&slots).unwrap();
+    let flipped = engine.join("mdts").join("slots.u64");
+    let mut bytes = std::fs::read(&flipped).unwrap();
     let first = bytes.chunks_exact(8).position(|w| w != [0xff; 8]).unwrap();
     bytes[first * 8] ^= 1;
-    std::fs::write(&slots, bytes).unwrap();
+    std::fs::write(&flipped, bytes).unwrap();
     assert_eq!(compare_record(&engine.join("mdts")).1, 1);
     // A bad field in the header, or a payload that does not fit its word: exit 2, naming it.
     let path = engine.join("mdts-desc").join("dump.json");
@@ -511,15 +530,18 @@ fn render_dump_writes_every_scheme_in_an_engines_encoding_and_compare_judges_it_
     assert_eq!(output.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("unknown variant `diagonal`"), "{stderr}");
-    let output = fragsim()
+    let refused = fragsim()
         .args(["render", "--scene", SCENE, "--no-images", "--dump"])
         .arg(dir.join("refused"))
         .args(["--dump-payload", "u32:f32:8:8"])
         .output()
         .unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(stderr.contains("does not fit a 32-bit word"), "{stderr}");
+    assert_eq!(refused.status.code(), Some(2));
+    let refused_stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        refused_stderr.contains("does not fit a 32-bit word"),
+        "{refused_stderr}"
+    );
 }
 
 #[test]

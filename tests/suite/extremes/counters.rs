@@ -8,6 +8,7 @@ use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, OrbitCamera, Scene};
 
 use super::{assert_exact, identity_view, viewport};
+use crate::support::prim_of;
 
 #[test]
 fn cuda_atomic_inc_past_capacity_overwrites_silently_where_fetch_add_counts_the_drop() {
@@ -86,11 +87,21 @@ fn atomic_inc_on_ten_thousand_coincident_fragments_keeps_only_the_remainder() {
         triangles: vec![[0, 1, 2]; n as usize - 1],
         ..mesh.clone()
     };
-    let view = identity_view(&fewer, 1, 1);
-    let run = run_serial(&view, &inc);
-    let prims: Vec<u32> = run.capture.pixel(0).iter().map(|&w| w as u32).collect();
+    let fewer_view = identity_view(&fewer, 1, 1);
+    let fewer_run = run_serial(&fewer_view, &inc);
+    let prims: Vec<u32> = fewer_run
+        .capture
+        .pixel(0)
+        .iter()
+        .map(|&w| prim_of(w))
+        .collect();
     assert_eq!(prims, (9992..9999).collect::<Vec<_>>());
-    let fixed = ABuffer::fixed(view.viewport(), 8, PostSort::Insertion, MEMORY_CAP_DEFAULT);
-    let run = run_serial(&view, &fixed.unwrap());
-    assert_eq!(run.stats.counters.dropped, u64::from(n) - 1 - 8);
+    let fixed = ABuffer::fixed(
+        fewer_view.viewport(),
+        8,
+        PostSort::Insertion,
+        MEMORY_CAP_DEFAULT,
+    );
+    let fixed_run = run_serial(&fewer_view, &fixed.unwrap());
+    assert_eq!(fixed_run.stats.counters.dropped, u64::from(n) - 1 - 8);
 }

@@ -80,13 +80,13 @@ fn non_finite_vertices_are_stopped_by_mesh_validation_and_by_the_pipeline() {
         assert!(mesh.validate("hand-built").is_err());
         let view = identity_view(&mesh, 8, 8);
         assert!(all_fragments(&view).is_empty(), "{bad}");
-        let view = View::new(
+        let perspective_view = View::new(
             &mesh,
             &perspective(0.1, 10.0),
             viewport(8, 8),
             CullMode::None,
         );
-        assert!(all_fragments(&view).is_empty(), "{bad}");
+        assert!(all_fragments(&perspective_view).is_empty(), "{bad}");
     }
 }
 

@@ -13,6 +13,7 @@ use super::{
     all_fragments, assert_exact, coverage, identity_view, perspective, soup, square, viewport,
     MAX_KEY,
 };
+use crate::support::prim_of;
 
 #[test]
 fn degenerate_triangles_produce_no_fragments() {
@@ -46,7 +47,7 @@ fn sliver_triangles_tile_the_screen_without_cracks_or_overlaps() {
     let n = 1000;
     let mut triangles: Vec<[[f32; 3]; 3]> = (0..n)
         .map(|i| {
-            let x = |i: usize| -1.0 + 2.0 * i as f32 / n as f32;
+            let x = |step: usize| -1.0 + 2.0 * step as f32 / n as f32;
             [[-1.0, 1.0, 0.5], [x(i), -1.0, 0.5], [x(i + 1), -1.0, 0.5]]
         })
         .collect();
@@ -71,8 +72,8 @@ fn vertices_at_1e7_are_clipped_to_the_guard_band_and_cover_the_screen_once() {
             .iter()
             .all(|f| f.depth_key == depth_key(0.5).unwrap()));
     }
-    let mesh = soup(&[[[-1e7, -1e7, 0.25], [3e7, -1e7, 0.25], [-1e7, 3e7, 0.25]]]);
-    assert!(coverage(&identity_view(&mesh, 33, 17))
+    let huge = soup(&[[[-1e7, -1e7, 0.25], [3e7, -1e7, 0.25], [-1e7, 3e7, 0.25]]]);
+    assert!(coverage(&identity_view(&huge, 33, 17))
         .iter()
         .all(|&c| c == 1));
 }
@@ -209,8 +210,8 @@ fn a_piece_with_a_vertex_at_w_0_is_dropped_as_documented() {
     assert!(all_fragments(&view).is_empty());
     // In front of w = 0 the same projection draws (depth z / w = 1 everywhere).
     let in_front = soup(&[[[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, 1.0]]]);
-    let view = View::new(&in_front, &camera, viewport(16, 16), CullMode::None);
-    let fragments = all_fragments(&view);
+    let in_front_view = View::new(&in_front, &camera, viewport(16, 16), CullMode::None);
+    let fragments = all_fragments(&in_front_view);
     assert!(!fragments.is_empty());
     assert!(fragments.iter().all(|f| f.depth_key == MAX_KEY));
 }
@@ -223,7 +224,8 @@ fn keys_of_layers(camera: &Camera, distances: &[f32]) -> (Vec<u32>, Mesh) {
         .collect();
     let mesh = soup(&triangles);
     let view = View::new(&mesh, camera, viewport(1, 1), CullMode::None);
-    let keys = (0..distances.len() as u32)
+    let layers = u32::try_from(distances.len()).expect("ten layers");
+    let keys = (0..layers)
         .map(|layer| {
             let mut key = None;
             for prim in [2 * layer, 2 * layer + 1] {
@@ -249,10 +251,10 @@ fn a_near_far_ratio_of_1e_minus_7_merges_distinct_layers_ordered_by_primitive() 
         distinct.len()
     );
     // With near/far = 1e-2 they are all distinct.
-    let (keys, _) = keys_of_layers(&perspective(1e-2, 1.0), &distances);
-    let mut distinct = keys.clone();
-    distinct.dedup();
-    assert_eq!(distinct.len(), distances.len());
+    let (far_keys, _) = keys_of_layers(&perspective(1e-2, 1.0), &distances);
+    let mut far_distinct = far_keys.clone();
+    far_distinct.dedup();
+    assert_eq!(far_distinct.len(), distances.len());
     // Merged layers are still captured exactly: equal keys in primitive order, as the oracle.
     let camera = perspective(1e-7, 1.0);
     let (_, mesh) = keys_of_layers(&camera, &[0.9, 0.8, 0.7, 0.6, 0.5]);
@@ -280,7 +282,7 @@ fn two_layers_closer_than_one_ulp_keep_both_in_primitive_order() {
         assert_eq!(list.len(), 2, "pixel {p}");
         assert_eq!(list[0] >> 32, list[1] >> 32);
         assert!(
-            (list[0] as u32) < 2 && (list[1] as u32) >= 2,
+            prim_of(list[0]) < 2 && prim_of(list[1]) >= 2,
             "pixel {p}: {list:x?}"
         );
     }

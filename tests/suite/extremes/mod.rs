@@ -40,6 +40,10 @@ fn perspective(near: f64, far: f64) -> Camera {
 }
 
 /// A mesh of unshared triangles, primitive id = position in `triangles`.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a hand-built soup has a few thousand triangles at most"
+)]
 fn soup(triangles: &[[[f32; 3]; 3]]) -> Mesh {
     Mesh {
         positions: triangles.iter().flatten().copied().collect(),

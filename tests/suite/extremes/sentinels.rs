@@ -149,9 +149,9 @@ fn a_signed_atomic_min_sees_the_librarys_empty_value_as_minus_one_and_keeps_noth
     let sorted: Vec<u32> = sorted.iter().map(|d| d.to_bits()).collect();
     assert_eq!(kept, sorted);
     assert!(outcomes.iter().all(|&o| o == Step::Stored));
-    let (kept, outcomes) = mdts32_run::<SignedMin>(&keys);
-    assert_eq!(kept, [] as [u32; 0]);
-    assert_eq!(outcomes, [Step::Stored; 4], "no walk notices");
+    let (signed_kept, signed_outcomes) = mdts32_run::<SignedMin>(&keys);
+    assert_eq!(signed_kept, [] as [u32; 0]);
+    assert_eq!(signed_outcomes, [Step::Stored; 4], "no walk notices");
 }
 
 /// `proof.md`'s cast to integer: with a unorm conversion, `round(d · (2^32 − 1))`, depth 1.0
@@ -160,6 +160,10 @@ fn a_signed_atomic_min_sees_the_librarys_empty_value_as_minus_one_and_keeps_noth
 /// reinterpretation the library uses (`depth_key`) keeps depth 1.0 at `0x3F800000`.
 #[test]
 fn a_unorm_depth_one_equals_the_empty_value_and_vanishes_from_the_librarys_mdts() {
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a depth in [0, 1] scaled to u32::MAX fits u32"
+    )]
     let unorm = |d: f64| (d * f64::from(u32::MAX)).round() as u32;
     let empty = Mdts::<u32>::new(viewport(1, 1), 4, Direction::Ascending, MEMORY_CAP_DEFAULT)
         .unwrap()

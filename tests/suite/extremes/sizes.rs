@@ -172,10 +172,15 @@ fn a_scene_with_zero_triangles_is_a_clear_error() {
         err.contains("nothing") && err.contains("no triangles"),
         "{err}"
     );
-    let err =
+    let points_err =
         Mesh::read_obj(&mut "v 0 0 0\nv 1 0 0\nv 1 1 0\n".as_bytes(), "points.obj").unwrap_err();
-    assert!(matches!(err, MeshError::Empty { .. }), "{err}");
-    assert!(err.to_string().contains("points.obj has no triangles"));
+    assert!(
+        matches!(points_err, MeshError::Empty { .. }),
+        "{points_err}"
+    );
+    assert!(points_err
+        .to_string()
+        .contains("points.obj has no triangles"));
 }
 
 #[test]

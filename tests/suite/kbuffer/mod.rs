@@ -163,9 +163,9 @@ fn constructors_reject_k_zero_no_passes_and_too_much_memory() {
     let least = layouts[1].0.least_bytes();
     assert!(KBuffer::new(v, 8, least).is_ok());
     assert!(too_much(KBuffer::new(v, 8, least - 1).map(drop)));
-    let least = layouts[3].0.least_bytes();
-    assert!(StencilRouted::new(v, 2, least).is_ok());
-    assert!(too_much(StencilRouted::new(v, 2, least - 1).map(drop)));
+    let least3 = layouts[3].0.least_bytes();
+    assert!(StencilRouted::new(v, 2, least3).is_ok());
+    assert!(too_much(StencilRouted::new(v, 2, least3 - 1).map(drop)));
 }
 
 // ---------------------------------------------------------------- random scenes
@@ -205,20 +205,20 @@ proptest! {
         prop_assert_eq!(diff.overflowed, run.stats.counters.dropped);
 
         let multipass = KBufferMultipass::new(view.viewport(), k, d, MEMORY_CAP_DEFAULT).unwrap();
-        let run = run_serial(&view, &multipass);
-        let diff = oracle.diff(&run.capture);
-        prop_assert!(diff.is_exact(), "multipass: {diff:?}");
-        prop_assert_eq!(diff.captured as usize, oracle.fragments());
-        prop_assert_eq!(run.stats.passes, serial_passes(&oracle, k));
+        let multipass_run = run_serial(&view, &multipass);
+        let multipass_diff = oracle.diff(&multipass_run.capture);
+        prop_assert!(multipass_diff.is_exact(), "multipass: {multipass_diff:?}");
+        prop_assert_eq!(usize::try_from(multipass_diff.captured), Ok(oracle.fragments()));
+        prop_assert_eq!(multipass_run.stats.passes, serial_passes(&oracle, k));
 
         let srab = StencilRouted::new(view.viewport(), srab_passes, MEMORY_CAP_DEFAULT).unwrap();
-        let run = run_serial(&view, &srab);
-        let diff = oracle.diff(&run.capture);
-        prop_assert!(diff.is_exact(), "srab: {diff:?}");
+        let srab_run = run_serial(&view, &srab);
+        let srab_diff = oracle.diff(&srab_run.capture);
+        prop_assert!(srab_diff.is_exact(), "srab: {srab_diff:?}");
         let capacity = 8 * srab_passes;
         let overflow: u64 = oracle.depth_complexity().iter().map(|&n| u64::from(n.saturating_sub(capacity))).sum();
-        prop_assert_eq!(diff.overflowed, overflow);
-        prop_assert_eq!(run.stats.counters.dropped, overflow);
-        prop_assert_eq!(run.stats.passes, srab_passes.min(d.div_ceil(8).max(1)));
+        prop_assert_eq!(srab_diff.overflowed, overflow);
+        prop_assert_eq!(srab_run.stats.counters.dropped, overflow);
+        prop_assert_eq!(srab_run.stats.passes, srab_passes.min(d.div_ceil(8).max(1)));
     }
 }

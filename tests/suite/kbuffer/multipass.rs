@@ -67,7 +67,7 @@ fn multipass_kbuffer_is_exact_serially_with_the_output_predicted_pass_by_pass() 
                 let run = run_serial(view, &scheme);
                 let diff = oracle.diff(&run.capture);
                 assert!(diff.is_exact(), "k = {k}: {diff:?}");
-                assert_eq!(diff.captured as usize, oracle.fragments());
+                assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
                 assert_eq!(run.stats.passes, serial_passes(&oracle, k), "k = {k}");
                 assert_eq!(run.stats.counters.dropped, 0);
                 // Pass by pass, in submission order, each pixel's output as predicted.
@@ -78,7 +78,8 @@ fn multipass_kbuffer_is_exact_serially_with_the_output_predicted_pass_by_pass() 
                     pass += 1;
                     for (p, &n) in counts.iter().enumerate() {
                         assert_eq!(
-                            captured_now(&scheme, &memory, p) as u32,
+                            u32::try_from(captured_now(&scheme, &memory, p))
+                                .expect("at most k fragments"),
                             output_after_passes(n, k, pass),
                             "pixel {p} of {n} fragments after {pass} passes, K = {k}"
                         );
@@ -119,7 +120,7 @@ fn multipass_under_random_interleavings_is_exact_in_at_least_the_serial_passes()
                 loop {
                     // Every walk of the pass in flight at once, stepped in random order.
                     let more = drive_pass(&scheme, &memory, pass, &all, |n| {
-                        (rng.next_u64() % n as u64) as usize
+                        usize::try_from(rng.next_u64() % n as u64).expect("below n")
                     });
                     pass += 1;
                     for (p, seen) in before.iter_mut().enumerate() {
@@ -174,7 +175,7 @@ fn multipass_under_lockstep_pays_for_the_hazards_with_passes_and_loses_nothing()
         passes += 1;
         let diff = oracle.diff(&scheme.resolve(&memory));
         assert!(diff.is_exact(), "{write_back:?}: {diff:?}");
-        assert_eq!(diff.captured as usize, oracle.fragments());
+        assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
         let serial = serial_passes(&oracle, 2);
         assert_eq!(serial, 3);
         assert!(passes > serial, "{write_back:?}: {passes} passes");
@@ -202,7 +203,7 @@ fn multipass_on_the_bunny_under_the_scheduled_executor_loses_nothing_in_at_least
                 run.stats.passes
             );
             assert!(diff.is_exact(), "K = {k}, {write_back:?}: {diff:?}");
-            assert_eq!(diff.captured as usize, oracle.fragments());
+            assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
             assert!(run.stats.passes >= serial, "K = {k}, {write_back:?}");
             assert!(run.stats.passes <= 2 * d + 1, "K = {k}, {write_back:?}");
         }

@@ -182,7 +182,8 @@ fn three_fragments_show_each_machines_failure_classes() {
                 .map(|_| {
                     let mut script: Vec<usize> = (0..18).map(|i| i / 6).collect();
                     for i in (1..script.len()).rev() {
-                        script.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+                        let j = rng.next_u64() % (i as u64 + 1);
+                        script.swap(i, usize::try_from(j).expect("at most i"));
                     }
                     script
                 })

@@ -28,7 +28,7 @@ fn srab_equals_the_oracle_where_depth_complexity_is_at_most_8() {
                 let diff = oracle.diff(&run.capture);
                 assert!(diff.is_exact(), "{diff:?}");
                 assert_eq!((diff.overflowed, run.stats.passes), (0, 1));
-                assert_eq!(diff.captured as usize, oracle.fragments());
+                assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
             }
         }
     }
@@ -54,7 +54,7 @@ fn srab_reports_exactly_the_ninth_fragment_as_overflow() {
         };
         for (p, &n) in complexity.iter().enumerate() {
             assert_eq!(overflow[p], n.saturating_sub(8), "pixel {p}");
-            assert_eq!(run.capture.pixel(p).len() as u32, n.min(8), "pixel {p}");
+            assert_eq!(run.capture.pixel(p).len(), n.min(8) as usize, "pixel {p}");
         }
     }
     // A second geometry pass routes the ninth; on the serial executor it is exact.
@@ -63,7 +63,7 @@ fn srab_reports_exactly_the_ninth_fragment_as_overflow() {
     let diff = oracle.diff(&run.capture);
     assert!(diff.is_exact(), "{diff:?}");
     assert_eq!((diff.overflowed, run.stats.passes), (0, 2));
-    assert_eq!(diff.captured as usize, oracle.fragments());
+    assert_eq!(usize::try_from(diff.captured), Ok(oracle.fragments()));
     // One spelling whatever the passes: the catalog's.
     assert_eq!((srab.name(), two.name()), ("srab".into(), "srab".into()));
 }

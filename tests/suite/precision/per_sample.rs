@@ -13,6 +13,7 @@ use fragsim::raster::{
 };
 
 use super::{capture_of, certain_pixel, f32_vertex, judge, options, shared_edge_pixels, F32};
+use crate::support::prim_of;
 
 /// The bunny at `width × height` rasterized per sample at `samples` (the standard pattern) under
 /// `vertex_precision`, the rest of the reference conventions.
@@ -45,6 +46,11 @@ fn with_sampled_bunny(
 /// owning the samples exactly on it when it is a top or left edge of the positively oriented
 /// triangle (y down), depth interpolated in f64 and rounded once to f32. One sorted list per sample
 /// of the sample-expanded framebuffer.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "narrowing is the point: an engine keys the f32 rounding of its depth; sample \
+              coordinates are of a test view, so they fit usize"
+)]
 fn engine_like_samples(view: &View<'_>) -> Vec<Vec<u64>> {
     let pattern = view.samples().expect("a per-sample view");
     let pixels = view.pixel_viewport();
@@ -168,7 +174,7 @@ fn a_dropped_sample_and_a_sample_depth_past_its_interval_are_different_per_sampl
         with_f32_samples((64, 48), samples, |oracle, precision, [lists, _]| {
             let p = certain_pixel(precision, &lists);
             let q = precision.pixel(p)[0];
-            let i = lists[p].iter().position(|&w| w as u32 == q.prim).unwrap();
+            let i = lists[p].iter().position(|&w| prim_of(w) == q.prim).unwrap();
             let mut dropped = lists.clone();
             dropped[p].remove(i);
             let mut deeper = lists.clone();
@@ -211,7 +217,7 @@ fn per_sample_joint_snaps_decide_shared_edges_and_catch_a_dropped_or_doubled_sam
         for &(p, present, absent) in shared.iter().take(8) {
             assert_eq!(judged.verdicts[p] & flags::AMBIGUOUS, 0, "sample {p}");
             let mut dropped = lists.clone();
-            dropped[p].retain(|&w| w as u32 != present);
+            dropped[p].retain(|&w| prim_of(w) != present);
             let flags = judge(precision, oracle, &dropped).verdicts[p];
             assert_ne!(flags & flags::MISSING, 0, "sample {p} dropped: {flags:#b}");
             let key_lo = precision
@@ -223,8 +229,12 @@ fn per_sample_joint_snaps_decide_shared_edges_and_catch_a_dropped_or_doubled_sam
             let mut doubled = lists.clone();
             doubled[p].push(u64::from(key_lo) << 32 | u64::from(absent));
             doubled[p].sort_unstable();
-            let flags = judge(precision, oracle, &doubled).verdicts[p];
-            assert_ne!(flags & flags::EXTRA, 0, "sample {p} doubled: {flags:#b}");
+            let doubled_flags = judge(precision, oracle, &doubled).verdicts[p];
+            assert_ne!(
+                doubled_flags & flags::EXTRA,
+                0,
+                "sample {p} doubled: {doubled_flags:#b}"
+            );
         }
     });
 }

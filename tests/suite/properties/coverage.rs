@@ -124,7 +124,8 @@ fn check_robust_coverage(
     let wrong: Vec<(u32, u32, Option<u32>, u32)> = (0..got.len())
         .filter(|&p| got[p] > 1 || expected[p].is_some_and(|e| e != got[p]))
         .map(|p| {
-            let (x, y) = (p as u32 % viewport.width, p as u32 / viewport.width);
+            let index = u32::try_from(p).expect("a pixel of a test viewport");
+            let (x, y) = (index % viewport.width, index / viewport.width);
             (x, y, expected[p], got[p])
         })
         .take(8)
@@ -198,7 +199,7 @@ fn strategy_building_blocks() {
     for n in 1..=3 {
         let mesh = crate::support::strategies::lattice_cube(n, &[true, false, false]);
         assert!(is_closed(&mesh));
-        assert_eq!(mesh.triangles.len() as u32, 12 * n * n);
+        assert_eq!(mesh.triangles.len(), 12 * n as usize * n as usize);
     }
     let open = Mesh {
         positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
@@ -223,9 +224,9 @@ fn closed_scenes_are_in_view() {
         name: "cube".into(),
         mesh: crate::support::strategies::lattice_cube(2, &[false, true]),
     };
-    let counts = coverage(&cube.view(viewport, &OrbitCamera::default()).unwrap());
-    assert_eq!(counts.iter().max(), Some(&2));
-    assert!(odd_pixels(&counts).is_empty());
+    let cube_counts = coverage(&cube.view(viewport, &OrbitCamera::default()).unwrap());
+    assert_eq!(cube_counts.iter().max(), Some(&2));
+    assert!(odd_pixels(&cube_counts).is_empty());
 }
 
 /// Coverage of `mesh` through the identity camera: per pixel, how many of its triangles cover

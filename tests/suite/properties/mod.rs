@@ -130,7 +130,8 @@ fn check_tiling(viewport: Viewport, tiling: &PlanarTiling) -> Result<(), TestCas
     let wrong: Vec<(u32, u32, u32, u32)> = (0..got.len())
         .filter(|&p| got[p] != expected[p])
         .map(|p| {
-            let (x, y) = (p as u32 % viewport.width, p as u32 / viewport.width);
+            let index = u32::try_from(p).expect("a pixel of a test viewport");
+            let (x, y) = (index % viewport.width, index / viewport.width);
             (x, y, expected[p], got[p])
         })
         .take(8)

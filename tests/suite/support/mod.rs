@@ -5,6 +5,7 @@
 //!   re-exported so that the suites keep their `crate::support::strategies` paths).
 //! - [`json_lines`]: the records of a `--json` output (`docs/json-schema.md`).
 //! - [`scratch`]: a fresh directory for a test's files.
+//! - [`prim_of`]: the primitive id of a packed entry.
 
 pub(crate) use fragsim_testkit::strategies;
 
@@ -31,4 +32,14 @@ pub(crate) fn scratch(group: &str, name: &str) -> std::path::PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// The primitive id of a packed entry (a depth key over a primitive id in one u64): its low 32
+/// bits, the depth key above them dropped.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "an entry packs its primitive id in the low 32 bits; keeping just those is the point"
+)]
+pub(crate) const fn prim_of(entry: u64) -> u32 {
+    entry as u32
 }

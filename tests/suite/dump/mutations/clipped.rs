@@ -20,6 +20,7 @@ use fragsim::raster::scene_spec::{SceneSpec, ViewProjection};
 use fragsim::raster::{Conventions, Viewport};
 
 use super::{run_battery, scratch, Judge, Layout, CAPACITY, K, UNORM24};
+use crate::support::prim_of;
 
 /// Two ground strips 6 units wide from 2 units behind the eye to 30 ahead, at `y = 0`
 /// (primitives 0 and 1) and `y = 0.1` (2 and 3), and a post 3 units ahead standing through both
@@ -57,6 +58,10 @@ fn normalized(a: [f64; 3]) -> [f64; 3] {
 /// `(0, −0.2, −1)`): a right-handed view and a Vulkan projection (depth in [0, 1]) of 60° with
 /// the near plane at 0.1 and the far one at 100, their product's entries the f32 values a uniform
 /// holds (the matrix of `backends/wgpu/tests/clipped.rs`, built without glam).
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "narrowing is the point: the engine's matrix holds each f64 product rounded to f32"
+)]
 fn engine_matrix() -> ViewProjection {
     let (near, far) = (0.1, 100.0);
     let focal = 1.0 / 30_f64.to_radians().tan();
@@ -97,7 +102,9 @@ fn mutants_of_clipped_triangles_are_different_exactly_and_under_f32() {
     let scene = spec.load(None).unwrap();
     let viewport = Viewport::new(64, 48).unwrap();
     let view = spec.view(&scene, viewport).unwrap();
-    let clipped = (0..scene.mesh.triangles.len() as u32)
+    let triangle_count =
+        u32::try_from(scene.mesh.triangles.len()).expect("a ground of a few strips");
+    let clipped = (0..triangle_count)
         .filter(|&prim| view.clipped(prim).is_some())
         .count();
     assert_eq!(clipped, CLIPPED, "the ground's triangles are clipped");
@@ -109,11 +116,11 @@ fn mutants_of_clipped_triangles_are_different_exactly_and_under_f32() {
         "every clipped triangle analysed"
     );
     // The mutants' sites are pixels of two fragments or more: each holds a clipped one.
-    let prim = |word: &u64| *word as u32;
+    let clipped_prims = u32::try_from(CLIPPED).expect("a few clipped triangles");
     assert!(
         (0..oracle.pixels())
             .filter(|&p| oracle.pixel(p).len() >= 2)
-            .all(|p| oracle.pixel(p).iter().any(|w| prim(w) < CLIPPED as u32)),
+            .all(|p| oracle.pixel(p).iter().any(|&w| prim_of(w) < clipped_prims)),
         "every pixel two fragments deep holds a clipped one"
     );
     let exact_conventions = Conventions {
@@ -132,7 +139,7 @@ fn mutants_of_clipped_triangles_are_different_exactly_and_under_f32() {
     let engine_lists = DumpScheme::LinkedLists {
         scheme: SchemeName::LinkedList,
         k: K,
-        pool: oracle.fragments() as u32 + 8,
+        pool: u32::try_from(oracle.fragments()).expect("a 64 × 48 view's fragments") + 8,
         spec: LayoutSpec::FRAGSIM_LISTS,
     };
     let schemes: [(&str, DumpScheme, Option<LayoutSpec>); 5] = [
@@ -176,7 +183,7 @@ fn mutants_of_clipped_triangles_are_different_exactly_and_under_f32() {
         .into_iter()
         .map(|(name, scheme, encoding)| {
             let unorm = encoding.is_some_and(
-                |spec| matches!(spec, LayoutSpec::Slots { payload: Some(p), .. } if p == UNORM24),
+                |layout| matches!(layout, LayoutSpec::Slots { payload: Some(p), .. } if p == UNORM24),
             );
             let (exact, within) = if unorm {
                 (unorm_exact.clone(), unorm_f32.clone())

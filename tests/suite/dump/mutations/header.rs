@@ -101,7 +101,7 @@ impl Conflict {
                 } else if header.get("capacity").is_some() && arrays.contains_key("slots") {
                     let pixels =
                         header["width"].as_u64().unwrap() * header["height"].as_u64().unwrap();
-                    let count = pixels as usize + 1;
+                    let count = usize::try_from(pixels).expect("a test viewport's pixels") + 1;
                     words_file("offsets.u32", count);
                     edit_header(dir, |h| {
                         h["arrays"]["offsets"] =
@@ -169,7 +169,7 @@ fn header_conflicts_are_refused_by_name_exactly_and_under_f32() {
     let lists = DumpScheme::LinkedLists {
         scheme: SchemeName::LinkedList,
         k: K,
-        pool: oracle.fragments() as u32,
+        pool: u32::try_from(oracle.fragments()).expect("a 48 × 36 view's fragments"),
         spec: LayoutSpec::FRAGSIM_LISTS,
     };
     let mdts = DumpScheme::Mdts {

@@ -5,6 +5,7 @@ use fragsim::dump::{Dump, LayoutSpec, SlotOrder, Words};
 use fragsim::oracle::precision::Possible;
 
 use super::storage::{links, set, words, Item, Storage};
+use crate::support::prim_of;
 
 /// A way to change a capture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -255,12 +256,12 @@ pub(super) fn mutant(
         Kind::NeighbourId if storage.has_ids() && n >= 1 => {
             let item = items[0];
             let taken = |prim: u32| {
-                site.reference.iter().any(|&r| r as u32 == prim)
+                site.reference.iter().any(|&r| prim_of(r) == prim)
                     || site
                         .possible
                         .is_some_and(|ps| ps.iter().any(|e| e.prim == prim))
             };
-            let count = site.triangles.len() as u32;
+            let count = u32::try_from(site.triangles.len()).expect("a test scene's triangles");
             let prim = (1..count)
                 .flat_map(|d| [item.prim().wrapping_add(d), item.prim().wrapping_sub(d)])
                 .find(|&q| q < count && !taken(q))?;
@@ -369,7 +370,11 @@ pub(super) fn mutant(
 /// carry none, by primitive id otherwise); judged exactly only, the reference's key.
 fn interval(site: &Site<'_>, storage: &Storage, item: Item) -> Option<(u32, u32)> {
     let Some(possible) = site.possible else {
-        let key = site.reference.iter().find(|&&r| r as u32 == item.prim())? >> 32;
+        let key = site
+            .reference
+            .iter()
+            .find(|&&r| prim_of(r) == item.prim())?
+            >> 32;
         return Some((key as u32, key as u32));
     };
     let entry = if storage.has_ids() {
@@ -453,6 +458,10 @@ fn counted(out: &mut Dump, storage: &Storage, p: usize, kind: Kind, list: &[Item
 
 /// A linked list's links cut: a node unlinked from the middle, the tail after the head orphaned,
 /// or the farthest node past the resolve's k unlinked; the nodes stay handed out.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "links are words of a u32 array read widened by `words`, so they fit usize"
+)]
 fn unlinked(out: &mut Dump, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
     let (mut heads, mut next) = (words(out, "heads"), words(out, "next"));
     let chain = links(&heads, &next, p);
@@ -481,6 +490,10 @@ fn unlinked(out: &mut Dump, p: usize, kind: Kind, list: &[Item]) -> Option<()> {
 /// The room exact storage (`offsets`) gives: pixel `p`'s cut by one (its last fragment
 /// dropped) or grown by one (an empty slot), or every pixel's taken away; the counters are
 /// left as they were.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "offsets are words of a u32 array read widened by `words`, and only ever cut by one"
+)]
 fn roomed(out: &mut Dump, storage: &Storage, p: usize, kind: Kind) -> Option<()> {
     if !matches!(storage, Storage::ABuffer { .. }) || !out.arrays.contains_key("offsets") {
         return None;
@@ -530,7 +543,7 @@ pub(super) fn outside_fields(encoded: &mut Dump, p: usize) -> Option<()> {
             null,
             node_base,
         } => {
-            let head = words(encoded, "heads")[p] as u32;
+            let head = u32::try_from(words(encoded, "heads")[p]).expect("a u32 array's word");
             (head != null).then_some(())?;
             ("nodes", (payload, (head - node_base) as usize))
         }

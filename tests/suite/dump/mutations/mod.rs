@@ -265,14 +265,15 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
         let mut order = pool.clone();
         // A seeded shuffle: the first MUTANTS pixels the kind applies to.
         for i in (1..order.len()).rev() {
-            order.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+            let j = rng.next_u64() % (i as u64 + 1);
+            order.swap(i, usize::try_from(j).expect("at most i"));
         }
         // Per judge: mutants judged as expected, mutants tried, and whether they were expected
         // EQUAL (a conforming change).
         let mut counts = vec![(0, 0, false); layout.judges.len()];
-        let mut tried = 0;
+        let mut mutants_tried = 0;
         for &p in &order {
-            if tried == MUTANTS || (tried == 1 && kind.global(&storage)) {
+            if mutants_tried == MUTANTS || (mutants_tried == 1 && kind.global(&storage)) {
                 break;
             }
             let possible = layout.possible.map(|precision| precision.pixel(p));
@@ -288,7 +289,7 @@ fn run(layout: &Layout<'_>, seed: u64, tallies: &mut Vec<Tally>, wrong: &mut Vec
             if kind == Kind::OutsideBits && kinds::outside_fields(&mut changed, p).is_none() {
                 continue;
             }
-            tried += 1;
+            mutants_tried += 1;
             for ((judge_name, judge), count) in layout.judges.iter().zip(&mut counts) {
                 let expected = match change {
                     Change::Broken => false,
@@ -387,8 +388,8 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
     let unorm_exact =
         Precision::derive(&view, &exact_conventions).stored_as(UNORM24.depth, &oracle);
     let unorm_f32 = f32_analysis.clone().stored_as(UNORM24.depth, &oracle);
-    let record = |view: &View<'_>, spec: &SceneSpec, scheme: DumpScheme| {
-        Dump::record(view, spec.clone(), &scheme, "battery").unwrap()
+    let record = |scene_view: &View<'_>, scene_spec: &SceneSpec, scheme: DumpScheme| {
+        Dump::record(scene_view, scene_spec.clone(), &scheme, "battery").unwrap()
     };
     let mdts = |direction| DumpScheme::Mdts { k: K, direction };
     let abuffer = DumpScheme::ABufferFixed {
@@ -399,7 +400,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
         scheme,
         k: K,
         // Room past the scene's fragments, for a counter one too many.
-        pool: oracle.fragments() as u32 + 8,
+        pool: u32::try_from(oracle.fragments()).expect("a test view's fragments") + 8,
         spec: LayoutSpec::FRAGSIM_LISTS,
     };
     let engine_numbering = LayoutSpec::LinkedList {
@@ -479,7 +480,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             DumpScheme::LinkedLists {
                 scheme: SchemeName::LinkedList,
                 k: K,
-                pool: oracle.fragments() as u32,
+                pool: u32::try_from(oracle.fragments()).expect("a test view's fragments"),
                 spec: LayoutSpec::FRAGSIM_LISTS,
             },
             None,

@@ -4,6 +4,8 @@
 
 use fragsim::dump::{Dump, DumpScheme, LayoutSpec, Words};
 
+use crate::support::prim_of;
+
 /// One stored entry: fragsim's fragment word (`key << 32 | prim`; a bare key's `key << 32`), and
 /// a masked node's coverage mask (0 elsewhere).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,7 +20,7 @@ impl Item {
     }
 
     pub(super) fn prim(self) -> u32 {
-        self.word as u32
+        prim_of(self.word)
     }
 
     pub(super) fn with_key(self, key: u32) -> Self {
@@ -67,6 +69,11 @@ pub(super) fn words(dump: &Dump, name: &str) -> Vec<u64> {
     }
 }
 
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "a u32 array's words were read widened by `words`, so writing them back narrows \
+              nothing"
+)]
 pub(super) fn set(dump: &mut Dump, name: &str, new: &[u64]) {
     let stored = match &dump.arrays[name] {
         Words::U64(_) => Words::U64(new.to_vec()),
@@ -76,6 +83,10 @@ pub(super) fn set(dump: &mut Dump, name: &str, new: &[u64]) {
 }
 
 /// The links of pixel `p`'s list in fragsim's numbering, head first.
+#[expect(
+    clippy::cast_possible_truncation,
+    reason = "links are words of a u32 array, so they fit usize"
+)]
 pub(super) fn links(heads: &[u64], next: &[u64], p: usize) -> Vec<u64> {
     let mut list = Vec::new();
     let mut link = heads[p];
@@ -166,6 +177,11 @@ impl Storage {
     }
 
     /// Pixel `p`'s stored list, in stored order.
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "counters, links and masks are words of u32 arrays read widened by `words`, so \
+                  they fit usize and u32"
+    )]
     pub(super) fn read(&self, dump: &Dump, p: usize) -> Vec<Item> {
         let item = |word| Item { word, mask: 0 };
         match self {
@@ -222,6 +238,10 @@ impl Storage {
     /// Writes pixel `p`'s list as a run that stored `items` would: the slots after them empty,
     /// a counter that counts them (plus any overflow it counted), a linked list through its
     /// first nodes (a shorter list leaves its last nodes handed out and unreached).
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "links are words of a u32 array read widened by `words`, so they fit usize"
+    )]
     pub(super) fn write(&self, dump: &mut Dump, p: usize, items: &[Item]) {
         match self {
             Self::Slots { k, word } => {
@@ -280,7 +300,7 @@ impl Storage {
                     let i = p * capacity + s;
                     (nodes[i], masks[i]) = items
                         .get(s)
-                        .map_or((u64::MAX, 0), |i| (i.word, u64::from(i.mask)));
+                        .map_or((u64::MAX, 0), |item| (item.word, u64::from(item.mask)));
                 }
                 counters[p] = items.len() as u64 + overflow;
                 set(dump, "counters", &counters);
