@@ -109,7 +109,7 @@ pub(crate) fn check_capture(
 ) {
     assert_eq!(capture.pixels(), lists.len(), "{name}: pixel count");
     let mask = match capture.identity {
-        Identity::KeyAndPrim => u64::MAX,
+        Identity::KeyAndPrim | Identity::MaskedNodes(_) => u64::MAX,
         Identity::KeyOnly => u64::MAX << 32,
         Identity::PrimOnly => panic!("{name}: no exact scheme keeps primitive ids only"),
     };

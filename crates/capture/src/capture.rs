@@ -12,6 +12,13 @@ pub enum Identity {
     /// sequence in canonical depth order. The high half is the lossy depth key the scheme holds
     /// (what the image judge shades), never compared.
     PrimOnly,
+    /// Masked nodes, `samples` a pixel (the masked-node A-buffer's per-sample resolve): each
+    /// sample's list holds the nodes whose coverage mask holds the sample, as the packed words
+    /// of their nearest depth key (the nearest of the primitive's samples in the pixel) and
+    /// primitive id. Compared node by node with the oracle's lists, each primitive's samples in
+    /// a pixel merged into one node, the masks included: the capacity counts nodes a pixel,
+    /// and a pixel's dropped nodes are reported on its first sample.
+    MaskedNodes(u32),
 }
 
 /// Which of a pixel's fragments a scheme promises to keep.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_dump::triangles::TriangleExport;
-use fragsim_dump::{masked_spec, Dump, DumpScheme, Encoding, MASKED_SCHEME};
+use fragsim_dump::{masked_spec, Dump, DumpScheme, Encoding};
 use fragsim_raster::{SceneSpec, View};
 
 use crate::args::{ConventionsArgs, SceneArgs};
@@ -146,6 +146,9 @@ impl DumpStage {
         view: &View<'_>,
         scene: &SceneSpec,
     ) -> Result<(), String> {
+        if name.entry().dump == Some(DumpLayout::MaskedNodes) {
+            return self.add_nodes(name, run, view, scene);
+        }
         let scheme = match DumpScheme::for_run(
             name,
             run.slots.unwrap_or(1),
@@ -194,32 +197,40 @@ impl DumpStage {
         Ok(())
     }
 
-    /// Stages the masked-node A-buffer's memory of `capacity` nodes a pixel after a serial run
-    /// over `view` (which rasterizes per sample).
+    /// Stages the words of a masked-node run ([`DumpLayout::MaskedNodes`]): its counters, node
+    /// words and masks as the run left them, in the masked-node layout.
     ///
     /// # Errors
-    /// A dump that cannot be recorded or written.
-    pub(crate) fn add_masked(
+    /// A run that kept no memory, or a dump that cannot be recorded or written.
+    fn add_nodes(
         &mut self,
+        name: SchemeName,
+        run: &NamedRun,
         view: &View<'_>,
         scene: &SceneSpec,
-        capacity: u32,
     ) -> Result<(), String> {
+        let memory = run
+            .memory
+            .as_ref()
+            .ok_or_else(|| format!("render --dump: {name}: the run kept no memory"))?;
         let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
         let spec = recorded_spec(scene, view)?;
         let (layout, ignored) = masked_spec(&self.encoding);
         if !ignored.is_empty() {
             eprintln!(
-                "render --dump: {MASKED_SCHEME}'s layout has no {}: written without",
+                "render --dump: {name}'s layout has no {}: written without",
                 ignored.join(" or ")
             );
         }
-        let dump = Dump::record_masked(view, spec, capacity, &producer)
-            .and_then(|dump| dump.in_layout(layout))
-            .map_err(|e| format!("render --dump: {MASKED_SCHEME}: {e}"))?;
-        dump.write(&self.staging.join(MASKED_SCHEME))
+        let capacity = run.slots.unwrap_or(1);
+        let words64 = memory.words64.clone();
+        let dump =
+            Dump::masked_of_memory(view, spec, capacity, &memory.words32, words64, &producer)
+                .and_then(|dump| dump.in_layout(layout))
+                .map_err(|e| format!("render --dump: {name}: {e}"))?;
+        dump.write(&self.staging.join(name.name()))
             .map_err(|e| e.to_string())?;
-        self.written.push(MASKED_SCHEME);
+        self.written.push(name.name());
         Ok(())
     }
 

@@ -75,7 +75,7 @@ pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
 pub use fragsim_capture::catalog::{SchemeName, Sizing};
 pub use hazard::HazardArgs;
-pub use render::{RenderArgs, RenderScheme, RunSummary, TieChoice};
+pub use render::{RenderArgs, RunSummary, TieChoice};
 pub use schemes::{Fault, SchemeChoice};
 pub use sweep::SweepArgs;
 

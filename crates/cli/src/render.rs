@@ -3,17 +3,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use std::sync::OnceLock;
-
-use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
-use fragsim_capture::catalog::Count;
-use fragsim_capture::schemes::masked_abuffer::MaskedABuffer;
-use fragsim_dump::{Dump, MASKED_SCHEME};
-use fragsim_oracle::samples::SampleOracle;
-use fragsim_oracle::verdict::{judge, judge_run, Candidate, Options, Reference, RunVerdict};
+use fragsim_oracle::verdict::{judge_run, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};
-use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::{depth_from_key, Conventions, UpAxis, View};
 use serde::Serialize;
 
@@ -33,11 +25,9 @@ pub struct RenderArgs {
     /// Scheme sizing and executors.
     #[command(flatten)]
     pub schemes: SchemeArgs,
-    /// Schemes to run, comma-separated, or `all`; with `--samples` 2 or more also
-    /// `abuffer-masked`, the masked-node A-buffer (per-pixel nodes with coverage masks, judged
-    /// against the per-pixel view of the per-sample oracle).
+    /// Schemes to run, comma-separated, or `all`.
     #[arg(long, value_delimiter = ',', default_value = "mdts,abuffer")]
-    pub scheme: Vec<RenderScheme>,
+    pub scheme: Vec<SchemeChoice>,
     /// Directory for the PNG images.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -65,39 +55,6 @@ pub struct RenderArgs {
     /// Inject a fault into every scheme (to show that a verdict can fail; tests only).
     #[arg(long, hide = true)]
     pub inject_fault: Option<Fault>,
-}
-
-/// A `render --scheme` value: a catalog scheme (or `all`), or the masked-node A-buffer, which is
-/// no catalog scheme (its walks start from merged nodes, not fragments) and runs only per sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RenderScheme {
-    /// A catalog scheme, or `all`.
-    Catalog(SchemeChoice),
-    /// The masked-node A-buffer ([`MASKED_SCHEME`]).
-    Masked,
-}
-
-impl ValueEnum for RenderScheme {
-    fn value_variants<'a>() -> &'a [Self] {
-        static VARIANTS: OnceLock<Vec<RenderScheme>> = OnceLock::new();
-        VARIANTS.get_or_init(|| {
-            SchemeChoice::value_variants()
-                .iter()
-                .map(|&c| Self::Catalog(c))
-                .chain([Self::Masked])
-                .collect()
-        })
-    }
-
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        match self {
-            Self::Catalog(choice) => choice.to_possible_value(),
-            Self::Masked => Some(PossibleValue::new(MASKED_SCHEME).help(
-                "The masked-node A-buffer: per-pixel nodes with coverage masks (--samples 2 or \
-                 more; --capacity nodes a pixel).",
-            )),
-        }
-    }
 }
 
 /// `--ties`: [`Ties`] on the command line.
@@ -209,15 +166,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     let viewport = view.viewport();
     let pixels = view.pixel_viewport();
     let samples = view.samples().map_or(1, |pattern| pattern.count() as usize);
-    let catalog: Vec<SchemeChoice> = args
-        .scheme
-        .iter()
-        .filter_map(|s| match s {
-            RenderScheme::Catalog(choice) => Some(*choice),
-            RenderScheme::Masked => None,
-        })
-        .collect();
-    let schemes = SchemeChoice::expand(&catalog);
+    let schemes = SchemeChoice::expand(&args.scheme);
     let sizing = args.schemes.sizing();
     check_memory_cap_early(&schemes, viewport, &sizing).map_err(|e| e.to_string())?;
     let executors = args.schemes.executors();
@@ -317,14 +266,6 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
             stage.add(name, run, &view, &spec)?;
         }
     }
-    let mut masked_line = None;
-    if args.scheme.contains(&RenderScheme::Masked) {
-        let (capacity, line) = masked(&view, &spec, &sizing)?;
-        masked_line = Some(line);
-        if let Some(stage) = &mut dumps {
-            stage.add_masked(&view, &spec, capacity)?;
-        }
-    }
     if let Some(stage) = dumps {
         stage.finish()?;
     }
@@ -368,10 +309,6 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
         }
     } else {
         print_table(&rows, &scene.name, &view, &oracle, oracle_ms, args)?;
-        // Under the table its header describes (the scene, the pixels and samples).
-        if let Some(line) = masked_line {
-            outln!("{line}");
-        }
     }
     Ok(rows)
 }
@@ -424,69 +361,6 @@ fn drawn_of(args: &RenderArgs) -> Result<String, String> {
 /// The mesh file cannot be read (for its name).
 fn caption(args: &RenderArgs, what: &str) -> Result<String, String> {
     Ok(format!("{}: {what}", drawn_of(args)?))
-}
-
-/// Runs the masked-node A-buffer serially over `view` (which must rasterize per sample, at the
-/// sample count `spec` declares) and judges the memory it leaves as `compare oracle DUMP` judges
-/// its dump ([`fragsim_oracle::verdict::judge`] against the per-pixel view of the per-sample
-/// oracle: nodes beyond the capacity overflow by design). Returns its capacity (`--capacity`, or
-/// under `auto` the most nodes a pixel of that view has) and the line saying the verdict.
-#[expect(
-    clippy::cast_possible_truncation,
-    reason = "a pixel holds at most one fragment per triangle, and triangle ids are u32"
-)]
-fn masked(
-    view: &View<'_>,
-    spec: &SceneSpec,
-    sizing: &fragsim_capture::catalog::Sizing,
-) -> Result<(u32, String), String> {
-    let Some(pattern) = view.samples() else {
-        return Err(format!(
-            "--scheme {MASKED_SCHEME} runs per sample: it needs --samples 2, 4, 8 or 16"
-        ));
-    };
-    let oracle = SampleOracle::build(view).map_err(|e| e.to_string())?;
-    let per_pixel = oracle.per_pixel();
-    let capacity = match sizing.capacity {
-        Count::Fixed(c) => c,
-        Count::Auto => (0..per_pixel.pixels())
-            .map(|p| per_pixel.pixel(p).len() as u32)
-            .max()
-            .unwrap_or(0)
-            .max(1),
-    };
-    // The run's memory is refused beyond the cap before anything is allocated.
-    MaskedABuffer::new(
-        view.pixel_viewport(),
-        pattern.count(),
-        capacity,
-        sizing.memory_cap,
-    )
-    .map_err(|e| e.to_string())?;
-    let producer = format!("fragsim {}", env!("CARGO_PKG_VERSION"));
-    let dump =
-        Dump::record_masked(view, spec.clone(), capacity, &producer).map_err(|e| e.to_string())?;
-    let pixels = view.pixel_viewport();
-    let reference = Reference::masked(per_pixel, (pixels.width, pixels.height));
-    let options = Options {
-        depth_ulps: 0,
-        examples: 0,
-    };
-    let verdict = judge(&reference, Candidate::Dump(&dump), &options)?;
-    let lists = dump.masked_lists().map_err(|e| e.to_string())?;
-    let overflowed: u64 = lists.overflow.iter().map(|&o| u64::from(o)).sum();
-    let holds = if verdict.equal {
-        "equal to"
-    } else {
-        "differs from"
-    };
-    let line = format!(
-        "{MASKED_SCHEME} (serial): {} samples, capacity {capacity}, {} nodes stored, {overflowed} \
-         overflowed: {holds} the per-pixel view of the per-sample oracle",
-        pattern.count(),
-        lists.nodes.len()
-    );
-    Ok((capacity, line))
 }
 
 /// Prints the table of `rows` under a line naming the scene, its pixels and fragments, then what

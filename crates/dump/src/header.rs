@@ -6,7 +6,6 @@ use std::collections::BTreeMap;
 use fragsim_raster::Viewport;
 use serde::{Deserialize, Serialize};
 
-use crate::masked::MASKED_SCHEME;
 use crate::{err, DumpError, LayoutSpec};
 use fragsim_capture::catalog::DumpLayout;
 use fragsim_raster::scene_spec::SceneSpec;
@@ -178,8 +177,8 @@ impl Header {
         }
         let layout = DumpLayout::named(&self.scheme);
         let used: &[&str] = match layout {
-            _ if self.scheme == MASKED_SCHEME => &["counters", "nodes", "masks"],
             None => return Ok(()),
+            Some(DumpLayout::MaskedNodes) => &["counters", "nodes", "masks"],
             Some(DumpLayout::SlotArray(_) | DumpLayout::KBufferSlots) => &["slots"],
             Some(DumpLayout::CountersAndSlots) => &["counters", "slots", "offsets"],
             Some(DumpLayout::LinkedLists) => &["heads", "next", "nodes", "counter"],

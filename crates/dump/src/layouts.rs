@@ -257,6 +257,7 @@ impl DumpScheme {
             ));
         };
         Ok(match layout {
+            DumpLayout::MaskedNodes => return err(masked_apart(name.name())),
             DumpLayout::SlotArray(SlotWord::Fragment) => Self::Mdts {
                 k: slots,
                 direction: Direction::Ascending,
@@ -312,8 +313,11 @@ impl DumpScheme {
             DumpLayout::SlotArray(SlotWord::Fragment)
             | DumpLayout::KBufferSlots
             | DumpLayout::CountersAndSlots => "key<<32|prim",
-            // The description is in `"layout"`.
-            DumpLayout::LinkedLists | DumpLayout::LayerMajor | DumpLayout::Memory => "",
+            // The description is in `"layout"` (no dump scheme is masked: `masked_apart`).
+            DumpLayout::LinkedLists
+            | DumpLayout::LayerMajor
+            | DumpLayout::Memory
+            | DumpLayout::MaskedNodes => "",
         }
     }
 
@@ -336,8 +340,9 @@ impl DumpScheme {
                 words32: Some("counters"),
                 words64: Some("layers"),
             },
-            // Linked lists split the u32 words three ways (`Dump::record`).
-            DumpLayout::LinkedLists | DumpLayout::Memory => ArrayNames {
+            // Linked lists split the u32 words three ways (`Dump::record`); no dump scheme is
+            // masked (`masked_apart`).
+            DumpLayout::LinkedLists | DumpLayout::Memory | DumpLayout::MaskedNodes => ArrayNames {
                 words32: Some("words32"),
                 words64: Some("words64"),
             },
@@ -411,7 +416,8 @@ impl DumpScheme {
                     DumpLayout::Memory => "memory",
                     DumpLayout::SlotArray(_)
                     | DumpLayout::KBufferSlots
-                    | DumpLayout::CountersAndSlots => "slots",
+                    | DumpLayout::CountersAndSlots
+                    | DumpLayout::MaskedNodes => "slots",
                 };
                 if spec.kind() != expected {
                     return err(format!(
@@ -477,6 +483,7 @@ impl DumpScheme {
             _ => {}
         }
         let slots = match layout {
+            DumpLayout::MaskedNodes => return err(masked_apart(name)),
             DumpLayout::SlotArray(SlotWord::Fragment) => Self::Mdts {
                 k: k()?,
                 direction: Direction::Ascending,
@@ -575,3 +582,9 @@ impl Dump {
 
 #[cfg(test)]
 mod tests;
+
+/// Why a masked-node dump has no [`DumpScheme`]: its nodes carry masks, and `masked.rs` reads,
+/// checks and writes them apart from the layouts of fragments.
+fn masked_apart(name: &str) -> String {
+    format!("{name} dumps masked nodes, read and written apart from the layouts of fragments")
+}

@@ -93,7 +93,7 @@ use fragsim_raster::SceneSpecError;
 
 pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{Direction, DumpScheme};
-pub use masked::{masked_spec, node_capture, MASKED_SCHEME};
+pub use masked::{masked_spec, MASKED_SCHEME};
 pub use read::HEADER_BYTES_LIMIT;
 pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
 pub use word_check::{CorruptWord, Corruption, Counter, WordCheck};

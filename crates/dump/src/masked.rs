@@ -14,7 +14,7 @@
 
 use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists};
 use fragsim_capture::Scheme as _;
-use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_capture::{Capacity, Capture};
 use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::View;
@@ -42,26 +42,6 @@ struct Masked {
 /// A masked-node dump's words in fragsim's pixel-major order: the counters, the nodes
 /// (fragsim's words) and the masks.
 type OwnWords = (Vec<u32>, Vec<u64>, Vec<u32>);
-
-/// The capture of masked lists' nodes as words `key << 32 | prim`, with `capacity` nodes a pixel
-/// and each pixel's overflow: what an A-buffer of the nodes would hold.
-#[must_use]
-pub fn node_capture(lists: &MaskedLists, capacity: Capacity) -> Capture {
-    let mut capture = Capture::with_pixels(
-        lists.pixels(),
-        Identity::KeyAndPrim,
-        Keeps::All {
-            capacity,
-            overflow: lists.overflow.clone(),
-        },
-    );
-    for p in 0..lists.pixels() {
-        capture
-            .lists
-            .push_pixel(lists.pixel(p).iter().map(|n| n.packed()));
-    }
-    capture
-}
 
 impl Dump {
     /// Whether this is a masked-node dump ([`MASKED_SCHEME`]).
@@ -158,14 +138,13 @@ impl Dump {
         self.masked()
     }
 
-    /// The nodes as a capture ([`node_capture`]): what [`Dump::capture`] gives of a masked-node
+    /// The nodes as a capture ([`MaskedLists::packed_capture`]): what [`Dump::capture`] gives of a masked-node
     /// dump.
     pub(super) fn masked_capture(&self) -> Result<Capture, DumpError> {
         let capacity = self.masked_checked()?.capacity;
-        Ok(node_capture(
-            &self.masked_lists()?,
-            Capacity::PerPixel(capacity),
-        ))
+        Ok(self
+            .masked_lists()?
+            .packed_capture(Capacity::PerPixel(capacity)))
     }
 
     /// The word rules of the masked-node layout: the A-buffer's on the nodes (no empty marker
@@ -247,14 +226,43 @@ impl Dump {
             .insert_all(view, &memory)
             // The view's sample count was checked above: a refusal here is the dump's to report.
             .map_err(|e| DumpError::Invalid(e.to_string()))?;
-        let n = pixels.pixels();
         let u32s: Vec<u32> = (0..WordMemory::<u32>::len(&memory))
             .map(|i| WordMemory::<u32>::load(&memory, i))
             .collect();
         let u64s: Vec<u64> = (0..WordMemory::<u64>::len(&memory))
             .map(|i| WordMemory::<u64>::load(&memory, i))
             .collect();
-        let (counters, masks) = u32s.split_at(n);
+        Self::masked_of_memory(view, scene, capacity, &u32s, u64s, producer)
+    }
+
+    /// Records the words a run of the masked-node A-buffer of `capacity` nodes a pixel over
+    /// `view` left (`words32`: the counters, then the masks; `words64`: the nodes) as a dump:
+    /// what `render --dump` writes of the run it reports, on whatever executor ran it.
+    ///
+    /// # Errors
+    /// Words of another number than the scheme's layout holds.
+    pub fn masked_of_memory(
+        view: &View<'_>,
+        scene: SceneSpec,
+        capacity: u32,
+        words32: &[u32],
+        words64: Vec<u64>,
+        producer: &str,
+    ) -> Result<Self, DumpError> {
+        let pixels = view.pixel_viewport();
+        let n = pixels.pixels();
+        let nodes = n * capacity as usize;
+        if (words32.len(), words64.len()) != (n + nodes, nodes) {
+            return err(format!(
+                "{MASKED_SCHEME} of {n} pixels and {capacity} nodes a pixel holds {} u32 and {nodes} \
+                 u64 words, the run left {} and {}",
+                n + nodes,
+                words32.len(),
+                words64.len()
+            ));
+        }
+        let u64s = words64;
+        let (counters, masks) = words32.split_at(n);
         let slots = vec![n as u64, u64::from(capacity)];
         let mut dump = Self {
             header: Header {

@@ -11,7 +11,7 @@ use fragsim_dump::{CorruptWord, Counter, WordCheck};
 #[must_use]
 pub fn with_identity(capture: &Capture, identity: Identity) -> Capture {
     let mask = match identity {
-        Identity::KeyAndPrim => u64::MAX,
+        Identity::KeyAndPrim | Identity::MaskedNodes(_) => u64::MAX,
         Identity::KeyOnly => u64::MAX << 32,
         Identity::PrimOnly => u64::from(u32::MAX),
     };

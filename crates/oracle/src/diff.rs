@@ -6,6 +6,8 @@ use fragsim_capture::{Capture, Identity, Keeps};
 
 use crate::{Oracle, Ties};
 
+mod masked_nodes;
+
 impl Oracle {
     /// Compares a capture with this oracle, pixel by pixel, under the capture's promise, with
     /// ties ordered by primitive id ([`Ties::ByPrimitive`]).
@@ -32,6 +34,9 @@ impl Oracle {
             self.pixels(),
             "capture and oracle cover different viewports"
         );
+        if let Identity::MaskedNodes(samples) = capture.identity {
+            return self.diff_masked_nodes(capture, samples);
+        }
         let mut diff = Diff::default();
         let mask = ties.mask(capture.identity);
         let masks_captured = mask != u64::MAX && capture.identity != Identity::KeyOnly;

@@ -61,7 +61,7 @@ impl Ties {
     pub(crate) fn mask(self, identity: Identity) -> u64 {
         match (self, identity) {
             (_, Identity::PrimOnly) => u64::from(u32::MAX),
-            (Self::ByPrimitive, Identity::KeyAndPrim) => u64::MAX,
+            (Self::ByPrimitive, Identity::KeyAndPrim | Identity::MaskedNodes(_)) => u64::MAX,
             _ => u64::MAX << 32,
         }
     }

@@ -40,12 +40,20 @@ impl SampleOracle {
     /// # Errors
     /// A view that does not rasterize per sample.
     pub fn build(view: &View<'_>) -> Result<Self, UnsampledViewError> {
-        let pattern = view.samples().ok_or(UnsampledViewError)?;
-        Ok(Self {
-            pattern,
+        view.samples().ok_or(UnsampledViewError)?;
+        Ok(Self::of_view(view))
+    }
+
+    /// The per-sample oracle of `view` at its samples, or, for a view that does not rasterize
+    /// per sample, at one sample at the pixel centre: then its oracle, bit for bit (what a
+    /// masked-node capture at one sample is judged against).
+    #[must_use]
+    pub fn of_view(view: &View<'_>) -> Self {
+        Self {
+            pattern: view.samples().unwrap_or(SamplePattern::CENTRE),
             pixels: view.pixel_viewport(),
             oracle: Oracle::build(view),
-        })
+        }
     }
 
     /// The sample pattern.
@@ -81,31 +89,7 @@ impl SampleOracle {
     /// theirs.
     #[must_use]
     pub fn per_pixel(&self) -> MaskedLists {
-        let n = self.pattern.count();
-        let lists = self.oracle.lists();
-        let mut nodes: Vec<(u32, MaskedNode)> = Vec::new();
-        let mut by_prim: BTreeMap<u32, MaskedNode> = BTreeMap::new();
-        for pixel in 0..self.pixels.pixels() {
-            by_prim.clear();
-            for sample in 0..n {
-                for &packed in lists.pixel(pixel * n as usize + sample as usize) {
-                    let (depth_key, prim) = (depth_key(packed), primitive_id(packed));
-                    let node = by_prim.entry(prim).or_insert(MaskedNode {
-                        depth_key,
-                        prim,
-                        mask: 0,
-                    });
-                    node.mask |= 1 << sample;
-                    node.depth_key = node.depth_key.min(depth_key);
-                }
-            }
-            #[expect(
-                clippy::cast_possible_truncation,
-                reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
-            )]
-            nodes.extend(by_prim.values().map(|&node| (pixel as u32, node)));
-        }
-        MaskedLists::from_nodes(n, self.pixels.pixels(), nodes)
+        nodes_per_pixel(self.oracle.lists(), self.pattern.count())
     }
 
     /// How a per-sample resolve (`candidate`, indexed like [`SampleOracle::oracle`]) departs
@@ -130,7 +114,7 @@ impl SampleOracle {
     pub fn capture_error(&self, capture: &Capture) -> SampleDeviation {
         let identify = match capture.identity {
             Identity::KeyOnly => depth_key,
-            Identity::KeyAndPrim | Identity::PrimOnly => primitive_id,
+            Identity::KeyAndPrim | Identity::PrimOnly | Identity::MaskedNodes(_) => primitive_id,
         };
         self.error_by(&capture.lists, identify)
     }
@@ -187,4 +171,36 @@ pub struct SampleDeviation {
     pub wrong_samples: u64,
     /// Of those, samples with every fragment present but in another order.
     pub misordered_samples: u64,
+}
+
+/// The per-pixel view of per-sample lists (`samples` a pixel, indexed `pixel * samples + s`):
+/// every pixel's fragments merged into one node per primitive, its mask the samples of the
+/// pixel whose lists hold the primitive, its depth key the nearest of theirs.
+#[must_use]
+pub(crate) fn nodes_per_pixel(lists: &PixelLists, samples: u32) -> MaskedLists {
+    let n = samples as usize;
+    let pixels = lists.pixels() / n;
+    let mut nodes: Vec<(u32, MaskedNode)> = Vec::new();
+    let mut by_prim: BTreeMap<u32, MaskedNode> = BTreeMap::new();
+    for pixel in 0..pixels {
+        by_prim.clear();
+        for sample in 0..samples {
+            for &packed in lists.pixel(pixel * n + sample as usize) {
+                let (depth_key, prim) = (depth_key(packed), primitive_id(packed));
+                let node = by_prim.entry(prim).or_insert(MaskedNode {
+                    depth_key,
+                    prim,
+                    mask: 0,
+                });
+                node.mask |= 1 << sample;
+                node.depth_key = node.depth_key.min(depth_key);
+            }
+        }
+        #[expect(
+            clippy::cast_possible_truncation,
+            reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
+        )]
+        nodes.extend(by_prim.values().map(|&node| (pixel as u32, node)));
+    }
+    MaskedLists::from_nodes(samples, pixels, nodes)
 }

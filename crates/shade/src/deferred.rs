@@ -104,7 +104,9 @@ pub fn complete<'c>(
 ) -> (Cow<'c, Capture>, Option<&'static str>) {
     match capture.identity {
         // Packed MDTS carries its own (lossy) depth in the high half: shaded as it is.
-        Identity::KeyAndPrim | Identity::PrimOnly => (Cow::Borrowed(capture), None),
+        Identity::KeyAndPrim | Identity::PrimOnly | Identity::MaskedNodes(_) => {
+            (Cow::Borrowed(capture), None)
+        }
         Identity::KeyOnly => {
             let entries = (0..capture.pixels())
                 .into_par_iter()

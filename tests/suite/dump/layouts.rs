@@ -45,6 +45,11 @@ fn every_catalog_scheme_dumps_reads_back_what_it_captured_and_compares_equal() {
         let mut inexact = Vec::new();
         for entry in CATALOG {
             assert!(entry.dump.is_some(), "{} has no dump layout", entry.name);
+            if entry.dump == Some(DumpLayout::MaskedNodes) {
+                // Masked nodes are no layout of fragments: their dumps are recorded, read back
+                // and judged node by node in `dump/samples.rs`.
+                continue;
+            }
             let (dump, captured) = dumped(entry.name, view, &sizing());
             let path = dir.join(entry.name);
             dump.write(&path).unwrap();

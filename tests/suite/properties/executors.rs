@@ -136,7 +136,7 @@ fn every_catalog_entry_is_what_it_builds() {
         let slots = match entry.storage {
             Storage::Slots(n) => n,
             Storage::K | Storage::KAndPool => 3,
-            Storage::Capacity => 2,
+            Storage::Capacity | Storage::Nodes => 2,
             Storage::Counted => continue,
         };
         assert_eq!(named.slots, Some(slots), "{}", entry.name);

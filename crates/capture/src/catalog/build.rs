@@ -14,8 +14,11 @@ use fragsim_raster::Viewport;
 /// The sizes a constructor builds with, every `auto` already resolved.
 #[derive(Debug, Clone, Copy)]
 pub struct Build<'a> {
-    /// The viewport the scheme's storage covers.
+    /// The viewport the scheme's storage covers: the sample-expanded framebuffer of a view
+    /// rasterizing per sample.
     pub viewport: Viewport,
+    /// Samples a pixel of the view (1 without multisampling).
+    pub samples: u32,
     /// Slots per pixel of the K-sized schemes.
     pub k: u32,
     /// Slots per pixel of the capacity-sized schemes.
@@ -35,11 +38,12 @@ pub struct Build<'a> {
 
 impl<'a> Build<'a> {
     /// Sizes without a counting pass: `k` and `capacity` slots, `layers` layers, a pool of
-    /// `capacity` nodes per pixel.
+    /// `capacity` nodes per pixel, one sample a pixel.
     #[must_use]
     pub fn fixed(viewport: Viewport, k: u32, capacity: u32, layers: u32, memory_cap: u64) -> Self {
         Build {
             viewport,
+            samples: 1,
             k,
             capacity,
             layers: layers.max(1),
@@ -48,6 +52,23 @@ impl<'a> Build<'a> {
             counts: None,
             order: None,
         }
+    }
+
+    /// The render target in pixels: [`Build::viewport`] less its samples, for a scheme whose
+    /// storage is per pixel while its capture is per sample (the masked-node A-buffer).
+    ///
+    /// # Errors
+    /// A viewport whose width is no whole number of pixels of [`Build::samples`] samples.
+    pub fn pixel_viewport(&self) -> Result<Viewport, CaptureError> {
+        let samples = self.samples.max(1);
+        if !self.viewport.width.is_multiple_of(samples) {
+            return Err(CaptureError::BadParameter(format!(
+                "a framebuffer {} samples wide holds no whole pixels of {samples} samples",
+                self.viewport.width
+            )));
+        }
+        Viewport::new(self.viewport.width / samples, self.viewport.height)
+            .map_err(|e| CaptureError::BadParameter(e.to_string()))
     }
 
     /// The counting pass's per-pixel counts, which a scheme sized exactly to the scene needs.

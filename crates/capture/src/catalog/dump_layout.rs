@@ -29,6 +29,10 @@ pub enum DumpLayout {
     /// order) and decodes them with its own resolve (which keeps the gaps, duplicates and
     /// disorder a hazard leaves, for the diff to see).
     KBufferSlots,
+    /// The masked-node A-buffer's `counters` `[pixels]`, node words `[pixels, capacity]` and
+    /// their coverage `masks` `[pixels, capacity]`: the layout of `fragsim_dump`'s masked-node
+    /// dumps, judged node by node, masks included.
+    MaskedNodes,
     /// The scheme's own words as they are after its last pass (`words32`, `words64`), decoded by
     /// its own resolve: schemes whose memory is no list per pixel (bucket histograms, peeling's
     /// layer records, stencil-routed samples). Each entry dumps under its own name.
@@ -113,6 +117,7 @@ mod tests {
             DumpLayout::LinkedLists,
             DumpLayout::LayerMajor,
             DumpLayout::KBufferSlots,
+            DumpLayout::MaskedNodes,
             DumpLayout::Memory,
         ];
         for layout in layouts {
@@ -125,7 +130,7 @@ mod tests {
             .iter()
             .filter(|e| e.dump.is_some_and(DumpLayout::names_its_scheme))
             .count();
-        assert_eq!(DumpLayout::names().count(), 5 + own);
+        assert_eq!(DumpLayout::names().count(), 6 + own);
     }
 
     #[test]

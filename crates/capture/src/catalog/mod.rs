@@ -58,6 +58,7 @@ use crate::schemes::linked_list::{
     Resolve::{KeepFirst, KeepNearest},
 };
 use crate::schemes::loop32::Loop32;
+use crate::schemes::masked_abuffer::MaskedABuffer;
 use crate::schemes::mdts::{
     Direction::{Ascending, Descending},
     Mdts,
@@ -106,6 +107,9 @@ pub enum Storage {
     /// Sized to the scene by its own counting pass, always (storage for every fragment, or a
     /// record of every layer).
     Counted,
+    /// [`Sizing::capacity`] masked nodes per pixel (where it is `auto`, the entry's own counting
+    /// pass of nodes first: one `fetch_add` per node, the deepest pixel's count).
+    Nodes,
 }
 
 /// How many geometry passes a scheme runs (its counting pass, where one runs, not included).
@@ -222,10 +226,12 @@ macro_rules! catalog {
     (@flag $value:literal) => { $value };
 }
 
-use DumpLayout::{CountersAndSlots, KBufferSlots, LayerMajor, LinkedLists, Memory, SlotArray};
+use DumpLayout::{
+    CountersAndSlots, KBufferSlots, LayerMajor, LinkedLists, MaskedNodes, Memory, SlotArray,
+};
 use Passes::{Fixed, PerLayers, UntilConfirmed, UpTo};
 use SlotWord::{Fragment, FragmentPlusOne, Key};
-use Storage::{Capacity, Counted, KAndPool, Slots, K};
+use Storage::{Capacity, Counted, KAndPool, Nodes, Slots, K};
 
 catalog! {
     Mdts "mdts" Fixed(1), K, Some(SlotArray(Fragment)),
@@ -339,6 +345,9 @@ catalog! {
     LinkedListNearest "linked-list-nearest" Fixed(1), KAndPool, Some(LinkedLists),
         "Per-pixel linked lists, the resolve keeping the `--k` nearest (nvpro-samples).";
         |b| (LinkedList::new(b.viewport, b.pool, b.k, KeepNearest, b.memory_cap)?, Some(b.k));
+    AbufferMasked "abuffer-masked" Fixed(1), Nodes, Some(MaskedNodes),
+        "The masked-node A-buffer (the multisampled OIT of Bevy and nvpro-samples): a primitive's samples in a pixel merged into one node with its coverage mask, `--capacity` nodes a pixel (`auto`: its own counting pass of nodes), overflow counted per pixel; resolved per sample.";
+        |b| (MaskedABuffer::new(b.pixel_viewport()?, b.samples, b.capacity, b.memory_cap)?, Some(b.capacity));
 }
 
 impl SchemeName {
@@ -373,6 +382,7 @@ impl SchemeName {
             Storage::Capacity => capacity_auto,
             Storage::KAndPool => k_auto || capacity_auto,
             Storage::Counted => true,
+            Storage::Nodes => capacity_auto,
         }
     }
 }

@@ -2,13 +2,14 @@
 //! one, and one frame on an executor ([`SchemeRunner::run`]); the memory cap checked before any of it
 //! ([`check_memory_cap_early`]).
 
-use super::{Build, Count, SchemeName, SchemeVisitor, Sizing};
+use super::{Build, Count, SchemeName, SchemeVisitor, Sizing, Storage};
 
 use crate::depth_count::{DepthCount, DepthCounts};
 use crate::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use crate::executors::tiled::TiledExecutor;
 use crate::executors::{self, Executor, ParallelExecutor, Run, SerialExecutor};
 use crate::primitive_order::PrimitiveOrder;
+use crate::schemes::masked_abuffer::MaskedABuffer;
 use crate::{CaptureError, Descriptor, Guarantee, Scheme, Step, WalkInput};
 use fragsim_memory::{Memory, WordMemory};
 use fragsim_raster::{View, Viewport};
@@ -132,15 +133,24 @@ impl SchemeRunner {
         ] {
             *cap = Some(sizing.memory_cap);
         }
-        let counted = name.needs_count_pass(sizing).then(|| {
-            DepthCounts::from_run(run_with_fault(
+        let samples = view.samples().map_or(1, |pattern| pattern.count());
+        let counted = match name.needs_count_pass(sizing) {
+            false => None,
+            // Masked-node storage counts its nodes, not the per-sample fragments.
+            true if name.entry().storage == Storage::Nodes => {
+                let counter = MaskedABuffer::node_counter(view.pixel_viewport(), samples)?;
+                let run = run_with_fault(&counter, self, executor, view, None);
+                let counts = counter.masked_frame(&run).lists.overflow;
+                Some(DepthCounts { counts, run })
+            }
+            true => Some(DepthCounts::from_run(run_with_fault(
                 &DepthCount::new(viewport),
                 self,
                 executor,
                 view,
                 None,
-            ))
-        });
+            ))),
+        };
         // What `auto` sizes resolve to: the count pass's maximum depth complexity (at least 1).
         let scene_max = counted.as_ref().map_or(1, |c| c.max().max(1));
         let resolve = |count: Count| match count {
@@ -155,6 +165,7 @@ impl SchemeRunner {
             .then(|| PrimitiveOrder::of_view(view));
         let build = Build {
             viewport,
+            samples,
             k: resolve(sizing.k),
             capacity,
             layers: scene_max,

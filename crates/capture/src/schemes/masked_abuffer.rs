@@ -171,19 +171,23 @@ impl MaskedABuffer {
                 "{samples} samples per pixel: a coverage mask holds 1 to 32"
             )));
         }
-        let (name, layout, guarantee) = match storage {
+        let (name, layout, guarantee, capacity) = match storage {
             MaskedStorage::Slots(capacity) => {
                 let slots = pixels * capacity as usize;
                 (
                     "abuffer-masked",
                     Layout::counters_and_slots(pixels + slots, slots),
                     Guarantee::ExactWithinCapacity(capacity),
+                    Capacity::PerPixel(capacity),
                 )
             }
+            // The pool's one counter counts what it drops in all, never per pixel: exact while
+            // the frame's nodes fit it, a node lost past it.
             MaskedStorage::Pool(nodes) => (
                 "linked-list-masked",
                 Layout::counters_and_slots(pixels + 1 + 2 * nodes, nodes),
                 Guarantee::Exact,
+                Capacity::Unbounded,
             ),
         };
         Ok(Self {
@@ -193,11 +197,9 @@ impl MaskedABuffer {
             descriptor: Descriptor {
                 name: name.into(),
                 layout,
-                identity: Identity::KeyAndPrim,
+                identity: Identity::MaskedNodes(samples),
                 guarantee,
-                // Judged against the per-sample oracle with each primitive's samples in a pixel
-                // merged (`fragsim_oracle::SampleOracle::per_pixel`), while the nodes fit.
-                promise: Promise::All(Capacity::Unbounded),
+                promise: Promise::All(capacity),
                 pixels: pixels * samples as usize,
                 counts_every_drop: true,
             },
@@ -302,8 +304,18 @@ impl MaskedABuffer {
 
     /// The counting pass that sizes a masked-node A-buffer to the scene (`--capacity auto`): one
     /// geometry pass that merges nodes as [`MaskedABuffer::frame`] does and only counts them, a
-    /// `fetch_add` each; the frame's [`MaskedLists::overflow`] holds every pixel's node count
-    /// (no node is stored). Its memory is one `u32` counter a pixel.
+    /// `fetch_add` each, every walk ending [`Step::Dropped`]; its frame's
+    /// [`MaskedLists::overflow`] holds every pixel's node count (no node is stored). Its memory
+    /// is one `u32` counter a pixel.
+    ///
+    /// # Errors
+    /// A sample count outside 1 to 32.
+    pub fn node_counter(pixels: Viewport, samples: u32) -> Result<Self, CaptureError> {
+        // Capacity 0, which `new` refuses for a capture: every insertion only counts.
+        Self::built(pixels.pixels(), samples, MaskedStorage::Slots(0))
+    }
+
+    /// The frame of the [`MaskedABuffer::node_counter`] of `view`.
     ///
     /// # Errors
     /// As [`MaskedABuffer::capture`], or a sample count outside 1 to 32.
@@ -313,8 +325,7 @@ impl MaskedABuffer {
         view: &View<'_>,
         parallel: bool,
     ) -> Result<MaskedFrame, CaptureError> {
-        // Capacity 0, which `new` refuses for a capture: every insertion only counts.
-        Self::built(pixels.pixels(), samples, MaskedStorage::Slots(0))?.frame(view, parallel)
+        Self::node_counter(pixels, samples)?.frame(view, parallel)
     }
 
     /// The post pass in nodes: each pixel's stored nodes (its slots, or its list walked from the

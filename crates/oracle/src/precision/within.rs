@@ -122,7 +122,7 @@ pub fn compare_within(
         total.overflow_miscounted_pixels += u64::from(flags & flags::MISCOUNTED != 0);
         comparison.record(p, flags, options.examples, words, || {
             let mask = match candidate.identity {
-                Identity::KeyAndPrim => u64::MAX,
+                Identity::KeyAndPrim | Identity::MaskedNodes(_) => u64::MAX,
                 Identity::KeyOnly => u64::MAX << 32,
                 Identity::PrimOnly => u64::from(u32::MAX),
             };
@@ -235,7 +235,7 @@ fn assign(
         match identity {
             Identity::PrimOnly => q.prim == prim,
             Identity::KeyOnly => inside(),
-            Identity::KeyAndPrim => q.prim == prim && inside(),
+            Identity::KeyAndPrim | Identity::MaskedNodes(_) => q.prim == prim && inside(),
         }
     };
     // Per possibility, the candidates it admits, an exact reference match first.

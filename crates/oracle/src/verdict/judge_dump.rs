@@ -21,7 +21,7 @@ use std::path::Path;
 
 use fragsim_capture::schemes::masked_abuffer::{MaskedLists, MaskedNode};
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
-use fragsim_dump::{node_capture, Dump, DumpError, WordCheck};
+use fragsim_dump::{Dump, DumpError, WordCheck};
 
 use crate::compare::{compare_with, flags, CompareOptions, Comparison};
 use crate::precision::{compare_within, f32_reference, Bounds, Precision};
@@ -166,7 +166,7 @@ impl JudgeDump for Dump {
         }
         let capture = self.capture()?;
         let words = self.check_words()?;
-        let oracle = Oracle::from_capture(&node_capture(reference, Capacity::Unbounded));
+        let oracle = Oracle::from_capture(&reference.packed_capture(Capacity::Unbounded));
         let mut nodes = compare_with(&oracle, &capture, Some(&words), options);
         let mut wrong_masks = Vec::new();
         for p in 0..lists.pixels() {

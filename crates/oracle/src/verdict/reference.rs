@@ -13,7 +13,7 @@ use crate::compare::complete_pixels;
 use crate::edge_ties::{candidates, pipeline_rule};
 use crate::precision::Precision;
 use crate::Oracle;
-use fragsim_dump::{node_capture, Dump};
+use fragsim_dump::Dump;
 
 /// The reference side of a verdict ([`super::judge`]).
 #[derive(Clone, Debug)]
@@ -166,10 +166,9 @@ impl<'a> Reference<'a> {
     #[must_use]
     pub fn masked(nodes: MaskedLists, (width, height): (u32, u32)) -> Self {
         Self {
-            lists: Cow::Owned(Oracle::from_capture(&node_capture(
-                &nodes,
-                Capacity::Unbounded,
-            ))),
+            lists: Cow::Owned(Oracle::from_capture(
+                &nodes.packed_capture(Capacity::Unbounded),
+            )),
             kind: Kind::Masked {
                 nodes,
                 within: None,
@@ -287,7 +286,7 @@ impl<'a> Reference<'a> {
             Keeps::All { .. } => return None,
         };
         let mask = match candidate.identity {
-            Identity::KeyAndPrim => u64::MAX,
+            Identity::KeyAndPrim | Identity::MaskedNodes(_) => u64::MAX,
             Identity::KeyOnly => u64::MAX << 32,
             Identity::PrimOnly => return None,
         };

@@ -157,6 +157,9 @@ pub(super) fn what_is_compared(
 ) -> String {
     let words = match candidate.identity {
         Identity::KeyAndPrim => "depth key (f32 bits) and primitive id of every fragment",
+        Identity::MaskedNodes(_) => {
+            "nearest depth key (f32 bits), primitive id and samples covered of every masked node"
+        }
         Identity::KeyOnly => "depth keys (f32 bits) of every fragment",
         Identity::PrimOnly => "primitive ids in depth order",
     };

@@ -216,7 +216,7 @@ pub fn judge_sides(
     let oracle = match &view {
         None => None,
         Some(view) if masked => {
-            let sampled = SampleOracle::build(view)?;
+            let sampled = SampleOracle::of_view(view);
             #[expect(
                 clippy::shadow_unrelated,
                 reason = "the masked reference, the one this arm builds"

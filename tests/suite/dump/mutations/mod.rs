@@ -29,9 +29,7 @@ use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::schemes::masked_abuffer::MaskedLists;
 use fragsim::capture::Capacity;
 use fragsim::dump::Direction;
-use fragsim::dump::{
-    node_capture, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder,
-};
+use fragsim::dump::{DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
 use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
 use fragsim::oracle::precision::{compare_within, f32_reference, Precision};
 use fragsim::oracle::samples::SampleOracle;
@@ -560,7 +558,7 @@ fn every_non_conforming_mutant_is_different_and_every_conforming_change_equal() 
             ..sampled.conventions
         },
     );
-    let nodes = Oracle::from_capture(&node_capture(&per_pixel, Capacity::Unbounded));
+    let nodes = Oracle::from_capture(&per_pixel.packed_capture(Capacity::Unbounded));
     let deepest = nodes.max_depth_complexity();
     for (name, scheme) in [
         ("mdts-4x", mdts(Direction::Ascending)),

@@ -4,7 +4,7 @@
 
 use fragsim_raster::Fragment;
 
-use crate::capture::PixelLists;
+use crate::capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use crate::walk_input::WalkInput;
 
 /// One primitive's coverage of one pixel: its nearest depth key over the samples it covers, and
@@ -162,6 +162,24 @@ impl MaskedLists {
             nodes,
             overflow: overflow.iter().step_by(per_pixel).copied().collect(),
         }
+    }
+
+    /// The lists as a capture of one list a pixel: each node's packed identity
+    /// ([`MaskedNode::packed`]), masks left out, kept as `capacity` nodes a pixel keep them,
+    /// with the pixels' overflow. What the node-by-node comparisons judge, the masks apart.
+    #[must_use]
+    pub fn packed_capture(&self, capacity: Capacity) -> Capture {
+        let keeps = Keeps::All {
+            capacity,
+            overflow: self.overflow.clone(),
+        };
+        let mut capture = Capture::with_pixels(self.pixels(), Identity::KeyAndPrim, keeps);
+        for p in 0..self.pixels() {
+            capture
+                .lists
+                .push_pixel(self.pixel(p).iter().map(|n| n.packed()));
+        }
+        capture
     }
 
     /// The resolve per sample: each sample's list (indexed by sample index, as a per-sample
