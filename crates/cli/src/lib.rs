@@ -62,7 +62,7 @@ pub mod record;
 mod render;
 mod schemes;
 mod sweep;
-mod table;
+use fragsim_measure::table;
 
 use std::process::ExitCode;
 
