@@ -10,7 +10,7 @@ use fragsim_raster::{Conventions, DepthRange, Scene, VertexPrecision, View, Wind
 
 pub use fragsim_capture::catalog::Count;
 use fragsim_capture::catalog::Sizing;
-use fragsim_dump::{Encoding, ListNumbering, Payload, SlotOrder};
+use fragsim_dump::{kebab, Encoding, ListNumbering, Payload, SlotOrder};
 use fragsim_measure::SchemeSetup;
 pub use fragsim_measure::Shard;
 pub use fragsim_raster::scene_spec::args::SceneArgs;
@@ -71,11 +71,11 @@ pub struct DumpArgs {
     /// The payload word of slots, list nodes and layers, `DTYPE:DEPTH:SHIFT:PRIM_BITS`: `u64` or
     /// `u32`; `f32`, `unorm24` or `unorm16` depth from bit SHIFT; the primitive id in the low
     /// `PRIM_BITS` bits (fragsim's: `u64:f32:32:32`; a D24 depth over an 8-bit id: `u32:unorm24:8:8`).
-    #[arg(long, value_name = "PAYLOAD", requires = "dir", value_parser = parse_payload)]
+    #[arg(long, value_name = "PAYLOAD", requires = "dir", value_parser = str::parse::<Payload>)]
     pub dump_payload: Option<Payload>,
     /// Linked lists' node numbering `NULL:NODE_BASE`: `0:1` (fragsim, nvpro-samples) or
     /// `4294967295:0` (Vulkan-Samples).
-    #[arg(long, value_name = "NULL:NODE_BASE", requires = "dir", value_parser = parse_list_numbering)]
+    #[arg(long, value_name = "NULL:NODE_BASE", requires = "dir", value_parser = str::parse::<ListNumbering>)]
     pub dump_list_numbering: Option<ListNumbering>,
 }
 
@@ -89,47 +89,6 @@ impl DumpArgs {
             list_numbering: self.dump_list_numbering,
         }
     }
-}
-
-/// `--dump-payload`: `DTYPE:DEPTH:SHIFT:PRIM_BITS`, checked as a header's payload is.
-fn parse_payload(text: &str) -> Result<Payload, String> {
-    let [dtype, depth, shift, prim_bits] = fields(text, "DTYPE:DEPTH:SHIFT:PRIM_BITS")?;
-    let number = |field: &str, name: &str| {
-        field
-            .parse::<u32>()
-            .map_err(|e| format!("{name} {field:?}: {e}"))
-    };
-    let payload = Payload {
-        dtype: kebab(dtype)?,
-        depth: kebab(depth)?,
-        depth_shift: number(shift, "SHIFT")?,
-        prim_bits: number(prim_bits, "PRIM_BITS")?,
-    };
-    payload.check().map_err(|e| e.to_string())?;
-    Ok(payload)
-}
-
-/// `--dump-list-numbering`: `NULL:NODE_BASE`.
-fn parse_list_numbering(text: &str) -> Result<ListNumbering, String> {
-    let [null, node_base] = fields(text, "NULL:NODE_BASE")?;
-    let number = |field: &str| field.parse::<u32>().map_err(|e| format!("{field:?}: {e}"));
-    Ok(ListNumbering {
-        null: number(null)?,
-        node_base: number(node_base)?,
-    })
-}
-
-/// The `N` colon-separated fields of `text`, which must have the form `form`.
-fn fields<'a, const N: usize>(text: &'a str, form: &str) -> Result<[&'a str; N], String> {
-    let parts: Vec<&str> = text.split(':').collect();
-    parts
-        .try_into()
-        .map_err(|_| format!("{text:?} is not {form}"))
-}
-
-/// A conventions value by its kebab-case name, as a dump header spells it.
-fn kebab<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, String> {
-    serde_json::from_value(serde_json::Value::String(text.into())).map_err(|e| e.to_string())
 }
 
 /// Says on stderr when `view` of `scene` covers no pixel: the command still runs (and exits 0

@@ -1,24 +1,22 @@
 //! `fragsim bench`: the speed/accuracy trade of every scheme on one scene (the measurement, its
-//! Markdown report and chart are `fragsim_measure::bench`'s), and what it prints and writes: its
-//! JSON Lines records, the terminal tables, bench.md and the chart.
+//! Markdown report, terminal tables, JSON Lines records and chart are `fragsim_measure::bench`'s),
+//! and what it prints and writes: the records, the terminal tables, bench.md and the chart.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_measure::approximate::{ApproximateName, ApproximateRow};
-use fragsim_measure::bench::report::{markdown, msaa_markdown, speed_accuracy_chart};
-use fragsim_measure::bench::{BenchParams, BenchReport, BenchRow};
-use fragsim_measure::cells::percent;
+use fragsim_measure::approximate::ApproximateName;
+use fragsim_measure::bench::report::{
+    markdown, msaa_terminal_table, records, speed_accuracy_chart, terminal_table,
+};
+use fragsim_measure::bench::{BenchParams, BenchReport};
 use fragsim_measure::colour_judge::EffectName;
 use fragsim_measure::images::Images;
-use fragsim_measure::multisampled::{MsaaReport, SampledRow};
 use fragsim_raster::Conventions;
-use serde::Serialize;
 
 use crate::args::{SceneArgs, SchemeArgs, Shard};
 use crate::record::Context;
 use crate::schemes::SchemeChoice;
-use crate::table::{Column, Table};
 
 /// Options of `fragsim bench`.
 #[derive(Debug, Clone, Args)]
@@ -111,35 +109,6 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<BenchReport, String> {
     Ok(report)
 }
 
-/// One line of bench's JSON Lines: a row with what the whole bench measured.
-#[derive(Serialize)]
-struct BenchRecord<'a> {
-    #[serde(flatten)]
-    row: &'a BenchRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// One line of bench's JSON Lines for an approximate scheme: its row with what the whole bench
-/// measured.
-#[derive(Serialize)]
-struct ApproximateRecord<'a> {
-    #[serde(flatten)]
-    row: &'a ApproximateRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
-/// One line of bench's JSON Lines for a multisampled scheme (`--samples`): its row with what the
-/// whole bench measured.
-#[derive(Serialize)]
-struct SampledRecord<'a> {
-    #[serde(flatten)]
-    row: &'a SampledRow,
-    #[serde(flatten)]
-    bench: &'a BenchReport,
-}
-
 /// Writes the report's records, Markdown and chart into `--out` and prints its table.
 ///
 /// # Errors
@@ -148,29 +117,7 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
     let bench_context = Context::of_scene("bench", &args.scene)?.sized(&args.schemes);
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let mut lines = String::new();
-    for row in &report.rows {
-        let context = bench_context.on(&row.executor, row.threads);
-        let record = BenchRecord { row, bench: report };
-        lines.push_str(&crate::record::line("bench", &context, &record)?);
-        lines.push('\n');
-    }
-    for row in &report.approximate {
-        let context = bench_context.on("primitive-order", row.threads);
-        let record = ApproximateRecord { row, bench: report };
-        lines.push_str(&crate::record::line(
-            "bench-approximate",
-            &context,
-            &record,
-        )?);
-        lines.push('\n');
-    }
-    for row in report.msaa.iter().flat_map(|m| &m.rows) {
-        let context = bench_context.on(&row.executor, row.threads);
-        let record = SampledRecord { row, bench: report };
-        lines.push_str(&crate::record::line("bench-msaa", &context, &record)?);
-        lines.push('\n');
-    }
+    let lines = records(report, &bench_context)?;
     let json_path = args.out.join("bench.jsonl");
     std::fs::write(&json_path, &lines)
         .map_err(|e| format!("cannot write {}: {e}", json_path.display()))?;
@@ -205,78 +152,4 @@ fn write_outputs(report: &BenchReport, args: &BenchArgs) -> Result<(), String> {
         outln!("{wrote} (bench.md: {tables})");
     }
     Ok(())
-}
-
-/// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
-/// first, aligned, in about 120 characters (bench.md holds all 26).
-fn terminal_table(report: &BenchReport) -> String {
-    let columns: [Column<BenchRow>; 10] = [
-        ("scheme", |r| r.scheme.clone()),
-        ("executor", |r| r.executor.clone()),
-        ("passes", |r| r.passes.to_string()),
-        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
-        ("lost", |r| r.lost.to_string()),
-        ("mismatched px", |r| r.mismatched_pixels.to_string()),
-        ("EPR %", |r| {
-            r.error_pixel_rate
-                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
-        }),
-        ("PSNR dB", |r| r.colour.cells()[2].clone()),
-        ("frame ms", |r| format!("{:.2}", r.time_ms)),
-        ("vs DP", |r| {
-            r.speedup_vs_depth_peeling
-                .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
-        }),
-    ];
-    let mut text = markdown(report)
-        .lines()
-        .next()
-        .unwrap_or_default()
-        .to_string();
-    text.push_str("\n\n");
-    text.push_str(&Table::of(&columns, &report.rows, 2).text(2));
-    text.push_str(
-        "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
-         should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
-         pixels whose 8-bit colour of the effect differs, in % of the covered pixels; PSNR dB of \
-         that image; frame ms the median frame; vs DP speed-up over depth peeling.\n",
-    );
-    text
-}
-
-/// What `bench --samples` prints on a terminal under the single-sample table: the line of
-/// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
-/// (bench.md holds every column and their key).
-fn msaa_terminal_table(msaa: &MsaaReport) -> String {
-    let columns: [Column<SampledRow>; 10] = [
-        ("scheme", |r| r.scheme.clone()),
-        ("storage", |r| r.storage.to_string()),
-        ("executor", |r| r.executor.clone()),
-        ("passes", |r| r.passes.to_string()),
-        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
-        ("overflow", |r| {
-            format!("{} {}", r.overflowed, r.overflow_unit)
-        }),
-        ("lost", |r| r.lost.to_string()),
-        ("wrong samples", |r| r.wrong_samples.to_string()),
-        ("EPR %", |r| {
-            r.error_pixel_rate
-                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
-        }),
-        ("frame ms", |r| format!("{:.2}", r.time_ms)),
-    ];
-    let mut text = msaa_markdown(msaa)
-        .lines()
-        .find(|line| !line.is_empty())
-        .unwrap_or_default()
-        .to_string();
-    text.push_str("\n\n");
-    text.push_str(&Table::of(&columns, &msaa.rows, 3).text(2));
-    text.push_str(
-        "Columns: overflow what found no room (sample fragments, or whole masked nodes); lost \
-         sample fragments the scheme owed and is missing (per-sample storage: beyond the \
-         overflow); wrong samples samples whose list differs from the per-sample oracle's; the \
-         rest as above.\n",
-    );
-    text
 }

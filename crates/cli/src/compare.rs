@@ -5,16 +5,17 @@
 //! the other side's header names. The verdict is the oracle's
 //! ([`fragsim_oracle::verdict::judge_sides`]: the candidate's lists decoded by the scheme's own
 //! post pass and judged under its promise, every word of its storage checked against its layout);
-//! this module holds the arguments and prints the verdict as text, JSON Lines and a difference
-//! image. Exit code 0 only when every pixel is equal.
+//! the difference image is `fragsim_shade::verdict_image`'s and the lists side by side
+//! `fragsim_oracle::verdict::Example::rows`; this module holds the arguments and prints the
+//! verdict as text and JSON Lines. Exit code 0 only when every pixel is equal.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Args;
-use fragsim_oracle::compare::flags;
-use fragsim_oracle::verdict::{judge_sides, Entry, Options, Side, SidesOptions, Summary, Verdict};
+use fragsim_oracle::verdict::{judge_sides, Entry, Options, Side, SidesOptions, Summary};
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::VertexPrecision;
+use fragsim_shade::verdict_image::write_difference_image;
 
 use crate::args::parse_bytes;
 use crate::record::{Context, Slots};
@@ -110,8 +111,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
     let (image, legend) = if args.no_image {
         (None, Vec::new())
     } else {
-        let legend = legend(&verdict);
-        write_image(&verdict, &legend, &args.image)?;
+        let legend = write_difference_image(&verdict, &args.image).map_err(|e| e.to_string())?;
         (Some(args.image.display().to_string()), legend)
     };
     let report = Report {
@@ -120,7 +120,7 @@ pub fn compare(args: &CompareArgs) -> Result<bool, String> {
         width: verdict.width,
         height: verdict.height,
         image,
-        legend: legend.into_iter().map(|(_, entry)| entry).collect(),
+        legend,
     };
     if args.json {
         print_json(&report)?;
@@ -149,109 +149,6 @@ fn check_mesh_replaces(args: &CompareArgs, sides: [&Side; 2]) -> Result<(), Stri
         }
     }
     Ok(())
-}
-
-/// Colour of a pixel's verdict in the difference image.
-fn colour(flags: u8, fragments: usize) -> [u8; 3] {
-    let wrong = flags & (flags::MISSING | flags::EXTRA);
-    match () {
-        () if flags & flags::CORRUPT != 0 => [40, 220, 40],
-        () if wrong == flags::MISSING | flags::EXTRA => [220, 50, 220],
-        () if wrong == flags::MISSING => [230, 40, 40],
-        () if wrong == flags::EXTRA => [60, 90, 255],
-        () if flags & flags::MISORDERED != 0 => [250, 220, 0],
-        () if flags & flags::MISCOUNTED != 0 => [255, 140, 0],
-        () if flags & flags::OVERFLOWED != 0 => [0, 90, 90],
-        () if fragments > 0 => [70, 70, 70],
-        () => [0, 0, 0],
-    }
-}
-
-/// The legend of the difference image: every colour [`colour`] gives, what it means, and how
-/// many pixels have it. A verdict's count is the report's (every pixel with that flag), though a
-/// pixel of several verdicts is drawn in the colour of the one listed first: the entry says how
-/// many of its pixels are drawn above, so that the legend and the text agree ("missing 1" in
-/// both where the one missing pixel is also corrupt).
-fn legend(v: &Verdict) -> Vec<(image::Rgb<u8>, String)> {
-    // (the flags a pixel must all have, the fragments its reference holds, the meaning): the
-    // verdicts in the order their colours win, then the equal pixels, covered or not.
-    let meanings: [(u8, usize, &str); 9] = [
-        (flags::CORRUPT, 0, "corrupt word"),
-        (flags::MISSING | flags::EXTRA, 0, "missing and extra"),
-        (flags::MISSING, 0, "missing"),
-        (flags::EXTRA, 0, "extra"),
-        (flags::MISORDERED, 0, "misordered"),
-        (flags::MISCOUNTED, 0, "overflow miscounted"),
-        (flags::OVERFLOWED, 0, "overflowed (by design)"),
-        (0, 1, "equal, covered"),
-        (0, 0, "no fragment"),
-    ];
-    let mut counts = [(0_u64, 0_u64); 9];
-    for (&flags, &n) in v.comparison.verdicts.iter().zip(&v.reference_fragments) {
-        let drawn = colour(flags, n as usize);
-        for (&(wanted, covered, _), (has, drawn_above)) in meanings.iter().zip(&mut counts) {
-            let own = colour(wanted, covered);
-            let counted = if wanted == 0 {
-                // The equal pixels are counted as drawn.
-                drawn == own
-            } else {
-                flags & wanted == wanted
-            };
-            if counted {
-                *has += 1;
-                *drawn_above += u64::from(drawn != own);
-            }
-        }
-    }
-    meanings
-        .iter()
-        .zip(counts)
-        .map(|(&(f, n, meaning), (count, drawn_above))| {
-            let above = if drawn_above > 0 {
-                format!(" ({drawn_above} drawn above)")
-            } else {
-                String::new()
-            };
-            (
-                image::Rgb(colour(f, n)),
-                format!("{meaning}: {count}{above}"),
-            )
-        })
-        .collect()
-}
-
-/// The difference image of `v`, one column per list (a per-sample layout's samples side by
-/// side), with its `legend`.
-#[expect(
-    clippy::cast_possible_truncation,
-    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
-)]
-fn write_image(
-    v: &Verdict,
-    legend: &[(image::Rgb<u8>, String)],
-    path: &Path,
-) -> Result<(), String> {
-    let width = v.width * v.lists_per_pixel;
-    let image = image::RgbImage::from_fn(width, v.height, |x, y| {
-        let p = (y * width + x) as usize;
-        image::Rgb(colour(
-            v.comparison.verdicts[p],
-            v.reference_fragments[p] as usize,
-        ))
-    });
-    let differing = v
-        .comparison
-        .verdicts
-        .iter()
-        .enumerate()
-        .filter(|&(_, &v)| v & flags::DIFFERS != 0)
-        .map(|(p, _)| ((p % width as usize) as u32, (p / width as usize) as u32));
-    // Rings only where differences are sparse: dense ones show alone, and rings would hide some.
-    let ring = differing.clone().count() <= fragsim_shade::legend::MARKS;
-    let marks: Vec<(u32, u32)> = differing.take(fragsim_shade::legend::MARKS).collect();
-    let figure = fragsim_shade::legend::difference_figure(&image, legend, &marks, ring)
-        .map_err(|e| e.to_string())?;
-    fragsim_shade::save_png(&figure, path).map_err(|e| e.to_string())
 }
 
 /// The report as JSON Lines: the report's fields flattened into one `compare` record (a group's
@@ -440,8 +337,8 @@ fn print_report(report: &Report<'_>) {
                 None => format!("{:.9} [{}]", e.depth, e.key),
             })
         };
-        for (a, b) in aligned(&e.reference, &e.candidate) {
-            let same = matches!((a, b), (Some(a), Some(b)) if same_fragment(a, b));
+        for (a, b) in e.rows() {
+            let same = matches!((a, b), (Some(a), Some(b)) if a.same_fragment(b));
             outln!(
                 "{} {:<36} {:<36}",
                 if same { ' ' } else { '*' },
@@ -458,84 +355,4 @@ fn print_report(report: &Report<'_>) {
         outln!("  legend: {}", report.legend.join("; "));
     }
     outln!("verdict: {}", r.word());
-}
-
-/// Whether two shown entries are the same fragment: the same depth key and primitive.
-fn same_fragment(a: &Entry, b: &Entry) -> bool {
-    a.key == b.key && a.prim == b.prim
-}
-
-/// The most cells of the table [`aligned`] matches two lists with (16 MiB of them).
-const ALIGNED_CELLS: usize = 1 << 22;
-
-/// The rows of a differing pixel's two lists side by side, aligned by fragment rather than by
-/// index, so that one missing fragment marks one row, not every row after it: the longest run
-/// of fragments both lists hold in the same order is matched row for row; between two matched
-/// rows the rest go in depth order, a reference and a candidate entry of the same primitive on
-/// one row (a depth that moved), every other entry on a row of its own.
-fn aligned<'e>(
-    reference: &'e [Entry],
-    candidate: &'e [Entry],
-) -> Vec<(Option<&'e Entry>, Option<&'e Entry>)> {
-    let (n, m) = (reference.len(), candidate.len());
-    // Lists too long for the table below are merged in depth order alone.
-    if (n + 1).saturating_mul(m + 1) > ALIGNED_CELLS {
-        let (reference, candidate): (Vec<&Entry>, Vec<&Entry>) =
-            (reference.iter().collect(), candidate.iter().collect());
-        return unmatched_rows(&reference, &candidate);
-    }
-    // common[i][j]: the longest common subsequence of reference[i..] and candidate[j..].
-    let mut common = vec![vec![0_u32; m + 1]; n + 1];
-    for i in (0..n).rev() {
-        for j in (0..m).rev() {
-            common[i][j] = if same_fragment(&reference[i], &candidate[j]) {
-                common[i + 1][j + 1] + 1
-            } else {
-                common[i + 1][j].max(common[i][j + 1])
-            };
-        }
-    }
-    let mut rows = Vec::with_capacity(n.max(m));
-    let (mut i, mut j) = (0, 0);
-    let (mut gap_reference, mut gap_candidate) = (Vec::new(), Vec::new());
-    while i < n || j < m {
-        if i < n && j < m && same_fragment(&reference[i], &candidate[j]) {
-            rows.extend(unmatched_rows(&gap_reference, &gap_candidate));
-            gap_reference.clear();
-            gap_candidate.clear();
-            rows.push((Some(&reference[i]), Some(&candidate[j])));
-            (i, j) = (i + 1, j + 1);
-        } else if j == m || (i < n && common[i + 1][j] >= common[i][j + 1]) {
-            gap_reference.push(&reference[i]);
-            i += 1;
-        } else {
-            gap_candidate.push(&candidate[j]);
-            j += 1;
-        }
-    }
-    rows.extend(unmatched_rows(&gap_reference, &gap_candidate));
-    rows
-}
-
-/// The rows of entries neither list matched between two matched rows, merged in depth order: a
-/// reference and a candidate entry of the same primitive share a row.
-fn unmatched_rows<'e>(
-    reference: &[&'e Entry],
-    candidate: &[&'e Entry],
-) -> Vec<(Option<&'e Entry>, Option<&'e Entry>)> {
-    let mut rows = Vec::with_capacity(reference.len() + candidate.len());
-    let (mut r, mut c) = (reference.iter().peekable(), candidate.iter().peekable());
-    loop {
-        let row = match (r.peek(), c.peek()) {
-            (None, None) => break,
-            (Some(&&a), Some(&&b)) if a.prim.is_some() && a.prim == b.prim => {
-                (r.next().copied(), c.next().copied())
-            }
-            (Some(&&a), Some(&&b)) if b.depth < a.depth => (None, c.next().copied()),
-            (Some(_), _) => (r.next().copied(), None),
-            (None, Some(_)) => (None, c.next().copied()),
-        };
-        rows.push(row);
-    }
-    rows
 }

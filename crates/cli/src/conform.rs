@@ -16,20 +16,18 @@
 //! the fragments, the cases past K and the capacity, with ties, and empty; a claim no case
 //! exercised is said to be so. A backend that fails to run on the smallest case too fails
 //! whatever the case: the run stops at once with that, unshrunk.
+//!
+//! The run, the record and the saved case are `fragsim_testkit::conform`'s; this module holds
+//! the options, the progress and what is printed.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Args;
-use fragsim_capture::catalog::SchemeName;
-use fragsim_oracle::PixelMismatch;
 use fragsim_raster::scene_spec::{mesh_hash, SceneSpec};
-use fragsim_raster::{depth_from_key, Conventions, VertexPrecision};
-use fragsim_testkit::command::write_case;
-use fragsim_testkit::{
-    Battery, Case, CommandBackend, Counterexample, Event, Exercised, Failure, Input, Limits, Params,
-};
-use serde::Serialize;
+use fragsim_raster::VertexPrecision;
+use fragsim_testkit::conform::{ConformParams, Conformance, Entry, Found};
+use fragsim_testkit::{Case, Event, Params};
 
 use crate::args::Shard;
 use crate::record::{self, Context, Slots};
@@ -116,160 +114,37 @@ fn positive(text: &str) -> Result<f64, String> {
     }
 }
 
-/// A fragment as the report shows it.
-#[derive(Debug, Serialize)]
-struct Entry {
-    key: String,
-    depth: f32,
-    prim: u32,
-}
-
-#[expect(
-    clippy::cast_possible_truncation,
-    reason = "a word packs the depth key (high 32 bits) and the primitive id (low 32)"
-)]
-fn entries(words: &[u64]) -> Vec<Entry> {
-    words
-        .iter()
-        .map(|&w| Entry {
-            // As `compare` prints keys: 8 hex digits.
-            key: format!("{:08x}", w >> 32),
-            depth: depth_from_key((w >> 32) as u32),
-            prim: w as u32,
-        })
-        .collect()
-}
-
-/// What the checked cases exercised, as the `conform` record carries it.
-#[derive(Debug, Serialize)]
-struct ExercisedRecord {
-    /// Cases counted: those that passed.
-    exercised_cases: u32,
-    exercised_fragments: u64,
-    deepest_pixel: u32,
-    k_cut_cases: u32,
-    over_capacity_cases: u32,
-    overflow_cases: u32,
-    overflow_fragments: u64,
-    tie_cases: u32,
-    empty_cases: u32,
-}
-
-impl From<Exercised> for ExercisedRecord {
-    fn from(e: Exercised) -> Self {
-        Self {
-            exercised_cases: e.cases,
-            exercised_fragments: e.fragments,
-            deepest_pixel: e.deepest_pixel,
-            k_cut_cases: e.k_cut_cases,
-            over_capacity_cases: e.over_capacity_cases,
-            overflow_cases: e.overflow_cases,
-            overflow_fragments: e.overflow_fragments,
-            tie_cases: e.tie_cases,
-            empty_cases: e.empty_cases,
-        }
-    }
-}
-
-/// The `conform` record.
-#[derive(Debug, Serialize)]
-struct Summary {
-    passed: bool,
-    backend: String,
-    conform_scheme: String,
-    cases: u32,
-    seed: u64,
-    vertex_precision: String,
-    /// `I/N` under `--shard` (`null` unsharded).
-    shard: Option<String>,
-    /// Cases checked (a shard's own).
-    cases_run: u32,
-    /// The failing case's number among the seed's `cases` (the same in a shard as unsharded).
-    case_number: Option<u32>,
-    shrink_steps: Option<u32>,
-    property: Option<String>,
-    message: Option<String>,
-    triangles: Option<usize>,
-    fragments: Option<usize>,
-    saved: Option<String>,
-    replay: Option<Vec<String>>,
-    /// On a failure, whether the backend failed to run on the smallest case too (not shrunk).
-    case_independent: Option<bool>,
-    #[serde(flatten)]
-    exercised: ExercisedRecord,
-}
-
-/// One differing pixel of the counterexample, both lists.
-#[derive(Debug, Serialize)]
-struct PixelRecord {
-    pixel: usize,
-    x: u32,
-    y: u32,
-    reference: Vec<Entry>,
-    candidate: Vec<Entry>,
-}
-
 /// Runs `conform`; returns whether every case passed.
 ///
 /// # Errors
 /// An unknown scheme, a command that cannot run, files that cannot be written.
 pub fn conform(args: &ConformArgs) -> Result<bool, String> {
-    let scheme = SchemeName::from_name(&args.scheme).ok_or_else(|| {
-        let names: Vec<&str> = fragsim_capture::catalog::CATALOG
-            .iter()
-            .map(|e| e.name)
-            .collect();
-        format!(
-            "unknown scheme {}: one of {}",
-            args.scheme,
-            names.join(", ")
-        )
-    })?;
-    if !args.backend.contains("{out}") {
-        return Err(format!(
-            "--backend `{}` has no {{out}}: the command must be told where to write its dump",
-            args.backend
-        ));
-    }
-    let shard = args.shard.unwrap_or(Shard::WHOLE);
-    // This shard's cases: those numbered `shard.index`, `shard.index + shard.count`, … of all.
-    let shard_cases = (args.cases + shard.count - shard.index) / shard.count;
-    let params = Params {
-        scheme,
+    let params = ConformParams {
+        backend: args.backend.clone(),
+        scheme: args.scheme.clone(),
         k: args.k,
         capacity: args.capacity,
-    };
-    let work = args.save.join("work");
-    std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
-    let backend = CommandBackend {
-        template: args.backend.clone(),
+        cases: args.cases,
+        seed: args.seed,
+        shard: args.shard.map(|s| (s.index, s.count)),
         timeout: Duration::from_secs_f64(args.timeout),
-        work: work.clone(),
+        max_side: args.max_side,
+        max_triangles: args.max_triangles,
+        shrink_steps: args.shrink_steps,
+        save: args.save.clone(),
         vertex_precision: if args.vertex_precision == "f32" {
             VertexPrecision::F32
         } else {
             VertexPrecision::F64
         },
         power_of_two: args.power_of_two,
+        fragsim: std::env::current_exe().map_err(|e| format!("fragsim's own path: {e}"))?,
     };
-    let max_triangles = args
-        .max_triangles
-        .unwrap_or((args.k.max(args.capacity) + 4).clamp(7, 64));
-    let battery = Battery::new(&backend, params)
-        .cases(args.cases)
-        .seed(args.seed)
-        .shard(shard.index, shard.count)
-        .shrink_steps(args.shrink_steps)
-        .limits(Limits {
-            max_side: args.max_side,
-            max_triangles: max_triangles as usize,
-            power_of_two: args.power_of_two,
-            ..Limits::default()
-        });
+    let shard_cases = params.shard_cases();
     let bar = crate::progress::bar(u64::from(shard_cases), "conform");
     // Case N starts once case N − 1 has passed; the last case's pass is the run's end.
     let mut cases_started = 0;
-    let result = battery.run_with(&mut |event| match event {
+    let result = fragsim_testkit::conform::conform(&params, &mut |event| match event {
         Event::Case(n) => {
             bar.set_position(u64::from(n));
             cases_started = n;
@@ -285,107 +160,30 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
         }
     });
     bar.finish_and_clear();
-    if args.progress_lines && result.is_ok() {
-        eprintln!("conform: {shard_cases} of {shard_cases} cases passed");
-    }
-    // The cases' files are scratch; the saved case is written afresh below.
-    let _ = std::fs::remove_dir_all(&work);
-    let mut summary = Summary {
-        passed: true,
-        backend: args.backend.clone(),
-        conform_scheme: scheme.name().to_string(),
-        cases: args.cases,
-        seed: args.seed,
-        vertex_precision: args.vertex_precision.clone(),
-        shard: args.shard.map(|s| s.to_string()),
-        cases_run: shard_cases,
-        case_number: None,
-        shrink_steps: None,
-        property: None,
-        message: None,
-        triangles: None,
-        fragments: None,
-        saved: None,
-        replay: None,
-        case_independent: None,
-        exercised: Exercised::default().into(),
-    };
-    let saved = args.save.join("case");
-    let found = match result {
-        Ok(passed) => {
-            // A failing case saved by an earlier run no longer describes this backend.
-            if saved.exists() {
-                std::fs::remove_dir_all(&saved)
-                    .map_err(|e| format!("cannot remove {}: {e}", saved.display()))?;
-            }
-            let spec = SceneSpec::named("generated", 0.0, 0.0);
-            let context = sized(
-                Context::new("conform", &spec, args.max_side, args.max_side),
-                &params,
-            );
-            summary.exercised = passed.exercised.into();
-            if args.json {
-                record::emit("conform", &context, &summary)?;
-            } else {
-                #[expect(clippy::shadow_unrelated, reason = "the shard the arguments name")]
-                let cases = match args.shard {
-                    Some(shard) => format!("{shard_cases} cases (shard {shard} of {})", args.cases),
-                    None => format!("{} cases", args.cases),
-                };
-                outln!(
-                    "conform: {} passes {cases} of {} (k {}, capacity {}, seed {}, {} vertex \
-                     stage):",
-                    args.backend,
-                    scheme.name(),
-                    args.k,
-                    args.capacity,
-                    args.seed,
-                    args.vertex_precision
-                );
-                for line in exercised_lines(&passed.exercised, args.k, args.capacity) {
-                    outln!("  {line}");
-                }
-            }
-            return Ok(true);
+    let conformance = result?;
+    let Some(found) = &conformance.found else {
+        if args.progress_lines {
+            eprintln!("conform: {shard_cases} of {shard_cases} cases passed");
         }
-        Err(Failure::Refused(message)) => return Err(message),
-        Err(Failure::Counterexample(found)) => found,
+        print_pass(args, &conformance, shard_cases)?;
+        return Ok(true);
     };
-    let replay = save(&backend, &found, &params, &saved)?;
-    summary.exercised = found.exercised.into();
+    let counterexample = &found.counterexample;
+    let mesh = found.saved.join("scene").join("mesh.obj");
     let spec = Case::scene_and_camera(
-        &saved.join("scene").join("mesh.obj").display().to_string(),
-        mesh_hash(found.submitted.obj().as_bytes()),
+        &mesh.display().to_string(),
+        mesh_hash(counterexample.submitted.obj().as_bytes()),
     );
-    let viewport = found.submitted.viewport;
+    let viewport = counterexample.submitted.viewport;
     let context = sized(
         Context::new("conform", &spec, viewport.width, viewport.height),
-        &params,
+        &conformance.params,
     );
-    summary = Summary {
-        passed: false,
-        cases_run: found.cases_run,
-        case_number: Some(found.case_number),
-        shrink_steps: Some(found.shrink_steps),
-        property: Some(found.property.to_string()),
-        message: Some(found.message.clone()),
-        triangles: Some(found.submitted.triangles.len()),
-        fragments: Some(found.fragments),
-        saved: Some(saved.display().to_string()),
-        replay: Some(replay.clone()),
-        case_independent: Some(found.case_independent),
-        ..summary
-    };
-    let pixels: Vec<PixelRecord> = found
-        .mismatches()
-        .iter()
-        .map(|m| pixel_record(m, viewport.width))
-        .collect();
-    let mut lines = vec![record::line("conform", &context, &summary)?];
-    for p in &pixels {
+    let mut lines = vec![record::line("conform", &context, &conformance.record)?];
+    for p in &found.pixels {
         lines.push(record::line("counterexample_pixel", &context, p)?);
     }
-    let report = saved.join("conform.jsonl");
+    let report = found.saved.join("conform.jsonl");
     std::fs::write(&report, lines.join("\n") + "\n")
         .map_err(|e| format!("cannot write {}: {e}", report.display()))?;
     if args.json {
@@ -393,9 +191,38 @@ pub fn conform(args: &ConformArgs) -> Result<bool, String> {
             outln!("{line}");
         }
     } else {
-        print_counterexample(args, &found, &pixels, &saved, &replay);
+        print_counterexample(args, found);
     }
     Ok(false)
+}
+
+/// Prints a pass: the `conform` record, or the claims the cases exercised.
+fn print_pass(args: &ConformArgs, passed: &Conformance, shard_cases: u32) -> Result<(), String> {
+    if args.json {
+        let spec = SceneSpec::named("generated", 0.0, 0.0);
+        let context = sized(
+            Context::new("conform", &spec, args.max_side, args.max_side),
+            &passed.params,
+        );
+        return record::emit("conform", &context, &passed.record);
+    }
+    let cases = match args.shard {
+        Some(shard) => format!("{shard_cases} cases (shard {shard} of {})", args.cases),
+        None => format!("{} cases", args.cases),
+    };
+    outln!(
+        "conform: {} passes {cases} of {} (k {}, capacity {}, seed {}, {} vertex stage):",
+        args.backend,
+        passed.scheme.name(),
+        args.k,
+        args.capacity,
+        args.seed,
+        args.vertex_precision
+    );
+    for line in passed.exercised.claims(args.k, args.capacity) {
+        outln!("  {line}");
+    }
+    Ok(())
 }
 
 /// The context with the run's K and capacity.
@@ -405,116 +232,17 @@ fn sized(mut context: Context, params: &Params) -> Context {
     context
 }
 
-#[expect(
-    clippy::cast_possible_truncation,
-    reason = "pixel indices fit u32: viewports are at most 16384² pixels (Viewport::new)"
-)]
-fn pixel_record(m: &PixelMismatch, width: u32) -> PixelRecord {
-    PixelRecord {
-        pixel: m.pixel,
-        x: m.pixel as u32 % width,
-        y: m.pixel as u32 / width,
-        reference: entries(&m.expected),
-        candidate: entries(&m.got),
-    }
-}
-
-/// Runs the backend once more on the shrunk case inside `dir` (`dir/scene`, `dir/out`), and
-/// writes `dir/replay.sh`; returns the replay's command lines.
-fn save(
-    backend: &CommandBackend,
-    found: &Counterexample,
-    params: &Params,
-    dir: &Path,
-) -> Result<Vec<String>, String> {
-    let case = &found.submitted;
-    let scene = case.scene();
-    let view = scene
-        .view_under(case.viewport, &Case::camera(), Conventions::REFERENCE)
-        .map_err(|e| e.to_string())?;
-    let input = Input {
-        case,
-        view: &view,
-        params,
-    };
-    // The dump may be missing when the failure is the backend's own (a crash, a timeout):
-    // the scene files are saved all the same. A backend that fails whatever the case is not run
-    // again (a timeout would cost its whole length once more).
-    let rerun = if found.case_independent {
-        #[expect(
-            clippy::shadow_unrelated,
-            reason = "the scene file's path in the counterexample's directory"
-        )]
-        let scene = dir.join("scene");
-        if dir.exists() {
-            std::fs::remove_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        }
-        for d in [&scene, &dir.join("out")] {
-            std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
-        }
-        write_case(case, &view, params, &scene).map_err(|e| e.to_string())?;
-        Err(found.message.clone())
-    } else {
-        backend.run_in(&input, dir).map_err(|e| e.to_string())
-    };
-    let absolute = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    // Every path absolute, so that the script runs from any directory: the backend's command
-    // from the directory conform ran in (its own paths may be relative to it), and this very
-    // fragsim (which need not be on PATH).
-    let here = std::env::current_dir().map_err(|e| format!("the working directory: {e}"))?;
-    let fragsim = std::env::current_exe().map_err(|e| format!("fragsim's own path: {e}"))?;
-    let replay = vec![
-        format!("cd {} || exit 2", shell_quoted(&here)),
-        backend.command_line(&absolute.join("scene"), &absolute.join("out"), params),
-        format!(
-            "{} compare oracle {}{}",
-            shell_quoted(&fragsim),
-            shell_quoted(&absolute.join("out")),
-            match backend.vertex_precision {
-                VertexPrecision::F32 => " --vertex-precision f32",
-                VertexPrecision::F64 => "",
-            }
-        ),
-    ];
-    let mut script = String::from(
-        "#!/bin/sh\n# Replays fragsim conform's smallest failing case (from any directory).\n",
-    );
-    if let Err(e) = rerun {
-        script.push_str(&if found.case_independent {
-            format!("# The backend failed whatever the case, this one too: {e}\n")
-        } else {
-            format!("# On saving, the backend failed again: {e}\n")
-        });
-    }
-    for line in &replay {
-        script.push_str(line);
-        script.push('\n');
-    }
-    let path = dir.join("replay.sh");
-    std::fs::write(&path, script).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    Ok(replay)
-}
-
-/// `path` quoted for `sh`: in single quotes, a quote inside written `'\''`.
-fn shell_quoted(path: &Path) -> String {
-    format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
-}
-
-fn print_counterexample(
-    args: &ConformArgs,
-    found: &Counterexample,
-    pixels: &[PixelRecord],
-    saved: &Path,
-    replay: &[String],
-) {
-    let case = &found.submitted;
-    if found.case_independent {
+/// Prints the smallest failing case, its differing pixels, and where it is saved.
+fn print_counterexample(args: &ConformArgs, found: &Found) {
+    let counterexample = &found.counterexample;
+    let case = &counterexample.submitted;
+    if counterexample.case_independent {
         outln!(
             "conform: {} FAILS `{}` whatever the case: on case {} of {} (seed {}) and on the \
              smallest case, not shrunk:",
             args.backend,
-            found.property,
-            found.case_number,
+            counterexample.property,
+            counterexample.case_number,
             args.cases,
             args.seed,
         );
@@ -522,21 +250,21 @@ fn print_counterexample(
         outln!(
             "conform: {} FAILS `{}` on case {} of {} (seed {}), shrunk in {} steps to:",
             args.backend,
-            found.property,
-            found.case_number,
+            counterexample.property,
+            counterexample.case_number,
             args.cases,
             args.seed,
-            found.shrink_steps
+            counterexample.shrink_steps
         );
     }
-    outln!("  {}", found.message);
+    outln!("  {}", counterexample.message);
     outln!(
         "  viewport {}x{}, {} triangles, {} fragments (corners in half pixels, y down: (1, 1) is \
          pixel (0, 0)'s centre):",
         case.viewport.width,
         case.viewport.height,
         case.triangles.len(),
-        found.fragments
+        counterexample.fragments
     );
     for (prim, t) in case.triangles.iter().enumerate() {
         let corners: Vec<String> = t
@@ -547,7 +275,7 @@ fn print_counterexample(
             .collect();
         outln!("    prim {prim}: {}", corners.join(" "));
     }
-    for p in pixels {
+    for p in &found.pixels {
         outln!("  pixel ({}, {}):", p.x, p.y);
         let show = |list: &[Entry]| {
             list.iter()
@@ -558,56 +286,20 @@ fn print_counterexample(
         outln!("    oracle:  [{}]", show(&p.reference));
         outln!("    backend: [{}]", show(&p.candidate));
     }
-    if found.exercised.cases > 0 {
+    if counterexample.exercised.cases > 0 {
         outln!(
             "  the {} cases that passed before it:",
-            found.exercised.cases
+            counterexample.exercised.cases
         );
-        for line in exercised_lines(&found.exercised, args.k, args.capacity) {
+        for line in counterexample.exercised.claims(args.k, args.capacity) {
             outln!("    {line}");
         }
     }
     outln!(
         "  saved in {} (scene/, out/, conform.jsonl); replay:",
-        saved.display()
+        found.saved.display()
     );
-    for line in replay {
+    for line in &found.replay {
         outln!("    {line}");
     }
-}
-
-/// What the cases exercised, in lines: each claim of a pass with the cases that exercised it,
-/// or said never to have been exercised.
-fn exercised_lines(e: &Exercised, k: u32, capacity: u32) -> Vec<String> {
-    let of = |n: u32| format!("{n} of {}", e.cases);
-    let mut lines = vec![format!(
-        "equal to the oracle and order-independent in {} cases ({} fragments, {} empty cases)",
-        e.cases, e.fragments, e.empty_cases
-    )];
-    lines.push(if e.overflow_cases > 0 {
-        format!(
-            "overflow as predicted in {} cases ({} fragments overflowed)",
-            of(e.overflow_cases),
-            e.overflow_fragments
-        )
-    } else {
-        format!(
-            "overflow: never exercised (no case exceeded the scheme's storage: deepest pixel {}, \
-             k {k}, capacity {capacity})",
-            e.deepest_pixel
-        )
-    });
-    lines.push(format!(
-        "deepest pixel {} fragments; deeper than K ({k}) in {} cases, than the capacity \
-         ({capacity}) in {}",
-        e.deepest_pixel,
-        of(e.k_cut_cases),
-        of(e.over_capacity_cases)
-    ));
-    lines.push(if e.tie_cases > 0 {
-        format!("ties (fragments at one depth) in {} cases", of(e.tie_cases))
-    } else {
-        "ties: never exercised (no pixel held two fragments at one depth)".to_string()
-    });
-    lines
 }

@@ -8,8 +8,8 @@
 //! fragment per thread under the scheduled executor, and `Oracle::diff` counts the covered pixels
 //! whose list differs from the oracle's `K` nearest (a fragment lost, duplicated or out of order).
 //! The measurement and its reports (hazard.md, baselines.md, the charts) are
-//! `fragsim_measure::hazard`'s; this module holds the options, the JSON Lines records and what is
-//! printed and written where.
+//! `fragsim_measure::hazard`'s, and so are its JSON Lines records; this module holds the options
+//! and what is printed and written where.
 
 use std::path::PathBuf;
 
@@ -17,11 +17,10 @@ use clap::Args;
 use fragsim_measure::hazard::{report, HazardReport};
 use fragsim_measure::hazard::{Campaign, HazardParams};
 use fragsim_raster::Conventions;
-use serde::Serialize;
 
 use crate::args::SceneArgs;
 use crate::explain::WriteBackArg;
-use crate::record::{Context, Slots};
+use crate::record::Context;
 
 /// Options of `fragsim hazard`.
 #[derive(Debug, Clone, Args)]
@@ -76,45 +75,6 @@ pub struct HazardArgs {
     pub json: bool,
 }
 
-/// One line of hazard's JSON Lines: a row of the rates (the context carries the scheduled
-/// executor and the threads in flight).
-#[derive(Serialize)]
-struct HazardRecord<'a> {
-    scheme: &'static str,
-    write_back: &'a str,
-    policy: &'a str,
-    seeds: u64,
-    /// Fraction of covered pixels whose list differs from the oracle's K nearest, mean over
-    /// the seeds.
-    mismatched_pixel_rate: f64,
-    /// The same, per seed.
-    mismatched_pixel_rate_per_seed: &'a [f64],
-    lost: u64,
-    extra: u64,
-    duplicates: u64,
-    misordered_pixels: u64,
-    /// The rate among the pixels of each depth-complexity bucket (`dc_1`, `dc_2`, `dc_3_4`, …);
-    /// `null` for a bucket without pixels.
-    #[serde(flatten)]
-    by_depth_complexity: std::collections::BTreeMap<String, Option<f64>>,
-}
-
-/// One line of `hazard --baselines`' JSON Lines (the context carries K and the executor).
-#[derive(Serialize)]
-struct BaselineRecord<'a> {
-    scheme: &'a str,
-    passes: u32,
-    overflowed: u64,
-    lost: u64,
-    extra: u64,
-    duplicates: u64,
-    misordered_pixels: u64,
-    error_pixels: u64,
-    /// `error_pixels` over the covered pixels.
-    error_pixel_rate: f64,
-    memory_bytes: u64,
-}
-
 /// Runs `hazard`.
 ///
 /// # Errors
@@ -158,59 +118,17 @@ fn write_baselines(args: &HazardArgs, report: &HazardReport) -> Result<(), Strin
         return say_wrote(args, &["baselines.md", "baselines.json"]);
     }
     let context = Context::of_scene("hazard", &args.scene)?;
-    for r in &report.baselines {
-        let mut context = context.on(&r.executor, 0);
-        context.threads = None;
-        context.k = Some(Slots::Fixed(r.k));
-        let record = BaselineRecord {
-            scheme: &r.scheme,
-            passes: r.passes,
-            overflowed: r.overflowed,
-            lost: r.lost,
-            extra: r.extra,
-            duplicates: r.duplicates,
-            misordered_pixels: r.misordered_pixels,
-            error_pixels: r.error_pixels,
-            error_pixel_rate: r.error_pixels as f64 / report.covered.max(1) as f64,
-            memory_bytes: r.memory_bytes,
-        };
-        crate::record::emit("baseline", &context, &record)?;
+    for line in report::baseline_records(report, &context)? {
+        outln!("{line}");
     }
     say_wrote(args, &["baselines.md", "baselines.json"])
 }
 
 /// Hazard's JSON Lines: one record per row.
 fn print_json(args: &HazardArgs, report: &HazardReport) -> Result<(), String> {
-    let mut context = Context::of_scene("hazard", &args.scene)?;
-    context.k = Some(Slots::Fixed(report.k));
-    for r in &report.rows {
-        let by_depth_complexity = report
-            .buckets
-            .iter()
-            .zip(&r.rate_by_depth_complexity)
-            .map(|((label, n), &rate)| {
-                let key = format!("mismatched_pixel_rate_dc_{}", label.replace('–', "_"));
-                (key, (*n > 0).then_some(rate))
-            })
-            .collect();
-        let record = HazardRecord {
-            scheme: "kbuffer",
-            write_back: &r.write_back,
-            policy: &r.policy,
-            seeds: args.seeds,
-            mismatched_pixel_rate: r.rate,
-            mismatched_pixel_rate_per_seed: &r.rate_per_seed,
-            lost: r.lost,
-            extra: r.extra,
-            duplicates: r.duplicates,
-            misordered_pixels: r.misordered_pixels,
-            by_depth_complexity,
-        };
-        crate::record::emit(
-            "hazard",
-            &context.on("scheduled", r.threads_in_flight),
-            &record,
-        )?;
+    let context = Context::of_scene("hazard", &args.scene)?;
+    for line in report::records(report, &context, args.seeds)? {
+        outln!("{line}");
     }
     Ok(())
 }

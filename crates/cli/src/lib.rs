@@ -60,7 +60,7 @@ pub mod record;
 mod render;
 mod schemes;
 mod sweep;
-mod table;
+use fragsim_measure::table;
 
 use std::process::ExitCode;
 

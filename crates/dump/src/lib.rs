@@ -95,7 +95,7 @@ pub use header::{ArraySpec, Dtype, Header, Words};
 pub use layouts::{Direction, DumpScheme};
 pub use masked::{masked_spec, MASKED_SCHEME};
 pub use read::HEADER_BYTES_LIMIT;
-pub use spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
+pub use spec::{kebab, DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
 pub use word_check::{CorruptWord, Corruption, Counter, WordCheck};
 
 /// The `format` field of every dump header.

@@ -132,6 +132,48 @@ pub struct Payload {
     pub prim_bits: u32,
 }
 
+/// A payload as an option spells it, `DTYPE:DEPTH:SHIFT:PRIM_BITS` (fragsim's:
+/// `u64:f32:32:32`; a D24 depth over an 8-bit id: `u32:unorm24:8:8`), checked as a header's is
+/// ([`Payload::check`]).
+impl std::str::FromStr for Payload {
+    type Err = DumpError;
+
+    fn from_str(text: &str) -> Result<Self, DumpError> {
+        let [dtype, depth, shift, prim_bits] = fields(text, "DTYPE:DEPTH:SHIFT:PRIM_BITS")?;
+        let number = |field: &str, name: &str| {
+            field
+                .parse::<u32>()
+                .map_err(|e| DumpError::Invalid(format!("{name} {field:?}: {e}")))
+        };
+        let payload = Self {
+            dtype: kebab(dtype)?,
+            depth: kebab(depth)?,
+            depth_shift: number(shift, "SHIFT")?,
+            prim_bits: number(prim_bits, "PRIM_BITS")?,
+        };
+        payload.check()?;
+        Ok(payload)
+    }
+}
+
+/// The `N` colon-separated fields of `text`, which must have the form `form`.
+fn fields<'a, const N: usize>(text: &'a str, form: &str) -> Result<[&'a str; N], DumpError> {
+    let parts: Vec<&str> = text.split(':').collect();
+    parts
+        .try_into()
+        .map_err(|_| DumpError::Invalid(format!("{text:?} is not {form}")))
+}
+
+/// A value by its kebab-case name, as a dump header spells it (`slot-major`, `unorm24`,
+/// `lower-left`): how options name a header's values.
+///
+/// # Errors
+/// No value of `T` has that name (the message lists those that do).
+pub fn kebab<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, DumpError> {
+    serde_json::from_value(serde_json::Value::String(text.into()))
+        .map_err(|e| DumpError::Invalid(e.to_string()))
+}
+
 /// The largest depth key of a fragment: depth 1.0 (fragments outside `[0, 1]` are dropped, and
 /// `-0.0` is stored as `+0.0`), so a stored key above it is no fragment's.
 pub(super) const LARGEST_KEY: u32 = 0x3F80_0000;
@@ -321,6 +363,25 @@ pub struct ListNumbering {
     pub null: u32,
     /// The first node's number.
     pub node_base: u32,
+}
+
+/// A numbering as an option spells it, `NULL:NODE_BASE` (fragsim's and nvpro-samples': `0:1`;
+/// Vulkan-Samples': `4294967295:0`).
+impl std::str::FromStr for ListNumbering {
+    type Err = DumpError;
+
+    fn from_str(text: &str) -> Result<Self, DumpError> {
+        let [null, node_base] = fields(text, "NULL:NODE_BASE")?;
+        let number = |field: &str| {
+            field
+                .parse::<u32>()
+                .map_err(|e| DumpError::Invalid(format!("{field:?}: {e}")))
+        };
+        Ok(Self {
+            null: number(null)?,
+            node_base: number(node_base)?,
+        })
+    }
 }
 
 /// An encoding asked of every dump written at once (`render --dump-order`, `--dump-payload`,

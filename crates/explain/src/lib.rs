@@ -14,7 +14,8 @@
 //! - [`hazard`]: the hazard rate over a scene against the oracle, by width and depth complexity
 //!   (`docs/rmw-hazard.md`);
 //! - [`baselines`]: the k-buffer family's passes and losses on every executor
-//!   (`docs/baselines/kbuffer.md`).
+//!   (`docs/baselines/kbuffer.md`);
+//! - [`report`]: what `fragsim explain` reports of a scheme, the lines and the step table.
 //!
 //! Which catalog schemes can be explained is [`Shown::of`]; the command line offers
 //! [`Shown::schemes`].
@@ -30,6 +31,7 @@ pub mod hazard;
 pub mod interleaving;
 pub mod kbuffer;
 pub mod mdts;
+pub mod report;
 pub mod spinlock;
 
 use fragsim_capture::catalog::{DumpLayout, Entry, Passes, SchemeName, SlotWord, CATALOG};

@@ -5,8 +5,9 @@
 //!
 //! Why a crate of its own: the command line (`fragsim-cli`) is clap glue and printing, and the
 //! Python package and a backend's own bench call the same measurements. Each measurement takes a
-//! plain parameter struct and returns plain result structs; its reports (Markdown, charts) are
-//! functions of those. It never prints: what it has to say while it runs (steps done, a warning)
+//! plain parameter struct and returns plain result structs; its reports (Markdown, the terminal
+//! tables laid out by [`table::Table`], charts) are functions of those, and [`record`] is the
+//! JSON Lines output model every command's records share. It never prints: what it has to say while it runs (steps done, a warning)
 //! goes to the caller's [`Progress`], and the only files it writes are the images and charts a
 //! caller asks for ([`images::Images`], the reports' charts).
 
@@ -26,8 +27,10 @@ pub mod hazard;
 pub mod images;
 pub mod multisampled;
 pub mod progress;
+pub mod record;
 pub mod setup;
 pub mod sweep;
+pub mod table;
 
 pub use progress::{Progress, Silent};
 pub use setup::{SchemeSetup, Shard};

@@ -1,6 +1,7 @@
 //! `sweep`: the error-pixel rate of each scheme at many view angles around the model (the
 //! bucket depth peeling paper's Figure 6), and the colour error over the image and per
-//! depth-complexity bucket at each angle, with each angle's frame time.
+//! depth-complexity bucket at each angle, with each angle's frame time; its tables and charts
+//! are [`report`]'s.
 
 use fragsim_capture::catalog::{SchemeName, SchemeRunner};
 use fragsim_capture::primitive_order::PrimitiveOrder;
@@ -13,6 +14,8 @@ use crate::approximate::ApproximateName;
 use crate::colour_by_depth::ColourByDepth;
 use crate::colour_judge::{ColourColumns, ColourJudge, EffectName};
 use crate::{Progress, SchemeSetup, Shard};
+
+pub mod report;
 
 /// What `sweep` measures, and how.
 #[derive(Debug, Clone)]

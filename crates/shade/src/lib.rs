@@ -4,8 +4,9 @@
 //! transparency ([`approximate`]: WBOIT, MLAB, tail blending), with the error-pixel rate
 //! and, for approximate images, the colour error ([`colour_error`]: mean and maximum absolute
 //! error per channel, PSNR),
-//! and the deferred attribute pass that gives captures what shading needs beyond their words
-//! ([`deferred`]: normals, primitive ids of key-only captures).
+//! the deferred attribute pass that gives captures what shading needs beyond their words
+//! ([`deferred`]: normals, primitive ids of key-only captures), and the difference image of a
+//! verdict ([`verdict_image`]: a colour per pixel's verdict, with its legend).
 //!
 //! ```
 //! let counts = vec![0, 1, 2, 3];
@@ -28,6 +29,7 @@ pub mod effects;
 mod error;
 pub mod legend;
 pub mod plot;
+pub mod verdict_image;
 
 pub use error::{DrawError, SaveError};
 

@@ -52,7 +52,7 @@ pub struct CommandBackend {
 }
 
 /// A path as one shell word.
-fn quoted(path: &Path) -> String {
+pub(crate) fn quoted(path: &Path) -> String {
     format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
 }
 

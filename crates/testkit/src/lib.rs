@@ -10,6 +10,8 @@
 //! - [`command`]: [`CommandBackend`], any program that reads a case's files and writes a dump.
 //! - [`judge`]: the verdict `fragsim compare` gives, on a backend's output.
 //! - [`battery`]: the properties a claim implies, and a shrunk counterexample on a failure.
+//! - [`conform`]: `fragsim conform`, the battery against a command, its record and the saved
+//!   counterexample.
 //!
 //! Everything here runs fragsim's own pipeline (`fragsim-raster`), schemes (`fragsim-capture`)
 //! and oracle (`fragsim-oracle`); nothing is re-implemented, so a property that holds here holds
@@ -39,6 +41,7 @@ pub mod backend;
 pub mod battery;
 pub mod case;
 pub mod command;
+pub mod conform;
 pub mod judge;
 pub mod strategies;
 

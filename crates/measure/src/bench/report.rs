@@ -1,13 +1,18 @@
 //! What `bench` reports beside its rows: bench.md (every column of every row with their key,
-//! the approximate rows, the colour error per depth-complexity bucket, the multisampled rows) and
-//! the speed/accuracy chart. Text and files, never stdout: the command line prints them.
+//! the approximate rows, the colour error per depth-complexity bucket, the multisampled rows),
+//! the terminal tables (the columns a reader scans first), the JSON Lines records and the
+//! speed/accuracy chart. Text and files, never stdout: the command line prints them.
 
 use std::path::Path;
 
-use super::BenchReport;
+use serde::Serialize;
+
+use super::{BenchReport, BenchRow};
 use crate::approximate::ApproximateRow;
 use crate::cells::{bucket_cells, family, mean_of_channels, percent};
-use crate::multisampled::MsaaReport;
+use crate::multisampled::{MsaaReport, SampledRow};
+use crate::record::{line, Context};
+use crate::table::{Column, Table};
 
 /// The bench's own speed/accuracy chart: one point per scheme and executor.
 ///
@@ -296,4 +301,138 @@ stage included).
 ",
     );
     text
+}
+
+/// What bench prints on a terminal: the scene line of bench.md and the columns a reader scans
+/// first, aligned, in about 120 characters (bench.md holds all 26).
+#[must_use]
+pub fn terminal_table(report: &BenchReport) -> String {
+    let columns: [Column<BenchRow>; 10] = [
+        ("scheme", |r| r.scheme.clone()),
+        ("executor", |r| r.executor.clone()),
+        ("passes", |r| r.passes.to_string()),
+        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
+        ("lost", |r| r.lost.to_string()),
+        ("mismatched px", |r| r.mismatched_pixels.to_string()),
+        ("EPR %", |r| {
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
+        }),
+        ("PSNR dB", |r| r.colour.cells()[2].clone()),
+        ("frame ms", |r| format!("{:.2}", r.time_ms)),
+        ("vs DP", |r| {
+            r.speedup_vs_depth_peeling
+                .map_or_else(|| "n/a".into(), |v| format!("{v:.2}"))
+        }),
+    ];
+    let mut text = markdown(report)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    text.push_str("\n\n");
+    text.push_str(&Table::of(&columns, &report.rows, 2).text(2));
+    text.push_str(
+        "Columns: passes geometry passes a frame; B/px storage bytes a pixel; lost fragments it \
+         should have kept; mismatched px pixels whose list differs from the oracle's; EPR % \
+         pixels whose 8-bit colour of the effect differs, in % of the covered pixels; PSNR dB of \
+         that image; frame ms the median frame; vs DP speed-up over depth peeling.\n",
+    );
+    text
+}
+
+/// What `bench --samples` prints on a terminal under the single-sample table: the line of
+/// bench.md that opens the multisampled table, and its columns a reader scans first, aligned
+/// (bench.md holds every column and their key).
+#[must_use]
+pub fn msaa_terminal_table(msaa: &MsaaReport) -> String {
+    let columns: [Column<SampledRow>; 10] = [
+        ("scheme", |r| r.scheme.clone()),
+        ("storage", |r| r.storage.to_string()),
+        ("executor", |r| r.executor.clone()),
+        ("passes", |r| r.passes.to_string()),
+        ("B/px", |r| format!("{:.1}", r.bytes_per_pixel)),
+        ("overflow", |r| {
+            format!("{} {}", r.overflowed, r.overflow_unit)
+        }),
+        ("lost", |r| r.lost.to_string()),
+        ("wrong samples", |r| r.wrong_samples.to_string()),
+        ("EPR %", |r| {
+            r.error_pixel_rate
+                .map_or_else(|| "n/a".into(), |e| percent(e, 3))
+        }),
+        ("frame ms", |r| format!("{:.2}", r.time_ms)),
+    ];
+    let mut text = msaa_markdown(msaa)
+        .lines()
+        .find(|line| !line.is_empty())
+        .unwrap_or_default()
+        .to_string();
+    text.push_str("\n\n");
+    text.push_str(&Table::of(&columns, &msaa.rows, 3).text(2));
+    text.push_str(
+        "Columns: overflow what found no room (sample fragments, or whole masked nodes); lost \
+         sample fragments the scheme owed and is missing (per-sample storage: beyond the \
+         overflow); wrong samples samples whose list differs from the per-sample oracle's; the \
+         rest as above.\n",
+    );
+    text
+}
+
+/// One line of bench's JSON Lines: a row with what the whole bench measured.
+#[derive(Serialize)]
+struct BenchRecord<'a> {
+    #[serde(flatten)]
+    row: &'a BenchRow,
+    #[serde(flatten)]
+    bench: &'a BenchReport,
+}
+
+/// One line of bench's JSON Lines for an approximate scheme: its row with what the whole bench
+/// measured.
+#[derive(Serialize)]
+struct ApproximateRecord<'a> {
+    #[serde(flatten)]
+    row: &'a ApproximateRow,
+    #[serde(flatten)]
+    bench: &'a BenchReport,
+}
+
+/// One line of bench's JSON Lines for a multisampled scheme (`--samples`): its row with what the
+/// whole bench measured.
+#[derive(Serialize)]
+struct SampledRecord<'a> {
+    #[serde(flatten)]
+    row: &'a SampledRow,
+    #[serde(flatten)]
+    bench: &'a BenchReport,
+}
+
+/// bench's JSON Lines (`docs/json-schema.md`; bench.jsonl holds the same): a `bench` line per
+/// row, a `bench-approximate` line per approximate row, a `bench-msaa` line per multisampled
+/// row, each in `context` (the scene's, sized) on the row's executor and threads.
+///
+/// # Errors
+/// A record cannot be serialised (a bug).
+pub fn records(report: &BenchReport, context: &Context) -> Result<String, String> {
+    let mut lines = String::new();
+    for row in &report.rows {
+        let on = context.on(&row.executor, row.threads);
+        let record = BenchRecord { row, bench: report };
+        lines.push_str(&line("bench", &on, &record)?);
+        lines.push('\n');
+    }
+    for row in &report.approximate {
+        let on = context.on("primitive-order", row.threads);
+        let record = ApproximateRecord { row, bench: report };
+        lines.push_str(&line("bench-approximate", &on, &record)?);
+        lines.push('\n');
+    }
+    for row in report.msaa.iter().flat_map(|m| &m.rows) {
+        let on = context.on(&row.executor, row.threads);
+        let record = SampledRecord { row, bench: report };
+        lines.push_str(&line("bench-msaa", &on, &record)?);
+        lines.push('\n');
+    }
+    Ok(lines)
 }

@@ -1,14 +1,17 @@
 //! What `hazard` reports: hazard.md (the rates, per seed and per depth-complexity bucket, with
 //! their key), baselines.md, and the two charts (pixels wrong against threads in flight and
-//! against depth complexity). Text and files, never stdout: the command line prints them.
+//! against depth complexity), and the JSON Lines records of the rows. Text and files, never
+//! stdout: the command line prints them.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use fragsim_explain::hazard::POLICIES;
 use fragsim_shade::plot::{chart, chart_with_ticks, Series};
+use serde::Serialize;
 
 use super::HazardReport;
+use crate::record::{line, Context, Slots};
 
 /// What hazard.md's tables mean, under them.
 const KEY: &str = "
@@ -213,4 +216,120 @@ pub fn charts(report: &HazardReport, dir: &Path, ext: &str) -> Result<[String; 2
     )
     .map_err(|e| e.to_string())?;
     Ok([vs_width, vs_dc])
+}
+
+/// One line of hazard's JSON Lines: a row of the rates (the context carries the scheduled
+/// executor and the threads in flight).
+#[derive(Serialize)]
+struct HazardRecord<'a> {
+    scheme: &'static str,
+    write_back: &'a str,
+    policy: &'a str,
+    seeds: u64,
+    /// Fraction of covered pixels whose list differs from the oracle's K nearest, mean over
+    /// the seeds.
+    mismatched_pixel_rate: f64,
+    /// The same, per seed.
+    mismatched_pixel_rate_per_seed: &'a [f64],
+    lost: u64,
+    extra: u64,
+    duplicates: u64,
+    misordered_pixels: u64,
+    /// The rate among the pixels of each depth-complexity bucket (`dc_1`, `dc_2`, `dc_3_4`, …);
+    /// `null` for a bucket without pixels.
+    #[serde(flatten)]
+    by_depth_complexity: std::collections::BTreeMap<String, Option<f64>>,
+}
+
+/// One line of `hazard --baselines`' JSON Lines (the context carries K and the executor).
+#[derive(Serialize)]
+struct BaselineRecord<'a> {
+    scheme: &'a str,
+    passes: u32,
+    overflowed: u64,
+    lost: u64,
+    extra: u64,
+    duplicates: u64,
+    misordered_pixels: u64,
+    error_pixels: u64,
+    /// `error_pixels` over the covered pixels.
+    error_pixel_rate: f64,
+    memory_bytes: u64,
+}
+
+/// The rates' JSON Lines records (`docs/json-schema.md`), one `hazard` line per row, in
+/// `context` (the scene's) with the report's K; `seeds`: the seeds each row ran.
+///
+/// # Errors
+/// A record cannot be serialised (a bug).
+pub fn records(
+    report: &HazardReport,
+    context: &Context,
+    seeds: u64,
+) -> Result<Vec<String>, String> {
+    let mut context = context.clone();
+    context.k = Some(Slots::Fixed(report.k));
+    report
+        .rows
+        .iter()
+        .map(|r| {
+            let by_depth_complexity = report
+                .buckets
+                .iter()
+                .zip(&r.rate_by_depth_complexity)
+                .map(|((label, n), &rate)| {
+                    let key = format!("mismatched_pixel_rate_dc_{}", label.replace('–', "_"));
+                    (key, (*n > 0).then_some(rate))
+                })
+                .collect();
+            let record = HazardRecord {
+                scheme: "kbuffer",
+                write_back: &r.write_back,
+                policy: &r.policy,
+                seeds,
+                mismatched_pixel_rate: r.rate,
+                mismatched_pixel_rate_per_seed: &r.rate_per_seed,
+                lost: r.lost,
+                extra: r.extra,
+                duplicates: r.duplicates,
+                misordered_pixels: r.misordered_pixels,
+                by_depth_complexity,
+            };
+            line(
+                "hazard",
+                &context.on("scheduled", r.threads_in_flight),
+                &record,
+            )
+        })
+        .collect()
+}
+
+/// The baselines' JSON Lines records, one `baseline` line per row, in `context` (the scene's)
+/// with each row's K and executor.
+///
+/// # Errors
+/// A record cannot be serialised (a bug).
+pub fn baseline_records(report: &HazardReport, context: &Context) -> Result<Vec<String>, String> {
+    report
+        .baselines
+        .iter()
+        .map(|r| {
+            let mut context = context.on(&r.executor, 0);
+            context.threads = None;
+            context.k = Some(Slots::Fixed(r.k));
+            let record = BaselineRecord {
+                scheme: &r.scheme,
+                passes: r.passes,
+                overflowed: r.overflowed,
+                lost: r.lost,
+                extra: r.extra,
+                duplicates: r.duplicates,
+                misordered_pixels: r.misordered_pixels,
+                error_pixels: r.error_pixels,
+                error_pixel_rate: r.error_pixels as f64 / report.covered.max(1) as f64,
+                memory_bytes: r.memory_bytes,
+            };
+            line("baseline", &context, &record)
+        })
+        .collect()
 }

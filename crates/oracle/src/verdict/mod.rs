@@ -35,6 +35,7 @@ mod hints;
 mod judge_dump;
 mod reference;
 mod report;
+mod rows;
 mod run;
 mod sides;
 #[cfg(test)]
@@ -61,6 +62,7 @@ pub use error::VerdictError;
 pub use judge_dump::{JudgeDump, MaskedComparison, WrongMask};
 pub use reference::Reference;
 pub use report::{Corrupt, Entry, Example, FragmentTotals, SampleCounts, Summary, WordTotals};
+pub use rows::{aligned, Row};
 pub use run::{judge_run, RunVerdict};
 pub use sides::{judge_sides, Side, SideReport, SidesOptions};
 

@@ -1,14 +1,15 @@
-//! The one table printer of the command line's terminal output: `render`'s summary, `bench`'s
-//! and `sweep`'s tables and `explain`'s step-by-step table are each a [`Table`] (headings, rows
-//! of cells, each column as wide as its widest cell), laid out as aligned text or as a Markdown
-//! table, so that no command lays out columns by hand.
+//! The one table layout of terminal output: `render`'s summary, `bench`'s and `sweep`'s tables
+//! ([`crate::bench::report::terminal_table`], [`crate::sweep::report::terminal_tables`]) and
+//! `explain`'s step-by-step table are each a [`Table`] (headings, rows of cells, each column as
+//! wide as its widest cell), laid out as aligned text or as a Markdown table, so that no report
+//! lays out columns by hand.
 
 /// A column of a table of `Row`s: its heading, and the cell it shows of a row.
-pub(crate) type Column<Row> = (&'static str, fn(&Row) -> String);
+pub type Column<Row> = (&'static str, fn(&Row) -> String);
 
 /// A table: headings, rows of cells, and how its columns align.
 #[derive(Debug, Clone)]
-pub(crate) struct Table {
+pub struct Table {
     /// One heading a column.
     headings: Vec<String>,
     /// The first `left` columns (names) align left, the rest (numbers) right.
@@ -21,7 +22,7 @@ pub(crate) struct Table {
 
 impl Table {
     /// A table with `headings` and no rows, its first `left` columns aligned left.
-    pub(crate) fn new(headings: Vec<String>, left: usize) -> Self {
+    pub fn new(headings: Vec<String>, left: usize) -> Self {
         Self {
             headings,
             left,
@@ -31,7 +32,7 @@ impl Table {
     }
 
     /// The table of `rows`, one column per `(heading, cell)`.
-    pub(crate) fn of<Row>(columns: &[Column<Row>], rows: &[Row], left: usize) -> Self {
+    pub fn of<Row>(columns: &[Column<Row>], rows: &[Row], left: usize) -> Self {
         let mut table = Self::new(
             columns
                 .iter()
@@ -46,19 +47,19 @@ impl Table {
     }
 
     /// With column `c` at least `least_widths[c]` wide, so that short runs line up with long.
-    pub(crate) fn at_least(mut self, least_widths: Vec<usize>) -> Self {
+    pub fn at_least(mut self, least_widths: Vec<usize>) -> Self {
         self.least_widths = least_widths;
         self
     }
 
     /// Adds a row, one cell a column.
-    pub(crate) fn push(&mut self, cells: Vec<String>) {
+    pub fn push(&mut self, cells: Vec<String>) {
         debug_assert_eq!(cells.len(), self.headings.len(), "one cell a column");
         self.rows.push(cells);
     }
 
     /// Whether the table has no row.
-    pub(crate) fn is_empty(&self) -> bool {
+    pub fn is_empty(&self) -> bool {
         self.rows.is_empty()
     }
 
@@ -92,7 +93,7 @@ impl Table {
 
     /// As text: the line of headings, then a line a row, `gap` spaces between columns, no
     /// trailing spaces.
-    pub(crate) fn text(&self, gap: usize) -> String {
+    pub fn text(&self, gap: usize) -> String {
         let widths = self.widths();
         let separator = " ".repeat(gap);
         let mut text = String::new();
@@ -105,7 +106,7 @@ impl Table {
 
     /// As a Markdown table, padded so that it lines up as text too: the headings, the rule, a
     /// line a row.
-    pub(crate) fn markdown(&self) -> String {
+    pub fn markdown(&self) -> String {
         let widths = self.widths();
         let line = |cells: Vec<String>| format!("| {} |\n", cells.join(" | "));
         let rule: Vec<String> = widths.iter().map(|&w| "-".repeat(w)).collect();
