@@ -84,7 +84,7 @@ pub struct MaskedLists {
     pub nodes: Vec<MaskedNode>,
     /// Nodes each pixel dropped for lack of storage, where the storage counts them per pixel
     /// (the A-buffer's counters); all 0 for an oracle's view and for a pool's lists, whose one
-    /// counter counts them in all ([`MaskedFrame::dropped`]).
+    /// counter counts them in all ([`MaskedFrame::dropped`](super::MaskedFrame::dropped)).
     pub overflow: Vec<u32>,
 }
 
