@@ -24,10 +24,10 @@ use std::time::Instant;
 
 use fragsim::capture::executors::Run;
 use fragsim::capture::executors::{ParallelExecutor, TiledExecutor};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::raster::{Mesh, OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::mdts::Mdts;
 
 /// FreePipe's configuration, as `fragsim bench` runs it: K = 20 slots, 20 per A-buffer pixel.
 const SLOTS: u32 = 20;

@@ -26,11 +26,11 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughpu
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::executors::{ParallelExecutor, SerialExecutor};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::AtomicMemory;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::mdts::Mdts;
 use rayon::prelude::*;
 
 /// Fragments per rayon work item when capturing a pre-rasterized stream.

@@ -4,13 +4,18 @@
 //! users see one library:
 //! - [`raster`]: scenes, camera and the exact rasterizer that produces fragments;
 //! - [`memory`]: the simulated GPU's memory, the `Memory` seam the schemes step on;
-//! - [`capture`]: the schemes (MDTS, A-buffer) and the executors;
+//! - [`capture`]: the `Scheme` trait, the captures a run returns and the executors that run a
+//!   frame;
+//! - [`schemes`]: the capture schemes, one module each (MDTS, the A-buffer, the baselines the
+//!   papers measure, the OIT backends engines ship);
+//! - [`catalog`]: every scheme by name, built and run on any executor;
 //! - [`dump`]: the dump format GPU backends write, and the triangle export;
 //! - [`oracle`]: the serial reference lists, the per-pixel diff and the verdict;
 //! - [`shade`]: images of the results.
 //!
 //! ```
-//! use fragsim::capture::{executors, schemes::mdts::Mdts};
+//! use fragsim::capture::executors;
+//! use fragsim::schemes::mdts::Mdts;
 //! use fragsim::raster::{OrbitCamera, Scene, Viewport};
 //! use fragsim::oracle::Oracle;
 //!
@@ -32,8 +37,10 @@
 use fragsim_cli as _;
 
 pub use fragsim_capture as capture;
+pub use fragsim_catalog as catalog;
 pub use fragsim_dump as dump;
 pub use fragsim_memory as memory;
 pub use fragsim_oracle as oracle;
 pub use fragsim_raster as raster;
+pub use fragsim_schemes as schemes;
 pub use fragsim_shade as shade;

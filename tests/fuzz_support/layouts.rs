@@ -28,8 +28,8 @@
 //! The shape of the memory of a `memory` dump is the scheme's own, from the catalog (or wrong on
 //! purpose); its words are arbitrary, so each scheme's resolve runs on memory no run left.
 
-use fragsim::capture::catalog::SchemeName;
 use fragsim::capture::Capture;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::{
     ArraySpec, Corruption, DepthFormat, Dtype, Dump, DumpError, Header, Payload, Words,
 };

@@ -7,12 +7,12 @@
 //! and for one-pass schemes that count every drop the counted drops must equal what the capture
 //! is missing.
 
-use fragsim::capture::catalog::{Build, Passes, SchemeVisitor, CATALOG};
 use fragsim::capture::executors::frame::{self, Counters, Run};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::{
     inputs_of, Capture, Guarantee, Identity, Keeps, Scheme, MEMORY_CAP_DEFAULT,
 };
+use fragsim::catalog::{Build, Passes, SchemeVisitor, CATALOG};
 use fragsim::memory::SerialMemory;
 use fragsim::raster::{depth_key, Fragment, Viewport};
 

@@ -1,7 +1,7 @@
 //! The A-buffer.
 
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
 
 use super::{abuffer_model, fragments, one_pixel, DISTINCT};
 

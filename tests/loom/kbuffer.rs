@@ -5,11 +5,11 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
 use fragsim::memory::SerialMemory;
 use fragsim::raster::Fragment;
+use fragsim::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim::schemes::mdts::Direction;
 
 use super::{
     check_k_best, explore, fragments, k_best_error, one_pixel, run_threads, Walks, DISTINCT,
@@ -85,7 +85,7 @@ fn kbuffer_model(
 }
 
 /// The negative control (2 threads, K = 3, exhaustive): the library's k-buffer with separate
-/// stores (`crates/capture/src/schemes/kbuffer/mod.rs`: `K` loads, an insertion in registers, `K` stores, one
+/// stores (`crates/schemes/src/kbuffer/mod.rs`: `K` loads, an insertion in registers, `K` stores, one
 /// memory operation per step) is correct when its two walks run one after the other, but loom
 /// finds interleavings that lose a fragment, and the very checker that passes MDTS
 /// (`check_k_best`) panics on them.

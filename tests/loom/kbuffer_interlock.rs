@@ -1,4 +1,4 @@
-//! The interlocked k-buffer (`crates/capture/src/schemes/kbuffer/interlock.rs`): the k-buffer's
+//! The interlocked k-buffer (`crates/schemes/src/kbuffer/interlock.rs`): the k-buffer's
 //! read–insert–write-back as one critical section under the pixel lock. Two fragments of one
 //! pixel, every interleaving: none is lost, and the walks count what fell off; the plain
 //! k-buffer (render targets), run through the same model, is the control that loses one.
@@ -6,11 +6,11 @@
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::schemes::kbuffer::interlock::KBufferInterlock;
-use fragsim::capture::schemes::kbuffer::KBuffer;
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
+use fragsim::schemes::kbuffer::interlock::KBufferInterlock;
+use fragsim::schemes::kbuffer::KBuffer;
+use fragsim::schemes::mdts::Direction;
 
 use super::{explore, fragments, k_best_error, one_pixel, run_threads, Walks, DISTINCT};
 

@@ -1,4 +1,4 @@
-//! The ordered interlock (`crates/capture/src/schemes/kbuffer/interlock_ordered.rs`): a pixel's
+//! The ordered interlock (`crates/schemes/src/kbuffer/interlock_ordered.rs`): a pixel's
 //! critical sections under its lock, entered in primitive order. Two fragments of one pixel,
 //! submitted in list order, every interleaving of their attempts with at most
 //! [`PREEMPTIONS`] preemptions (a walk that finds an earlier fragment still to come yields before
@@ -30,11 +30,11 @@ use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
 use fragsim::capture::primitive_order::PrimitiveOrder;
-use fragsim::capture::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::WordMemory;
 use fragsim::raster::Fragment;
+use fragsim::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
+use fragsim::schemes::mdts::Direction;
 
 use super::{explore, fragments, k_best_error, one_pixel, run_spinning, DISTINCT};
 

@@ -1,4 +1,4 @@
-//! The spinlocked k-buffer (`crates/capture/src/schemes/kbuffer/spinlock.rs`), both loop shapes:
+//! The spinlocked k-buffer (`crates/schemes/src/kbuffer/spinlock.rs`), both loop shapes:
 //! the lock held across the critical section's `2 K` steps. Two fragments of one pixel, every
 //! interleaving (loom's threads are independently scheduled, as since Volta): mutual exclusion
 //! (never two walks between their lock and their release) and no fragment lost; the same
@@ -14,11 +14,11 @@
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Lock, Loop, SpinInsert};
-use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
+use fragsim::schemes::kbuffer::spinlock::{KBufferSpinlock, Lock, Loop, SpinInsert};
+use fragsim::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim::schemes::mdts::Direction;
 use loom::sync::atomic::{AtomicU32, Ordering::SeqCst};
 
 use super::{explore, fragments, k_best_error, one_pixel, run_spinning, run_threads, DISTINCT};

@@ -25,11 +25,11 @@ use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use fragsim::capture::schemes::abuffer::ABuffer;
-use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{Keeps, Promise, Scheme, Step, MEMORY_CAP_DEFAULT};
 use fragsim::memory::{Memory, WordMemory};
 use fragsim::raster::{depth_key, Fragment, Viewport};
+use fragsim::schemes::abuffer::ABuffer;
+use fragsim::schemes::mdts::{Direction, Mdts, MdtsWord};
 use loom::sync::atomic::{
     AtomicU32, AtomicU64,
     Ordering::{Acquire, Relaxed, Release},

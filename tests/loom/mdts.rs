@@ -1,7 +1,7 @@
 //! MDTS on each of its words and directions: u64 words (depth key and primitive id) ascending,
 //! the probing walk, u32 words (depth key only) and descending.
 
-use fragsim::capture::schemes::mdts::Direction;
+use fragsim::schemes::mdts::Direction;
 
 use super::{fragments, keyed, mdts_model, mdts_probe_model, DISTINCT, TIES};
 

@@ -1,5 +1,5 @@
 //! MDTS with the 64-bit `atomicMin` emulated on 32-bit words
-//! (`crates/capture/src/schemes/mdts_emulated64.rs`). Two fragments of one pixel, every
+//! (`crates/schemes/src/mdts_emulated64.rs`). Two fragments of one pixel, every
 //! interleaving: the unlocked emulation (loads and stores of the halves) tears, leaving in a slot
 //! a value neither fragment carried, which loom finds; the emulation inside a per-slot lock keeps
 //! exactly the `K` nearest, drops counted, in every interleaving.
@@ -10,10 +10,10 @@
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::schemes::mdts::Direction;
-use fragsim::capture::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::raster::Fragment;
+use fragsim::schemes::mdts::Direction;
+use fragsim::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
 
 use super::{explore, fragments, k_best_error, one_pixel, run_spinning, DISTINCT};
 

@@ -1,10 +1,10 @@
 //! Shipping OIT schemes (`docs/baselines/shipping.md`).
 
-use fragsim::capture::schemes::layer_counter::LayerCounter;
-use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};
-use fragsim::capture::schemes::loop32::Loop32;
 use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
 use fragsim::memory::WordMemory;
+use fragsim::schemes::layer_counter::LayerCounter;
+use fragsim::schemes::linked_list::{LinkedList, Resolve};
+use fragsim::schemes::loop32::Loop32;
 
 use super::{explore, fragments, keyed, one_pixel, run_threads, LoomMemory, Walks, DISTINCT, TIES};
 

@@ -3,10 +3,10 @@
 use std::sync::atomic::{AtomicUsize, Ordering as StdOrdering};
 use std::sync::Arc;
 
-use fragsim::capture::schemes::mdts::Direction;
 use fragsim::capture::{Descriptor, Guarantee, Identity, Promise, Scheme, Step};
 use fragsim::memory::{Layout, Memory, WordMemory};
 use fragsim::raster::Fragment;
+use fragsim::schemes::mdts::Direction;
 
 use super::{explore, k_best_error, keyed, run_threads, Walks, TIES};
 

@@ -2,11 +2,11 @@
 //! executors equal the serial oracle fragment for fragment.
 
 use fragsim::capture::executors::{run_parallel, run_serial, Executor};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::mdts::{Direction, Mdts};
 
 #[test]
 fn bunny_both_schemes_both_executors_equal_the_oracle() {

@@ -6,15 +6,15 @@
 //! `K` nearest then and only then when the first `K` submitted are not the `K` nearest. A different
 //! submission order (`--shuffle`) keeps different fragments, as on a GPU.
 
-use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::executors::{Executor, ParallelExecutor};
 use fragsim::capture::primitive_order::PrimitiveOrder;
-use fragsim::capture::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
-use fragsim::capture::schemes::layer_counter::LayerCounter;
 use fragsim::capture::{Capture, Guarantee, MEMORY_CAP_DEFAULT};
+use fragsim::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::kbuffer::interlock_ordered::{KBufferInterlockOrdered, Keep};
+use fragsim::schemes::layer_counter::LayerCounter;
 
 fn sizing(k: u32) -> Sizing {
     Sizing {

@@ -7,16 +7,16 @@
 //! executor with every fragment in flight at once in one warp (so which fragments contend is
 //! known); the real-scene test runs each catalog entry on every executor through the catalog.
 
-use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::capture::executors::scheduled::{
     run_fragments, Granularity, Policy, Schedule, WARP_LANES,
 };
 use fragsim::capture::executors::Executor;
-use fragsim::capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
-use fragsim::capture::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
 use fragsim::capture::{Guarantee, MEMORY_CAP_DEFAULT};
+use fragsim::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
+use fragsim::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
+use fragsim::schemes::mdts_emulated64::{Emulation, MdtsEmulated64};
 use proptest::prelude::*;
 
 /// Fragments on `pixels` pixels, primitive ids in submission order, depth keys from six values;

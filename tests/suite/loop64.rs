@@ -5,14 +5,14 @@
 //! the oracle's `K` nearest and its drops the fragments it lacks; on streams with many equal
 //! depths under GPU-like schedules, the `K` nearest every time, where loop32 loses some.
 
-use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
-use fragsim::capture::schemes::loop32::Loop32;
-use fragsim::capture::schemes::loop64::Loop64;
 use fragsim::capture::{Guarantee, MEMORY_CAP_DEFAULT};
+use fragsim::catalog::{Count, SchemeName, SchemeRunner, Sizing};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
+use fragsim::schemes::loop32::Loop32;
+use fragsim::schemes::loop64::Loop64;
 
 #[test]
 fn loop64_is_exact_on_every_executor() {

@@ -25,6 +25,7 @@ mod effects;
 mod explain;
 mod extremes;
 mod flag_dialect;
+mod frame_loop;
 mod honest_reports;
 mod interlock_ordered;
 mod json_lines;

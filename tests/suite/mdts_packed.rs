@@ -4,14 +4,14 @@
 use crate::support::prim_of;
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::{run_parallel, run_serial};
-use fragsim::capture::schemes::mdts::Mdts;
-use fragsim::capture::schemes::mdts_packed::{
-    depth20, held_depth, remapped_depth, Colours, MdtsPacked, COLOURS,
-};
 use fragsim::capture::{Capture, CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
+use fragsim::schemes::mdts::Mdts;
+use fragsim::schemes::mdts_packed::{
+    depth20, held_depth, remapped_depth, Colours, MdtsPacked, COLOURS,
+};
 use rayon::prelude::*;
 
 /// Key of depth 1.0.

@@ -7,18 +7,18 @@ use std::path::PathBuf;
 
 use fragsim::capture::executors::tiled::run_tiled;
 use fragsim::capture::executors::{run_parallel, run_serial, Executor, Run};
-use fragsim::capture::schemes::abuffer::ABuffer;
-use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
-use fragsim::capture::schemes::kbuffer::multipass::KBufferMultipass;
-use fragsim::capture::schemes::kbuffer::KBuffer;
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
-use fragsim::capture::schemes::peeling::DepthPeeling;
-use fragsim::capture::schemes::stencil_routed::StencilRouted;
-use fragsim::capture::schemes::zbuffer::ZBuffer;
 use fragsim::capture::Scheme;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
+use fragsim::schemes::abuffer::ABuffer;
+use fragsim::schemes::dual_peeling::DualDepthPeeling;
+use fragsim::schemes::kbuffer::multipass::KBufferMultipass;
+use fragsim::schemes::kbuffer::KBuffer;
+use fragsim::schemes::mdts::{Direction, Mdts};
+use fragsim::schemes::peeling::DepthPeeling;
+use fragsim::schemes::stencil_routed::StencilRouted;
+use fragsim::schemes::zbuffer::ZBuffer;
 
 fn shared_meshes() -> Option<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");

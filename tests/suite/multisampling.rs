@@ -8,15 +8,15 @@
 
 use std::path::PathBuf;
 
-use fragsim::capture::catalog::{Count, SchemeRunner, Sizing, CATALOG};
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::executors::{run_serial, run_tiled, ParallelExecutor};
-use fragsim::capture::schemes::masked_abuffer::{MaskedABuffer, MaskedStorage};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
+use fragsim::catalog::{Count, SchemeRunner, Sizing, CATALOG};
 use fragsim::oracle::samples::SampleOracle;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, SamplePattern, Scene, View, Viewport};
+use fragsim::schemes::masked_abuffer::{MaskedABuffer, MaskedStorage};
 
 fn view_of(scene: &Scene, side: u32, angle: f64) -> View<'_> {
     scene
@@ -221,7 +221,7 @@ fn mdts_and_the_abuffer_run_per_sample_equal_the_per_sample_oracle_on_every_exec
             memory_cap: MEMORY_CAP_DEFAULT,
         };
         for name in ["mdts", "abuffer", "abuffer-exact"] {
-            let scheme = fragsim::capture::catalog::SchemeName::from_name(name).unwrap();
+            let scheme = fragsim::catalog::SchemeName::from_name(name).unwrap();
             for executor in [Executor::Serial, Executor::Parallel, Executor::Tiled] {
                 let run = runner.run(scheme, executor, &sampled, &sizing).unwrap();
                 let diff = oracle.oracle().diff(&run.run.capture);

@@ -2,7 +2,7 @@
 //! (name, storage, identity, guarantee, promise, pixels, stated once) and the steps that are its
 //! own (`begin`, `step`, `resolve_pixel`). Every executor, the oracle's diff and the scheduled
 //! executor's interleavings then take it as they take the catalog's schemes; naming it on the
-//! command line is one `catalog!` line more (`crates/capture/src/catalog/mod.rs` says so).
+//! command line is one `catalog!` line more (`crates/catalog/src/lib.rs` says so).
 //!
 //! The scheme is the far buffer, the z-buffer's mirror: one `atomicMax` per fragment on a word a
 //! pixel, which keeps each pixel's farthest fragment (the far layer that dual depth peeling's

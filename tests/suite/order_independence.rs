@@ -12,13 +12,13 @@
 //! capacity the scene does not exceed; a scheme that merges equal depths does only on scenes
 //! without them.
 
-use fragsim::capture::catalog::{
-    Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing, Storage, CATALOG,
-};
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::primitive_order::PrimitiveOrder;
 use fragsim::capture::{inputs_of, Capture, Guarantee, Keeps, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::catalog::{
+    Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing, Storage, CATALOG,
+};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
 use proptest::prelude::*;

@@ -7,13 +7,13 @@ use fragsim::capture::executors::scheduled::{
     run_fragments, run_scheduled, Granularity, Policy, Schedule,
 };
 use fragsim::capture::executors::{run_parallel, run_serial, Run};
-use fragsim::capture::schemes::dual_peeling::DualDepthPeeling;
-use fragsim::capture::schemes::peeling::DepthPeeling;
-use fragsim::capture::schemes::zbuffer::ZBuffer;
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::Layout;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::dual_peeling::DualDepthPeeling;
+use fragsim::schemes::peeling::DepthPeeling;
+use fragsim::schemes::zbuffer::ZBuffer;
 use proptest::prelude::*;
 
 /// How many of pixel `p`'s fragments share their depth key with the fragment before them in

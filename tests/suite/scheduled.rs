@@ -4,12 +4,12 @@
 use fragsim::capture::executors::scheduled::{
     run_fragments, run_scheduled, Granularity, Policy, Schedule,
 };
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{Capture, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::Op;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::mdts::{Direction, Mdts};
 use proptest::prelude::*;
 
 fn policy() -> impl Strategy<Value = Policy> {

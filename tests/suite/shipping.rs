@@ -21,14 +21,14 @@ use fragsim::capture::executors::scheduled::{
 };
 use fragsim::capture::executors::tiled::run_tiled;
 use fragsim::capture::executors::{run_parallel, run_serial, Executor};
-use fragsim::capture::schemes::layer_counter::LayerCounter;
-use fragsim::capture::schemes::linked_list::{LinkedList, Resolve};
-use fragsim::capture::schemes::loop32::Loop32;
-use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::capture::{Capture, Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::Op;
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::layer_counter::LayerCounter;
+use fragsim::schemes::linked_list::{LinkedList, Resolve};
+use fragsim::schemes::loop32::Loop32;
+use fragsim::schemes::mdts::Mdts;
 use proptest::prelude::*;
 
 /// A stream of fragments on `pixels` pixels: primitive ids in submission order, depth keys from

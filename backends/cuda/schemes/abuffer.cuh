@@ -1,4 +1,4 @@
-// Mirrors crates/capture/src/schemes/abuffer.rs: FreePipe's A-buffer (§4.2) on fixed arrays. Each
+// Mirrors crates/schemes/src/abuffer.rs: FreePipe's A-buffer (§4.2) on fixed arrays. Each
 // fragment takes a slot with fetch-and-add on its pixel's counter and stores its word there when
 // the slot is below the capacity; the counter keeps counting past it, so counter - capacity is the
 // pixel's overflow. The post pass sorts each pixel's min(counter, capacity) words (one thread per

@@ -1,4 +1,4 @@
-// Mirrors crates/capture/src/schemes/kbuffer/mod.rs, DELIBERATELY BROKEN, as `kbuffer-stores` is: the
+// Mirrors crates/schemes/src/kbuffer/mod.rs, DELIBERATELY BROKEN, as `kbuffer-stores` is: the
 // k-buffer's read-modify-write (Bavoil et al. 2007) as CUDA code writes it without atomics. Read
 // all K slots, insert in registers, write all K back with plain (volatile) loads and stores;
 // concurrent fragments of one pixel overwrite each other, and `fragsim compare` must catch it. It

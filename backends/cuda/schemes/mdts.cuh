@@ -1,4 +1,4 @@
-// Mirrors crates/capture/src/schemes/mdts.rs: the multi-depth test scheme, FreePipe (Liu et al.,
+// Mirrors crates/schemes/src/mdts.rs: the multi-depth test scheme, FreePipe (Liu et al.,
 // I3D 2010) §4.1.1 and Table 1. Each pixel owns K words initialised to the empty sentinel; a
 // fragment walks them with `old = atomicMin(&A[i], new)`, stops on an empty slot and carries
 // `max(new, old)` on. Both word widths of mdts.rs: u64 words `key<<32|prim` (dump scheme `mdts`)

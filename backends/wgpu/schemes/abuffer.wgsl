@@ -1,4 +1,4 @@
-// abuffer.wgsl: the A-buffer (crates/capture/src/schemes/abuffer.rs), FreePipe's fixed storage
+// abuffer.wgsl: the A-buffer (crates/schemes/src/abuffer.rs), FreePipe's fixed storage
 // and the exact storage of a counting pass, each followed by the post pass's per-pixel sort.
 //
 // Fixed (fs_main, then cs_sort_fixed): one atomicAdd per fragment on its pixel's counter hands

@@ -1,4 +1,4 @@
-// kbuffer.wgsl: the non-atomic k-buffer (crates/capture/src/schemes/kbuffer/mod.rs, Bavoil et al.
+// kbuffer.wgsl: the non-atomic k-buffer (crates/schemes/src/kbuffer/mod.rs, Bavoil et al.
 // 2007): a fragment reads its pixel's K sorted slots and writes back the ones its insertion
 // shifts, with plain loads and stores. Two fragments of one pixel that interleave their reads
 // and writes lose one of them: the race this shader exists to show on real hardware. Words are

@@ -1,5 +1,5 @@
 // kbuffer_spinlock.wgsl: the k-buffer inside a per-pixel spinlock
-// (crates/capture/src/schemes/kbuffer/spinlock.rs, Loop::Fixed: the catalog's
+// (crates/schemes/src/kbuffer/spinlock.rs, Loop::Fixed: the catalog's
 // kbuffer-spinlock-fixed; nvpro-samples' spinlock mode). A fragment takes its pixel's lock word
 // with atomicCompareExchangeWeak(lock, 0, 1); the holder's path (load the K slots, insert, store
 // them back, release the lock) is inside the loop body, so that lanes of one subgroup that failed

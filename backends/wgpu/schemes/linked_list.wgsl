@@ -1,4 +1,4 @@
-// linked_list.wgsl: per-pixel linked lists (crates/capture/src/schemes/linked_list.rs; Yang et
+// linked_list.wgsl: per-pixel linked lists (crates/schemes/src/linked_list.rs; Yang et
 // al. 2010, Vulkan-Samples' oit_linked_lists, nvpro-samples' linked list). A fragment takes node
 // n = atomicAdd(counter, 1) + 1 of the pool (node 0 ends a list, as fragsim and nvpro number
 // them); past the pool it is discarded, the counter counting on. Otherwise it swaps itself in as

@@ -1,4 +1,4 @@
-// mdts.wgsl: the multi-depth test scheme (crates/capture/src/schemes/mdts.rs, FreePipe §4.1.1).
+// mdts.wgsl: the multi-depth test scheme (crates/schemes/src/mdts.rs, FreePipe §4.1.1).
 // A fragment walks its pixel's K slots: old = atomicMin(slot, value); an empty old value (all
 // ones) means it landed; otherwise it carries max(value, old) on to the next slot, and past slot
 // K - 1 the carried value is dropped. Under any interleaving each pixel ends with its K smallest

@@ -1,5 +1,5 @@
 //! The schemes as WGSL shaders (`backends/wgpu/schemes/`, each file named after the Rust module
-//! in `crates/capture/src/schemes/` that it mirrors) and, per scheme, its passes, the storage
+//! in `crates/schemes/src/` that it mirrors) and, per scheme, its passes, the storage
 //! buffers they bind and the dump layout those are read back as (the catalog's layout for the
 //! scheme, `docs/dump-format.md`).
 //!
@@ -7,8 +7,8 @@
 //! which), on the dump words of `docs/dump-format.md`; every buffer starts at the word the Rust
 //! scheme's memory starts at, so the dump's untouched words are the layout's empty markers.
 
-use fragsim_capture::schemes::linked_list::Resolve;
 use fragsim_dump::{Dtype, LayoutSpec};
+use fragsim_schemes::linked_list::Resolve;
 
 use crate::device::GpuError;
 
@@ -528,11 +528,11 @@ mod tests {
 
     #[test]
     fn the_kbuffers_bind_the_catalog_schemes_words_and_dump_its_slot_layout() {
-        use fragsim_capture::catalog::DumpLayout;
-        use fragsim_capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
-        use fragsim_capture::schemes::kbuffer::KBuffer;
         use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
+        use fragsim_catalog::DumpLayout;
         use fragsim_raster::Viewport;
+        use fragsim_schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
+        use fragsim_schemes::kbuffer::KBuffer;
 
         let viewport = Viewport::new(6, 5).unwrap();
         let pixels = viewport.pixels() as u64;

@@ -9,7 +9,7 @@
 //! Each case is two captures (its submission order and another), each a fresh pipeline on the
 //! adapter; the cases are at most 8×8 pixels and 6 triangles, as `fragsim conform`'s defaults.
 
-use fragsim_capture::catalog::SchemeName;
+use fragsim_catalog::SchemeName;
 use fragsim_testkit::{Battery, Case, Failure, Limits, Params};
 use fragsim_wgpu::{adapter_or_skip, Mode, Plant, WgpuBackend};
 

@@ -9,9 +9,9 @@
 use std::process::Command;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-use fragsim_capture::catalog::DumpLayout;
-use fragsim_capture::schemes::linked_list::Resolve;
+use fragsim_catalog::DumpLayout;
 use fragsim_dump::{Dump, Words};
+use fragsim_schemes::linked_list::Resolve;
 
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::SceneSpec;

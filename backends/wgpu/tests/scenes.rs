@@ -13,9 +13,9 @@
 
 use std::path::PathBuf;
 
-use fragsim_capture::schemes::linked_list::Resolve;
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::Viewport;
+use fragsim_schemes::linked_list::Resolve;
 use fragsim_wgpu::judge::{judge, Within};
 use fragsim_wgpu::{adapter_or_skip, capture, say_skipped, Gpu, GpuScheme, Mode};
 

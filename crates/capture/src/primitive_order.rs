@@ -1,6 +1,6 @@
 //! The order a GPU's rasterizer hands a pixel its fragments in: submission order. The ordered
-//! fragment-shader interlock ([`kbuffer::interlock_ordered`](crate::schemes::kbuffer::interlock_ordered))
-//! runs a pixel's critical sections in this order.
+//! fragment-shader interlock (`fragsim_schemes::kbuffer::interlock_ordered`) runs a pixel's
+//! critical sections in this order.
 //!
 //! **What it is.** For each pixel, the primitives that cover it, in the order they were
 //! submitted ([`View::submitted`]): a fragment's *rank* at its pixel is the number of the

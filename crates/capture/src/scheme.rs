@@ -51,7 +51,7 @@ impl PixelRun {
     /// The run of `words_per_pixel` words a pixel from `pixel`'s first word on, before `end`:
     /// empty where the pixels' first words lie in a run of untouched words, else to resolve
     /// while their first words lie in the run of written blocks (at least `pixel` itself).
-    pub(crate) fn of_first_words<W: fragsim_memory::Word, A: fragsim_memory::WordMemory<W>>(
+    pub fn of_first_words<W: fragsim_memory::Word, A: fragsim_memory::WordMemory<W>>(
         words: &A,
         pixel: usize,
         end: usize,
@@ -324,7 +324,7 @@ pub trait Scheme: Sync {
 /// Runs `step` until it ends the walk, counting each step into `steps`: a walk's loop, for
 /// [`Scheme::insert_state`] and the schemes that run it on a span of memory.
 #[inline]
-pub(crate) fn walk_to_end(steps: &mut u64, mut step: impl FnMut() -> Step) -> Step {
+pub fn walk_to_end(steps: &mut u64, mut step: impl FnMut() -> Step) -> Step {
     loop {
         *steps += 1;
         match step() {

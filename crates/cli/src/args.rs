@@ -8,8 +8,8 @@ use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_raster::conventions::MAX_SUBPIXEL_BITS;
 use fragsim_raster::{Conventions, DepthRange, Scene, VertexPrecision, View, WindowOrigin};
 
-pub use fragsim_capture::catalog::Count;
-use fragsim_capture::catalog::Sizing;
+pub use fragsim_catalog::Count;
+use fragsim_catalog::Sizing;
 use fragsim_dump::{kebab, Encoding, ListNumbering, Payload, SlotOrder};
 use fragsim_measure::SchemeSetup;
 pub use fragsim_measure::Shard;

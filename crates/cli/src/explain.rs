@@ -9,7 +9,7 @@
 //!   input (a fragment lost or duplicated); that run is shrunk (fragments dropped, then context
 //!   switches removed, each change kept only if the hazard still shows) and printed with the
 //!   lost value named. The shortest losing interleaving is 4 steps on render targets and `4 K`
-//!   with separate stores (`fragsim_capture::schemes::kbuffer` says why).
+//!   with separate stores (`fragsim_schemes::kbuffer` says why).
 //! - `--scheme mdts`: the densest interleaving (most context switches) among the seeds, with
 //!   `docs/proof.md`'s invariant checked after every step: each slot only ever decreases, and the
 //!   multiset of slot values plus the values carried in flight (plus those carried past the last
@@ -22,10 +22,10 @@
 
 use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
-use fragsim_capture::catalog::SchemeName;
-use fragsim_capture::schemes::kbuffer::WriteBack;
+use fragsim_catalog::SchemeName;
 use fragsim_explain::report::ExplainParams;
 use fragsim_explain::Shown;
+use fragsim_schemes::kbuffer::WriteBack;
 
 use crate::table::Table;
 
@@ -94,7 +94,7 @@ struct ExplainRecord<'a> {
     lines: Vec<&'a str>,
 }
 
-/// The k-buffer's machine, on the command line (`fragsim_capture::schemes::kbuffer::WriteBack`).
+/// The k-buffer's machine, on the command line (`fragsim_schemes::kbuffer::WriteBack`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum WriteBackArg {
     /// The read of the K slots is one step, the write-back one step, write-backs commit in

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fragsim_capture::catalog::DumpLayout;
+use fragsim_catalog::DumpLayout;
 use fragsim_dump::triangles::TriangleExport;
 use fragsim_dump::{masked_spec, Dump, DumpScheme, Encoding};
 use fragsim_raster::{SceneSpec, View};

@@ -73,7 +73,7 @@ pub use compare::{compare, CompareArgs};
 pub use conform::{conform, ConformArgs};
 pub use explain::{ExplainArgs, ExplainedScheme, WriteBackArg};
 pub use export::ExportArgs;
-pub use fragsim_capture::catalog::{SchemeName, Sizing};
+pub use fragsim_catalog::{SchemeName, Sizing};
 pub use hazard::HazardArgs;
 pub use render::{RenderArgs, RunSummary, TieChoice};
 pub use schemes::{Fault, SchemeChoice};

@@ -2,7 +2,7 @@
 //! one flat record per line. The records and their context are `fragsim_measure::record`'s; this
 //! module prints them.
 
-use fragsim_capture::catalog::Sizing;
+use fragsim_catalog::Sizing;
 use serde::Serialize;
 
 use crate::args::SchemeArgs;

@@ -1,11 +1,11 @@
-//! The command line's names for schemes: exactly the catalog's ([`fragsim_capture::catalog`]),
+//! The command line's names for schemes: exactly the catalog's ([`fragsim_catalog`]),
 //! plus `all`. Building and running them is the library's ([`SchemeRunner::run`]).
 
 use clap::builder::PossibleValue;
 use clap::ValueEnum;
 use std::sync::OnceLock;
 
-pub(crate) use fragsim_capture::catalog::{
+pub(crate) use fragsim_catalog::{
     check_memory_cap_early, NamedRun, SchemeName, SchemeRunner, CATALOG,
 };
 
@@ -64,7 +64,7 @@ pub enum Fault {
     MiscountOverflow,
 }
 
-impl From<Fault> for fragsim_capture::catalog::Fault {
+impl From<Fault> for fragsim_catalog::Fault {
     fn from(fault: Fault) -> Self {
         match fault {
             Fault::MiscountOverflow => Self::MiscountOverflow,

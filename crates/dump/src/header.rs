@@ -7,7 +7,7 @@ use fragsim_raster::Viewport;
 use serde::{Deserialize, Serialize};
 
 use crate::{err, DumpError, LayoutSpec};
-use fragsim_capture::catalog::DumpLayout;
+use fragsim_catalog::DumpLayout;
 use fragsim_raster::scene_spec::SceneSpec;
 
 /// The element type of an array file: always little-endian.
@@ -64,7 +64,7 @@ pub struct Header {
     /// Viewport height in pixels.
     pub height: u32,
     /// The layout's name: the catalog name of the scheme that heads it (`docs/dump-format.md`,
-    /// [`DumpLayout::scheme`](fragsim_capture::catalog::DumpLayout::scheme)).
+    /// [`DumpLayout::scheme`](fragsim_catalog::DumpLayout::scheme)).
     pub scheme: String,
     /// MDTS slots per pixel.
     #[serde(default, skip_serializing_if = "Option::is_none")]

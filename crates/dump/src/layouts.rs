@@ -3,12 +3,10 @@
 //! arrays are read in `arrays.rs`).
 //!
 //! The layouts and the header names that select them are the catalog's
-//! ([`fragsim_capture::catalog::DumpLayout`]): a header's `scheme` is the name of the catalog entry
+//! ([`fragsim_catalog::DumpLayout`]): a header's `scheme` is the name of the catalog entry
 //! that heads a layout, and [`DumpScheme`] is that layout with the parameters its arrays need.
 
-use fragsim_capture::catalog::{
-    Build, DumpLayout, SchemeName, SchemeVisitor, SlotWord, Storage, CATALOG,
-};
+use fragsim_catalog::{Build, DumpLayout, SchemeName, SchemeVisitor, SlotWord, Storage, CATALOG};
 use fragsim_raster::Viewport;
 
 use crate::spec::{DepthFormat, Encoding, LayoutSpec, ListNumbering, Payload, SlotOrder};
@@ -237,7 +235,7 @@ impl DumpScheme {
 
     /// The layout scheme `name`'s memory has after a run of it built with `sizes`, with `slots`
     /// slots per pixel (K, or the capacity) and the per-pixel `counts` of its counting pass,
-    /// where one ran ([`NamedRun`](fragsim_capture::catalog::NamedRun) holds all three).
+    /// where one ran ([`NamedRun`](fragsim_catalog::NamedRun) holds all three).
     ///
     /// # Errors
     /// A scheme the catalog gives no dump layout (the error lists those it gives one), storage

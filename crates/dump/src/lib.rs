@@ -45,7 +45,7 @@
 //!
 //! The parts: the header and its words (`header.rs`), the layout description (`spec.rs`), the
 //! layouts and their word rules (`layouts.rs`, from the catalog's
-//! [`DumpLayout`](fragsim_capture::catalog::DumpLayout), which names each scheme's layout
+//! [`DumpLayout`](fragsim_catalog::DumpLayout), which names each scheme's layout
 //! without knowing the format; `word_check.rs`), linked lists and layers turned into fragsim's
 //! memory with their links checked (`lists.rs`), slot arrays in an engine's order and payload
 //! turned into fragsim's (`slots.rs`), the array shapes a header states (`shapes.rs`), the

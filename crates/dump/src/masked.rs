@@ -12,12 +12,13 @@
 //! fragsim's words before the scheme's own post pass ([`MaskedABuffer::node_lists`]) runs, so that a
 //! dump is decoded exactly as fragsim decodes its own runs.
 
-use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedLists};
+use fragsim_capture::MaskedLists;
 use fragsim_capture::Scheme as _;
 use fragsim_capture::{Capacity, Capture};
 use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::scene_spec::SceneSpec;
 use fragsim_raster::View;
+use fragsim_schemes::masked_abuffer::MaskedABuffer;
 
 use crate::slots::{words_of, Placement, SlotCodec};
 use crate::spec::{Encoding, LayoutSpec, SlotOrder, LARGEST_KEY};

@@ -14,8 +14,8 @@ use crate::header::{array_bytes, check_array, check_distinct_files, check_file_n
 use crate::shapes::check_shapes;
 use crate::{err, io_err, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use crate::{FORMAT, HEADER_FILE, VERSION};
-use fragsim_capture::catalog::{SchemeName, SchemeVisitor};
 use fragsim_capture::MEMORY_CAP_DEFAULT;
+use fragsim_catalog::{SchemeName, SchemeVisitor};
 use fragsim_raster::files::{read_regular, FileError};
 
 /// The most bytes a dump header may have: a header is a few kilobytes, its `extra` included.

@@ -3,7 +3,7 @@
 //! an A-buffer's counters beside their capacities.
 
 use crate::layouts::Direction;
-use fragsim_capture::catalog::SchemeName;
+use fragsim_catalog::SchemeName;
 use serde::Serialize;
 
 use crate::layouts::DumpScheme;

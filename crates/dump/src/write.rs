@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use fragsim_capture::catalog::DumpLayout;
 use fragsim_capture::Scheme;
+use fragsim_catalog::DumpLayout;
 use fragsim_memory::{SerialMemory, WordMemory};
 use fragsim_raster::View;
 
@@ -14,7 +14,7 @@ use crate::header::{check_array, check_distinct_files, check_file_name};
 use crate::{err, io_err, ArraySpec, Dtype, Dump, DumpError, DumpScheme, Header, Words};
 use crate::{LayoutSpec, ListNumbering};
 use crate::{FORMAT, HEADER_FILE, VERSION};
-use fragsim_capture::catalog::SchemeVisitor;
+use fragsim_catalog::SchemeVisitor;
 use fragsim_raster::scene_spec::SceneSpec;
 
 /// Runs a scheme serially over a view and copies its memory out.

@@ -4,17 +4,17 @@
 //!
 //! Why: the k-buffer family trades passes for exactness, and the table shows where each one
 //! loses (only under concurrent hazards) and what its exactness costs. The schemes come from the
-//! catalog ([`fragsim_capture::catalog::CATALOG`]): the k-buffer entries on the machines asked for,
+//! catalog ([`fragsim_catalog::CATALOG`]): the k-buffer entries on the machines asked for,
 //! built by their catalog constructors, and `srab` at every pass count its catalog entry allows.
 
-use fragsim_capture::catalog::{Build, SchemeName, SchemeVisitor, CATALOG};
 use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
 use fragsim_capture::executors::{run_parallel, run_serial, Executor, Run};
-use fragsim_capture::schemes::kbuffer::WriteBack;
-use fragsim_capture::schemes::stencil_routed::StencilRouted;
 use fragsim_capture::{Scheme, MEMORY_CAP_DEFAULT};
+use fragsim_catalog::{Build, SchemeName, SchemeVisitor, CATALOG};
 use fragsim_oracle::Oracle;
 use fragsim_raster::{View, Viewport};
+use fragsim_schemes::kbuffer::WriteBack;
+use fragsim_schemes::stencil_routed::StencilRouted;
 use serde::Serialize;
 
 /// One (scheme, executor) run of the table.
@@ -116,7 +116,7 @@ impl SchemeVisitor for NameOf {
 
 /// The table's schemes, in its order: for each K of `ks` and each machine of `machines`, the
 /// catalog's k-buffer schemes on that machine (catalog order,
-/// [`Entry::read_modify_write`](fragsim_capture::catalog::Entry::read_modify_write)); then `srab`
+/// [`Entry::read_modify_write`](fragsim_catalog::Entry::read_modify_write)); then `srab`
 /// at 1 up to the passes of its catalog entry. Multi-pass k-buffers' output lists hold `layers`
 /// (the scene's maximum depth complexity, as `render` sizes them).
 ///

@@ -9,9 +9,9 @@
 //! `fragsim hazard` prints these rows (`docs/rmw-hazard.md`).
 
 use fragsim_capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack};
 use fragsim_oracle::Oracle;
 use fragsim_raster::View;
+use fragsim_schemes::kbuffer::{KBuffer, WriteBack};
 use serde::Serialize;
 
 use crate::baselines::BaselineRow;

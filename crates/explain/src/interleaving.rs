@@ -160,9 +160,9 @@ pub fn interleavings(order: &[u32], limit: u64) -> Option<Vec<Vec<u32>>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fragsim_capture::schemes::kbuffer::EMPTY;
-    use fragsim_capture::schemes::mdts::Mdts;
     use fragsim_raster::Viewport;
+    use fragsim_schemes::kbuffer::EMPTY;
+    use fragsim_schemes::mdts::Mdts;
 
     #[test]
     fn interleavings_are_the_distinct_reorderings_and_stop_past_the_limit() {

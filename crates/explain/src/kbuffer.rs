@@ -4,14 +4,14 @@
 //!
 //! Why: `fragsim explain` prints the interleaving, and a loss reads only when it is small. The
 //! shortest losing interleaving is 4 steps on render targets and `4 K` with separate stores
-//! (`fragsim_capture::schemes::kbuffer` says why); the shrinker reaches them from what a seed found by
+//! (`fragsim_schemes::kbuffer` says why); the shrinker reaches them from what a seed found by
 //! dropping fragments, then moving steps, each change kept only while the damage still shows.
 
 use std::collections::BTreeMap;
 
 use fragsim_capture::executors::scheduled::{run_fragments, Trace};
-use fragsim_capture::schemes::kbuffer::{KBuffer, EMPTY};
 use fragsim_raster::Fragment;
+use fragsim_schemes::kbuffer::{KBuffer, EMPTY};
 
 use crate::interleaving::{
     interleavings, memory_after, nearest, record, schedule, step_count, switches,
@@ -187,8 +187,8 @@ pub fn shrink(
 mod tests {
     use super::*;
     use crate::interleaving::one_pixel;
-    use fragsim_capture::schemes::kbuffer::WriteBack;
     use fragsim_raster::Viewport;
+    use fragsim_schemes::kbuffer::WriteBack;
 
     fn kbuffer(k: u32, machine: WriteBack) -> KBuffer {
         let viewport = Viewport::new(1, 1).unwrap();

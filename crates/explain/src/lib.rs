@@ -8,7 +8,7 @@
 //!   explicit order and the slot words after every step;
 //! - [`kbuffer`]: the k-buffer's damage (fragments lost or duplicated), the search for a damaging
 //!   seed and the shrinker that makes its interleaving the shortest (Bavoil et al. 2007's
-//!   read–modify–write hazard; `fragsim_capture::schemes::kbuffer` says why 4 steps suffice);
+//!   read–modify–write hazard; `fragsim_schemes::kbuffer` says why 4 steps suffice);
 //! - [`mdts`]: `docs/proof.md`'s invariant of MDTS (FreePipe, Liu et al. 2010) checked at every
 //!   step of the densest interleaving;
 //! - [`hazard`]: the hazard rate over a scene against the oracle, by width and depth complexity
@@ -34,8 +34,8 @@ pub mod mdts;
 pub mod report;
 pub mod spinlock;
 
-use fragsim_capture::catalog::{DumpLayout, Entry, Passes, SchemeName, SlotWord, CATALOG};
-use fragsim_capture::schemes::kbuffer::WriteBack;
+use fragsim_catalog::{DumpLayout, Entry, Passes, SchemeName, SlotWord, CATALOG};
+use fragsim_schemes::kbuffer::WriteBack;
 
 /// What `fragsim explain` shows of a catalog scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,9 +7,9 @@
 //! step, so the proof's induction can be followed on a run that actually happened.
 
 use fragsim_capture::executors::scheduled::{run_fragments, Trace};
-use fragsim_capture::schemes::kbuffer::EMPTY;
-use fragsim_capture::schemes::mdts::Mdts;
 use fragsim_raster::Fragment;
+use fragsim_schemes::kbuffer::EMPTY;
+use fragsim_schemes::mdts::Mdts;
 
 use crate::interleaving::{record, schedule, switches};
 

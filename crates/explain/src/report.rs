@@ -5,12 +5,12 @@
 //! A row of the table is one step, however many memory operations it did (a render-target read
 //! is `K` loads under the pixel's lock, shown as one `read`).
 
-use fragsim_capture::catalog::SchemeName;
 use fragsim_capture::executors::scheduled::Trace;
-use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack, EMPTY};
-use fragsim_capture::schemes::mdts::Mdts;
+use fragsim_catalog::SchemeName;
 use fragsim_memory::{Op, TraceEvent};
 use fragsim_raster::{Fragment, Viewport};
+use fragsim_schemes::kbuffer::{KBuffer, WriteBack, EMPTY};
+use fragsim_schemes::mdts::Mdts;
 
 use crate::interleaving::{memory_after, nearest, one_pixel, schedule, step_count, switches};
 use crate::{kbuffer, mdts, Shown};

@@ -1,5 +1,5 @@
 //! The spinlocked k-buffer's deadlock under lockstep warps
-//! (`fragsim_capture::schemes::kbuffer::spinlock`): the shortest deadlocking schedule, found by a
+//! (`fragsim_schemes::kbuffer::spinlock`): the shortest deadlocking schedule, found by a
 //! bounded search, and the fixed loop run on the same fragments.
 //!
 //! The search runs the naive loop on the first `n` fragments of one pixel, `n` = 2, 3, … up to
@@ -17,10 +17,10 @@ use std::fmt;
 use fragsim_capture::executors::scheduled::{
     run_fragments, Deadlock, Granularity, Policy, Schedule, WARP_LANES,
 };
-use fragsim_capture::schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
 use fragsim_capture::{CaptureError, MEMORY_CAP_DEFAULT};
 use fragsim_memory::{Op, TraceEvent};
 use fragsim_raster::{Fragment, Viewport};
+use fragsim_schemes::kbuffer::spinlock::{KBufferSpinlock, Loop};
 
 /// What `explain --scheme kbuffer-spinlock` reports.
 #[derive(Debug, Clone)]

@@ -19,8 +19,8 @@
 
 use std::time::{Duration, Instant};
 
-use fragsim_capture::catalog::Count;
 use fragsim_capture::primitive_order::PrimitiveOrder;
+use fragsim_catalog::Count;
 use fragsim_oracle::Oracle;
 use fragsim_shade::approximate::{in_submission_order, Approximation};
 use fragsim_shade::effects::Effect;

@@ -6,9 +6,9 @@
 
 use std::time::Duration;
 
-use fragsim_capture::catalog::{check_memory_cap_early, SchemeName, SchemeRunner};
 use fragsim_capture::executors::Executor;
 use fragsim_capture::primitive_order::PrimitiveOrder;
+use fragsim_catalog::{check_memory_cap_early, SchemeName, SchemeRunner};
 use fragsim_oracle::verdict::{judge_run, RunVerdict};
 use fragsim_oracle::{Oracle, Ties};
 use fragsim_raster::{SamplePattern, SceneSpec, Viewport};

@@ -89,7 +89,7 @@ mod tests {
     /// so a family looks the same on bench's chart and sweep's.
     #[test]
     fn every_catalog_family_has_a_chart_marker() {
-        for entry in fragsim_capture::catalog::CATALOG {
+        for entry in fragsim_catalog::CATALOG {
             let family = family(entry.name);
             assert!(
                 fragsim_shade::plot::FAMILIES.contains(&family),

@@ -9,7 +9,6 @@
 //! row is `fragsim_explain::hazard::rate`'s and a baseline `fragsim_explain::baselines`'s; this
 //! module walks the campaign and gathers the report.
 
-use fragsim_capture::schemes::kbuffer::{KBuffer, WriteBack};
 use fragsim_capture::MEMORY_CAP_DEFAULT;
 use fragsim_explain::baselines;
 use fragsim_explain::hazard::{covered_by_bucket, machine_name, rate, BUCKETS, POLICIES};
@@ -19,6 +18,7 @@ pub use fragsim_explain::{
 };
 use fragsim_oracle::Oracle;
 use fragsim_raster::{SceneSpec, View, Viewport};
+use fragsim_schemes::kbuffer::{KBuffer, WriteBack};
 
 use crate::Progress;
 

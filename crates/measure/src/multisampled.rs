@@ -21,12 +21,12 @@
 //! way ([`ColourJudge::per_sample`]). Memory is what the scheme allocated, sized by `--k` and
 //! `--capacity` or by its own counting pass, never by the oracle.
 
-use fragsim_capture::catalog::{check_memory_cap_early, Count, SchemeName, SchemeRunner, Sizing};
 use fragsim_capture::executors::Executor;
-use fragsim_capture::schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
 use fragsim_capture::Scheme as _;
+use fragsim_catalog::{check_memory_cap_early, Count, SchemeName, SchemeRunner, Sizing};
 use fragsim_oracle::samples::{SampleDeviation, SampleOracle};
 use fragsim_raster::{Camera, OrbitCamera, SamplePattern, Scene, View};
+use fragsim_schemes::masked_abuffer::{MaskedABuffer, MaskedFrame, MaskedStorage};
 use fragsim_shade::effects::error_pixels;
 use serde::Serialize;
 

@@ -9,7 +9,7 @@
 //!
 //! The records are built here, as lines of text ([`line()`]); the command line prints them.
 
-use fragsim_capture::catalog::{Count, Sizing};
+use fragsim_catalog::{Count, Sizing};
 use fragsim_raster::SceneSpec;
 #[cfg(feature = "args")]
 use fragsim_raster::{scene_spec::args::SceneArgs, Conventions};

@@ -2,8 +2,8 @@
 //! sizes, executors, threads and submission order of every scheme run ([`SchemeSetup`]), and a
 //! shard of a campaign split over machines ([`Shard`]).
 
-use fragsim_capture::catalog::Sizing;
 use fragsim_capture::executors::Executor;
+use fragsim_catalog::Sizing;
 use fragsim_raster::View;
 
 /// How schemes are sized and run.

@@ -3,8 +3,8 @@
 //! depth-complexity bucket at each angle, with each angle's frame time; its tables and charts
 //! are [`report`]'s.
 
-use fragsim_capture::catalog::{SchemeName, SchemeRunner};
 use fragsim_capture::primitive_order::PrimitiveOrder;
+use fragsim_catalog::{SchemeName, SchemeRunner};
 use fragsim_oracle::Oracle;
 use fragsim_raster::{SceneSpec, Viewport};
 use fragsim_shade::colour_error::{BucketDeviation, ColourDeviation, DEPTH_BUCKETS};

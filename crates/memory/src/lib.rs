@@ -212,7 +212,7 @@ pub trait Memory: WordMemory<u32> + WordMemory<u64> {
     ///
     /// A scheme uses it to make one step of several words indivisible: a render target's read or
     /// write of a pixel's `K` slots, which the GPU's ROP performs as one operation
-    /// (`fragsim_capture::schemes::kbuffer::WriteBack::RenderTarget`). The words themselves
+    /// (the k-buffer's `WriteBack::RenderTarget`, in `fragsim-schemes`). The words themselves
     /// stay `Relaxed`: the ordering comes from the fences around the lock word's `swap` and
     /// `store` (C++ fence–fence synchronisation: a release fence before the store that frees the
     /// lock synchronises with the acquire fence after the `swap` that reads it free). Memories

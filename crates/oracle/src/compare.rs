@@ -1,6 +1,11 @@
 //! Comparing a capture (a dump's decoded lists, or a run's) with a reference pixel by pixel: the
 //! verdict of every pixel, and the totals.
 
+mod allowance;
+
+pub use allowance::MiscountedCounter;
+pub(crate) use allowance::{counter_note, hold_to_reference};
+
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use serde::Serialize;
 
@@ -156,8 +161,8 @@ pub struct Comparison {
     /// a counter that handed out a node no fragment took: never equal.
     pub unreachable_nodes: u64,
     /// Linked lists: a node counter other than any the reference's fragments allow
-    /// ([`crate::verdict::MiscountedCounter`]): never equal.
-    pub miscounted_counter: Option<crate::verdict::MiscountedCounter>,
+    /// ([`MiscountedCounter`]): never equal.
+    pub miscounted_counter: Option<MiscountedCounter>,
 }
 
 /// The joint judgement of the pixels whose coverage hangs on a vertex's snap: every triangle
@@ -525,7 +530,7 @@ pub fn compare_with(
             })
         });
     }
-    crate::verdict::hold_to_reference(&mut comparison, candidate, words, reference, None, options);
+    hold_to_reference(&mut comparison, candidate, words, reference, None, options);
     comparison
 }
 

@@ -15,8 +15,8 @@
 
 use std::collections::BTreeMap;
 
-use fragsim_capture::schemes::masked_abuffer::{MaskedLists, MaskedNode};
 use fragsim_capture::{Capture, Identity, PixelLists};
+use fragsim_capture::{MaskedLists, MaskedNode};
 use fragsim_raster::{SamplePattern, View, Viewport};
 
 use crate::Oracle;

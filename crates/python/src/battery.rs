@@ -9,9 +9,9 @@
 //! gives. A Python exception in the callable, or arrays that are no dump, fail the case (shrunk
 //! like any other): the message carries the exception.
 
-use fragsim_capture::catalog::SchemeName;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::Guarantee;
+use fragsim_catalog::SchemeName;
 use fragsim_dump::Dump;
 use fragsim_raster::scene_spec::mesh_hash;
 use fragsim_raster::VertexPrecision;

@@ -19,7 +19,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use fragsim_capture::catalog::CATALOG;
+use fragsim_catalog::CATALOG;
 use fragsim_dump::triangles::TriangleExport;
 use fragsim_dump::{Dump, Words};
 use fragsim_measure::hazard::{hazard_in_view, machine_named, Campaign};

@@ -24,7 +24,7 @@
 //! left to judge: so it is a shading option of those bounded captures, applied here to every
 //! pixel's fragments in submission order. MLAB's node structure is a capture with a checkable
 //! promise (its node depths are exactly the `K` nearest, whatever the interleaving), so it is
-//! also the catalog's `mlab` ([`fragsim_capture::schemes::mlab`], judged on every executor);
+//! also the catalog's `mlab` (`fragsim_schemes::mlab`, judged on every executor);
 //! its colour, the approximation, is measured here.
 //!
 //! **Guarantees.** [`Approximation::Mlab`] and [`Approximation::TailBlend`] with `K` nodes are

@@ -4,12 +4,12 @@
 //! Guarantee: a backend sees only the case's view (fragsim's vertex stage already applied; a
 //! backend that rasterizes itself reads the case's mesh) and the scheme's sizes; what it returns
 //! is judged by [`crate::judge`], the code `fragsim compare` judges dumps with. Source: the
-//! catalog (`fragsim_capture::catalog`) and the dump format (`docs/dump-format.md`).
+//! catalog (`fragsim_catalog`) and the dump format (`docs/dump-format.md`).
 
-use fragsim_capture::catalog::{Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing};
 use fragsim_capture::executors::scheduled::run_scheduled;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::{Capture, CaptureError, Guarantee, Scheme, MEMORY_CAP_DEFAULT};
+use fragsim_catalog::{Build, Count, SchemeName, SchemeRunner, SchemeVisitor, Sizing};
 use fragsim_dump::Dump;
 use fragsim_raster::{VertexPrecision, View, Viewport};
 

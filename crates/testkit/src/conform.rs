@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use fragsim_capture::catalog::{SchemeName, CATALOG};
+use fragsim_catalog::{SchemeName, CATALOG};
 use fragsim_oracle::PixelMismatch;
 use fragsim_raster::{depth_from_key, Conventions, VertexPrecision};
 use serde::Serialize;

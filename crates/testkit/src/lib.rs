@@ -21,7 +21,7 @@
 //! [`Backend`]):
 //!
 //! ```
-//! use fragsim_capture::catalog::SchemeName;
+//! use fragsim_catalog::SchemeName;
 //! use fragsim_capture::executors::Executor;
 //! use fragsim_testkit::{Battery, CatalogBackend, Params};
 //!

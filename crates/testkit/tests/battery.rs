@@ -5,9 +5,9 @@
 //! handful already exercises the judge end to end; the k-buffer's hazard needs two fragments of a
 //! pixel in flight together, which the first few dozen cases give.
 
-use fragsim_capture::catalog::SchemeName;
 use fragsim_capture::executors::Executor;
 use fragsim_capture::Guarantee;
+use fragsim_catalog::SchemeName;
 use fragsim_testkit::{Battery, CatalogBackend, Failure, Params, Property};
 
 fn params(scheme: SchemeName) -> Params {

@@ -11,8 +11,8 @@
 
 use std::cell::Cell;
 
-use fragsim_capture::catalog::SchemeName;
 use fragsim_capture::Guarantee;
+use fragsim_catalog::SchemeName;
 use fragsim_dump::{Dump, DumpScheme, Words};
 use fragsim_oracle::Oracle;
 use fragsim_raster::scene_spec::mesh_hash;

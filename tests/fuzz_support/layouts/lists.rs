@@ -2,7 +2,7 @@
 //! numbering, links drawn from a few node numbers around the pool) and a layer-major dump
 //! (counters past their layers), each with the model of what decoding must give.
 
-use fragsim::capture::catalog::SchemeName;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::{Corruption, Header, LayoutSpec, Words};
 use fragsim::raster::Viewport;
 

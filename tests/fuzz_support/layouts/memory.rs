@@ -1,8 +1,8 @@
 //! The `dump_layouts` target's memory layout: a memory dump of a catalog scheme that dumps so,
 //! sized as the scheme's own memory (or one word off), with arbitrary words.
 
-use fragsim::capture::catalog::{Build, DumpLayout, SchemeName, SchemeVisitor, CATALOG};
 use fragsim::capture::Scheme;
+use fragsim::catalog::{Build, DumpLayout, SchemeName, SchemeVisitor, CATALOG};
 use fragsim::dump::{Header, LayoutSpec, Words};
 use fragsim::raster::Viewport;
 

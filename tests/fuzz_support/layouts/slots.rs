@@ -1,7 +1,7 @@
 //! The `dump_layouts` target's slot layouts: an MDTS, A-buffer or k-buffer slot dump, slot-major
 //! or pixel-major with any payload, and its model: the same words in fragsim's own encoding.
 
-use fragsim::capture::catalog::{DumpLayout, SchemeName, CATALOG};
+use fragsim::catalog::{DumpLayout, SchemeName, CATALOG};
 use fragsim::dump::{Corruption, Dtype, Dump, Header, LayoutSpec, Payload, SlotOrder, Words};
 use fragsim::raster::Viewport;
 

@@ -2,9 +2,9 @@
 //! storage below the depth complexity as overflow.
 
 use fragsim::capture::executors::run_parallel;
-use fragsim::capture::schemes::bucket::{Adp, ADP_SUBINTERVALS};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, Scene};
+use fragsim::schemes::bucket::{Adp, ADP_SUBINTERVALS};
 
 use super::{both, honest, predicted_loss, view_of};
 

@@ -1,10 +1,10 @@
 //! BDP and BDP2: exact within their bucket capacities, and losing exactly what a bucket cannot hold.
 
 use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
-use fragsim::capture::schemes::bucket::{Adp, Bdp, Bdp2, Buckets};
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, Scene, Viewport};
+use fragsim::schemes::bucket::{Adp, Bdp, Bdp2, Buckets};
 
 use super::{both, honest, predicted_loss, view_of};
 

@@ -1,9 +1,9 @@
 //! The error rates on the bunny (`docs/baselines/bucket.md`).
 
 use fragsim::capture::executors::run_parallel;
-use fragsim::capture::schemes::bucket::{Adp, Bdp, Bdp2};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, Viewport};
+use fragsim::schemes::bucket::{Adp, Bdp, Bdp2};
 
 use super::honest;
 

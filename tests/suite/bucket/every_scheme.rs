@@ -3,10 +3,10 @@
 
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::schemes::bucket::{Adp, Bdp, Bdp2, Buckets, ADP_SUBINTERVALS};
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::bucket::{Adp, Bdp, Bdp2, Buckets, ADP_SUBINTERVALS};
 use proptest::prelude::*;
 
 use super::{honest, predicted_loss};

@@ -2,9 +2,9 @@
 //! predicts losses the runs do not have (the control that the predictions depend on the routing).
 
 use fragsim::capture::executors::run_serial;
-use fragsim::capture::schemes::bucket::{Bdp, Bdp2};
 use fragsim::oracle::Oracle;
 use fragsim::raster::Scene;
+use fragsim::schemes::bucket::{Bdp, Bdp2};
 
 use super::{exact_subinterval, predicted_loss, predicted_loss_routed, view_of, Router};
 

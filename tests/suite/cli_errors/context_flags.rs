@@ -121,10 +121,7 @@ fn help_with_help_prints_help() {
 /// scheme (it ran `abuffer-fixed`).
 #[test]
 fn every_scheme_name_a_run_prints_is_the_name_it_was_given() {
-    let names: Vec<&str> = fragsim::capture::catalog::CATALOG
-        .iter()
-        .map(|e| e.name)
-        .collect();
+    let names: Vec<&str> = fragsim::catalog::CATALOG.iter().map(|e| e.name).collect();
     let output = fragsim(&[
         "--scene",
         "quads:2",

@@ -344,7 +344,7 @@ fn render_dumps_every_scheme_or_nothing() {
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     written.sort();
-    let mut every: Vec<String> = fragsim::capture::catalog::CATALOG
+    let mut every: Vec<String> = fragsim::catalog::CATALOG
         .iter()
         .map(|e| e.name.to_string())
         .collect();

@@ -3,9 +3,9 @@
 //! compares equal with the oracle; linked-list and layer-major dumps in another engine's
 //! encoding read the same; each rule of their words names a corrupted word, a cycle included.
 
-use fragsim::capture::catalog::{Count, DumpLayout, SchemeName, SchemeRunner, Sizing, CATALOG};
 use fragsim::capture::executors::Executor;
 use fragsim::capture::Capture;
+use fragsim::catalog::{Count, DumpLayout, SchemeName, SchemeRunner, Sizing, CATALOG};
 use fragsim::dump::{Corruption, DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, Words};
 use fragsim::oracle::compare::{self, flags};
 use fragsim::oracle::Oracle;

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use fragsim::capture::catalog::SchemeName;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::Direction;
 use fragsim::dump::{Dump, DumpScheme, Words};
 use fragsim::oracle::compare::{CompareOptions, Comparison};

@@ -3,7 +3,7 @@
 //! `render --dump` writes them, read back to fragsim's own words and judged by `compare` as
 //! fragsim's own dumps are; a mutated word is named as stored; a bad field is a clear error.
 
-use fragsim::capture::catalog::SchemeName;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::Direction;
 use fragsim::dump::{
     Corruption, DepthFormat, Dtype, Dump, DumpError, DumpScheme, LayoutSpec, Payload, SlotOrder,
@@ -560,7 +560,7 @@ fn the_k_buffers_and_loop64_dump_their_own_slot_words() {
     ];
     with_view(|view, oracle| {
         let k = oracle.max_depth_complexity();
-        let sizes = fragsim::capture::catalog::Build::fixed(view.viewport(), k, 1, 1, u64::MAX);
+        let sizes = fragsim::catalog::Build::fixed(view.viewport(), k, 1, 1, u64::MAX);
         for name in schemes {
             let scheme = SchemeName::from_name(name).unwrap();
             let memory = DumpScheme::Memory {

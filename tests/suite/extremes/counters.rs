@@ -1,11 +1,11 @@
 //! Counters: CUDA's `atomicInc` past capacity against the library's counted `fetch_add`.
 
 use fragsim::capture::executors::{run_parallel, run_serial};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::abuffer_atomic_inc::ABufferAtomicInc;
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, OrbitCamera, Scene};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::abuffer_atomic_inc::ABufferAtomicInc;
 
 use super::{assert_exact, identity_view, viewport};
 use crate::support::prim_of;

@@ -2,11 +2,11 @@
 //! eye planes, and layers closer than the depth precision.
 
 use fragsim::capture::executors::{run_parallel, run_serial};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::MEMORY_CAP_DEFAULT;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Camera, CullMode, Mesh, OrbitCamera, Scene, View};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::mdts::{Direction, Mdts};
 
 use super::camera::camera_from_columns;
 use super::{

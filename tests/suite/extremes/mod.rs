@@ -7,11 +7,11 @@ mod camera;
 
 use camera::{camera_from_columns, identity_camera};
 use fragsim::capture::executors::{run_parallel, run_serial};
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{Scheme, Step, MEMORY_CAP_DEFAULT};
 use fragsim::memory::Memory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Camera, CullMode, Fragment, Mesh, View, Viewport};
+use fragsim::schemes::mdts::{Direction, Mdts};
 
 mod counters;
 mod depth_encoding;

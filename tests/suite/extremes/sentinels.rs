@@ -2,13 +2,13 @@
 //! signed and unsigned `atomicMin`, and FreePipe's Table 1 with its mixed sentinels.
 
 use fragsim::capture::executors::run_serial;
-use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{
     Descriptor, Guarantee, Identity, Promise, Scheme, Step, MEMORY_CAP_DEFAULT,
 };
 use fragsim::memory::{Layout, Memory, SerialMemory, WordMemory};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, EMPTY_KEY};
+use fragsim::schemes::mdts::{Direction, Mdts, MdtsWord};
 use proptest::prelude::*;
 
 use super::{mdts32_run, viewport, MAX_KEY};

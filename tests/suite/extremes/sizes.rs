@@ -5,11 +5,11 @@ use std::time::Instant;
 
 use assert_cmd::Command;
 use fragsim::capture::executors::run_serial;
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Mesh, MeshError, OrbitCamera, Scene, Viewport};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::mdts::{Direction, Mdts};
 
 use super::{assert_exact, coverage, identity_view, soup, viewport};
 

@@ -13,13 +13,13 @@ mod srab;
 use fragsim::capture::executors::frame;
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::executors::scheduled::{Granularity, Policy, Schedule};
-use fragsim::capture::schemes::kbuffer::multipass::KBufferMultipass;
-use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::schemes::stencil_routed::StencilRouted;
 use fragsim::capture::{CaptureError, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::kbuffer::multipass::KBufferMultipass;
+use fragsim::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim::schemes::stencil_routed::StencilRouted;
 use proptest::prelude::*;
 
 /// Looking straight down the z axis at `quads:N`: every pixel the quads cover has N fragments.

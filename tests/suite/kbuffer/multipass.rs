@@ -3,12 +3,12 @@
 
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::executors::scheduled::run_scheduled;
-use fragsim::capture::schemes::kbuffer::multipass::KBufferMultipass;
-use fragsim::capture::schemes::kbuffer::WriteBack;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, SplitMix64, View};
+use fragsim::schemes::kbuffer::multipass::KBufferMultipass;
+use fragsim::schemes::kbuffer::WriteBack;
 
 use super::{
     bunny_256_scheduled, captured_now, drive_pass, fragments, head_on, viewport, MACHINES,

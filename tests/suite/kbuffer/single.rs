@@ -4,12 +4,12 @@
 
 use fragsim::capture::executors::run_serial;
 use fragsim::capture::executors::scheduled::{run_scheduled, Granularity, Policy, Schedule};
-use fragsim::capture::schemes::kbuffer::{KBuffer, WriteBack};
-use fragsim::capture::schemes::stencil_routed::StencilRouted;
 use fragsim::capture::{Capture, Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, SplitMix64, View};
+use fragsim::schemes::kbuffer::{KBuffer, WriteBack};
+use fragsim::schemes::stencil_routed::StencilRouted;
 
 use super::{bunny_256_scheduled, drive, one_pixel_quads, viewport, MACHINES};
 

@@ -2,11 +2,11 @@
 //! its second pass wrong when it sees another order.
 
 use fragsim::capture::executors::{run_parallel, run_serial};
-use fragsim::capture::schemes::stencil_routed::StencilRouted;
 use fragsim::capture::{Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::SerialMemory;
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene};
+use fragsim::schemes::stencil_routed::StencilRouted;
 
 use super::{drive_pass, head_on, one_pixel_quads, viewport};
 

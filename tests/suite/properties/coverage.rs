@@ -3,11 +3,11 @@
 
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
 use fragsim::capture::executors::{run_parallel, run_serial};
-use fragsim::capture::schemes::abuffer::ABuffer;
-use fragsim::capture::schemes::mdts::Mdts;
 use fragsim::raster::{
     depth_from_key, depth_key, CullMode, Mesh, OrbitCamera, Scene, View, Viewport, EMPTY_KEY,
 };
+use fragsim::schemes::abuffer::ABuffer;
+use fragsim::schemes::mdts::Mdts;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 

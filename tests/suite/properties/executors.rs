@@ -1,16 +1,16 @@
 //! The schemes against the serial oracle on concurrent executors, every catalog entry tiled against
 //! serial, serial against concurrent, and the control that the concurrency settings interleave.
 
-use fragsim::capture::catalog::{Count, SchemeName, SchemeRunner, Sizing, Storage, CATALOG};
 use fragsim::capture::depth_count::DepthCount;
 use fragsim::capture::executors::tiled::run_tiled;
 use fragsim::capture::executors::{run_serial, Executor, Run};
-use fragsim::capture::schemes::abuffer::{ABuffer, PostSort};
-use fragsim::capture::schemes::kbuffer::KBuffer;
-use fragsim::capture::schemes::mdts::{Direction, Mdts};
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
+use fragsim::catalog::{Count, SchemeName, SchemeRunner, Sizing, Storage, CATALOG};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::abuffer::{ABuffer, PostSort};
+use fragsim::schemes::kbuffer::KBuffer;
+use fragsim::schemes::mdts::{Direction, Mdts};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 

@@ -8,10 +8,10 @@
 
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
 use fragsim::capture::executors::{ParallelExecutor, Run};
-use fragsim::capture::schemes::mdts::{Direction, Mdts, MdtsWord};
 use fragsim::capture::{Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::oracle::Oracle;
 use fragsim::raster::{CullMode, OrbitCamera, Scene, View, Viewport};
+use fragsim::schemes::mdts::{Direction, Mdts, MdtsWord};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 

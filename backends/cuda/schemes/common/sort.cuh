@@ -1,4 +1,4 @@
-// Mirrors crates/capture/src/schemes/common/sort.rs (`insertion_sort`): the per-pixel sort of
+// Mirrors crates/schemes/src/common/sort.rs (`insertion_sort`): the per-pixel sort of
 // FreePipe's post pass (§4.2), an insertion sort in registers (local memory for long lists) when
 // the list fits KMAX_LOCAL entries, else in place in global memory.
 #pragma once

@@ -1,4 +1,4 @@
-// Mirrors crates/capture/src/schemes/common/word.rs (the fragment word encoding, `MdtsWord`):
+// Mirrors crates/schemes/src/common/word.rs (the fragment word encoding, `MdtsWord`):
 // a u64 word is `depth_key << 32 | prim`, so every fragment is distinct and ordered by depth, then
 // primitive; a u32 word is the depth key alone. All ones is the empty sentinel of both widths: no
 // depth key reaches it (the largest is 0x3F800000, depth 1.0).

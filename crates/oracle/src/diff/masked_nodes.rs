@@ -12,8 +12,8 @@
 //! of the row's other columns, sample fragments: a node counts the samples its mask covers, so
 //! that captured + overflow + lost − extra is the oracle's fragments, as on every row.
 
-use fragsim_capture::schemes::masked_abuffer::{MaskedLists, MaskedNode};
 use fragsim_capture::{Capacity, Capture, Keeps};
+use fragsim_capture::{MaskedLists, MaskedNode};
 
 use crate::samples::nodes_per_pixel;
 use crate::{Diff, Oracle, PixelMismatch};

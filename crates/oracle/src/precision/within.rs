@@ -133,7 +133,7 @@ pub fn compare_within(
             }
         });
     }
-    crate::verdict::hold_to_reference(
+    crate::compare::hold_to_reference(
         &mut comparison,
         candidate,
         words,

@@ -4,7 +4,7 @@
 
 use std::borrow::Cow;
 
-use fragsim_capture::schemes::masked_abuffer::MaskedLists;
+use fragsim_capture::MaskedLists;
 
 use super::reference::MaskedWithin;
 use super::{compare_options, Candidate, JudgeDump, Options, Outcome, VerdictError};

@@ -19,8 +19,8 @@
 
 use std::path::Path;
 
-use fragsim_capture::schemes::masked_abuffer::{MaskedLists, MaskedNode};
 use fragsim_capture::{Capacity, Capture, Identity, Keeps};
+use fragsim_capture::{MaskedLists, MaskedNode};
 use fragsim_dump::{Dump, DumpError, WordCheck};
 
 use crate::compare::{compare_with, flags, CompareOptions, Comparison};

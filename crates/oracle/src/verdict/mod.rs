@@ -29,7 +29,6 @@
 mod against_dump;
 mod against_masked;
 mod against_oracle;
-mod allowance;
 mod error;
 mod hints;
 mod judge_dump;
@@ -56,8 +55,7 @@ use reference::Kind;
 #[cfg(doc)]
 use crate::{compare::compare_with, precision::compare_within};
 
-pub(crate) use allowance::hold_to_reference;
-pub use allowance::MiscountedCounter;
+pub use crate::compare::MiscountedCounter;
 pub use error::VerdictError;
 pub use judge_dump::{JudgeDump, MaskedComparison, WrongMask};
 pub use reference::Reference;
@@ -294,7 +292,7 @@ impl Judged {
             .filter(|p| !p.is_exact())
             .map(Precision::bounds);
         self.notes.extend(overflow_notes(&comparison, capture));
-        self.notes.extend(allowance::counter_note(&comparison));
+        self.notes.extend(crate::compare::counter_note(&comparison));
         let lists_per_pixel = reference.lists_per_pixel();
         let (width, height) = (reference.width, reference.height);
         let vertex_precision = reference.vertex_precision();

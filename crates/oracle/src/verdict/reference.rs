@@ -4,7 +4,7 @@
 
 use std::borrow::Cow;
 
-use fragsim_capture::schemes::masked_abuffer::MaskedLists;
+use fragsim_capture::MaskedLists;
 use fragsim_capture::{Capacity, Capture, Identity, Keeps, PixelLists};
 use fragsim_raster::{Conventions, EdgeTies, VertexPrecision, View};
 

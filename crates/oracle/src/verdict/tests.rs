@@ -2,7 +2,7 @@
 //! own MDTS, and that dump with one fragment taken out; a masked-node dump whose nodes a merge
 //! with a planted bug made.
 
-use fragsim_capture::schemes::masked_abuffer::{merge_samples, MaskedLists, MaskedNode};
+use fragsim_capture::{merge_samples, MaskedLists, MaskedNode};
 use fragsim_dump::Direction;
 use fragsim_raster::{Fragment, VertexPrecision, View, Viewport};
 

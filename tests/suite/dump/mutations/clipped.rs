@@ -11,7 +11,7 @@
 //! thousands of subpixels under the analysis's per-coordinate bounds, and no pixel of it is clean
 //! of doubt enough to mutate; that scene is judged from a real lavapipe capture instead.
 
-use fragsim::capture::catalog::SchemeName;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::Direction;
 use fragsim::dump::{DepthFormat, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
 use fragsim::oracle::precision::{f32_reference, Precision};

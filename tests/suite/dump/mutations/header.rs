@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use fragsim::capture::catalog::SchemeName;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::Direction;
 use fragsim::dump::{Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
 use fragsim::oracle::Oracle;

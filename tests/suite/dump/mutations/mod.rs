@@ -25,9 +25,9 @@ mod storage;
 
 use std::path::Path;
 
-use fragsim::capture::catalog::SchemeName;
-use fragsim::capture::schemes::masked_abuffer::MaskedLists;
 use fragsim::capture::Capacity;
+use fragsim::capture::MaskedLists;
+use fragsim::catalog::SchemeName;
 use fragsim::dump::Direction;
 use fragsim::dump::{DepthFormat, Dtype, Dump, DumpScheme, LayoutSpec, Payload, SlotOrder};
 use fragsim::oracle::compare::{compare_with, flags, CompareOptions, Comparison};
