@@ -26,6 +26,7 @@ mod explain;
 mod extremes;
 mod flag_dialect;
 mod honest_reports;
+mod injected_fault;
 mod interlock_ordered;
 mod json_lines;
 mod kbuffer;
