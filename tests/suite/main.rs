@@ -27,6 +27,7 @@ mod extremes;
 mod flag_dialect;
 mod frame_loop;
 mod honest_reports;
+mod injected_fault;
 mod interlock_ordered;
 mod json_lines;
 mod kbuffer;

@@ -43,7 +43,7 @@ mod run;
 
 pub use build::{Build, SchemeVisitor};
 pub use dump_layout::{DumpLayout, SlotWord};
-pub use run::{check_memory_cap_early, Fault, MemoryWords, NamedRun, RunError, SchemeRunner};
+pub use run::{check_memory_cap_early, MemoryWords, NamedRun, RunError, SchemeRunner};
 
 use fragsim_capture::CaptureError;
 use fragsim_schemes::abuffer::{

@@ -87,13 +87,6 @@ impl MemoryWords {
     }
 }
 
-/// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Fault {
-    /// Every scheme that counts its own overflow reports one fragment more at pixel 0.
-    MiscountOverflow,
-}
-
 /// Runs catalog schemes by name on any executor, keeping each executor's storage between frames
 /// of the same scheme (the executors themselves are [`fragsim_capture::executors`]).
 #[derive(Debug, Default)]
@@ -104,8 +97,6 @@ pub struct SchemeRunner {
     /// Run the next frames on fresh storage that counts read-modify-write operations
     /// ([`RunStats::locked_ops`](fragsim_capture::executors::RunStats)), untimed.
     pub count_locked_ops: bool,
-    /// A fault injected into every scheme run (tests only).
-    pub fault: Option<Fault>,
     /// Copy each run's memory after its last pass into [`NamedRun::memory`].
     pub keep_memory: bool,
 }
@@ -139,16 +130,15 @@ impl SchemeRunner {
             // Masked-node storage counts its nodes, not the per-sample fragments.
             true if name.entry().storage == Storage::Nodes => {
                 let counter = MaskedABuffer::node_counter(view.pixel_viewport(), samples)?;
-                let run = run_with_fault(&counter, self, executor, view, None);
+                let run = run_on(&counter, self, executor, view);
                 let counts = counter.masked_frame(&run).lists.overflow;
                 Some(DepthCounts { counts, run })
             }
-            true => Some(DepthCounts::from_run(run_with_fault(
+            true => Some(DepthCounts::from_run(run_on(
                 &DepthCount::new(viewport),
                 self,
                 executor,
                 view,
-                None,
             ))),
         };
         // What `auto` sizes resolve to: the count pass's maximum depth complexity (at least 1).
@@ -283,7 +273,7 @@ impl SchemeVisitor for RunOn<'_, '_, '_> {
     type Output = NamedRun;
     fn visit<S: Scheme>(self, scheme: &S, slots: Option<u32>) -> NamedRun {
         let kept = self.runner.keep_memory.then(|| Mutex::new(None));
-        let run = run_with_fault(scheme, self.runner, self.executor, self.view, kept.as_ref());
+        let run = run_keeping(scheme, self.runner, self.executor, self.view, kept.as_ref());
         NamedRun {
             run,
             name: scheme.name(),
@@ -296,25 +286,20 @@ impl SchemeVisitor for RunOn<'_, '_, '_> {
     }
 }
 
-/// One frame of `scheme` on `executor`, with the runner's fault injected where one is set and
-/// its memory after the last pass copied into `keep` where given.
-fn run_with_fault<S: Scheme>(
+/// One frame of `scheme` on `executor`, its memory after the last pass copied into `keep` where
+/// given; the bare scheme runs where nothing is kept, so that a run without `--dump` pays nothing
+/// for the copy and keeps its tile-local path.
+fn run_keeping<S: Scheme>(
     scheme: &S,
     runner: &mut SchemeRunner,
     executor: Executor,
     view: &View<'_>,
     keep: Option<&Mutex<Option<MemoryWords>>>,
 ) -> Run {
-    let miscount = runner.fault == Some(Fault::MiscountOverflow);
-    if !miscount && keep.is_none() {
-        return run_on(scheme, runner, executor, view);
+    match keep {
+        None => run_on(scheme, runner, executor, view),
+        Some(keep) => run_on(&KeepingMemory { scheme, keep }, runner, executor, view),
     }
-    let instrumented = Instrumented {
-        scheme,
-        miscount,
-        keep,
-    };
-    run_on(&instrumented, runner, executor, view)
 }
 
 /// One frame of `scheme` on `executor`.
@@ -335,16 +320,16 @@ fn run_on<S: Scheme>(
     }
 }
 
-/// The scheme, watched: with `miscount` ([`Fault::MiscountOverflow`]) reporting one overflowing
-/// fragment more at pixel 0 than it counted, and with `keep` copying its memory out after the
-/// last pass (where the between-pass kernel asks for no more), before the post pass reads it.
-struct Instrumented<'a, S> {
+/// The scheme, its memory copied into `keep` after the last pass (where the between-pass kernel
+/// asks for no more), before the post pass reads it: what `render --dump` writes. Every other
+/// method is the scheme's own, so that the run kept is the run reported (its gathering,
+/// prefetches, walks and post pass unchanged).
+struct KeepingMemory<'a, S> {
     scheme: &'a S,
-    miscount: bool,
-    keep: Option<&'a Mutex<Option<MemoryWords>>>,
+    keep: &'a Mutex<Option<MemoryWords>>,
 }
 
-impl<S: Scheme> Scheme for Instrumented<'_, S> {
+impl<S: Scheme> Scheme for KeepingMemory<'_, S> {
     type State = S::State;
     type Input = S::Input;
 
@@ -352,8 +337,9 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
         self.scheme.descriptor()
     }
     fn tile_local(&self) -> bool {
-        // The memory kept for a dump is read in the layout it declares, screen-ordered.
-        self.keep.is_none() && self.scheme.tile_local()
+        // The memory kept for a dump is read in the layout it declares, screen-ordered: the
+        // tiled executor's own pixel numbering would scramble it.
+        false
     }
     fn gathering(&self) -> <S::Input as WalkInput>::Gathering {
         self.scheme.gathering()
@@ -378,8 +364,8 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
     }
     fn end_pass<M: Memory>(&self, pass: u32, memory: &M) -> bool {
         let more = self.scheme.end_pass(pass, memory);
-        if let (false, Some(keep)) = (more, self.keep) {
-            if let Ok(mut kept) = keep.lock() {
+        if !more {
+            if let Ok(mut kept) = self.keep.lock() {
                 *kept = Some(MemoryWords::read(memory));
             }
         }
@@ -391,16 +377,9 @@ impl<S: Scheme> Scheme for Instrumented<'_, S> {
         pixel: usize,
         end: usize,
     ) -> fragsim_capture::PixelRun {
-        // The miscounted pixel is resolved on its own, so that its count is the one altered.
-        match self.scheme.pixel_run(memory, pixel, end) {
-            fragsim_capture::PixelRun::Empty(_) if self.miscount && pixel == 0 => {
-                fragsim_capture::PixelRun::Resolve(1)
-            }
-            run => run,
-        }
+        self.scheme.pixel_run(memory, pixel, end)
     }
     fn resolve_pixel<M: Memory>(&self, memory: &M, pixel: usize, out: &mut Vec<u64>) -> u32 {
-        let overflow = self.scheme.resolve_pixel(memory, pixel, out);
-        overflow + u32::from(self.miscount && pixel == 0)
+        self.scheme.resolve_pixel(memory, pixel, out)
     }
 }

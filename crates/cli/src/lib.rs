@@ -76,7 +76,7 @@ pub use export::ExportArgs;
 pub use fragsim_catalog::{SchemeName, Sizing};
 pub use hazard::HazardArgs;
 pub use render::{RenderArgs, RunSummary, TieChoice};
-pub use schemes::{Fault, SchemeChoice};
+pub use schemes::SchemeChoice;
 pub use sweep::SweepArgs;
 
 /// fragsim: the CPU reference simulator of GPU atomics for multi-fragment rendering.
@@ -156,25 +156,47 @@ pub fn main() -> ExitCode {
         None => cli.render,
     };
     match render::render(&args) {
-        Ok(summary) if summary.iter().all(|run| run.keeps_guarantee) => ExitCode::SUCCESS,
         Ok(summary) => {
-            for run in summary.iter().filter(|run| !run.keeps_guarantee) {
-                eprintln!(
-                    "error: {} on the {} executor breaks its guarantee `{}` ({} mismatched pixels, {} with a miscounted overflow)",
-                    run.scheme,
-                    run.executor,
-                    run.guarantee,
-                    run.mismatched_pixels,
-                    run.overflow_miscounted_pixels
-                );
+            let (code, broken) = render_verdict(&summary);
+            for message in broken {
+                eprintln!("error: {message}");
             }
-            ExitCode::from(1)
+            code
         }
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::from(2)
         }
     }
+}
+
+/// `render`'s exit code for the runs it made, with what it prints on stderr (each after
+/// `error: `): success when every run kept its guarantee; 1 and one message for each run that
+/// broke it, naming its scheme, executor and guarantee and counting the pixels that show it.
+/// Apart from [`main`] so that the unit tests below see a broken guarantee fail `render`
+/// without a scheme that breaks one (the integration suite's fault-injecting wrapper shows that
+/// the verdict itself can fail: `tests/suite/injected_fault.rs`).
+fn render_verdict(summary: &[RunSummary]) -> (ExitCode, Vec<String>) {
+    let broken: Vec<String> = summary
+        .iter()
+        .filter(|run| !run.keeps_guarantee)
+        .map(|run| {
+            format!(
+                "{} on the {} executor breaks its guarantee `{}` ({} mismatched pixels, {} with a miscounted overflow)",
+                run.scheme,
+                run.executor,
+                run.guarantee,
+                run.mismatched_pixels,
+                run.overflow_miscounted_pixels
+            )
+        })
+        .collect();
+    let code = if broken.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    };
+    (code, broken)
 }
 
 /// The command line's definition: the derived one, with `sweep --view` hidden from `sweep
@@ -258,5 +280,77 @@ fn exit_code(result: Result<bool, String>, failure: &str) -> ExitCode {
             eprintln!("error: {message}");
             ExitCode::from(2)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A row of `scheme` on `executor` whose run kept its guarantee or not, the rest of it what
+    /// an A-buffer of capacity 2 that miscounted one pixel's overflow reports.
+    fn row(scheme: &str, executor: &str, keeps_guarantee: bool) -> RunSummary {
+        RunSummary {
+            scheme: scheme.into(),
+            guarantee: "exact-within-capacity(2)".into(),
+            keeps_guarantee,
+            guarantee_owed: true,
+            executor: executor.into(),
+            threads: 1,
+            triangles: 8,
+            fragments: 40,
+            reference_fragments: 40,
+            passes: 1,
+            count_pass_ms: None,
+            max_depth_complexity: 4,
+            memory_ops: 80,
+            captured: 32,
+            overflowed: 8,
+            reported_overflow: 8 + u64::from(!keeps_guarantee),
+            overflow_miscounted_pixels: u64::from(!keeps_guarantee),
+            lost: 0,
+            extra: 0,
+            mismatched_pixels: u64::from(!keeps_guarantee),
+            time_ms: 0.0,
+            pass_ms: 0.0,
+            resolve_ms: 0.0,
+            memory_bytes: 0,
+            allocated_bytes: 0,
+            slots_per_pixel: Some(2),
+        }
+    }
+
+    #[test]
+    fn render_succeeds_when_every_run_keeps_its_guarantee() {
+        let summary = [
+            row("abuffer", "serial", true),
+            row("abuffer", "parallel", true),
+        ];
+        let (code, broken) = render_verdict(&summary);
+        assert_eq!(code, ExitCode::SUCCESS, "{broken:?}");
+        assert!(broken.is_empty(), "nothing is printed: {broken:?}");
+        assert_eq!(
+            render_verdict(&[]).0,
+            ExitCode::SUCCESS,
+            "no runs, nothing broken"
+        );
+    }
+
+    #[test]
+    fn render_exits_1_naming_each_run_that_breaks_its_guarantee() {
+        let summary = [
+            row("abuffer", "serial", true),
+            row("abuffer-exact", "parallel", false),
+        ];
+        let (code, broken) = render_verdict(&summary);
+        assert_eq!(code, ExitCode::from(1), "{broken:?}");
+        assert_eq!(
+            broken,
+            [
+                "abuffer-exact on the parallel executor breaks its guarantee \
+              `exact-within-capacity(2)` (1 mismatched pixels, 1 with a miscounted overflow)"
+            ],
+            "one message, for the run that broke its guarantee only"
+        );
     }
 }

@@ -10,7 +10,7 @@ use fragsim_raster::{depth_from_key, Conventions, UpAxis, View};
 use serde::Serialize;
 
 use crate::args::{ConventionsArgs, DumpArgs, SceneArgs, SchemeArgs};
-use crate::schemes::{check_memory_cap_early, Fault, SchemeChoice, SchemeRunner};
+use crate::schemes::{check_memory_cap_early, SchemeChoice, SchemeRunner};
 use crate::table::Table;
 
 /// Options of `fragsim render`.
@@ -52,9 +52,6 @@ pub struct RenderArgs {
     /// (compared by distinct depth key, as loop32 and 32-bit peeling keep them).
     #[arg(long, default_value = "by-primitive")]
     pub ties: TieChoice,
-    /// Inject a fault into every scheme (to show that a verdict can fail; tests only).
-    #[arg(long, hide = true)]
-    pub inject_fault: Option<Fault>,
 }
 
 /// `--ties`: [`Ties`] on the command line.
@@ -179,7 +176,6 @@ pub(crate) fn render(args: &RenderArgs) -> Result<Vec<RunSummary>, String> {
     progress.inc(1);
     let max_dc = oracle.max_depth_complexity();
     let mut runner = SchemeRunner::default();
-    runner.fault = args.inject_fault.map(Into::into);
     // A dump holds the memory of the run it reports, not a serial re-run's.
     runner.keep_memory = args.dump.dir.is_some();
     let mut rows = Vec::new();

@@ -56,18 +56,3 @@ impl ValueEnum for SchemeChoice {
         })
     }
 }
-
-/// A deliberate fault, for the tests that show a verdict can fail (`render --inject-fault`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Fault {
-    /// Every scheme that counts its own overflow reports one fragment more at pixel 0.
-    MiscountOverflow,
-}
-
-impl From<Fault> for fragsim_catalog::Fault {
-    fn from(fault: Fault) -> Self {
-        match fault {
-            Fault::MiscountOverflow => Self::MiscountOverflow,
-        }
-    }
-}
