@@ -6,7 +6,7 @@
 //! (`gl_SampleMaskIn`, WGSL's `sample_mask`). So here each primitive's per-sample fragments in
 //! one pixel (from a view rasterizing per sample, [`fragsim_raster::samples`]) are merged into one
 //! [`MaskedNode`]: the union of their sample bits and the nearest of their depth keys
-//! ([`merge_samples`]; fan pieces of one clipped triangle merge too, since they share the
+//! ([`merge_samples`](fragsim_capture::merge_samples); fan pieces of one clipped triangle merge too, since they share the
 //! primitive id). In the A-buffer ([`MaskedStorage::Slots`]) each node takes a slot of its pixel
 //! with a `fetch_add` on the pixel's counter and writes its packed `(depth key, primitive id)`
 //! word and its mask with two plain stores. In the linked list ([`MaskedStorage::Pool`], the
