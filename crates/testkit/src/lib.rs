@@ -21,8 +21,8 @@
 //! [`Backend`]):
 //!
 //! ```
-//! use fragsim_catalog::SchemeName;
 //! use fragsim_capture::executors::Executor;
+//! use fragsim_catalog::SchemeName;
 //! use fragsim_testkit::{Battery, CatalogBackend, Params};
 //!
 //! let backend = CatalogBackend::on(Executor::Parallel);
