@@ -5,7 +5,8 @@
 //! `fragsim_cli`'s unit test of its exit code (`render_verdict`, `crates/cli/src/lib.rs`).
 
 use fragsim::capture::depth_count::{DepthCount, DepthCounts};
-use fragsim::capture::executors::{run_parallel, run_serial, run_tiled, Executor, Run};
+use fragsim::capture::executors::scheduled::{Granularity, Policy, Schedule};
+use fragsim::capture::executors::{run_serial, Executor, Run};
 use fragsim::capture::{Descriptor, PixelRun, Scheme, Simt, Step, WalkInput, MEMORY_CAP_DEFAULT};
 use fragsim::catalog::{Build, SchemeName, SchemeVisitor};
 use fragsim::memory::Memory;
@@ -13,8 +14,18 @@ use fragsim::oracle::verdict::{judge_run, RunVerdict};
 use fragsim::oracle::{Oracle, Ties};
 use fragsim::raster::{OrbitCamera, Scene, View, Viewport};
 
+use crate::support::run_on;
+
 /// The pixel whose overflow the wrapper miscounts.
 const MISCOUNTED_PIXEL: usize = 0;
+
+/// The scheduled executor's interleaving: walks picked at random, several in flight.
+const SCHEDULE: Schedule = Schedule {
+    policy: Policy::Random,
+    in_flight: 8,
+    granularity: Granularity::Fragment,
+    seed: 0,
+};
 
 /// `scheme`, reporting one overflowing fragment more at pixel 0 than it counted: its fragments
 /// stay right, only its count is wrong, the smallest fault the verdict must catch. Every other
@@ -71,16 +82,6 @@ impl<S: Scheme> Scheme for MiscountingOverflow<'_, S> {
     }
 }
 
-/// One frame of `scheme` on `executor` (the fresh storage of the executor's `run_*`).
-fn run_on<S: Scheme>(executor: Executor, view: &View<'_>, scheme: &S) -> Run {
-    match executor {
-        Executor::Serial => run_serial(view, scheme),
-        Executor::Parallel => run_parallel(view, scheme),
-        Executor::Tiled => run_tiled(view, scheme),
-        Executor::Scheduled => unreachable!("the test runs no scheduled executor"),
-    }
-}
-
 /// A verdict of the test: the run's executor, whether the fault was injected, and the verdict.
 type Judged = (Executor, bool, RunVerdict);
 
@@ -110,9 +111,9 @@ impl SchemeVisitor for BareAndMiscounting<'_, '_> {
             judged.push((
                 executor,
                 false,
-                judge(executor, run_on(executor, self.view, scheme)),
+                judge(executor, run_on(executor, self.view, scheme, &SCHEDULE)),
             ));
-            let faulty = run_on(executor, self.view, &miscounting);
+            let faulty = run_on(executor, self.view, &miscounting, &SCHEDULE);
             judged.push((executor, true, judge(executor, faulty)));
         }
         judged
@@ -139,7 +140,12 @@ fn a_scheme_misreporting_its_overflow_by_one_breaks_its_guarantee() {
         counts: Some(&counted.counts),
         ..Build::fixed(viewport, 1, 2, counted.max(), MEMORY_CAP_DEFAULT)
     };
-    let executors = [Executor::Serial, Executor::Parallel, Executor::Tiled];
+    let executors = [
+        Executor::Serial,
+        Executor::Parallel,
+        Executor::Tiled,
+        Executor::Scheduled,
+    ];
     for name in ["abuffer", "abuffer-exact"] {
         let judged = SchemeName::from_name(name)
             .unwrap()

@@ -16,20 +16,19 @@
 //! values, so that ties are common; "serial" is the scheduled executor with one fragment in flight
 //! (submission order), the rest are seeded GPU-like interleavings.
 
-use fragsim::capture::executors::scheduled::{
-    run_fragments, run_scheduled, Granularity, Policy, Schedule,
-};
-use fragsim::capture::executors::tiled::run_tiled;
-use fragsim::capture::executors::{run_parallel, run_serial, Executor};
+use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy, Schedule};
+use fragsim::capture::executors::Executor;
 use fragsim::capture::{Capture, Keeps, Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::Op;
 use fragsim::oracle::{Oracle, Ties};
-use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, View, Viewport};
+use fragsim::raster::{depth_key, Fragment, OrbitCamera, Scene, Viewport};
 use fragsim::schemes::layer_counter::LayerCounter;
 use fragsim::schemes::linked_list::{LinkedList, Resolve};
 use fragsim::schemes::loop32::Loop32;
 use fragsim::schemes::mdts::Mdts;
 use proptest::prelude::*;
+
+use crate::support::run_on;
 
 /// A stream of fragments on `pixels` pixels: primitive ids in submission order, depth keys from
 /// six values (so that many fragments share one).
@@ -388,29 +387,20 @@ fn shipping_schemes_on_every_executor() {
     )
     .unwrap();
     let captures = |f: &dyn Fn(Executor) -> Capture| Executor::EVERY.map(f);
-    for got in captures(&|e| on(e, &view, &counter, &schedule)) {
+    for got in captures(&|e| run_on(e, &view, &counter, &schedule).capture) {
         let diff = oracle.diff(&got);
         assert_eq!((diff.overflowed, diff.lost), (excess, 0));
         assert!(diff.is_exact());
     }
-    for got in captures(&|e| on(e, &view, &loop32, &schedule)) {
+    for got in captures(&|e| run_on(e, &view, &loop32, &schedule).capture) {
         assert!(oracle.diff_with(&got, Ties::MergeEqualDepths).is_exact());
     }
-    for got in captures(&|e| on(e, &view, &nearest, &schedule)) {
+    for got in captures(&|e| run_on(e, &view, &nearest, &schedule).capture) {
         assert!(oracle.diff(&got).is_exact());
     }
     // N = the maximum depth complexity: every list fits, keep-first is exact too.
-    for got in captures(&|e| on(e, &view, &first, &schedule)) {
+    for got in captures(&|e| run_on(e, &view, &first, &schedule).capture) {
         assert!(oracle.diff(&got).is_exact());
-    }
-}
-
-fn on<S: Scheme>(executor: Executor, view: &View<'_>, scheme: &S, schedule: &Schedule) -> Capture {
-    match executor {
-        Executor::Serial => run_serial(view, scheme).capture,
-        Executor::Parallel => run_parallel(view, scheme).capture,
-        Executor::Tiled => run_tiled(view, scheme).capture,
-        Executor::Scheduled => run_scheduled(view, scheme, schedule, false).run.capture,
     }
 }
 

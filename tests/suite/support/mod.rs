@@ -6,6 +6,7 @@
 //! - [`json_lines`]: the records of a `--json` output (`docs/json-schema.md`).
 //! - [`scratch`]: a fresh directory for a test's files.
 //! - [`prim_of`]: the primitive id of a packed entry.
+//! - [`run_on`]: one frame of a scheme on any executor, on fresh storage.
 
 pub(crate) use fragsim_testkit::strategies;
 
@@ -42,4 +43,23 @@ pub(crate) fn scratch(group: &str, name: &str) -> std::path::PathBuf {
 )]
 pub(crate) const fn prim_of(entry: u64) -> u32 {
     entry as u32
+}
+
+/// One frame of `scheme` on `executor`, on the fresh storage of that executor's `run_*`;
+/// `schedule` is the scheduled executor's.
+pub(crate) fn run_on<S: fragsim::capture::Scheme>(
+    executor: fragsim::capture::executors::Executor,
+    view: &fragsim::raster::View<'_>,
+    scheme: &S,
+    schedule: &fragsim::capture::executors::scheduled::Schedule,
+) -> fragsim::capture::executors::Run {
+    use fragsim::capture::executors::{run_parallel, run_serial, run_tiled, Executor};
+    match executor {
+        Executor::Serial => run_serial(view, scheme),
+        Executor::Parallel => run_parallel(view, scheme),
+        Executor::Tiled => run_tiled(view, scheme),
+        Executor::Scheduled => {
+            fragsim::capture::executors::scheduled::run_scheduled(view, scheme, schedule, false).run
+        }
+    }
 }
