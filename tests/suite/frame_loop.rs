@@ -10,17 +10,12 @@ use fragsim::capture::executors::scheduled::{run_fragments, Granularity, Policy,
 use fragsim::capture::executors::tiled::TiledExecutor;
 use fragsim::capture::{Scheme, MEMORY_CAP_DEFAULT};
 use fragsim::memory::{SerialMemory, WordMemory};
-use fragsim::raster::{Fragment, OrbitCamera, Scene, View, Viewport};
+use fragsim::raster::{Fragment, OrbitCamera, Scene, Viewport};
 use fragsim::schemes::abuffer::{ABuffer, PostSort};
 use fragsim::schemes::mdts::{Direction, Mdts};
 use fragsim::schemes::peeling::DepthPeeling;
 
-/// The view's fragments in submission order.
-fn fragments(view: &View<'_>) -> Vec<Fragment> {
-    let mut all = Vec::new();
-    (0..view.triangle_count()).for_each(|prim| view.rasterize(prim, &mut |f| all.push(f)));
-    all
-}
+use crate::support::fragments;
 
 /// Every word of `memory`: the `u32` array, then the `u64` array widened.
 fn words(memory: &SerialMemory) -> Vec<u64> {

@@ -18,6 +18,8 @@ use fragsim::oracle::Oracle;
 use fragsim::raster::{Fragment, OrbitCamera, SamplePattern, Scene, View, Viewport};
 use fragsim::schemes::masked_abuffer::{MaskedABuffer, MaskedStorage};
 
+use crate::support::fragments;
+
 fn view_of(scene: &Scene, side: u32, angle: f64) -> View<'_> {
     scene
         .view(
@@ -25,15 +27,6 @@ fn view_of(scene: &Scene, side: u32, angle: f64) -> View<'_> {
             &OrbitCamera::default().at_angle(angle),
         )
         .unwrap()
-}
-
-/// Every fragment of `view` in its scan order.
-fn fragments(view: &View<'_>) -> Vec<Fragment> {
-    let mut all = Vec::new();
-    for prim in 0..view.triangle_count() {
-        view.rasterize(prim, &mut |f| all.push(f));
-    }
-    all
 }
 
 /// The rules evaluated directly at every sample of every pixel, for every piece of every

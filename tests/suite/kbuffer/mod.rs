@@ -22,6 +22,8 @@ use fragsim::schemes::kbuffer::{KBuffer, WriteBack};
 use fragsim::schemes::stencil_routed::StencilRouted;
 use proptest::prelude::*;
 
+use crate::support::fragments;
+
 /// Looking straight down the z axis at `quads:N`: every pixel the quads cover has N fragments.
 pub(super) fn head_on() -> OrbitCamera {
     OrbitCamera {
@@ -32,15 +34,6 @@ pub(super) fn head_on() -> OrbitCamera {
 
 pub(super) fn viewport(width: u32, height: u32) -> Viewport {
     Viewport::new(width, height).unwrap()
-}
-
-/// The view's fragments in submission order.
-pub(super) fn fragments(view: &View<'_>) -> Vec<Fragment> {
-    let mut all = Vec::new();
-    for prim in 0..view.triangle_count() {
-        view.rasterize(prim, &mut |f| all.push(f));
-    }
-    all
 }
 
 /// The fragments of pixel 0 of a 1×1 view of `quads:n` seen head-on, nearest first.

@@ -7,6 +7,7 @@
 //! - [`scratch`]: a fresh directory for a test's files.
 //! - [`prim_of`]: the primitive id of a packed entry.
 //! - [`run_on`]: one frame of a scheme on any executor, on fresh storage.
+//! - [`fragments`]: every fragment of a view, in submission order.
 
 pub(crate) use fragsim_testkit::strategies;
 
@@ -62,4 +63,14 @@ pub(crate) fn run_on<S: fragsim::capture::Scheme>(
             fragsim::capture::executors::scheduled::run_scheduled(view, scheme, schedule, false).run
         }
     }
+}
+
+/// Every fragment of `view`, in submission order (triangle after triangle, each in its scan
+/// order).
+pub(crate) fn fragments(view: &fragsim::raster::View<'_>) -> Vec<fragsim::raster::Fragment> {
+    let mut all = Vec::new();
+    for prim in 0..view.triangle_count() {
+        view.rasterize(prim, &mut |f| all.push(f));
+    }
+    all
 }
